@@ -1,0 +1,124 @@
+//! Renders a toolconf derivation IR (the JSON that `derive/derive.py` writes) through the Tera
+//! templates in `templates/` into the files under `generated/`.
+//!
+//! A template named `<kind>.<ext>.tera` renders to `<model>.<ext>`; Rust output goes through
+//! rustfmt so that the checked-in code is exactly what `make derive` produces.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+use serde_json::Value;
+use tera::{Context, Tera};
+
+/// The IR schema this renderer understands (`schema` in the JSON).
+pub const IR_SCHEMA: u64 = 1;
+
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    #[error("cannot read {path}: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("{path} is not valid JSON: {source}")]
+    Json { path: PathBuf, source: serde_json::Error },
+    #[error("IR schema {found} is not the one this renderer understands ({expected})")]
+    Schema { found: String, expected: u64 },
+    #[error("IR has no model.name")]
+    NoModelName,
+    #[error("template error: {0}")]
+    Template(String),
+    #[error("two templates render to the same file {0}")]
+    Clash(String),
+    #[error("rustfmt failed: {0}")]
+    Rustfmt(String),
+}
+
+/// One rendered file: its name (relative to the output folder) and contents.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Rendered {
+    pub file_name: String,
+    pub contents: String,
+}
+
+/// Reads and checks an IR file.
+pub fn read_ir(path: &Path) -> Result<Value, RenderError> {
+    let text = std::fs::read_to_string(path).map_err(|source| RenderError::Io { path: path.into(), source })?;
+    let ir: Value = serde_json::from_str(&text).map_err(|source| RenderError::Json { path: path.into(), source })?;
+    match ir.get("schema").and_then(Value::as_u64) {
+        Some(IR_SCHEMA) => Ok(ir),
+        other => Err(RenderError::Schema { found: format!("{other:?}"), expected: IR_SCHEMA }),
+    }
+}
+
+/// Loads every `*.tera` file of a folder, in name order.
+pub fn load_templates(dir: &Path) -> Result<Vec<(String, String)>, RenderError> {
+    let io = |source| RenderError::Io { path: dir.into(), source };
+    let mut names: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(io)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "tera"))
+        .collect();
+    names.sort();
+    names
+        .into_iter()
+        .map(|p| {
+            let text = std::fs::read_to_string(&p).map_err(|source| RenderError::Io { path: p.clone(), source })?;
+            let name = p.file_name().unwrap_or_default().to_string_lossy().into_owned();
+            Ok((name, text))
+        })
+        .collect()
+}
+
+/// Renders the IR through each template; Rust outputs are formatted with rustfmt.
+pub fn render(ir: &Value, templates: &[(String, String)]) -> Result<Vec<Rendered>, RenderError> {
+    let model = ir.pointer("/model/name").and_then(Value::as_str).ok_or(RenderError::NoModelName)?;
+    let mut tera = Tera::default();
+    tera.autoescape_on(vec![]);
+    tera.add_raw_templates(templates.iter().map(|(n, t)| (n.as_str(), t.as_str())))
+        .map_err(|e| RenderError::Template(chain(&e)))?;
+    let context = Context::from_value(ir.clone()).map_err(|e| RenderError::Template(chain(&e)))?;
+    let mut out: Vec<Rendered> = Vec::new();
+    for (name, _) in templates {
+        let ext = name.trim_end_matches(".tera").rsplit('.').next().unwrap_or("txt");
+        let file_name = format!("{model}.{ext}");
+        if out.iter().any(|r| r.file_name == file_name) {
+            return Err(RenderError::Clash(file_name));
+        }
+        let text = tera.render(name, &context).map_err(|e| RenderError::Template(chain(&e)))?;
+        let contents = if ext == "rs" { rustfmt(&text)? } else { text };
+        out.push(Rendered { file_name, contents });
+    }
+    Ok(out)
+}
+
+/// Formats Rust source with the toolchain's rustfmt (edition 2021, default style).
+pub fn rustfmt(source: &str) -> Result<String, RenderError> {
+    let mut child = Command::new(std::env::var("RUSTFMT").unwrap_or_else(|_| "rustfmt".into()))
+        .args(["--edition", "2021", "--emit", "stdout", "--quiet"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| RenderError::Rustfmt(format!("cannot start rustfmt: {e}")))?;
+    child
+        .stdin
+        .take()
+        .ok_or_else(|| RenderError::Rustfmt("no stdin".into()))?
+        .write_all(source.as_bytes())
+        .map_err(|e| RenderError::Rustfmt(e.to_string()))?;
+    let output = child.wait_with_output().map_err(|e| RenderError::Rustfmt(e.to_string()))?;
+    if !output.status.success() {
+        return Err(RenderError::Rustfmt(String::from_utf8_lossy(&output.stderr).into_owned()));
+    }
+    String::from_utf8(output.stdout).map_err(|e| RenderError::Rustfmt(e.to_string()))
+}
+
+fn chain(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        text.push_str(": ");
+        text.push_str(&s.to_string());
+        source = s.source();
+    }
+    text
+}

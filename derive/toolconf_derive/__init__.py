@@ -1,0 +1,1 @@
+"""toolconf's derivation stage: model description -> SymPy derivation, checked by CasADi -> JSON IR."""

@@ -1,0 +1,138 @@
+"""The intermediate representation: one JSON document per model that the Tera renderer turns into
+Rust and a report. It carries the CSE'd expressions (printed as Rust f64 code), the shapes, the
+docs, and the CasADi test vectors; the renderer needs nothing else."""
+
+from __future__ import annotations
+
+import numpy as np
+import sympy as sp
+
+from .crosscheck import check_against_casadi
+from .functions import Function
+from .rust_printer import RustPrinter, float_literal
+from .symbolic import Derivation
+
+IR_SCHEMA = 1
+
+
+def _rust_type(shape: tuple[int, int]) -> str:
+    r, c = shape
+    return f"SVector<f64, {r}>" if c == 1 else f"SMatrix<f64, {r}, {c}>"
+
+
+def _const_name(name: str) -> str:
+    return name.upper()
+
+
+def function_ir(fn: Function, d: Derivation, vectors: int) -> dict:
+    declared = {s.name for s in d.params + list(d.constants) + d.x + d.u}
+    for arg in fn.args:
+        declared |= {s.name for s, _, _ in arg.reads}
+    entries, where = [], []
+    for oi, out in enumerate(fn.outputs):
+        for r in range(out.value.rows):
+            for c in range(r if out.symmetric else 0, out.value.cols):
+                if out.value[r, c] != 0:
+                    entries.append(out.value[r, c])
+                    where.append((oi, r, c))
+    temporaries = (sp.Symbol(f"t{i}", real=True) for i in range(10**6))
+    replacements, reduced = sp.cse(entries, symbols=temporaries, order="canonical")
+    clash = declared & {str(t) for t, _ in replacements}
+    if clash:
+        raise ValueError(f"CSE temporaries clash with model names: {sorted(clash)}")
+
+    used = set()
+    for t, e in replacements:
+        used |= e.free_symbols
+    for e in reduced:
+        used |= e.free_symbols
+    printer = RustPrinter()
+
+    bindings = []
+    for arg in fn.args:
+        for s, i, j in arg.reads:
+            if s in used:
+                bindings.append({"name": s.name, "arg": arg.name, "row": i, "col": j, "vector": arg.shape[1] == 1})
+    constants = [{"name": c.name, "rust": _const_name(c.name)} for c in d.constants if c in used]
+
+    outputs = []
+    for out in fn.outputs:
+        outputs.append({
+            "name": out.name, "doc": out.doc, "rows": out.value.rows, "cols": out.value.cols,
+            "rust_type": _rust_type(out.value.shape), "symmetric": out.symmetric, "entries": [],
+        })
+    for (oi, r, c), e in zip(where, reduced):
+        outputs[oi]["entries"].append({"row": r, "col": c, "rust": printer(e)})
+
+    return {
+        "name": fn.name,
+        "doc": fn.doc,
+        "equation": fn.equation,
+        "args": [
+            {"name": a.name, "doc": a.doc, "rows": a.shape[0], "cols": a.shape[1],
+             "rust_type": _rust_type(a.shape), "symmetric": a.symmetric,
+             "used": any(b["arg"] == a.name for b in bindings)}
+            for a in fn.args
+        ],
+        "outputs": outputs,
+        "constants": constants,
+        "bindings": bindings,
+        "temporaries": [{"name": str(t), "rust": printer(e)} for t, e in replacements],
+        "test_vectors": test_vectors(fn, d, vectors),
+    }
+
+
+def test_vectors(fn: Function, d: Derivation, count: int) -> list[dict]:
+    """`count` random valid inputs and CasADi's outputs for them (row-major), after checking
+    that SymPy's closed forms give the same numbers: the derivation stops if they do not."""
+    rng = fn.rng()
+    samples = [{a.name: a.sample(rng) for a in fn.args} for _ in range(count)]
+    reference = [[np.asarray(o, dtype=float) for o in fn.casadi(v)] for v in samples]
+    check_against_casadi(fn, d, samples, reference)
+    return [
+        {
+            "inputs": {name: [float(x) for x in np.asarray(val).reshape(-1)] for name, val in v.items()},
+            "outputs": {o.name: [float(x) for x in ref.reshape(o.value.shape).reshape(-1)]
+                        for o, ref in zip(fn.outputs, refs)},
+        }
+        for v, refs in zip(samples, reference)
+    ]
+
+
+def model_ir(d: Derivation, functions: list[Function], generator: dict, report: dict, vectors: int) -> dict:
+    m = d.model
+    printer = RustPrinter()
+    return {
+        "schema": IR_SCHEMA,
+        "generator": generator,
+        "model": {
+            "name": m.name,
+            "title": m.title,
+            "source": m.source,
+            "dof": m.dof,
+            "state_dim": m.state_dim,
+            "parameters": [{"name": p.name, "latex": p.latex, "unit": p.unit, "doc": p.doc} for p in m.parameters],
+            "constants": [{"name": c.name, "rust": _const_name(c.name), "value": c.value, "unit": c.unit,
+                           "doc": c.doc} for c in m.constants],
+            "state": [{"name": s.name, "latex": s.latex} for s in m.state],
+            "control": [{"name": s.name, "latex": s.latex} for s in m.u],
+            "equilibrium": {
+                "x": [printer(v) for v in d.x_e],
+                "u": [printer(v) for v in d.u_e],
+            },
+        },
+        "tasks": [
+            {
+                "name": t.task.name, "index": t.task.index, "title": t.task.title, "doc": t.task.doc,
+                "terms": t.task.terms, "sensitivity_terms": t.task.sensitivity_terms,
+                "goals": [{"term": term, "rust": [printer(sp.sympify(v)) for v in
+                                                  m.goals.get(t.task.name, {}).get(term, ["0"] * m.dof)]}
+                          for term in t.task.sensitivity_terms],
+                "precisions": [{"term": term, "rust": float_literal(t.task.default_precision[term]),
+                                "value": t.task.default_precision[term]} for term in t.task.terms],
+            }
+            for t in d.tasks
+        ],
+        "functions": [function_ir(fn, d, vectors) for fn in functions],
+        "report": report,
+    }

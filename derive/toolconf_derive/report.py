@@ -1,0 +1,96 @@
+"""Report data: the derived closed forms in LaTeX (SymPy's printer) and the entry-by-entry
+comparison with what the paper prints. The report template renders this into generated/<model>.md."""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from .symbolic import TERM_LATEX, Derivation, parse, tidy
+
+
+def _latex(d: Derivation, e) -> str:
+    return sp.latex(e, symbol_names=d.symbol_latex, mat_str="bmatrix", mat_delim="")
+
+
+def _compare(d: Derivation, label: str, derived: sp.Matrix, printed_rows: list[list[str]]) -> list[dict]:
+    symbols = {str(s): s for s in d.params + list(d.constants)}
+    rows = []
+    for i, row in enumerate(printed_rows):
+        for j, text in enumerate(row):
+            printed = parse(d.model, text, symbols, f"printed.{label}[{i}][{j}]")
+            difference = tidy(derived[i, j] - printed)
+            rows.append({
+                "entry": f"{label}[{i + 1},{j + 1}]",
+                "derived": _latex(d, derived[i, j]),
+                "printed": _latex(d, printed),
+                "equal": difference == 0,
+                "difference": _latex(d, difference),
+            })
+    return rows
+
+
+def report_data(d: Derivation) -> dict:
+    m = d.model
+    n = m.dof
+    comparisons = []
+    if m.printed_a is not None:
+        comparisons += _compare(d, "A", d.a, m.printed_a)
+    if m.printed_b is not None:
+        comparisons += _compare(d, "B", d.b, m.printed_b)
+
+    tasks = []
+    for t in d.tasks:
+        task = t.task
+        defaults = {term: sp.nsimplify(task.default_precision[term]) * sp.eye(n) for term in task.terms}
+        confidence_default = t.confidence.subs(
+            {s: defaults[term][i, j] for term, reads in t.precision_reads.items() for s, i, j in reads}
+        ).applyfunc(tidy)
+        formula = " + ".join(
+            rf"\left(\frac{{\partial {TERM_LATEX[term]}}}{{\partial U}}\right)^{{T}} P^{{{TERM_LATEX[term]}}}"
+            rf" \frac{{\partial {TERM_LATEX[term]}}}{{\partial U}}"
+            for term in task.sensitivity_terms
+        ) + r" + P^{U}"
+        tasks.append({
+            "name": task.name,
+            "index": task.index,
+            "title": task.title,
+            "doc": task.doc,
+            "sensitivities": [
+                {"term": term, "what": rf"\frac{{\partial {TERM_LATEX[term]}}}{{\partial U}}",
+                 "formula": task.sensitivity[term], "latex": _latex(d, t.sensitivity[term])}
+                for term in task.sensitivity_terms
+            ],
+            "confidence_formula": formula,
+            "default_precisions": ", ".join(
+                f"P^{{{TERM_LATEX[term]}}} = {sp.latex(sp.nsimplify(task.default_precision[term]))} I"
+                for term in task.terms
+            ),
+            "confidence_default": _latex(d, confidence_default),
+            "remarks": [
+                {
+                    "what": rf"\frac{{\partial {TERM_LATEX[r['remark'].term]}}}{{\partial U}}",
+                    "text": " ".join(r["remark"].text.split()),
+                    "alternative_formula": r["remark"].alternative,
+                    "alternative": _latex(d, r["alternative"]),
+                    "used": _latex(d, r["used"]),
+                    "equal": (r["alternative"] - r["used"]).applyfunc(tidy) == sp.zeros(n, n),
+                }
+                for r in t.remarks
+            ],
+        })
+
+    return {
+        "printed_where": m.printed_where,
+        "equations": [
+            {"lhs": rf"\ddot{{{c.latex}}}", "rhs": _latex(d, e)}
+            for c, e in zip(m.q, d.q_ddot)
+        ],
+        "equation_refs": m.equations,
+        "equilibrium_x": _latex(d, d.x_e.T),
+        "equilibrium_u": _latex(d, d.u_e.T),
+        "a": _latex(d, d.a),
+        "b": _latex(d, d.b),
+        "comparisons": comparisons,
+        "differences": [c for c in comparisons if not c["equal"]],
+        "tasks": tasks,
+    }

@@ -1,0 +1,24 @@
+//! The crate's error type: every bad input names the value that is wrong.
+
+/// Everything that can go wrong in toolconf, each naming the offending value.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Error {
+    /// A tool parameter that is not a finite number > 0.
+    #[error("invalid arm parameter {name} = {value}: must be a finite number > 0")]
+    InvalidParameter { name: &'static str, value: f64 },
+    /// An arm given in text that is not four comma-separated numbers.
+    #[error("invalid arm '{text}': expected M1,M2,L1,L2 (four comma-separated numbers), {reason}")]
+    ArmSyntax { text: String, reason: String },
+    /// A task name that is not one of the paper's tasks.
+    #[error("unknown task '{0}': expected position, velocity or acceleration (or 1, 2, 3)")]
+    UnknownTask(String),
+    /// A goal that is not finite.
+    #[error("invalid goal {name} = {value}: must be finite")]
+    InvalidGoal { name: String, value: f64 },
+    /// A precision matrix that is not finite, symmetric and positive semi-definite.
+    #[error("invalid precision {name}: {reason}")]
+    InvalidPrecision { name: String, reason: String },
+    /// Π^U that is not positive definite, so it is no precision and ln|Π^U| is undefined.
+    #[error("control confidence Π^U is not positive definite for this arm and task (determinant {determinant:e}); check the task's precisions")]
+    NotPositiveDefinite { determinant: f64 },
+}
