@@ -1,0 +1,48 @@
+//! A numeric table of A, B, the task sensitivities and Π^U for a fixed list of tools, per task,
+//! pinned by an insta snapshot: a change in the derivation that moves any number is a reviewed diff.
+
+use std::fmt::Write;
+
+use toolconf::{control_confidence, sensitivities, Arm, Task, TaskKind};
+
+/// Tools spanning the paper's parameter domain [0.1, 0.6], corners and the CLI example.
+const TOOLS: [[f64; 4]; 5] = [
+    [0.3, 0.4, 0.5, 0.2],
+    [0.1, 0.1, 0.1, 0.1],
+    [0.6, 0.6, 0.6, 0.6],
+    [0.1, 0.6, 0.6, 0.1],
+    [0.55, 0.15, 0.25, 0.45],
+];
+
+fn row(name: &str, values: impl IntoIterator<Item = f64>) -> String {
+    let cells: Vec<String> = values.into_iter().map(|v| format!("{v:.12e}")).collect();
+    format!("  {name:<16} {}\n", cells.join(" "))
+}
+
+#[test]
+fn linearisation_sensitivities_and_confidence_table() {
+    let mut out = String::new();
+    for [m1, m2, l1, l2] in TOOLS {
+        let arm = Arm::new(m1, m2, l1, l2).unwrap();
+        writeln!(out, "arm {arm}").unwrap();
+        let a = arm.state_matrix();
+        let b = arm.input_matrix();
+        out += &row("A[3,:]", a.row(2).iter().copied());
+        out += &row("A[4,:]", a.row(3).iter().copied());
+        out += &row("B[3,:]", b.row(2).iter().copied());
+        out += &row("B[4,:]", b.row(3).iter().copied());
+        for kind in TaskKind::ALL {
+            let s = sensitivities(&arm, kind);
+            let c = control_confidence(&arm, &Task::paper(kind)).unwrap();
+            writeln!(out, " task {kind}").unwrap();
+            for (name, m) in [("dtheta/dU", s.d_theta_du), ("dthetadot/dU", s.d_theta_dot_du), ("dthetaddot/dU", Some(s.d_theta_ddot_du))] {
+                if let Some(m) = m {
+                    out += &row(name, m.transpose().iter().copied());
+                }
+            }
+            out += &row("Pi^U", c.pi_u.transpose().iter().copied());
+            out += &row("ln|Pi^U|", [c.logdet]);
+        }
+    }
+    insta::assert_snapshot!(out);
+}
