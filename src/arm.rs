@@ -73,7 +73,11 @@ impl Arm {
 
 impl fmt::Display for Arm {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "m1={} m2={} l1={} l2={}", self.m1, self.m2, self.l1, self.l2)
+        write!(
+            f,
+            "m1={} m2={} l1={} l2={}",
+            self.m1, self.m2, self.l1, self.l2
+        )
     }
 }
 
@@ -82,10 +86,17 @@ impl FromStr for Arm {
     type Err = Error;
 
     fn from_str(text: &str) -> Result<Self, Error> {
-        let syntax = |reason: String| Error::ArmSyntax { text: text.to_string(), reason };
+        let syntax = |reason: String| Error::ArmSyntax {
+            text: text.to_string(),
+            reason,
+        };
         let values: Vec<f64> = text
             .split(',')
-            .map(|v| v.trim().parse::<f64>().map_err(|e| syntax(format!("'{}' is not a number ({e})", v.trim()))))
+            .map(|v| {
+                v.trim()
+                    .parse::<f64>()
+                    .map_err(|e| syntax(format!("'{}' is not a number ({e})", v.trim())))
+            })
             .collect::<Result<_, _>>()?;
         match values[..] {
             [m1, m2, l1, l2] => Arm::new(m1, m2, l1, l2),

@@ -22,11 +22,19 @@ pub fn sensitivities(arm: &Arm, kind: TaskKind) -> Sensitivities {
     match kind {
         TaskKind::Position => {
             let (d_theta, d_theta_dot, d_theta_ddot) = arm2::position_sensitivity(&p);
-            Sensitivities { d_theta_du: Some(d_theta), d_theta_dot_du: Some(d_theta_dot), d_theta_ddot_du: d_theta_ddot }
+            Sensitivities {
+                d_theta_du: Some(d_theta),
+                d_theta_dot_du: Some(d_theta_dot),
+                d_theta_ddot_du: d_theta_ddot,
+            }
         }
         TaskKind::Velocity => {
             let (d_theta_dot, d_theta_ddot) = arm2::velocity_sensitivity(&p);
-            Sensitivities { d_theta_du: None, d_theta_dot_du: Some(d_theta_dot), d_theta_ddot_du: d_theta_ddot }
+            Sensitivities {
+                d_theta_du: None,
+                d_theta_dot_du: Some(d_theta_dot),
+                d_theta_ddot_du: d_theta_ddot,
+            }
         }
         TaskKind::Acceleration => Sensitivities {
             d_theta_du: None,
@@ -60,7 +68,10 @@ pub fn control_confidence(arm: &Arm, task: &Task) -> Result<ControlConfidence, E
     if !(pi_u[(0, 0)] > 0.0 && determinant > 0.0 && determinant.is_finite()) {
         return Err(Error::NotPositiveDefinite { determinant });
     }
-    Ok(ControlConfidence { pi_u, logdet: determinant.ln() })
+    Ok(ControlConfidence {
+        pi_u,
+        logdet: determinant.ln(),
+    })
 }
 
 /// Π^U without validation; the hot path for ranking many tools with one validated task.
@@ -74,9 +85,14 @@ pub fn pi_u(arm: &Arm, task: &Task) -> Matrix2 {
             &task.precision_theta_ddot,
             &task.precision_u,
         ),
-        TaskKind::Velocity => {
-            arm2::velocity_control_confidence(&p, &task.precision_theta_dot, &task.precision_theta_ddot, &task.precision_u)
+        TaskKind::Velocity => arm2::velocity_control_confidence(
+            &p,
+            &task.precision_theta_dot,
+            &task.precision_theta_ddot,
+            &task.precision_u,
+        ),
+        TaskKind::Acceleration => {
+            arm2::acceleration_control_confidence(&p, &task.precision_theta_ddot, &task.precision_u)
         }
-        TaskKind::Acceleration => arm2::acceleration_control_confidence(&p, &task.precision_theta_ddot, &task.precision_u),
     }
 }

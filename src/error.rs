@@ -18,6 +18,9 @@ pub enum Error {
     /// A precision matrix that is not finite, symmetric and positive semi-definite.
     #[error("invalid precision {name}: {reason}")]
     InvalidPrecision { name: String, reason: String },
+    /// A numeric option outside its domain.
+    #[error("invalid {name} = {value}")]
+    InvalidOption { name: &'static str, value: f64 },
     /// Π^U that is not positive definite, so it is no precision and ln|Π^U| is undefined.
     #[error("control confidence Π^U is not positive definite for this arm and task (determinant {determinant:e}); check the task's precisions")]
     NotPositiveDefinite { determinant: f64 },

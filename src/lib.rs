@@ -11,9 +11,14 @@
 //! Flow: model description → derivation → JSON IR → templates → generated code → this runtime.
 
 pub mod arm;
+pub mod closed_loop;
 pub mod confidence;
 pub mod error;
 pub mod generated;
+pub mod integrate;
+pub mod mpc;
+pub mod select;
+pub mod stats;
 pub mod task;
 
 pub use arm::Arm;

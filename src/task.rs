@@ -21,7 +21,11 @@ pub enum TaskKind {
 }
 
 impl TaskKind {
-    pub const ALL: [TaskKind; 3] = [TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration];
+    pub const ALL: [TaskKind; 3] = [
+        TaskKind::Position,
+        TaskKind::Velocity,
+        TaskKind::Acceleration,
+    ];
 
     /// The task's number in the paper (1, 2, 3).
     pub fn paper_index(self) -> u8 {
@@ -128,11 +132,16 @@ impl Task {
 
     /// Checks goals are finite and precisions finite, symmetric and positive semi-definite.
     pub fn validate(&self) -> Result<(), Error> {
-        for (name, goal) in
-            [("theta_g", &self.goal_theta), ("theta_dot_g", &self.goal_theta_dot), ("theta_ddot_g", &self.goal_theta_ddot)]
-        {
+        for (name, goal) in [
+            ("theta_g", &self.goal_theta),
+            ("theta_dot_g", &self.goal_theta_dot),
+            ("theta_ddot_g", &self.goal_theta_ddot),
+        ] {
             if let Some(&value) = goal.iter().find(|v| !v.is_finite()) {
-                return Err(Error::InvalidGoal { name: name.into(), value });
+                return Err(Error::InvalidGoal {
+                    name: name.into(),
+                    value,
+                });
             }
         }
         for (name, p) in [
@@ -148,12 +157,22 @@ impl Task {
 }
 
 fn check_precision(name: &str, p: &Matrix2) -> Result<(), Error> {
-    let invalid = |reason: String| Error::InvalidPrecision { name: name.into(), reason };
+    let invalid = |reason: String| Error::InvalidPrecision {
+        name: name.into(),
+        reason,
+    };
     if p.iter().any(|v| !v.is_finite()) {
-        return Err(invalid(format!("has a non-finite entry: {:?}", p.as_slice())));
+        return Err(invalid(format!(
+            "has a non-finite entry: {:?}",
+            p.as_slice()
+        )));
     }
     if (p[(0, 1)] - p[(1, 0)]).abs() > 1e-12 * p.amax().max(1.0) {
-        return Err(invalid(format!("is not symmetric ({} vs {})", p[(0, 1)], p[(1, 0)])));
+        return Err(invalid(format!(
+            "is not symmetric ({} vs {})",
+            p[(0, 1)],
+            p[(1, 0)]
+        )));
     }
     // Positive semi-definite 2×2: non-negative diagonal and determinant.
     let det = p[(0, 0)] * p[(1, 1)] - p[(0, 1)] * p[(1, 0)];

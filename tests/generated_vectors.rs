@@ -14,7 +14,11 @@ fn load(model: &str) -> Value {
 }
 
 fn numbers(v: &Value) -> Vec<f64> {
-    v.as_array().expect("array").iter().map(|x| x.as_f64().expect("number")).collect()
+    v.as_array()
+        .expect("array")
+        .iter()
+        .map(|x| x.as_f64().expect("number"))
+        .collect()
 }
 
 fn vector<const N: usize>(inputs: &Value, name: &str) -> SVector<f64, N> {
@@ -35,7 +39,9 @@ fn rows<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> Vec<f64> {
 fn evaluate_arm2(name: &str, i: &Value) -> Option<Vec<Vec<f64>>> {
     let p = || vector::<4>(i, "params");
     Some(match name {
-        "dynamics" => vec![arm2::dynamics(&vector(i, "x"), &vector(i, "u"), &p()).as_slice().to_vec()],
+        "dynamics" => vec![arm2::dynamics(&vector(i, "x"), &vector(i, "u"), &p())
+            .as_slice()
+            .to_vec()],
         "dynamics_jacobian" => {
             let (fx, fu) = arm2::dynamics_jacobian(&vector(i, "x"), &vector(i, "u"), &p());
             vec![rows(&fx), rows(&fu)]
@@ -65,7 +71,11 @@ fn evaluate_arm2(name: &str, i: &Value) -> Option<Vec<Vec<f64>>> {
             &matrix(i, "p_u"),
         ))],
         "acceleration_control_confidence" => {
-            vec![rows(&arm2::acceleration_control_confidence(&p(), &matrix(i, "p_theta_ddot"), &matrix(i, "p_u")))]
+            vec![rows(&arm2::acceleration_control_confidence(
+                &p(),
+                &matrix(i, "p_theta_ddot"),
+                &matrix(i, "p_u"),
+            ))]
         }
         _ => return None,
     })
@@ -75,20 +85,37 @@ fn evaluate_arm2(name: &str, i: &Value) -> Option<Vec<Vec<f64>>> {
 fn arm2_functions_match_casadi_vectors() {
     let ir = load("arm2");
     let functions = ir["functions"].as_array().expect("functions");
-    assert!(functions.len() >= 10, "IR has {} functions", functions.len());
+    assert!(
+        functions.len() >= 10,
+        "IR has {} functions",
+        functions.len()
+    );
     let mut checked = 0;
     for f in functions {
         let name = f["name"].as_str().expect("name");
-        let outputs: Vec<&str> = f["outputs"].as_array().unwrap().iter().map(|o| o["name"].as_str().unwrap()).collect();
+        let outputs: Vec<&str> = f["outputs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|o| o["name"].as_str().unwrap())
+            .collect();
         let vectors = f["test_vectors"].as_array().expect("test vectors");
-        assert!(vectors.len() >= 100, "{name}: only {} test vectors", vectors.len());
+        assert!(
+            vectors.len() >= 100,
+            "{name}: only {} test vectors",
+            vectors.len()
+        );
         for (k, v) in vectors.iter().enumerate() {
-            let got = evaluate_arm2(name, &v["inputs"]).unwrap_or_else(|| panic!("generated function {name} is not checked"));
+            let got = evaluate_arm2(name, &v["inputs"])
+                .unwrap_or_else(|| panic!("generated function {name} is not checked"));
             for (out, got) in outputs.iter().zip(got) {
                 let want = numbers(&v["outputs"][out]);
                 assert_eq!(got.len(), want.len(), "{name}.{out}: shape");
                 let scale = want.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-                let err = got.iter().zip(&want).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+                let err = got
+                    .iter()
+                    .zip(&want)
+                    .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
                 assert!(
                     err <= TOLERANCE * scale,
                     "{name}.{out} vector {k}: max |rust - casadi| = {err:e} > 1e-12 * {scale:e}\n rust {got:?}\n casadi {want:?}"

@@ -6,7 +6,8 @@ use proptest::prelude::*;
 use toolconf::{control_confidence, sensitivities, Arm, Error, Matrix2, Task, TaskKind, Vector2};
 
 fn arm_strategy() -> impl Strategy<Value = Arm> {
-    (0.1..0.6f64, 0.1..0.6f64, 0.1..0.6f64, 0.1..0.6f64).prop_map(|(a, b, c, d)| Arm::new(a, b, c, d).unwrap())
+    (0.1..0.6f64, 0.1..0.6f64, 0.1..0.6f64, 0.1..0.6f64)
+        .prop_map(|(a, b, c, d)| Arm::new(a, b, c, d).unwrap())
 }
 
 fn rel(a: f64, b: f64, scale: f64) -> f64 {
@@ -23,20 +24,20 @@ fn finite_difference_linearisation(arm: &Arm) -> (SMatrix<f64, 4, 4>, SMatrix<f6
     for j in 0..4 {
         let mut dx = SVector::<f64, 4>::zeros();
         dx[j] = h;
-        a.set_column(j, &((arm.dynamics(&(xe + dx), &ue) - arm.dynamics(&(xe - dx), &ue)) / (2.0 * h)));
+        a.set_column(
+            j,
+            &((arm.dynamics(&(xe + dx), &ue) - arm.dynamics(&(xe - dx), &ue)) / (2.0 * h)),
+        );
     }
     for j in 0..2 {
         let mut du = Vector2::zeros();
         du[j] = h;
-        b.set_column(j, &((arm.dynamics(&xe, &(ue + du)) - arm.dynamics(&xe, &(ue - du))) / (2.0 * h)));
+        b.set_column(
+            j,
+            &((arm.dynamics(&xe, &(ue + du)) - arm.dynamics(&xe, &(ue - du))) / (2.0 * h)),
+        );
     }
     (a, b)
-}
-
-fn blocks(arm: &Arm) -> (Matrix2, Matrix2) {
-    let a = arm.state_matrix();
-    let b = arm.input_matrix();
-    (a.fixed_view::<2, 2>(2, 0).into_owned(), b.fixed_view::<2, 2>(2, 0).into_owned())
 }
 
 proptest! {
@@ -112,17 +113,33 @@ proptest! {
 fn velocity_confidence_matches_the_paper_formula_by_hand() {
     let (m1, m2, l1, l2, g) = (0.3_f64, 0.4_f64, 0.5_f64, 0.2_f64, 9.81_f64);
     let d = m1 + 3.0 * m2;
-    let a21 = Matrix2::new(-3.0 * (m1 + 2.0 * m2) * g / (2.0 * l1 * d), 9.0 * m2 * g / (4.0 * l1 * d), 0.0, -3.0 * g / (2.0 * l2));
-    let b2 = Matrix2::new(3.0 / (l1 * l1 * d), -3.0 * (3.0 * l1 + 2.0 * l2) / (2.0 * l1 * l1 * l2 * d), 0.0, 3.0 / (m2 * l2 * l2));
+    let a21 = Matrix2::new(
+        -3.0 * (m1 + 2.0 * m2) * g / (2.0 * l1 * d),
+        9.0 * m2 * g / (4.0 * l1 * d),
+        0.0,
+        -3.0 * g / (2.0 * l2),
+    );
+    let b2 = Matrix2::new(
+        3.0 / (l1 * l1 * d),
+        -3.0 * (3.0 * l1 + 2.0 * l2) / (2.0 * l1 * l1 * l2 * d),
+        0.0,
+        3.0 / (m2 * l2 * l2),
+    );
     // 2×2 inverse by the adjugate.
     let det = a21[(0, 0)] * a21[(1, 1)] - a21[(0, 1)] * a21[(1, 0)];
     let a21_inv = Matrix2::new(a21[(1, 1)], -a21[(0, 1)], -a21[(1, 0)], a21[(0, 0)]) / det;
     let s = a21_inv * b2;
-    let by_hand = s.transpose() * (50.0 * Matrix2::identity()) * s + Matrix2::identity() + Matrix2::identity();
+    let by_hand = s.transpose() * (50.0 * Matrix2::identity()) * s
+        + Matrix2::identity()
+        + Matrix2::identity();
 
     let arm = Arm::new(m1, m2, l1, l2).unwrap();
     let c = control_confidence(&arm, &Task::paper(TaskKind::Velocity)).unwrap();
-    assert!((c.pi_u - by_hand).amax() <= 1e-12 * by_hand.amax(), "{} vs {by_hand}", c.pi_u);
+    assert!(
+        (c.pi_u - by_hand).amax() <= 1e-12 * by_hand.amax(),
+        "{} vs {by_hand}",
+        c.pi_u
+    );
     let logdet = (by_hand[(0, 0)] * by_hand[(1, 1)] - by_hand[(0, 1)] * by_hand[(1, 0)]).ln();
     assert!((c.logdet - logdet).abs() < 1e-12);
 }
@@ -140,9 +157,18 @@ fn invalid_arms_are_errors_naming_the_parameter() {
             other => panic!("expected an error for {name}, got {other:?}"),
         }
     }
-    assert!(matches!("0.3,0.4,x,0.2".parse::<Arm>(), Err(Error::ArmSyntax { .. })));
-    assert!(matches!("0.3,0.4,0.5".parse::<Arm>(), Err(Error::ArmSyntax { .. })));
-    assert_eq!("0.3, 0.4,0.5 ,0.2".parse::<Arm>().unwrap(), Arm::new(0.3, 0.4, 0.5, 0.2).unwrap());
+    assert!(matches!(
+        "0.3,0.4,x,0.2".parse::<Arm>(),
+        Err(Error::ArmSyntax { .. })
+    ));
+    assert!(matches!(
+        "0.3,0.4,0.5".parse::<Arm>(),
+        Err(Error::ArmSyntax { .. })
+    ));
+    assert_eq!(
+        "0.3, 0.4,0.5 ,0.2".parse::<Arm>().unwrap(),
+        Arm::new(0.3, 0.4, 0.5, 0.2).unwrap()
+    );
 }
 
 #[test]
@@ -150,13 +176,25 @@ fn invalid_tasks_are_errors() {
     let arm = Arm::new(0.3, 0.4, 0.5, 0.2).unwrap();
     let mut task = Task::paper(TaskKind::Position);
     task.precision_theta[(0, 1)] = 3.0;
-    assert!(matches!(control_confidence(&arm, &task), Err(Error::InvalidPrecision { .. })));
+    assert!(matches!(
+        control_confidence(&arm, &task),
+        Err(Error::InvalidPrecision { .. })
+    ));
     let mut task = Task::paper(TaskKind::Position);
     task.goal_theta[1] = f64::NAN;
-    assert!(matches!(control_confidence(&arm, &task), Err(Error::InvalidGoal { .. })));
+    assert!(matches!(
+        control_confidence(&arm, &task),
+        Err(Error::InvalidGoal { .. })
+    ));
     let mut task = Task::paper(TaskKind::Acceleration);
     task.precision_theta_ddot = Matrix2::zeros();
-    assert!(matches!(control_confidence(&arm, &task), Err(Error::NotPositiveDefinite { .. })));
-    assert!(matches!("jump".parse::<TaskKind>(), Err(Error::UnknownTask(_))));
+    assert!(matches!(
+        control_confidence(&arm, &task),
+        Err(Error::NotPositiveDefinite { .. })
+    ));
+    assert!(matches!(
+        "jump".parse::<TaskKind>(),
+        Err(Error::UnknownTask(_))
+    ));
     assert_eq!("2".parse::<TaskKind>().unwrap(), TaskKind::Velocity);
 }

@@ -35,7 +35,11 @@ fn linearisation_sensitivities_and_confidence_table() {
             let s = sensitivities(&arm, kind);
             let c = control_confidence(&arm, &Task::paper(kind)).unwrap();
             writeln!(out, " task {kind}").unwrap();
-            for (name, m) in [("dtheta/dU", s.d_theta_du), ("dthetadot/dU", s.d_theta_dot_du), ("dthetaddot/dU", Some(s.d_theta_ddot_du))] {
+            for (name, m) in [
+                ("dtheta/dU", s.d_theta_du),
+                ("dthetadot/dU", s.d_theta_dot_du),
+                ("dthetaddot/dU", Some(s.d_theta_ddot_du)),
+            ] {
                 if let Some(m) = m {
                     out += &row(name, m.transpose().iter().copied());
                 }

@@ -1,9 +1,10 @@
 //! `toolconf confidence --arm M1,M2,L1,L2 --task T [--json]`.
 
 use serde_json::json;
-use toolconf::{control_confidence, sensitivities, Arm, Error, Task, TaskKind};
+use toolconf::{control_confidence, sensitivities, Arm, Task, TaskKind};
 
-use super::output::{matrix_rows, print_matrix};
+use super::output::{matrix_rows, print_matrix, CliError};
+use super::{parse_arm, parse_task};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -18,15 +19,7 @@ pub struct Args {
     json: bool,
 }
 
-fn parse_arm(s: &str) -> Result<Arm, String> {
-    s.parse().map_err(|e: Error| e.to_string())
-}
-
-fn parse_task(s: &str) -> Result<TaskKind, String> {
-    s.parse().map_err(|e: Error| e.to_string())
-}
-
-pub fn run(args: &Args) -> Result<(), Error> {
+pub fn run(args: &Args) -> Result<(), CliError> {
     let task = Task::paper(args.task);
     let confidence = control_confidence(&args.arm, &task)?;
     let s = sensitivities(&args.arm, args.task);
@@ -34,7 +27,11 @@ pub fn run(args: &Args) -> Result<(), Error> {
     let b = args.arm.input_matrix();
     if args.json {
         let mut sens = serde_json::Map::new();
-        for (name, m) in [("d_theta_du", s.d_theta_du), ("d_theta_dot_du", s.d_theta_dot_du), ("d_theta_ddot_du", Some(s.d_theta_ddot_du))] {
+        for (name, m) in [
+            ("d_theta_du", s.d_theta_du),
+            ("d_theta_dot_du", s.d_theta_dot_du),
+            ("d_theta_ddot_du", Some(s.d_theta_ddot_du)),
+        ] {
             if let Some(m) = m {
                 sens.insert(name.into(), matrix_rows(&m));
             }
@@ -48,13 +45,25 @@ pub fn run(args: &Args) -> Result<(), Error> {
             "pi_u": matrix_rows(&confidence.pi_u),
             "logdet": confidence.logdet,
         });
-        println!("{}", serde_json::to_string_pretty(&out).expect("JSON of finite numbers"));
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&out).expect("JSON of finite numbers")
+        );
         return Ok(());
     }
-    println!("arm: {}    task: {} (task {})", args.arm, args.task, args.task.paper_index());
+    println!(
+        "arm: {}    task: {} (task {})",
+        args.arm,
+        args.task,
+        args.task.paper_index()
+    );
     print_matrix("A = df/dX at the equilibrium", &a);
     print_matrix("B = df/dU at the equilibrium", &b);
-    for (name, m) in [("dtheta/dU", s.d_theta_du), ("dtheta_dot/dU", s.d_theta_dot_du), ("dtheta_ddot/dU", Some(s.d_theta_ddot_du))] {
+    for (name, m) in [
+        ("dtheta/dU", s.d_theta_du),
+        ("dtheta_dot/dU", s.d_theta_dot_du),
+        ("dtheta_ddot/dU", Some(s.d_theta_ddot_du)),
+    ] {
         if let Some(m) = m {
             print_matrix(name, &m);
         }

@@ -1,12 +1,16 @@
 //! Command-line front end: parses arguments, runs one subcommand, prints text or JSON.
-//! Bad input is a message on stderr and exit status 2.
+//! Bad input is a message on stderr and exit status 2; a failed simulation exits with 1.
 
 mod confidence;
+mod episode_args;
 mod output;
+mod select;
+mod simulate;
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use toolconf::{Arm, Error, TaskKind};
 
 /// Confidence-aware decision-making and control for tool selection.
 #[derive(Parser)]
@@ -20,18 +24,32 @@ struct Cli {
 enum Command {
     /// The linearised model (A, B), the task's sensitivities and the control confidence Π^U.
     Confidence(confidence::Args),
+    /// One closed-loop episode of the active-inference controller: task error, ∫F dt, ∫J dt.
+    Simulate(simulate::Args),
+    /// Draw random tools, simulate each, and choose by ∫F, ∫J and confidence.
+    Select(select::Args),
+}
+
+pub(crate) fn parse_arm(s: &str) -> Result<Arm, String> {
+    s.parse().map_err(|e: Error| e.to_string())
+}
+
+pub(crate) fn parse_task(s: &str) -> Result<TaskKind, String> {
+    s.parse().map_err(|e: Error| e.to_string())
 }
 
 pub fn run() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Confidence(args) => confidence::run(&args),
+        Command::Simulate(args) => simulate::run(&args),
+        Command::Select(args) => select::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
             eprintln!("toolconf: error: {err}");
-            ExitCode::from(2)
+            ExitCode::from(err.exit_code())
         }
     }
 }

@@ -5,7 +5,11 @@ use serde_json::Value;
 
 /// A matrix as a JSON list of rows.
 pub fn matrix_rows<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> Value {
-    Value::from((0..R).map(|i| (0..C).map(|j| m[(i, j)]).collect::<Vec<f64>>()).collect::<Vec<_>>())
+    Value::from(
+        (0..R)
+            .map(|i| (0..C).map(|j| m[(i, j)]).collect::<Vec<f64>>())
+            .collect::<Vec<_>>(),
+    )
 }
 
 /// A titled matrix, one row a line, in a width that keeps columns aligned.
@@ -15,4 +19,42 @@ pub fn print_matrix<const R: usize, const C: usize>(title: &str, m: &SMatrix<f64
         let row: Vec<String> = (0..C).map(|j| format!("{:>16.9e}", m[(i, j)])).collect();
         println!("  [{}]", row.join(" "));
     }
+}
+
+/// What a command can fail with; `exit_code` maps bad input to 2 and failed work to 1.
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    #[error(transparent)]
+    Input(#[from] toolconf::Error),
+    #[error(transparent)]
+    Simulation(#[from] toolconf::closed_loop::SimulationError),
+    #[error("cannot write {path}: {source}")]
+    Io {
+        path: std::path::PathBuf,
+        source: std::io::Error,
+    },
+}
+
+impl CliError {
+    pub fn exit_code(&self) -> u8 {
+        use toolconf::closed_loop::SimulationError;
+        match self {
+            CliError::Input(_) | CliError::Simulation(SimulationError::Input(_)) => 2,
+            CliError::Simulation(_) | CliError::Io { .. } => 1,
+        }
+    }
+}
+
+/// Writes a whole file or nothing: a temporary file beside the target, renamed into place, so an
+/// interrupted run never leaves a half-written file.
+pub fn write_atomically(path: &std::path::Path, contents: &str) -> Result<(), CliError> {
+    let io = |source| CliError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".partial");
+    let tmp = std::path::PathBuf::from(tmp);
+    std::fs::write(&tmp, contents).map_err(io)?;
+    std::fs::rename(&tmp, path).map_err(io)
 }

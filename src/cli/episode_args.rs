@@ -1,0 +1,47 @@
+//! Episode options shared by the commands that simulate (defaults: the paper's).
+
+use toolconf::closed_loop::EpisodeOptions;
+use toolconf::Error;
+
+#[derive(clap::Args, Debug, Clone)]
+pub struct EpisodeArgs {
+    /// Constant torque perturbation ΔT on both joints [N m].
+    #[arg(long = "perturb", default_value_t = 0.0, allow_hyphen_values = true)]
+    pub perturbation: f64,
+    /// End time of the episode [s].
+    #[arg(long, default_value_t = 5.0)]
+    pub t_end: f64,
+    /// Output grid spacing [s].
+    #[arg(long, default_value_t = 0.05)]
+    pub dt: f64,
+    /// Learning rate γ of the controller.
+    #[arg(long = "gamma", default_value_t = 1.0)]
+    pub learning_rate: f64,
+    /// Integrator relative tolerance (ode45 default 1e-3).
+    #[arg(long, default_value_t = 1e-3)]
+    pub rtol: f64,
+    /// Integrator absolute tolerance (ode45 default 1e-6).
+    #[arg(long, default_value_t = 1e-6)]
+    pub atol: f64,
+}
+
+impl EpisodeArgs {
+    pub fn options(&self, record_trajectory: bool) -> Result<EpisodeOptions, Error> {
+        for (name, value) in [("rtol", self.rtol), ("atol", self.atol)] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(Error::InvalidOption { name, value });
+            }
+        }
+        let mut o = EpisodeOptions {
+            t_end: self.t_end,
+            dt: self.dt,
+            perturbation: self.perturbation,
+            learning_rate: self.learning_rate,
+            record_trajectory,
+            ..EpisodeOptions::default()
+        };
+        o.integrator.rtol = self.rtol;
+        o.integrator.atol = self.atol;
+        Ok(o)
+    }
+}

@@ -1,0 +1,131 @@
+//! Decision-making: draw random tools, run every tool's episode (in parallel), and choose by
+//! ∫F (the paper's confidence-aware objective), ∫J (classic optimal-control cost) and ln|Π^U|
+//! alone (confidence, no simulation needed).
+//!
+//! Tools are drawn from a documented stream so that a seed names a tool set exactly: ChaCha8
+//! (`rand_chacha::ChaCha8Rng::seed_from_u64(seed)`), each draw u = (next_u64 >> 11)·2⁻⁵³ ∈ [0, 1),
+//! each parameter 0.1 + 0.5·u, in the order m1, m2, l1, l2, tool after tool. Draws happen before
+//! any parallel work and every episode is independent and deterministic, so results are identical
+//! whatever the number of threads.
+
+use rand::{RngCore, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+
+use crate::closed_loop::{simulate, EpisodeOptions, Metrics, SimulationError};
+use crate::confidence::control_confidence;
+use crate::{Arm, Error, Task};
+
+/// The paper's parameter domain for m1, m2, l1, l2 ("Implementation details").
+pub const PARAMETER_RANGE: (f64, f64) = (0.1, 0.6);
+
+/// A seeded stream of random tools.
+pub struct ToolSampler {
+    rng: ChaCha8Rng,
+}
+
+impl ToolSampler {
+    pub fn new(seed: u64) -> Self {
+        Self {
+            rng: ChaCha8Rng::seed_from_u64(seed),
+        }
+    }
+
+    fn uniform(&mut self) -> f64 {
+        (self.rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+
+    /// The next tool, parameters uniform on [0.1, 0.6).
+    pub fn next_tool(&mut self) -> Arm {
+        let (lo, hi) = PARAMETER_RANGE;
+        let mut p = [0.0; 4];
+        for v in &mut p {
+            *v = lo + (hi - lo) * self.uniform();
+        }
+        Arm::new(p[0], p[1], p[2], p[3]).expect("parameters drawn from [0.1, 0.6) are valid")
+    }
+
+    pub fn tools(&mut self, n: usize) -> Vec<Arm> {
+        (0..n).map(|_| self.next_tool()).collect()
+    }
+}
+
+/// `n` tools drawn from `seed` (see the module docs for the stream).
+pub fn draw_tools(n: usize, seed: u64) -> Vec<Arm> {
+    ToolSampler::new(seed).tools(n)
+}
+
+/// One tool's evaluation: its confidence (no simulation needed) and its episode.
+#[derive(Debug, Clone)]
+pub struct ToolResult {
+    pub index: usize,
+    pub arm: Arm,
+    pub logdet: Result<f64, Error>,
+    pub episode: Result<Metrics, SimulationError>,
+}
+
+/// Runs every tool's episode in parallel; the result order is the tools' order.
+pub fn evaluate(tools: &[Arm], task: &Task, options: &EpisodeOptions) -> Vec<ToolResult> {
+    let options = EpisodeOptions {
+        record_trajectory: false,
+        ..options.clone()
+    };
+    tools
+        .par_iter()
+        .enumerate()
+        .map(|(index, arm)| ToolResult {
+            index,
+            arm: *arm,
+            logdet: control_confidence(arm, task).map(|c| c.logdet),
+            episode: simulate(arm, task, &options).map(|e| e.metrics),
+        })
+        .collect()
+}
+
+/// An objective that ranks tools.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Objective {
+    /// argmin ∫F dt: performance + control effort + confidence (the paper's criterion).
+    FreeEnergy,
+    /// argmin ∫J dt: performance + control effort (optimal control).
+    CostJ,
+    /// argmax ln|Π^U|: confidence alone, without simulating.
+    Confidence,
+}
+
+impl Objective {
+    pub const ALL: [Objective; 3] = [
+        Objective::FreeEnergy,
+        Objective::CostJ,
+        Objective::Confidence,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Objective::FreeEnergy => "free_energy",
+            Objective::CostJ => "cost_j",
+            Objective::Confidence => "confidence",
+        }
+    }
+
+    /// The value to minimise for a tool, if the tool has one.
+    pub fn score(self, r: &ToolResult) -> Option<f64> {
+        match self {
+            Objective::FreeEnergy => r.episode.as_ref().ok().map(|m| m.free_energy),
+            Objective::CostJ => r.episode.as_ref().ok().map(|m| m.cost_j),
+            Objective::Confidence => r.logdet.as_ref().ok().map(|l| -l),
+        }
+    }
+
+    /// The index of the chosen tool; ties go to the earlier tool, failed tools are skipped.
+    pub fn choose(self, results: &[ToolResult]) -> Option<usize> {
+        results
+            .iter()
+            .filter_map(|r| self.score(r).map(|s| (r.index, s)))
+            .fold(None, |best: Option<(usize, f64)>, (i, s)| match best {
+                Some((_, b)) if b <= s => best,
+                _ => Some((i, s)),
+            })
+            .map(|(i, _)| i)
+    }
+}
