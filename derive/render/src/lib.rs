@@ -17,9 +17,15 @@ pub const IR_SCHEMA: u64 = 1;
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
     #[error("cannot read {path}: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
     #[error("{path} is not valid JSON: {source}")]
-    Json { path: PathBuf, source: serde_json::Error },
+    Json {
+        path: PathBuf,
+        source: serde_json::Error,
+    },
     #[error("IR schema {found} is not the one this renderer understands ({expected})")]
     Schema { found: String, expected: u64 },
     #[error("IR has no model.name")]
@@ -41,17 +47,29 @@ pub struct Rendered {
 
 /// Reads and checks an IR file.
 pub fn read_ir(path: &Path) -> Result<Value, RenderError> {
-    let text = std::fs::read_to_string(path).map_err(|source| RenderError::Io { path: path.into(), source })?;
-    let ir: Value = serde_json::from_str(&text).map_err(|source| RenderError::Json { path: path.into(), source })?;
+    let text = std::fs::read_to_string(path).map_err(|source| RenderError::Io {
+        path: path.into(),
+        source,
+    })?;
+    let ir: Value = serde_json::from_str(&text).map_err(|source| RenderError::Json {
+        path: path.into(),
+        source,
+    })?;
     match ir.get("schema").and_then(Value::as_u64) {
         Some(IR_SCHEMA) => Ok(ir),
-        other => Err(RenderError::Schema { found: format!("{other:?}"), expected: IR_SCHEMA }),
+        other => Err(RenderError::Schema {
+            found: format!("{other:?}"),
+            expected: IR_SCHEMA,
+        }),
     }
 }
 
 /// Loads every `*.tera` file of a folder, in name order.
 pub fn load_templates(dir: &Path) -> Result<Vec<(String, String)>, RenderError> {
-    let io = |source| RenderError::Io { path: dir.into(), source };
+    let io = |source| RenderError::Io {
+        path: dir.into(),
+        source,
+    };
     let mut names: Vec<PathBuf> = std::fs::read_dir(dir)
         .map_err(io)?
         .filter_map(|e| e.ok().map(|e| e.path()))
@@ -61,8 +79,15 @@ pub fn load_templates(dir: &Path) -> Result<Vec<(String, String)>, RenderError> 
     names
         .into_iter()
         .map(|p| {
-            let text = std::fs::read_to_string(&p).map_err(|source| RenderError::Io { path: p.clone(), source })?;
-            let name = p.file_name().unwrap_or_default().to_string_lossy().into_owned();
+            let text = std::fs::read_to_string(&p).map_err(|source| RenderError::Io {
+                path: p.clone(),
+                source,
+            })?;
+            let name = p
+                .file_name()
+                .unwrap_or_default()
+                .to_string_lossy()
+                .into_owned();
             Ok((name, text))
         })
         .collect()
@@ -70,7 +95,10 @@ pub fn load_templates(dir: &Path) -> Result<Vec<(String, String)>, RenderError> 
 
 /// Renders the IR through each template; Rust outputs are formatted with rustfmt.
 pub fn render(ir: &Value, templates: &[(String, String)]) -> Result<Vec<Rendered>, RenderError> {
-    let model = ir.pointer("/model/name").and_then(Value::as_str).ok_or(RenderError::NoModelName)?;
+    let model = ir
+        .pointer("/model/name")
+        .and_then(Value::as_str)
+        .ok_or(RenderError::NoModelName)?;
     let mut tera = Tera::default();
     tera.autoescape_on(vec![]);
     tera.add_raw_templates(templates.iter().map(|(n, t)| (n.as_str(), t.as_str())))
@@ -78,14 +106,23 @@ pub fn render(ir: &Value, templates: &[(String, String)]) -> Result<Vec<Rendered
     let context = Context::from_value(ir.clone()).map_err(|e| RenderError::Template(chain(&e)))?;
     let mut out: Vec<Rendered> = Vec::new();
     for (name, _) in templates {
-        let ext = name.trim_end_matches(".tera").rsplit('.').next().unwrap_or("txt");
+        let ext = name
+            .trim_end_matches(".tera")
+            .rsplit('.')
+            .next()
+            .unwrap_or("txt");
         let file_name = format!("{model}.{ext}");
         if out.iter().any(|r| r.file_name == file_name) {
             return Err(RenderError::Clash(file_name));
         }
-        let text = tera.render(name, &context).map_err(|e| RenderError::Template(chain(&e)))?;
+        let text = tera
+            .render(name, &context)
+            .map_err(|e| RenderError::Template(chain(&e)))?;
         let contents = if ext == "rs" { rustfmt(&text)? } else { text };
-        out.push(Rendered { file_name, contents });
+        out.push(Rendered {
+            file_name,
+            contents,
+        });
     }
     Ok(out)
 }
@@ -105,9 +142,13 @@ pub fn rustfmt(source: &str) -> Result<String, RenderError> {
         .ok_or_else(|| RenderError::Rustfmt("no stdin".into()))?
         .write_all(source.as_bytes())
         .map_err(|e| RenderError::Rustfmt(e.to_string()))?;
-    let output = child.wait_with_output().map_err(|e| RenderError::Rustfmt(e.to_string()))?;
+    let output = child
+        .wait_with_output()
+        .map_err(|e| RenderError::Rustfmt(e.to_string()))?;
     if !output.status.success() {
-        return Err(RenderError::Rustfmt(String::from_utf8_lossy(&output.stderr).into_owned()));
+        return Err(RenderError::Rustfmt(
+            String::from_utf8_lossy(&output.stderr).into_owned(),
+        ));
     }
     String::from_utf8(output.stdout).map_err(|e| RenderError::Rustfmt(e.to_string()))
 }

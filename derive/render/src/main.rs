@@ -23,7 +23,10 @@ fn run(args: &[String]) -> Result<(), RenderError> {
         let ir = read_ir(&path)?;
         for file in render(&ir, &templates)? {
             let target = out.join(&file.file_name);
-            std::fs::write(&target, file.contents).map_err(|source| RenderError::Io { path: target.clone(), source })?;
+            std::fs::write(&target, file.contents).map_err(|source| RenderError::Io {
+                path: target.clone(),
+                source,
+            })?;
             println!("render: {} -> {}", path.display(), target.display());
         }
     }
