@@ -58,6 +58,17 @@ impl ActiveInference {
         -self.learning_rate * gradient
     }
 
+    /// The gains γ·(K_θ, K_θ̇, K_θ̈) and γ·P^U of U̇ = −γ ∂F/∂U, for the closed-loop Jacobian.
+    pub fn scaled_gains(&self) -> [Matrix2; 4] {
+        let g = self.learning_rate;
+        [
+            g * self.gain_theta,
+            g * self.gain_theta_dot,
+            g * self.gain_theta_ddot,
+            g * self.task.precision_u,
+        ]
+    }
+
     /// The performance and control-cost part of F, ½[Σ eᵀPe + UᵀP^U U] over the task's terms:
     /// the optimal-control cost J of the paper (F without the confidence term).
     #[inline]

@@ -5,14 +5,11 @@
 //! process Ẋ = f(X, U + ΔT) with a constant torque perturbation ΔT on both joints; the
 //! controller observes θ, θ̇ and the plant's θ̈ and updates U̇ = −γ ∂F/∂U (eq. U_dot_deriv).
 
-use nalgebra::SVector;
-
-use super::controller::ActiveInference;
+use super::system::ClosedLoop;
 use crate::integrate::{solve_grid, uniform_grid, IntegrationError, Options as IntegratorOptions};
 use crate::{Arm, Error, State, Task, Vector2};
 
-/// The closed-loop state Z = [X; U].
-pub type JointState = SVector<f64, 6>;
+pub use super::system::JointState;
 
 /// A grid state whose magnitude passes this is a diverging simulation, not a result.
 const DIVERGENCE_BOUND: f64 = 1e6;
@@ -110,27 +107,6 @@ impl SimulationError {
     }
 }
 
-/// The closed-loop right-hand side Ż = [f(X, U + ΔT); −γ ∂F/∂U], with the plant's θ̈.
-#[inline]
-fn closed_loop(
-    arm_params: &SVector<f64, 4>,
-    controller: &ActiveInference,
-    perturbation: &Vector2,
-    z: &JointState,
-) -> (JointState, Vector2) {
-    let x = z.fixed_rows::<4>(0).into_owned();
-    let u = z.fixed_rows::<2>(4).into_owned();
-    let x_dot = crate::generated::arm2::dynamics(&x, &(u + perturbation), arm_params);
-    let theta = x.fixed_rows::<2>(0).into_owned();
-    let theta_dot = x.fixed_rows::<2>(2).into_owned();
-    let theta_ddot = x_dot.fixed_rows::<2>(2).into_owned();
-    let u_dot = controller.control_rate(&theta, &theta_dot, &theta_ddot, &u);
-    let mut z_dot = JointState::zeros();
-    z_dot.fixed_rows_mut::<4>(0).copy_from(&x_dot);
-    z_dot.fixed_rows_mut::<2>(4).copy_from(&u_dot);
-    (z_dot, theta_ddot)
-}
-
 /// Runs one episode of `arm` on `task`.
 pub fn simulate(
     arm: &Arm,
@@ -138,9 +114,8 @@ pub fn simulate(
     options: &EpisodeOptions,
 ) -> Result<Episode, SimulationError> {
     check_options(options)?;
-    let controller = ActiveInference::new(arm, task, options.learning_rate)?;
-    let params = arm.params();
-    let perturbation = Vector2::repeat(options.perturbation);
+    let system = ClosedLoop::new(arm, task, options.learning_rate, options.perturbation)?;
+    let controller = &system.controller;
     let grid = uniform_grid(0.0, options.t_end, options.dt);
     let mut z0 = JointState::zeros();
     z0.fixed_rows_mut::<4>(0).copy_from(&options.x0);
@@ -156,9 +131,9 @@ pub fn simulate(
     let mut previous: Option<(f64, f64, f64)> = None;
     let mut divergence: Option<(f64, f64)> = None;
 
-    let rhs = |_t: f64, z: &JointState| closed_loop(&params, &controller, &perturbation, z).0;
+    let rhs = |_t: f64, z: &JointState| system.rhs(z);
     let stats = solve_grid(rhs, &z0, &grid, &options.integrator, |_, t, z| {
-        let (_, theta_ddot) = closed_loop(&params, &controller, &perturbation, z);
+        let (_, theta_ddot) = system.rhs_and_acceleration(z);
         let theta = z.fixed_rows::<2>(0).into_owned();
         let theta_dot = z.fixed_rows::<2>(2).into_owned();
         let u = z.fixed_rows::<2>(4).into_owned();

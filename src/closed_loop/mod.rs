@@ -3,8 +3,8 @@
 
 mod controller;
 mod episode;
+mod system;
 
 pub use controller::ActiveInference;
-pub use episode::{
-    simulate, Episode, EpisodeOptions, JointState, Metrics, SimulationError, Trajectory,
-};
+pub use episode::{simulate, Episode, EpisodeOptions, Metrics, SimulationError, Trajectory};
+pub use system::{ClosedLoop, JointJacobian, JointState};
