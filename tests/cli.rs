@@ -112,3 +112,163 @@ fn bad_input_exits_2_with_a_message_naming_the_value() {
         assert!(out.stdout.is_empty());
     }
 }
+
+#[test]
+fn simulate_json_and_csv() {
+    let dir = std::env::temp_dir().join(format!("toolconf-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("trajectory.csv");
+    let out = toolconf(&[
+        "simulate",
+        "--arm",
+        "0.3,0.4,0.5,0.2",
+        "--task",
+        "position",
+        "--perturb",
+        "-0.8",
+        "--json",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    for key in [
+        "task_error",
+        "free_energy",
+        "cost_j",
+        "logdet",
+        "rhs_evals",
+        "arm",
+        "task",
+        "perturb",
+    ] {
+        assert!(v.get(key).is_some(), "missing key {key}");
+    }
+    assert_eq!(v["perturb"], -0.8);
+    assert_eq!(v["task"], "position");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(
+        lines[0],
+        "t,theta1,theta2,theta1_dot,theta2_dot,theta1_ddot,theta2_ddot,u1,u2"
+    );
+    assert_eq!(lines.len(), 102);
+    assert!(lines[1..]
+        .iter()
+        .all(|l| l.split(',').count() == 9 && !l.contains("NaN")));
+    assert!(!dir.join("trajectory.csv.partial").exists());
+    // The trajectory and the metrics agree: task error is the sum over the CSV's θ rows.
+    let g = [std::f64::consts::FRAC_PI_3, std::f64::consts::FRAC_PI_6];
+    let sum: f64 = lines[1..]
+        .iter()
+        .map(|l| {
+            let c: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            100.0 * ((c[1] - g[0]).powi(2) + (c[2] - g[1]).powi(2))
+        })
+        .sum();
+    assert!((sum - v["task_error"].as_f64().unwrap()).abs() < 1e-9 * sum);
+}
+
+#[test]
+fn select_chooses_by_each_objective() {
+    let out = toolconf(&[
+        "select", "--task", "velocity", "--tools", "6", "--seed", "3", "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let tools = v["tools"].as_array().unwrap();
+    assert_eq!(tools.len(), 6);
+    let column = |key: &str| {
+        tools
+            .iter()
+            .map(|t| t[key].as_f64().unwrap())
+            .collect::<Vec<_>>()
+    };
+    let argmin = |x: Vec<f64>| (0..x.len()).min_by(|&a, &b| x[a].total_cmp(&x[b])).unwrap();
+    assert_eq!(v["choice"]["free_energy"], argmin(column("free_energy")));
+    assert_eq!(v["choice"]["cost_j"], argmin(column("cost_j")));
+    assert_eq!(
+        v["choice"]["confidence"],
+        argmin(column("logdet").into_iter().map(|l| -l).collect())
+    );
+    // Same seed, same tools and numbers.
+    let again = toolconf(&[
+        "select", "--task", "velocity", "--tools", "6", "--seed", "3", "--json",
+    ]);
+    assert_eq!(out.stdout, again.stdout);
+}
+
+#[test]
+fn simulate_and_select_reject_bad_input() {
+    for (args, needle) in [
+        (
+            vec!["simulate", "--arm", "0.3,0.4,0.5,0", "--task", "position"],
+            "l2 = 0",
+        ),
+        (
+            vec![
+                "simulate",
+                "--arm",
+                "0.3,0.4,0.5,0.2",
+                "--task",
+                "position",
+                "--perturb",
+                "nan",
+            ],
+            "perturbation",
+        ),
+        (
+            vec![
+                "simulate",
+                "--arm",
+                "0.3,0.4,0.5,0.2",
+                "--task",
+                "position",
+                "--dt",
+                "0",
+            ],
+            "dt",
+        ),
+        (
+            vec![
+                "simulate",
+                "--arm",
+                "0.3,0.4,0.5,0.2",
+                "--task",
+                "position",
+                "--rtol",
+                "-1",
+            ],
+            "rtol",
+        ),
+        (
+            vec!["select", "--task", "velocity", "--tools", "0"],
+            "--tools",
+        ),
+        (
+            vec!["select", "--task", "sideways", "--tools", "3"],
+            "unknown task",
+        ),
+    ] {
+        let out = toolconf(&args);
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains(needle),
+            "{args:?}: stderr lacks '{needle}':\n{err}"
+        );
+    }
+}

@@ -9,19 +9,19 @@ pub struct EpisodeArgs {
     #[arg(long = "perturb", default_value_t = 0.0, allow_hyphen_values = true)]
     pub perturbation: f64,
     /// End time of the episode [s].
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, default_value_t = 5.0, allow_hyphen_values = true)]
     pub t_end: f64,
     /// Output grid spacing [s].
-    #[arg(long, default_value_t = 0.05)]
+    #[arg(long, default_value_t = 0.05, allow_hyphen_values = true)]
     pub dt: f64,
     /// Learning rate γ of the controller.
-    #[arg(long = "gamma", default_value_t = 1.0)]
+    #[arg(long = "gamma", default_value_t = 1.0, allow_hyphen_values = true)]
     pub learning_rate: f64,
     /// Integrator relative tolerance (ode45 default 1e-3).
-    #[arg(long, default_value_t = 1e-3)]
+    #[arg(long, default_value_t = 1e-3, allow_hyphen_values = true)]
     pub rtol: f64,
     /// Integrator absolute tolerance (ode45 default 1e-6).
-    #[arg(long, default_value_t = 1e-6)]
+    #[arg(long, default_value_t = 1e-6, allow_hyphen_values = true)]
     pub atol: f64,
 }
 
