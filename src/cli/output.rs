@@ -28,6 +28,8 @@ pub enum CliError {
     Input(#[from] toolconf::Error),
     #[error(transparent)]
     Simulation(#[from] toolconf::closed_loop::SimulationError),
+    #[error(transparent)]
+    Mpc(#[from] toolconf::mpc::MpcEpisodeError),
     #[error("cannot write {path}: {source}")]
     Io {
         path: std::path::PathBuf,
@@ -39,8 +41,10 @@ impl CliError {
     pub fn exit_code(&self) -> u8 {
         use toolconf::closed_loop::SimulationError;
         match self {
-            CliError::Input(_) | CliError::Simulation(SimulationError::Input(_)) => 2,
-            CliError::Simulation(_) | CliError::Io { .. } => 1,
+            CliError::Input(_)
+            | CliError::Simulation(SimulationError::Input(_))
+            | CliError::Mpc(toolconf::mpc::MpcEpisodeError::Input(_)) => 2,
+            CliError::Simulation(_) | CliError::Mpc(_) | CliError::Io { .. } => 1,
         }
     }
 }

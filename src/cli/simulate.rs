@@ -4,7 +4,8 @@ use std::path::PathBuf;
 
 use serde_json::json;
 use toolconf::closed_loop::{simulate, Trajectory};
-use toolconf::{Arm, Task, TaskKind};
+use toolconf::mpc::{simulate_mpc, MpcOptions};
+use toolconf::{Arm, Error, Task, TaskKind};
 
 use super::episode_args::EpisodeArgs;
 use super::output::{write_atomically, CliError};
@@ -26,9 +27,61 @@ pub struct Args {
     /// Write the trajectory on the output grid to this CSV file.
     #[arg(long)]
     csv: Option<PathBuf>,
+    /// The controller: the paper's active inference (aic) or the linear MPC baseline (mpc).
+    #[arg(long, value_enum, default_value_t = Controller::Aic)]
+    controller: Controller,
+    #[command(flatten)]
+    mpc: MpcArgs,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Controller {
+    Aic,
+    Mpc,
+}
+
+/// Options of the MPC baseline (used with `--controller mpc`).
+#[derive(clap::Args, Debug, Clone)]
+pub struct MpcArgs {
+    /// MPC control period [s] (zero-order hold); the output step must be a whole number of periods.
+    #[arg(long, default_value_t = 0.05, allow_hyphen_values = true)]
+    pub mpc_period: f64,
+    /// MPC prediction horizon [s].
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    pub horizon: f64,
+    /// Torque bound per joint [N m] for the MPC (inf for none).
+    #[arg(long, default_value_t = 5.0, allow_hyphen_values = true)]
+    pub torque_limit: f64,
+}
+
+impl MpcArgs {
+    pub fn options(&self) -> Result<MpcOptions, Error> {
+        for (name, value) in [
+            ("MPC period", self.mpc_period),
+            ("MPC horizon", self.horizon),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(Error::InvalidOption { name, value });
+            }
+        }
+        if self.torque_limit.is_nan() || self.torque_limit <= 0.0 {
+            return Err(Error::InvalidOption {
+                name: "torque limit",
+                value: self.torque_limit,
+            });
+        }
+        Ok(MpcOptions {
+            period: self.mpc_period,
+            horizon: self.horizon,
+            torque_limit: self.torque_limit,
+        })
+    }
 }
 
 pub fn run(args: &Args) -> Result<(), CliError> {
+    if args.controller == Controller::Mpc {
+        return run_mpc(args);
+    }
     let task = Task::paper(args.task);
     let options = args.episode.options(args.csv.is_some())?;
     let episode = simulate(&args.arm, &task, &options)?;
@@ -71,6 +124,74 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         );
         if let Some(path) = &args.csv {
             println!("trajectory     {}", path.display());
+        }
+    }
+    Ok(())
+}
+
+fn run_mpc(args: &Args) -> Result<(), CliError> {
+    let task = Task::paper(args.task);
+    let options = args.episode.options(args.csv.is_some())?;
+    let episode = simulate_mpc(&args.arm, &task, &options, &args.mpc.options()?)?;
+    let m = &episode.metrics;
+    if let (Some(path), Some(tr)) = (&args.csv, &episode.trajectory) {
+        write_atomically(path, &trajectory_csv(tr))?;
+    }
+    if args.json {
+        let out = json!({
+            "arm": args.arm,
+            "task": args.task,
+            "controller": "mpc",
+            "perturb": args.episode.perturbation,
+            "task_error": m.task_error,
+            "free_energy": m.free_energy,
+            "cost_j": m.cost_j,
+            "control_effort": m.control_effort,
+            "logdet": m.logdet,
+            "rhs_evals": m.rhs_evals,
+            "qp_solves": m.qp_solves,
+            "qp_iterations": m.qp_iterations,
+            "median_solve_time_us": m.median_solve_time.as_secs_f64() * 1e6,
+            "max_solve_time_us": m.max_solve_time.as_secs_f64() * 1e6,
+            "solver_status": m.worst_status,
+        });
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&out).expect("finite numbers")
+        );
+    } else {
+        println!(
+            "arm: {}    task: {} (task {})    controller: MPC    perturbation: {} N m",
+            args.arm,
+            args.task,
+            args.task.paper_index(),
+            args.episode.perturbation
+        );
+        println!("task error       {:.9e}", m.task_error);
+        println!(
+            "integral J dt    {:.9e}  (J*: the cost the MPC achieves)",
+            m.cost_j
+        );
+        println!(
+            "integral F dt    {:.9e}  (J* - T/2 ln|Pi^U|)",
+            m.free_energy
+        );
+        println!(
+            "control effort   {:.9e}  (integral |U|^2 dt)",
+            m.control_effort
+        );
+        println!("ln|Pi^U|         {:.9e}", m.logdet);
+        println!("rhs evals        {}", m.rhs_evals);
+        println!(
+            "QP solves        {} ({} iterations, median {:.1} us, max {:.1} us, status {})",
+            m.qp_solves,
+            m.qp_iterations,
+            m.median_solve_time.as_secs_f64() * 1e6,
+            m.max_solve_time.as_secs_f64() * 1e6,
+            m.worst_status
+        );
+        if let Some(path) = &args.csv {
+            println!("trajectory       {}", path.display());
         }
     }
     Ok(())

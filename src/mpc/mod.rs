@@ -37,6 +37,7 @@
 //! release profile but ≈ 6–12 ms in the dev profile; time experiments in release.
 
 mod discretise;
+mod episode;
 #[cfg(test)]
 mod lqr;
 mod qp;
@@ -47,6 +48,7 @@ use clarabel::solver::SolverStatus;
 use nalgebra::SVector;
 
 pub use discretise::{discretise, Discretised};
+pub use episode::{simulate_mpc, MpcEpisode, MpcEpisodeError, MpcMetrics};
 use qp::{QpSolver, StageCost};
 
 use crate::{Arm, Task, Vector2};

@@ -1,0 +1,188 @@
+//! The MPC baseline on the same nonlinear plant as the active-inference loop: the controller
+//! sees the state every control period and holds its torque (zero-order hold) while the plant
+//! Ẋ = f(X, U + ΔT) is integrated; metrics are those of the active-inference episode.
+
+use std::time::Duration;
+
+use super::{Mpc, MpcError, MpcOptions};
+use crate::closed_loop::{ActiveInference, EpisodeOptions, Trajectory};
+use crate::generated::arm2;
+use crate::integrate::{solve_grid, IntegrationError};
+use crate::{Arm, Error, State, Task, Vector2};
+
+/// What an MPC episode measures: the active-inference episode's metrics where they apply.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MpcMetrics {
+    /// Σ over the output grid of the task's weighted error (as for the active-inference loop).
+    pub task_error: f64,
+    /// ∫J dt, trapezoidal on the output grid: the cost the MPC achieves (objective J*).
+    pub cost_j: f64,
+    /// ∫J dt − ½ T ln|Π^U|: the free energy the same trajectory would have for the tool's
+    /// control confidence (Π^U is a property of the tool and task, not of the controller).
+    pub free_energy: f64,
+    /// ∫|U|² dt, trapezoidal on the output grid.
+    pub control_effort: f64,
+    /// ln|Π^U| of the tool for the task.
+    pub logdet: f64,
+    /// Right-hand-side evaluations of the plant.
+    pub rhs_evals: usize,
+    /// One QP per control period, plus one at the final time.
+    pub qp_solves: usize,
+    pub qp_iterations: u64,
+    pub median_solve_time: Duration,
+    pub max_solve_time: Duration,
+    /// `Solved`, or the first other accepted status (`AlmostSolved`).
+    pub worst_status: String,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct MpcEpisode {
+    pub metrics: MpcMetrics,
+    pub trajectory: Option<Trajectory>,
+}
+
+/// Why an MPC episode failed, naming the tool and time.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MpcEpisodeError {
+    #[error(transparent)]
+    Input(#[from] Error),
+    #[error("MPC for arm {arm}: {source}")]
+    Setup { arm: Arm, source: MpcError },
+    #[error("MPC for arm {arm} failed at t = {t} s: {source}")]
+    Controller { arm: Arm, t: f64, source: MpcError },
+    #[error("simulation of arm {arm} under MPC failed: {source}")]
+    Integration { arm: Arm, source: IntegrationError },
+}
+
+/// Runs the MPC baseline for one episode with the same options (horizon, grid, initial state,
+/// perturbation, integrator) as the active-inference episode. The output grid spacing must be a
+/// whole number of control periods. The paper's U0 is not used: the MPC chooses U at t = 0.
+pub fn simulate_mpc(
+    arm: &Arm,
+    task: &Task,
+    options: &EpisodeOptions,
+    mpc_options: &MpcOptions,
+) -> Result<MpcEpisode, MpcEpisodeError> {
+    let metrics_of = ActiveInference::new(arm, task, 1.0)?;
+    let period = mpc_options.period;
+    let steps = whole_ratio(options.t_end, period).ok_or(Error::InvalidOption {
+        name: "end time t_end (not a whole number of MPC periods)",
+        value: options.t_end,
+    })?;
+    let every = whole_ratio(options.dt, period).ok_or(Error::InvalidOption {
+        name: "output step dt (not a whole number of MPC periods)",
+        value: options.dt,
+    })?;
+    if !options.perturbation.is_finite() {
+        return Err(Error::InvalidOption {
+            name: "perturbation dT",
+            value: options.perturbation,
+        }
+        .into());
+    }
+    let mut mpc = Mpc::new(arm, task, mpc_options)
+        .map_err(|source| MpcEpisodeError::Setup { arm: *arm, source })?;
+    let params = arm.params();
+    let perturbation = Vector2::repeat(options.perturbation);
+    let logdet = metrics_of.logdet;
+
+    let mut solve_times = Vec::with_capacity(steps + 1);
+    let mut qp_iterations = 0u64;
+    let mut worst_status = String::from("Solved");
+    let mut control = |mpc: &mut Mpc, x: &State, t: f64| -> Result<Vector2, MpcEpisodeError> {
+        let u = mpc
+            .control(x)
+            .map_err(|source| MpcEpisodeError::Controller {
+                arm: *arm,
+                t,
+                source,
+            })?;
+        let info = mpc.last_solve();
+        solve_times.push(info.solve_time);
+        qp_iterations += u64::from(info.iterations);
+        if info.status != "Solved" && worst_status == "Solved" {
+            worst_status = info.status;
+        }
+        Ok(u)
+    };
+
+    let mut trajectory = options.record_trajectory.then(Trajectory::default);
+    let (mut task_error, mut int_j, mut effort) = (0.0, 0.0, 0.0);
+    let mut previous: Option<(f64, f64, f64)> = None;
+    let mut sample = |t: f64, x: &State, u: &Vector2| {
+        let theta_ddot = arm2::dynamics(x, &(u + perturbation), &params)
+            .fixed_rows::<2>(2)
+            .into_owned();
+        let theta = x.fixed_rows::<2>(0).into_owned();
+        let theta_dot = x.fixed_rows::<2>(2).into_owned();
+        task_error += metrics_of.task_error(&theta, &theta_dot, &theta_ddot);
+        let j = metrics_of.cost_j(&theta, &theta_dot, &theta_ddot, u);
+        let e = u.norm_squared();
+        if let Some((t0, j0, e0)) = previous {
+            int_j += 0.5 * (t - t0) * (j + j0);
+            effort += 0.5 * (t - t0) * (e + e0);
+        }
+        previous = Some((t, j, e));
+        if let Some(tr) = trajectory.as_mut() {
+            tr.t.push(t);
+            tr.theta.push(theta);
+            tr.theta_dot.push(theta_dot);
+            tr.theta_ddot.push(theta_ddot);
+            tr.u.push(*u);
+        }
+    };
+
+    let mut x = options.x0;
+    let mut u = control(&mut mpc, &x, 0.0)?;
+    sample(0.0, &x, &u);
+    let mut rhs_evals = 0;
+    for k in 0..steps {
+        let (t0, t1) = (k as f64 * period, (k + 1) as f64 * period);
+        let held = u + perturbation;
+        let mut next = x;
+        let stats = solve_grid(
+            |_, x: &State| arm2::dynamics(x, &held, &params),
+            &x,
+            &[t0, t1],
+            &options.integrator,
+            |i, _, y| {
+                if i == 1 {
+                    next = *y;
+                }
+            },
+        )
+        .map_err(|source| MpcEpisodeError::Integration { arm: *arm, source })?;
+        rhs_evals += stats.rhs_evals;
+        x = next;
+        u = control(&mut mpc, &x, t1)?;
+        if (k + 1) % every == 0 {
+            sample(t1, &x, &u);
+        }
+    }
+
+    solve_times.sort_unstable();
+    let metrics = MpcMetrics {
+        task_error,
+        cost_j: int_j,
+        free_energy: int_j - 0.5 * options.t_end * logdet,
+        control_effort: effort,
+        logdet,
+        rhs_evals,
+        qp_solves: solve_times.len(),
+        qp_iterations,
+        median_solve_time: solve_times[solve_times.len() / 2],
+        max_solve_time: *solve_times.last().expect("at least one solve"),
+        worst_status,
+    };
+    Ok(MpcEpisode {
+        metrics,
+        trajectory,
+    })
+}
+
+/// n when `total` = n · `step` for a whole n ≥ 1 (to 1e-9 relative), else `None`.
+fn whole_ratio(total: f64, step: f64) -> Option<usize> {
+    let n = (total / step).round();
+    (total.is_finite() && step > 0.0 && n >= 1.0 && (n * step - total).abs() <= 1e-9 * total.abs())
+        .then_some(n as usize)
+}
