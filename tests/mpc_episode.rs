@@ -62,7 +62,7 @@ fn the_first_torque_is_the_controllers_answer_at_the_initial_state() {
 #[test]
 fn mpc_episodes_are_deterministic() {
     let options = EpisodeOptions {
-        perturbation: -0.1,
+        perturbation: 0.0,
         ..EpisodeOptions::default()
     };
     let a = simulate_mpc(&arm(), &near_task(), &options, &MpcOptions::default()).unwrap();
