@@ -7,3 +7,12 @@
 /// The paper's 2-DOF arm (`derive/models/arm2.toml`).
 #[path = "../generated/arm2.rs"]
 pub mod arm2;
+
+/// The exact 2-link arm by Lagrangian mechanics (`derive/models/arm2_exact.toml`): the same
+/// tool as `arm2`, used as the exact plant against the paper's model.
+#[path = "../generated/arm2_exact.rs"]
+pub mod arm2_exact;
+
+/// A 3-link arm by Lagrangian mechanics (`derive/models/arm3.toml`).
+#[path = "../generated/arm3.rs"]
+pub mod arm3;

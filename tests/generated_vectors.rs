@@ -4,7 +4,6 @@
 
 use nalgebra::{SMatrix, SVector};
 use serde_json::Value;
-use toolconf::generated::arm2;
 
 const TOLERANCE: f64 = 1e-12;
 
@@ -34,56 +33,64 @@ fn rows<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> Vec<f64> {
     m.transpose().as_slice().to_vec()
 }
 
-/// Evaluates one generated function of arm2 by its IR name; `None` for a name not wired here,
-/// which fails the test so that every emitted function is checked.
-fn evaluate_arm2(name: &str, i: &Value) -> Option<Vec<Vec<f64>>> {
-    let p = || vector::<4>(i, "params");
-    Some(match name {
-        "dynamics" => vec![arm2::dynamics(&vector(i, "x"), &vector(i, "u"), &p())
-            .as_slice()
-            .to_vec()],
-        "dynamics_jacobian" => {
-            let (fx, fu) = arm2::dynamics_jacobian(&vector(i, "x"), &vector(i, "u"), &p());
-            vec![rows(&fx), rows(&fu)]
+/// Evaluates one generated function of a model module by its IR name; `None` for a name not
+/// wired here, which fails the test so that every emitted function is checked.
+macro_rules! evaluator {
+    ($name:ident, $m:ident) => {
+        fn $name(name: &str, i: &Value) -> Option<Vec<Vec<f64>>> {
+            use toolconf::generated::$m as m;
+            let p = || vector(i, "params");
+            Some(match name {
+                "dynamics" => vec![m::dynamics(&vector(i, "x"), &vector(i, "u"), &p())
+                    .as_slice()
+                    .to_vec()],
+                "dynamics_jacobian" => {
+                    let (fx, fu) = m::dynamics_jacobian(&vector(i, "x"), &vector(i, "u"), &p());
+                    vec![rows(&fx), rows(&fu)]
+                }
+                "state_matrix" => vec![rows(&m::state_matrix(&p()))],
+                "input_matrix" => vec![rows(&m::input_matrix(&p()))],
+                "position_sensitivity" => {
+                    let (a, b, c) = m::position_sensitivity(&p());
+                    vec![rows(&a), rows(&b), rows(&c)]
+                }
+                "velocity_sensitivity" => {
+                    let (a, b) = m::velocity_sensitivity(&p());
+                    vec![rows(&a), rows(&b)]
+                }
+                "acceleration_sensitivity" => vec![rows(&m::acceleration_sensitivity(&p()))],
+                "position_control_confidence" => vec![rows(&m::position_control_confidence(
+                    &p(),
+                    &matrix(i, "p_theta"),
+                    &matrix(i, "p_theta_dot"),
+                    &matrix(i, "p_theta_ddot"),
+                    &matrix(i, "p_u"),
+                ))],
+                "velocity_control_confidence" => vec![rows(&m::velocity_control_confidence(
+                    &p(),
+                    &matrix(i, "p_theta_dot"),
+                    &matrix(i, "p_theta_ddot"),
+                    &matrix(i, "p_u"),
+                ))],
+                "acceleration_control_confidence" => {
+                    vec![rows(&m::acceleration_control_confidence(
+                        &p(),
+                        &matrix(i, "p_theta_ddot"),
+                        &matrix(i, "p_u"),
+                    ))]
+                }
+                _ => return None,
+            })
         }
-        "state_matrix" => vec![rows(&arm2::state_matrix(&p()))],
-        "input_matrix" => vec![rows(&arm2::input_matrix(&p()))],
-        "position_sensitivity" => {
-            let (a, b, c) = arm2::position_sensitivity(&p());
-            vec![rows(&a), rows(&b), rows(&c)]
-        }
-        "velocity_sensitivity" => {
-            let (a, b) = arm2::velocity_sensitivity(&p());
-            vec![rows(&a), rows(&b)]
-        }
-        "acceleration_sensitivity" => vec![rows(&arm2::acceleration_sensitivity(&p()))],
-        "position_control_confidence" => vec![rows(&arm2::position_control_confidence(
-            &p(),
-            &matrix(i, "p_theta"),
-            &matrix(i, "p_theta_dot"),
-            &matrix(i, "p_theta_ddot"),
-            &matrix(i, "p_u"),
-        ))],
-        "velocity_control_confidence" => vec![rows(&arm2::velocity_control_confidence(
-            &p(),
-            &matrix(i, "p_theta_dot"),
-            &matrix(i, "p_theta_ddot"),
-            &matrix(i, "p_u"),
-        ))],
-        "acceleration_control_confidence" => {
-            vec![rows(&arm2::acceleration_control_confidence(
-                &p(),
-                &matrix(i, "p_theta_ddot"),
-                &matrix(i, "p_u"),
-            ))]
-        }
-        _ => return None,
-    })
+    };
 }
 
-#[test]
-fn arm2_functions_match_casadi_vectors() {
-    let ir = load("arm2");
+evaluator!(evaluate_arm2, arm2);
+evaluator!(evaluate_arm2_exact, arm2_exact);
+evaluator!(evaluate_arm3, arm3);
+
+fn check(model: &str, evaluate: fn(&str, &Value) -> Option<Vec<Vec<f64>>>) {
+    let ir = load(model);
     let functions = ir["functions"].as_array().expect("functions");
     assert!(
         functions.len() >= 10,
@@ -106,8 +113,8 @@ fn arm2_functions_match_casadi_vectors() {
             vectors.len()
         );
         for (k, v) in vectors.iter().enumerate() {
-            let got = evaluate_arm2(name, &v["inputs"])
-                .unwrap_or_else(|| panic!("generated function {name} is not checked"));
+            let got = evaluate(name, &v["inputs"])
+                .unwrap_or_else(|| panic!("{model}: generated function {name} is not checked"));
             for (out, got) in outputs.iter().zip(got) {
                 let want = numbers(&v["outputs"][out]);
                 assert_eq!(got.len(), want.len(), "{name}.{out}: shape");
@@ -118,11 +125,26 @@ fn arm2_functions_match_casadi_vectors() {
                     .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
                 assert!(
                     err <= TOLERANCE * scale,
-                    "{name}.{out} vector {k}: max |rust - casadi| = {err:e} > 1e-12 * {scale:e}\n rust {got:?}\n casadi {want:?}"
+                    "{model}: {name}.{out} vector {k}: max |rust - casadi| = {err:e} > 1e-12 * {scale:e}\n rust {got:?}\n casadi {want:?}"
                 );
                 checked += 1;
             }
         }
     }
     assert!(checked >= 1000);
+}
+
+#[test]
+fn arm2_functions_match_casadi_vectors() {
+    check("arm2", evaluate_arm2);
+}
+
+#[test]
+fn arm2_exact_functions_match_casadi_vectors() {
+    check("arm2_exact", evaluate_arm2_exact);
+}
+
+#[test]
+fn arm3_functions_match_casadi_vectors() {
+    check("arm3", evaluate_arm3);
 }

@@ -46,6 +46,8 @@ class Model:
     equilibrium_q: list[str]
     equilibrium_q_dot: list[str]
     equilibrium_u: list[str]
+    links: list[dict] = field(default_factory=list)
+    gravity: str = "g"
     goals: dict[str, dict[str, list[str]]] = field(default_factory=dict)
     printed_where: str = ""
     printed_a: list[list[str]] | None = None
@@ -142,6 +144,8 @@ def load_model(path: Path) -> Model:
         equilibrium_q=[str(v) for v in _require(eq, "q", f"{path}: [equilibrium]")],
         equilibrium_q_dot=[str(v) for v in _require(eq, "q_dot", f"{path}: [equilibrium]")],
         equilibrium_u=[str(v) for v in _require(eq, "u", f"{path}: [equilibrium]")],
+        links=list(dyn.get("links", [])),
+        gravity=str(dyn.get("gravity", "g")),
         goals={task: {term: [str(v) for v in vs] for term, vs in terms.items()}
                for task, terms in raw.get("goals", {}).items()},
         printed_where=printed.get("where", ""),
@@ -170,10 +174,21 @@ def _validate_model(m: Model) -> None:
         for term, values in terms.items():
             if term not in ("theta", "theta_dot", "theta_ddot") or len(values) != m.dof:
                 raise DescriptionError(f"{where}: goals.{task}.{term} must be a known term with {m.dof} entries")
-    if m.dynamics_kind != "explicit":
-        raise DescriptionError(f"{where}: dynamics.kind '{m.dynamics_kind}' is not known (known: explicit)")
-    if len(m.q_ddot) != m.dof:
-        raise DescriptionError(f"{where}: dynamics.q_ddot has {len(m.q_ddot)} entries, model.dof is {m.dof}")
+    if m.dynamics_kind == "explicit":
+        if len(m.q_ddot) != m.dof:
+            raise DescriptionError(f"{where}: dynamics.q_ddot has {len(m.q_ddot)} entries, model.dof is {m.dof}")
+    elif m.dynamics_kind == "planar_chain":
+        if len(m.links) != m.dof:
+            raise DescriptionError(f"{where}: dynamics.links has {len(m.links)} links, model.dof is {m.dof}")
+        known = {p.name for p in m.parameters}
+        for i, link in enumerate(m.links):
+            for key in ("mass", "length"):
+                if link.get(key) not in known:
+                    raise DescriptionError(f"{where}: dynamics.links[{i}].{key} must name a parameter, got {link.get(key)!r}")
+        if m.gravity not in {c.name for c in m.constants}:
+            raise DescriptionError(f"{where}: dynamics.gravity must name a constant, got {m.gravity!r}")
+    else:
+        raise DescriptionError(f"{where}: dynamics.kind '{m.dynamics_kind}' is not known (known: explicit, planar_chain)")
     n2 = 2 * m.dof
     if m.printed_a is not None and (len(m.printed_a) != n2 or any(len(r) != n2 for r in m.printed_a)):
         raise DescriptionError(f"{where}: printed.A must be {n2}x{n2}")

@@ -20,6 +20,7 @@ import casadi as ca
 import mpmath
 import numpy as np
 
+from .chain import casadi_chain
 from .description import Model, Task
 
 
@@ -40,7 +41,14 @@ class CasadiModel:
         for c in model.constants:
             names[c.name] = c.value
         functions = {"sin": ca.sin, "cos": ca.cos, "sqrt": ca.sqrt, "pi": math.pi}
-        q_ddot = [eval(e, {"__builtins__": {}, **functions}, names) for e in model.q_ddot]  # noqa: S307
+        if model.dynamics_kind == "planar_chain":
+            q_ddot = casadi_chain(
+                [names[c.name] for c in model.q], [names[c.name] for c in model.q_dot], [names[c.name] for c in model.u],
+                [names[link["mass"]] for link in model.links], [names[link["length"]] for link in model.links],
+                names[model.gravity],
+            )
+        else:
+            q_ddot = [eval(e, {"__builtins__": {}, **functions}, names) for e in model.q_ddot]  # noqa: S307
         f = ca.vertcat(self.x[n:], *q_ddot)
         self.dynamics = ca.Function("dynamics", [self.x, self.u, self.p], [f])
         self.jacobian = ca.Function(

@@ -29,6 +29,21 @@ def _compare(d: Derivation, label: str, derived: sp.Matrix, printed_rows: list[l
     return rows
 
 
+def _equations(d: Derivation) -> list[dict]:
+    m = d.model
+    if d.lagrangian is None:
+        return [{"lhs": rf"\ddot{{{c.latex}}}", "rhs": _latex(d, e)} for c, e in zip(m.q, d.q_ddot)]
+    lag = d.lagrangian
+    return [
+        {"lhs": "T", "rhs": _latex(d, lag["T"])},
+        {"lhs": "V", "rhs": _latex(d, lag["V"])},
+        {"lhs": "M(q) = \\partial^2 T / \\partial \\dot q^2", "rhs": _latex(d, lag["M"])},
+        {"lhs": "Q", "rhs": _latex(d, lag["Q"])},
+        {"lhs": "\\ddot q", "rhs": "M(q)^{-1}\\left(Q - \\frac{\\partial (M \\dot q)}{\\partial q}\\dot q"
+         " + \\frac{\\partial T}{\\partial q} - \\frac{\\partial V}{\\partial q}\\right)"},
+    ]
+
+
 def report_data(d: Derivation) -> dict:
     m = d.model
     n = m.dof
@@ -81,10 +96,7 @@ def report_data(d: Derivation) -> dict:
 
     return {
         "printed_where": m.printed_where,
-        "equations": [
-            {"lhs": rf"\ddot{{{c.latex}}}", "rhs": _latex(d, e)}
-            for c, e in zip(m.q, d.q_ddot)
-        ],
+        "equations": _equations(d),
         "equation_refs": m.equations,
         "equilibrium_x": _latex(d, d.x_e.T),
         "equilibrium_u": _latex(d, d.u_e.T),

@@ -11,7 +11,8 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from .description import Model, Task, DescriptionError
+from .chain import sympy_chain
+from .description import DescriptionError, Model, Task
 
 TERM_LATEX = {
     "theta": r"\theta",
@@ -97,6 +98,8 @@ class Derivation:
     a: sp.Matrix               # df/dX at the equilibrium (tidy)
     b: sp.Matrix               # df/dU at the equilibrium (tidy)
     tasks: list[TaskDerivation]
+    # T, V, M(q) and Q of a Lagrangian model (None for explicit equations of motion).
+    lagrangian: dict | None = None
 
     @property
     def x(self) -> list[sp.Symbol]:
@@ -125,7 +128,14 @@ def derive(model: Model, tasks: list[Task]) -> Derivation:
     u = [sp.Symbol(c.name, **real) for c in model.u]
     symbols = {str(s): s for s in params + list(consts) + q + q_dot + u}
 
-    q_ddot = sp.Matrix([parse(model, e, symbols, f"dynamics.q_ddot[{i}]") for i, e in enumerate(model.q_ddot)])
+    lagrangian = None
+    if model.dynamics_kind == "planar_chain":
+        masses = [symbols[link["mass"]] for link in model.links]
+        lengths = [symbols[link["length"]] for link in model.links]
+        q_ddot, kinetic, potential, mass, forces = sympy_chain(q, q_dot, u, masses, lengths, symbols[model.gravity])
+        lagrangian = {"T": kinetic, "V": potential, "M": mass, "Q": forces}
+    else:
+        q_ddot = sp.Matrix([parse(model, e, symbols, f"dynamics.q_ddot[{i}]") for i, e in enumerate(model.q_ddot)])
     stray = set().union(*(e.free_symbols for e in q_ddot)) - set(symbols.values())
     if stray:
         raise DescriptionError(f"{model.path}: dynamics use undeclared names: {sorted(map(str, stray))}")
@@ -174,5 +184,5 @@ def derive(model: Model, tasks: list[Task]) -> Derivation:
             remarks.append({"remark": r, "alternative": alt, "used": sens[r.term]})
         derived_tasks.append(TaskDerivation(task, sens, precision, reads, confidence, remarks))
 
-    return Derivation(model, params, consts, q, q_dot, u, q_ddot, f, f_x, f_u, x_e, u_e, a, b, derived_tasks)
+    return Derivation(model, params, consts, q, q_dot, u, q_ddot, f, f_x, f_u, x_e, u_e, a, b, derived_tasks, lagrangian)
 
