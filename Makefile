@@ -9,10 +9,10 @@ export PYTHONHASHSEED := 0
 
 .PHONY: run test derive drift-check venv clean-venv bench
 
-## make run: build in release mode and run the main job.
+## make run: build in release mode and reproduce the paper's Results (results/report.md).
 run:
 	cargo build --release --quiet
-	./target/release/toolconf confidence --arm 0.3,0.4,0.5,0.2 --task velocity
+	./target/release/toolconf reproduce --out results/
 
 ## make test: the whole suite, including the check that `make derive` leaves generated/ unchanged.
 test: drift-check

@@ -14,6 +14,7 @@ pub mod arm;
 pub mod closed_loop;
 pub mod confidence;
 pub mod error;
+pub mod experiments;
 pub mod generated;
 pub mod integrate;
 pub mod mpc;

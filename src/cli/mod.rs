@@ -4,6 +4,7 @@
 mod confidence;
 mod episode_args;
 mod output;
+mod reproduce;
 mod select;
 mod simulate;
 
@@ -28,6 +29,8 @@ enum Command {
     Simulate(simulate::Args),
     /// Draw random tools, simulate each, and choose by ∫F, ∫J and confidence.
     Select(select::Args),
+    /// Run every experiment of the paper's Results section: CSVs, SVG figures, report.
+    Reproduce(reproduce::Args),
 }
 
 pub(crate) fn parse_arm(s: &str) -> Result<Arm, String> {
@@ -44,6 +47,7 @@ pub fn run() -> ExitCode {
         Command::Confidence(args) => confidence::run(&args),
         Command::Simulate(args) => simulate::run(&args),
         Command::Select(args) => select::run(&args),
+        Command::Reproduce(args) => reproduce::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,93 @@
+//! `toolconf reproduce [--out DIR] [--seed S] [--quick] [--only IDS]`: every experiment of the
+//! paper's Results section, with CSVs, SVG figures and a report (Markdown and HTML).
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+use toolconf::experiments::{experiment_ids, reproduce, Config, Plan, ReproduceError};
+
+use super::output::CliError;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Directory for the CSVs, figures and report (created if missing).
+    #[arg(long, default_value = "results")]
+    out: PathBuf,
+    /// Master seed; each experiment derives its own sub-seed from it.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Small counts instead of the paper's (for tests: seconds, not statistics).
+    #[arg(long)]
+    quick: bool,
+    /// Run only these experiments (comma-separated: fig2,fig3,fig4,fig5,fig6,fig7).
+    #[arg(long, value_delimiter = ',', value_parser = parse_experiment)]
+    only: Option<Vec<String>>,
+}
+
+fn parse_experiment(s: &str) -> Result<String, String> {
+    let ids = experiment_ids();
+    if ids.contains(&s) {
+        Ok(s.to_string())
+    } else {
+        Err(format!(
+            "unknown experiment {s:?}; known: {}",
+            ids.join(", ")
+        ))
+    }
+}
+
+pub fn run(args: &Args) -> Result<(), CliError> {
+    let mut command = format!(
+        "toolconf reproduce --out {} --seed {}",
+        args.out.display(),
+        args.seed
+    );
+    if args.quick {
+        command.push_str(" --quick");
+    }
+    if let Some(only) = &args.only {
+        command.push_str(&format!(" --only {}", only.join(",")));
+    }
+    let config = Config {
+        out_dir: args.out.clone(),
+        seed: args.seed,
+        plan: if args.quick {
+            Plan::quick()
+        } else {
+            Plan::paper()
+        },
+        only: args.only.clone(),
+        progress: std::io::stderr().is_terminal(),
+        command,
+    };
+    let summary = reproduce(&config).map_err(|e| match e {
+        ReproduceError::Io { path, source } => CliError::Io { path, source },
+        other => CliError::Io {
+            path: args.out.clone(),
+            source: std::io::Error::other(other.to_string()),
+        },
+    })?;
+    for section in &summary.sections {
+        for v in section.verdicts() {
+            println!("{:<34} {}", v.claim, v.outcome.words());
+        }
+    }
+    let secs = summary.wall.as_secs_f64();
+    println!(
+        "{} episodes in {:.2} s on {} thread(s) ({:.0} episodes/s)",
+        summary.episodes(),
+        secs,
+        summary.threads,
+        if secs > 0.0 {
+            summary.episodes() as f64 / secs
+        } else {
+            0.0
+        }
+    );
+    println!("report: {}", summary.report_md.display());
+    println!(
+        "report (HTML, figures inline): {}",
+        summary.report_html.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,66 @@
+//! Small pieces the figure modules share: labels, tool columns, axis choices.
+
+use crate::{Arm, TaskKind};
+
+use super::csv::Cell;
+use super::report::Block;
+
+/// "task 1 (position)".
+pub fn task_label(kind: TaskKind) -> String {
+    format!("task {} ({})", kind.paper_index(), kind.name())
+}
+
+/// The four parameter cells m1, m2, l1, l2 of a tool.
+pub fn arm_cells(arm: &Arm) -> [Cell; 4] {
+    [arm.m1(), arm.m2(), arm.l1(), arm.l2()].map(Cell::from)
+}
+
+pub const ARM_COLUMNS: [&str; 4] = ["m1", "m2", "l1", "l2"];
+
+/// A log y axis when the positive values span more than a factor 30 (and none is ≤ 0).
+pub fn wants_log(values: &[f64]) -> bool {
+    let (lo, hi) = values
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+            (l.min(v), h.max(v))
+        });
+    lo > 0.0 && hi.is_finite() && hi / lo > 30.0
+}
+
+/// "ΔT = −0.8 N m" style label of a perturbation.
+pub fn dt_label(dt: f64) -> String {
+    let s = format!("{dt:+.1}");
+    let s = if s == "+0.0" || s == "-0.0" {
+        "0".to_string()
+    } else {
+        s
+    };
+    s.replace('-', "−")
+}
+
+/// The "data and files" paragraph of a section.
+pub fn files_block(files: &[String], rows: usize, failed: usize, what: &str) -> Block {
+    let names: Vec<String> = files.iter().map(|f| format!("`{f}`")).collect();
+    Block::p(format!(
+        "Data: {} ({rows} {what}; {failed} failed episode{} recorded with its error and left out \
+         of the statistics).",
+        names.join(", "),
+        if failed == 1 { "" } else { "s" }
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn labels() {
+        assert_eq!(task_label(TaskKind::Velocity), "task 2 (velocity)");
+        assert_eq!(dt_label(-0.8), "−0.8");
+        assert_eq!(dt_label(0.0), "0");
+        assert_eq!(dt_label(0.4), "+0.4");
+        assert!(wants_log(&[1.0, 100.0]));
+        assert!(!wants_log(&[0.0, 100.0]));
+        assert!(!wants_log(&[10.0, 100.0]));
+    }
+}

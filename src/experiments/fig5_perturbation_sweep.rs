@@ -1,0 +1,396 @@
+//! Fig. 5 (claim C2 over a range of perturbations): velocity task, constant perturbations
+//! ΔT = −1.0 … 1.0 N m; variability of task performance |task error(ΔT) − task error(0)| against
+//! control confidence, per ΔT, and negative against positive ΔT.
+//!
+//! Seeds: tools from `"fig5/tools"`, bootstrap from `"fig5/bootstrap/<ΔT>"`.
+
+use crate::select::draw_tools;
+use crate::stats::summary;
+use crate::{Task, TaskKind};
+
+use super::batch::{map_ordered, run_tool, ToolRuns};
+use super::common::{arm_cells, dt_label, files_block, wants_log};
+use super::csv::{Cell, CsvWriter};
+use super::plot::{self, diverging, Colour, Legend, Panel, Series, XyPanel};
+use super::report::{Block, Outcome, Section, Verdict};
+use super::verdict::{mean_sd, negative_correlation_rule, num, p_value, Comparison, Correlation};
+use super::{Context, Experiment, Plan, ReproduceError};
+
+pub struct Fig5;
+
+const CSV: &str = "fig5_perturbation_sweep.csv";
+const SVG: &str = "fig5_perturbation_sweep.svg";
+pub const HEADER: [&str; 11] = [
+    "tool",
+    "m1",
+    "m2",
+    "l1",
+    "l2",
+    "logdet",
+    "perturbation",
+    "task_error",
+    "task_error_unperturbed",
+    "abs_change",
+    "error",
+];
+
+/// The non-zero perturbations of the sweep; episode 0 of every tool is the unperturbed one and
+/// episode k + 1 is `sweep[k]`.
+fn sweep(plan: &Plan) -> Vec<f64> {
+    plan.fig5_perturbations
+        .iter()
+        .copied()
+        .filter(|&d| d != 0.0)
+        .collect()
+}
+
+/// The episode index of perturbation `dt` (0 for ΔT = 0).
+fn episode_of(sweep: &[f64], dt: f64) -> usize {
+    sweep.iter().position(|&d| d == dt).map_or(0, |k| k + 1)
+}
+
+impl Experiment for Fig5 {
+    fn id(&self) -> &'static str {
+        "fig5"
+    }
+
+    fn title(&self) -> &'static str {
+        "Fig. 5: variability over a range of perturbations, velocity task (C2)"
+    }
+
+    fn outputs(&self) -> Vec<String> {
+        vec![CSV.into(), SVG.into()]
+    }
+
+    fn planned_episodes(&self, plan: &Plan) -> u64 {
+        (plan.fig5_tools * (1 + sweep(plan).len())) as u64
+    }
+
+    fn run(&self, ctx: &Context) -> Result<Section, ReproduceError> {
+        let plan = ctx.plan;
+        let task = Task::paper(TaskKind::Velocity);
+        let sweep = sweep(plan);
+        let mut listed: Vec<f64> = plan.fig5_perturbations.clone();
+        if !listed.contains(&0.0) {
+            listed.insert(0, 0.0);
+        }
+        let options: Vec<_> = std::iter::once(0.0)
+            .chain(sweep.iter().copied())
+            .map(|d| ctx.perturbed(d))
+            .collect();
+        let tools = draw_tools(plan.fig5_tools, ctx.seed_for(self, "tools"));
+        let indices: Vec<usize> = (0..tools.len()).collect();
+        let mut csv = CsvWriter::create(&ctx.path(CSV), &HEADER)?;
+        // The sink sees the tools in order, so a counter names them.
+        let mut next = 0usize;
+        let results: Vec<ToolRuns> = map_ordered(
+            &indices,
+            ctx.progress,
+            options.len() as u64,
+            |&i| run_tool(&tools[i], &task, &options),
+            |r| {
+                let i = next;
+                next += 1;
+                for &dt in &listed {
+                    let k = episode_of(&sweep, dt);
+                    let mut row = vec![Cell::from(i)];
+                    row.extend(arm_cells(&r.arm));
+                    row.extend([
+                        Cell::from(r.logdet()),
+                        Cell::from(dt),
+                        Cell::from(r.task_error(k)),
+                        Cell::from(r.task_error(0)),
+                        Cell::from(r.abs_change(k)),
+                        Cell::from(r.error_of(&[0, k])),
+                    ]);
+                    csv.row(row)?;
+                }
+                Ok(())
+            },
+        )?;
+
+        // Per ΔT: correlation of confidence with variability.
+        let mut rows = Vec::new();
+        let mut outcomes = Vec::new();
+        let mut dots = Vec::new();
+        let jobs: Vec<(Vec<f64>, Vec<f64>, u64)> = sweep
+            .iter()
+            .enumerate()
+            .map(|(k, dt)| {
+                let (x, y) = results
+                    .iter()
+                    .filter_map(|r| Some((r.logdet()?, r.abs_change(k + 1)?)))
+                    .unzip();
+                (x, y, ctx.seed_for(self, &format!("bootstrap/{dt:+.1}")))
+            })
+            .collect();
+        let corrs = Correlation::compute_all(&jobs, plan.bootstrap_resamples, plan.level);
+        for (k, &dt) in sweep.iter().enumerate() {
+            let ok: Vec<(f64, f64)> = results
+                .iter()
+                .filter_map(|r| Some((r.logdet()?, r.abs_change(k + 1)?)))
+                .collect();
+            let y: Vec<f64> = ok.iter().map(|p| p.1).collect();
+            let corr = &corrs[k];
+            let outcome = corr.negative_outcome();
+            outcomes.push((dt, outcome));
+            rows.push(vec![
+                dt_label(dt),
+                ok.len().to_string(),
+                (tools.len() - ok.len()).to_string(),
+                mean_sd(&y),
+                corr.rho_cell(),
+                corr.ci_cell(),
+                outcome.words().into(),
+            ]);
+            dots.push(Series::new(
+                format!("ΔT = {}", dt_label(dt)),
+                diverging(dt / sweep.iter().fold(0.0, |m: f64, d| m.max(d.abs()))),
+                ok,
+            ));
+        }
+
+        // Negative against positive ΔT of the same magnitude.
+        let magnitudes: Vec<f64> = sweep
+            .iter()
+            .copied()
+            .filter(|&d| d > 0.0 && sweep.contains(&-d))
+            .collect();
+        let change = |r: &ToolRuns, dt: f64| r.abs_change(episode_of(&sweep, dt));
+        let mut sign_rows = Vec::new();
+        let mut every_magnitude = !magnitudes.is_empty();
+        for &m in &magnitudes {
+            let neg: Vec<Option<f64>> = results.iter().map(|r| change(r, -m)).collect();
+            let pos: Vec<Option<f64>> = results.iter().map(|r| change(r, m)).collect();
+            let c = Comparison::compute(&neg, &pos);
+            let more = neg
+                .iter()
+                .zip(&pos)
+                .filter_map(|(a, b)| Some((*a)? > (*b)?))
+                .collect::<Vec<_>>();
+            every_magnitude &= c.mean_difference().is_some_and(|d| d > 0.0);
+            sign_rows.push(vec![
+                format!("{m:.1}"),
+                c.mean_a.map_or("-".into(), num),
+                c.mean_b.map_or("-".into(), num),
+                format!("{} of {}", more.iter().filter(|&&b| b).count(), more.len()),
+                c.p().map_or("-".into(), p_value),
+            ]);
+        }
+        let per_tool = |sign: f64| -> Vec<Option<f64>> {
+            results
+                .iter()
+                .map(|r| {
+                    let v: Option<Vec<f64>> =
+                        magnitudes.iter().map(|&m| change(r, sign * m)).collect();
+                    let v = v?;
+                    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+                })
+                .collect()
+        };
+        let pooled = Comparison::compute(&per_tool(-1.0), &per_tool(1.0));
+        let pooled_greater = pooled.a_greater(plan.alpha);
+        let sign_outcome = match (pooled_greater, every_magnitude) {
+            (None, _) => Outcome::NotJudged,
+            (Some(true), true) => Outcome::Holds,
+            (Some(true), false) | (Some(false), true) => Outcome::Partly,
+            (Some(false), false) => Outcome::DoesNotHold,
+        };
+        let judged: Vec<Outcome> = outcomes
+            .iter()
+            .map(|o| o.1)
+            .filter(|o| *o != Outcome::NotJudged)
+            .collect();
+        let range_outcome = if judged.is_empty() {
+            Outcome::NotJudged
+        } else if judged.len() == outcomes.len() && judged.iter().all(|o| *o == Outcome::Holds) {
+            Outcome::Holds
+        } else if judged.iter().any(|o| *o != Outcome::DoesNotHold) {
+            Outcome::Partly
+        } else {
+            Outcome::DoesNotHold
+        };
+        let count = |o: Outcome| outcomes.iter().filter(|x| x.1 == o).count();
+
+        // Right panel: mean variability per ΔT for the least and most confident third.
+        let mut ranked: Vec<&ToolRuns> = results.iter().filter(|r| r.logdet().is_some()).collect();
+        ranked.sort_by(|a, b| {
+            a.logdet()
+                .unwrap_or(0.0)
+                .total_cmp(&b.logdet().unwrap_or(0.0))
+        });
+        let third = ranked.len() / 3;
+        let group_line = |group: &[&ToolRuns]| -> Vec<(f64, f64)> {
+            sweep
+                .iter()
+                .filter_map(|&dt| {
+                    let v: Vec<f64> = group.iter().filter_map(|r| change(r, dt)).collect();
+                    Some((dt, summary(&v).ok()?.mean))
+                })
+                .collect()
+        };
+        let mut lines = Vec::new();
+        if third >= 2 {
+            lines.push(Series::new(
+                format!("lowest-confidence third ({third} tools)"),
+                Colour(200, 30, 30),
+                group_line(&ranked[..third]),
+            ));
+            lines.push(Series::new(
+                format!("highest-confidence third ({third} tools)"),
+                Colour(30, 80, 200),
+                group_line(&ranked[ranked.len() - third..]),
+            ));
+        }
+        lines.push(Series::new(
+            "all tools",
+            Colour(60, 60, 60),
+            group_line(&ranked),
+        ));
+        let all_y: Vec<f64> = dots
+            .iter()
+            .flat_map(|s| s.points.iter().map(|p| p.1))
+            .collect();
+        let line_y: Vec<f64> = lines
+            .iter()
+            .flat_map(|s| s.points.iter().map(|p| p.1))
+            .collect();
+        let svg = plot::save(
+            &ctx.path(SVG),
+            &[
+                Panel::Xy(XyPanel {
+                    title: "Velocity task: variability against confidence, by ΔT".into(),
+                    x_label: "control confidence ln|Π^U|".into(),
+                    y_label: "|task error(ΔT) − task error(0)|".into(),
+                    dots,
+                    lines: vec![],
+                    log_y: wants_log(&all_y),
+                    legend: Legend::UpperRight,
+                    headroom: 0.8,
+                }),
+                Panel::Xy(XyPanel {
+                    title: "Mean variability per ΔT (negative ΔT opposes the controller)".into(),
+                    x_label: "perturbation ΔT [N m]".into(),
+                    y_label: "mean |change of task error|".into(),
+                    dots: lines
+                        .iter()
+                        .map(|s| Series::new("", s.colour, s.points.clone()))
+                        .collect(),
+                    lines,
+                    log_y: wants_log(&line_y),
+                    legend: Legend::UpperRight,
+                    headroom: 0.3,
+                }),
+            ],
+            (640, 480),
+        )?;
+
+        let failed = results.iter().filter(|r| !r.error().is_empty()).count();
+        let blocks =
+            vec![
+                Block::p(format!(
+                "{} random tools on task 2 (velocity), each simulated without perturbation and \
+                 with every constant ΔT of {{{}}} N m on both joints (the paper does not say how \
+                 many tools it used). Variability = |task error(ΔT) − task error(0)|.",
+                tools.len(),
+                sweep.iter().map(|d| dt_label(*d)).collect::<Vec<_>>().join(", ")
+            )),
+                files_block(
+                    &[CSV.into(), SVG.into()],
+                    results.len() * listed.len(),
+                    failed,
+                    "rows, one per tool and ΔT (ΔT = 0 is the reference)",
+                ),
+                Block::table(
+                    &[
+                        "ΔT [N m]",
+                        "n",
+                        "failed",
+                        "variability mean ± sd",
+                        "Spearman ρ",
+                        "bootstrap CI",
+                        "verdict for this ΔT",
+                    ],
+                    rows,
+                ),
+                Block::p(
+                    "Negative against positive perturbations of the same size (per tool; Wilcoxon \
+                 signed-rank p, two-sided):",
+                ),
+                Block::table(
+                    &[
+                        "|ΔT| [N m]",
+                        "mean variability, ΔT < 0",
+                        "mean variability, ΔT > 0",
+                        "tools with more variability at ΔT < 0",
+                        "p",
+                    ],
+                    sign_rows,
+                ),
+                Block::Figure {
+                    file: SVG.into(),
+                    caption:
+                        "Left: variability of task performance against control confidence, one \
+                          colour per ΔT (blue negative, red positive). Right: mean variability per \
+                          ΔT for the least and the most confident third of the tools. Compare \
+                          with the paper's Fig. 5."
+                            .into(),
+                    svg,
+                },
+                Block::Verdict(Verdict {
+                    claim: "C2 (Fig. 5), range of ΔT".into(),
+                    statement:
+                        "\"The trend remains the same for a range of perturbations\": tools \
+                            with low control confidence show high variability, tools with high \
+                            confidence low variability, for every ΔT."
+                            .into(),
+                    outcome: range_outcome,
+                    evidence: format!(
+                        "of {} perturbations, the negative correlation holds for {}, partly holds \
+                     for {}, does not hold for {}, cannot be judged for {} (table above).",
+                        outcomes.len(),
+                        count(Outcome::Holds),
+                        count(Outcome::Partly),
+                        count(Outcome::DoesNotHold),
+                        count(Outcome::NotJudged)
+                    ),
+                    rule: format!(
+                        "per ΔT the correlation rule: {} Overall: holds if it holds for every ΔT, \
+                     partly holds if it holds or partly holds for at least one, does not hold \
+                     otherwise.",
+                        negative_correlation_rule(plan.level)
+                    ),
+                }),
+                Block::Verdict(Verdict {
+                    claim: "C2 (Fig. 5), sign of ΔT".into(),
+                    statement: "\"Higher variability when the perturbation resists the controller \
+                            (perturbing torque is negative and opposes the controller torque).\""
+                        .into(),
+                    outcome: sign_outcome,
+                    evidence: format!(
+                    "per-tool mean variability over |ΔT| ∈ {{{}}}: ΔT < 0 {} against ΔT > 0 {}; \
+                     {}. Mean variability larger for ΔT < 0 at every |ΔT|: {}.",
+                    magnitudes.iter().map(|m| format!("{m:.1}")).collect::<Vec<_>>().join(", "),
+                    pooled.mean_a.map_or("-".into(), num),
+                    pooled.mean_b.map_or("-".into(), num),
+                    pooled.describe(),
+                    if every_magnitude { "yes" } else { "no" }
+                ),
+                    rule: format!(
+                    "holds if the per-tool variability is significantly larger for negative ΔT \
+                     (Wilcoxon p < {} with a positive mean difference) and the mean is larger \
+                     for the negative ΔT at every |ΔT|; partly holds if only one of the two; \
+                     does not hold if neither.",
+                    plan.alpha
+                ),
+                }),
+            ];
+        Ok(Section {
+            id: self.id(),
+            title: self.title().into(),
+            blocks,
+            episodes: (results.len() * options.len()) as u64,
+            rhs_evals: results.iter().map(ToolRuns::rhs_evals).sum(),
+        })
+    }
+}

@@ -1,0 +1,469 @@
+//! Fig. 7 (claim C4): trials of random tools on the velocity task; the tools chosen by every
+//! decision rule (∫F, ∫J, confidence alone, and any added rule) compared on control confidence,
+//! task error and sensitivity to ΔT = −0.8 N m (|change of task error|), with box plots,
+//! mean ± sd and paired tests between every two rules.
+//!
+//! Seeds: trial k draws its tools from `"fig7/trial/<k>"`.
+
+use crate::select::{draw_tools, evaluate, ToolResult};
+use crate::stats::summary;
+use crate::{Arm, Task, TaskKind};
+
+use super::batch::map_ordered;
+use super::common::{arm_cells, dt_label, files_block, ARM_COLUMNS};
+use super::csv::{Cell, CsvWriter};
+use super::objectives::{choices, decision_rules, DecisionRule, Trial};
+use super::plot::{self, BoxPanel, Panel};
+use super::report::{Block, Outcome, Section, Verdict};
+use super::verdict::{num, Comparison};
+use super::{Context, Experiment, Plan, ReproduceError};
+
+pub struct Fig7;
+
+const CSV: &str = "fig7_benchmark.csv";
+const CHOICES_CSV: &str = "fig7_choices.csv";
+const SVG: &str = "fig7_benchmark.svg";
+pub const TASK: TaskKind = TaskKind::Velocity;
+pub const CHOICES_HEADER: [&str; 6] = [
+    "trial",
+    "rule",
+    "tool",
+    "logdet",
+    "task_error",
+    "abs_change",
+];
+
+/// The per-tool header: parameters, metrics, perturbed task error, one `chosen_by_<rule>` per
+/// rule, error.
+pub fn header() -> Vec<String> {
+    let mut h: Vec<String> = ["trial", "tool"]
+        .into_iter()
+        .chain(ARM_COLUMNS)
+        .chain([
+            "logdet",
+            "task_error",
+            "free_energy",
+            "cost_j",
+            "task_error_perturbed",
+            "abs_change",
+        ])
+        .map(String::from)
+        .collect();
+    h.extend(
+        decision_rules()
+            .iter()
+            .map(|r| format!("chosen_by_{}", r.id())),
+    );
+    h.push("error".into());
+    h
+}
+
+struct TrialResult {
+    tools: Vec<Arm>,
+    results: Vec<ToolResult>,
+    perturbed: Vec<ToolResult>,
+    chosen: Vec<Option<usize>>,
+}
+
+impl TrialResult {
+    fn logdet(&self, i: usize) -> Option<f64> {
+        self.results[i].logdet.as_ref().ok().copied()
+    }
+
+    fn task_error(&self, i: usize) -> Option<f64> {
+        self.results[i].episode.as_ref().ok().map(|m| m.task_error)
+    }
+
+    fn perturbed_error(&self, i: usize) -> Option<f64> {
+        self.perturbed[i]
+            .episode
+            .as_ref()
+            .ok()
+            .map(|m| m.task_error)
+    }
+
+    fn abs_change(&self, i: usize) -> Option<f64> {
+        Some((self.perturbed_error(i)? - self.task_error(i)?).abs()).filter(|v| v.is_finite())
+    }
+
+    fn error(&self, i: usize) -> String {
+        let (r, p) = (&self.results[i], &self.perturbed[i]);
+        match (&r.logdet, &r.episode, &p.episode) {
+            (Err(e), _, _) => e.to_string(),
+            (_, Err(e), _) => e.to_string(),
+            (_, _, Err(e)) => format!("perturbed episode: {e}"),
+            _ => String::new(),
+        }
+    }
+}
+
+/// The three measures of the figure, each a function of (trial, chosen tool).
+const METRICS: [(&str, &str); 3] = [
+    ("confidence", "control confidence ln|Π^U|"),
+    ("task error", "task error"),
+    ("sensitivity", "|change of task error| under ΔT"),
+];
+
+fn metric(t: &TrialResult, m: usize, tool: usize) -> Option<f64> {
+    match m {
+        0 => t.logdet(tool),
+        1 => t.task_error(tool),
+        _ => t.abs_change(tool),
+    }
+}
+
+impl Experiment for Fig7 {
+    fn id(&self) -> &'static str {
+        "fig7"
+    }
+
+    fn title(&self) -> &'static str {
+        "Fig. 7: benchmarking tool selection by F, J and confidence (C4)"
+    }
+
+    fn outputs(&self) -> Vec<String> {
+        vec![CSV.into(), CHOICES_CSV.into(), SVG.into()]
+    }
+
+    fn planned_episodes(&self, plan: &Plan) -> u64 {
+        2 * (plan.fig7_trials * plan.fig7_tools) as u64
+    }
+
+    fn run(&self, ctx: &Context) -> Result<Section, ReproduceError> {
+        let plan = ctx.plan;
+        let task = Task::paper(TASK);
+        let rules = decision_rules();
+        let perturbed = ctx.perturbed(plan.perturbation);
+        let trials: Vec<usize> = (0..plan.fig7_trials).collect();
+        let header = header();
+        let header: Vec<&str> = header.iter().map(String::as_str).collect();
+        let mut csv = CsvWriter::create(&ctx.path(CSV), &header)?;
+        let mut choices_csv = CsvWriter::create(&ctx.path(CHOICES_CSV), &CHOICES_HEADER)?;
+        let mut next = 0usize;
+        let done = map_ordered(
+            &trials,
+            ctx.progress,
+            2 * plan.fig7_tools as u64,
+            |&k| {
+                let tools = draw_tools(plan.fig7_tools, ctx.seed_for(self, &format!("trial/{k}")));
+                let results = evaluate(&tools, &task, &ctx.options);
+                let perturbed = evaluate(&tools, &task, &perturbed);
+                let chosen = choices(
+                    &rules,
+                    &Trial {
+                        task: &task,
+                        tools: &tools,
+                        results: &results,
+                        options: &ctx.options,
+                    },
+                );
+                TrialResult {
+                    tools,
+                    results,
+                    perturbed,
+                    chosen,
+                }
+            },
+            |t| {
+                let k = next;
+                next += 1;
+                for (i, r) in t.results.iter().enumerate() {
+                    let m = r.episode.as_ref().ok();
+                    let mut row = vec![Cell::from(k), Cell::from(i)];
+                    row.extend(arm_cells(&t.tools[i]));
+                    row.extend([
+                        Cell::from(t.logdet(i)),
+                        Cell::from(t.task_error(i)),
+                        Cell::from(m.map(|m| m.free_energy)),
+                        Cell::from(m.map(|m| m.cost_j)),
+                        Cell::from(t.perturbed_error(i)),
+                        Cell::from(t.abs_change(i)),
+                    ]);
+                    row.extend(t.chosen.iter().map(|c| Cell::from(*c == Some(i))));
+                    row.push(Cell::from(t.error(i)));
+                    csv.row(row)?;
+                }
+                for (rule, c) in rules.iter().zip(&t.chosen) {
+                    let at = |m: usize| c.and_then(|i| metric(t, m, i));
+                    choices_csv.row(vec![
+                        Cell::from(k),
+                        Cell::from(rule.id()),
+                        c.map_or(Cell::Empty, Cell::from),
+                        Cell::from(at(0)),
+                        Cell::from(at(1)),
+                        Cell::from(at(2)),
+                    ])?;
+                }
+                Ok(())
+            },
+        )?;
+
+        // values[m][r][k]: measure m of the tool rule r chose in trial k.
+        let values: Vec<Vec<Vec<Option<f64>>>> = (0..METRICS.len())
+            .map(|m| {
+                (0..rules.len())
+                    .map(|r| {
+                        done.iter()
+                            .map(|t| t.chosen[r].and_then(|i| metric(t, m, i)))
+                            .collect()
+                    })
+                    .collect()
+            })
+            .collect();
+        let present = |v: &[Option<f64>]| -> Vec<f64> { v.iter().flatten().copied().collect() };
+
+        let mut summary_rows = Vec::new();
+        for (m, (name, _)) in METRICS.iter().enumerate() {
+            for (r, rule) in rules.iter().enumerate() {
+                let v = present(&values[m][r]);
+                summary_rows.push(match summary(&v) {
+                    Ok(s) => vec![
+                        name.to_string(),
+                        rule.label().into(),
+                        s.n.to_string(),
+                        format!("{} ± {}", num(s.mean), num(s.sd)),
+                        format!("{} [{}, {}]", num(s.median), num(s.q1), num(s.q3)),
+                    ],
+                    Err(e) => vec![
+                        name.to_string(),
+                        rule.label().into(),
+                        v.len().to_string(),
+                        format!("undefined: {e}"),
+                        "-".into(),
+                    ],
+                });
+            }
+        }
+        let compare =
+            |m: usize, a: usize, b: usize| Comparison::compute(&values[m][a], &values[m][b]);
+        let mut test_rows = Vec::new();
+        for (m, (name, _)) in METRICS.iter().enumerate() {
+            for a in 0..rules.len() {
+                for b in a + 1..rules.len() {
+                    let c = compare(m, a, b);
+                    test_rows.push(vec![
+                        name.to_string(),
+                        format!("{} − {}", rules[a].label(), rules[b].label()),
+                        c.describe(),
+                    ]);
+                }
+            }
+        }
+
+        let panels: Vec<Panel> = METRICS
+            .iter()
+            .enumerate()
+            .map(|(m, (name, axis))| {
+                Panel::Boxes(BoxPanel {
+                    title: format!("{name} of the chosen tool"),
+                    y_label: if m == 2 {
+                        format!("{axis} = {} N m", dt_label(plan.perturbation))
+                    } else {
+                        axis.to_string()
+                    },
+                    groups: rules
+                        .iter()
+                        .enumerate()
+                        .map(|(r, rule)| {
+                            (short(rule.as_ref()), rule.colour(), present(&values[m][r]))
+                        })
+                        .collect(),
+                })
+            })
+            .collect();
+        let svg = plot::save(&ctx.path(SVG), &panels, (440, 440))?;
+
+        let verdicts = verdicts(&rules, &compare, plan.alpha);
+        let failed = done
+            .iter()
+            .map(|t| {
+                (0..t.tools.len())
+                    .filter(|&i| !t.error(i).is_empty())
+                    .count()
+            })
+            .sum();
+        let mut blocks = vec![
+            Block::p(format!(
+                "{} trials, each of {} random tools on task 2 (velocity). Every tool is simulated \
+                 without and with ΔT = {} N m; each rule picks a tool from the unperturbed \
+                 episodes ({}), and the chosen tools are compared on control confidence, task \
+                 error and sensitivity |task error(ΔT) − task error(0)|. Paired tests pair the \
+                 rules' tools trial by trial (a trial where both rules chose the same tool is a \
+                 zero difference).",
+                done.len(),
+                plan.fig7_tools,
+                dt_label(plan.perturbation),
+                rules
+                    .iter()
+                    .map(|r| r.label())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )),
+            files_block(
+                &[CSV.into(), CHOICES_CSV.into(), SVG.into()],
+                done.len() * plan.fig7_tools,
+                failed,
+                "tool rows, two episodes each, and one choice row per trial and rule",
+            ),
+            Block::table(
+                &["measure", "rule", "n", "mean ± sd", "median [q1, q3]"],
+                summary_rows,
+            ),
+            Block::table(&["measure", "difference", "paired tests"], test_rows),
+            Block::Figure {
+                file: SVG.into(),
+                caption: "The tools chosen by each rule: box plots (median, quartiles, whiskers \
+                          at 1.5 IQR, outliers as rings) with mean ± sd (triangle and bar) beside \
+                          each box. Compare with the paper's Fig. 7."
+                    .into(),
+                svg,
+            },
+        ];
+        blocks.extend(verdicts.into_iter().map(Block::Verdict));
+        Ok(Section {
+            id: self.id(),
+            title: self.title().into(),
+            blocks,
+            episodes: 2 * (done.len() * plan.fig7_tools) as u64,
+            rhs_evals: done
+                .iter()
+                .flat_map(|t| t.results.iter().chain(&t.perturbed))
+                .filter_map(|r| r.episode.as_ref().ok())
+                .map(|m| m.rhs_evals as u64)
+                .sum(),
+        })
+    }
+}
+
+/// The label up to its first space ("F", "J", "confidence").
+fn short(rule: &dyn DecisionRule) -> String {
+    rule.label().split(' ').next().unwrap_or("").to_string()
+}
+
+fn verdicts(
+    rules: &[Box<dyn DecisionRule>],
+    compare: &dyn Fn(usize, usize, usize) -> Comparison,
+    alpha: f64,
+) -> Vec<Verdict> {
+    let find = |id: &str| rules.iter().position(|r| r.id() == id);
+    let (Some(f), Some(j), Some(c)) = (find("free_energy"), find("cost_j"), find("confidence"))
+    else {
+        return vec![];
+    };
+    let significant = format!("Wilcoxon signed-rank p < {alpha} (two-sided)");
+    let directional = |better: Option<bool>| match better {
+        None => Outcome::NotJudged,
+        Some(true) => Outcome::Holds,
+        Some(false) => Outcome::DoesNotHold,
+    };
+    let mut out = Vec::new();
+
+    let conf = compare(0, f, j);
+    out.push(Verdict {
+        claim: "C4, confidence".into(),
+        statement: "\"The tools selected by J showed lower control confidence\" than those \
+                    selected by F."
+            .into(),
+        outcome: directional(conf.a_greater(alpha)),
+        evidence: format!(
+            "ln|Π^U| of F's tool − J's tool: {}.",
+            conf.describe()
+        ),
+        rule: format!("holds if F's tools have the higher confidence with {significant}; does not hold otherwise."),
+    });
+
+    let sens = compare(2, j, f);
+    out.push(Verdict {
+        claim: "C4, sensitivity".into(),
+        statement: "\"The tool selected using F has a superior tolerance to control \
+                    perturbations than the tool selected using J\": J's tools have the higher \
+                    sensitivity to a constant perturbation."
+            .into(),
+        outcome: directional(sens.a_greater(alpha)),
+        evidence: format!(
+            "|change of task error| of J's tool − F's tool: {}.",
+            sens.describe()
+        ),
+        rule: format!("holds if J's tools are the more sensitive with {significant}; does not hold otherwise."),
+    });
+
+    let others: Vec<usize> = (0..rules.len()).filter(|&r| r != f).collect();
+    let error_cmp: Vec<(usize, Comparison)> =
+        others.iter().map(|&r| (r, compare(1, r, f))).collect();
+    let lowest = error_cmp
+        .iter()
+        .all(|(_, c)| c.mean_difference().is_some_and(|d| d > 0.0) || c.identical());
+    let all_significant = error_cmp
+        .iter()
+        .all(|(_, c)| c.a_greater(alpha) == Some(true));
+    let judged = error_cmp.iter().all(|(_, c)| c.mean_difference().is_some());
+    out.push(Verdict {
+        claim: "C4, task error".into(),
+        statement: "\"F has the lowest average task error\" of the rules.".into(),
+        outcome: if !judged {
+            Outcome::NotJudged
+        } else if lowest && all_significant {
+            Outcome::Holds
+        } else if lowest {
+            Outcome::Partly
+        } else {
+            Outcome::DoesNotHold
+        },
+        evidence: error_cmp
+            .iter()
+            .map(|(r, c)| {
+                format!(
+                    "task error of {}'s tool − F's tool: {}",
+                    short(rules[*r].as_ref()),
+                    c.describe()
+                )
+            })
+            .collect::<Vec<_>>()
+            .join("; ")
+            + ".",
+        rule: format!(
+            "holds if F's mean task error is the lowest and lower than each other rule's with \
+             {significant}; partly holds if it is the lowest mean but not significantly lower \
+             than every other; does not hold if another rule has a lower mean."
+        ),
+    });
+
+    let similar: Vec<(usize, Comparison)> =
+        (0..METRICS.len()).map(|m| (m, compare(m, c, f))).collect();
+    let verdicts: Vec<Option<bool>> = similar.iter().map(|(_, s)| s.similar(alpha)).collect();
+    let yes = verdicts.iter().filter(|v| **v == Some(true)).count();
+    out.push(Verdict {
+        claim: "C4, confidence-only selection".into(),
+        statement: "\"The confidence-based tool selection showed similar confidence, task error \
+                    and sensitivity to that of F.\""
+            .into(),
+        outcome: if verdicts.iter().any(Option::is_none) {
+            Outcome::NotJudged
+        } else if yes == METRICS.len() {
+            Outcome::Holds
+        } else if yes > 0 {
+            Outcome::Partly
+        } else {
+            Outcome::DoesNotHold
+        },
+        evidence: similar
+            .iter()
+            .map(|(m, s)| {
+                format!(
+                    "{} (confidence's tool − F's): {}",
+                    METRICS[*m].0,
+                    s.describe()
+                )
+            })
+            .collect::<Vec<_>>()
+            .join("; ")
+            + ".",
+        rule: format!(
+            "a measure counts as similar when the paired difference is not significant \
+             (Wilcoxon p ≥ {alpha}) or the two rules chose the same tool in every trial (no \
+             significant difference is weaker evidence than a proof of equality); holds if all \
+             three measures are similar, partly holds if one or two are, does not hold if none."
+        ),
+    });
+    out
+}

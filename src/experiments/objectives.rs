@@ -1,0 +1,80 @@
+//! The decision rules the selection experiments (Figs. 6 and 7) compare.
+//!
+//! A rule sees a whole trial (the task, the tools, and every tool's confidence and unperturbed
+//! active-inference episode) and names the tool it picks. The paper's three are ∫F, ∫J and
+//! confidence alone ([`crate::select::Objective`]). Another rule, for instance a ranking by an
+//! MPC baseline's cost J*, implements [`DecisionRule`] (running whatever it needs inside
+//! `choose`) and is added to [`decision_rules`]; the experiments then report its choices, its
+//! tools' statistics and its paired tests against every other rule without further changes.
+
+use plotters::style::RGBColor;
+
+use crate::closed_loop::EpisodeOptions;
+use crate::select::{Objective, ToolResult};
+use crate::{Arm, Task};
+
+/// One trial of a selection experiment, as the rules see it.
+pub struct Trial<'a> {
+    pub task: &'a Task,
+    pub tools: &'a [Arm],
+    /// Every tool's confidence and unperturbed episode, in tool order.
+    pub results: &'a [ToolResult],
+    /// The episode settings the results were computed with.
+    pub options: &'a EpisodeOptions,
+}
+
+/// A way of choosing one tool of a trial.
+pub trait DecisionRule: Send + Sync {
+    /// Identifier used in CSV columns (`chosen_by_<id>`) and file rows.
+    fn id(&self) -> &'static str;
+    /// Label in figures and the report.
+    fn label(&self) -> &'static str;
+    /// Fill colour in figures.
+    fn colour(&self) -> RGBColor;
+    /// The index of the chosen tool, `None` if it cannot choose (e.g. every tool failed).
+    fn choose(&self, trial: &Trial) -> Option<usize>;
+}
+
+/// The paper's objectives through [`Objective::choose`] (ties go to the earlier tool).
+pub struct Paper(pub Objective);
+
+impl DecisionRule for Paper {
+    fn id(&self) -> &'static str {
+        self.0.name()
+    }
+
+    fn label(&self) -> &'static str {
+        match self.0 {
+            Objective::FreeEnergy => "F (∫F dt)",
+            Objective::CostJ => "J (∫J dt)",
+            Objective::Confidence => "confidence (ln|Π^U|)",
+        }
+    }
+
+    fn colour(&self) -> RGBColor {
+        match self.0 {
+            Objective::FreeEnergy => RGBColor(0, 114, 178),
+            Objective::CostJ => RGBColor(213, 94, 0),
+            Objective::Confidence => RGBColor(0, 158, 115),
+        }
+    }
+
+    fn choose(&self, trial: &Trial) -> Option<usize> {
+        self.0.choose(trial.results)
+    }
+}
+
+/// Every rule the selection experiments compare, in report order. The first two are the pair
+/// Fig. 6 contrasts (F and J).
+pub fn decision_rules() -> Vec<Box<dyn DecisionRule>> {
+    vec![
+        Box::new(Paper(Objective::FreeEnergy)),
+        Box::new(Paper(Objective::CostJ)),
+        Box::new(Paper(Objective::Confidence)),
+    ]
+}
+
+/// One trial's choices, one entry per rule of [`decision_rules`].
+pub fn choices(rules: &[Box<dyn DecisionRule>], trial: &Trial) -> Vec<Option<usize>> {
+    rules.iter().map(|r| r.choose(trial)).collect()
+}
