@@ -220,3 +220,23 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn the_exact_plant_changes_the_world_not_the_agent() {
+    use toolconf::closed_loop::Plant;
+    for p in ARMS {
+        let paper = run(&arm(p), TaskKind::Position, &EpisodeOptions::default());
+        let exact = run(
+            &arm(p),
+            TaskKind::Position,
+            &EpisodeOptions {
+                plant: Plant::Exact,
+                ..EpisodeOptions::default()
+            },
+        );
+        assert_eq!(paper.logdet, exact.logdet);
+        assert_ne!(paper.task_error, exact.task_error);
+        let identity = exact.free_energy - exact.cost_j + 2.5 * exact.logdet;
+        assert!(identity.abs() <= 1e-9 * exact.cost_j.abs().max(1.0));
+    }
+}

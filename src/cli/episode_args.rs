@@ -1,6 +1,6 @@
 //! Episode options shared by the commands that simulate (defaults: the paper's).
 
-use toolconf::closed_loop::EpisodeOptions;
+use toolconf::closed_loop::{EpisodeOptions, Plant};
 use toolconf::Error;
 
 #[derive(clap::Args, Debug, Clone)]
@@ -23,6 +23,28 @@ pub struct EpisodeArgs {
     /// Integrator absolute tolerance (ode45 default 1e-6).
     #[arg(long, default_value_t = 1e-6, allow_hyphen_values = true)]
     pub atol: f64,
+    /// Plant: the paper's generative process, or the exact Lagrangian 2-link dynamics.
+    #[arg(long, value_enum, default_value_t = PlantArg::Paper)]
+    pub plant: PlantArg,
+}
+
+/// The simulated arm's equations of motion (the agent always uses the paper's model).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum PlantArg {
+    /// The paper's generative process (appendix "Tool Dynamics").
+    #[default]
+    Paper,
+    /// The exact 2-link Lagrangian dynamics of the same arm.
+    Exact,
+}
+
+impl From<PlantArg> for Plant {
+    fn from(p: PlantArg) -> Self {
+        match p {
+            PlantArg::Paper => Plant::Paper,
+            PlantArg::Exact => Plant::Exact,
+        }
+    }
 }
 
 impl EpisodeArgs {
@@ -38,6 +60,7 @@ impl EpisodeArgs {
             perturbation: self.perturbation,
             learning_rate: self.learning_rate,
             record_trajectory,
+            plant: self.plant.into(),
             ..EpisodeOptions::default()
         };
         o.integrator.rtol = self.rtol;

@@ -7,4 +7,4 @@ mod system;
 
 pub use controller::ActiveInference;
 pub use episode::{simulate, Episode, EpisodeOptions, Metrics, SimulationError, Trajectory};
-pub use system::{ClosedLoop, JointJacobian, JointState};
+pub use system::{ClosedLoop, JointJacobian, JointState, Plant};

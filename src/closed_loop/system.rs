@@ -4,7 +4,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::controller::ActiveInference;
-use crate::generated::arm2;
+use crate::generated::{arm2, arm2_exact};
 use crate::{Arm, Error, Task, Vector2};
 
 /// The closed-loop state Z = [X; U] = [θ1 θ2 θ̇1 θ̇2 T1 T2].
@@ -12,21 +12,75 @@ pub type JointState = SVector<f64, 6>;
 /// ∂Ż/∂Z.
 pub type JointJacobian = SMatrix<f64, 6, 6>;
 
-/// Plant (the nonlinear generative process with a constant torque perturbation ΔT on both
-/// joints) and active-inference controller, which observes θ, θ̇ and the plant's θ̈.
+/// Which equations of motion drive the arm. The agent's model (A, B, sensitivities, Π^U) is
+/// always the paper's; only the simulated world changes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
+pub enum Plant {
+    /// The paper's generative process, eqs. (theta_1_ddot), (theta_2_ddot) (`generated::arm2`).
+    #[default]
+    Paper,
+    /// The exact 2-link Lagrangian dynamics of the same tool (`generated::arm2_exact`): link 2's
+    /// pivot accelerates with link 1, which the paper's generative process ignores.
+    Exact,
+}
+
+impl Plant {
+    pub fn name(self) -> &'static str {
+        match self {
+            Plant::Paper => "paper",
+            Plant::Exact => "exact",
+        }
+    }
+
+    #[inline]
+    fn dynamics(self, x: &SVector<f64, 4>, u: &Vector2, p: &SVector<f64, 4>) -> SVector<f64, 4> {
+        match self {
+            Plant::Paper => arm2::dynamics(x, u, p),
+            Plant::Exact => arm2_exact::dynamics(x, u, p),
+        }
+    }
+
+    #[inline]
+    fn dynamics_jacobian(
+        self,
+        x: &SVector<f64, 4>,
+        u: &Vector2,
+        p: &SVector<f64, 4>,
+    ) -> (SMatrix<f64, 4, 4>, SMatrix<f64, 4, 2>) {
+        match self {
+            Plant::Paper => arm2::dynamics_jacobian(x, u, p),
+            Plant::Exact => arm2_exact::dynamics_jacobian(x, u, p),
+        }
+    }
+}
+
+/// Plant (the nonlinear arm with a constant torque perturbation ΔT on both joints) and
+/// active-inference controller, which observes θ, θ̇ and the plant's θ̈.
 #[derive(Debug, Clone, Copy)]
 pub struct ClosedLoop {
     params: SVector<f64, 4>,
     pub controller: ActiveInference,
     perturbation: Vector2,
+    plant: Plant,
 }
 
 impl ClosedLoop {
+    /// The closed loop on the paper's generative process.
     pub fn new(
         arm: &Arm,
         task: &Task,
         learning_rate: f64,
         perturbation: f64,
+    ) -> Result<Self, Error> {
+        Self::with_plant(arm, task, learning_rate, perturbation, Plant::Paper)
+    }
+
+    pub fn with_plant(
+        arm: &Arm,
+        task: &Task,
+        learning_rate: f64,
+        perturbation: f64,
+        plant: Plant,
     ) -> Result<Self, Error> {
         if !perturbation.is_finite() {
             return Err(Error::InvalidOption {
@@ -38,6 +92,7 @@ impl ClosedLoop {
             params: arm.params(),
             controller: ActiveInference::new(arm, task, learning_rate)?,
             perturbation: Vector2::repeat(perturbation),
+            plant,
         })
     }
 
@@ -46,7 +101,9 @@ impl ClosedLoop {
     pub fn rhs_and_acceleration(&self, z: &JointState) -> (JointState, Vector2) {
         let x = z.fixed_rows::<4>(0).into_owned();
         let u = z.fixed_rows::<2>(4).into_owned();
-        let x_dot = arm2::dynamics(&x, &(u + self.perturbation), &self.params);
+        let x_dot = self
+            .plant
+            .dynamics(&x, &(u + self.perturbation), &self.params);
         let theta = x.fixed_rows::<2>(0).into_owned();
         let theta_dot = x.fixed_rows::<2>(2).into_owned();
         let theta_ddot = x_dot.fixed_rows::<2>(2).into_owned();
@@ -72,7 +129,9 @@ impl ClosedLoop {
     pub fn jacobian(&self, z: &JointState) -> JointJacobian {
         let x = z.fixed_rows::<4>(0).into_owned();
         let u = z.fixed_rows::<2>(4).into_owned();
-        let (f_x, f_u) = arm2::dynamics_jacobian(&x, &(u + self.perturbation), &self.params);
+        let (f_x, f_u) = self
+            .plant
+            .dynamics_jacobian(&x, &(u + self.perturbation), &self.params);
         let [k_theta, k_theta_dot, k_theta_ddot, p_u] = self.controller.scaled_gains();
         let accel_x = f_x.fixed_view::<2, 4>(2, 0);
         let accel_u = f_u.fixed_view::<2, 2>(2, 0);
