@@ -28,6 +28,7 @@
 pub mod batch;
 mod common;
 pub mod csv;
+mod exact_plant;
 mod fig2_confidence_vs_error;
 mod fig3_trajectories;
 mod fig4_perturbation_change;
@@ -164,6 +165,8 @@ pub struct Context<'a> {
     /// The paper's episode settings (ode45 tolerances, 5 s, dt 0.05, ΔT = 0).
     pub options: EpisodeOptions,
     pub progress: &'a ProgressBar,
+    /// Prefix of every file the experiment writes (empty, or e.g. `exact_plant_`).
+    pub file_prefix: &'a str,
 }
 
 impl Context<'_> {
@@ -173,7 +176,7 @@ impl Context<'_> {
     }
 
     pub fn path(&self, file: &str) -> PathBuf {
-        self.out_dir.join(file)
+        self.out_dir.join(format!("{}{file}", self.file_prefix))
     }
 
     /// The paper's options with a constant perturbation ΔT.
@@ -208,6 +211,21 @@ pub fn experiments() -> Vec<Box<dyn Experiment>> {
         Box::new(fig5_perturbation_sweep::Fig5),
         Box::new(fig6_selection_grid::Fig6),
         Box::new(fig7_benchmark::Fig7),
+        Box::new(exact_plant::OnExactPlant {
+            inner: Box::new(fig2_confidence_vs_error::Fig2),
+            id: "fig2_exact",
+            title: "Exact plant: Fig. 2, confidence and task error (C1)",
+        }),
+        Box::new(exact_plant::OnExactPlant {
+            inner: Box::new(fig4_perturbation_change::Fig4),
+            id: "fig4_exact",
+            title: "Exact plant: Fig. 4, confidence and sensitivity to a perturbation (C2)",
+        }),
+        Box::new(exact_plant::OnExactPlant {
+            inner: Box::new(fig7_benchmark::Fig7),
+            id: "fig7_exact",
+            title: "Exact plant: Fig. 7, benchmarking tool selection (C4)",
+        }),
     ]
 }
 
@@ -293,6 +311,7 @@ pub fn reproduce(config: &Config) -> Result<Summary, ReproduceError> {
         plan: &config.plan,
         options: EpisodeOptions::default(),
         progress: &progress,
+        file_prefix: "",
     };
     let start = Instant::now();
     let mut sections = Vec::new();
