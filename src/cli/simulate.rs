@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use serde_json::json;
 use toolconf::closed_loop::{simulate, Trajectory};
-use toolconf::mpc::{simulate_mpc, MpcOptions};
+use toolconf::mpc::{simulate_mpc, MpcModel, MpcOptions};
 use toolconf::{Arm, Error, Task, TaskKind};
 
 use super::episode_args::EpisodeArgs;
@@ -52,6 +52,24 @@ pub struct MpcArgs {
     /// Torque bound per joint [N m] for the MPC (inf for none).
     #[arg(long, default_value_t = 5.0, allow_hyphen_values = true)]
     pub torque_limit: f64,
+    /// MPC prediction model: re-linearised at every step (local) or the paper's linearisation
+    /// at the hanging equilibrium (equilibrium; with --disturbance-observer false, the
+    /// original linear MPC).
+    #[arg(long, value_enum, default_value_t = MpcModelArg::Local)]
+    pub mpc_model: MpcModelArg,
+    /// Estimate a constant input disturbance and plan with it (offset-free MPC): true or false.
+    #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
+    pub disturbance_observer: bool,
+    /// Gain of the disturbance observer, in (0, 1] (1: the last step's estimate as is).
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    pub observer_gain: f64,
+}
+
+/// `--mpc-model` values.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MpcModelArg {
+    Equilibrium,
+    Local,
 }
 
 impl MpcArgs {
@@ -70,10 +88,22 @@ impl MpcArgs {
                 value: self.torque_limit,
             });
         }
+        if !(self.observer_gain > 0.0 && self.observer_gain <= 1.0) {
+            return Err(Error::InvalidOption {
+                name: "observer gain (must be in (0, 1])",
+                value: self.observer_gain,
+            });
+        }
         Ok(MpcOptions {
             period: self.mpc_period,
             horizon: self.horizon,
             torque_limit: self.torque_limit,
+            model: match self.mpc_model {
+                MpcModelArg::Equilibrium => MpcModel::Equilibrium,
+                MpcModelArg::Local => MpcModel::Local,
+            },
+            disturbance_observer: self.disturbance_observer,
+            observer_gain: self.observer_gain,
         })
     }
 }

@@ -33,6 +33,8 @@ pub struct MpcMetrics {
     pub max_solve_time: Duration,
     /// `Solved`, or the first other accepted status (`AlmostSolved`).
     pub worst_status: String,
+    /// The disturbance observer's final estimate d̂ [N m] (zero without the observer).
+    pub disturbance_estimate: Vector2,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -173,6 +175,7 @@ pub fn simulate_mpc(
         median_solve_time: solve_times[solve_times.len() / 2],
         max_solve_time: *solve_times.last().expect("at least one solve"),
         worst_status,
+        disturbance_estimate: mpc.disturbance_estimate(),
     };
     Ok(MpcEpisode {
         metrics,
