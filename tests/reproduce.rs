@@ -319,3 +319,57 @@ fn an_unknown_experiment_is_bad_input() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("fig9"));
 }
+
+#[test]
+fn the_mpc_comparison_runs_when_switched_on() {
+    let dir = fresh_dir("mpc");
+    finish(reproduce(&dir, 2, &["--only", "mpc", "--mpc"]));
+    let out = files(&dir);
+    let text = std::str::from_utf8(&out["mpc_comparison.csv"]).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(
+        lines[0],
+        format!(
+            "task,tool,{ARM},logdet,perturbation,controller,task_error,cost_j,control_effort,error"
+        )
+    );
+    // quick: 1 tool × 3 tasks × 2 controllers × 2 perturbations
+    assert_eq!(lines.len() - 1, 12);
+    assert!(lines[1..].iter().all(|l| cells(l).len() == 13));
+    let report = std::str::from_utf8(&out["report.md"]).unwrap();
+    assert!(report.contains("Active inference against the MPC baseline"));
+    assert!(report.contains("J* (MPC)"));
+}
+
+#[test]
+fn mpc_cost_rule_picks_the_tool_with_the_lowest_mpc_cost() {
+    use toolconf::closed_loop::EpisodeOptions;
+    use toolconf::experiments::objectives::{DecisionRule, MpcCost, Trial};
+    use toolconf::mpc::{simulate_mpc, MpcOptions};
+    use toolconf::select::{draw_tools, evaluate};
+    use toolconf::{Task, TaskKind};
+    let tools = draw_tools(3, 21);
+    let task = Task::paper(TaskKind::Velocity);
+    let options = EpisodeOptions::default();
+    let results = evaluate(&tools, &task, &options);
+    let trial = Trial {
+        task: &task,
+        tools: &tools,
+        results: &results,
+        options: &options,
+    };
+    let chosen = MpcCost(MpcOptions::default()).choose(&trial).unwrap();
+    let costs: Vec<f64> = tools
+        .iter()
+        .map(|a| {
+            simulate_mpc(a, &task, &options, &MpcOptions::default())
+                .unwrap()
+                .metrics
+                .cost_j
+        })
+        .collect();
+    assert!(
+        costs.iter().all(|c| costs[chosen] <= *c),
+        "chose {chosen} of {costs:?}"
+    );
+}

@@ -22,6 +22,10 @@ pub struct Args {
     /// Run only these experiments (comma-separated: fig2,fig3,fig4,fig5,fig6,fig7).
     #[arg(long, value_delimiter = ',', value_parser = parse_experiment)]
     only: Option<Vec<String>>,
+    /// Also run the MPC baseline: J* in Fig. 7 and the active-inference-against-MPC section
+    /// (about ten times the run time of the paper's experiments).
+    #[arg(long)]
+    mpc: bool,
 }
 
 fn parse_experiment(s: &str) -> Result<String, String> {
@@ -48,13 +52,19 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if let Some(only) = &args.only {
         command.push_str(&format!(" --only {}", only.join(",")));
     }
+    if args.mpc {
+        command.push_str(" --mpc");
+    }
     let config = Config {
         out_dir: args.out.clone(),
         seed: args.seed,
-        plan: if args.quick {
-            Plan::quick()
-        } else {
-            Plan::paper()
+        plan: Plan {
+            mpc: args.mpc,
+            ..if args.quick {
+                Plan::quick()
+            } else {
+                Plan::paper()
+            }
         },
         only: args.only.clone(),
         progress: std::io::stderr().is_terminal(),

@@ -89,6 +89,8 @@ pub struct Metrics {
     /// Jacobian evaluations and LU factorisations (0 unless the stiff method ran).
     pub jacobian_evals: usize,
     pub factorisations: usize,
+    /// ∫|U|² dt, trapezoidal on the grid (the controller's torque, without ΔT).
+    pub control_effort: f64,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -144,9 +146,9 @@ pub fn simulate(
         ..Trajectory::default()
     });
     let mut task_error = 0.0;
-    let (mut int_f, mut int_j) = (0.0, 0.0);
-    // (t, F, J) at the previous grid point, for the trapezoidal rule.
-    let mut previous: Option<(f64, f64, f64)> = None;
+    let (mut int_f, mut int_j, mut effort) = (0.0, 0.0, 0.0);
+    // (t, F, J, |U|²) at the previous grid point, for the trapezoidal rule.
+    let mut previous: Option<(f64, f64, f64, f64)> = None;
     let mut divergence: Option<(f64, f64)> = None;
 
     let rhs = |_t: f64, z: &JointState| system.rhs(z);
@@ -168,12 +170,14 @@ pub fn simulate(
         task_error += controller.task_error(&theta, &theta_dot, &theta_ddot);
         let j = controller.cost_j(&theta, &theta_dot, &theta_ddot, &u);
         let f = j - 0.5 * controller.logdet;
-        if let Some((t_prev, f_prev, j_prev)) = previous {
+        let e = u.norm_squared();
+        if let Some((t_prev, f_prev, j_prev, e_prev)) = previous {
             let h = t - t_prev;
             int_f += 0.5 * h * (f + f_prev);
             int_j += 0.5 * h * (j + j_prev);
+            effort += 0.5 * h * (e + e_prev);
         }
-        previous = Some((t, f, j));
+        previous = Some((t, f, j, e));
         if let Some(tr) = trajectory.as_mut() {
             tr.t.push(t);
             tr.theta.push(theta);
@@ -199,6 +203,7 @@ pub fn simulate(
         rhs_evals: stats.rhs_evals,
         steps: stats.steps,
         rejected_steps: stats.rejected,
+        control_effort: effort,
         jacobian_evals: stats.jacobian_evals,
         factorisations: stats.factorisations,
     };

@@ -12,13 +12,28 @@ use crate::{Arm, Task, TaskKind};
 use super::batch::map_ordered;
 use super::common::{arm_cells, dt_label, files_block, ARM_COLUMNS};
 use super::csv::{Cell, CsvWriter};
-use super::objectives::{choices, decision_rules, DecisionRule, Trial};
+use super::objectives::{choices, decision_rules, DecisionRule, MpcCost, Trial};
 use super::plot::{self, BoxPanel, Panel};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::{num, Comparison};
 use super::{Context, Experiment, Plan, ReproduceError};
+use crate::mpc::MpcOptions;
 
-pub struct Fig7;
+/// Fig. 7; `with_mpc` adds the MPC baseline's J* ranking to the paper's three rules when the run
+/// has the MPC switched on ([`Plan::mpc`]).
+pub struct Fig7 {
+    pub with_mpc: bool,
+}
+
+impl Fig7 {
+    fn rules(&self, plan: &Plan) -> Vec<Box<dyn DecisionRule>> {
+        let mut rules = decision_rules();
+        if self.with_mpc && plan.mpc {
+            rules.push(Box::new(MpcCost(MpcOptions::default())));
+        }
+        rules
+    }
+}
 
 const CSV: &str = "fig7_benchmark.csv";
 const CHOICES_CSV: &str = "fig7_choices.csv";
@@ -35,7 +50,7 @@ pub const CHOICES_HEADER: [&str; 6] = [
 
 /// The per-tool header: parameters, metrics, perturbed task error, one `chosen_by_<rule>` per
 /// rule, error.
-pub fn header() -> Vec<String> {
+pub fn header(rules: &[Box<dyn DecisionRule>]) -> Vec<String> {
     let mut h: Vec<String> = ["trial", "tool"]
         .into_iter()
         .chain(ARM_COLUMNS)
@@ -49,11 +64,7 @@ pub fn header() -> Vec<String> {
         ])
         .map(String::from)
         .collect();
-    h.extend(
-        decision_rules()
-            .iter()
-            .map(|r| format!("chosen_by_{}", r.id())),
-    );
+    h.extend(rules.iter().map(|r| format!("chosen_by_{}", r.id())));
     h.push("error".into());
     h
 }
@@ -126,16 +137,17 @@ impl Experiment for Fig7 {
     }
 
     fn planned_episodes(&self, plan: &Plan) -> u64 {
-        2 * (plan.fig7_trials * plan.fig7_tools) as u64
+        (if self.with_mpc && plan.mpc { 3 } else { 2 })
+            * (plan.fig7_trials * plan.fig7_tools) as u64
     }
 
     fn run(&self, ctx: &Context) -> Result<Section, ReproduceError> {
         let plan = ctx.plan;
         let task = Task::paper(TASK);
-        let rules = decision_rules();
+        let rules = self.rules(plan);
         let perturbed = ctx.perturbed(plan.perturbation);
         let trials: Vec<usize> = (0..plan.fig7_trials).collect();
-        let header = header();
+        let header = header(&rules);
         let header: Vec<&str> = header.iter().map(String::as_str).collect();
         let mut csv = CsvWriter::create(&ctx.path(CSV), &header)?;
         let mut choices_csv = CsvWriter::create(&ctx.path(CHOICES_CSV), &CHOICES_HEADER)?;

@@ -35,6 +35,7 @@ mod fig4_perturbation_change;
 mod fig5_perturbation_sweep;
 mod fig6_selection_grid;
 mod fig7_benchmark;
+mod mpc_comparison;
 pub mod objectives;
 pub mod plot;
 pub mod report;
@@ -77,6 +78,10 @@ pub struct Plan {
     pub level: f64,
     /// Significance level of the paired tests.
     pub alpha: f64,
+    /// Also run the MPC baseline: its J* ranking in Fig. 7 and the AIC-against-MPC section.
+    pub mpc: bool,
+    /// Tools of the AIC-against-MPC comparison (each on 3 tasks, 2 perturbations, 2 controllers).
+    pub mpc_tools: usize,
 }
 
 impl Plan {
@@ -97,6 +102,8 @@ impl Plan {
             bootstrap_resamples: 2000,
             level: 0.95,
             alpha: 0.05,
+            mpc: false,
+            mpc_tools: 20,
         }
     }
 
@@ -113,6 +120,7 @@ impl Plan {
             fig7_trials: 6,
             fig7_tools: 4,
             bootstrap_resamples: 200,
+            mpc_tools: 1,
             ..Self::paper()
         }
     }
@@ -200,6 +208,10 @@ pub trait Experiment: Sync {
     fn planned_episodes(&self, plan: &Plan) -> u64;
     /// Runs it: writes its files and returns its report section.
     fn run(&self, ctx: &Context) -> Result<Section, ReproduceError>;
+    /// Whether it runs only with the MPC baseline switched on ([`Plan::mpc`]).
+    fn needs_mpc(&self) -> bool {
+        false
+    }
 }
 
 /// The registry: every experiment, in report order.
@@ -210,7 +222,7 @@ pub fn experiments() -> Vec<Box<dyn Experiment>> {
         Box::new(fig4_perturbation_change::Fig4),
         Box::new(fig5_perturbation_sweep::Fig5),
         Box::new(fig6_selection_grid::Fig6),
-        Box::new(fig7_benchmark::Fig7),
+        Box::new(fig7_benchmark::Fig7 { with_mpc: true }),
         Box::new(exact_plant::OnExactPlant {
             inner: Box::new(fig2_confidence_vs_error::Fig2),
             id: "fig2_exact",
@@ -222,10 +234,11 @@ pub fn experiments() -> Vec<Box<dyn Experiment>> {
             title: "Exact plant: Fig. 4, confidence and sensitivity to a perturbation (C2)",
         }),
         Box::new(exact_plant::OnExactPlant {
-            inner: Box::new(fig7_benchmark::Fig7),
+            inner: Box::new(fig7_benchmark::Fig7 { with_mpc: false }),
             id: "fig7_exact",
             title: "Exact plant: Fig. 7, benchmarking tool selection (C4)",
         }),
+        Box::new(mpc_comparison::MpcComparison),
     ]
 }
 
@@ -278,7 +291,11 @@ impl Summary {
 pub fn reproduce(config: &Config) -> Result<Summary, ReproduceError> {
     let all = experiments();
     let selected: Vec<&dyn Experiment> = match &config.only {
-        None => all.iter().map(|e| e.as_ref()).collect(),
+        None => all
+            .iter()
+            .filter(|e| config.plan.mpc || !e.needs_mpc())
+            .map(|e| e.as_ref())
+            .collect(),
         Some(ids) => {
             for id in ids {
                 if !all.iter().any(|e| e.id() == id) {

@@ -10,6 +10,7 @@
 use plotters::style::RGBColor;
 
 use crate::closed_loop::EpisodeOptions;
+use crate::mpc::{simulate_mpc, MpcOptions};
 use crate::select::{Objective, ToolResult};
 use crate::{Arm, Task};
 
@@ -61,6 +62,42 @@ impl DecisionRule for Paper {
 
     fn choose(&self, trial: &Trial) -> Option<usize> {
         self.0.choose(trial.results)
+    }
+}
+
+/// J*: the tool whose MPC baseline (default options: re-linearised, offset-free, 1 s horizon,
+/// ±5 N m) achieves the lowest ∫J dt on the trial's task. The conventional optimal-control way of
+/// ranking tools: simulate an optimal controller on each and keep the cheapest.
+pub struct MpcCost(pub MpcOptions);
+
+impl DecisionRule for MpcCost {
+    fn id(&self) -> &'static str {
+        "mpc_cost"
+    }
+
+    fn label(&self) -> &'static str {
+        "J* (MPC ∫J dt)"
+    }
+
+    fn colour(&self) -> RGBColor {
+        RGBColor(204, 121, 167)
+    }
+
+    fn choose(&self, trial: &Trial) -> Option<usize> {
+        trial
+            .tools
+            .iter()
+            .enumerate()
+            .filter_map(|(i, arm)| {
+                simulate_mpc(arm, trial.task, trial.options, &self.0)
+                    .ok()
+                    .map(|e| (i, e.metrics.cost_j))
+            })
+            .fold(None, |best: Option<(usize, f64)>, (i, c)| match best {
+                Some((_, b)) if b <= c => best,
+                _ => Some((i, c)),
+            })
+            .map(|(i, _)| i)
     }
 }
 

@@ -2,6 +2,7 @@
 
 use nalgebra::SVector;
 
+use super::stiffness::StiffnessDetector;
 use super::{IntegrationError, Settings, Stats};
 
 // Tableau of Dormand & Prince (1980), as matrices A, B, E of ode45.m.
@@ -51,6 +52,30 @@ struct Attempt<const D: usize> {
     y_new: SVector<f64, D>,
     /// Stages k1, k3, k4, k5, k6, k7 (k2 has zero weight in the solution, estimate and interpolant).
     k: [SVector<f64, D>; 6],
+    /// The point stage 6 was evaluated at, for the stiffness test.
+    y6: SVector<f64, D>,
+}
+
+/// How a DP5 integration ended.
+pub(super) enum Outcome<const D: usize> {
+    /// `tf` reached.
+    Finished(Stats),
+    /// The stiffness detector fired on the step that ended at `Handoff::t`; the integration
+    /// stopped there, with every grid point up to that time output.
+    Stiff(Handoff<D>),
+}
+
+/// Where DP5 stopped when it found the problem stiff, for another method to carry on.
+pub(super) struct Handoff<const D: usize> {
+    pub t: f64,
+    pub y: SVector<f64, D>,
+    /// f(t, y).
+    pub f: SVector<f64, D>,
+    /// The step size DP5 would have tried next.
+    pub abs_h: f64,
+    /// The first grid point not yet output.
+    pub next: usize,
+    pub stats: Stats,
 }
 
 /// MATLAB's `eps(t)`: the distance from |t| to the next larger double.
@@ -81,10 +106,8 @@ where
         t + C5 * h,
         &(y + (k1 * A51 + k2 * A52 + k3 * A53 + k4 * A54) * h),
     );
-    let k6 = rhs(
-        t + h,
-        &(y + (k1 * A61 + k2 * A62 + k3 * A63 + k4 * A64 + k5 * A65) * h),
-    );
+    let y6 = y + (k1 * A61 + k2 * A62 + k3 * A63 + k4 * A64 + k5 * A65) * h;
+    let k6 = rhs(t + h, &y6);
     // ode45 "purifies" h to the representable t_new − t before forming y_new.
     let h = t_new - t;
     let y_new = y + (k1 * B1 + k3 * B3 + k4 * B4 + k5 * B5 + k6 * B6) * h;
@@ -93,6 +116,7 @@ where
         t_new,
         y_new,
         k: [*k1, k3, k4, k5, k6, k7],
+        y6,
     }
 }
 
@@ -136,14 +160,17 @@ fn interpolate<const D: usize>(
         + k[5] * w(&BI7)
 }
 
-/// The `ode45` main loop over a validated grid and settings.
+/// The `ode45` main loop over a validated grid and settings. With a `detector`, the steps are
+/// also tested for stiffness and the integration stops at the end of the step the detector
+/// fires on (the steps taken until then are exactly those without a detector).
 pub(super) fn integrate<const D: usize, F, O>(
     mut rhs: F,
     y0: &SVector<f64, D>,
     grid: &[f64],
     s: &Settings,
+    mut detector: Option<&mut StiffnessDetector>,
     mut output: O,
-) -> Result<Stats, IntegrationError>
+) -> Result<Outcome<D>, IntegrationError>
 where
     F: FnMut(f64, &SVector<f64, D>) -> SVector<f64, D>,
     O: FnMut(usize, f64, &SVector<f64, D>),
@@ -233,8 +260,11 @@ where
             next += 1;
         }
         if done {
-            return Ok(stats);
+            return Ok(Outcome::Finished(stats));
         }
+        let stiff = detector
+            .as_mut()
+            .is_some_and(|d| d.stiff_after(h, &step.y6, &step.y_new, &step.k[4], &step.k[5]));
 
         if no_failures {
             // err may be 0, hence the explicit cap at 5× growth.
@@ -248,12 +278,22 @@ where
         t = step.t_new;
         y = step.y_new;
         k1 = step.k[5];
+        if stiff {
+            return Ok(Outcome::Stiff(Handoff {
+                t,
+                y,
+                f: k1,
+                abs_h,
+                next,
+                stats,
+            }));
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::super::{solve_grid, uniform_grid, IntegrationError, Options, Stats};
+    use super::super::{solve_grid, uniform_grid, IntegrationError, Method, Options, Stats};
     use nalgebra::{vector, SVector};
 
     type V1 = SVector<f64, 1>;
@@ -339,6 +379,7 @@ mod tests {
             initial_step: Some(h),
             max_step: Some(h),
             max_steps: 10_000,
+            method: Method::Explicit,
         };
         let grid = [0.0, 10.0];
         let (coarse, s) = max_error(oscillator, osc_exact, &grid, &fixed(0.2));
@@ -456,7 +497,9 @@ mod tests {
             Stats {
                 rhs_evals: 61,
                 steps: 10,
-                rejected: 0
+                rejected: 0,
+                jacobian_evals: 0,
+                factorisations: 0,
             }
         );
     }
@@ -468,9 +511,11 @@ mod tests {
             calls += 1;
             y * -50.0
         };
+        // y' = −50y turns stiff once y has decayed: Auto would switch to Rodas5P.
         let options = Options {
             initial_step: Some(1.0),
             max_step: Some(1.0),
+            method: Method::Explicit,
             ..Options::default()
         };
         let stats = solve_grid(rhs, &vector![1.0], &[0.0, 3.0], &options, |_, _, _| {}).unwrap();

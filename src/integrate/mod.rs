@@ -1,10 +1,26 @@
 //! Dormand–Prince 5(4) integration that reproduces MATLAB's `ode45`, the solver the paper used
-//! for its 5 s closed-loop simulations sampled every 0.05 s.
+//! for its 5 s closed-loop simulations sampled every 0.05 s, and the Rosenbrock method Rodas5P
+//! for stiff problems, with an automatic switch from the first to the second.
 //!
 //! States are fixed-size `nalgebra::SVector<f64, D>`, so the stepping loop allocates nothing and
 //! the right-hand side is called through a generic closure (no dynamic dispatch).
 //!
-//! # What follows `ode45`
+//! # Methods ([`Options::method`])
+//!
+//! * [`Method::Explicit`]: DP5, exactly `ode45` (below).
+//! * [`Method::Stiff`]: Rodas5P (Steinebach 2023), a stiffly accurate L-stable Rosenbrock
+//!   method of order 5(4) with a dense output of order 4, one Jacobian per step and one LU
+//!   factorisation per attempt, with `ode45`'s error norm and step-size rules (see the
+//!   `rosenbrock` module). The Jacobian comes from the caller
+//!   ([`solve_grid_with_jacobian`]) or from forward differences ([`solve_grid`]).
+//! * [`Method::Auto`] (the default): DP5 with Hairer's stiffness detection (`DOPRI5`'s test:
+//!   `h·|λ| > 3.25`, |λ| estimated as `‖k7 − k6‖/‖y7 − y6‖`, on 15 accepted steps, the count
+//!   cleared by 6 consecutive steps below), then Rodas5P from the end of the step the test
+//!   fired on to `tf` (no switch back), starting with the step DP5 would have tried next and
+//!   DP5's `f(t, y)`. Until the test fires, the steps, output and [`Stats`] are exactly those
+//!   of [`Method::Explicit`]: a problem never found stiff is integrated by DP5 bit for bit.
+//!
+//! # What DP5 follows of `ode45`
 //!
 //! Sources: L. F. Shampine & M. W. Reichelt, "The MATLAB ODE Suite", SIAM J. Sci. Comput. 18(1),
 //! 1997; MATLAB's `ode45.m`, `ntrp45.m` and `odearguments.m`; J. R. Dormand & P. J. Prince,
@@ -41,10 +57,24 @@
 //! * [`Options::max_steps`] bounds attempted steps (`ode45` has no such limit).
 
 mod dopri5;
+mod rosenbrock;
+mod stiffness;
 
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 
-/// Error control and step-size limits. The defaults are `ode45`'s.
+/// Which integration method runs (see the module docs).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// Dormand–Prince 5(4), `ode45`.
+    Explicit,
+    /// Rodas5P, a Rosenbrock (linearly implicit) method, using the Jacobian.
+    Stiff,
+    /// DP5 until its stiffness detection fires, Rodas5P from there on.
+    #[default]
+    Auto,
+}
+
+/// Error control, step-size limits and method. The tolerances and limits default to `ode45`'s.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Options {
     /// Relative tolerance (`RelTol`), finite and > 0.
@@ -57,6 +87,8 @@ pub struct Options {
     pub max_step: Option<f64>,
     /// Most step attempts (accepted + rejected) before giving up, ≥ 1.
     pub max_steps: usize,
+    /// The method, [`Method::Auto`] by default.
+    pub method: Method,
 }
 
 impl Default for Options {
@@ -67,6 +99,7 @@ impl Default for Options {
             initial_step: None,
             max_step: None,
             max_steps: 1_000_000,
+            method: Method::default(),
         }
     }
 }
@@ -74,12 +107,19 @@ impl Default for Options {
 /// Work done by one integration.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Stats {
-    /// Right-hand-side evaluations, `f(t0, y0)` included: `6·(steps + rejected) + 1` thanks to FSAL.
+    /// Right-hand-side evaluations, `f(t0, y0)` included. DP5: `6·(steps + rejected) + 1`
+    /// thanks to FSAL; Rodas5P from `t0`: `steps + 7·(steps + rejected)` (an attempt with a
+    /// singular iteration matrix costs none), plus `D + 1` per Jacobian formed by finite
+    /// differences.
     pub rhs_evals: usize,
     /// Accepted steps.
     pub steps: usize,
     /// Rejected step attempts.
     pub rejected: usize,
+    /// Jacobian evaluations, one per Rodas5P step (0 for DP5).
+    pub jacobian_evals: usize,
+    /// LU factorisations of the iteration matrix, one per Rodas5P attempt (0 for DP5).
+    pub factorisations: usize,
 }
 
 /// Why an integration stopped early or could not start.
@@ -118,14 +158,18 @@ impl IntegrationError {
     }
 }
 
-/// Integrates from `grid[0]` to `grid.last()` and calls `output(i, t_i, &y_i)` for every grid
-/// point (i = 0 included, with y0), in order, values between steps taken from the method's
-/// dense-output interpolant.
+/// Integrates from `grid[0]` to `grid.last()` with `options.method` and calls
+/// `output(i, t_i, &y_i)` for every grid point (i = 0 included, with y0), in order, values
+/// between steps taken from the method's dense-output interpolant.
 ///
 /// `grid` must have at least two finite, strictly increasing points. The step sizes are chosen
 /// by error control, not by the grid (as in `ode45` with more than two `tspan` entries), except
 /// that the default initial step is at most `grid[1] − grid[0]`. On error, `output` has already
 /// been called for the grid points reached before the failure.
+///
+/// When Rodas5P runs, its Jacobian is formed by forward differences (`D + 1` evaluations of `rhs`
+/// per step, ∂f/∂t included, counted in [`Stats::rhs_evals`]); [`solve_grid_with_jacobian`]
+/// takes an analytic one.
 pub fn solve_grid<const D: usize, F, O>(
     rhs: F,
     y0: &SVector<f64, D>,
@@ -137,12 +181,161 @@ where
     F: FnMut(f64, &SVector<f64, D>) -> SVector<f64, D>,
     O: FnMut(usize, f64, &SVector<f64, D>),
 {
-    validate_grid(grid)?;
     let settings = resolve(options, grid)?;
+    let problem = FiniteDifference {
+        rhs,
+        threshold: settings.threshold,
+    };
+    solve(problem, y0, grid, options.method, &settings, output)
+}
+
+/// [`solve_grid`] with an analytic Jacobian: `jacobian(t, y)` returns `(∂f/∂y, ∂f/∂t)` at
+/// `(t, y)` (∂f/∂t is zero for an autonomous problem). It is called once per Rodas5P step, so
+/// never when DP5 runs.
+pub fn solve_grid_with_jacobian<const D: usize, F, J, O>(
+    rhs: F,
+    jacobian: J,
+    y0: &SVector<f64, D>,
+    grid: &[f64],
+    options: &Options,
+    output: O,
+) -> Result<Stats, IntegrationError>
+where
+    F: FnMut(f64, &SVector<f64, D>) -> SVector<f64, D>,
+    J: FnMut(f64, &SVector<f64, D>) -> (SMatrix<f64, D, D>, SVector<f64, D>),
+    O: FnMut(usize, f64, &SVector<f64, D>),
+{
+    let settings = resolve(options, grid)?;
+    solve(
+        Analytic { rhs, jacobian },
+        y0,
+        grid,
+        options.method,
+        &settings,
+        output,
+    )
+}
+
+/// Runs `method` on a validated grid and settings.
+fn solve<const D: usize, P, O>(
+    mut problem: P,
+    y0: &SVector<f64, D>,
+    grid: &[f64],
+    method: Method,
+    settings: &Settings,
+    mut output: O,
+) -> Result<Stats, IntegrationError>
+where
+    P: rosenbrock::Problem<D>,
+    O: FnMut(usize, f64, &SVector<f64, D>),
+{
     if !y0.iter().all(|v| v.is_finite()) {
         return Err(IntegrationError::NonFinite { t: grid[0] });
     }
-    dopri5::integrate(rhs, y0, grid, &settings, output)
+    let mut detector = match method {
+        Method::Explicit => None,
+        Method::Auto => Some(stiffness::StiffnessDetector::default()),
+        Method::Stiff => {
+            let t0 = grid[0];
+            output(0, t0, y0);
+            let f = problem.rhs(t0, y0);
+            if !f.iter().all(|v| v.is_finite()) {
+                return Err(IntegrationError::NonFinite { t: t0 });
+            }
+            let start = rosenbrock::Start {
+                t: t0,
+                y: *y0,
+                f,
+                abs_h: settings.initial_step,
+                next: 1,
+                stats: Stats {
+                    rhs_evals: 1,
+                    ..Stats::default()
+                },
+            };
+            return rosenbrock::integrate(&mut problem, start, grid, settings, output);
+        }
+    };
+    let rhs = |t: f64, y: &SVector<f64, D>| problem.rhs(t, y);
+    match dopri5::integrate(rhs, y0, grid, settings, detector.as_mut(), &mut output)? {
+        dopri5::Outcome::Finished(stats) => Ok(stats),
+        dopri5::Outcome::Stiff(at) => {
+            let start = rosenbrock::Start {
+                t: at.t,
+                y: at.y,
+                f: at.f,
+                abs_h: Some(at.abs_h),
+                next: at.next,
+                stats: at.stats,
+            };
+            rosenbrock::integrate(&mut problem, start, grid, settings, output)
+        }
+    }
+}
+
+/// A problem with its analytic Jacobian.
+struct Analytic<F, J> {
+    rhs: F,
+    jacobian: J,
+}
+
+impl<const D: usize, F, J> rosenbrock::Problem<D> for Analytic<F, J>
+where
+    F: FnMut(f64, &SVector<f64, D>) -> SVector<f64, D>,
+    J: FnMut(f64, &SVector<f64, D>) -> (SMatrix<f64, D, D>, SVector<f64, D>),
+{
+    #[inline]
+    fn rhs(&mut self, t: f64, y: &SVector<f64, D>) -> SVector<f64, D> {
+        (self.rhs)(t, y)
+    }
+
+    #[inline]
+    fn jacobian(
+        &mut self,
+        t: f64,
+        y: &SVector<f64, D>,
+        _f: &SVector<f64, D>,
+    ) -> (SMatrix<f64, D, D>, SVector<f64, D>, usize) {
+        let (dfdy, dfdt) = (self.jacobian)(t, y);
+        (dfdy, dfdt, 0)
+    }
+}
+
+/// A problem whose Jacobian is formed by forward differences, as `rodas.f` does without one:
+/// column j with the increment `√eps·max(|y_j|, atol/rtol)`, ∂f/∂t with `√(eps·max(|t|, 1e-5))`.
+struct FiniteDifference<F> {
+    rhs: F,
+    threshold: f64,
+}
+
+impl<const D: usize, F> rosenbrock::Problem<D> for FiniteDifference<F>
+where
+    F: FnMut(f64, &SVector<f64, D>) -> SVector<f64, D>,
+{
+    #[inline]
+    fn rhs(&mut self, t: f64, y: &SVector<f64, D>) -> SVector<f64, D> {
+        (self.rhs)(t, y)
+    }
+
+    fn jacobian(
+        &mut self,
+        t: f64,
+        y: &SVector<f64, D>,
+        f: &SVector<f64, D>,
+    ) -> (SMatrix<f64, D, D>, SVector<f64, D>, usize) {
+        let sqrt_eps = f64::EPSILON.sqrt();
+        let mut dfdy = SMatrix::<f64, D, D>::zeros();
+        for j in 0..D {
+            let mut shifted = *y;
+            shifted[j] += sqrt_eps * y[j].abs().max(self.threshold);
+            // The increment as represented, not as intended.
+            let delta = shifted[j] - y[j];
+            dfdy.set_column(j, &(((self.rhs)(t, &shifted) - f) / delta));
+        }
+        let t_shifted = t + (f64::EPSILON * t.abs().max(1e-5)).sqrt();
+        let dfdt = ((self.rhs)(t_shifted, y) - f) / (t_shifted - t);
+        (dfdy, dfdt, D + 1)
+    }
 }
 
 /// `t0, t0 + dt, t0 + 2·dt, …, tf`: each point is `t0 + i·dt` (no accumulated rounding) and the
@@ -197,6 +390,7 @@ fn validate_grid(grid: &[f64]) -> Result<(), IntegrationError> {
 }
 
 fn resolve(options: &Options, grid: &[f64]) -> Result<Settings, IntegrationError> {
+    validate_grid(grid)?;
     let positive = |name: &str, value: f64| {
         if value.is_finite() && value > 0.0 {
             Ok(value)

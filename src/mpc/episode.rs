@@ -6,7 +6,6 @@ use std::time::Duration;
 
 use super::{Mpc, MpcError, MpcOptions};
 use crate::closed_loop::{ActiveInference, EpisodeOptions, Trajectory};
-use crate::generated::arm2;
 use crate::integrate::{solve_grid, IntegrationError};
 use crate::{Arm, Error, State, Task, Vector2};
 
@@ -112,7 +111,7 @@ pub fn simulate_mpc(
     let (mut task_error, mut int_j, mut effort) = (0.0, 0.0, 0.0);
     let mut previous: Option<(f64, f64, f64)> = None;
     let mut sample = |t: f64, x: &State, u: &Vector2| {
-        let theta_ddot = arm2::dynamics(x, &(u + perturbation), &params)
+        let theta_ddot = options.plant.dynamics(x, &(u + perturbation), &params)
             .fixed_rows::<2>(2)
             .into_owned();
         let theta = x.fixed_rows::<2>(0).into_owned();
@@ -143,7 +142,7 @@ pub fn simulate_mpc(
         let held = u + perturbation;
         let mut next = x;
         let stats = solve_grid(
-            |_, x: &State| arm2::dynamics(x, &held, &params),
+            |_, x: &State| options.plant.dynamics(x, &held, &params),
             &x,
             &[t0, t1],
             &options.integrator,
