@@ -50,3 +50,52 @@ fn linearisation_sensitivities_and_confidence_table() {
     }
     insta::assert_snapshot!(out);
 }
+
+/// The Lagrangian models' linearisation and Π^U for the paper's default precisions, per task.
+#[test]
+fn lagrangian_models_table() {
+    use nalgebra::{SMatrix, SVector};
+    use toolconf::generated::{arm2_exact, arm3};
+
+    fn rows<const R: usize, const C: usize>(name: &str, m: &SMatrix<f64, R, C>) -> String {
+        (0..R)
+            .map(|i| row(&format!("{name}[{}]", i + 1), m.row(i).iter().copied()))
+            .collect()
+    }
+
+    let mut out = String::new();
+    for p in [[0.3, 0.4, 0.5, 0.2], [0.1, 0.6, 0.6, 0.1]] {
+        let p = SVector::<f64, 4>::from(p);
+        writeln!(out, "arm2_exact {:?}", p.as_slice()).unwrap();
+        out += &rows("A", &arm2_exact::state_matrix(&p));
+        out += &rows("B", &arm2_exact::input_matrix(&p));
+        let eye = SMatrix::<f64, 2, 2>::identity();
+        out += &rows(
+            "Pi^U position",
+            &arm2_exact::position_control_confidence(&p, &(100.0 * eye), &(50.0 * eye), &eye, &eye),
+        );
+        out += &rows(
+            "Pi^U velocity",
+            &arm2_exact::velocity_control_confidence(&p, &(50.0 * eye), &eye, &eye),
+        );
+    }
+    for p in [
+        [0.3, 0.4, 0.2, 0.5, 0.2, 0.35],
+        [0.6, 0.1, 0.3, 0.1, 0.6, 0.2],
+    ] {
+        let p = SVector::<f64, 6>::from(p);
+        writeln!(out, "arm3 {:?}", p.as_slice()).unwrap();
+        out += &rows("A", &arm3::state_matrix(&p));
+        out += &rows("B", &arm3::input_matrix(&p));
+        let eye = SMatrix::<f64, 3, 3>::identity();
+        out += &rows(
+            "Pi^U position",
+            &arm3::position_control_confidence(&p, &(100.0 * eye), &(50.0 * eye), &eye, &eye),
+        );
+        out += &rows(
+            "Pi^U velocity",
+            &arm3::velocity_control_confidence(&p, &(50.0 * eye), &eye, &eye),
+        );
+    }
+    insta::assert_snapshot!(out);
+}
