@@ -17,6 +17,7 @@ pub mod error;
 pub mod experiments;
 pub mod generated;
 pub mod integrate;
+pub mod model;
 pub mod mpc;
 pub mod select;
 pub mod stats;

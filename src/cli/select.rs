@@ -1,6 +1,12 @@
-//! `toolconf select --task T --tools N --seed S [--json]`.
+//! `toolconf select --task T --tools N --seed S [--models arm2,arm3] [--json]`.
+//!
+//! With the default `--models arm2` this is the 2-link selection of `toolconf::select`, output
+//! unchanged; with other models the set is drawn and ranked by `toolconf::model::mixed`.
 
 use serde_json::{json, Value};
+use toolconf::model::mixed::{
+    draw_mixed_tools, evaluate_mixed, MixedObjective, MixedResult, ModelKind,
+};
 use toolconf::select::{draw_tools, evaluate, Objective, ToolResult};
 use toolconf::{Task, TaskKind};
 
@@ -19,6 +25,10 @@ pub struct Args {
     /// Seed of the tool stream: the same seed draws the same tools.
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// Models the tools are drawn from, comma-separated (arm2, arm2_exact, arm3). Per tool a
+    /// model is drawn, then its parameters; each tool runs its own model's version of the task.
+    #[arg(long, value_delimiter = ',', default_value = "arm2", value_parser = parse_model)]
+    models: Vec<ModelKind>,
     #[command(flatten)]
     episode: EpisodeArgs,
     /// Print one JSON object instead of text.
@@ -44,7 +54,14 @@ fn tool_json(r: &ToolResult) -> Value {
     v
 }
 
+fn parse_model(s: &str) -> Result<ModelKind, String> {
+    s.parse()
+}
+
 pub fn run(args: &Args) -> Result<(), CliError> {
+    if args.models != [ModelKind::Arm2] {
+        return run_mixed(args);
+    }
     let task = Task::paper(args.task);
     let options = args.episode.options(false)?;
     let tools = draw_tools(args.tools as usize, args.seed);
@@ -109,6 +126,115 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         match c {
             Some(i) => println!("chosen by {:<12} tool {i}", o.name()),
             None => println!("chosen by {:<12} none (every tool failed)", o.name()),
+        }
+    }
+    Ok(())
+}
+
+fn mixed_tool_json(r: &MixedResult) -> Value {
+    let params: serde_json::Map<String, Value> = r
+        .tool
+        .named_parameters()
+        .into_iter()
+        .map(|(name, value)| (name.to_string(), json!(value)))
+        .collect();
+    let mut v = json!({ "index": r.index, "model": r.model().name(), "arm": params });
+    match &r.logdet {
+        Ok(l) => {
+            v["logdet"] = json!(l);
+            v["logdet_per_joint"] = json!(r.logdet_per_joint());
+        }
+        Err(e) => v["logdet_error"] = json!(e.to_string()),
+    }
+    match &r.episode {
+        Ok(m) => {
+            v["task_error"] = json!(m.task_error);
+            v["free_energy"] = json!(m.free_energy);
+            v["cost_j"] = json!(m.cost_j);
+            v["rhs_evals"] = json!(m.rhs_evals);
+        }
+        Err(e) => v["error"] = json!(e.to_string()),
+    }
+    v
+}
+
+/// Selection over tools of several models (each on its own model's paper-style task).
+fn run_mixed(args: &Args) -> Result<(), CliError> {
+    let options = args.episode.options(false)?;
+    let tools = draw_mixed_tools(&args.models, args.tools as usize, args.seed)?;
+    let results = evaluate_mixed(&tools, args.task, &options);
+    let choices: Vec<(MixedObjective, Option<usize>)> = MixedObjective::ALL
+        .iter()
+        .map(|o| (*o, o.choose(&results)))
+        .collect();
+    let models: Vec<&str> = args.models.iter().map(|m| m.name()).collect();
+    if args.json {
+        let mut choice = serde_json::Map::new();
+        for (o, c) in &choices {
+            choice.insert(o.name().into(), json!(c));
+        }
+        let out = json!({
+            "task": args.task,
+            "seed": args.seed,
+            "perturb": args.episode.perturbation,
+            "models": models,
+            "tools": results.iter().map(mixed_tool_json).collect::<Vec<_>>(),
+            "choice": choice,
+        });
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&out).expect("finite numbers")
+        );
+        return Ok(());
+    }
+    println!(
+        "task: {} (task {})    tools: {}    seed: {}    models: {}",
+        args.task,
+        args.task.paper_index(),
+        args.tools,
+        args.seed,
+        models.join(",")
+    );
+    println!(
+        "{:>5}  {:<10} {:>12} {:>12}  {:>14} {:>14} {:>14}  parameters",
+        "tool", "model", "ln|Pi^U|", "ln|Pi^U|/n", "task error", "int F dt", "int J dt"
+    );
+    for r in &results {
+        let (logdet, per_joint) = match (&r.logdet, r.logdet_per_joint()) {
+            (Ok(l), Some(n)) => (format!("{l:.6}"), format!("{n:.6}")),
+            _ => ("error".to_string(), "error".to_string()),
+        };
+        let metrics = match &r.episode {
+            Ok(m) => format!(
+                "{:>14.6e} {:>14.6e} {:>14.6e}",
+                m.task_error, m.free_energy, m.cost_j
+            ),
+            Err(e) => format!("failed: {e}"),
+        };
+        let params: Vec<String> = r
+            .tool
+            .named_parameters()
+            .into_iter()
+            .map(|(name, value)| format!("{name}={value:.4}"))
+            .collect();
+        println!(
+            "{:>5}  {:<10} {:>12} {:>12}  {}  {}",
+            r.index,
+            r.model().name(),
+            logdet,
+            per_joint,
+            metrics,
+            params.join(" ")
+        );
+    }
+    for (o, c) in &choices {
+        match c {
+            Some(i) => println!(
+                "chosen by {:<21} tool {i} ({})",
+                o.name(),
+                results[*i].model().name()
+            ),
+            None => println!("chosen by {:<21} none (every tool failed)", o.name()),
         }
     }
     Ok(())

@@ -1,0 +1,336 @@
+//! Tool sets that mix models: a seeded draw, parallel evaluation, and choices by ∫F, ∫J, ln|Π^U|
+//! and the normalised confidence ln|Π^U|/n (docs/mixed-tools.md).
+//!
+//! # The stream
+//!
+//! The draws extend [`crate::select::ToolSampler`]'s documented mapping: ChaCha8
+//! (`ChaCha8Rng::seed_from_u64(seed)`), each draw u = (next_u64 >> 11)·2⁻⁵³ ∈ [0, 1). Per tool,
+//! first the model: with k models in the set, index min(⌊k·u⌋, k − 1) into the set as given
+//! (no draw when k = 1, so a set of only `arm2` is exactly `select::draw_tools`); then the
+//! model's parameters, each 0.1 + 0.5·u, in the model's parameter order (arm2: m1 m2 l1 l2;
+//! arm3: m1 m2 m3 l1 l2 l3). Draws happen before any parallel work, so results do not depend on
+//! the number of threads.
+//!
+//! # The task
+//!
+//! Each tool runs its own model's paper-style task ([`ArmModel::paper_task`]): the paper's
+//! precisions (P = value·I of the model's size) and the model's goals from
+//! `derive/models/<model>.toml`. arm2 and arm2_exact use the paper's goals; arm3's extend them
+//! (position θ^g = [π/3, π/3, π/6]: the end joint keeps the 2-link end goal π/6 and the middle
+//! joint follows link 1; velocity θ̇^g = [0, 0, 2] and acceleration θ̈^g = [0, 0, 0.1] on the
+//! last joint). Every episode starts at its model's hanging equilibrium with U0 = 0.1 on every
+//! joint.
+
+use std::fmt;
+use std::str::FromStr;
+
+use rand::{RngCore, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+
+use super::{
+    control_confidence, simulate, simulate_on, Arm2, Arm2ExactTool, Arm2Tool, Arm3, Arm3Tool,
+    ArmModel, EpisodeOptionsN, ModelSimulationError, TaskN, ToolN,
+};
+use crate::closed_loop::{EpisodeOptions, Metrics, Plant};
+use crate::generated;
+use crate::select::PARAMETER_RANGE;
+use crate::{Error, TaskKind};
+
+/// The models a mixed set can draw from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum ModelKind {
+    /// The paper's 2-DOF arm.
+    Arm2,
+    /// The exact 2-link Lagrangian arm.
+    Arm2Exact,
+    /// The 3-link Lagrangian arm.
+    Arm3,
+}
+
+impl ModelKind {
+    pub const ALL: [ModelKind; 3] = [ModelKind::Arm2, ModelKind::Arm2Exact, ModelKind::Arm3];
+
+    /// The generated module's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKind::Arm2 => generated::arm2::NAME,
+            ModelKind::Arm2Exact => generated::arm2_exact::NAME,
+            ModelKind::Arm3 => generated::arm3::NAME,
+        }
+    }
+
+    /// The control dimension n (joints).
+    pub fn dof(self) -> usize {
+        match self {
+            ModelKind::Arm2 => generated::arm2::DOF,
+            ModelKind::Arm2Exact => generated::arm2_exact::DOF,
+            ModelKind::Arm3 => generated::arm3::DOF,
+        }
+    }
+}
+
+impl fmt::Display for ModelKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for ModelKind {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        let s = s.trim().to_ascii_lowercase();
+        ModelKind::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown model '{s}': expected arm2, arm2_exact or arm3"))
+    }
+}
+
+/// A tool of any model.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AnyTool {
+    Arm2(Arm2Tool),
+    Arm2Exact(Arm2ExactTool),
+    Arm3(Arm3Tool),
+}
+
+impl AnyTool {
+    pub fn model(&self) -> ModelKind {
+        match self {
+            AnyTool::Arm2(_) => ModelKind::Arm2,
+            AnyTool::Arm2Exact(_) => ModelKind::Arm2Exact,
+            AnyTool::Arm3(_) => ModelKind::Arm3,
+        }
+    }
+
+    /// (name, value) of every parameter, in the model's order.
+    pub fn named_parameters(&self) -> Vec<(&'static str, f64)> {
+        match self {
+            AnyTool::Arm2(t) => t.named_parameters().to_vec(),
+            AnyTool::Arm2Exact(t) => t.named_parameters().to_vec(),
+            AnyTool::Arm3(t) => t.named_parameters().to_vec(),
+        }
+    }
+
+    /// Builds a validated tool of `model` from its parameters in the model's order.
+    pub fn new(model: ModelKind, params: &[f64]) -> Result<Self, Error> {
+        fn array<const NP: usize>(model: ModelKind, params: &[f64]) -> Result<[f64; NP], Error> {
+            params.try_into().map_err(|_| Error::InvalidOption {
+                name: match model {
+                    ModelKind::Arm3 => "parameter count (arm3 takes 6)",
+                    _ => "parameter count (arm2 takes 4)",
+                },
+                value: params.len() as f64,
+            })
+        }
+        Ok(match model {
+            ModelKind::Arm2 => AnyTool::Arm2(ToolN::new(array(model, params)?)?),
+            ModelKind::Arm2Exact => AnyTool::Arm2Exact(ToolN::new(array(model, params)?)?),
+            ModelKind::Arm3 => AnyTool::Arm3(ToolN::new(array(model, params)?)?),
+        })
+    }
+}
+
+impl fmt::Display for AnyTool {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            AnyTool::Arm2(t) => write!(f, "{}({t})", Arm2::NAME),
+            AnyTool::Arm2Exact(t) => write!(f, "{t:?}"),
+            AnyTool::Arm3(t) => write!(f, "{}({t})", Arm3::NAME),
+        }
+    }
+}
+
+/// A seeded stream of tools of several models (see the module docs for the mapping).
+pub struct MixedSampler {
+    rng: ChaCha8Rng,
+    models: Vec<ModelKind>,
+}
+
+impl MixedSampler {
+    /// Errors if `models` is empty.
+    pub fn new(models: &[ModelKind], seed: u64) -> Result<Self, Error> {
+        if models.is_empty() {
+            return Err(Error::InvalidOption {
+                name: "number of models",
+                value: 0.0,
+            });
+        }
+        Ok(Self {
+            rng: ChaCha8Rng::seed_from_u64(seed),
+            models: models.to_vec(),
+        })
+    }
+
+    fn uniform(&mut self) -> f64 {
+        (self.rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+
+    fn parameters<const NP: usize>(&mut self) -> [f64; NP] {
+        let (lo, hi) = PARAMETER_RANGE;
+        let mut p = [0.0; NP];
+        for v in &mut p {
+            *v = lo + (hi - lo) * self.uniform();
+        }
+        p
+    }
+
+    /// The next tool: its model (if the set has more than one), then its parameters.
+    pub fn next_tool(&mut self) -> AnyTool {
+        let k = self.models.len();
+        let model = if k == 1 {
+            self.models[0]
+        } else {
+            let i = ((k as f64) * self.uniform()) as usize;
+            self.models[i.min(k - 1)]
+        };
+        let valid = "parameters drawn from [0.1, 0.6) are valid";
+        match model {
+            ModelKind::Arm2 => AnyTool::Arm2(ToolN::new(self.parameters()).expect(valid)),
+            ModelKind::Arm2Exact => AnyTool::Arm2Exact(ToolN::new(self.parameters()).expect(valid)),
+            ModelKind::Arm3 => AnyTool::Arm3(ToolN::new(self.parameters()).expect(valid)),
+        }
+    }
+
+    pub fn tools(&mut self, n: usize) -> Vec<AnyTool> {
+        (0..n).map(|_| self.next_tool()).collect()
+    }
+}
+
+/// `n` tools of the given models drawn from `seed`.
+pub fn draw_mixed_tools(models: &[ModelKind], n: usize, seed: u64) -> Result<Vec<AnyTool>, Error> {
+    Ok(MixedSampler::new(models, seed)?.tools(n))
+}
+
+/// One tool's evaluation in a mixed set.
+#[derive(Debug, Clone)]
+pub struct MixedResult {
+    pub index: usize,
+    pub tool: AnyTool,
+    /// ln|Π^U| on the tool's own task.
+    pub logdet: Result<f64, Error>,
+    pub episode: Result<Metrics, ModelSimulationError>,
+}
+
+impl MixedResult {
+    pub fn model(&self) -> ModelKind {
+        self.tool.model()
+    }
+
+    /// ln|Π^U|/n, n the tool's control dimension: the comparable confidence.
+    pub fn logdet_per_joint(&self) -> Option<f64> {
+        self.logdet
+            .as_ref()
+            .ok()
+            .map(|l| l / self.model().dof() as f64)
+    }
+}
+
+fn evaluate_one<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    tool: &ToolN<M, N, NX, NP, NZ>,
+    kind: TaskKind,
+    common: &EpisodeOptions,
+) -> (Result<f64, Error>, Result<Metrics, ModelSimulationError>)
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let task = TaskN::paper::<M, NX, NP, NZ>(kind);
+    let options = EpisodeOptionsN::from_common::<M, NP, NZ>(common);
+    (
+        control_confidence(tool, &task).map(|c| c.logdet),
+        simulate(tool, &task, &options),
+    )
+}
+
+/// Evaluates every tool on its own model's paper-style `kind` task, in parallel; the result
+/// order is the tools' order. `common` gives the horizon, grid, perturbation, learning rate and
+/// integrator ([`EpisodeOptionsN::from_common`]); `common.plant == Plant::Exact` simulates the
+/// arm2 tools on the exact 2-link dynamics (as `--plant exact` does for 2-link selection), other
+/// models always on their own dynamics.
+pub fn evaluate_mixed(
+    tools: &[AnyTool],
+    kind: TaskKind,
+    common: &EpisodeOptions,
+) -> Vec<MixedResult> {
+    tools
+        .par_iter()
+        .enumerate()
+        .map(|(index, tool)| {
+            let (logdet, episode) = match tool {
+                AnyTool::Arm2(t) if common.plant == Plant::Exact => {
+                    let task = TaskN::paper::<Arm2, 4, 4, 6>(kind);
+                    let options = EpisodeOptionsN::from_common::<Arm2, 4, 6>(common);
+                    (
+                        control_confidence(t, &task).map(|c| c.logdet),
+                        simulate_on::<Arm2, super::Arm2Exact, 2, 4, 4, 6>(t, &task, &options),
+                    )
+                }
+                AnyTool::Arm2(t) => evaluate_one(t, kind, common),
+                AnyTool::Arm2Exact(t) => evaluate_one(t, kind, common),
+                AnyTool::Arm3(t) => evaluate_one(t, kind, common),
+            };
+            MixedResult {
+                index,
+                tool: *tool,
+                logdet,
+                episode,
+            }
+        })
+        .collect()
+}
+
+/// An objective that ranks tools of a mixed set.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum MixedObjective {
+    /// argmin ∫F dt.
+    FreeEnergy,
+    /// argmin ∫J dt.
+    CostJ,
+    /// argmax ln|Π^U| (raw: favours more joints, see docs/mixed-tools.md).
+    Confidence,
+    /// argmax ln|Π^U|/n, the per-joint (geometric-mean) confidence.
+    NormalisedConfidence,
+}
+
+impl MixedObjective {
+    pub const ALL: [MixedObjective; 4] = [
+        MixedObjective::FreeEnergy,
+        MixedObjective::CostJ,
+        MixedObjective::Confidence,
+        MixedObjective::NormalisedConfidence,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            MixedObjective::FreeEnergy => "free_energy",
+            MixedObjective::CostJ => "cost_j",
+            MixedObjective::Confidence => "confidence",
+            MixedObjective::NormalisedConfidence => "normalised_confidence",
+        }
+    }
+
+    /// The value to minimise for a tool, if the tool has one.
+    pub fn score(self, r: &MixedResult) -> Option<f64> {
+        match self {
+            MixedObjective::FreeEnergy => r.episode.as_ref().ok().map(|m| m.free_energy),
+            MixedObjective::CostJ => r.episode.as_ref().ok().map(|m| m.cost_j),
+            MixedObjective::Confidence => r.logdet.as_ref().ok().map(|l| -l),
+            MixedObjective::NormalisedConfidence => r.logdet_per_joint().map(|l| -l),
+        }
+    }
+
+    /// The index of the chosen tool; ties go to the earlier tool, failed tools are skipped
+    /// (as [`crate::select::Objective::choose`]).
+    pub fn choose(self, results: &[MixedResult]) -> Option<usize> {
+        results
+            .iter()
+            .filter_map(|r| self.score(r).map(|s| (r.index, s)))
+            .fold(None, |best: Option<(usize, f64)>, (i, s)| match best {
+                Some((_, b)) if b <= s => best,
+                _ => Some((i, s)),
+            })
+            .map(|(i, _)| i)
+    }
+}

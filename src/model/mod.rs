@@ -1,0 +1,568 @@
+//! A runtime generic over the arm model: the same confidence, controller and closed loop as the
+//! 2-link modules ([`crate::confidence`], [`crate::closed_loop`]) for any model that
+//! `make derive` generates, with fixed sizes as const generics.
+//!
+//! * [`ArmModel`] is implemented for the marker types [`Arm2`], [`Arm2Exact`] and [`Arm3`] by one
+//!   `arm_model!` line each, forwarding to the generated module (adding a model = one line).
+//! * [`ToolN`] (validated parameters), [`TaskN`] (goals and precisions), [`control_confidence`]
+//!   (Π^U and ln|Π^U|), [`ActiveInferenceN`], [`ClosedLoopN`] and [`simulate`] mirror their 2-link
+//!   counterparts operation for operation, so that with [`Arm2`] they reproduce
+//!   [`crate::closed_loop::simulate`] bit for bit (tests/generic_runtime.rs).
+//! * [`mixed`] draws and ranks tool sets that mix models.
+//!
+//! The sizes are N (joints = torques), NX = 2N (state X = [θ; θ̇]), NP (tool parameters) and
+//! NZ = NX + N (closed-loop state Z = [X; U]). NZ is a parameter of its own because stable Rust
+//! cannot write `NX + N` in a type; the `arm_model!` macro sets it and [`ClosedLoopN::new`]
+//! checks `NX == 2N` and `NZ == NX + N` at compile time (a post-monomorphisation assertion).
+
+use std::fmt;
+use std::fmt::Debug;
+use std::marker::PhantomData;
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::generated;
+use crate::{Arm, Error, Task, TaskKind};
+
+pub mod mixed;
+mod runtime;
+
+pub use runtime::{
+    simulate, simulate_on, ActiveInferenceN, ClosedLoopN, EpisodeOptionsN, ModelSimulationError,
+};
+
+/// The equations and closed forms of one generated model, with N joints, state dimension NX,
+/// NP tool parameters and closed-loop dimension NZ = NX + N.
+pub trait ArmModel<const N: usize, const NX: usize, const NP: usize, const NZ: usize>:
+    Copy + Debug + Default + Send + Sync + 'static
+{
+    /// The model's name (`generated::<name>`).
+    const NAME: &'static str;
+    /// The tool parameters in the order every function takes them.
+    const PARAMETER_NAMES: [&'static str; NP];
+    /// The equilibrium state X^e the model is linearised at.
+    const EQUILIBRIUM_STATE: [f64; NX];
+
+    /// Ẋ = f(X, U; p).
+    fn dynamics(
+        x: &SVector<f64, NX>,
+        u: &SVector<f64, N>,
+        p: &SVector<f64, NP>,
+    ) -> SVector<f64, NX>;
+    /// (∂f/∂X, ∂f/∂U) at any X, U.
+    fn dynamics_jacobian(
+        x: &SVector<f64, NX>,
+        u: &SVector<f64, N>,
+        p: &SVector<f64, NP>,
+    ) -> (SMatrix<f64, NX, NX>, SMatrix<f64, NX, N>);
+    /// A = ∂f/∂X at the equilibrium.
+    fn state_matrix(p: &SVector<f64, NP>) -> SMatrix<f64, NX, NX>;
+    /// B = ∂f/∂U at the equilibrium.
+    fn input_matrix(p: &SVector<f64, NP>) -> SMatrix<f64, NX, N>;
+    /// The task's sensitivities ∂(task variable)/∂U.
+    fn sensitivities(kind: TaskKind, p: &SVector<f64, NP>) -> SensitivitiesN<N>;
+    /// Π^U = Σ Sᵀ P S over the task's terms + P^U, unvalidated (the generated closed form).
+    fn pi_u(task: &TaskN<N>, p: &SVector<f64, NP>) -> SMatrix<f64, N, N>;
+    /// The model's paper-style task: its own goals (`derive/models/<name>.toml`) and the
+    /// paper's precisions (`derive/tasks.toml`).
+    fn paper_task(kind: TaskKind) -> TaskN<N>;
+
+    /// X^e as a vector.
+    fn equilibrium_state() -> SVector<f64, NX> {
+        SVector::from(Self::EQUILIBRIUM_STATE)
+    }
+}
+
+/// Implements [`ArmModel`] for a marker type by forwarding to `crate::generated::$module`.
+macro_rules! arm_model {
+    ($(#[$doc:meta])* $marker:ident => $module:ident) => {
+        $(#[$doc])*
+        #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
+        pub struct $marker;
+
+        impl
+            ArmModel<
+                { generated::$module::DOF },
+                { generated::$module::STATE_DIM },
+                { generated::$module::PARAMETER_COUNT },
+                { generated::$module::STATE_DIM + generated::$module::DOF },
+            > for $marker
+        {
+            const NAME: &'static str = generated::$module::NAME;
+            const PARAMETER_NAMES: [&'static str; generated::$module::PARAMETER_COUNT] =
+                generated::$module::PARAMETER_NAMES;
+            const EQUILIBRIUM_STATE: [f64; generated::$module::STATE_DIM] =
+                generated::$module::EQUILIBRIUM_STATE;
+
+            #[inline]
+            fn dynamics(
+                x: &SVector<f64, { generated::$module::STATE_DIM }>,
+                u: &SVector<f64, { generated::$module::DOF }>,
+                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
+            ) -> SVector<f64, { generated::$module::STATE_DIM }> {
+                generated::$module::dynamics(x, u, p)
+            }
+
+            #[inline]
+            fn dynamics_jacobian(
+                x: &SVector<f64, { generated::$module::STATE_DIM }>,
+                u: &SVector<f64, { generated::$module::DOF }>,
+                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
+            ) -> (
+                SMatrix<f64, { generated::$module::STATE_DIM }, { generated::$module::STATE_DIM }>,
+                SMatrix<f64, { generated::$module::STATE_DIM }, { generated::$module::DOF }>,
+            ) {
+                generated::$module::dynamics_jacobian(x, u, p)
+            }
+
+            fn state_matrix(
+                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
+            ) -> SMatrix<f64, { generated::$module::STATE_DIM }, { generated::$module::STATE_DIM }>
+            {
+                generated::$module::state_matrix(p)
+            }
+
+            fn input_matrix(
+                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
+            ) -> SMatrix<f64, { generated::$module::STATE_DIM }, { generated::$module::DOF }> {
+                generated::$module::input_matrix(p)
+            }
+
+            fn sensitivities(
+                kind: TaskKind,
+                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
+            ) -> SensitivitiesN<{ generated::$module::DOF }> {
+                match kind {
+                    TaskKind::Position => {
+                        let (d_theta, d_theta_dot, d_theta_ddot) =
+                            generated::$module::position_sensitivity(p);
+                        SensitivitiesN {
+                            d_theta_du: Some(d_theta),
+                            d_theta_dot_du: Some(d_theta_dot),
+                            d_theta_ddot_du: d_theta_ddot,
+                        }
+                    }
+                    TaskKind::Velocity => {
+                        let (d_theta_dot, d_theta_ddot) =
+                            generated::$module::velocity_sensitivity(p);
+                        SensitivitiesN {
+                            d_theta_du: None,
+                            d_theta_dot_du: Some(d_theta_dot),
+                            d_theta_ddot_du: d_theta_ddot,
+                        }
+                    }
+                    TaskKind::Acceleration => SensitivitiesN {
+                        d_theta_du: None,
+                        d_theta_dot_du: None,
+                        d_theta_ddot_du: generated::$module::acceleration_sensitivity(p),
+                    },
+                }
+            }
+
+            fn pi_u(
+                task: &TaskN<{ generated::$module::DOF }>,
+                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
+            ) -> SMatrix<f64, { generated::$module::DOF }, { generated::$module::DOF }> {
+                match task.kind {
+                    TaskKind::Position => generated::$module::position_control_confidence(
+                        p,
+                        &task.precision_theta,
+                        &task.precision_theta_dot,
+                        &task.precision_theta_ddot,
+                        &task.precision_u,
+                    ),
+                    TaskKind::Velocity => generated::$module::velocity_control_confidence(
+                        p,
+                        &task.precision_theta_dot,
+                        &task.precision_theta_ddot,
+                        &task.precision_u,
+                    ),
+                    TaskKind::Acceleration => generated::$module::acceleration_control_confidence(
+                        p,
+                        &task.precision_theta_ddot,
+                        &task.precision_u,
+                    ),
+                }
+            }
+
+            fn paper_task(kind: TaskKind) -> TaskN<{ generated::$module::DOF }> {
+                let eye = SMatrix::identity();
+                let zero = SVector::zeros();
+                match kind {
+                    TaskKind::Position => {
+                        use generated::$module::position as p;
+                        TaskN {
+                            kind,
+                            goal_theta: SVector::from(p::GOAL_THETA),
+                            goal_theta_dot: SVector::from(p::GOAL_THETA_DOT),
+                            goal_theta_ddot: SVector::from(p::GOAL_THETA_DDOT),
+                            precision_theta: eye * p::PRECISION_THETA,
+                            precision_theta_dot: eye * p::PRECISION_THETA_DOT,
+                            precision_theta_ddot: eye * p::PRECISION_THETA_DDOT,
+                            precision_u: eye * p::PRECISION_U,
+                        }
+                    }
+                    TaskKind::Velocity => {
+                        use generated::$module::velocity as p;
+                        TaskN {
+                            kind,
+                            goal_theta: zero,
+                            goal_theta_dot: SVector::from(p::GOAL_THETA_DOT),
+                            goal_theta_ddot: SVector::from(p::GOAL_THETA_DDOT),
+                            precision_theta: SMatrix::zeros(),
+                            precision_theta_dot: eye * p::PRECISION_THETA_DOT,
+                            precision_theta_ddot: eye * p::PRECISION_THETA_DDOT,
+                            precision_u: eye * p::PRECISION_U,
+                        }
+                    }
+                    TaskKind::Acceleration => {
+                        use generated::$module::acceleration as p;
+                        TaskN {
+                            kind,
+                            goal_theta: zero,
+                            goal_theta_dot: zero,
+                            goal_theta_ddot: SVector::from(p::GOAL_THETA_DDOT),
+                            precision_theta: SMatrix::zeros(),
+                            precision_theta_dot: SMatrix::zeros(),
+                            precision_theta_ddot: eye * p::PRECISION_THETA_DDOT,
+                            precision_u: eye * p::PRECISION_U,
+                        }
+                    }
+                }
+            }
+        }
+    };
+}
+
+arm_model!(
+    /// The paper's 2-DOF arm (`generated::arm2`).
+    Arm2 => arm2
+);
+arm_model!(
+    /// The exact 2-link Lagrangian arm (`generated::arm2_exact`).
+    Arm2Exact => arm2_exact
+);
+arm_model!(
+    /// The 3-link Lagrangian arm (`generated::arm3`).
+    Arm3 => arm3
+);
+
+/// A tool of the paper's 2-DOF model.
+pub type Arm2Tool = ToolN<Arm2, 2, 4, 4, 6>;
+/// A tool of the exact 2-link model.
+pub type Arm2ExactTool = ToolN<Arm2Exact, 2, 4, 4, 6>;
+/// A tool of the 3-link model.
+pub type Arm3Tool = ToolN<Arm3, 3, 6, 6, 9>;
+
+/// The sensitivities ∂(task variable)/∂U a task's controller uses; `None` for unused terms
+/// (the N-joint [`crate::Sensitivities`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SensitivitiesN<const N: usize> {
+    pub d_theta_du: Option<SMatrix<f64, N, N>>,
+    pub d_theta_dot_du: Option<SMatrix<f64, N, N>>,
+    pub d_theta_ddot_du: SMatrix<f64, N, N>,
+}
+
+/// One tool of model `M`: its parameters, each finite and > 0.
+///
+/// The parameters are private so that every `ToolN` has passed [`ToolN::new`].
+pub struct ToolN<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> {
+    params: SVector<f64, NP>,
+    model: PhantomData<M>,
+}
+
+// Manual impls: derives would require `M: Clone` etc. through `PhantomData`'s bounds anyway, and
+// `M` is a zero-sized marker.
+impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> Clone
+    for ToolN<M, N, NX, NP, NZ>
+{
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> Copy
+    for ToolN<M, N, NX, NP, NZ>
+{
+}
+impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> PartialEq
+    for ToolN<M, N, NX, NP, NZ>
+{
+    fn eq(&self, other: &Self) -> bool {
+        self.params == other.params
+    }
+}
+
+impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> ToolN<M, N, NX, NP, NZ>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    /// Validates and builds a tool from its parameters in [`ArmModel::PARAMETER_NAMES`] order.
+    /// A non-positive, NaN or infinite value is an [`Error::InvalidParameter`] naming it.
+    pub fn new(params: [f64; NP]) -> Result<Self, Error> {
+        for (name, value) in M::PARAMETER_NAMES.into_iter().zip(params) {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(Error::InvalidParameter { name, value });
+            }
+        }
+        Ok(Self {
+            params: SVector::from(params),
+            model: PhantomData,
+        })
+    }
+
+    /// The parameter vector p the generated functions take.
+    pub fn params(&self) -> SVector<f64, NP> {
+        self.params
+    }
+
+    /// The model's name.
+    pub fn model_name(&self) -> &'static str {
+        M::NAME
+    }
+
+    /// (name, value) of every parameter, in order.
+    pub fn named_parameters(&self) -> [(&'static str, f64); NP] {
+        std::array::from_fn(|i| (M::PARAMETER_NAMES[i], self.params[i]))
+    }
+
+    /// Ẋ = f(X, U; p).
+    pub fn dynamics(&self, x: &SVector<f64, NX>, u: &SVector<f64, N>) -> SVector<f64, NX> {
+        M::dynamics(x, u, &self.params)
+    }
+
+    /// A at the equilibrium.
+    pub fn state_matrix(&self) -> SMatrix<f64, NX, NX> {
+        M::state_matrix(&self.params)
+    }
+
+    /// B at the equilibrium.
+    pub fn input_matrix(&self) -> SMatrix<f64, NX, N> {
+        M::input_matrix(&self.params)
+    }
+
+    /// The task's sensitivities.
+    pub fn sensitivities(&self, kind: TaskKind) -> SensitivitiesN<N> {
+        M::sensitivities(kind, &self.params)
+    }
+}
+
+impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> Debug
+    for ToolN<M, N, NX, NP, NZ>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}({self})", M::NAME)
+    }
+}
+
+/// `m1=… m2=… …`, as [`Arm`] prints itself.
+impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> fmt::Display
+    for ToolN<M, N, NX, NP, NZ>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, (name, value)) in self.named_parameters().iter().enumerate() {
+            if i > 0 {
+                f.write_str(" ")?;
+            }
+            write!(f, "{name}={value}")?;
+        }
+        Ok(())
+    }
+}
+
+impl From<&Arm> for Arm2Tool {
+    fn from(arm: &Arm) -> Self {
+        Self {
+            params: arm.params(),
+            model: PhantomData,
+        }
+    }
+}
+
+impl From<&Arm> for Arm2ExactTool {
+    fn from(arm: &Arm) -> Self {
+        Self {
+            params: arm.params(),
+            model: PhantomData,
+        }
+    }
+}
+
+/// A task for N joints: goals and prior precisions (the N-joint [`Task`]). A term the task's
+/// controller does not use has precision zero.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TaskN<const N: usize> {
+    pub kind: TaskKind,
+    pub goal_theta: SVector<f64, N>,
+    pub goal_theta_dot: SVector<f64, N>,
+    pub goal_theta_ddot: SVector<f64, N>,
+    pub precision_theta: SMatrix<f64, N, N>,
+    pub precision_theta_dot: SMatrix<f64, N, N>,
+    pub precision_theta_ddot: SMatrix<f64, N, N>,
+    pub precision_u: SMatrix<f64, N, N>,
+}
+
+impl<const N: usize> TaskN<N> {
+    /// Model `M`'s paper-style task ([`ArmModel::paper_task`]).
+    pub fn paper<M, const NX: usize, const NP: usize, const NZ: usize>(kind: TaskKind) -> Self
+    where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
+        M::paper_task(kind)
+    }
+
+    /// Checks goals are finite and precisions finite, symmetric and positive semi-definite,
+    /// with the errors [`Task::validate`] gives.
+    pub fn validate(&self) -> Result<(), Error> {
+        for (name, goal) in [
+            ("theta_g", &self.goal_theta),
+            ("theta_dot_g", &self.goal_theta_dot),
+            ("theta_ddot_g", &self.goal_theta_ddot),
+        ] {
+            if let Some(&value) = goal.iter().find(|v| !v.is_finite()) {
+                return Err(Error::InvalidGoal {
+                    name: name.into(),
+                    value,
+                });
+            }
+        }
+        for (name, p) in [
+            ("P_theta", &self.precision_theta),
+            ("P_theta_dot", &self.precision_theta_dot),
+            ("P_theta_ddot", &self.precision_theta_ddot),
+            ("P_u", &self.precision_u),
+        ] {
+            check_precision(name, p)?;
+        }
+        Ok(())
+    }
+}
+
+impl From<&Task> for TaskN<2> {
+    fn from(t: &Task) -> Self {
+        Self {
+            kind: t.kind,
+            goal_theta: t.goal_theta,
+            goal_theta_dot: t.goal_theta_dot,
+            goal_theta_ddot: t.goal_theta_ddot,
+            precision_theta: t.precision_theta,
+            precision_theta_dot: t.precision_theta_dot,
+            precision_theta_ddot: t.precision_theta_ddot,
+            precision_u: t.precision_u,
+        }
+    }
+}
+
+/// Finite, symmetric (to 1e-12 relative) and positive semi-definite: the smallest eigenvalue
+/// of the symmetric part is ≥ −1e-12·max|P| (for N = 2 the determinant test of [`Task::validate`]).
+fn check_precision<const N: usize>(name: &str, p: &SMatrix<f64, N, N>) -> Result<(), Error> {
+    let invalid = |reason: String| Error::InvalidPrecision {
+        name: name.into(),
+        reason,
+    };
+    if p.iter().any(|v| !v.is_finite()) {
+        return Err(invalid(format!(
+            "has a non-finite entry: {:?}",
+            p.as_slice()
+        )));
+    }
+    let scale = p.amax();
+    for i in 0..N {
+        for j in (i + 1)..N {
+            if (p[(i, j)] - p[(j, i)]).abs() > 1e-12 * scale.max(1.0) {
+                return Err(invalid(format!(
+                    "is not symmetric ({} vs {})",
+                    p[(i, j)],
+                    p[(j, i)]
+                )));
+            }
+        }
+    }
+    let not_psd = || invalid("is not positive semi-definite".into());
+    if N == 2 {
+        let det = p[(0, 0)] * p[(1, 1)] - p[(0, 1)] * p[(1, 0)];
+        if p[(0, 0)] < 0.0 || p[(1, 1)] < 0.0 || det < -1e-12 * scale.powi(2) {
+            return Err(not_psd());
+        }
+    } else if N > 0 {
+        // Dynamic storage: nalgebra's eigen-decomposition needs dimension bounds a const
+        // generic N cannot state on stable Rust. Once per task, so the allocation is moot.
+        let symmetric = nalgebra::DMatrix::from_fn(N, N, |i, j| 0.5 * (p[(i, j)] + p[(j, i)]));
+        let smallest = symmetric.symmetric_eigenvalues().min();
+        if smallest < -1e-12 * scale {
+            return Err(not_psd());
+        }
+    }
+    Ok(())
+}
+
+/// Π^U with ln|Π^U| for N joints (the N-joint [`crate::ControlConfidence`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ControlConfidenceN<const N: usize> {
+    /// Π^U, symmetric positive definite.
+    pub pi_u: SMatrix<f64, N, N>,
+    /// ln|Π^U|.
+    pub logdet: f64,
+}
+
+impl<const N: usize> ControlConfidenceN<N> {
+    /// ln|Π^U|/N: the mean log precision per control channel, ln of the geometric mean of Π^U's
+    /// eigenvalues; the quantity comparable across models with different N (docs/mixed-tools.md).
+    pub fn logdet_per_joint(&self) -> f64 {
+        self.logdet / N as f64
+    }
+}
+
+/// The closed-form control confidence of `tool` for `task`: Π^U and ln|Π^U|.
+///
+/// Errors if the task is invalid or Π^U is not positive definite
+/// ([`Error::NotPositiveDefinite`], with the determinant). ln|Π^U| is 2 Σ ln L_ii of the
+/// Cholesky factor; for N = 2 it is ln(Π₀₀Π₁₁ − Π₀₁Π₁₀), the 2-link runtime's exact closed form,
+/// so that the generic path reproduces [`crate::control_confidence`] bit for bit.
+pub fn control_confidence<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    tool: &ToolN<M, N, NX, NP, NZ>,
+    task: &TaskN<N>,
+) -> Result<ControlConfidenceN<N>, Error>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    task.validate()?;
+    let pi_u = M::pi_u(task, &tool.params);
+    let logdet = logdet_of(&pi_u)?;
+    Ok(ControlConfidenceN { pi_u, logdet })
+}
+
+/// ln|Π| of a symmetric positive definite Π, or [`Error::NotPositiveDefinite`].
+pub fn logdet_of<const N: usize>(pi: &SMatrix<f64, N, N>) -> Result<f64, Error> {
+    if N == 2 {
+        let determinant = pi[(0, 0)] * pi[(1, 1)] - pi[(0, 1)] * pi[(1, 0)];
+        if !(pi[(0, 0)] > 0.0 && determinant > 0.0 && determinant.is_finite()) {
+            return Err(Error::NotPositiveDefinite { determinant });
+        }
+        return Ok(determinant.ln());
+    }
+    let not_pd = || Error::NotPositiveDefinite {
+        determinant: nalgebra::DMatrix::from_fn(N, N, |i, j| pi[(i, j)]).determinant(),
+    };
+    if pi.iter().any(|v| !v.is_finite()) {
+        return Err(not_pd());
+    }
+    let cholesky = nalgebra::Cholesky::new(*pi).ok_or_else(not_pd)?;
+    let l = cholesky.l_dirty();
+    let mut logdet = 0.0;
+    for i in 0..N {
+        let d = l[(i, i)];
+        if !(d > 0.0 && d.is_finite()) {
+            return Err(not_pd());
+        }
+        logdet += 2.0 * d.ln();
+    }
+    if logdet.is_finite() {
+        Ok(logdet)
+    } else {
+        Err(not_pd())
+    }
+}

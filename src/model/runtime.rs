@@ -1,0 +1,484 @@
+//! The active-inference controller, closed loop and episode for any [`ArmModel`], operation for
+//! operation the 2-link `src/closed_loop/{controller,system,episode}.rs`.
+
+use std::marker::PhantomData;
+
+use nalgebra::{SMatrix, SVector};
+
+use super::{control_confidence, ArmModel, TaskN, ToolN};
+use crate::closed_loop::{EpisodeOptions, Metrics};
+use crate::integrate::{
+    solve_grid_with_jacobian, uniform_grid, IntegrationError, Method, Options as IntegratorOptions,
+};
+use crate::{Error, TaskKind};
+
+/// A grid state whose magnitude passes this is a diverging simulation, not a result (as in
+/// [`crate::closed_loop::simulate`]).
+const DIVERGENCE_BOUND: f64 = 1e6;
+
+/// Compile-time check of the sizes: NX = 2N and NZ = NX + N.
+struct Dims<const N: usize, const NX: usize, const NZ: usize>;
+
+impl<const N: usize, const NX: usize, const NZ: usize> Dims<N, NX, NZ> {
+    const CHECK: () = assert!(
+        NX == 2 * N && NZ == NX + N,
+        "model sizes must satisfy NX == 2N and NZ == NX + N"
+    );
+}
+
+/// The controller of one tool for one task: U̇ = −γ ∂F/∂U (the N-joint
+/// [`crate::closed_loop::ActiveInference`]).
+#[derive(Debug, Clone, Copy)]
+pub struct ActiveInferenceN<const N: usize> {
+    pub task: TaskN<N>,
+    /// Learning rate γ.
+    pub learning_rate: f64,
+    gain_theta: SMatrix<f64, N, N>,
+    gain_theta_dot: SMatrix<f64, N, N>,
+    gain_theta_ddot: SMatrix<f64, N, N>,
+    /// ln|Π^U|.
+    pub logdet: f64,
+}
+
+impl<const N: usize> ActiveInferenceN<N> {
+    pub fn new<M, const NX: usize, const NP: usize, const NZ: usize>(
+        tool: &ToolN<M, N, NX, NP, NZ>,
+        task: &TaskN<N>,
+        learning_rate: f64,
+    ) -> Result<Self, Error>
+    where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
+        if !(learning_rate.is_finite() && learning_rate > 0.0) {
+            return Err(Error::InvalidOption {
+                name: "learning rate",
+                value: learning_rate,
+            });
+        }
+        let confidence = control_confidence(tool, task)?;
+        let s = tool.sensitivities(task.kind);
+        let zero = SMatrix::<f64, N, N>::zeros();
+        let gain = |s: Option<SMatrix<f64, N, N>>, p: &SMatrix<f64, N, N>| {
+            s.map_or(zero, |s| s.transpose() * p)
+        };
+        Ok(Self {
+            task: *task,
+            learning_rate,
+            gain_theta: gain(s.d_theta_du, &task.precision_theta),
+            gain_theta_dot: gain(s.d_theta_dot_du, &task.precision_theta_dot),
+            gain_theta_ddot: gain(Some(s.d_theta_ddot_du), &task.precision_theta_ddot),
+            logdet: confidence.logdet,
+        })
+    }
+
+    /// U̇ = −γ ∂F/∂U.
+    #[inline]
+    pub fn control_rate(
+        &self,
+        theta: &SVector<f64, N>,
+        theta_dot: &SVector<f64, N>,
+        theta_ddot: &SVector<f64, N>,
+        u: &SVector<f64, N>,
+    ) -> SVector<f64, N> {
+        let t = &self.task;
+        let gradient = self.gain_theta * (theta - t.goal_theta)
+            + self.gain_theta_dot * (theta_dot - t.goal_theta_dot)
+            + self.gain_theta_ddot * (theta_ddot - t.goal_theta_ddot)
+            + t.precision_u * u;
+        -self.learning_rate * gradient
+    }
+
+    /// γ·(K_θ, K_θ̇, K_θ̈, P^U).
+    pub fn scaled_gains(&self) -> [SMatrix<f64, N, N>; 4] {
+        let g = self.learning_rate;
+        [
+            g * self.gain_theta,
+            g * self.gain_theta_dot,
+            g * self.gain_theta_ddot,
+            g * self.task.precision_u,
+        ]
+    }
+
+    /// J = ½[Σ eᵀPe + UᵀP^U U] over the task's terms.
+    #[inline]
+    pub fn cost_j(
+        &self,
+        theta: &SVector<f64, N>,
+        theta_dot: &SVector<f64, N>,
+        theta_ddot: &SVector<f64, N>,
+        u: &SVector<f64, N>,
+    ) -> f64 {
+        let t = &self.task;
+        let q = |e: SVector<f64, N>, p: &SMatrix<f64, N, N>| e.dot(&(p * e));
+        let mut sum = q(*theta_ddot - t.goal_theta_ddot, &t.precision_theta_ddot)
+            + u.dot(&(t.precision_u * u));
+        if t.kind != TaskKind::Acceleration {
+            sum += q(*theta_dot - t.goal_theta_dot, &t.precision_theta_dot);
+        }
+        if t.kind == TaskKind::Position {
+            sum += q(*theta - t.goal_theta, &t.precision_theta);
+        }
+        0.5 * sum
+    }
+
+    /// F = J − ½ ln|Π^U|.
+    #[inline]
+    pub fn free_energy(
+        &self,
+        theta: &SVector<f64, N>,
+        theta_dot: &SVector<f64, N>,
+        theta_ddot: &SVector<f64, N>,
+        u: &SVector<f64, N>,
+    ) -> f64 {
+        self.cost_j(theta, theta_dot, theta_ddot, u) - 0.5 * self.logdet
+    }
+
+    /// The task's own weighted error at one instant.
+    #[inline]
+    pub fn task_error(
+        &self,
+        theta: &SVector<f64, N>,
+        theta_dot: &SVector<f64, N>,
+        theta_ddot: &SVector<f64, N>,
+    ) -> f64 {
+        let t = &self.task;
+        let (e, p) = match t.kind {
+            TaskKind::Position => (theta - t.goal_theta, &t.precision_theta),
+            TaskKind::Velocity => (theta_dot - t.goal_theta_dot, &t.precision_theta_dot),
+            TaskKind::Acceleration => (theta_ddot - t.goal_theta_ddot, &t.precision_theta_ddot),
+        };
+        e.dot(&(p * e))
+    }
+}
+
+/// Ż = [f_P(X, U + ΔT); −γ ∂F/∂U]: the controller uses model `M`, the simulated world (plant)
+/// is model `P` with the same tool parameters (`P = M` normally; `M = Arm2, P = Arm2Exact` is
+/// [`crate::closed_loop::Plant::Exact`]).
+#[derive(Debug, Clone, Copy)]
+pub struct ClosedLoopN<P, const N: usize, const NX: usize, const NP: usize, const NZ: usize> {
+    params: SVector<f64, NP>,
+    pub controller: ActiveInferenceN<N>,
+    perturbation: SVector<f64, N>,
+    plant: PhantomData<P>,
+}
+
+impl<P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>
+    ClosedLoopN<P, N, NX, NP, NZ>
+where
+    P: ArmModel<N, NX, NP, NZ>,
+{
+    /// The closed loop of `tool` (controller model `M`) on plant `P`.
+    pub fn new<M>(
+        tool: &ToolN<M, N, NX, NP, NZ>,
+        task: &TaskN<N>,
+        learning_rate: f64,
+        perturbation: f64,
+    ) -> Result<Self, Error>
+    where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
+        #[allow(clippy::let_unit_value)]
+        let () = Dims::<N, NX, NZ>::CHECK;
+        if !perturbation.is_finite() {
+            return Err(Error::InvalidOption {
+                name: "perturbation dT",
+                value: perturbation,
+            });
+        }
+        Ok(Self {
+            params: tool.params(),
+            controller: ActiveInferenceN::new(tool, task, learning_rate)?,
+            perturbation: SVector::repeat(perturbation),
+            plant: PhantomData,
+        })
+    }
+
+    /// Ż and the plant's θ̈.
+    #[inline]
+    pub fn rhs_and_acceleration(
+        &self,
+        z: &SVector<f64, NZ>,
+    ) -> (SVector<f64, NZ>, SVector<f64, N>) {
+        let x = z.fixed_rows::<NX>(0).into_owned();
+        let u = z.fixed_rows::<N>(NX).into_owned();
+        let x_dot = P::dynamics(&x, &(u + self.perturbation), &self.params);
+        let theta = x.fixed_rows::<N>(0).into_owned();
+        let theta_dot = x.fixed_rows::<N>(N).into_owned();
+        let theta_ddot = x_dot.fixed_rows::<N>(N).into_owned();
+        let u_dot = self
+            .controller
+            .control_rate(&theta, &theta_dot, &theta_ddot, &u);
+        let mut z_dot = SVector::<f64, NZ>::zeros();
+        z_dot.fixed_rows_mut::<NX>(0).copy_from(&x_dot);
+        z_dot.fixed_rows_mut::<N>(NX).copy_from(&u_dot);
+        (z_dot, theta_ddot)
+    }
+
+    /// Ż.
+    #[inline]
+    pub fn rhs(&self, z: &SVector<f64, NZ>) -> SVector<f64, NZ> {
+        self.rhs_and_acceleration(z).0
+    }
+
+    /// ∂Ż/∂Z from the generated ∂f/∂X, ∂f/∂U and the controller's constant gains.
+    #[inline]
+    pub fn jacobian(&self, z: &SVector<f64, NZ>) -> SMatrix<f64, NZ, NZ> {
+        let x = z.fixed_rows::<NX>(0).into_owned();
+        let u = z.fixed_rows::<N>(NX).into_owned();
+        let (f_x, f_u) = P::dynamics_jacobian(&x, &(u + self.perturbation), &self.params);
+        let [k_theta, k_theta_dot, k_theta_ddot, p_u] = self.controller.scaled_gains();
+        let accel_x = f_x.fixed_view::<N, NX>(N, 0);
+        let accel_u = f_u.fixed_view::<N, N>(N, 0);
+        let mut j = SMatrix::<f64, NZ, NZ>::zeros();
+        j.fixed_view_mut::<NX, NX>(0, 0).copy_from(&f_x);
+        j.fixed_view_mut::<NX, N>(0, NX).copy_from(&f_u);
+        let mut du_dx = -(k_theta_ddot * accel_x);
+        let mut block = du_dx.fixed_view_mut::<N, N>(0, 0);
+        block -= k_theta;
+        let mut block = du_dx.fixed_view_mut::<N, N>(0, N);
+        block -= k_theta_dot;
+        j.fixed_view_mut::<N, NX>(NX, 0).copy_from(&du_dx);
+        j.fixed_view_mut::<N, N>(NX, NX)
+            .copy_from(&(-(k_theta_ddot * accel_u) - p_u));
+        j
+    }
+}
+
+/// Options of one episode for N joints (the N-joint [`EpisodeOptions`] without trajectory
+/// recording and plant choice: the plant is a type parameter of [`simulate_on`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EpisodeOptionsN<const N: usize, const NX: usize> {
+    pub t_end: f64,
+    pub dt: f64,
+    /// Initial state X0.
+    pub x0: SVector<f64, NX>,
+    /// Initial torque U0.
+    pub u0: SVector<f64, N>,
+    /// Constant torque perturbation ΔT on every joint [N m].
+    pub perturbation: f64,
+    pub learning_rate: f64,
+    /// Integrator options; [`Method::Auto`] runs DP5 on tasks 1–2 and the DP5-to-Rodas5P
+    /// switch on task 3, as [`crate::closed_loop::simulate`] does.
+    pub integrator: IntegratorOptions,
+}
+
+impl<const N: usize, const NX: usize> EpisodeOptionsN<N, NX> {
+    /// The paper's options for model `M`: X0 = M's equilibrium, U0 = 0.1 on every joint, the
+    /// rest [`EpisodeOptions::default`].
+    pub fn paper<M, const NP: usize, const NZ: usize>() -> Self
+    where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
+        Self::from_common::<M, NP, NZ>(&EpisodeOptions::default())
+    }
+
+    /// `common`'s horizon, grid, perturbation, learning rate and integrator, with model `M`'s
+    /// equilibrium as X0 and U0 = `common.u0[0]` on every joint (0.1 by default). `common.x0`,
+    /// `common.plant` and `common.record_trajectory` are not used.
+    pub fn from_common<M, const NP: usize, const NZ: usize>(common: &EpisodeOptions) -> Self
+    where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
+        Self {
+            t_end: common.t_end,
+            dt: common.dt,
+            x0: M::equilibrium_state(),
+            u0: SVector::repeat(common.u0[0]),
+            perturbation: common.perturbation,
+            learning_rate: common.learning_rate,
+            integrator: common.integrator,
+        }
+    }
+}
+
+impl From<&EpisodeOptions> for EpisodeOptionsN<2, 4> {
+    /// The 2-link options as they are (X0 and U0 included); `plant` and `record_trajectory` are
+    /// not used.
+    fn from(o: &EpisodeOptions) -> Self {
+        Self {
+            t_end: o.t_end,
+            dt: o.dt,
+            x0: o.x0,
+            u0: o.u0,
+            perturbation: o.perturbation,
+            learning_rate: o.learning_rate,
+            integrator: o.integrator,
+        }
+    }
+}
+
+/// Why an episode of the generic runtime failed (the generic
+/// [`crate::closed_loop::SimulationError`]; the tool is named as `model(m1=… …)`).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ModelSimulationError {
+    #[error(transparent)]
+    Input(#[from] Error),
+    #[error("simulation of {tool} failed: {source}")]
+    Integration {
+        tool: String,
+        source: IntegrationError,
+    },
+    #[error("simulation of {tool} diverged at t = {t} s: |state| = {magnitude:e} exceeds {DIVERGENCE_BOUND:e}")]
+    Diverged {
+        tool: String,
+        t: f64,
+        magnitude: f64,
+    },
+}
+
+impl ModelSimulationError {
+    /// The time the failure happened at, if it is a failure of the simulation itself.
+    pub fn time(&self) -> Option<f64> {
+        match self {
+            ModelSimulationError::Input(_) => None,
+            ModelSimulationError::Integration { source, .. } => source.time(),
+            ModelSimulationError::Diverged { t, .. } => Some(*t),
+        }
+    }
+}
+
+/// One episode of `tool` on `task`, the plant being the tool's own model.
+pub fn simulate<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    tool: &ToolN<M, N, NX, NP, NZ>,
+    task: &TaskN<N>,
+    options: &EpisodeOptionsN<N, NX>,
+) -> Result<Metrics, ModelSimulationError>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    simulate_on::<M, M, N, NX, NP, NZ>(tool, task, options)
+}
+
+/// One episode of `tool` (controller model `M`) on `task`, simulated on plant model `P`.
+pub fn simulate_on<M, P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    tool: &ToolN<M, N, NX, NP, NZ>,
+    task: &TaskN<N>,
+    options: &EpisodeOptionsN<N, NX>,
+) -> Result<Metrics, ModelSimulationError>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+    P: ArmModel<N, NX, NP, NZ>,
+{
+    check_options(options)?;
+    let system = ClosedLoopN::<P, N, NX, NP, NZ>::new(
+        tool,
+        task,
+        options.learning_rate,
+        options.perturbation,
+    )?;
+    let controller = &system.controller;
+    let grid = uniform_grid(0.0, options.t_end, options.dt);
+    let mut z0 = SVector::<f64, NZ>::zeros();
+    z0.fixed_rows_mut::<NX>(0).copy_from(&options.x0);
+    z0.fixed_rows_mut::<N>(NX).copy_from(&options.u0);
+
+    let mut task_error = 0.0;
+    let (mut int_f, mut int_j, mut effort) = (0.0, 0.0, 0.0);
+    let mut previous: Option<(f64, f64, f64, f64)> = None;
+    let mut divergence: Option<(f64, f64)> = None;
+
+    let rhs = |_t: f64, z: &SVector<f64, NZ>| system.rhs(z);
+    let jacobian = |_t: f64, z: &SVector<f64, NZ>| (system.jacobian(z), SVector::zeros());
+    let mut integrator = options.integrator;
+    if integrator.method == Method::Auto && task.kind != TaskKind::Acceleration {
+        integrator.method = Method::Explicit;
+    }
+    let describe = || format!("{}({tool})", M::NAME);
+    let stats = solve_grid_with_jacobian(rhs, jacobian, &z0, &grid, &integrator, |_, t, z| {
+        let (_, theta_ddot) = system.rhs_and_acceleration(z);
+        let theta = z.fixed_rows::<N>(0).into_owned();
+        let theta_dot = z.fixed_rows::<N>(N).into_owned();
+        let u = z.fixed_rows::<N>(NX).into_owned();
+        let magnitude = z.amax();
+        if divergence.is_none() && magnitude > DIVERGENCE_BOUND {
+            divergence = Some((t, magnitude));
+        }
+        task_error += controller.task_error(&theta, &theta_dot, &theta_ddot);
+        let j = controller.cost_j(&theta, &theta_dot, &theta_ddot, &u);
+        let f = j - 0.5 * controller.logdet;
+        let e = u.norm_squared();
+        if let Some((t_prev, f_prev, j_prev, e_prev)) = previous {
+            let h = t - t_prev;
+            int_f += 0.5 * h * (f + f_prev);
+            int_j += 0.5 * h * (j + j_prev);
+            effort += 0.5 * h * (e + e_prev);
+        }
+        previous = Some((t, f, j, e));
+    })
+    .map_err(|source| ModelSimulationError::Integration {
+        tool: describe(),
+        source,
+    })?;
+
+    if let Some((t, magnitude)) = divergence {
+        return Err(ModelSimulationError::Diverged {
+            tool: describe(),
+            t,
+            magnitude,
+        });
+    }
+    let metrics = Metrics {
+        task_error,
+        free_energy: int_f,
+        cost_j: int_j,
+        logdet: controller.logdet,
+        rhs_evals: stats.rhs_evals,
+        steps: stats.steps,
+        rejected_steps: stats.rejected,
+        control_effort: effort,
+        jacobian_evals: stats.jacobian_evals,
+        factorisations: stats.factorisations,
+    };
+    if ![metrics.task_error, metrics.free_energy, metrics.cost_j]
+        .iter()
+        .all(|v| v.is_finite())
+    {
+        return Err(ModelSimulationError::Diverged {
+            tool: describe(),
+            t: options.t_end,
+            magnitude: f64::INFINITY,
+        });
+    }
+    Ok(metrics)
+}
+
+fn check_options<const N: usize, const NX: usize>(o: &EpisodeOptionsN<N, NX>) -> Result<(), Error> {
+    let positive = |name, value: f64| {
+        if value.is_finite() && value > 0.0 {
+            Ok(())
+        } else {
+            Err(Error::InvalidOption { name, value })
+        }
+    };
+    positive("end time t_end", o.t_end)?;
+    positive("output step dt", o.dt)?;
+    if o.dt > o.t_end {
+        return Err(Error::InvalidOption {
+            name: "output step dt (larger than t_end)",
+            value: o.dt,
+        });
+    }
+    for &v in o.x0.iter() {
+        if !v.is_finite() {
+            return Err(Error::InvalidOption {
+                name: "initial state X0",
+                value: v,
+            });
+        }
+    }
+    for &v in o.u0.iter() {
+        if !v.is_finite() {
+            return Err(Error::InvalidOption {
+                name: "initial torque U0",
+                value: v,
+            });
+        }
+    }
+    if !o.perturbation.is_finite() {
+        return Err(Error::InvalidOption {
+            name: "perturbation dT",
+            value: o.perturbation,
+        });
+    }
+    Ok(())
+}

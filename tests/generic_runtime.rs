@@ -1,0 +1,474 @@
+//! The model-generic runtime (`toolconf::model`): with `Arm2` it reproduces the 2-link runtime
+//! bit for bit; arm3 runs; bad input gives typed errors; mixed tool sets draw and rank
+//! deterministically.
+
+use std::process::Command;
+
+use nalgebra::SMatrix;
+use proptest::prelude::*;
+use serde_json::Value;
+use toolconf::closed_loop::{self, EpisodeOptions, Metrics, Plant};
+use toolconf::model::mixed::{
+    draw_mixed_tools, evaluate_mixed, AnyTool, MixedObjective, MixedResult, ModelKind,
+};
+use toolconf::model::{
+    self, control_confidence, simulate, simulate_on, Arm2, Arm2Exact, Arm2Tool, Arm3, Arm3Tool,
+    ArmModel, EpisodeOptionsN, TaskN,
+};
+use toolconf::select::{draw_tools, PARAMETER_RANGE};
+use toolconf::{Arm, Error, Task, TaskKind};
+
+/// Every field of the metrics as bits, so that "equal" means bit-identical (and NaN-safe).
+fn bits(m: &Metrics) -> [u64; 10] {
+    [
+        m.task_error.to_bits(),
+        m.free_energy.to_bits(),
+        m.cost_j.to_bits(),
+        m.logdet.to_bits(),
+        m.control_effort.to_bits(),
+        m.rhs_evals as u64,
+        m.steps as u64,
+        m.rejected_steps as u64,
+        m.jacobian_evals as u64,
+        m.factorisations as u64,
+    ]
+}
+
+fn arms() -> Vec<Arm> {
+    let mut arms = vec![
+        Arm::new(0.3, 0.4, 0.5, 0.2).unwrap(),
+        Arm::new(0.5, 0.5, 0.5, 0.5).unwrap(),
+        Arm::new(0.1, 0.6, 0.2, 0.35).unwrap(),
+        Arm::new(0.55, 0.12, 0.45, 0.15).unwrap(),
+    ];
+    arms.extend(draw_tools(3, 11));
+    arms
+}
+
+#[test]
+fn arm2_reproduces_the_two_link_runtime_bit_for_bit() {
+    let mut compared = 0;
+    for arm in arms() {
+        let tool = Arm2Tool::from(&arm);
+        for kind in TaskKind::ALL {
+            let task = Task::paper(kind);
+            let task_n = TaskN::paper::<Arm2, 4, 4, 6>(kind);
+            assert_eq!(task_n, TaskN::from(&task), "paper task {kind}");
+
+            let reference = toolconf::control_confidence(&arm, &task).unwrap();
+            let generic = control_confidence(&tool, &task_n).unwrap();
+            assert_eq!(reference.logdet.to_bits(), generic.logdet.to_bits());
+            assert_eq!(reference.pi_u, generic.pi_u);
+
+            for perturbation in [0.0, -0.8] {
+                for plant in [Plant::Paper, Plant::Exact] {
+                    let options = EpisodeOptions {
+                        perturbation,
+                        plant,
+                        ..EpisodeOptions::default()
+                    };
+                    let reference = closed_loop::simulate(&arm, &task, &options);
+                    let options_n = EpisodeOptionsN::from(&options);
+                    let generic = match plant {
+                        Plant::Paper => simulate(&tool, &task_n, &options_n),
+                        Plant::Exact => {
+                            simulate_on::<Arm2, Arm2Exact, 2, 4, 4, 6>(&tool, &task_n, &options_n)
+                        }
+                    };
+                    match (reference, generic) {
+                        (Ok(r), Ok(g)) => {
+                            assert_eq!(
+                                bits(&r.metrics),
+                                bits(&g),
+                                "{arm} {kind} dT={perturbation} {plant:?}: {:?} vs {g:?}",
+                                r.metrics
+                            );
+                            compared += 1;
+                        }
+                        (Err(r), Err(g)) => assert_eq!(r.time(), g.time()),
+                        (r, g) => panic!("{arm} {kind} dT={perturbation}: {r:?} vs {g:?}"),
+                    }
+                }
+            }
+        }
+    }
+    assert!(compared >= 70, "only {compared} episodes compared");
+}
+
+#[test]
+fn arm2_paper_options_are_the_two_link_defaults() {
+    let paper = EpisodeOptionsN::paper::<Arm2, 4, 6>();
+    assert_eq!(paper, EpisodeOptionsN::from(&EpisodeOptions::default()));
+}
+
+#[test]
+fn arm3_runs_every_task_with_finite_metrics() {
+    let tool = Arm3Tool::new([0.3, 0.25, 0.2, 0.4, 0.35, 0.3]).unwrap();
+    for kind in TaskKind::ALL {
+        let task = Arm3::paper_task(kind);
+        for perturbation in [0.0, -0.8] {
+            let options = EpisodeOptionsN {
+                perturbation,
+                ..EpisodeOptionsN::paper::<Arm3, 6, 9>()
+            };
+            let m = simulate(&tool, &task, &options).unwrap();
+            for v in [
+                m.task_error,
+                m.free_energy,
+                m.cost_j,
+                m.logdet,
+                m.control_effort,
+            ] {
+                assert!(v.is_finite(), "{kind} dT={perturbation}: {m:?}");
+            }
+            assert!(m.rhs_evals > 0);
+            let c = control_confidence(&tool, &task).unwrap();
+            assert_eq!(m.logdet.to_bits(), c.logdet.to_bits());
+            assert!(
+                (m.free_energy - (m.cost_j - 0.5 * m.logdet * 5.0)).abs()
+                    < 1e-9 * m.free_energy.abs().max(1.0)
+            );
+        }
+    }
+    // Task 3: Π^U = P^θ̈ + P^U exactly (∂θ̈/∂U = I), whatever the tool.
+    let task = Arm3::paper_task(TaskKind::Acceleration);
+    let c = control_confidence(&tool, &task).unwrap();
+    assert_eq!(c.pi_u, task.precision_theta_ddot + task.precision_u);
+    assert_eq!(c.pi_u, SMatrix::<f64, 3, 3>::identity() * 10.0);
+    assert!((c.logdet - 3.0 * 10f64.ln()).abs() < 1e-14);
+    assert!((c.logdet_per_joint() - 10f64.ln()).abs() < 1e-15);
+}
+
+#[test]
+fn arm3_goals_extend_the_two_link_ones() {
+    let two = Arm2::paper_task(TaskKind::Position);
+    let three = Arm3::paper_task(TaskKind::Position);
+    assert_eq!(three.goal_theta[2], two.goal_theta[1]);
+    assert_eq!(three.goal_theta[0], two.goal_theta[0]);
+    let v = Arm3::paper_task(TaskKind::Velocity);
+    assert_eq!(v.goal_theta_dot.as_slice(), &[0.0, 0.0, 2.0]);
+    let a = Arm3::paper_task(TaskKind::Acceleration);
+    assert_eq!(a.goal_theta_ddot.as_slice(), &[0.0, 0.0, 0.1]);
+    assert_eq!(Arm3::NAME, "arm3");
+    assert_eq!(Arm3::PARAMETER_NAMES, ["m1", "m2", "m3", "l1", "l2", "l3"]);
+}
+
+#[test]
+fn invalid_input_gives_typed_errors() {
+    assert_eq!(
+        Arm3Tool::new([0.3, -1.0, 0.2, 0.4, 0.35, 0.3]).unwrap_err(),
+        Error::InvalidParameter {
+            name: "m2",
+            value: -1.0
+        }
+    );
+    match Arm3Tool::new([0.3, 0.2, 0.2, 0.4, 0.35, f64::NAN]).unwrap_err() {
+        Error::InvalidParameter { name, value } => {
+            assert_eq!(name, "l3");
+            assert!(value.is_nan());
+        }
+        e => panic!("{e:?}"),
+    }
+    assert_eq!(
+        Arm2Tool::new([0.3, 0.2, 0.0, 0.4]).unwrap_err(),
+        Error::InvalidParameter {
+            name: "l1",
+            value: 0.0
+        }
+    );
+    assert!(matches!(
+        AnyTool::new(ModelKind::Arm3, &[0.3, 0.3, 0.3, 0.3]),
+        Err(Error::InvalidOption { .. })
+    ));
+    assert!(matches!(
+        AnyTool::new(ModelKind::Arm3, &[0.3, 0.3, 0.3, 0.3, 0.3, f64::INFINITY]),
+        Err(Error::InvalidParameter { name: "l3", .. })
+    ));
+
+    let tool = Arm3Tool::new([0.3, 0.25, 0.2, 0.4, 0.35, 0.3]).unwrap();
+    // All-zero precisions: Π^U = 0 is no precision.
+    let mut task = Arm3::paper_task(TaskKind::Acceleration);
+    task.precision_theta_ddot = SMatrix::zeros();
+    assert!(matches!(
+        control_confidence(&tool, &task),
+        Err(Error::NotPositiveDefinite { .. })
+    ));
+    // Not positive semi-definite.
+    let mut task = Arm3::paper_task(TaskKind::Velocity);
+    task.precision_theta_dot[(2, 2)] = -1.0;
+    assert!(matches!(
+        control_confidence(&tool, &task),
+        Err(Error::InvalidPrecision { ref name, .. }) if name == "P_theta_dot"
+    ));
+    // Not symmetric.
+    let mut task = Arm3::paper_task(TaskKind::Position);
+    task.precision_theta[(0, 2)] = 3.0;
+    assert!(matches!(
+        control_confidence(&tool, &task),
+        Err(Error::InvalidPrecision { ref name, .. }) if name == "P_theta"
+    ));
+    // A non-finite goal.
+    let mut task = Arm3::paper_task(TaskKind::Position);
+    task.goal_theta[1] = f64::NAN;
+    assert!(matches!(
+        control_confidence(&tool, &task),
+        Err(Error::InvalidGoal { .. })
+    ));
+    // Options and learning rate.
+    let task = Arm3::paper_task(TaskKind::Position);
+    let bad = EpisodeOptionsN {
+        dt: -0.1,
+        ..EpisodeOptionsN::paper::<Arm3, 6, 9>()
+    };
+    assert!(matches!(
+        simulate(&tool, &task, &bad),
+        Err(model::ModelSimulationError::Input(
+            Error::InvalidOption { .. }
+        ))
+    ));
+    let bad = EpisodeOptionsN {
+        learning_rate: 0.0,
+        ..EpisodeOptionsN::paper::<Arm3, 6, 9>()
+    };
+    assert!(matches!(
+        simulate(&tool, &task, &bad),
+        Err(model::ModelSimulationError::Input(
+            Error::InvalidOption { .. }
+        ))
+    ));
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Random valid arm3 tools never panic: confidence and a short episode give a value or a
+    /// typed error, and an episode that succeeds has finite metrics.
+    #[test]
+    fn random_arm3_tools_never_panic(
+        params in prop::array::uniform6(0.05f64..2.0),
+        kind in prop::sample::select(TaskKind::ALL.to_vec()),
+        perturbation in -1.0f64..1.0,
+    ) {
+        let tool = Arm3Tool::new(params).unwrap();
+        let task = Arm3::paper_task(kind);
+        let c = control_confidence(&tool, &task).unwrap();
+        prop_assert!(c.logdet.is_finite());
+        let options = EpisodeOptionsN {
+            t_end: 1.0,
+            perturbation,
+            ..EpisodeOptionsN::paper::<Arm3, 6, 9>()
+        };
+        if let Ok(m) = simulate(&tool, &task, &options) {
+            prop_assert!(m.task_error.is_finite() && m.free_energy.is_finite());
+        }
+    }
+}
+
+#[test]
+fn a_set_of_only_arm2_is_the_two_link_stream() {
+    let mixed = draw_mixed_tools(&[ModelKind::Arm2], 20, 5).unwrap();
+    let plain = draw_tools(20, 5);
+    for (m, p) in mixed.iter().zip(&plain) {
+        assert_eq!(*m, AnyTool::Arm2(Arm2Tool::from(p)));
+    }
+    assert!(draw_mixed_tools(&[], 3, 0).is_err());
+}
+
+#[test]
+fn mixed_draws_are_seeded_and_in_range() {
+    let models = [ModelKind::Arm2, ModelKind::Arm3];
+    let a = draw_mixed_tools(&models, 40, 9).unwrap();
+    assert_eq!(a, draw_mixed_tools(&models, 40, 9).unwrap());
+    assert_ne!(a, draw_mixed_tools(&models, 40, 10).unwrap());
+    let (lo, hi) = PARAMETER_RANGE;
+    let mut seen = [0; 2];
+    for t in &a {
+        seen[usize::from(t.model() == ModelKind::Arm3)] += 1;
+        for (_, v) in t.named_parameters() {
+            assert!((lo..hi).contains(&v));
+        }
+    }
+    assert!(seen[0] > 5 && seen[1] > 5, "{seen:?}");
+}
+
+fn argmin(results: &[MixedResult], key: impl Fn(&MixedResult) -> f64) -> usize {
+    (0..results.len())
+        .min_by(|&a, &b| key(&results[a]).total_cmp(&key(&results[b])))
+        .unwrap()
+}
+
+#[test]
+fn mixed_evaluation_matches_each_models_own_runtime_and_choices() {
+    let models = [ModelKind::Arm2, ModelKind::Arm3];
+    let tools = draw_mixed_tools(&models, 6, 7).unwrap();
+    let options = EpisodeOptions::default();
+    let results = evaluate_mixed(&tools, TaskKind::Velocity, &options);
+    for r in &results {
+        match r.tool {
+            AnyTool::Arm2(t) => {
+                let p = t.params();
+                let arm = Arm::new(p[0], p[1], p[2], p[3]).unwrap();
+                let reference =
+                    closed_loop::simulate(&arm, &Task::paper(TaskKind::Velocity), &options)
+                        .unwrap();
+                assert_eq!(bits(&reference.metrics), bits(r.episode.as_ref().unwrap()));
+            }
+            AnyTool::Arm3(t) => {
+                let task = Arm3::paper_task(TaskKind::Velocity);
+                let m = simulate(&t, &task, &EpisodeOptionsN::paper::<Arm3, 6, 9>()).unwrap();
+                assert_eq!(bits(&m), bits(r.episode.as_ref().unwrap()));
+            }
+            AnyTool::Arm2Exact(_) => unreachable!(),
+        }
+        let per_joint = r.logdet_per_joint().unwrap();
+        assert_eq!(
+            per_joint,
+            r.logdet.clone().unwrap() / r.model().dof() as f64
+        );
+    }
+    let ok = |r: &MixedResult| r.episode.clone().unwrap();
+    assert_eq!(
+        MixedObjective::FreeEnergy.choose(&results),
+        Some(argmin(&results, |r| ok(r).free_energy))
+    );
+    assert_eq!(
+        MixedObjective::CostJ.choose(&results),
+        Some(argmin(&results, |r| ok(r).cost_j))
+    );
+    assert_eq!(
+        MixedObjective::Confidence.choose(&results),
+        Some(argmin(&results, |r| -r.logdet.clone().unwrap()))
+    );
+    assert_eq!(
+        MixedObjective::NormalisedConfidence.choose(&results),
+        Some(argmin(&results, |r| -r.logdet_per_joint().unwrap()))
+    );
+}
+
+#[test]
+fn mixed_selection_snapshot() {
+    let models = [ModelKind::Arm2, ModelKind::Arm3, ModelKind::Arm2Exact];
+    let tools = draw_mixed_tools(&models, 6, 2024).unwrap();
+    let mut text = String::new();
+    for kind in TaskKind::ALL {
+        let results = evaluate_mixed(&tools, kind, &EpisodeOptions::default());
+        text.push_str(&format!("task {kind}\n"));
+        for r in &results {
+            let params: Vec<String> = r
+                .tool
+                .named_parameters()
+                .iter()
+                .map(|(n, v)| format!("{n}={v:.6}"))
+                .collect();
+            let m = r.episode.as_ref().unwrap();
+            text.push_str(&format!(
+                "  {} {:<10} logdet={:.9} per_joint={:.9} task_error={:.9e} int_f={:.9e} int_j={:.9e} effort={:.9e} rhs={} | {}\n",
+                r.index,
+                r.model().name(),
+                r.logdet.as_ref().unwrap(),
+                r.logdet_per_joint().unwrap(),
+                m.task_error,
+                m.free_energy,
+                m.cost_j,
+                m.control_effort,
+                m.rhs_evals,
+                params.join(" ")
+            ));
+        }
+        for o in MixedObjective::ALL {
+            text.push_str(&format!(
+                "  chosen by {}: {:?}\n",
+                o.name(),
+                o.choose(&results)
+            ));
+        }
+    }
+    insta::assert_snapshot!("mixed_selection", text);
+}
+
+fn toolconf(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_toolconf"))
+        .args(args)
+        .output()
+        .expect("run toolconf")
+}
+
+#[test]
+fn cli_default_models_keep_the_two_link_output() {
+    for json in [false, true] {
+        let mut base = vec![
+            "select", "--task", "position", "--tools", "4", "--seed", "3",
+        ];
+        if json {
+            base.push("--json");
+        }
+        let default = toolconf(&base);
+        assert!(default.status.success());
+        let mut explicit = base.clone();
+        explicit.extend(["--models", "arm2"]);
+        assert_eq!(default.stdout, toolconf(&explicit).stdout);
+        if json {
+            let v: Value = serde_json::from_slice(&default.stdout).unwrap();
+            assert!(v["tools"][0].get("model").is_none());
+            assert!(v["choice"].get("normalised_confidence").is_none());
+        }
+    }
+}
+
+#[test]
+fn cli_mixed_selection_json_and_text() {
+    let out = toolconf(&[
+        "select",
+        "--task",
+        "velocity",
+        "--tools",
+        "5",
+        "--seed",
+        "1",
+        "--models",
+        "arm2,arm3",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let tools = v["tools"].as_array().unwrap();
+    assert_eq!(tools.len(), 5);
+    for t in tools {
+        let model = t["model"].as_str().unwrap();
+        let n = if model == "arm3" { 3.0 } else { 2.0 };
+        let logdet = t["logdet"].as_f64().unwrap();
+        assert_eq!(t["logdet_per_joint"].as_f64().unwrap(), logdet / n);
+        assert_eq!(
+            t["arm"].as_object().unwrap().len(),
+            if model == "arm3" { 6 } else { 4 }
+        );
+    }
+    for key in [
+        "free_energy",
+        "cost_j",
+        "confidence",
+        "normalised_confidence",
+    ] {
+        assert!(v["choice"][key].is_u64(), "{key}");
+    }
+    let text = toolconf(&[
+        "select",
+        "--task",
+        "velocity",
+        "--tools",
+        "5",
+        "--seed",
+        "1",
+        "--models",
+        "arm2,arm3",
+    ]);
+    let text = String::from_utf8(text.stdout).unwrap();
+    assert!(text.contains("arm3"));
+    assert!(text.contains("chosen by normalised_confidence"));
+    let bad = toolconf(&["select", "--task", "velocity", "--models", "arm7"]);
+    assert_eq!(bad.status.code(), Some(2));
+}
