@@ -21,6 +21,9 @@ pub enum Error {
     /// A numeric option outside its domain.
     #[error("invalid {name} = {value}")]
     InvalidOption { name: &'static str, value: f64 },
+    /// A combination of options that is not supported, with the reason.
+    #[error("unsupported: {0}")]
+    Unsupported(String),
     /// Π^U that is not positive definite, so it is no precision and ln|Π^U| is undefined.
     #[error("control confidence Π^U is not positive definite for this arm and task (determinant {determinant:e}); check the task's precisions")]
     NotPositiveDefinite { determinant: f64 },

@@ -14,6 +14,7 @@ use rayon::prelude::*;
 
 use crate::closed_loop::{simulate, EpisodeOptions, Metrics, SimulationError};
 use crate::confidence::control_confidence;
+use crate::mpc::{simulate_mpc, MpcEpisodeError, MpcMetrics, MpcOptions};
 use crate::{Arm, Error, Task};
 
 /// The paper's parameter domain for m1, m2, l1, l2 ("Implementation details").
@@ -80,6 +81,37 @@ pub fn evaluate(tools: &[Arm], task: &Task, options: &EpisodeOptions) -> Vec<Too
             episode: simulate(arm, task, &options).map(|e| e.metrics),
         })
         .collect()
+}
+
+/// The MPC baseline's episode for every tool, in parallel, in the tools' order: the cost it
+/// achieves, ∫J dt, is the objective J* (issue 5), the conventional optimal-control ranking.
+pub fn evaluate_mpc(
+    tools: &[Arm],
+    task: &Task,
+    options: &EpisodeOptions,
+    mpc: &MpcOptions,
+) -> Vec<Result<MpcMetrics, MpcEpisodeError>> {
+    let options = EpisodeOptions {
+        record_trajectory: false,
+        ..options.clone()
+    };
+    tools
+        .par_iter()
+        .map(|arm| simulate_mpc(arm, task, &options, mpc).map(|e| e.metrics))
+        .collect()
+}
+
+/// argmin J* over the tools whose MPC episode succeeded; ties go to the earlier tool.
+pub fn choose_by_mpc_cost(results: &[Result<MpcMetrics, MpcEpisodeError>]) -> Option<usize> {
+    results
+        .iter()
+        .enumerate()
+        .filter_map(|(i, r)| r.as_ref().ok().map(|m| (i, m.cost_j)))
+        .fold(None, |best: Option<(usize, f64)>, (i, c)| match best {
+            Some((_, b)) if b <= c => best,
+            _ => Some((i, c)),
+        })
+        .map(|(i, _)| i)
 }
 
 /// An objective that ranks tools.

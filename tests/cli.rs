@@ -272,3 +272,35 @@ fn simulate_and_select_reject_bad_input() {
         );
     }
 }
+
+#[test]
+fn select_ranks_by_the_mpc_cost_when_asked() {
+    let out = toolconf(&[
+        "select", "--task", "velocity", "--tools", "2", "--seed", "3", "--mpc", "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let costs: Vec<f64> = v["tools"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["mpc_cost"].as_f64().unwrap())
+        .collect();
+    let best = if costs[1] < costs[0] { 1 } else { 0 };
+    assert_eq!(v["choice"]["mpc_cost"], best);
+    let mixed = toolconf(&[
+        "select",
+        "--task",
+        "velocity",
+        "--tools",
+        "2",
+        "--mpc",
+        "--models",
+        "arm2,arm3",
+    ]);
+    assert_eq!(mixed.status.code(), Some(2));
+}

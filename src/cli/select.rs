@@ -7,12 +7,15 @@ use serde_json::{json, Value};
 use toolconf::model::mixed::{
     draw_mixed_tools, evaluate_mixed, MixedObjective, MixedResult, ModelKind,
 };
-use toolconf::select::{draw_tools, evaluate, Objective, ToolResult};
+use toolconf::select::{
+    choose_by_mpc_cost, draw_tools, evaluate, evaluate_mpc, Objective, ToolResult,
+};
 use toolconf::{Task, TaskKind};
 
 use super::episode_args::EpisodeArgs;
 use super::output::CliError;
 use super::parse_task;
+use super::simulate::MpcArgs;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -34,6 +37,11 @@ pub struct Args {
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
+    /// Also rank by J*, the cost the MPC baseline achieves on each tool (2-link tools only).
+    #[arg(long)]
+    mpc: bool,
+    #[command(flatten)]
+    mpc_options: MpcArgs,
 }
 
 fn tool_json(r: &ToolResult) -> Value {
@@ -60,6 +68,12 @@ fn parse_model(s: &str) -> Result<ModelKind, String> {
 
 pub fn run(args: &Args) -> Result<(), CliError> {
     if args.models != [ModelKind::Arm2] {
+        if args.mpc {
+            return Err(toolconf::Error::Unsupported(
+                "--mpc ranks 2-link tools only (the MPC baseline is built on the 2-link model); drop --models or --mpc".into(),
+            )
+            .into());
+        }
         return run_mixed(args);
     }
     let task = Task::paper(args.task);
@@ -70,16 +84,36 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         .iter()
         .map(|o| (*o, o.choose(&results)))
         .collect();
+    let mpc = if args.mpc {
+        Some(evaluate_mpc(
+            &tools,
+            &task,
+            &options,
+            &args.mpc_options.options()?,
+        ))
+    } else {
+        None
+    };
     if args.json {
         let mut choice = serde_json::Map::new();
         for (o, c) in &choices {
             choice.insert(o.name().into(), json!(c));
         }
+        let mut tools_json: Vec<Value> = results.iter().map(tool_json).collect();
+        if let Some(mpc) = &mpc {
+            choice.insert("mpc_cost".into(), json!(choose_by_mpc_cost(mpc)));
+            for (t, r) in tools_json.iter_mut().zip(mpc) {
+                match r {
+                    Ok(m) => t["mpc_cost"] = json!(m.cost_j),
+                    Err(e) => t["mpc_error"] = json!(e.to_string()),
+                }
+            }
+        }
         let out = json!({
             "task": args.task,
             "seed": args.seed,
             "perturb": args.episode.perturbation,
-            "tools": results.iter().map(tool_json).collect::<Vec<_>>(),
+            "tools": tools_json,
             "choice": choice,
         });
         println!(
@@ -122,10 +156,27 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             metrics
         );
     }
+    if let Some(mpc) = &mpc {
+        for (i, r) in mpc.iter().enumerate() {
+            match r {
+                Ok(m) => println!("tool {i:>3}  J* (MPC int J dt) {:>14.6e}", m.cost_j),
+                Err(e) => println!("tool {i:>3}  MPC failed: {e}"),
+            }
+        }
+    }
     for (o, c) in &choices {
         match c {
             Some(i) => println!("chosen by {:<12} tool {i}", o.name()),
             None => println!("chosen by {:<12} none (every tool failed)", o.name()),
+        }
+    }
+    if let Some(mpc) = &mpc {
+        match choose_by_mpc_cost(mpc) {
+            Some(i) => println!("chosen by {:<12} tool {i}", "mpc_cost"),
+            None => println!(
+                "chosen by {:<12} none (every MPC episode failed)",
+                "mpc_cost"
+            ),
         }
     }
     Ok(())
