@@ -14,6 +14,11 @@ run:
 	cargo build --release --quiet
 	./target/release/toolconf reproduce --out results/
 
+## make bench: criterion benchmarks (Π^U per tool, closed-loop RHS, episodes, a batch of 1000,
+## the default reproduce); reports in target/criterion/. Peers: bench/peers/run.sh.
+bench:
+	cargo bench --bench confidence --bench episode --bench stiff --bench reproduce
+
 ## make test: the whole suite, including the check that `make derive` leaves generated/ unchanged.
 test: drift-check
 	cargo test --workspace --quiet

@@ -1,0 +1,48 @@
+//! Control confidence per tool, Π^U and ln|Π^U|, for each of the paper's tasks:
+//!
+//! * `checked`: [`control_confidence`], the public API (validates the task, checks Π^U ≻ 0);
+//! * `unchecked`: [`pi_u`] and the log-determinant, the per-tool work once the task is validated;
+//! * `checked_1000_tools`: the API over 1000 random tools (per tool: the time / 1000, printed as
+//!   throughput).
+//!
+//! `cargo bench --bench confidence`; target ≤ 20 ns per tool on one core.
+
+use std::hint::black_box;
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use toolconf::confidence::pi_u;
+use toolconf::select::draw_tools;
+use toolconf::{control_confidence, Arm, Task, TaskKind};
+
+fn confidence(c: &mut Criterion) {
+    let arm = Arm::new(0.3, 0.4, 0.5, 0.2).unwrap();
+    let tools = draw_tools(1000, 42);
+    let mut group = c.benchmark_group("confidence");
+    for kind in TaskKind::ALL {
+        let task = Task::paper(kind);
+        group.throughput(Throughput::Elements(1));
+        group.bench_function(format!("{kind}/checked"), |b| {
+            b.iter(|| control_confidence(black_box(&arm), black_box(&task)).unwrap())
+        });
+        group.bench_function(format!("{kind}/unchecked"), |b| {
+            b.iter(|| {
+                let p = pi_u(black_box(&arm), black_box(&task));
+                let logdet = (p[(0, 0)] * p[(1, 1)] - p[(0, 1)] * p[(1, 0)]).ln();
+                (p, logdet)
+            })
+        });
+        group.throughput(Throughput::Elements(tools.len() as u64));
+        group.bench_function(format!("{kind}/checked_1000_tools"), |b| {
+            b.iter(|| {
+                black_box(&tools)
+                    .iter()
+                    .map(|arm| control_confidence(arm, &task).unwrap().logdet)
+                    .sum::<f64>()
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, confidence);
+criterion_main!(benches);

@@ -1,0 +1,60 @@
+//! The closed loop: one right-hand-side evaluation, one episode per task at the paper's defaults
+//! on a fixed arm (one thread), and 1000 task-1 episodes on all cores via `select::evaluate`.
+//!
+//! `cargo bench --bench episode`; target: a task-1 episode ≤ 25 µs on one core.
+
+use std::hint::black_box;
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use toolconf::closed_loop::{simulate, ClosedLoop, EpisodeOptions, JointState};
+use toolconf::select::{draw_tools, evaluate};
+use toolconf::{Arm, Task, TaskKind};
+
+/// The fixed arm of the README (m1, m2, l1, l2).
+fn arm() -> Arm {
+    Arm::new(0.3, 0.4, 0.5, 0.2).unwrap()
+}
+
+fn rhs(c: &mut Criterion) {
+    let arm = arm();
+    let mut group = c.benchmark_group("rhs");
+    for kind in TaskKind::ALL {
+        let system = ClosedLoop::new(&arm, &Task::paper(kind), 1.0, 0.0).unwrap();
+        let z = JointState::from([-1.2, -1.9, 0.7, -0.4, 0.3, -0.2]);
+        group.bench_function(kind.name(), |b| b.iter(|| system.rhs(black_box(&z))));
+    }
+    group.finish();
+}
+
+fn episode(c: &mut Criterion) {
+    let arm = arm();
+    let options = EpisodeOptions::default();
+    let mut group = c.benchmark_group("episode");
+    for kind in TaskKind::ALL {
+        let task = Task::paper(kind);
+        group.bench_function(kind.name(), |b| {
+            b.iter(|| simulate(black_box(&arm), &task, &options).unwrap().metrics)
+        });
+    }
+    group.finish();
+}
+
+fn batch(c: &mut Criterion) {
+    let tools = draw_tools(1000, 42);
+    let task = Task::paper(TaskKind::Position);
+    let options = EpisodeOptions::default();
+    let mut group = c.benchmark_group("batch");
+    group.sample_size(20);
+    group.throughput(Throughput::Elements(tools.len() as u64));
+    group.bench_function(
+        format!(
+            "position_1000_tools_{}_threads",
+            rayon::current_num_threads()
+        ),
+        |b| b.iter(|| evaluate(black_box(&tools), &task, &options)),
+    );
+    group.finish();
+}
+
+criterion_group!(benches, rhs, episode, batch);
+criterion_main!(benches);
