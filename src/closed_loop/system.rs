@@ -34,7 +34,12 @@ impl Plant {
 
     /// Ẋ = f(X, U; p) of this plant.
     #[inline]
-    pub fn dynamics(self, x: &SVector<f64, 4>, u: &Vector2, p: &SVector<f64, 4>) -> SVector<f64, 4> {
+    pub fn dynamics(
+        self,
+        x: &SVector<f64, 4>,
+        u: &Vector2,
+        p: &SVector<f64, 4>,
+    ) -> SVector<f64, 4> {
         match self {
             Plant::Paper => arm2::dynamics(x, u, p),
             Plant::Exact => arm2_exact::dynamics(x, u, p),

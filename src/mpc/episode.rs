@@ -111,7 +111,9 @@ pub fn simulate_mpc(
     let (mut task_error, mut int_j, mut effort) = (0.0, 0.0, 0.0);
     let mut previous: Option<(f64, f64, f64)> = None;
     let mut sample = |t: f64, x: &State, u: &Vector2| {
-        let theta_ddot = options.plant.dynamics(x, &(u + perturbation), &params)
+        let theta_ddot = options
+            .plant
+            .dynamics(x, &(u + perturbation), &params)
             .fixed_rows::<2>(2)
             .into_owned();
         let theta = x.fixed_rows::<2>(0).into_owned();
