@@ -103,13 +103,21 @@ pub fn evaluate_mpc(
 
 /// argmin J* over the tools whose MPC episode succeeded; ties go to the earlier tool.
 pub fn choose_by_mpc_cost(results: &[Result<MpcMetrics, MpcEpisodeError>]) -> Option<usize> {
-    results
-        .iter()
-        .enumerate()
-        .filter_map(|(i, r)| r.as_ref().ok().map(|m| (i, m.cost_j)))
-        .fold(None, |best: Option<(usize, f64)>, (i, c)| match best {
-            Some((_, b)) if b <= c => best,
-            _ => Some((i, c)),
+    first_argmin(
+        results
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| r.as_ref().ok().map(|m| (i, m.cost_j))),
+    )
+}
+
+/// The index of the smallest score, the earlier index on ties: how every objective chooses
+/// (tools without a score, e.g. failed episodes, are simply absent from `scores`).
+pub fn first_argmin(scores: impl Iterator<Item = (usize, f64)>) -> Option<usize> {
+    scores
+        .fold(None, |best: Option<(usize, f64)>, (i, s)| match best {
+            Some((_, b)) if b <= s => best,
+            _ => Some((i, s)),
         })
         .map(|(i, _)| i)
 }
@@ -151,13 +159,10 @@ impl Objective {
 
     /// The index of the chosen tool; ties go to the earlier tool, failed tools are skipped.
     pub fn choose(self, results: &[ToolResult]) -> Option<usize> {
-        results
-            .iter()
-            .filter_map(|r| self.score(r).map(|s| (r.index, s)))
-            .fold(None, |best: Option<(usize, f64)>, (i, s)| match best {
-                Some((_, b)) if b <= s => best,
-                _ => Some((i, s)),
-            })
-            .map(|(i, _)| i)
+        first_argmin(
+            results
+                .iter()
+                .filter_map(|r| self.score(r).map(|s| (r.index, s))),
+        )
     }
 }

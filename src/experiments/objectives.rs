@@ -84,20 +84,11 @@ impl DecisionRule for MpcCost {
     }
 
     fn choose(&self, trial: &Trial) -> Option<usize> {
-        trial
-            .tools
-            .iter()
-            .enumerate()
-            .filter_map(|(i, arm)| {
-                simulate_mpc(arm, trial.task, trial.options, &self.0)
-                    .ok()
-                    .map(|e| (i, e.metrics.cost_j))
-            })
-            .fold(None, |best: Option<(usize, f64)>, (i, c)| match best {
-                Some((_, b)) if b <= c => best,
-                _ => Some((i, c)),
-            })
-            .map(|(i, _)| i)
+        crate::select::first_argmin(trial.tools.iter().enumerate().filter_map(|(i, arm)| {
+            simulate_mpc(arm, trial.task, trial.options, &self.0)
+                .ok()
+                .map(|e| (i, e.metrics.cost_j))
+        }))
     }
 }
 

@@ -324,13 +324,10 @@ impl MixedObjective {
     /// The index of the chosen tool; ties go to the earlier tool, failed tools are skipped
     /// (as [`crate::select::Objective::choose`]).
     pub fn choose(self, results: &[MixedResult]) -> Option<usize> {
-        results
-            .iter()
-            .filter_map(|r| self.score(r).map(|s| (r.index, s)))
-            .fold(None, |best: Option<(usize, f64)>, (i, s)| match best {
-                Some((_, b)) if b <= s => best,
-                _ => Some((i, s)),
-            })
-            .map(|(i, _)| i)
+        crate::select::first_argmin(
+            results
+                .iter()
+                .filter_map(|r| self.score(r).map(|s| (r.index, s))),
+        )
     }
 }
