@@ -5,7 +5,6 @@ use std::str::FromStr;
 
 use serde::Serialize;
 
-use crate::generated::arm2;
 use crate::{Error, Matrix2, Vector2};
 
 /// Which task-specific controller (appendix "Task specific controllers").
@@ -83,101 +82,14 @@ pub struct Task {
 
 impl Task {
     /// The paper's task with its published goals and precisions (generated from
-    /// `derive/tasks.toml` and the model's goals).
+    /// `derive/tasks.toml` and the model's goals): the 2-link model's [`crate::model::TaskN`].
     pub fn paper(kind: TaskKind) -> Self {
-        let eye = Matrix2::identity();
-        let zero = Vector2::zeros();
-        match kind {
-            TaskKind::Position => {
-                use arm2::position as p;
-                Task {
-                    kind,
-                    goal_theta: Vector2::from(p::GOAL_THETA),
-                    goal_theta_dot: Vector2::from(p::GOAL_THETA_DOT),
-                    goal_theta_ddot: Vector2::from(p::GOAL_THETA_DDOT),
-                    precision_theta: eye * p::PRECISION_THETA,
-                    precision_theta_dot: eye * p::PRECISION_THETA_DOT,
-                    precision_theta_ddot: eye * p::PRECISION_THETA_DDOT,
-                    precision_u: eye * p::PRECISION_U,
-                }
-            }
-            TaskKind::Velocity => {
-                use arm2::velocity as p;
-                Task {
-                    kind,
-                    goal_theta: zero,
-                    goal_theta_dot: Vector2::from(p::GOAL_THETA_DOT),
-                    goal_theta_ddot: Vector2::from(p::GOAL_THETA_DDOT),
-                    precision_theta: Matrix2::zeros(),
-                    precision_theta_dot: eye * p::PRECISION_THETA_DOT,
-                    precision_theta_ddot: eye * p::PRECISION_THETA_DDOT,
-                    precision_u: eye * p::PRECISION_U,
-                }
-            }
-            TaskKind::Acceleration => {
-                use arm2::acceleration as p;
-                Task {
-                    kind,
-                    goal_theta: zero,
-                    goal_theta_dot: zero,
-                    goal_theta_ddot: Vector2::from(p::GOAL_THETA_DDOT),
-                    precision_theta: Matrix2::zeros(),
-                    precision_theta_dot: Matrix2::zeros(),
-                    precision_theta_ddot: eye * p::PRECISION_THETA_DDOT,
-                    precision_u: eye * p::PRECISION_U,
-                }
-            }
-        }
+        (&crate::model::TaskN::paper::<crate::model::Arm2, 4, 4, 6>(kind)).into()
     }
 
-    /// Checks goals are finite and precisions finite, symmetric and positive semi-definite.
+    /// Checks goals are finite and precisions finite, symmetric and positive semi-definite
+    /// (the checks of [`crate::model::TaskN::validate`]).
     pub fn validate(&self) -> Result<(), Error> {
-        for (name, goal) in [
-            ("theta_g", &self.goal_theta),
-            ("theta_dot_g", &self.goal_theta_dot),
-            ("theta_ddot_g", &self.goal_theta_ddot),
-        ] {
-            if let Some(&value) = goal.iter().find(|v| !v.is_finite()) {
-                return Err(Error::InvalidGoal {
-                    name: name.into(),
-                    value,
-                });
-            }
-        }
-        for (name, p) in [
-            ("P_theta", &self.precision_theta),
-            ("P_theta_dot", &self.precision_theta_dot),
-            ("P_theta_ddot", &self.precision_theta_ddot),
-            ("P_u", &self.precision_u),
-        ] {
-            check_precision(name, p)?;
-        }
-        Ok(())
+        crate::model::TaskN::from(self).validate()
     }
-}
-
-fn check_precision(name: &str, p: &Matrix2) -> Result<(), Error> {
-    let invalid = |reason: String| Error::InvalidPrecision {
-        name: name.into(),
-        reason,
-    };
-    if p.iter().any(|v| !v.is_finite()) {
-        return Err(invalid(format!(
-            "has a non-finite entry: {:?}",
-            p.as_slice()
-        )));
-    }
-    if (p[(0, 1)] - p[(1, 0)]).abs() > 1e-12 * p.amax().max(1.0) {
-        return Err(invalid(format!(
-            "is not symmetric ({} vs {})",
-            p[(0, 1)],
-            p[(1, 0)]
-        )));
-    }
-    // Positive semi-definite 2×2: non-negative diagonal and determinant.
-    let det = p[(0, 0)] * p[(1, 1)] - p[(0, 1)] * p[(1, 0)];
-    if p[(0, 0)] < 0.0 || p[(1, 1)] < 0.0 || det < -1e-12 * p.amax().powi(2) {
-        return Err(invalid("is not positive semi-definite".into()));
-    }
-    Ok(())
 }

@@ -224,42 +224,5 @@ pub fn simulate(
 }
 
 fn check_options(o: &EpisodeOptions) -> Result<(), Error> {
-    let positive = |name, value: f64| {
-        if value.is_finite() && value > 0.0 {
-            Ok(())
-        } else {
-            Err(Error::InvalidOption { name, value })
-        }
-    };
-    positive("end time t_end", o.t_end)?;
-    positive("output step dt", o.dt)?;
-    if o.dt > o.t_end {
-        return Err(Error::InvalidOption {
-            name: "output step dt (larger than t_end)",
-            value: o.dt,
-        });
-    }
-    for &v in o.x0.iter() {
-        if !v.is_finite() {
-            return Err(Error::InvalidOption {
-                name: "initial state X0",
-                value: v,
-            });
-        }
-    }
-    for &v in o.u0.iter() {
-        if !v.is_finite() {
-            return Err(Error::InvalidOption {
-                name: "initial torque U0",
-                value: v,
-            });
-        }
-    }
-    if !o.perturbation.is_finite() {
-        return Err(Error::InvalidOption {
-            name: "perturbation dT",
-            value: o.perturbation,
-        });
-    }
-    Ok(())
+    crate::model::runtime::check_options(&crate::model::runtime::EpisodeOptionsN::<2, 4>::from(o))
 }

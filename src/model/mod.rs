@@ -25,7 +25,7 @@ use crate::generated;
 use crate::{Arm, Error, Task, TaskKind};
 
 pub mod mixed;
-mod runtime;
+pub(crate) mod runtime;
 
 pub use runtime::{
     simulate, simulate_on, ActiveInferenceN, ClosedLoopN, EpisodeOptionsN, ModelSimulationError,
@@ -456,8 +456,23 @@ impl From<&Task> for TaskN<2> {
     }
 }
 
+impl From<&TaskN<2>> for Task {
+    fn from(t: &TaskN<2>) -> Self {
+        Self {
+            kind: t.kind,
+            goal_theta: t.goal_theta,
+            goal_theta_dot: t.goal_theta_dot,
+            goal_theta_ddot: t.goal_theta_ddot,
+            precision_theta: t.precision_theta,
+            precision_theta_dot: t.precision_theta_dot,
+            precision_theta_ddot: t.precision_theta_ddot,
+            precision_u: t.precision_u,
+        }
+    }
+}
+
 /// Finite, symmetric (to 1e-12 relative) and positive semi-definite: the smallest eigenvalue
-/// of the symmetric part is ≥ −1e-12·max|P| (for N = 2 the determinant test of [`Task::validate`]).
+/// of the symmetric part is ≥ −1e-12·max|P| (for N = 2 the closed-form determinant test).
 fn check_precision<const N: usize>(name: &str, p: &SMatrix<f64, N, N>) -> Result<(), Error> {
     let invalid = |reason: String| Error::InvalidPrecision {
         name: name.into(),

@@ -442,7 +442,9 @@ where
     Ok(metrics)
 }
 
-fn check_options<const N: usize, const NX: usize>(o: &EpisodeOptionsN<N, NX>) -> Result<(), Error> {
+pub(crate) fn check_options<const N: usize, const NX: usize>(
+    o: &EpisodeOptionsN<N, NX>,
+) -> Result<(), Error> {
     let positive = |name, value: f64| {
         if value.is_finite() && value > 0.0 {
             Ok(())
