@@ -93,6 +93,44 @@ pub mod acceleration {
     pub const PRECISION_U: f64 = 0.0;
 }
 
+/// The parameter-only factors of [`dynamics`], computed once per tool: [`dynamics_with`]
+/// then only combines them with the state and control (derive/toolconf_derive/hoist.py).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DynamicsCoefficients {
+    pub k: [f64; 8],
+}
+
+impl DynamicsCoefficients {
+    /// - `params`: tool parameters [m1 m2 l1 l2]
+    #[inline]
+    #[must_use]
+    pub fn new(params: &SVector<f64, 4>) -> Self {
+        let g = G;
+        let m1 = params[0];
+        let m2 = params[1];
+        let l1 = params[2];
+        let l2 = params[3];
+        let s0 = 3.0 * m2;
+        let s1 = 1.0 / (m1 + s0);
+        let s2 = 1.0 / l2;
+        let s3 = s1 / l1;
+        let s4 = (3.0 / 2.0) * g;
+        let s5 = m2 * s3;
+        Self {
+            k: [
+                3.0 * s1 / l1.powi(2),
+                -(9.0 / 2.0) * s2 * s3,
+                -s3 * s4 * (m1 + 2.0 * m2),
+                -s0 * s1,
+                -(3.0 / 2.0) * l2 * s5,
+                (9.0 / 4.0) * g * s5,
+                3.0 / (l2.powi(2) * m2),
+                -s2 * s4,
+            ],
+        }
+    }
+}
+
 /// The generative process X_dot = f(X, U; p): joint rates and the nonlinear joint accelerations.
 ///
 /// From eq. (theta_1_ddot), eq. (theta_2_ddot).
@@ -107,35 +145,90 @@ pub fn dynamics(
     u: &SVector<f64, 2>,
     params: &SVector<f64, 4>,
 ) -> SVector<f64, 4> {
-    let g = G;
+    dynamics_with(x, u, &DynamicsCoefficients::new(params))
+}
+
+/// [`dynamics`] with the tool's [`DynamicsCoefficients`] computed beforehand.
+#[inline]
+#[must_use]
+pub fn dynamics_with(
+    x: &SVector<f64, 4>,
+    u: &SVector<f64, 2>,
+    coefficients: &DynamicsCoefficients,
+) -> SVector<f64, 4> {
     let theta1 = x[0];
     let theta2 = x[1];
     let theta1_dot = x[2];
     let theta2_dot = x[3];
     let torque1 = u[0];
     let torque2 = u[1];
-    let m1 = params[0];
-    let m2 = params[1];
-    let l1 = params[2];
-    let l2 = params[3];
-    let t0 = l1.powi(2);
-    let t1 = theta1 - theta2;
-    let t2 = m2 * t1.sin();
-    let t3 = l2 / 2.0;
-    let t4 = -g * m2 * t3 * theta2.cos() + torque2;
+    let k0 = coefficients.k[0];
+    let k1 = coefficients.k[1];
+    let k2 = coefficients.k[2];
+    let k3 = coefficients.k[3];
+    let k4 = coefficients.k[4];
+    let k5 = coefficients.k[5];
+    let k6 = coefficients.k[6];
+    let k7 = coefficients.k[7];
+    let t0 = theta1 - theta2;
+    let t1 = t0.cos();
+    let t2 = theta2.cos();
+    let t3 = t0.sin();
     // X_dot
     let mut x_dot = <SVector<f64, 4>>::zeros();
     x_dot[0] = theta1_dot;
     x_dot[1] = theta2_dot;
-    x_dot[2] = -(g * l1 * (m1 / 2.0 + m2) * theta1.cos()
-        + l1 * t2 * t3 * theta2_dot.powi(2)
-        + (3.0 / 2.0) * l1 * t4 * t1.cos() / l2
-        + t0 * t2 * theta1_dot.powi(2)
-        - torque1
-        + torque2)
-        / (t0 * (m1 / 3.0 + m2));
-    x_dot[3] = 3.0 * t4 / (l2.powi(2) * m2);
+    x_dot[2] = k0 * torque1 - k0 * torque2
+        + k1 * t1 * torque2
+        + k2 * theta1.cos()
+        + k3 * t3 * theta1_dot.powi(2)
+        + k4 * t3 * theta2_dot.powi(2)
+        + k5 * t1 * t2;
+    x_dot[3] = k6 * torque2 + k7 * t2;
     x_dot
+}
+
+/// The parameter-only factors of [`dynamics_jacobian`], computed once per tool: [`dynamics_jacobian_with`]
+/// then only combines them with the state and control (derive/toolconf_derive/hoist.py).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DynamicsJacobianCoefficients {
+    pub k: [f64; 10],
+}
+
+impl DynamicsJacobianCoefficients {
+    /// - `params`: tool parameters [m1 m2 l1 l2]
+    #[inline]
+    #[must_use]
+    pub fn new(params: &SVector<f64, 4>) -> Self {
+        let g = G;
+        let m1 = params[0];
+        let m2 = params[1];
+        let l1 = params[2];
+        let l2 = params[3];
+        let s0 = 1.0 / l2;
+        let s1 = 3.0 * m2;
+        let s2 = 1.0 / (m1 + s1);
+        let s3 = 1.0 / l1;
+        let s4 = s2 * s3;
+        let s5 = (3.0 / 2.0) * g;
+        let s6 = s1 * s2;
+        let s7 = m2 * s2;
+        let s8 = s3 * s7;
+        Self {
+            k: [
+                (9.0 / 2.0) * s0 * s4,
+                s4 * s5 * (m1 + 2.0 * m2),
+                -s6,
+                -(3.0 / 2.0) * l2 * s8,
+                -(9.0 / 4.0) * g * s8,
+                -6.0 * s7,
+                -l2 * s3 * s6,
+                s0 * s5,
+                3.0 * s2 / l1.powi(2),
+                3.0 / (l2.powi(2) * m2),
+            ],
+        }
+    }
 }
 
 /// Jacobians (df/dX, df/dU) of the generative process at any state and control.
@@ -152,45 +245,54 @@ pub fn dynamics_jacobian(
     u: &SVector<f64, 2>,
     params: &SVector<f64, 4>,
 ) -> (SMatrix<f64, 4, 4>, SMatrix<f64, 4, 2>) {
-    let g = G;
+    dynamics_jacobian_with(x, u, &DynamicsJacobianCoefficients::new(params))
+}
+
+/// [`dynamics_jacobian`] with the tool's [`DynamicsJacobianCoefficients`] computed beforehand.
+#[inline]
+#[must_use]
+pub fn dynamics_jacobian_with(
+    x: &SVector<f64, 4>,
+    u: &SVector<f64, 2>,
+    coefficients: &DynamicsJacobianCoefficients,
+) -> (SMatrix<f64, 4, 4>, SMatrix<f64, 4, 2>) {
     let theta1 = x[0];
     let theta2 = x[1];
     let theta1_dot = x[2];
     let theta2_dot = x[3];
     let torque2 = u[1];
-    let m1 = params[0];
-    let m2 = params[1];
-    let l1 = params[2];
-    let l2 = params[3];
-    let t0 = g * l1;
-    let t1 = l1.powi(2);
-    let t2 = theta1 - theta2;
-    let t3 = t2.cos();
-    let t4 = m2 * t3;
-    let t5 = l2 / 2.0;
-    let t6 = t2.sin();
-    let t7 = (3.0 / 2.0) / l2;
-    let t8 = l1 * t7;
-    let t9 = -l1 * t4 * t5 * theta2_dot.powi(2) - t1 * t4 * theta1_dot.powi(2)
-        + t6 * t8 * (-g * m2 * t5 * theta2.cos() + torque2);
-    let t10 = 1.0 / (m1 / 3.0 + m2);
-    let t11 = t10 / t1;
-    let t12 = theta2.sin();
-    let t13 = m2 * t10 * t6;
+    let k0 = coefficients.k[0];
+    let k1 = coefficients.k[1];
+    let k2 = coefficients.k[2];
+    let k3 = coefficients.k[3];
+    let k4 = coefficients.k[4];
+    let k5 = coefficients.k[5];
+    let k6 = coefficients.k[6];
+    let k7 = coefficients.k[7];
+    let k8 = coefficients.k[8];
+    let k9 = coefficients.k[9];
+    let t0 = theta1 - theta2;
+    let t1 = t0.sin();
+    let t2 = t0.cos();
+    let t3 = k0 * t1 * torque2
+        + k2 * t2 * theta1_dot.powi(2)
+        + k3 * t2 * theta2_dot.powi(2)
+        + k4 * t1 * theta2.cos();
+    let t4 = theta2.sin();
     // df/dX
     let mut f_x = <SMatrix<f64, 4, 4>>::zeros();
     f_x[(0, 2)] = 1.0;
     f_x[(1, 3)] = 1.0;
-    f_x[(2, 0)] = -t11 * (-t0 * (m1 / 2.0 + m2) * theta1.sin() - t9);
-    f_x[(2, 1)] = -t11 * ((3.0 / 4.0) * t0 * t12 * t4 + t9);
-    f_x[(2, 2)] = -2.0 * t13 * theta1_dot;
-    f_x[(2, 3)] = -l2 * t13 * theta2_dot / l1;
-    f_x[(3, 1)] = g * t12 * t7;
+    f_x[(2, 0)] = k1 * theta1.sin() + t3;
+    f_x[(2, 1)] = k4 * t2 * t4 - t3;
+    f_x[(2, 2)] = k5 * t1 * theta1_dot;
+    f_x[(2, 3)] = k6 * t1 * theta2_dot;
+    f_x[(3, 1)] = k7 * t4;
     // df/dU
     let mut f_u = <SMatrix<f64, 4, 2>>::zeros();
-    f_u[(2, 0)] = t11;
-    f_u[(2, 1)] = -t11 * (t3 * t8 + 1.0);
-    f_u[(3, 1)] = 3.0 / (l2.powi(2) * m2);
+    f_u[(2, 0)] = k8;
+    f_u[(2, 1)] = -k0 * t2 - k8;
+    f_u[(3, 1)] = k9;
     (f_x, f_u)
 }
 

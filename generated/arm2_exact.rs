@@ -93,6 +93,46 @@ pub mod acceleration {
     pub const PRECISION_U: f64 = 0.0;
 }
 
+/// The parameter-only factors of [`dynamics`], computed once per tool: [`dynamics_with`]
+/// then only combines them with the state and control (derive/toolconf_derive/hoist.py).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DynamicsCoefficients {
+    pub k: [f64; 12],
+}
+
+impl DynamicsCoefficients {
+    /// - `params`: tool parameters [m1 m2 l1 l2]
+    #[inline]
+    #[must_use]
+    pub fn new(params: &SVector<f64, 4>) -> Self {
+        let g = G;
+        let m1 = params[0];
+        let m2 = params[1];
+        let l1 = params[2];
+        let l2 = params[3];
+        let s0 = l2 * m2;
+        let s1 = l1 / 2.0;
+        let s2 = l2.powi(2);
+        let s3 = l1.powi(2);
+        Self {
+            k: [
+                -9.0 * m2,
+                4.0 * m1 + 12.0 * m2,
+                g * m1,
+                2.0 * g * m2,
+                s0,
+                -s1,
+                m2 * s2 / 3.0,
+                -l1,
+                -s0 / 2.0,
+                -s0 * s1,
+                36.0 / (m2 * s2 * s3),
+                s3 * (m1 / 3.0 + m2),
+            ],
+        }
+    }
+}
+
 /// The generative process X_dot = f(X, U; p): joint rates and the nonlinear joint accelerations.
 ///
 /// From Lagrangian mechanics of uniform rods.
@@ -107,6 +147,17 @@ pub fn dynamics(
     u: &SVector<f64, 2>,
     params: &SVector<f64, 4>,
 ) -> SVector<f64, 4> {
+    dynamics_with(x, u, &DynamicsCoefficients::new(params))
+}
+
+/// [`dynamics`] with the tool's [`DynamicsCoefficients`] computed beforehand.
+#[inline]
+#[must_use]
+pub fn dynamics_with(
+    x: &SVector<f64, 4>,
+    u: &SVector<f64, 2>,
+    coefficients: &DynamicsCoefficients,
+) -> SVector<f64, 4> {
     let g = G;
     let theta1 = x[0];
     let theta2 = x[1];
@@ -114,29 +165,100 @@ pub fn dynamics(
     let theta2_dot = x[3];
     let torque1 = u[0];
     let torque2 = u[1];
-    let m1 = params[0];
-    let m2 = params[1];
-    let l1 = params[2];
-    let l2 = params[3];
+    let k0 = coefficients.k[0];
+    let k1 = coefficients.k[1];
+    let k2 = coefficients.k[2];
+    let k3 = coefficients.k[3];
+    let k4 = coefficients.k[4];
+    let k5 = coefficients.k[5];
+    let k6 = coefficients.k[6];
+    let k7 = coefficients.k[7];
+    let k8 = coefficients.k[8];
+    let k9 = coefficients.k[9];
+    let k10 = coefficients.k[10];
+    let k11 = coefficients.k[11];
     let t0 = theta1 - theta2;
     let t1 = t0.sin();
-    let t2 = l2 * m2;
-    let t3 = -t2 * (g * theta2.cos() - l1 * t1 * theta1_dot.powi(2)) / 2.0 + torque2;
-    let t4 = t0.cos();
-    let t5 = l1 / 2.0;
-    let t6 = t2 * t4 * t5;
-    let t7 = l2.powi(2);
-    let t8 = g * theta1.cos();
-    let t9 = -t5 * (m1 * t8 + 2.0 * m2 * t8 + t1 * t2 * theta2_dot.powi(2)) + torque1 - torque2;
-    let t10 = l1.powi(2);
-    let t11 = 36.0 / (m2 * t10 * t7 * (4.0 * m1 - 9.0 * m2 * t4.powi(2) + 12.0 * m2));
+    let t2 = k8 * (g * theta2.cos() + k7 * t1 * theta1_dot.powi(2)) + torque2;
+    let t3 = t0.cos();
+    let t4 = k9 * t3;
+    let t5 = theta1.cos();
+    let t6 = k5 * (k2 * t5 + k3 * t5 + k4 * t1 * theta2_dot.powi(2)) + torque1 - torque2;
+    let t7 = k10 / (k0 * t3.powi(2) + k1);
     // X_dot
     let mut x_dot = <SVector<f64, 4>>::zeros();
     x_dot[0] = theta1_dot;
     x_dot[1] = theta2_dot;
-    x_dot[2] = t11 * (m2 * t7 * t9 / 3.0 - t3 * t6);
-    x_dot[3] = t11 * (t10 * t3 * (m1 / 3.0 + m2) - t6 * t9);
+    x_dot[2] = t7 * (k6 * t6 + t2 * t4);
+    x_dot[3] = t7 * (k11 * t2 + t4 * t6);
     x_dot
+}
+
+/// The parameter-only factors of [`dynamics_jacobian`], computed once per tool: [`dynamics_jacobian_with`]
+/// then only combines them with the state and control (derive/toolconf_derive/hoist.py).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DynamicsJacobianCoefficients {
+    pub k: [f64; 26],
+}
+
+impl DynamicsJacobianCoefficients {
+    /// - `params`: tool parameters [m1 m2 l1 l2]
+    #[inline]
+    #[must_use]
+    pub fn new(params: &SVector<f64, 4>) -> Self {
+        let g = G;
+        let m1 = params[0];
+        let m2 = params[1];
+        let l1 = params[2];
+        let l2 = params[3];
+        let s0 = 12.0 * m2;
+        let s1 = l2 * m2;
+        let s2 = l2.powi(2);
+        let s3 = m2 * s2;
+        let s4 = l1 / 6.0;
+        let s5 = s1 / 2.0;
+        let s6 = l1 / 2.0;
+        let s7 = l1.powi(2);
+        let s8 = s7 / 4.0;
+        let s9 = m2.powi(2);
+        let s10 = s2 * s9;
+        let s11 = 1.0 / s7;
+        let s12 = s11 / s2;
+        let s13 = 1.0 / l1;
+        let s14 = m1 / 3.0 + m2;
+        let s15 = s14 * s7;
+        let s16 = 1.0 / l2;
+        Self {
+            k: [
+                -9.0 * m2,
+                4.0 * m1 + s0,
+                -g * m1,
+                -2.0 * g * m2,
+                s1,
+                -s3 * s4,
+                -l1,
+                -s5,
+                s1 * s6,
+                -s10 * s8,
+                36.0 * s12 / m2,
+                -s6,
+                s3 / 3.0,
+                -648.0 * s12,
+                -g,
+                l1 * s10 / 4.0,
+                l2.powi(3) * s4 * s9,
+                -18.0 * m2,
+                -l2 * s0 * s13,
+                s1 * s8,
+                l1.powi(3) * s14 * s5,
+                s15,
+                -s15 * s5,
+                36.0 * l1 * s14 * s16,
+                12.0 * s11,
+                -18.0 * s13 * s16,
+            ],
+        }
+    }
 }
 
 /// Jacobians (df/dX, df/dU) of the generative process at any state and control.
@@ -153,6 +275,17 @@ pub fn dynamics_jacobian(
     u: &SVector<f64, 2>,
     params: &SVector<f64, 4>,
 ) -> (SMatrix<f64, 4, 4>, SMatrix<f64, 4, 2>) {
+    dynamics_jacobian_with(x, u, &DynamicsJacobianCoefficients::new(params))
+}
+
+/// [`dynamics_jacobian`] with the tool's [`DynamicsJacobianCoefficients`] computed beforehand.
+#[inline]
+#[must_use]
+pub fn dynamics_jacobian_with(
+    x: &SVector<f64, 4>,
+    u: &SVector<f64, 2>,
+    coefficients: &DynamicsJacobianCoefficients,
+) -> (SMatrix<f64, 4, 4>, SMatrix<f64, 4, 2>) {
     let g = G;
     let theta1 = x[0];
     let theta2 = x[1];
@@ -160,80 +293,77 @@ pub fn dynamics_jacobian(
     let theta2_dot = x[3];
     let torque1 = u[0];
     let torque2 = u[1];
-    let m1 = params[0];
-    let m2 = params[1];
-    let l1 = params[2];
-    let l2 = params[3];
-    let t0 = theta1 - theta2;
-    let t1 = t0.sin();
-    let t2 = theta1_dot.powi(2);
-    let t3 = l2 * m2;
-    let t4 = t3 / 2.0;
-    let t5 = -t4 * (g * theta2.cos() - l1 * t1 * t2) + torque2;
-    let t6 = l1 / 2.0;
-    let t7 = t0.cos();
-    let t8 = t3 * t7;
-    let t9 = t6 * t8;
-    let t10 = l2.powi(2);
-    let t11 = theta1.cos();
-    let t12 = g * m1;
-    let t13 = 2.0 * g * m2;
-    let t14 = theta2_dot.powi(2);
-    let t15 = t1 * t3;
-    let t16 = -t6 * (t11 * t12 + t11 * t13 + t14 * t15) + torque1 - torque2;
-    let t17 = l1.powi(2);
-    let t18 = 1.0 / t17;
-    let t19 = 1.0 / t10;
-    let t20 = 12.0 * m2;
-    let t21 = t7.powi(2);
-    let t22 = 4.0 * m1 - 9.0 * m2 * t21 + t20;
-    let t23 = 648.0 * t1 * t18 * t19 * t7 / t22.powi(2);
-    let t24 = t23 * (m2 * t10 * t16 / 3.0 - t5 * t9);
-    let t25 = 1.0 / m2;
-    let t26 = 1.0 / t22;
-    let t27 = t17 / 4.0;
-    let t28 = m2.powi(2);
-    let t29 = t10 * t28;
-    let t30 = t21 * t27 * t29;
-    let t31 = theta1.sin();
-    let t32 = l2 * m2 * t14 * t7 - t12 * t31 - t13 * t31;
-    let t33 = m2 * t10;
-    let t34 = l1 / 6.0;
-    let t35 = t15 * t6;
-    let t36 = -t35 * t5;
-    let t37 = -g * theta2.sin() + l1 * t2 * t7;
-    let t38 = t18 * t26;
-    let t39 = 36.0 * t19 * t25 * t38;
-    let t40 = t1 * t26 * theta1_dot;
-    let t41 = 18.0 * t7;
-    let t42 = m2 * t41;
-    let t43 = t26 / l1;
-    let t44 = t1 * theta2_dot;
-    let t45 = m1 / 3.0 + m2;
-    let t46 = t17 * t45;
-    let t47 = t23 * (-t16 * t9 + t46 * t5);
-    let t48 = t16 * t35;
-    let t49 = 1.0 / l2;
+    let k0 = coefficients.k[0];
+    let k1 = coefficients.k[1];
+    let k2 = coefficients.k[2];
+    let k3 = coefficients.k[3];
+    let k4 = coefficients.k[4];
+    let k5 = coefficients.k[5];
+    let k6 = coefficients.k[6];
+    let k7 = coefficients.k[7];
+    let k8 = coefficients.k[8];
+    let k9 = coefficients.k[9];
+    let k10 = coefficients.k[10];
+    let k11 = coefficients.k[11];
+    let k12 = coefficients.k[12];
+    let k13 = coefficients.k[13];
+    let k14 = coefficients.k[14];
+    let k15 = coefficients.k[15];
+    let k16 = coefficients.k[16];
+    let k17 = coefficients.k[17];
+    let k18 = coefficients.k[18];
+    let k19 = coefficients.k[19];
+    let k20 = coefficients.k[20];
+    let k21 = coefficients.k[21];
+    let k22 = coefficients.k[22];
+    let k23 = coefficients.k[23];
+    let k24 = coefficients.k[24];
+    let k25 = coefficients.k[25];
+    let t0 = theta1_dot.powi(2);
+    let t1 = theta1 - theta2;
+    let t2 = t1.cos();
+    let t3 = t2.powi(2);
+    let t4 = k9 * t3;
+    let t5 = theta1.sin();
+    let t6 = theta2_dot.powi(2);
+    let t7 = k2 * t5 + k3 * t5 + k4 * t2 * t6;
+    let t8 = t1.sin();
+    let t9 = k6 * t0;
+    let t10 = k7 * (g * theta2.cos() + t8 * t9) + torque2;
+    let t11 = k8 * t8;
+    let t12 = t10 * t11;
+    let t13 = k0 * t3 + k1;
+    let t14 = 1.0 / t13;
+    let t15 = k10 * t14;
+    let t16 = k8 * t2;
+    let t17 = theta1.cos();
+    let t18 = k11 * (-k2 * t17 - k3 * t17 + k4 * t6 * t8) + torque1 - torque2;
+    let t19 = k13 * t2 * t8 / t13.powi(2);
+    let t20 = t19 * (k12 * t18 - t10 * t16);
+    let t21 = k14 * theta2.sin() - t2 * t9;
+    let t22 = t14 * t2;
+    let t23 = k17 * t22 * t8;
+    let t24 = t14 * t8;
+    let t25 = t19 * (k21 * t10 - t16 * t18);
+    let t26 = t11 * t18;
     // df/dX
     let mut f_x = <SMatrix<f64, 4, 4>>::zeros();
     f_x[(0, 2)] = 1.0;
     f_x[(1, 3)] = 1.0;
-    f_x[(2, 0)] = 36.0 * t18 * t19 * t25 * t26 * (-t2 * t30 - t32 * t33 * t34 - t36) - t24;
-    f_x[(2, 1)] = t24 + t39 * (l1 * t29 * t37 * t7 / 4.0 + l2.powi(3) * t14 * t28 * t34 * t7 + t36);
-    f_x[(2, 2)] = -t40 * t42;
-    f_x[(2, 3)] = -l2 * t20 * t43 * t44;
-    f_x[(3, 0)] =
-        36.0 * t18 * t19 * t25 * t26 * (l1.powi(3) * t2 * t4 * t45 * t7 + t27 * t32 * t8 + t48)
-            - t47;
-    f_x[(3, 1)] = t39 * (-t14 * t30 - t37 * t4 * t46 - t48) + t47;
-    f_x[(3, 2)] = 36.0 * l1 * t40 * t45 * t49;
-    f_x[(3, 3)] = t26 * t42 * t44;
+    f_x[(2, 0)] = t15 * (k5 * t7 + t0 * t4 + t12) + t20;
+    f_x[(2, 1)] = t15 * (k15 * t2 * t21 + k16 * t2 * t6 - t12) - t20;
+    f_x[(2, 2)] = t23 * theta1_dot;
+    f_x[(2, 3)] = k18 * t24 * theta2_dot;
+    f_x[(3, 0)] = t15 * (k19 * t2 * t7 + k20 * t0 * t2 + t26) + t25;
+    f_x[(3, 1)] = t15 * (k22 * t21 - t26 + t4 * t6) - t25;
+    f_x[(3, 2)] = k23 * t24 * theta1_dot;
+    f_x[(3, 3)] = -t23 * theta2_dot;
     // df/dU
     let mut f_u = <SMatrix<f64, 4, 2>>::zeros();
-    f_u[(2, 0)] = 12.0 * t38;
-    f_u[(2, 1)] = t39 * (-t33 / 3.0 - t9);
-    f_u[(3, 0)] = -t41 * t43 * t49;
-    f_u[(3, 1)] = t39 * (t46 + t9);
+    f_u[(2, 0)] = k24 * t14;
+    f_u[(2, 1)] = t15 * (-k12 - t16);
+    f_u[(3, 0)] = k25 * t22;
+    f_u[(3, 1)] = t15 * (k21 + t16);
     (f_x, f_u)
 }
 

@@ -100,6 +100,104 @@ pub mod acceleration {
     pub const PRECISION_U: f64 = 0.0;
 }
 
+/// The parameter-only factors of [`dynamics`], computed once per tool: [`dynamics_with`]
+/// then only combines them with the state and control (derive/toolconf_derive/hoist.py).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DynamicsCoefficients {
+    pub k: [f64; 42],
+}
+
+impl DynamicsCoefficients {
+    /// - `params`: tool parameters [m1 m2 m3 l1 l2 l3]
+    #[inline]
+    #[must_use]
+    pub fn new(params: &SVector<f64, 6>) -> Self {
+        let g = G;
+        let m1 = params[0];
+        let m2 = params[1];
+        let m3 = params[2];
+        let l1 = params[3];
+        let l2 = params[4];
+        let l3 = params[5];
+        let s0 = m3.powi(2);
+        let s1 = 36.0 * s0;
+        let s2 = m2.powi(2);
+        let s3 = m2 * m3;
+        let s4 = m1 * m3;
+        let s5 = m1 * m2;
+        let s6 = l3 * m3;
+        let s7 = s6 / 2.0;
+        let s8 = l1 / 2.0;
+        let s9 = l2.powi(2);
+        let s10 = s0 * s9;
+        let s11 = s6 / 6.0;
+        let s12 = l1 * m2;
+        let s13 = s12 * s9;
+        let s14 = g * m2;
+        let s15 = 2.0 * m3;
+        let s16 = l2 * m2;
+        let s17 = l3.powi(2);
+        let s18 = s10 * s17;
+        let s19 = s3 * s9;
+        let s20 = s17 / 9.0;
+        let s21 = l2 / 2.0;
+        let s22 = s0 * s17;
+        let s23 = l1 * l2 * s22;
+        let s24 = l1.powi(2);
+        let s25 = s24 / 4.0;
+        let s26 = s24 / 3.0;
+        let s27 = s10 * s24;
+        let s28 = s2 * s9;
+        let s29 = s19 * s24;
+        Self {
+            k: [
+                -s1,
+                -27.0 * s0,
+                -9.0 * s2,
+                -36.0 * s3,
+                -27.0 * s3,
+                -9.0 * s4,
+                -9.0 * s3,
+                54.0 * s0,
+                s1 + 12.0 * s2 + 48.0 * s3 + 12.0 * s4 + 4.0 * s5,
+                -l1,
+                -l2,
+                -s7,
+                -l3 * s10 * s8,
+                -s11 * s13,
+                s13 * s6 / 4.0,
+                g * m1,
+                2.0 * s14,
+                g * s15,
+                s16,
+                s6,
+                l2 * s15,
+                -s8,
+                -s18 / 4.0,
+                s18 / 3.0 + s19 * s20,
+                s14,
+                -s12,
+                -l1 * s15,
+                -s21,
+                -s23 / 3.0,
+                -l1 * m3 * s16 * s17 / 6.0,
+                s23 / 4.0,
+                108.0 / (m3 * s17 * s24 * s9),
+                -l3 * s0 * s21 * s24,
+                -s16 * s24 * s7,
+                -l2 * m1 * s11 * s24,
+                s16 * s25 * s6,
+                -s22 * s25,
+                s17 * s26 * s3 + s20 * s24 * s4 + s22 * s26,
+                -s27,
+                -s25 * s28,
+                -s29,
+                s24 * s5 * s9 / 9.0 + s26 * s28 + s26 * s4 * s9 + s27 + (4.0 / 3.0) * s29,
+            ],
+        }
+    }
+}
+
 /// The generative process X_dot = f(X, U; p): joint rates and the nonlinear joint accelerations.
 ///
 /// From Lagrangian mechanics of uniform rods.
@@ -114,6 +212,17 @@ pub fn dynamics(
     u: &SVector<f64, 3>,
     params: &SVector<f64, 6>,
 ) -> SVector<f64, 6> {
+    dynamics_with(x, u, &DynamicsCoefficients::new(params))
+}
+
+/// [`dynamics`] with the tool's [`DynamicsCoefficients`] computed beforehand.
+#[inline]
+#[must_use]
+pub fn dynamics_with(
+    x: &SVector<f64, 6>,
+    u: &SVector<f64, 3>,
+    coefficients: &DynamicsCoefficients,
+) -> SVector<f64, 6> {
     let g = G;
     let theta1 = x[0];
     let theta2 = x[1];
@@ -124,112 +233,220 @@ pub fn dynamics(
     let torque1 = u[0];
     let torque2 = u[1];
     let torque3 = u[2];
-    let m1 = params[0];
-    let m2 = params[1];
-    let m3 = params[2];
-    let l1 = params[3];
-    let l2 = params[4];
-    let l3 = params[5];
-    let t0 = l3.powi(2);
-    let t1 = t0 / 9.0;
-    let t2 = l2.powi(2);
-    let t3 = m2 * m3;
-    let t4 = t2 * t3;
-    let t5 = m3.powi(2);
-    let t6 = t2 * t5;
-    let t7 = t0 / 3.0;
-    let t8 = -theta3;
-    let t9 = t8 + theta2;
-    let t10 = t9.cos();
-    let t11 = t10.powi(2);
-    let t12 = t0 / 4.0;
-    let t13 = g * theta1.cos();
-    let t14 = 2.0 * t13;
-    let t15 = l2 * theta2_dot.powi(2);
-    let t16 = theta1 - theta2;
-    let t17 = t16.sin();
-    let t18 = m2 * t17;
-    let t19 = t8 + theta1;
-    let t20 = t19.sin();
-    let t21 = l3 * m3;
-    let t22 = t21 * theta3_dot.powi(2);
-    let t23 = 2.0 * m3;
-    let t24 = t17 * t23;
-    let t25 = l1 / 2.0;
-    let t26 = -t25 * (m1 * t13 + m2 * t14 + m3 * t14 + t15 * t18 + t15 * t24 + t20 * t22) + torque1
+    let k0 = coefficients.k[0];
+    let k1 = coefficients.k[1];
+    let k2 = coefficients.k[2];
+    let k3 = coefficients.k[3];
+    let k4 = coefficients.k[4];
+    let k5 = coefficients.k[5];
+    let k6 = coefficients.k[6];
+    let k7 = coefficients.k[7];
+    let k8 = coefficients.k[8];
+    let k9 = coefficients.k[9];
+    let k10 = coefficients.k[10];
+    let k11 = coefficients.k[11];
+    let k12 = coefficients.k[12];
+    let k13 = coefficients.k[13];
+    let k14 = coefficients.k[14];
+    let k15 = coefficients.k[15];
+    let k16 = coefficients.k[16];
+    let k17 = coefficients.k[17];
+    let k18 = coefficients.k[18];
+    let k19 = coefficients.k[19];
+    let k20 = coefficients.k[20];
+    let k21 = coefficients.k[21];
+    let k22 = coefficients.k[22];
+    let k23 = coefficients.k[23];
+    let k24 = coefficients.k[24];
+    let k25 = coefficients.k[25];
+    let k26 = coefficients.k[26];
+    let k27 = coefficients.k[27];
+    let k28 = coefficients.k[28];
+    let k29 = coefficients.k[29];
+    let k30 = coefficients.k[30];
+    let k31 = coefficients.k[31];
+    let k32 = coefficients.k[32];
+    let k33 = coefficients.k[33];
+    let k34 = coefficients.k[34];
+    let k35 = coefficients.k[35];
+    let k36 = coefficients.k[36];
+    let k37 = coefficients.k[37];
+    let k38 = coefficients.k[38];
+    let k39 = coefficients.k[39];
+    let k40 = coefficients.k[40];
+    let k41 = coefficients.k[41];
+    let t0 = -theta3;
+    let t1 = t0 + theta2;
+    let t2 = t1.cos();
+    let t3 = t2.powi(2);
+    let t4 = theta1.cos();
+    let t5 = theta2_dot.powi(2);
+    let t6 = theta1 - theta2;
+    let t7 = t6.sin();
+    let t8 = t5 * t7;
+    let t9 = t0 + theta1;
+    let t10 = t9.sin();
+    let t11 = k19 * theta3_dot.powi(2);
+    let t12 = k21 * (k15 * t4 + k16 * t4 + k17 * t4 + k18 * t8 + k20 * t8 + t10 * t11) + torque1
         - torque2;
-    let t27 = l1 * theta1_dot.powi(2);
-    let t28 = t9.sin();
-    let t29 = -t21 * (g * theta3.cos() - t15 * t28 - t20 * t27) / 2.0 + torque3;
-    let t30 = t19.cos();
-    let t31 = l3 * t30;
-    let t32 = l1 * t4;
-    let t33 = t25 * t6;
-    let t34 = t16.cos();
-    let t35 = l3 * t10;
-    let t36 = t34 * t35;
-    let t37 = -t31 * t32 / 6.0 - t31 * t33 + t32 * t36 / 4.0 + t33 * t36;
-    let t38 = l1 * l2;
-    let t39 = l1 * l2 * t0 * t10 * t30 * t5 / 4.0 - t0 * t3 * t34 * t38 / 6.0 - t34 * t38 * t5 * t7;
-    let t40 = g * theta2.cos();
-    let t41 = l2 / 2.0;
-    let t42 = -t41 * (m2 * t40 - t18 * t27 + t22 * t28 + t23 * t40 - t24 * t27) + torque2 - torque3;
-    let t43 = l1.powi(2);
-    let t44 = m2.powi(2);
-    let t45 = m1 * m3;
-    let t46 = t34.powi(2);
-    let t47 = t3 * t46;
-    let t48 = t30.powi(2);
-    let t49 = t44 * t46;
-    let t50 = 27.0 * t5;
-    let t51 = 108.0
-        / (m3
-            * t0
-            * t2
-            * t43
-            * (4.0 * m1 * m2
-                + 12.0 * m1 * m3
-                + 27.0 * m2 * m3 * t10 * t30 * t34
-                + 48.0 * m2 * m3
-                + 54.0 * t10 * t30 * t34 * t5
-                - 27.0 * t11 * t3
-                - 9.0 * t11 * t45
-                - t11 * t50
-                - 9.0 * t3 * t48
-                + 12.0 * t44
-                - 36.0 * t46 * t5
-                - 36.0 * t47
-                - t48 * t50
-                - 9.0 * t49
-                + 36.0 * t5));
-    let t52 = t43 * t45;
-    let t53 = t3 * t43;
-    let t54 = t43 * t5;
-    let t55 = l2 * l3 * m2 * m3 * t30 * t34 * t43 / 4.0 + l2 * l3 * t30 * t34 * t43 * t5 / 2.0
-        - l2 * t35 * t52 / 6.0
-        - t35 * t41 * t53
-        - t35 * t41 * t54;
-    let t56 = t43 * t6;
-    let t57 = t2 * t43;
-    let t58 = t57 / 3.0;
+    let t13 = t1.sin();
+    let t14 = theta1_dot.powi(2);
+    let t15 = k11 * (g * theta3.cos() + k10 * t13 * t5 + k9 * t10 * t14) + torque3;
+    let t16 = t9.cos();
+    let t17 = t6.cos();
+    let t18 = t17 * t2;
+    let t19 = k12 * t16 - k12 * t18 + k13 * t16 + k14 * t18;
+    let t20 = k28 * t17 + k29 * t17 + k30 * t16 * t2;
+    let t21 = theta2.cos();
+    let t22 = t14 * t7;
+    let t23 = k27 * (k17 * t21 + k24 * t21 + k25 * t22 + k26 * t22 + t11 * t13) + torque2 - torque3;
+    let t24 = t17.powi(2);
+    let t25 = t16.powi(2);
+    let t26 = t16 * t18;
+    let t27 = k31
+        / (k0 * t24 + k1 * t25 + k1 * t3 + k2 * t24 + k3 * t24 - k4 * t26
+            + k4 * t3
+            + k5 * t3
+            + k6 * t25
+            + k7 * t26
+            + k8);
+    let t28 = t16 * t17;
+    let t29 = k32 * t2 - k32 * t28 + k33 * t2 + k34 * t2 + k35 * t28;
     // X_dot
     let mut x_dot = <SVector<f64, 6>>::zeros();
     x_dot[0] = theta1_dot;
     x_dot[1] = theta2_dot;
     x_dot[2] = theta3_dot;
-    x_dot[3] = t51 * (t26 * (t1 * t4 - t11 * t12 * t6 + t6 * t7) + t29 * t37 + t39 * t42);
-    x_dot[4] =
-        t51 * (t26 * t39 + t29 * t55 + t42 * (t1 * t52 - t12 * t48 * t54 + t53 * t7 + t54 * t7));
-    x_dot[5] = t51
-        * (t26 * t37
-            + t29
-                * (m1 * m2 * t57 / 9.0 + (4.0 / 3.0) * t3 * t57 + t44 * t58 + t45 * t58
-                    - t46 * t56
-                    - t47 * t57
-                    - t49 * t57 / 4.0
-                    + t56)
-            + t42 * t55);
+    x_dot[3] = t27 * (t12 * (k22 * t3 + k23) + t15 * t19 + t20 * t23);
+    x_dot[4] = t27 * (t12 * t20 + t15 * t29 + t23 * (k36 * t25 + k37));
+    x_dot[5] = t27 * (t12 * t19 + t15 * (k38 * t24 + k39 * t24 + k40 * t24 + k41) + t23 * t29);
     x_dot
+}
+
+/// The parameter-only factors of [`dynamics_jacobian`], computed once per tool: [`dynamics_jacobian_with`]
+/// then only combines them with the state and control (derive/toolconf_derive/hoist.py).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DynamicsJacobianCoefficients {
+    pub k: [f64; 64],
+}
+
+impl DynamicsJacobianCoefficients {
+    /// - `params`: tool parameters [m1 m2 m3 l1 l2 l3]
+    #[inline]
+    #[must_use]
+    pub fn new(params: &SVector<f64, 6>) -> Self {
+        let g = G;
+        let m1 = params[0];
+        let m2 = params[1];
+        let m3 = params[2];
+        let l1 = params[3];
+        let l2 = params[4];
+        let l3 = params[5];
+        let s0 = m3.powi(2);
+        let s1 = 36.0 * s0;
+        let s2 = m2.powi(2);
+        let s3 = m2 * m3;
+        let s4 = m1 * m3;
+        let s5 = m1 * m2;
+        let s6 = l3 * m3;
+        let s7 = l1 / 2.0;
+        let s8 = l2.powi(2);
+        let s9 = s0 * s8;
+        let s10 = l1 * m2;
+        let s11 = s10 / 6.0;
+        let s12 = s6 * s8;
+        let s13 = g * m2;
+        let s14 = 2.0 * m3;
+        let s15 = l2 / 2.0;
+        let s16 = l3.powi(2);
+        let s17 = s0 * s16;
+        let s18 = l1 * l2 * s17;
+        let s19 = s16 * s9;
+        let s20 = s3 * s8;
+        let s21 = s16 / 9.0;
+        let s22 = s19 / 3.0 + s20 * s21;
+        let s23 = l2 * m2;
+        let s24 = l1.powi(2);
+        let s25 = s15 * s6;
+        let s26 = 4.0 * m3;
+        let s27 = l2 * s6;
+        let s28 = s24 / 4.0;
+        let s29 = s24 / 3.0;
+        let s30 = s17 * s24;
+        let s31 = s16 * s29 * s3 + s21 * s24 * s4 + s30 / 3.0;
+        let s32 = s2 * s8;
+        let s33 = s24 * s32;
+        let s34 = s24 * s9;
+        let s35 = s20 * s24;
+        Self {
+            k: [
+                -s1,
+                -27.0 * s0,
+                -9.0 * s2,
+                -36.0 * s3,
+                -27.0 * s3,
+                -9.0 * s4,
+                -9.0 * s3,
+                54.0 * s0,
+                s1 + 12.0 * s2 + 48.0 * s3 + 12.0 * s4 + 4.0 * s5,
+                -l1,
+                -l2,
+                -s6 / 2.0,
+                l3 * s7 * s9,
+                s11 * s12,
+                -s10 * s12 / 4.0,
+                s13,
+                g * s14,
+                s6,
+                -s10,
+                -l1 * s14,
+                -s15,
+                s18 / 3.0,
+                -s18 / 4.0,
+                l2 * m3 * s11 * s16,
+                -s19 / 4.0,
+                s22,
+                -g * m1,
+                -2.0 * s13,
+                s23,
+                l2 * s14,
+                -s7,
+                s6 * s7,
+                108.0 / (m3 * s16 * s24 * s8),
+                -72.0 * s0,
+                -18.0 * s2,
+                -72.0 * s3,
+                -18.0 * s3,
+                s25,
+                s19 / 2.0,
+                -54.0 * s3,
+                -18.0 * s4,
+                -g,
+                -l1 * s26,
+                -2.0 * s10,
+                l1 * s6,
+                2.0 * s23,
+                l2 * s26,
+                s27,
+                -l3 * s0 * s15 * s24,
+                -s23 * s28 * s6,
+                -s17 * s28,
+                s31,
+                -m2 * s24 * s25,
+                -m1 * s24 * s27 / 6.0,
+                s30 / 2.0,
+                s33 / 2.0,
+                2.0 * s34,
+                2.0 * s35,
+                -s34,
+                -s28 * s32,
+                -s35,
+                s24 * s5 * s8 / 9.0 + s29 * s4 * s8 + s33 / 3.0 + s34 + (4.0 / 3.0) * s35,
+                -s22,
+                -s31,
+            ],
+        }
+    }
 }
 
 /// Jacobians (df/dX, df/dU) of the generative process at any state and control.
@@ -246,6 +463,17 @@ pub fn dynamics_jacobian(
     u: &SVector<f64, 3>,
     params: &SVector<f64, 6>,
 ) -> (SMatrix<f64, 6, 6>, SMatrix<f64, 6, 3>) {
+    dynamics_jacobian_with(x, u, &DynamicsJacobianCoefficients::new(params))
+}
+
+/// [`dynamics_jacobian`] with the tool's [`DynamicsJacobianCoefficients`] computed beforehand.
+#[inline]
+#[must_use]
+pub fn dynamics_jacobian_with(
+    x: &SVector<f64, 6>,
+    u: &SVector<f64, 3>,
+    coefficients: &DynamicsJacobianCoefficients,
+) -> (SMatrix<f64, 6, 6>, SMatrix<f64, 6, 3>) {
     let g = G;
     let theta1 = x[0];
     let theta2 = x[1];
@@ -256,252 +484,247 @@ pub fn dynamics_jacobian(
     let torque1 = u[0];
     let torque2 = u[1];
     let torque3 = u[2];
-    let m1 = params[0];
-    let m2 = params[1];
-    let m3 = params[2];
-    let l1 = params[3];
-    let l2 = params[4];
-    let l3 = params[5];
+    let k0 = coefficients.k[0];
+    let k1 = coefficients.k[1];
+    let k2 = coefficients.k[2];
+    let k3 = coefficients.k[3];
+    let k4 = coefficients.k[4];
+    let k5 = coefficients.k[5];
+    let k6 = coefficients.k[6];
+    let k7 = coefficients.k[7];
+    let k8 = coefficients.k[8];
+    let k9 = coefficients.k[9];
+    let k10 = coefficients.k[10];
+    let k11 = coefficients.k[11];
+    let k12 = coefficients.k[12];
+    let k13 = coefficients.k[13];
+    let k14 = coefficients.k[14];
+    let k15 = coefficients.k[15];
+    let k16 = coefficients.k[16];
+    let k17 = coefficients.k[17];
+    let k18 = coefficients.k[18];
+    let k19 = coefficients.k[19];
+    let k20 = coefficients.k[20];
+    let k21 = coefficients.k[21];
+    let k22 = coefficients.k[22];
+    let k23 = coefficients.k[23];
+    let k24 = coefficients.k[24];
+    let k25 = coefficients.k[25];
+    let k26 = coefficients.k[26];
+    let k27 = coefficients.k[27];
+    let k28 = coefficients.k[28];
+    let k29 = coefficients.k[29];
+    let k30 = coefficients.k[30];
+    let k31 = coefficients.k[31];
+    let k32 = coefficients.k[32];
+    let k33 = coefficients.k[33];
+    let k34 = coefficients.k[34];
+    let k35 = coefficients.k[35];
+    let k36 = coefficients.k[36];
+    let k37 = coefficients.k[37];
+    let k38 = coefficients.k[38];
+    let k39 = coefficients.k[39];
+    let k40 = coefficients.k[40];
+    let k41 = coefficients.k[41];
+    let k42 = coefficients.k[42];
+    let k43 = coefficients.k[43];
+    let k44 = coefficients.k[44];
+    let k45 = coefficients.k[45];
+    let k46 = coefficients.k[46];
+    let k47 = coefficients.k[47];
+    let k48 = coefficients.k[48];
+    let k49 = coefficients.k[49];
+    let k50 = coefficients.k[50];
+    let k51 = coefficients.k[51];
+    let k52 = coefficients.k[52];
+    let k53 = coefficients.k[53];
+    let k54 = coefficients.k[54];
+    let k55 = coefficients.k[55];
+    let k56 = coefficients.k[56];
+    let k57 = coefficients.k[57];
+    let k58 = coefficients.k[58];
+    let k59 = coefficients.k[59];
+    let k60 = coefficients.k[60];
+    let k61 = coefficients.k[61];
+    let k62 = coefficients.k[62];
+    let k63 = coefficients.k[63];
     let t0 = theta1 - theta2;
     let t1 = t0.cos();
-    let t2 = l1 * theta1_dot.powi(2);
-    let t3 = m2 * t2;
-    let t4 = 2.0 * m3;
-    let t5 = t2 * t4;
-    let t6 = t1 * t3 + t1 * t5;
-    let t7 = -t6;
-    let t8 = l1 * t1;
-    let t9 = l3.powi(2);
-    let t10 = m2 * m3;
-    let t11 = l2 / 6.0;
-    let t12 = t10 * t11 * t9;
-    let t13 = t9 / 3.0;
-    let t14 = m3.powi(2);
-    let t15 = l2 * t14;
-    let t16 = t13 * t15;
-    let t17 = -theta3;
-    let t18 = t17 + theta2;
-    let t19 = t18.cos();
-    let t20 = t9 / 4.0;
-    let t21 = t15 * t20;
-    let t22 = t19 * t21;
-    let t23 = t17 + theta1;
-    let t24 = t23.cos();
-    let t25 = l1 * t24;
-    let t26 = t12 * t8 + t16 * t8 - t22 * t25;
-    let t27 = -t26;
-    let t28 = l2 / 2.0;
-    let t29 = t27 * t28;
-    let t30 = t2 * t24;
-    let t31 = l2.powi(2);
-    let t32 = t10 * t31;
-    let t33 = l1 * t32 / 6.0;
-    let t34 = l1 / 2.0;
-    let t35 = t14 * t31;
-    let t36 = t34 * t35;
-    let t37 = l3 * t36;
-    let t38 = l3 * t19;
-    let t39 = t32 / 4.0;
-    let t40 = t38 * t39;
-    let t41 = t19 * t37;
-    let t42 = -l3 * t24 * t33 + t1 * t41 - t24 * t37 + t40 * t8;
-    let t43 = l3 * m3;
-    let t44 = t43 / 2.0;
-    let t45 = t42 * t44;
-    let t46 = theta1.sin();
-    let t47 = g * m1;
-    let t48 = g * m2;
-    let t49 = 2.0 * t48;
-    let t50 = g * t4;
-    let t51 = l2 * theta2_dot.powi(2);
-    let t52 = m2 * t51;
-    let t53 = t1 * t52;
-    let t54 = t4 * t51;
-    let t55 = t1 * t54;
-    let t56 = theta3_dot.powi(2);
-    let t57 = l3 * m3 * t24 * t56 - t46 * t47 - t46 * t49 - t46 * t50 + t53 + t55;
-    let t58 = t9 / 9.0;
-    let t59 = t19.powi(2);
-    let t60 = t13 * t35 - t20 * t35 * t59 + t32 * t58;
-    let t61 = t34 * t60;
-    let t62 = t23.sin();
-    let t63 = t18.sin();
-    let t64 = -t44 * (g * theta3.cos() - t2 * t62 - t51 * t63) + torque3;
-    let t65 = l3 * t62;
-    let t66 = t36 * t65;
-    let t67 = t33 * t65;
-    let t68 = t0.sin();
-    let t69 = l1 * t68;
-    let t70 = t40 * t69 + t41 * t68;
-    let t71 = t66 + t67 - t70;
-    let t72 = l1 * t62;
-    let t73 = t22 * t72;
-    let t74 = t12 * t69 + t16 * t69;
-    let t75 = -t73 + t74;
-    let t76 = theta2.cos();
-    let t77 = t43 * t56;
-    let t78 = -t28 * (-t3 * t68 + t48 * t76 - t5 * t68 + t50 * t76 + t63 * t77) + torque2 - torque3;
-    let t79 = m2.powi(2);
-    let t80 = m1 * m3;
-    let t81 = t1.powi(2);
-    let t82 = t10 * t81;
-    let t83 = t24.powi(2);
-    let t84 = 27.0 * t10;
-    let t85 = t79 * t81;
-    let t86 = 27.0 * t14;
-    let t87 = 4.0 * m1 * m2
-        + 12.0 * m1 * m3
-        + 27.0 * m2 * m3 * t1 * t19 * t24
-        + 48.0 * m2 * m3
-        + 54.0 * t1 * t14 * t19 * t24
-        - 9.0 * t10 * t83
-        - 36.0 * t14 * t81
-        + 36.0 * t14
-        - 9.0 * t59 * t80
-        - t59 * t84
-        - t59 * t86
-        + 12.0 * t79
-        - 36.0 * t82
-        - t83 * t86
-        - 9.0 * t85;
-    let t88 = l1.powi(2);
-    let t89 = 108.0 / (m3 * t31 * t88 * t9);
-    let t90 = t89 / t87;
-    let t91 = t1 * t68;
-    let t92 = t79 * t91;
-    let t93 = 18.0 * t92;
-    let t94 = 72.0 * t91;
-    let t95 = t14 * t94;
-    let t96 = 54.0 * t14;
-    let t97 = t19 * t96;
-    let t98 = t24 * t68;
-    let t99 = t97 * t98;
-    let t100 = t10 * t94;
-    let t101 = t19 * t84;
-    let t102 = t101 * t98;
-    let t103 = t24 * t62;
-    let t104 = -t1 * t101 * t62 - t1 * t62 * t97 + 18.0 * t10 * t103 + t103 * t96;
-    let t105 = -t100 + t102 - t104 - t93 - t95 + t99;
-    let t106 = theta1.cos();
-    let t107 = -t34 * (t106 * t47 + t106 * t49 + t106 * t50 + t52 * t68 + t54 * t68 + t62 * t77)
+    let t2 = theta1_dot.powi(2);
+    let t3 = t1 * t2;
+    let t4 = k18 * t3 + k19 * t3;
+    let t5 = -theta3;
+    let t6 = t5 + theta1;
+    let t7 = t6.cos();
+    let t8 = t5 + theta2;
+    let t9 = t8.cos();
+    let t10 = k22 * t9;
+    let t11 = k21 * t1 + k23 * t1 + t10 * t7;
+    let t12 = -t11;
+    let t13 = k20 * t12;
+    let t14 = k12 * t7;
+    let t15 = k13 * t7;
+    let t16 = t1 * t9;
+    let t17 = k14 * t16;
+    let t18 = k12 * t16;
+    let t19 = t14 + t15 + t17 - t18;
+    let t20 = -t19;
+    let t21 = k31 * t7;
+    let t22 = t2 * t21;
+    let t23 = theta1.sin();
+    let t24 = theta3_dot.powi(2);
+    let t25 = k17 * t24;
+    let t26 = theta2_dot.powi(2);
+    let t27 = t1 * t26;
+    let t28 = k28 * t27 + k29 * t27;
+    let t29 = -k16 * t23 + k26 * t23 + k27 * t23 + t25 * t7 + t28;
+    let t30 = t9.powi(2);
+    let t31 = k24 * t30;
+    let t32 = k25 + t31;
+    let t33 = k30 * t32;
+    let t34 = t8.sin();
+    let t35 = k10 * t26;
+    let t36 = t6.sin();
+    let t37 = k9 * t2;
+    let t38 = k11 * (g * theta3.cos() + t34 * t35 + t36 * t37) + torque3;
+    let t39 = t0.sin();
+    let t40 = t39 * t9;
+    let t41 = k14 * t40;
+    let t42 = k12 * t40;
+    let t43 = k12 * t36 + k13 * t36;
+    let t44 = t41 - t42 + t43;
+    let t45 = t10 * t36;
+    let t46 = k21 * t39 + k23 * t39;
+    let t47 = t45 + t46;
+    let t48 = theta2.cos();
+    let t49 = t2 * t39;
+    let t50 = k20 * (k15 * t48 + k16 * t48 + k18 * t49 + k19 * t49 + t25 * t34) + torque2 - torque3;
+    let t51 = t1.powi(2);
+    let t52 = t7.powi(2);
+    let t53 = t16 * t7;
+    let t54 = k0 * t51 + k1 * t30 + k1 * t52 + k2 * t51 + k3 * t51 + k4 * t30 - k4 * t53
+        + k5 * t30
+        + k6 * t52
+        + k7 * t53
+        + k8;
+    let t55 = k32 / t54;
+    let t56 = t36 * t7;
+    let t57 = t16 * t36;
+    let t58 = k36 * t56 - k4 * t57 - k7 * t56 + k7 * t57;
+    let t59 = t1 * t39;
+    let t60 = t40 * t7;
+    let t61 = k33 * t59 + k34 * t59 + k35 * t59 - k4 * t60 + k7 * t60;
+    let t62 = t58 + t61;
+    let t63 = theta1.cos();
+    let t64 = t26 * t39;
+    let t65 = k30 * (k16 * t63 - k26 * t63 - k27 * t63 + k28 * t64 + k29 * t64 + t25 * t36)
         + torque1
         - torque2;
-    let t108 = t89 / t87.powi(2);
-    let t109 = t108 * (t107 * t60 + t27 * t78 + t42 * t64);
-    let t110 = t1 * t24;
-    let t111 = t110 * t63;
-    let t112 = t19 * t63;
-    let t113 = 54.0 * t10 * t112 - t111 * t84 - t111 * t96 + 18.0 * t112 * t80 + t63 * t97;
-    let t114 = t100 - t102 - t113 + t93 + t95 - t99;
-    let t115 = -t53 - t55;
-    let t116 = t9 / 2.0;
-    let t117 = t107 * t112 * t116 * t35;
-    let t118 = t19 * t51;
-    let t119 = theta2.sin();
-    let t120 = t19 * t77;
-    let t121 = -t119 * t48 - t119 * t50 + t120 + t6;
-    let t122 = t21 * t25 * t63;
-    let t123 = -t122 - t74;
-    let t124 = l3 * t63;
-    let t125 = -t1 * t37 * t63 - t124 * t39 * t8;
-    let t126 = t125 + t70;
-    let t127 = t104 + t113;
-    let t128 = t24 * t77;
-    let t129 = t122 + t73;
-    let t130 = t44 * (-g * theta3.sin() + t118 + t30);
-    let t131 = -t125 - t66 - t67;
-    let t132 = t69 * theta1_dot;
-    let t133 = 2.0 * m2;
-    let t134 = 4.0 * m3;
-    let t135 = -t132 * t133 - t132 * t134;
-    let t136 = t42 * t43;
-    let t137 = t72 * theta1_dot;
-    let t138 = l2 * t68 * theta2_dot;
-    let t139 = t133 * t138 + t134 * t138;
-    let t140 = t43 * theta3_dot;
-    let t141 = t140 * t72;
-    let t142 = l2 * t63;
-    let t143 = t140 * t142;
-    let t144 = t80 * t88;
-    let t145 = t10 * t88;
-    let t146 = t14 * t88;
-    let t147 = t13 * t145 + t13 * t146 + t144 * t58 - t146 * t20 * t83;
-    let t148 = t145 * t28;
-    let t149 = t146 * t28;
-    let t150 = l2 * t145 / 4.0;
-    let t151 = l3 * t150;
-    let t152 = l3 * t149;
-    let t153 = t11 * t144 * t38 - t110 * t151 - t110 * t152 + t148 * t38 + t149 * t38;
-    let t154 = -t153;
-    let t155 = t108 * (t107 * t27 + t147 * t78 + t154 * t64);
-    let t156 = t147 * t28;
-    let t157 = t103 * t116 * t146 * t78;
-    let t158 = t154 * t44;
-    let t159 = t27 * t34;
-    let t160 = t1 * t65;
-    let t161 = t149 * t160;
-    let t162 = t150 * t160;
-    let t163 = t151 * t98 + t152 * t98;
-    let t164 = -t161 - t162 - t163;
-    let t165 = l3 * t142 * t144 / 6.0 + t124 * t148 + t152 * t63;
-    let t166 = t163 + t165;
-    let t167 = t161 + t162 - t165;
-    let t168 = t35 * t88;
-    let t169 = t31 * t88;
-    let t170 = t169 / 3.0;
-    let t171 = t10 * t169;
-    let t172 = m1 * m2 * t169 / 9.0 - t168 * t81 + t168 - t169 * t82 - t169 * t85 / 4.0
-        + t170 * t79
-        + t170 * t80
-        + (4.0 / 3.0) * t171;
-    let t173 = t108 * (t107 * t42 + t154 * t78 + t172 * t64);
-    let t174 = 2.0 * t91;
-    let t175 = t168 * t174 + t169 * t92 / 2.0 + t171 * t174;
-    let t176 = t154 * t28;
-    let t177 = t172 * t44;
-    let t178 = t34 * t42;
+    let t66 = k32 / t54.powi(2);
+    let t67 = t66 * (t12 * t50 + t20 * t38 + t32 * t65);
+    let t68 = t34 * t9;
+    let t69 = k7 * t68;
+    let t70 = k39 * t68;
+    let t71 = k40 * t68;
+    let t72 = t1 * t34;
+    let t73 = t7 * t72;
+    let t74 = k4 * t73;
+    let t75 = k7 * t73;
+    let t76 = -t61 - t69 + t70 + t71 - t74 + t75;
+    let t77 = -t28;
+    let t78 = k37 * t9;
+    let t79 = t26 * t78;
+    let t80 = k38 * t65 * t68;
+    let t81 = theta2.sin();
+    let t82 = -k15 * t81 - k16 * t81 + k17 * t24 * t9 - t4;
+    let t83 = k22 * t34 * t7;
+    let t84 = -t46 + t83;
+    let t85 = -k12 * t72 + k14 * t72;
+    let t86 = -t41 + t42 + t85;
+    let t87 = t21 * t24;
+    let t88 = t24 * t78;
+    let t89 = k11 * (k41 * theta3.sin() - t35 * t9 - t37 * t7);
+    let t90 = -t43 - t85;
+    let t91 = -t45 - t83;
+    let t92 = -t58 + t69 - t70 - t71 + t74 - t75;
+    let t93 = t39 * theta1_dot;
+    let t94 = k42 * t93 + k43 * t93;
+    let t95 = k44 * t36;
+    let t96 = t95 * theta1_dot;
+    let t97 = t39 * theta2_dot;
+    let t98 = k45 * t97 + k46 * t97;
+    let t99 = k47 * t34;
+    let t100 = t99 * theta2_dot;
+    let t101 = t95 * theta3_dot;
+    let t102 = t99 * theta3_dot;
+    let t103 = k50 * t52;
+    let t104 = k51 + t103;
+    let t105 = k48 * t9;
+    let t106 = k52 * t9;
+    let t107 = k53 * t9;
+    let t108 = t1 * t7;
+    let t109 = k48 * t108;
+    let t110 = k49 * t108;
+    let t111 = t105 + t106 + t107 - t109 - t110;
+    let t112 = t66 * (t104 * t50 + t111 * t38 + t12 * t65);
+    let t113 = k20 * t104;
+    let t114 = k54 * t50 * t56;
+    let t115 = k30 * t12;
+    let t116 = t1 * t36;
+    let t117 = k48 * t116;
+    let t118 = k49 * t116;
+    let t119 = t39 * t7;
+    let t120 = k48 * t119 + k49 * t119;
+    let t121 = t117 + t118 + t120;
+    let t122 = k48 * t34 + k52 * t34 + k53 * t34;
+    let t123 = -t120 - t122;
+    let t124 = -t117 - t118 + t122;
+    let t125 = k58 * t51 + k59 * t51 + k60 * t51 + k61;
+    let t126 = t66 * (t111 * t50 + t125 * t38 + t20 * t65);
+    let t127 = k55 * t59 + k56 * t59 + k57 * t59;
+    let t128 = k20 * t111;
+    let t129 = k30 * t20;
     // df/dX
     let mut f_x = <SMatrix<f64, 6, 6>>::zeros();
     f_x[(0, 3)] = 1.0;
     f_x[(1, 4)] = 1.0;
     f_x[(2, 5)] = 1.0;
-    f_x[(3, 0)] = t105 * t109 + t90 * (-t29 * t7 + t30 * t45 - t57 * t61 + t64 * t71 + t75 * t78);
-    f_x[(3, 1)] = t109 * t114
-        + t90 * (-t115 * t61 + t117 + t118 * t45 - t121 * t29 + t123 * t78 + t126 * t64);
-    f_x[(3, 2)] = t109 * t127
-        + t90 * (-t117 + t120 * t29 + t128 * t61 + t129 * t78 - t130 * t42 + t131 * t64);
-    f_x[(3, 3)] = t90 * (-t135 * t29 + t136 * t137);
-    f_x[(3, 4)] = t90 * (l2 * l3 * m3 * t42 * t63 * theta2_dot - t139 * t61);
-    f_x[(3, 5)] = t90 * (-t141 * t60 - t143 * t27);
+    f_x[(3, 0)] = t55 * (t13 * t4 + t20 * t22 + t29 * t33 + t38 * t44 + t47 * t50) + t62 * t67;
+    f_x[(3, 1)] =
+        t55 * (t13 * t82 + t20 * t79 + t33 * t77 + t38 * t86 + t50 * t84 + t80) + t67 * t76;
+    f_x[(3, 2)] =
+        t55 * (t12 * t88 + t20 * t89 + t32 * t87 + t38 * t90 + t50 * t91 - t80) + t67 * t92;
+    f_x[(3, 3)] = t55 * (t13 * t94 + t20 * t96);
+    f_x[(3, 4)] = t55 * (t100 * t20 + t33 * t98);
+    f_x[(3, 5)] = t55 * (-t101 * t32 - t102 * t12);
     f_x[(4, 0)] =
-        t105 * t155 + t90 * (t107 * t75 - t156 * t7 + t157 + t158 * t30 - t159 * t57 + t164 * t64);
+        t112 * t62 + t55 * (t111 * t22 + t113 * t4 + t114 + t115 * t29 + t121 * t38 + t47 * t65);
     f_x[(4, 1)] =
-        t114 * t155 + t90 * (t107 * t123 - t115 * t159 + t118 * t158 - t121 * t156 + t166 * t64);
-    f_x[(4, 2)] = t127 * t155
-        + t90 * (t107 * t129 + t120 * t156 + t128 * t159 - t130 * t154 - t157 + t167 * t64);
-    f_x[(4, 3)] = t90 * (-t135 * t156 + t137 * t154 * t43);
-    f_x[(4, 4)] = t90 * (l2 * l3 * m3 * t154 * t63 * theta2_dot - t139 * t159);
-    f_x[(4, 5)] = t90 * (-t141 * t27 - t143 * t147);
-    f_x[(5, 0)] = t105 * t173
-        + t90 * (t107 * t71 + t164 * t78 + t175 * t64 - t176 * t7 + t177 * t30 - t178 * t57);
-    f_x[(5, 1)] = t114 * t173
-        + t90 * (t107 * t126 - t115 * t178 + t118 * t177 - t121 * t176 + t166 * t78 - t175 * t64);
-    f_x[(5, 2)] =
-        t127 * t173 + t90 * (t107 * t131 + t120 * t176 + t128 * t178 - t130 * t172 + t167 * t78);
-    f_x[(5, 3)] = t90 * (-t135 * t176 + t137 * t172 * t43);
-    f_x[(5, 4)] = t90 * (l2 * l3 * m3 * t172 * t63 * theta2_dot - t139 * t178);
-    f_x[(5, 5)] = t90 * (-t136 * t72 * theta3_dot - t143 * t154);
+        t112 * t76 + t55 * (t111 * t79 + t113 * t82 + t115 * t77 + t123 * t38 + t65 * t84);
+    f_x[(4, 2)] =
+        t112 * t92 + t55 * (t104 * t88 + t111 * t89 - t114 + t12 * t87 + t124 * t38 + t65 * t91);
+    f_x[(4, 3)] = t55 * (t111 * t96 + t113 * t94);
+    f_x[(4, 4)] = t55 * (t100 * t111 + t115 * t98);
+    f_x[(4, 5)] = t55 * (-t101 * t12 - t102 * t104);
+    f_x[(5, 0)] = t126 * t62
+        + t55 * (t121 * t50 + t125 * t22 + t127 * t38 + t128 * t4 + t129 * t29 + t44 * t65);
+    f_x[(5, 1)] = t126 * t76
+        + t55 * (t123 * t50 + t125 * t79 - t127 * t38 + t128 * t82 + t129 * t77 + t65 * t86);
+    f_x[(5, 2)] = t126 * t92 + t55 * (t111 * t88 + t124 * t50 + t125 * t89 + t20 * t87 + t65 * t90);
+    f_x[(5, 3)] = t55 * (t125 * t96 + t128 * t94);
+    f_x[(5, 4)] = t55 * (t100 * t125 + t129 * t98);
+    f_x[(5, 5)] = t55 * (-t101 * t20 - t102 * t111);
     // df/dU
     let mut f_u = <SMatrix<f64, 6, 3>>::zeros();
-    f_u[(3, 0)] = t60 * t90;
-    f_u[(3, 1)] = t90 * (-t26 - t60);
-    f_u[(3, 2)] = t90 * (t26 + t42);
-    f_u[(4, 0)] = t27 * t90;
-    f_u[(4, 1)] = t90 * (t147 + t26);
-    f_u[(4, 2)] = t90 * (-t147 - t153);
-    f_u[(5, 0)] = t42 * t90;
-    f_u[(5, 1)] = t90 * (-t153 - t42);
-    f_u[(5, 2)] = t90 * (t153 + t172);
+    f_u[(3, 0)] = t32 * t55;
+    f_u[(3, 1)] = t55 * (k62 - t11 - t31);
+    f_u[(3, 2)] = t55 * (t11 - t14 - t15 - t17 + t18);
+    f_u[(4, 0)] = t12 * t55;
+    f_u[(4, 1)] = t55 * (t104 + t11);
+    f_u[(4, 2)] = t55 * (k63 - t103 + t111);
+    f_u[(5, 0)] = t20 * t55;
+    f_u[(5, 1)] = t55 * (t111 + t19);
+    f_u[(5, 2)] = t55 * (-t105 - t106 - t107 + t109 + t110 + t125);
     (f_x, f_u)
 }
 

@@ -49,6 +49,9 @@ class Function:
     args: list[Arg]
     outputs: list[Output]
     casadi: Callable[[dict[str, np.ndarray]], list[np.ndarray]]
+    # Called ~10^3 times per episode with the same parameters: emit its parameter-only factors as
+    # a per-tool coefficient struct and a `<name>_with` that takes it (see hoist.py).
+    per_tool_coefficients: bool = False
 
     def rng(self) -> np.random.Generator:
         """A generator seeded from the function's name, so test vectors are the same on every run."""
@@ -111,12 +114,14 @@ def build_functions(d: Derivation, cm: CasadiModel) -> list[Function]:
             "The generative process X_dot = f(X, U; p): joint rates and the nonlinear joint accelerations.",
             eqs, [x, u, p], [Output("x_dot", "X_dot", d.f)],
             lambda v: [np.array(cm.dynamics(flat(v["x"]), flat(v["u"]), flat(v["params"])))],
+            per_tool_coefficients=True,
         ),
         Function(
             "dynamics_jacobian",
             "Jacobians (df/dX, df/dU) of the generative process at any state and control.",
             eqs, [x, u, p], [Output("f_x", "df/dX", d.f_x), Output("f_u", "df/dU", d.f_u)],
             lambda v: [np.array(j) for j in cm.jacobian(flat(v["x"]), flat(v["u"]), flat(v["params"]))],
+            per_tool_coefficients=True,
         ),
         Function(
             "state_matrix",

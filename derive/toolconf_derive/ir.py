@@ -8,11 +8,12 @@ import numpy as np
 import sympy as sp
 
 from .crosscheck import check_against_casadi
-from .functions import Function
+from .functions import Arg, Function
+from .hoist import Hoisted, hoist
 from .rust_printer import RustPrinter, float_literal
 from .symbolic import Derivation
 
-IR_SCHEMA = 1
+IR_SCHEMA = 2
 
 
 def _rust_type(shape: tuple[int, int]) -> str:
@@ -22,6 +23,44 @@ def _rust_type(shape: tuple[int, int]) -> str:
 
 def _const_name(name: str) -> str:
     return name.upper()
+
+
+def _temporaries(prefix: str):
+    return (sp.Symbol(f"{prefix}{i}", real=True) for i in range(10**6))
+
+
+def _code(entries: list[sp.Expr], d: Derivation, args: list, declared: set[str], prefix: str) -> dict:
+    """CSE'd Rust for `entries`: the constants and argument elements it reads, its temporaries
+    and the reduced entries."""
+    replacements, reduced = sp.cse(entries, symbols=_temporaries(prefix), order="canonical")
+    clash = declared & {str(t) for t, _ in replacements}
+    if clash:
+        raise ValueError(f"CSE temporaries clash with model names: {sorted(clash)}")
+    used = set()
+    for _, e in replacements:
+        used |= e.free_symbols
+    for e in reduced:
+        used |= e.free_symbols
+    printer = RustPrinter()
+    bindings = []
+    for arg in args:
+        for s, i, j in arg.reads:
+            if s in used:
+                if arg.name == "coefficients":
+                    access = f"coefficients.k[{i}]"
+                else:
+                    access = f"{arg.name}[{i}]" if arg.shape[1] == 1 else f"{arg.name}[({i}, {j})]"
+                bindings.append({"name": s.name, "arg": arg.name, "access": access})
+    return {
+        "constants": [{"name": c.name, "rust": _const_name(c.name)} for c in d.constants if c in used],
+        "bindings": bindings,
+        "temporaries": [{"name": str(t), "rust": printer(e)} for t, e in replacements],
+        "reduced": [printer(e) for e in reduced],
+    }
+
+
+def _struct_name(function: str) -> str:
+    return "".join(w.capitalize() for w in function.split("_")) + "Coefficients"
 
 
 def function_ir(fn: Function, d: Derivation, vectors: int) -> dict:
@@ -35,25 +74,32 @@ def function_ir(fn: Function, d: Derivation, vectors: int) -> dict:
                 if out.value[r, c] != 0:
                     entries.append(out.value[r, c])
                     where.append((oi, r, c))
-    temporaries = (sp.Symbol(f"t{i}", real=True) for i in range(10**6))
-    replacements, reduced = sp.cse(entries, symbols=temporaries, order="canonical")
-    clash = declared & {str(t) for t, _ in replacements}
-    if clash:
-        raise ValueError(f"CSE temporaries clash with model names: {sorted(clash)}")
 
-    used = set()
-    for t, e in replacements:
-        used |= e.free_symbols
-    for e in reduced:
-        used |= e.free_symbols
-    printer = RustPrinter()
-
-    bindings = []
-    for arg in fn.args:
-        for s, i, j in arg.reads:
-            if s in used:
-                bindings.append({"name": s.name, "arg": arg.name, "row": i, "col": j, "vector": arg.shape[1] == 1})
-    constants = [{"name": c.name, "rust": _const_name(c.name)} for c in d.constants if c in used]
+    coefficients = None
+    call_args = fn.args
+    if fn.per_tool_coefficients:
+        params = [a for a in fn.args if a.name == "params"]
+        hoisted = hoist(entries, [s for a in fn.args if a.name != "params" for s, _, _ in a.reads],
+                        set(d.constants))
+        if hoisted is None:
+            # Not cheaper per call: the coefficients are the parameters themselves, so that every
+            # model has the same `<name>_with` API.
+            ks = [sp.Symbol(f"k{i}", real=True) for i in range(len(d.params))]
+            hoisted = Hoisted(ks, list(d.params), [e.xreplace(dict(zip(d.params, ks))) for e in entries])
+        k = Arg("coefficients", "", (len(hoisted.symbols), 1), [(s, i, 0) for i, s in enumerate(hoisted.symbols)],
+                False, None)
+        coefficient_code = _code(hoisted.values, d, params, declared, "s")
+        coefficients = {
+            "struct": _struct_name(fn.name),
+            "count": len(hoisted.symbols),
+            "constants": coefficient_code["constants"],
+            "bindings": coefficient_code["bindings"],
+            "temporaries": coefficient_code["temporaries"],
+            "values": coefficient_code["reduced"],
+        }
+        entries = hoisted.entries
+        call_args = [a for a in fn.args if a.name != "params"] + [k]
+    code = _code(entries, d, call_args, declared, "t")
 
     outputs = []
     for out in fn.outputs:
@@ -61,9 +107,17 @@ def function_ir(fn: Function, d: Derivation, vectors: int) -> dict:
             "name": out.name, "doc": out.doc, "rows": out.value.rows, "cols": out.value.cols,
             "rust_type": _rust_type(out.value.shape), "symmetric": out.symmetric, "entries": [],
         })
-    for (oi, r, c), e in zip(where, reduced):
-        outputs[oi]["entries"].append({"row": r, "col": c, "rust": printer(e)})
+    for (oi, r, c), e in zip(where, code["reduced"]):
+        outputs[oi]["entries"].append({"row": r, "col": c, "rust": e})
 
+    bound_args = {b["arg"] for b in code["bindings"]}
+    if coefficients is not None:
+        coefficients["args"] = [
+            {"name": a.name, "rust_type": "&" + (coefficients["struct"] if a.name == "coefficients"
+                                                 else _rust_type(a.shape)),
+             "used": a.name in bound_args}
+            for a in call_args
+        ]
     return {
         "name": fn.name,
         "doc": fn.doc,
@@ -71,13 +125,14 @@ def function_ir(fn: Function, d: Derivation, vectors: int) -> dict:
         "args": [
             {"name": a.name, "doc": a.doc, "rows": a.shape[0], "cols": a.shape[1],
              "rust_type": _rust_type(a.shape), "symmetric": a.symmetric,
-             "used": any(b["arg"] == a.name for b in bindings)}
+             "used": a.name in bound_args or (coefficients is not None and a.name == "params")}
             for a in fn.args
         ],
+        "coefficients": coefficients,
         "outputs": outputs,
-        "constants": constants,
-        "bindings": bindings,
-        "temporaries": [{"name": str(t), "rust": printer(e)} for t, e in replacements],
+        "constants": code["constants"],
+        "bindings": code["bindings"],
+        "temporaries": code["temporaries"],
         "test_vectors": test_vectors(fn, d, vectors),
     }
 

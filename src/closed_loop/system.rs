@@ -60,11 +60,34 @@ impl Plant {
     }
 }
 
+#[derive(Debug, Clone, Copy)]
+enum PlantCoefficients {
+    Paper(arm2::DynamicsCoefficients),
+    Exact(arm2_exact::DynamicsCoefficients),
+}
+
+impl PlantCoefficients {
+    fn new(plant: Plant, p: &SVector<f64, 4>) -> Self {
+        match plant {
+            Plant::Paper => Self::Paper(arm2::DynamicsCoefficients::new(p)),
+            Plant::Exact => Self::Exact(arm2_exact::DynamicsCoefficients::new(p)),
+        }
+    }
+    #[inline]
+    fn dynamics(&self, x: &SVector<f64, 4>, u: &Vector2) -> SVector<f64, 4> {
+        match self {
+            Self::Paper(k) => arm2::dynamics_with(x, u, k),
+            Self::Exact(k) => arm2_exact::dynamics_with(x, u, k),
+        }
+    }
+}
+
 /// Plant (the nonlinear arm with a constant torque perturbation ΔT on both joints) and
 /// active-inference controller, which observes θ, θ̇ and the plant's θ̈.
 #[derive(Debug, Clone, Copy)]
 pub struct ClosedLoop {
     params: SVector<f64, 4>,
+    coefficients: PlantCoefficients,
     pub controller: ActiveInference,
     perturbation: Vector2,
     plant: Plant,
@@ -96,6 +119,7 @@ impl ClosedLoop {
         }
         Ok(Self {
             params: arm.params(),
+            coefficients: PlantCoefficients::new(plant, &arm.params()),
             controller: ActiveInference::new(arm, task, learning_rate)?,
             perturbation: Vector2::repeat(perturbation),
             plant,
@@ -107,9 +131,7 @@ impl ClosedLoop {
     pub fn rhs_and_acceleration(&self, z: &JointState) -> (JointState, Vector2) {
         let x = z.fixed_rows::<4>(0).into_owned();
         let u = z.fixed_rows::<2>(4).into_owned();
-        let x_dot = self
-            .plant
-            .dynamics(&x, &(u + self.perturbation), &self.params);
+        let x_dot = self.coefficients.dynamics(&x, &(u + self.perturbation));
         let theta = x.fixed_rows::<2>(0).into_owned();
         let theta_dot = x.fixed_rows::<2>(2).into_owned();
         let theta_ddot = x_dot.fixed_rows::<2>(2).into_owned();

@@ -43,6 +43,25 @@ pub trait ArmModel<const N: usize, const NX: usize, const NP: usize, const NZ: u
     /// The equilibrium state X^e the model is linearised at.
     const EQUILIBRIUM_STATE: [f64; NX];
 
+    /// The parameter-only factors of [`ArmModel::dynamics`], computed once per tool.
+    type DynamicsCoefficients: Copy + Debug + Send + Sync;
+    /// The parameter-only factors of [`ArmModel::dynamics_jacobian`], computed once per tool.
+    type JacobianCoefficients: Copy + Debug + Send + Sync;
+
+    fn dynamics_coefficients(p: &SVector<f64, NP>) -> Self::DynamicsCoefficients;
+    fn jacobian_coefficients(p: &SVector<f64, NP>) -> Self::JacobianCoefficients;
+    /// Ẋ = f(X, U; p) with the tool's coefficients: what an integrator calls ~10³ times per episode.
+    fn dynamics_with(
+        x: &SVector<f64, NX>,
+        u: &SVector<f64, N>,
+        k: &Self::DynamicsCoefficients,
+    ) -> SVector<f64, NX>;
+    /// (∂f/∂X, ∂f/∂U) with the tool's coefficients.
+    fn dynamics_jacobian_with(
+        x: &SVector<f64, NX>,
+        u: &SVector<f64, N>,
+        k: &Self::JacobianCoefficients,
+    ) -> (SMatrix<f64, NX, NX>, SMatrix<f64, NX, N>);
     /// Ẋ = f(X, U; p).
     fn dynamics(
         x: &SVector<f64, NX>,
@@ -93,6 +112,43 @@ macro_rules! arm_model {
                 generated::$module::PARAMETER_NAMES;
             const EQUILIBRIUM_STATE: [f64; generated::$module::STATE_DIM] =
                 generated::$module::EQUILIBRIUM_STATE;
+            type DynamicsCoefficients = generated::$module::DynamicsCoefficients;
+            type JacobianCoefficients = generated::$module::DynamicsJacobianCoefficients;
+
+            #[inline]
+            fn dynamics_coefficients(
+                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
+            ) -> Self::DynamicsCoefficients {
+                generated::$module::DynamicsCoefficients::new(p)
+            }
+
+            #[inline]
+            fn jacobian_coefficients(
+                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
+            ) -> Self::JacobianCoefficients {
+                generated::$module::DynamicsJacobianCoefficients::new(p)
+            }
+
+            #[inline]
+            fn dynamics_with(
+                x: &SVector<f64, { generated::$module::STATE_DIM }>,
+                u: &SVector<f64, { generated::$module::DOF }>,
+                k: &Self::DynamicsCoefficients,
+            ) -> SVector<f64, { generated::$module::STATE_DIM }> {
+                generated::$module::dynamics_with(x, u, k)
+            }
+
+            #[inline]
+            fn dynamics_jacobian_with(
+                x: &SVector<f64, { generated::$module::STATE_DIM }>,
+                u: &SVector<f64, { generated::$module::DOF }>,
+                k: &Self::JacobianCoefficients,
+            ) -> (
+                SMatrix<f64, { generated::$module::STATE_DIM }, { generated::$module::STATE_DIM }>,
+                SMatrix<f64, { generated::$module::STATE_DIM }, { generated::$module::DOF }>,
+            ) {
+                generated::$module::dynamics_jacobian_with(x, u, k)
+            }
 
             #[inline]
             fn dynamics(

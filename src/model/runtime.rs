@@ -155,8 +155,13 @@ impl<const N: usize> ActiveInferenceN<N> {
 /// is model `P` with the same tool parameters (`P = M` normally; `M = Arm2, P = Arm2Exact` is
 /// [`crate::closed_loop::Plant::Exact`]).
 #[derive(Debug, Clone, Copy)]
-pub struct ClosedLoopN<P, const N: usize, const NX: usize, const NP: usize, const NZ: usize> {
-    params: SVector<f64, NP>,
+pub struct ClosedLoopN<P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>
+where
+    P: ArmModel<N, NX, NP, NZ>,
+{
+    /// The plant's parameter-only factors, computed once per tool rather than once per call.
+    dynamics: P::DynamicsCoefficients,
+    jacobian: P::JacobianCoefficients,
     pub controller: ActiveInferenceN<N>,
     perturbation: SVector<f64, N>,
     plant: PhantomData<P>,
@@ -185,8 +190,10 @@ where
                 value: perturbation,
             });
         }
+        let params = tool.params();
         Ok(Self {
-            params: tool.params(),
+            dynamics: P::dynamics_coefficients(&params),
+            jacobian: P::jacobian_coefficients(&params),
             controller: ActiveInferenceN::new(tool, task, learning_rate)?,
             perturbation: SVector::repeat(perturbation),
             plant: PhantomData,
@@ -201,7 +208,7 @@ where
     ) -> (SVector<f64, NZ>, SVector<f64, N>) {
         let x = z.fixed_rows::<NX>(0).into_owned();
         let u = z.fixed_rows::<N>(NX).into_owned();
-        let x_dot = P::dynamics(&x, &(u + self.perturbation), &self.params);
+        let x_dot = P::dynamics_with(&x, &(u + self.perturbation), &self.dynamics);
         let theta = x.fixed_rows::<N>(0).into_owned();
         let theta_dot = x.fixed_rows::<N>(N).into_owned();
         let theta_ddot = x_dot.fixed_rows::<N>(N).into_owned();
@@ -225,7 +232,7 @@ where
     pub fn jacobian(&self, z: &SVector<f64, NZ>) -> SMatrix<f64, NZ, NZ> {
         let x = z.fixed_rows::<NX>(0).into_owned();
         let u = z.fixed_rows::<N>(NX).into_owned();
-        let (f_x, f_u) = P::dynamics_jacobian(&x, &(u + self.perturbation), &self.params);
+        let (f_x, f_u) = P::dynamics_jacobian_with(&x, &(u + self.perturbation), &self.jacobian);
         let [k_theta, k_theta_dot, k_theta_ddot, p_u] = self.controller.scaled_gains();
         let accel_x = f_x.fixed_view::<N, NX>(N, 0);
         let accel_u = f_u.fixed_view::<N, N>(N, 0);

@@ -1,0 +1,114 @@
+"""Per-tool coefficients: split a function of (X, U; p) into parameter-only factors, computed once
+per tool, and a per-call part that only combines them with the state and control.
+
+Integrating one episode evaluates the dynamics ~10^3 times with the same tool parameters. In the
+printed closed forms the parameters sit inside the expressions (e.g. the divisions by
+l1^2 (m1/3 + m2) and l2^2 m2 in the paper's accelerations), so every call would recompute them.
+Writing each output entry as sum_i c_i(p) r_i(X, U) moves every c_i into a struct built once per
+tool; what is left per call has no division by a parameter expression at all (arm2).
+
+The split is kept only when it makes the per-call code cheaper (operation count with divisions and
+transcendental calls weighted by their cost), so a model whose accelerations have a state-dependent
+denominator (the Lagrangian planar chains) never gets longer per call.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+
+# Rough relative costs (latency on x86-64) of the operations count_ops reports.
+WEIGHTS = {"DIV": 8, "POW": 2, "SIN": 20, "COS": 20, "SQRT": 8, "EXP": 20, "LOG": 20}
+
+
+def weighted_ops(exprs: list[sp.Expr]) -> int:
+    total = 0
+    for e in exprs:
+        visual = sp.count_ops(e, visual=True)
+        if visual == 0:
+            continue
+        subs = {s: WEIGHTS.get(s.name, 1) for s in visual.free_symbols}
+        total += int(visual.subs(subs))
+    return total
+
+
+def cse_cost(entries: list[sp.Expr]) -> int:
+    replacements, reduced = sp.cse(entries, order="canonical")
+    return weighted_ops([e for _, e in replacements] + list(reduced))
+
+
+@dataclass
+class Hoisted:
+    """`entries` rewritten over the coefficient symbols `symbols[i]` = `values[i]`(p)."""
+    symbols: list[sp.Symbol]
+    values: list[sp.Expr]
+    entries: list[sp.Expr]
+
+
+def hoist(entries: list[sp.Expr], per_call: list[sp.Symbol], constants: set[sp.Symbol],
+          prefix: str = "k") -> Hoisted | None:
+    """Writes each entry as sum_i c_i(p) r_i(per_call); None if that is not cheaper per call.
+    Numbers and the model's `constants` stay inline; anything else without a per-call symbol is a
+    coefficient."""
+    per_call_set = set(per_call)
+    values: list[sp.Expr] = []
+    index: dict[sp.Expr, sp.Symbol] = {}
+    symbols: list[sp.Symbol] = []
+
+    def coefficient(c: sp.Expr, tidy: bool = True) -> sp.Expr:
+        if tidy:
+            c = sp.factor(sp.cancel(c))
+        if c.is_Number or c in constants:
+            return c
+        # A coefficient and its negation share one field.
+        for sign, key in ((1, c), (-1, sp.factor(-c))):
+            if key in index:
+                return sign * index[key]
+        s = sp.Symbol(f"{prefix}{len(values)}", real=True)
+        index[c] = s
+        values.append(c)
+        symbols.append(s)
+        return s
+
+    def structural(e: sp.Expr) -> sp.Expr:
+        # Replaces every maximal parameter-only subexpression by a coefficient, keeping the
+        # expression's shape: never more work per call, and cheap for large expressions.
+        if not (e.free_symbols & per_call_set):
+            return coefficient(e, tidy=False)
+        if e.is_Atom:
+            return e
+        if e.is_Add or e.is_Mul:
+            constant = [a for a in e.args if not (a.free_symbols & per_call_set)]
+            varying = [structural(a) for a in e.args if a.free_symbols & per_call_set]
+            if constant:
+                varying.insert(0, coefficient(e.func(*constant), tidy=False))
+            return e.func(*varying)
+        return e.func(*[structural(a) for a in e.args])
+
+    def state_dependent_denominator(e: sp.Expr) -> bool:
+        return any(p.exp.is_negative and (p.base.free_symbols & per_call_set) for p in e.atoms(sp.Pow))
+
+    rewritten = []
+    for e in entries:
+        if not (e.free_symbols & per_call_set):
+            rewritten.append(coefficient(e))
+            continue
+        if state_dependent_denominator(e):
+            # Expanding over a state-dependent denominator multiplies the terms (and the
+            # derivation time) for nothing: hoist in place.
+            rewritten.append(structural(e))
+            continue
+        groups: dict[sp.Expr, sp.Expr] = {}
+        order: list[sp.Expr] = []
+        for term in sp.Add.make_args(sp.expand(e, power_exp=False, log=False)):
+            c, r = term.as_independent(*per_call, as_Add=False)
+            if r not in groups:
+                groups[r] = sp.Integer(0)
+                order.append(r)
+            groups[r] += c
+        rewritten.append(sp.Add(*[coefficient(groups[r]) * r for r in order if groups[r] != 0]))
+
+    if cse_cost(rewritten) >= cse_cost(entries):
+        return None
+    return Hoisted(symbols, values, rewritten)
