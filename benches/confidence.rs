@@ -3,7 +3,10 @@
 //! * `checked`: [`control_confidence`], the public API (validates the task, checks Π^U ≻ 0);
 //! * `unchecked`: [`pi_u`] and the log-determinant, the per-tool work once the task is validated;
 //! * `checked_1000_tools`: the API over 1000 random tools (per tool: the time / 1000, printed as
-//!   throughput).
+//!   throughput);
+//! * `validated`, `validated_1000_tools`: the ranking path, the task checked once
+//!   ([`TaskN::validated`]) and then [`ValidatedTaskN::control_confidence`] per tool (which
+//!   still checks that Π^U is positive definite).
 //!
 //! `cargo bench --bench confidence`; target ≤ 20 ns per tool on one core.
 
@@ -11,12 +14,15 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use toolconf::confidence::pi_u;
+use toolconf::model::{Arm2Tool, TaskN, ValidatedTaskN};
 use toolconf::select::draw_tools;
 use toolconf::{control_confidence, Arm, Task, TaskKind};
 
 fn confidence(c: &mut Criterion) {
     let arm = Arm::new(0.3, 0.4, 0.5, 0.2).unwrap();
     let tools = draw_tools(1000, 42);
+    let tool = Arm2Tool::from(&arm);
+    let generic_tools: Vec<Arm2Tool> = tools.iter().map(Arm2Tool::from).collect();
     let mut group = c.benchmark_group("confidence");
     for kind in TaskKind::ALL {
         let task = Task::paper(kind);
@@ -31,7 +37,24 @@ fn confidence(c: &mut Criterion) {
                 (p, logdet)
             })
         });
+        let validated: ValidatedTaskN<2> = TaskN::from(&task).validated().unwrap();
+        group.bench_function(format!("{kind}/validated"), |b| {
+            b.iter(|| {
+                black_box(&validated)
+                    .control_confidence(black_box(&tool))
+                    .unwrap()
+            })
+        });
         group.throughput(Throughput::Elements(tools.len() as u64));
+        group.bench_function(format!("{kind}/validated_1000_tools"), |b| {
+            b.iter(|| {
+                let v = black_box(&validated);
+                black_box(&generic_tools)
+                    .iter()
+                    .map(|t| v.control_confidence(t).unwrap().logdet)
+                    .sum::<f64>()
+            })
+        });
         group.bench_function(format!("{kind}/checked_1000_tools"), |b| {
             b.iter(|| {
                 black_box(&tools)

@@ -170,21 +170,19 @@ pub fn dynamics_with(
     let k5 = coefficients.k[5];
     let k6 = coefficients.k[6];
     let k7 = coefficients.k[7];
-    let t0 = theta1 - theta2;
-    let t1 = t0.cos();
-    let t2 = theta2.cos();
-    let t3 = t0.sin();
+    let (sin_theta1, cos_theta1) = crate::trig::sin_cos(theta1);
+    let (sin_theta2, cos_theta2) = crate::trig::sin_cos(theta2);
+    let trig0 = -cos_theta1 * sin_theta2 + cos_theta2 * sin_theta1;
+    let trig1 = cos_theta1 * cos_theta2 + sin_theta1 * sin_theta2;
     // X_dot
     let mut x_dot = <SVector<f64, 4>>::zeros();
     x_dot[0] = theta1_dot;
     x_dot[1] = theta2_dot;
-    x_dot[2] = k0 * torque1 - k0 * torque2
-        + k1 * t1 * torque2
-        + k2 * theta1.cos()
-        + k3 * t3 * theta1_dot.powi(2)
-        + k4 * t3 * theta2_dot.powi(2)
-        + k5 * t1 * t2;
-    x_dot[3] = k6 * torque2 + k7 * t2;
+    x_dot[2] = cos_theta1 * k2 + cos_theta2 * k5 * trig1 + k0 * torque1 - k0 * torque2
+        + k1 * torque2 * trig1
+        + k3 * theta1_dot.powi(2) * trig0
+        + k4 * theta2_dot.powi(2) * trig0;
+    x_dot[3] = cos_theta2 * k7 + k6 * torque2;
     x_dot
 }
 
@@ -271,27 +269,27 @@ pub fn dynamics_jacobian_with(
     let k7 = coefficients.k[7];
     let k8 = coefficients.k[8];
     let k9 = coefficients.k[9];
-    let t0 = theta1 - theta2;
-    let t1 = t0.sin();
-    let t2 = t0.cos();
-    let t3 = k0 * t1 * torque2
-        + k2 * t2 * theta1_dot.powi(2)
-        + k3 * t2 * theta2_dot.powi(2)
-        + k4 * t1 * theta2.cos();
-    let t4 = theta2.sin();
+    let (sin_theta1, cos_theta1) = crate::trig::sin_cos(theta1);
+    let (sin_theta2, cos_theta2) = crate::trig::sin_cos(theta2);
+    let trig0 = -cos_theta1 * sin_theta2 + cos_theta2 * sin_theta1;
+    let trig1 = cos_theta1 * cos_theta2 + sin_theta1 * sin_theta2;
+    let t0 = cos_theta2 * k4 * trig0
+        + k0 * torque2 * trig0
+        + k2 * theta1_dot.powi(2) * trig1
+        + k3 * theta2_dot.powi(2) * trig1;
     // df/dX
     let mut f_x = <SMatrix<f64, 4, 4>>::zeros();
     f_x[(0, 2)] = 1.0;
     f_x[(1, 3)] = 1.0;
-    f_x[(2, 0)] = k1 * theta1.sin() + t3;
-    f_x[(2, 1)] = k4 * t2 * t4 - t3;
-    f_x[(2, 2)] = k5 * t1 * theta1_dot;
-    f_x[(2, 3)] = k6 * t1 * theta2_dot;
-    f_x[(3, 1)] = k7 * t4;
+    f_x[(2, 0)] = k1 * sin_theta1 + t0;
+    f_x[(2, 1)] = k4 * sin_theta2 * trig1 - t0;
+    f_x[(2, 2)] = k5 * theta1_dot * trig0;
+    f_x[(2, 3)] = k6 * theta2_dot * trig0;
+    f_x[(3, 1)] = k7 * sin_theta2;
     // df/dU
     let mut f_u = <SMatrix<f64, 4, 2>>::zeros();
     f_u[(2, 0)] = k8;
-    f_u[(2, 1)] = -k0 * t2 - k8;
+    f_u[(2, 1)] = -k0 * trig1 - k8;
     f_u[(3, 1)] = k9;
     (f_x, f_u)
 }

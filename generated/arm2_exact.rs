@@ -177,20 +177,21 @@ pub fn dynamics_with(
     let k9 = coefficients.k[9];
     let k10 = coefficients.k[10];
     let k11 = coefficients.k[11];
-    let t0 = theta1 - theta2;
-    let t1 = t0.sin();
-    let t2 = k8 * (g * theta2.cos() + k7 * t1 * theta1_dot.powi(2)) + torque2;
-    let t3 = t0.cos();
-    let t4 = k9 * t3;
-    let t5 = theta1.cos();
-    let t6 = k5 * (k2 * t5 + k3 * t5 + k4 * t1 * theta2_dot.powi(2)) + torque1 - torque2;
-    let t7 = k10 / (k0 * t3.powi(2) + k1);
+    let (sin_theta1, cos_theta1) = crate::trig::sin_cos(theta1);
+    let (sin_theta2, cos_theta2) = crate::trig::sin_cos(theta2);
+    let trig0 = -cos_theta1 * sin_theta2 + cos_theta2 * sin_theta1;
+    let trig1 = cos_theta1 * cos_theta2 + sin_theta1 * sin_theta2;
+    let t0 = k8 * (cos_theta2 * g + k7 * theta1_dot.powi(2) * trig0) + torque2;
+    let t1 = k9 * trig1;
+    let t2 = k5 * (cos_theta1 * k2 + cos_theta1 * k3 + k4 * theta2_dot.powi(2) * trig0) + torque1
+        - torque2;
+    let t3 = k10 / (k0 * trig1.powi(2) + k1);
     // X_dot
     let mut x_dot = <SVector<f64, 4>>::zeros();
     x_dot[0] = theta1_dot;
     x_dot[1] = theta2_dot;
-    x_dot[2] = t7 * (k6 * t6 + t2 * t4);
-    x_dot[3] = t7 * (k11 * t2 + t4 * t6);
+    x_dot[2] = t3 * (k6 * t2 + t0 * t1);
+    x_dot[3] = t3 * (k11 * t0 + t1 * t2);
     x_dot
 }
 
@@ -319,51 +320,50 @@ pub fn dynamics_jacobian_with(
     let k23 = coefficients.k[23];
     let k24 = coefficients.k[24];
     let k25 = coefficients.k[25];
+    let (sin_theta1, cos_theta1) = crate::trig::sin_cos(theta1);
+    let (sin_theta2, cos_theta2) = crate::trig::sin_cos(theta2);
+    let trig0 = -cos_theta1 * sin_theta2 + cos_theta2 * sin_theta1;
+    let trig1 = cos_theta1 * cos_theta2 + sin_theta1 * sin_theta2;
     let t0 = theta1_dot.powi(2);
-    let t1 = theta1 - theta2;
-    let t2 = t1.cos();
-    let t3 = t2.powi(2);
-    let t4 = k9 * t3;
-    let t5 = theta1.sin();
-    let t6 = theta2_dot.powi(2);
-    let t7 = k2 * t5 + k3 * t5 + k4 * t2 * t6;
-    let t8 = t1.sin();
-    let t9 = k6 * t0;
-    let t10 = k7 * (g * theta2.cos() + t8 * t9) + torque2;
-    let t11 = k8 * t8;
-    let t12 = t10 * t11;
-    let t13 = k0 * t3 + k1;
-    let t14 = 1.0 / t13;
-    let t15 = k10 * t14;
-    let t16 = k8 * t2;
-    let t17 = theta1.cos();
-    let t18 = k11 * (-k2 * t17 - k3 * t17 + k4 * t6 * t8) + torque1 - torque2;
-    let t19 = k13 * t2 * t8 / t13.powi(2);
-    let t20 = t19 * (k12 * t18 - t10 * t16);
-    let t21 = k14 * theta2.sin() - t2 * t9;
-    let t22 = t14 * t2;
-    let t23 = k17 * t22 * t8;
-    let t24 = t14 * t8;
-    let t25 = t19 * (k21 * t10 - t16 * t18);
-    let t26 = t11 * t18;
+    let t1 = trig1.powi(2);
+    let t2 = k9 * t1;
+    let t3 = theta2_dot.powi(2);
+    let t4 = k2 * sin_theta1 + k3 * sin_theta1 + k4 * t3 * trig1;
+    let t5 = k6 * t0;
+    let t6 = k7 * (cos_theta2 * g + t5 * trig0) + torque2;
+    let t7 = k8 * trig0;
+    let t8 = t6 * t7;
+    let t9 = k0 * t1 + k1;
+    let t10 = 1.0 / t9;
+    let t11 = k10 * t10;
+    let t12 = k8 * trig1;
+    let t13 = k11 * (-cos_theta1 * k2 - cos_theta1 * k3 + k4 * t3 * trig0) + torque1 - torque2;
+    let t14 = k13 * trig0 * trig1 / t9.powi(2);
+    let t15 = t14 * (k12 * t13 - t12 * t6);
+    let t16 = k14 * sin_theta2 - t5 * trig1;
+    let t17 = t10 * trig1;
+    let t18 = k17 * t17 * trig0;
+    let t19 = t10 * trig0;
+    let t20 = t14 * (k21 * t6 - t12 * t13);
+    let t21 = t13 * t7;
     // df/dX
     let mut f_x = <SMatrix<f64, 4, 4>>::zeros();
     f_x[(0, 2)] = 1.0;
     f_x[(1, 3)] = 1.0;
-    f_x[(2, 0)] = t15 * (k5 * t7 + t0 * t4 + t12) + t20;
-    f_x[(2, 1)] = t15 * (k15 * t2 * t21 + k16 * t2 * t6 - t12) - t20;
-    f_x[(2, 2)] = t23 * theta1_dot;
-    f_x[(2, 3)] = k18 * t24 * theta2_dot;
-    f_x[(3, 0)] = t15 * (k19 * t2 * t7 + k20 * t0 * t2 + t26) + t25;
-    f_x[(3, 1)] = t15 * (k22 * t21 - t26 + t4 * t6) - t25;
-    f_x[(3, 2)] = k23 * t24 * theta1_dot;
-    f_x[(3, 3)] = -t23 * theta2_dot;
+    f_x[(2, 0)] = t11 * (k5 * t4 + t0 * t2 + t8) + t15;
+    f_x[(2, 1)] = t11 * (k15 * t16 * trig1 + k16 * t3 * trig1 - t8) - t15;
+    f_x[(2, 2)] = t18 * theta1_dot;
+    f_x[(2, 3)] = k18 * t19 * theta2_dot;
+    f_x[(3, 0)] = t11 * (k19 * t4 * trig1 + k20 * t0 * trig1 + t21) + t20;
+    f_x[(3, 1)] = t11 * (k22 * t16 + t2 * t3 - t21) - t20;
+    f_x[(3, 2)] = k23 * t19 * theta1_dot;
+    f_x[(3, 3)] = -t18 * theta2_dot;
     // df/dU
     let mut f_u = <SMatrix<f64, 4, 2>>::zeros();
-    f_u[(2, 0)] = k24 * t14;
-    f_u[(2, 1)] = t15 * (-k12 - t16);
-    f_u[(3, 0)] = k25 * t22;
-    f_u[(3, 1)] = t15 * (k21 + t16);
+    f_u[(2, 0)] = k24 * t10;
+    f_u[(2, 1)] = t11 * (-k12 - t12);
+    f_u[(3, 0)] = k25 * t17;
+    f_u[(3, 1)] = t11 * (k21 + t12);
     (f_x, f_u)
 }
 

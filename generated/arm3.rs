@@ -275,51 +275,57 @@ pub fn dynamics_with(
     let k39 = coefficients.k[39];
     let k40 = coefficients.k[40];
     let k41 = coefficients.k[41];
-    let t0 = -theta3;
-    let t1 = t0 + theta2;
-    let t2 = t1.cos();
-    let t3 = t2.powi(2);
-    let t4 = theta1.cos();
-    let t5 = theta2_dot.powi(2);
-    let t6 = theta1 - theta2;
-    let t7 = t6.sin();
-    let t8 = t5 * t7;
-    let t9 = t0 + theta1;
-    let t10 = t9.sin();
-    let t11 = k19 * theta3_dot.powi(2);
-    let t12 = k21 * (k15 * t4 + k16 * t4 + k17 * t4 + k18 * t8 + k20 * t8 + t10 * t11) + torque1
+    let (sin_theta1, cos_theta1) = crate::trig::sin_cos(theta1);
+    let (sin_theta2, cos_theta2) = crate::trig::sin_cos(theta2);
+    let (sin_theta3, cos_theta3) = crate::trig::sin_cos(theta3);
+    let trig0 = -cos_theta1 * sin_theta2 + cos_theta2 * sin_theta1;
+    let trig1 = -cos_theta1 * sin_theta3 + cos_theta3 * sin_theta1;
+    let trig2 = -cos_theta2 * sin_theta3 + cos_theta3 * sin_theta2;
+    let trig3 = cos_theta1 * cos_theta2 + sin_theta1 * sin_theta2;
+    let trig4 = cos_theta1 * cos_theta3 + sin_theta1 * sin_theta3;
+    let trig5 = cos_theta2 * cos_theta3 + sin_theta2 * sin_theta3;
+    let t0 = trig3 * trig5;
+    let t1 = -k12 * t0 + k12 * trig4 + k13 * trig4 + k14 * t0;
+    let t2 = theta2_dot.powi(2);
+    let t3 = theta1_dot.powi(2);
+    let t4 = k11 * (cos_theta3 * g + k10 * t2 * trig2 + k9 * t3 * trig1) + torque3;
+    let t5 = trig5.powi(2);
+    let t6 = t2 * trig0;
+    let t7 = k19 * theta3_dot.powi(2);
+    let t8 = k21
+        * (cos_theta1 * k15
+            + cos_theta1 * k16
+            + cos_theta1 * k17
+            + k18 * t6
+            + k20 * t6
+            + t7 * trig1)
+        + torque1
         - torque2;
-    let t13 = t1.sin();
-    let t14 = theta1_dot.powi(2);
-    let t15 = k11 * (g * theta3.cos() + k10 * t13 * t5 + k9 * t10 * t14) + torque3;
-    let t16 = t9.cos();
-    let t17 = t6.cos();
-    let t18 = t17 * t2;
-    let t19 = k12 * t16 - k12 * t18 + k13 * t16 + k14 * t18;
-    let t20 = k28 * t17 + k29 * t17 + k30 * t16 * t2;
-    let t21 = theta2.cos();
-    let t22 = t14 * t7;
-    let t23 = k27 * (k17 * t21 + k24 * t21 + k25 * t22 + k26 * t22 + t11 * t13) + torque2 - torque3;
-    let t24 = t17.powi(2);
-    let t25 = t16.powi(2);
-    let t26 = t16 * t18;
-    let t27 = k31
-        / (k0 * t24 + k1 * t25 + k1 * t3 + k2 * t24 + k3 * t24 - k4 * t26
-            + k4 * t3
-            + k5 * t3
-            + k6 * t25
-            + k7 * t26
+    let t9 = k28 * trig3 + k29 * trig3 + k30 * trig4 * trig5;
+    let t10 = t3 * trig0;
+    let t11 = k27 * (cos_theta2 * k17 + cos_theta2 * k24 + k25 * t10 + k26 * t10 + t7 * trig2)
+        + torque2
+        - torque3;
+    let t12 = trig3.powi(2);
+    let t13 = trig4.powi(2);
+    let t14 = t0 * trig4;
+    let t15 = k31
+        / (k0 * t12 + k1 * t13 + k1 * t5 + k2 * t12 + k3 * t12 - k4 * t14
+            + k4 * t5
+            + k5 * t5
+            + k6 * t13
+            + k7 * t14
             + k8);
-    let t28 = t16 * t17;
-    let t29 = k32 * t2 - k32 * t28 + k33 * t2 + k34 * t2 + k35 * t28;
+    let t16 = trig3 * trig4;
+    let t17 = -k32 * t16 + k32 * trig5 + k33 * trig5 + k34 * trig5 + k35 * t16;
     // X_dot
     let mut x_dot = <SVector<f64, 6>>::zeros();
     x_dot[0] = theta1_dot;
     x_dot[1] = theta2_dot;
     x_dot[2] = theta3_dot;
-    x_dot[3] = t27 * (t12 * (k22 * t3 + k23) + t15 * t19 + t20 * t23);
-    x_dot[4] = t27 * (t12 * t20 + t15 * t29 + t23 * (k36 * t25 + k37));
-    x_dot[5] = t27 * (t12 * t19 + t15 * (k38 * t24 + k39 * t24 + k40 * t24 + k41) + t23 * t29);
+    x_dot[3] = t15 * (t1 * t4 + t11 * t9 + t8 * (k22 * t5 + k23));
+    x_dot[4] = t15 * (t11 * (k36 * t13 + k37) + t17 * t4 + t8 * t9);
+    x_dot[5] = t15 * (t1 * t8 + t11 * t17 + t4 * (k38 * t12 + k39 * t12 + k40 * t12 + k41));
     x_dot
 }
 
@@ -417,8 +423,8 @@ impl DynamicsJacobianCoefficients {
                 -18.0 * s2,
                 -72.0 * s3,
                 -18.0 * s3,
-                s25,
                 s19 / 2.0,
+                s25,
                 -54.0 * s3,
                 -18.0 * s4,
                 -g,
@@ -432,9 +438,9 @@ impl DynamicsJacobianCoefficients {
                 -s23 * s28 * s6,
                 -s17 * s28,
                 s31,
+                s30 / 2.0,
                 -m2 * s24 * s25,
                 -m1 * s24 * s27 / 6.0,
-                s30 / 2.0,
                 s33 / 2.0,
                 2.0 * s34,
                 2.0 * s35,
@@ -548,183 +554,183 @@ pub fn dynamics_jacobian_with(
     let k61 = coefficients.k[61];
     let k62 = coefficients.k[62];
     let k63 = coefficients.k[63];
-    let t0 = theta1 - theta2;
-    let t1 = t0.cos();
-    let t2 = theta1_dot.powi(2);
-    let t3 = t1 * t2;
-    let t4 = k18 * t3 + k19 * t3;
-    let t5 = -theta3;
-    let t6 = t5 + theta1;
-    let t7 = t6.cos();
-    let t8 = t5 + theta2;
-    let t9 = t8.cos();
-    let t10 = k22 * t9;
-    let t11 = k21 * t1 + k23 * t1 + t10 * t7;
-    let t12 = -t11;
-    let t13 = k20 * t12;
-    let t14 = k12 * t7;
-    let t15 = k13 * t7;
-    let t16 = t1 * t9;
+    let (sin_theta1, cos_theta1) = crate::trig::sin_cos(theta1);
+    let (sin_theta2, cos_theta2) = crate::trig::sin_cos(theta2);
+    let (sin_theta3, cos_theta3) = crate::trig::sin_cos(theta3);
+    let trig0 = -cos_theta1 * sin_theta2 + cos_theta2 * sin_theta1;
+    let trig1 = -cos_theta1 * sin_theta3 + cos_theta3 * sin_theta1;
+    let trig2 = -cos_theta2 * sin_theta3 + cos_theta3 * sin_theta2;
+    let trig3 = cos_theta1 * cos_theta2 + sin_theta1 * sin_theta2;
+    let trig4 = cos_theta1 * cos_theta3 + sin_theta1 * sin_theta3;
+    let trig5 = cos_theta2 * cos_theta3 + sin_theta2 * sin_theta3;
+    let t0 = k12 * trig4;
+    let t1 = k13 * trig4;
+    let t2 = trig3 * trig5;
+    let t3 = k14 * t2;
+    let t4 = k12 * t2;
+    let t5 = t0 + t1 + t3 - t4;
+    let t6 = -t5;
+    let t7 = theta1_dot.powi(2);
+    let t8 = k31 * trig4;
+    let t9 = t7 * t8;
+    let t10 = t7 * trig3;
+    let t11 = k18 * t10 + k19 * t10;
+    let t12 = k22 * trig5;
+    let t13 = k21 * trig3 + k23 * trig3 + t12 * trig4;
+    let t14 = -t13;
+    let t15 = k20 * t14;
+    let t16 = trig0 * trig5;
     let t17 = k14 * t16;
     let t18 = k12 * t16;
-    let t19 = t14 + t15 + t17 - t18;
-    let t20 = -t19;
-    let t21 = k31 * t7;
-    let t22 = t2 * t21;
-    let t23 = theta1.sin();
-    let t24 = theta3_dot.powi(2);
-    let t25 = k17 * t24;
-    let t26 = theta2_dot.powi(2);
-    let t27 = t1 * t26;
+    let t19 = k12 * trig1 + k13 * trig1;
+    let t20 = t17 - t18 + t19;
+    let t21 = theta2_dot.powi(2);
+    let t22 = k10 * t21;
+    let t23 = k9 * t7;
+    let t24 = k11 * (cos_theta3 * g + t22 * trig2 + t23 * trig1) + torque3;
+    let t25 = theta3_dot.powi(2);
+    let t26 = k17 * t25;
+    let t27 = t21 * trig3;
     let t28 = k28 * t27 + k29 * t27;
-    let t29 = -k16 * t23 + k26 * t23 + k27 * t23 + t25 * t7 + t28;
-    let t30 = t9.powi(2);
+    let t29 = -k16 * sin_theta1 + k26 * sin_theta1 + k27 * sin_theta1 + t26 * trig4 + t28;
+    let t30 = trig5.powi(2);
     let t31 = k24 * t30;
     let t32 = k25 + t31;
     let t33 = k30 * t32;
-    let t34 = t8.sin();
-    let t35 = k10 * t26;
-    let t36 = t6.sin();
-    let t37 = k9 * t2;
-    let t38 = k11 * (g * theta3.cos() + t34 * t35 + t36 * t37) + torque3;
-    let t39 = t0.sin();
-    let t40 = t39 * t9;
-    let t41 = k14 * t40;
-    let t42 = k12 * t40;
-    let t43 = k12 * t36 + k13 * t36;
-    let t44 = t41 - t42 + t43;
-    let t45 = t10 * t36;
-    let t46 = k21 * t39 + k23 * t39;
-    let t47 = t45 + t46;
-    let t48 = theta2.cos();
-    let t49 = t2 * t39;
-    let t50 = k20 * (k15 * t48 + k16 * t48 + k18 * t49 + k19 * t49 + t25 * t34) + torque2 - torque3;
-    let t51 = t1.powi(2);
-    let t52 = t7.powi(2);
-    let t53 = t16 * t7;
-    let t54 = k0 * t51 + k1 * t30 + k1 * t52 + k2 * t51 + k3 * t51 + k4 * t30 - k4 * t53
+    let t34 = t12 * trig1;
+    let t35 = k21 * trig0 + k23 * trig0;
+    let t36 = t34 + t35;
+    let t37 = t7 * trig0;
+    let t38 = k20 * (cos_theta2 * k15 + cos_theta2 * k16 + k18 * t37 + k19 * t37 + t26 * trig2)
+        + torque2
+        - torque3;
+    let t39 = trig3.powi(2);
+    let t40 = trig4.powi(2);
+    let t41 = t2 * trig4;
+    let t42 = k0 * t39 + k1 * t30 + k1 * t40 + k2 * t39 + k3 * t39 + k4 * t30 - k4 * t41
         + k5 * t30
-        + k6 * t52
-        + k7 * t53
+        + k6 * t40
+        + k7 * t41
         + k8;
-    let t55 = k32 / t54;
-    let t56 = t36 * t7;
-    let t57 = t16 * t36;
-    let t58 = k36 * t56 - k4 * t57 - k7 * t56 + k7 * t57;
-    let t59 = t1 * t39;
-    let t60 = t40 * t7;
-    let t61 = k33 * t59 + k34 * t59 + k35 * t59 - k4 * t60 + k7 * t60;
-    let t62 = t58 + t61;
-    let t63 = theta1.cos();
-    let t64 = t26 * t39;
-    let t65 = k30 * (k16 * t63 - k26 * t63 - k27 * t63 + k28 * t64 + k29 * t64 + t25 * t36)
+    let t43 = k32 / t42;
+    let t44 = trig1 * trig4;
+    let t45 = t2 * trig1;
+    let t46 = k36 * t44 - k4 * t45 - k7 * t44 + k7 * t45;
+    let t47 = trig0 * trig3;
+    let t48 = t16 * trig4;
+    let t49 = k33 * t47 + k34 * t47 + k35 * t47 - k4 * t48 + k7 * t48;
+    let t50 = t46 + t49;
+    let t51 = t21 * trig0;
+    let t52 = k30
+        * (cos_theta1 * k16 - cos_theta1 * k26 - cos_theta1 * k27
+            + k28 * t51
+            + k29 * t51
+            + t26 * trig1)
         + torque1
         - torque2;
-    let t66 = k32 / t54.powi(2);
-    let t67 = t66 * (t12 * t50 + t20 * t38 + t32 * t65);
-    let t68 = t34 * t9;
-    let t69 = k7 * t68;
-    let t70 = k39 * t68;
-    let t71 = k40 * t68;
-    let t72 = t1 * t34;
-    let t73 = t7 * t72;
-    let t74 = k4 * t73;
-    let t75 = k7 * t73;
-    let t76 = -t61 - t69 + t70 + t71 - t74 + t75;
-    let t77 = -t28;
-    let t78 = k37 * t9;
-    let t79 = t26 * t78;
-    let t80 = k38 * t65 * t68;
-    let t81 = theta2.sin();
-    let t82 = -k15 * t81 - k16 * t81 + k17 * t24 * t9 - t4;
-    let t83 = k22 * t34 * t7;
-    let t84 = -t46 + t83;
-    let t85 = -k12 * t72 + k14 * t72;
-    let t86 = -t41 + t42 + t85;
-    let t87 = t21 * t24;
-    let t88 = t24 * t78;
-    let t89 = k11 * (k41 * theta3.sin() - t35 * t9 - t37 * t7);
-    let t90 = -t43 - t85;
-    let t91 = -t45 - t83;
-    let t92 = -t58 + t69 - t70 - t71 + t74 - t75;
-    let t93 = t39 * theta1_dot;
-    let t94 = k42 * t93 + k43 * t93;
-    let t95 = k44 * t36;
-    let t96 = t95 * theta1_dot;
-    let t97 = t39 * theta2_dot;
-    let t98 = k45 * t97 + k46 * t97;
-    let t99 = k47 * t34;
-    let t100 = t99 * theta2_dot;
-    let t101 = t95 * theta3_dot;
-    let t102 = t99 * theta3_dot;
-    let t103 = k50 * t52;
-    let t104 = k51 + t103;
-    let t105 = k48 * t9;
-    let t106 = k52 * t9;
-    let t107 = k53 * t9;
-    let t108 = t1 * t7;
-    let t109 = k48 * t108;
-    let t110 = k49 * t108;
-    let t111 = t105 + t106 + t107 - t109 - t110;
-    let t112 = t66 * (t104 * t50 + t111 * t38 + t12 * t65);
-    let t113 = k20 * t104;
-    let t114 = k54 * t50 * t56;
-    let t115 = k30 * t12;
-    let t116 = t1 * t36;
-    let t117 = k48 * t116;
-    let t118 = k49 * t116;
-    let t119 = t39 * t7;
-    let t120 = k48 * t119 + k49 * t119;
-    let t121 = t117 + t118 + t120;
-    let t122 = k48 * t34 + k52 * t34 + k53 * t34;
-    let t123 = -t120 - t122;
-    let t124 = -t117 - t118 + t122;
-    let t125 = k58 * t51 + k59 * t51 + k60 * t51 + k61;
-    let t126 = t66 * (t111 * t50 + t125 * t38 + t20 * t65);
-    let t127 = k55 * t59 + k56 * t59 + k57 * t59;
-    let t128 = k20 * t111;
-    let t129 = k30 * t20;
+    let t53 = k32 / t42.powi(2);
+    let t54 = t53 * (t14 * t38 + t24 * t6 + t32 * t52);
+    let t55 = trig2 * trig5;
+    let t56 = k7 * t55;
+    let t57 = k39 * t55;
+    let t58 = k40 * t55;
+    let t59 = trig2 * trig3;
+    let t60 = t59 * trig4;
+    let t61 = k4 * t60;
+    let t62 = k7 * t60;
+    let t63 = -t49 - t56 + t57 + t58 - t61 + t62;
+    let t64 = -t28;
+    let t65 = k38 * trig5;
+    let t66 = t21 * t65;
+    let t67 = -k12 * t59 + k14 * t59;
+    let t68 = -t17 + t18 + t67;
+    let t69 = k37 * t52 * t55;
+    let t70 = -k15 * sin_theta2 - k16 * sin_theta2 + k17 * t25 * trig5 - t11;
+    let t71 = k22 * trig2 * trig4;
+    let t72 = -t35 + t71;
+    let t73 = -t46 + t56 - t57 - t58 + t61 - t62;
+    let t74 = t25 * t8;
+    let t75 = t25 * t65;
+    let t76 = k11 * (k41 * sin_theta3 - t22 * trig5 - t23 * trig4);
+    let t77 = -t19 - t67;
+    let t78 = -t34 - t71;
+    let t79 = k44 * trig1;
+    let t80 = t79 * theta1_dot;
+    let t81 = theta1_dot * trig0;
+    let t82 = k42 * t81 + k43 * t81;
+    let t83 = theta2_dot * trig0;
+    let t84 = k45 * t83 + k46 * t83;
+    let t85 = k47 * trig2;
+    let t86 = t85 * theta2_dot;
+    let t87 = t79 * theta3_dot;
+    let t88 = t85 * theta3_dot;
+    let t89 = k50 * t40;
+    let t90 = k51 + t89;
+    let t91 = k48 * trig5;
+    let t92 = k53 * trig5;
+    let t93 = k54 * trig5;
+    let t94 = trig3 * trig4;
+    let t95 = k48 * t94;
+    let t96 = k49 * t94;
+    let t97 = t91 + t92 + t93 - t95 - t96;
+    let t98 = t53 * (t14 * t52 + t24 * t97 + t38 * t90);
+    let t99 = k20 * t90;
+    let t100 = k52 * t38 * t44;
+    let t101 = trig1 * trig3;
+    let t102 = k48 * t101;
+    let t103 = k49 * t101;
+    let t104 = trig0 * trig4;
+    let t105 = k48 * t104 + k49 * t104;
+    let t106 = t102 + t103 + t105;
+    let t107 = k30 * t14;
+    let t108 = k48 * trig2 + k53 * trig2 + k54 * trig2;
+    let t109 = -t105 - t108;
+    let t110 = -t102 - t103 + t108;
+    let t111 = k58 * t39 + k59 * t39 + k60 * t39 + k61;
+    let t112 = t53 * (t111 * t24 + t38 * t97 + t52 * t6);
+    let t113 = k55 * t47 + k56 * t47 + k57 * t47;
+    let t114 = k20 * t97;
+    let t115 = k30 * t6;
     // df/dX
     let mut f_x = <SMatrix<f64, 6, 6>>::zeros();
     f_x[(0, 3)] = 1.0;
     f_x[(1, 4)] = 1.0;
     f_x[(2, 5)] = 1.0;
-    f_x[(3, 0)] = t55 * (t13 * t4 + t20 * t22 + t29 * t33 + t38 * t44 + t47 * t50) + t62 * t67;
+    f_x[(3, 0)] = t43 * (t11 * t15 + t20 * t24 + t29 * t33 + t36 * t38 + t6 * t9) + t50 * t54;
     f_x[(3, 1)] =
-        t55 * (t13 * t82 + t20 * t79 + t33 * t77 + t38 * t86 + t50 * t84 + t80) + t67 * t76;
+        t43 * (t15 * t70 + t24 * t68 + t33 * t64 + t38 * t72 + t6 * t66 + t69) + t54 * t63;
     f_x[(3, 2)] =
-        t55 * (t12 * t88 + t20 * t89 + t32 * t87 + t38 * t90 + t50 * t91 - t80) + t67 * t92;
-    f_x[(3, 3)] = t55 * (t13 * t94 + t20 * t96);
-    f_x[(3, 4)] = t55 * (t100 * t20 + t33 * t98);
-    f_x[(3, 5)] = t55 * (-t101 * t32 - t102 * t12);
+        t43 * (t14 * t75 + t24 * t77 + t32 * t74 + t38 * t78 + t6 * t76 - t69) + t54 * t73;
+    f_x[(3, 3)] = t43 * (t15 * t82 + t6 * t80);
+    f_x[(3, 4)] = t43 * (t33 * t84 + t6 * t86);
+    f_x[(3, 5)] = t43 * (-t14 * t88 - t32 * t87);
     f_x[(4, 0)] =
-        t112 * t62 + t55 * (t111 * t22 + t113 * t4 + t114 + t115 * t29 + t121 * t38 + t47 * t65);
-    f_x[(4, 1)] =
-        t112 * t76 + t55 * (t111 * t79 + t113 * t82 + t115 * t77 + t123 * t38 + t65 * t84);
+        t43 * (t100 + t106 * t24 + t107 * t29 + t11 * t99 + t36 * t52 + t9 * t97) + t50 * t98;
+    f_x[(4, 1)] = t43 * (t107 * t64 + t109 * t24 + t52 * t72 + t66 * t97 + t70 * t99) + t63 * t98;
     f_x[(4, 2)] =
-        t112 * t92 + t55 * (t104 * t88 + t111 * t89 - t114 + t12 * t87 + t124 * t38 + t65 * t91);
-    f_x[(4, 3)] = t55 * (t111 * t96 + t113 * t94);
-    f_x[(4, 4)] = t55 * (t100 * t111 + t115 * t98);
-    f_x[(4, 5)] = t55 * (-t101 * t12 - t102 * t104);
-    f_x[(5, 0)] = t126 * t62
-        + t55 * (t121 * t50 + t125 * t22 + t127 * t38 + t128 * t4 + t129 * t29 + t44 * t65);
-    f_x[(5, 1)] = t126 * t76
-        + t55 * (t123 * t50 + t125 * t79 - t127 * t38 + t128 * t82 + t129 * t77 + t65 * t86);
-    f_x[(5, 2)] = t126 * t92 + t55 * (t111 * t88 + t124 * t50 + t125 * t89 + t20 * t87 + t65 * t90);
-    f_x[(5, 3)] = t55 * (t125 * t96 + t128 * t94);
-    f_x[(5, 4)] = t55 * (t100 * t125 + t129 * t98);
-    f_x[(5, 5)] = t55 * (-t101 * t20 - t102 * t111);
+        t43 * (-t100 + t110 * t24 + t14 * t74 + t52 * t78 + t75 * t90 + t76 * t97) + t73 * t98;
+    f_x[(4, 3)] = t43 * (t80 * t97 + t82 * t99);
+    f_x[(4, 4)] = t43 * (t107 * t84 + t86 * t97);
+    f_x[(4, 5)] = t43 * (-t14 * t87 - t88 * t90);
+    f_x[(5, 0)] = t112 * t50
+        + t43 * (t106 * t38 + t11 * t114 + t111 * t9 + t113 * t24 + t115 * t29 + t20 * t52);
+    f_x[(5, 1)] = t112 * t63
+        + t43 * (t109 * t38 + t111 * t66 - t113 * t24 + t114 * t70 + t115 * t64 + t52 * t68);
+    f_x[(5, 2)] = t112 * t73 + t43 * (t110 * t38 + t111 * t76 + t52 * t77 + t6 * t74 + t75 * t97);
+    f_x[(5, 3)] = t43 * (t111 * t80 + t114 * t82);
+    f_x[(5, 4)] = t43 * (t111 * t86 + t115 * t84);
+    f_x[(5, 5)] = t43 * (-t6 * t87 - t88 * t97);
     // df/dU
     let mut f_u = <SMatrix<f64, 6, 3>>::zeros();
-    f_u[(3, 0)] = t32 * t55;
-    f_u[(3, 1)] = t55 * (k62 - t11 - t31);
-    f_u[(3, 2)] = t55 * (t11 - t14 - t15 - t17 + t18);
-    f_u[(4, 0)] = t12 * t55;
-    f_u[(4, 1)] = t55 * (t104 + t11);
-    f_u[(4, 2)] = t55 * (k63 - t103 + t111);
-    f_u[(5, 0)] = t20 * t55;
-    f_u[(5, 1)] = t55 * (t111 + t19);
-    f_u[(5, 2)] = t55 * (-t105 - t106 - t107 + t109 + t110 + t125);
+    f_u[(3, 0)] = t32 * t43;
+    f_u[(3, 1)] = t43 * (k62 - t13 - t31);
+    f_u[(3, 2)] = t43 * (-t0 - t1 + t13 - t3 + t4);
+    f_u[(4, 0)] = t14 * t43;
+    f_u[(4, 1)] = t43 * (t13 + t90);
+    f_u[(4, 2)] = t43 * (k63 - t89 + t97);
+    f_u[(5, 0)] = t43 * t6;
+    f_u[(5, 1)] = t43 * (t5 + t97);
+    f_u[(5, 2)] = t43 * (t111 - t91 - t92 - t93 + t95 + t96);
     (f_x, f_u)
 }
 

@@ -22,6 +22,7 @@ pub mod mpc;
 pub mod select;
 pub mod stats;
 pub mod task;
+pub mod trig;
 
 pub use arm::Arm;
 pub use confidence::{control_confidence, sensitivities, ControlConfidence, Sensitivities};

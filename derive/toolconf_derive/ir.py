@@ -29,9 +29,38 @@ def _temporaries(prefix: str):
     return (sp.Symbol(f"{prefix}{i}", real=True) for i in range(10**6))
 
 
-def _code(entries: list[sp.Expr], d: Derivation, args: list, declared: set[str], prefix: str) -> dict:
-    """CSE'd Rust for `entries`: the constants and argument elements it reads, its temporaries
-    and the reduced entries."""
+def _trig_symbols(angle: sp.Symbol) -> tuple[sp.Symbol, sp.Symbol]:
+    return sp.Symbol(f"sin_{angle.name}", real=True), sp.Symbol(f"cos_{angle.name}", real=True)
+
+
+def joint_trigonometry(entries: list[sp.Expr], angles: list[sp.Symbol]):
+    """Replaces every sine and cosine in `entries` by a symbol: sin_q, cos_q for a joint angle q,
+    and for an angle sum or difference (sin(q1 - q2), ...) a `trig<i>` defined from those by the
+    addition theorems. One `sin_cos` per joint then covers all trigonometry (src/trig.rs), and
+    the entries keep their shape (each compound is one atom for hoisting and CSE).
+    Returns the rewritten entries and the compound definitions [(symbol, expression)]."""
+    single = {}
+    for q in angles:
+        s, c = _trig_symbols(q)
+        single[sp.sin(q)] = s
+        single[sp.cos(q)] = c
+    atoms = set()
+    for e in entries:
+        atoms |= e.atoms(sp.sin, sp.cos)
+    replace, compounds = dict(single), []
+    for a in sorted(atoms - set(single), key=sp.default_sort_key):
+        if not (a.args[0].free_symbols <= set(angles)):
+            continue
+        symbol = sp.Symbol(f"trig{len(compounds)}", real=True)
+        compounds.append((symbol, sp.expand_trig(a).xreplace(single)))
+        replace[a] = symbol
+    return [e.xreplace(replace) for e in entries], compounds
+
+
+def _code(entries: list[sp.Expr], d: Derivation, args: list, declared: set[str], prefix: str,
+          angles: list[sp.Symbol] = (), compounds: list[tuple[sp.Symbol, sp.Expr]] = ()) -> dict:
+    """CSE'd Rust for `entries`: the constants and argument elements it reads, the joint angles'
+    sin_cos it needs, its temporaries and the reduced entries."""
     replacements, reduced = sp.cse(entries, symbols=_temporaries(prefix), order="canonical")
     clash = declared & {str(t) for t, _ in replacements}
     if clash:
@@ -42,6 +71,18 @@ def _code(entries: list[sp.Expr], d: Derivation, args: list, declared: set[str],
     for e in reduced:
         used |= e.free_symbols
     printer = RustPrinter()
+    compound_code = []
+    for symbol, definition in compounds:
+        if symbol in used:
+            used |= definition.free_symbols
+            compound_code.append({"name": symbol.name, "rust": printer(definition)})
+    trig = []
+    for q in angles:
+        s, c = _trig_symbols(q)
+        if s in used or c in used:
+            used.add(q)
+            trig.append({"angle": q.name, "sin": s.name if s in used else "_",
+                         "cos": c.name if c in used else "_"})
     bindings = []
     for arg in args:
         for s, i, j in arg.reads:
@@ -54,6 +95,8 @@ def _code(entries: list[sp.Expr], d: Derivation, args: list, declared: set[str],
     return {
         "constants": [{"name": c.name, "rust": _const_name(c.name)} for c in d.constants if c in used],
         "bindings": bindings,
+        "trig": trig,
+        "compounds": compound_code,
         "temporaries": [{"name": str(t), "rust": printer(e)} for t, e in replacements],
         "reduced": [printer(e) for e in reduced],
     }
@@ -77,10 +120,15 @@ def function_ir(fn: Function, d: Derivation, vectors: int) -> dict:
 
     coefficients = None
     call_args = fn.args
+    angles: list[sp.Symbol] = []
+    compounds: list[tuple[sp.Symbol, sp.Expr]] = []
     if fn.per_tool_coefficients:
+        angles = d.x[:d.model.dof]
+        entries, compounds = joint_trigonometry(entries, angles)
+        per_call = [s for a in fn.args if a.name != "params" for s, _, _ in a.reads]
+        per_call += [t for q in angles for t in _trig_symbols(q)] + [c for c, _ in compounds]
         params = [a for a in fn.args if a.name == "params"]
-        hoisted = hoist(entries, [s for a in fn.args if a.name != "params" for s, _, _ in a.reads],
-                        set(d.constants))
+        hoisted = hoist(entries, per_call, set(d.constants))
         if hoisted is None:
             # Not cheaper per call: the coefficients are the parameters themselves, so that every
             # model has the same `<name>_with` API.
@@ -99,7 +147,7 @@ def function_ir(fn: Function, d: Derivation, vectors: int) -> dict:
         }
         entries = hoisted.entries
         call_args = [a for a in fn.args if a.name != "params"] + [k]
-    code = _code(entries, d, call_args, declared, "t")
+    code = _code(entries, d, call_args, declared, "t", angles, compounds)
 
     outputs = []
     for out in fn.outputs:
@@ -132,6 +180,8 @@ def function_ir(fn: Function, d: Derivation, vectors: int) -> dict:
         "outputs": outputs,
         "constants": code["constants"],
         "bindings": code["bindings"],
+        "trig": code["trig"],
+        "compounds": code["compounds"],
         "temporaries": code["temporaries"],
         "test_vectors": test_vectors(fn, d, vectors),
     }
