@@ -44,6 +44,16 @@ fn exponent(x: f64) -> i64 {
     ((x.to_bits() >> 52) & 0x7ff) as i64
 }
 
+/// One more term of the reduction: subtracts n·(part + tail) from `hi`, returning the new head,
+/// the rounding to carry and their difference.
+#[inline(always)]
+fn next_part(hi: f64, n: f64, part: f64, tail: f64) -> (f64, f64, f64) {
+    let w = n * part;
+    let new_hi = hi - w;
+    let w = n * tail - ((hi - new_hi) - w);
+    (new_hi, w, new_hi - w)
+}
+
 /// (sin x, cos x).
 #[inline(always)]
 pub fn sin_cos(x: f64) -> (f64, f64) {
@@ -57,17 +67,9 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     let mut w = n * PIO2_1T;
     let mut r = hi - w;
     if exponent(x) - exponent(r) > 16 {
-        let t = hi;
-        w = n * PIO2_2;
-        hi = t - w;
-        w = n * PIO2_2T - ((t - hi) - w);
-        r = hi - w;
+        (hi, w, r) = next_part(hi, n, PIO2_2, PIO2_2T);
         if exponent(x) - exponent(r) > 49 {
-            let t = hi;
-            w = n * PIO2_3;
-            hi = t - w;
-            w = n * PIO2_3T - ((t - hi) - w);
-            r = hi - w;
+            (hi, w, r) = next_part(hi, n, PIO2_3, PIO2_3T);
         }
     }
     let tail = (hi - r) - w;
