@@ -1,22 +1,17 @@
-//! One episode: the closed loop of plant and active-inference controller integrated over the
-//! paper's horizon, with the metrics the decision-maker ranks tools by.
-//!
-//! The joint state is Z = [X; U] = [θ1 θ2 θ̇1 θ̇2 T1 T2]. The plant is the nonlinear generative
-//! process Ẋ = f(X, U + ΔT) with a constant torque perturbation ΔT on both joints; the
-//! controller observes θ, θ̇ and the plant's θ̈ and updates U̇ = −γ ∂F/∂U (eq. U_dot_deriv).
+//! One episode of the paper's 2-DOF arm: a façade over the generic episode
+//! ([`crate::model::episode_on`]), keeping the 2-link options (with the run-time [`Plant`]) and
+//! errors that name the arm.
 
-use super::system::{ClosedLoop, Plant};
-use crate::integrate::{
-    solve_grid_with_jacobian, uniform_grid, IntegrationError, Method, Options as IntegratorOptions,
-};
-use crate::{Arm, Error, State, Task, TaskKind, Vector2};
+use super::system::Plant;
+use crate::integrate::{IntegrationError, Options as IntegratorOptions};
+use crate::model::runtime::{run_episode, EpisodeFailure, DIVERGENCE_BOUND};
+use crate::model::{Arm2, Arm2Exact, Arm2Tool, EpisodeN, EpisodeOptionsN, TaskN, TrajectoryN};
+use crate::{Arm, Error, State, Task, Vector2};
 
-pub use super::system::JointState;
+pub use crate::model::Metrics;
 
-/// A grid state whose magnitude passes this is a diverging simulation, not a result.
-const DIVERGENCE_BOUND: f64 = 1e6;
-
-/// Options of one episode; `Default` is the paper's "Implementation details".
+/// Options of one episode; `Default` is the paper's "Implementation details"
+/// ([`EpisodeOptionsN::paper`] for the 2-link arm, on the paper's plant).
 #[derive(Debug, Clone, PartialEq)]
 pub struct EpisodeOptions {
     /// End time [s] (paper: 5).
@@ -32,10 +27,11 @@ pub struct EpisodeOptions {
     /// Learning rate γ (default 1).
     pub learning_rate: f64,
     /// Integrator tolerances (defaults: MATLAB ode45's, rtol 1e-3, atol 1e-6) and method. The
-    /// default [`Method::Auto`] runs DP5 (`ode45`) on tasks 1 and 2, the paper's runs, and the
-    /// DP5-to-Rodas5P switch on task 3, whose θ̈ feedback (P^θ̈ = 10 acting through
-    /// ∂θ̈/∂U ~ 3/(m2·l2²)) makes it stiff. Hairer's test would find tasks 1 and 2 stiff for small
-    /// arms too (their P^θ̈ = 1), and switching there would move the paper's numbers.
+    /// default [`crate::integrate::Method::Auto`] runs DP5 (`ode45`) on tasks 1 and 2, the
+    /// paper's runs, and the DP5-to-Rodas5P switch on task 3, whose θ̈ feedback (P^θ̈ = 10
+    /// acting through ∂θ̈/∂U ~ 3/(m2·l2²)) makes it stiff. Hairer's test would find tasks 1 and 2
+    /// stiff for small arms too (their P^θ̈ = 1), and switching there would move the paper's
+    /// numbers.
     pub integrator: IntegratorOptions,
     /// Keep the trajectory on the output grid (the metrics are computed either way).
     pub record_trajectory: bool,
@@ -45,59 +41,26 @@ pub struct EpisodeOptions {
 
 impl Default for EpisodeOptions {
     fn default() -> Self {
+        let o = EpisodeOptionsN::paper::<Arm2, 4, 6>();
         Self {
-            t_end: 5.0,
-            dt: 0.05,
-            x0: Arm::equilibrium_state(),
-            u0: Vector2::new(0.1, 0.1),
-            perturbation: 0.0,
-            learning_rate: 1.0,
-            integrator: IntegratorOptions::default(),
-            record_trajectory: false,
+            t_end: o.t_end,
+            dt: o.dt,
+            x0: o.x0,
+            u0: o.u0,
+            perturbation: o.perturbation,
+            learning_rate: o.learning_rate,
+            integrator: o.integrator,
+            record_trajectory: o.record_trajectory,
             plant: Plant::Paper,
         }
     }
 }
 
 /// The trajectory on the output grid.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Trajectory {
-    pub t: Vec<f64>,
-    pub theta: Vec<Vector2>,
-    pub theta_dot: Vec<Vector2>,
-    /// The plant's θ̈ = f(X, U + ΔT), what the controller observes.
-    pub theta_ddot: Vec<Vector2>,
-    pub u: Vec<Vector2>,
-}
+pub type Trajectory = TrajectoryN<2>;
 
-/// What one episode measures.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Metrics {
-    /// Σ over all grid samples (t = 0 included) of the task's weighted error.
-    pub task_error: f64,
-    /// ∫F dt (eq. free_energy with the task's terms and −ln|Π^U|), trapezoidal on the grid.
-    pub free_energy: f64,
-    /// ∫J dt: the same without the confidence term.
-    pub cost_j: f64,
-    /// ln|Π^U|.
-    pub logdet: f64,
-    /// Right-hand-side evaluations of the closed loop.
-    pub rhs_evals: usize,
-    /// Accepted and rejected integrator steps.
-    pub steps: usize,
-    pub rejected_steps: usize,
-    /// Jacobian evaluations and LU factorisations (0 unless the stiff method ran).
-    pub jacobian_evals: usize,
-    pub factorisations: usize,
-    /// ∫|U|² dt, trapezoidal on the grid (the controller's torque, without ΔT).
-    pub control_effort: f64,
-}
-
-#[derive(Debug, Clone, PartialEq)]
-pub struct Episode {
-    pub metrics: Metrics,
-    pub trajectory: Option<Trajectory>,
-}
+/// One episode's metrics and, if asked for, trajectory.
+pub type Episode = EpisodeN<2>;
 
 /// Why an episode failed, with the tool, time and reason.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -119,110 +82,32 @@ impl SimulationError {
             SimulationError::Diverged { t, .. } => Some(*t),
         }
     }
+
+    fn named(failure: EpisodeFailure, arm: Arm) -> Self {
+        match failure {
+            EpisodeFailure::Input(e) => SimulationError::Input(e),
+            EpisodeFailure::Integration(source) => SimulationError::Integration { arm, source },
+            EpisodeFailure::Diverged { t, magnitude } => {
+                SimulationError::Diverged { arm, t, magnitude }
+            }
+        }
+    }
 }
 
-/// Runs one episode of `arm` on `task`.
+/// Runs one episode of `arm` on `task`: the generic episode of the paper's model, on the plant
+/// `options.plant` chooses. The plant is matched here, once, so that the integrator runs the
+/// monomorphised closed loop of that plant.
 pub fn simulate(
     arm: &Arm,
     task: &Task,
     options: &EpisodeOptions,
 ) -> Result<Episode, SimulationError> {
-    check_options(options)?;
-    let system = ClosedLoop::with_plant(
-        arm,
-        task,
-        options.learning_rate,
-        options.perturbation,
-        options.plant,
-    )?;
-    let controller = &system.controller;
-    let grid = uniform_grid(0.0, options.t_end, options.dt);
-    let mut z0 = JointState::zeros();
-    z0.fixed_rows_mut::<4>(0).copy_from(&options.x0);
-    z0.fixed_rows_mut::<2>(4).copy_from(&options.u0);
-
-    let mut trajectory = options.record_trajectory.then(|| Trajectory {
-        t: Vec::with_capacity(grid.len()),
-        ..Trajectory::default()
-    });
-    let mut task_error = 0.0;
-    let (mut int_f, mut int_j, mut effort) = (0.0, 0.0, 0.0);
-    // (t, F, J, |U|²) at the previous grid point, for the trapezoidal rule.
-    let mut previous: Option<(f64, f64, f64, f64)> = None;
-    let mut divergence: Option<(f64, f64)> = None;
-
-    let rhs = |_t: f64, z: &JointState| system.rhs(z);
-    // The closed loop is autonomous: ∂Ż/∂t = 0.
-    let jacobian = |_t: f64, z: &JointState| (system.jacobian(z), JointState::zeros());
-    let mut integrator = options.integrator;
-    if integrator.method == Method::Auto && task.kind != TaskKind::Acceleration {
-        integrator.method = Method::Explicit;
+    let tool = Arm2Tool::from(arm);
+    let task = TaskN::from(task);
+    let generic = EpisodeOptionsN::from(options);
+    match options.plant {
+        Plant::Paper => run_episode::<Arm2, Arm2, 2, 4, 4, 6>(&tool, &task, &generic),
+        Plant::Exact => run_episode::<Arm2, Arm2Exact, 2, 4, 4, 6>(&tool, &task, &generic),
     }
-    let stats = solve_grid_with_jacobian(rhs, jacobian, &z0, &grid, &integrator, |_, t, z| {
-        let (_, theta_ddot) = system.rhs_and_acceleration(z);
-        let theta = z.fixed_rows::<2>(0).into_owned();
-        let theta_dot = z.fixed_rows::<2>(2).into_owned();
-        let u = z.fixed_rows::<2>(4).into_owned();
-        let magnitude = z.amax();
-        if divergence.is_none() && magnitude > DIVERGENCE_BOUND {
-            divergence = Some((t, magnitude));
-        }
-        task_error += controller.task_error(&theta, &theta_dot, &theta_ddot);
-        let j = controller.cost_j(&theta, &theta_dot, &theta_ddot, &u);
-        let f = j - 0.5 * controller.logdet;
-        let e = u.norm_squared();
-        if let Some((t_prev, f_prev, j_prev, e_prev)) = previous {
-            let h = t - t_prev;
-            int_f += 0.5 * h * (f + f_prev);
-            int_j += 0.5 * h * (j + j_prev);
-            effort += 0.5 * h * (e + e_prev);
-        }
-        previous = Some((t, f, j, e));
-        if let Some(tr) = trajectory.as_mut() {
-            tr.t.push(t);
-            tr.theta.push(theta);
-            tr.theta_dot.push(theta_dot);
-            tr.theta_ddot.push(theta_ddot);
-            tr.u.push(u);
-        }
-    })
-    .map_err(|source| SimulationError::Integration { arm: *arm, source })?;
-
-    if let Some((t, magnitude)) = divergence {
-        return Err(SimulationError::Diverged {
-            arm: *arm,
-            t,
-            magnitude,
-        });
-    }
-    let metrics = Metrics {
-        task_error,
-        free_energy: int_f,
-        cost_j: int_j,
-        logdet: controller.logdet,
-        rhs_evals: stats.rhs_evals,
-        steps: stats.steps,
-        rejected_steps: stats.rejected,
-        control_effort: effort,
-        jacobian_evals: stats.jacobian_evals,
-        factorisations: stats.factorisations,
-    };
-    if ![metrics.task_error, metrics.free_energy, metrics.cost_j]
-        .iter()
-        .all(|v| v.is_finite())
-    {
-        return Err(SimulationError::Diverged {
-            arm: *arm,
-            t: options.t_end,
-            magnitude: f64::INFINITY,
-        });
-    }
-    Ok(Episode {
-        metrics,
-        trajectory,
-    })
-}
-
-fn check_options(o: &EpisodeOptions) -> Result<(), Error> {
-    crate::model::runtime::check_options(&crate::model::runtime::EpisodeOptionsN::<2, 4>::from(o))
+    .map_err(|failure| SimulationError::named(failure, *arm))
 }

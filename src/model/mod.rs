@@ -1,13 +1,18 @@
-//! A runtime generic over the arm model: the same confidence, controller and closed loop as the
-//! 2-link modules ([`crate::confidence`], [`crate::closed_loop`]) for any model that
-//! `make derive` generates, with fixed sizes as const generics.
+//! The runtime, generic over the arm model: control confidence, controller, closed loop and
+//! episode for any model that `make derive` generates, with fixed sizes as const generics.
+//!
+//! This is the implementation. The 2-link modules [`crate::confidence`] and
+//! [`crate::closed_loop`] are a façade over it for the paper's arm (`Arm`, `Task`, `Matrix2`,
+//! `Plant`, errors naming `arm m1=…`): they convert and delegate, so the math lives here once and
+//! nothing outside the generated 2-link model assumes 2×2.
 //!
 //! * [`ArmModel`] is implemented for the marker types [`Arm2`], [`Arm2Exact`] and [`Arm3`] by one
 //!   `arm_model!` line each, forwarding to the generated module (adding a model = one line).
 //! * [`ToolN`] (validated parameters), [`TaskN`] (goals and precisions), [`control_confidence`]
-//!   (Π^U and ln|Π^U|), [`ActiveInferenceN`], [`ClosedLoopN`] and [`simulate`] mirror their 2-link
-//!   counterparts operation for operation, so that with [`Arm2`] they reproduce
-//!   [`crate::closed_loop::simulate`] bit for bit (tests/generic_runtime.rs).
+//!   (Π^U and ln|Π^U|), [`ActiveInferenceN`], [`ClosedLoopN`], [`simulate`]/[`simulate_on`]
+//!   (metrics) and [`episode`]/[`episode_on`] (metrics and trajectory). With [`Arm2`] they are
+//!   the 2-link runtime; tests/generic_runtime.rs checks the façade and the generic entry points
+//!   agree bit for bit.
 //! * [`mixed`] draws and ranks tool sets that mix models.
 //!
 //! The sizes are N (joints = torques), NX = 2N (state X = [θ; θ̇]), NP (tool parameters) and
@@ -28,7 +33,8 @@ pub mod mixed;
 pub(crate) mod runtime;
 
 pub use runtime::{
-    simulate, simulate_on, ActiveInferenceN, ClosedLoopN, EpisodeOptionsN, ModelSimulationError,
+    episode, episode_on, simulate, simulate_on, ActiveInferenceN, ClosedLoopN, EpisodeN,
+    EpisodeOptionsN, Metrics, ModelSimulationError, TrajectoryN,
 };
 
 /// The equations and closed forms of one generated model, with N joints, state dimension NX,
@@ -310,12 +316,15 @@ pub type Arm2ExactTool = ToolN<Arm2Exact, 2, 4, 4, 6>;
 /// A tool of the 3-link model.
 pub type Arm3Tool = ToolN<Arm3, 3, 6, 6, 9>;
 
-/// The sensitivities ∂(task variable)/∂U a task's controller uses; `None` for unused terms
-/// (the N-joint [`crate::Sensitivities`]).
+/// The sensitivities ∂(task variable)/∂U that a task's controller uses (eq. U_dot_deriv); a term
+/// the task does not use is `None` ([`crate::Sensitivities`] is the 2-link one).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SensitivitiesN<const N: usize> {
+    /// ∂θ/∂U (task 1 only): [I O]A⁻¹(∂Ẋ/∂U − B) with ∂Ẋ/∂U = [I; I].
     pub d_theta_du: Option<SMatrix<f64, N, N>>,
+    /// ∂θ̇/∂U: [O I]A⁻¹(∂Ẋ/∂U − B) = I in task 1; −[I O]A⁻¹B in task 2, as the paper prints it.
     pub d_theta_dot_du: Option<SMatrix<f64, N, N>>,
+    /// ∂θ̈/∂U: I in tasks 1–2 (zero jerk); [I O](A²∂X/∂U + AB) in task 3, which is I too.
     pub d_theta_ddot_du: SMatrix<f64, N, N>,
 }
 
@@ -576,7 +585,8 @@ fn check_precision<const N: usize>(name: &str, p: &SMatrix<f64, N, N>) -> Result
     Ok(())
 }
 
-/// Π^U with ln|Π^U| for N joints (the N-joint [`crate::ControlConfidence`]).
+/// Π^U with its log-determinant ln|Π^U|, the confidence term of the free energy
+/// (eq. FE_components); [`crate::ControlConfidence`] is the 2-link one.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ControlConfidenceN<const N: usize> {
     /// Π^U, symmetric positive definite.
@@ -593,12 +603,13 @@ impl<const N: usize> ControlConfidenceN<N> {
     }
 }
 
-/// The closed-form control confidence of `tool` for `task`: Π^U and ln|Π^U|.
+/// The closed-form control confidence of `tool` for `task` (eq. control_conf and the closed
+/// forms after it): Π^U = Σ Sᵀ P S over the task's terms, plus P^U, and ln|Π^U|.
 ///
-/// Errors if the task is invalid or Π^U is not positive definite
-/// ([`Error::NotPositiveDefinite`], with the determinant). ln|Π^U| is 2 Σ ln L_ii of the
-/// Cholesky factor; for N = 2 it is ln(Π₀₀Π₁₁ − Π₀₁Π₁₀), the 2-link runtime's exact closed form,
-/// so that the generic path reproduces [`crate::control_confidence`] bit for bit.
+/// It depends only on the tool and the task's precisions, so it can be computed before the tool
+/// is used. Errors if the task is invalid or Π^U is not positive definite
+/// ([`Error::NotPositiveDefinite`], with the determinant; possible only with user precisions,
+/// e.g. all zero). ln|Π^U| comes from [`logdet_of`].
 pub fn control_confidence<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
     tool: &ToolN<M, N, NX, NP, NZ>,
     task: &TaskN<N>,
@@ -638,6 +649,13 @@ impl<const N: usize> ValidatedTaskN<N> {
 }
 
 /// ln|Π| of a symmetric positive definite Π, or [`Error::NotPositiveDefinite`].
+///
+/// In general 2 Σ ln L_ii of the Cholesky factor. For N = 2 it is ln(Π₀₀Π₁₁ − Π₀₁Π₁₀) instead:
+/// a symmetric 2×2 is positive definite iff Π₀₀ > 0 and its determinant > 0, so one product and
+/// one logarithm decide and give ln|Π| exactly; Cholesky would also round differently in the last
+/// bits, and the paper's numbers (tests/numbers_snapshot.rs and the figure snapshots) are pinned
+/// to every digit of this closed form. `N` is a constant, so the branch is resolved at compile
+/// time.
 #[inline]
 pub fn logdet_of<const N: usize>(pi: &SMatrix<f64, N, N>) -> Result<f64, Error> {
     if N == 2 {

@@ -1,20 +1,20 @@
-//! The active-inference controller, closed loop and episode for any [`ArmModel`], operation for
-//! operation the 2-link `src/closed_loop/{controller,system,episode}.rs`.
+//! The active-inference controller, closed loop and episode for any [`ArmModel`]: the one
+//! implementation. The 2-link `crate::closed_loop` (and `crate::confidence`) are façades over it
+//! that keep the paper's `Arm`/`Task`/`Matrix2` API and its error messages.
 
 use std::marker::PhantomData;
 
 use nalgebra::{SMatrix, SVector};
 
 use super::{control_confidence, ArmModel, TaskN, ToolN};
-use crate::closed_loop::{EpisodeOptions, Metrics};
+use crate::closed_loop::EpisodeOptions;
 use crate::integrate::{
     solve_grid_with_jacobian, uniform_grid, IntegrationError, Method, Options as IntegratorOptions,
 };
 use crate::{Error, TaskKind};
 
-/// A grid state whose magnitude passes this is a diverging simulation, not a result (as in
-/// [`crate::closed_loop::simulate`]).
-const DIVERGENCE_BOUND: f64 = 1e6;
+/// A grid state whose magnitude passes this is a diverging simulation, not a result.
+pub(crate) const DIVERGENCE_BOUND: f64 = 1e6;
 
 /// Compile-time check of the sizes: NX = 2N and NZ = NX + N.
 struct Dims<const N: usize, const NX: usize, const NZ: usize>;
@@ -26,17 +26,20 @@ impl<const N: usize, const NX: usize, const NZ: usize> Dims<N, NX, NZ> {
     );
 }
 
-/// The controller of one tool for one task: U̇ = −γ ∂F/∂U (the N-joint
-/// [`crate::closed_loop::ActiveInference`]).
+/// The task-based active-inference controller of one tool for one task, U̇ = −γ ∂F/∂U
+/// (eq. U_dot_deriv), with every matrix that does not change during an episode precomputed
+/// ([`crate::closed_loop::ActiveInference`] is its 2-link façade).
 #[derive(Debug, Clone, Copy)]
 pub struct ActiveInferenceN<const N: usize> {
     pub task: TaskN<N>,
-    /// Learning rate γ.
+    /// Learning rate γ of the gradient descent (eq. AIC_gradient_des).
     pub learning_rate: f64,
+    /// Sᵀ P for each term (zero for terms the task does not use), so that
+    /// ∂F/∂U = K_θ(θ − θ^g) + K_θ̇(θ̇ − θ̇^g) + K_θ̈(θ̈ − θ̈^g) + P^U U.
     gain_theta: SMatrix<f64, N, N>,
     gain_theta_dot: SMatrix<f64, N, N>,
     gain_theta_ddot: SMatrix<f64, N, N>,
-    /// ln|Π^U|.
+    /// ln|Π^U|, constant for the tool and task (eq. control_conf).
     pub logdet: f64,
 }
 
@@ -71,7 +74,7 @@ impl<const N: usize> ActiveInferenceN<N> {
         })
     }
 
-    /// U̇ = −γ ∂F/∂U.
+    /// U̇ = −γ ∂F/∂U (eq. U_dot_deriv) from the observed θ, θ̇, θ̈ and the current U (η^U = 0).
     #[inline]
     pub fn control_rate(
         &self,
@@ -88,7 +91,7 @@ impl<const N: usize> ActiveInferenceN<N> {
         -self.learning_rate * gradient
     }
 
-    /// γ·(K_θ, K_θ̇, K_θ̈, P^U).
+    /// The gains γ·(K_θ, K_θ̇, K_θ̈) and γ·P^U of U̇ = −γ ∂F/∂U, for the closed-loop Jacobian.
     pub fn scaled_gains(&self) -> [SMatrix<f64, N, N>; 4] {
         let g = self.learning_rate;
         [
@@ -99,7 +102,8 @@ impl<const N: usize> ActiveInferenceN<N> {
         ]
     }
 
-    /// J = ½[Σ eᵀPe + UᵀP^U U] over the task's terms.
+    /// The performance and control-cost part of F, ½[Σ eᵀPe + UᵀP^U U] over the task's terms:
+    /// the optimal-control cost J of the paper (F without the confidence term).
     #[inline]
     pub fn cost_j(
         &self,
@@ -121,7 +125,7 @@ impl<const N: usize> ActiveInferenceN<N> {
         0.5 * sum
     }
 
-    /// F = J − ½ ln|Π^U|.
+    /// F = J − ½ ln|Π^U| (eq. free_energy).
     #[inline]
     pub fn free_energy(
         &self,
@@ -133,7 +137,8 @@ impl<const N: usize> ActiveInferenceN<N> {
         self.cost_j(theta, theta_dot, theta_ddot, u) - 0.5 * self.logdet
     }
 
-    /// The task's own weighted error at one instant.
+    /// The task's own weighted error at one instant, the summand of the paper's task error:
+    /// task 1 (θ−θ^g)ᵀP^θ(θ−θ^g), task 2 on θ̇, task 3 on θ̈.
     #[inline]
     pub fn task_error(
         &self,
@@ -151,9 +156,10 @@ impl<const N: usize> ActiveInferenceN<N> {
     }
 }
 
-/// Ż = [f_P(X, U + ΔT); −γ ∂F/∂U]: the controller uses model `M`, the simulated world (plant)
-/// is model `P` with the same tool parameters (`P = M` normally; `M = Arm2, P = Arm2Exact` is
-/// [`crate::closed_loop::Plant::Exact`]).
+/// Ż = [f_P(X, U + ΔT); −γ ∂F/∂U], the object the integrators see: the controller uses model
+/// `M`, the simulated world (plant) is model `P` with the same tool parameters (`P = M`
+/// normally; `M = Arm2, P = Arm2Exact` is [`crate::closed_loop::Plant::Exact`]). The plant is a
+/// type so that the right-hand side, evaluated at every integrator stage, does not branch on it.
 #[derive(Debug, Clone, Copy)]
 pub struct ClosedLoopN<P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>
 where
@@ -200,7 +206,7 @@ where
         })
     }
 
-    /// Ż and the plant's θ̈.
+    /// Ż and the plant's θ̈ (what the controller observes).
     #[inline]
     pub fn rhs_and_acceleration(
         &self,
@@ -227,7 +233,9 @@ where
         self.rhs_and_acceleration(z).0
     }
 
-    /// ∂Ż/∂Z from the generated ∂f/∂X, ∂f/∂U and the controller's constant gains.
+    /// ∂Ż/∂Z, from the generated Jacobian of the plant (∂f/∂X, ∂f/∂U) and the controller's
+    /// constant gains: with θ̈ = f_θ̈(X, U + ΔT),
+    /// ∂U̇/∂X = −γ(K_θ[I O] + K_θ̇[O I] + K_θ̈ ∂f_θ̈/∂X) and ∂U̇/∂U = −γ(K_θ̈ ∂f_θ̈/∂U + P^U).
     #[inline]
     pub fn jacobian(&self, z: &SVector<f64, NZ>) -> SMatrix<f64, NZ, NZ> {
         let x = z.fixed_rows::<NX>(0).into_owned();
@@ -251,8 +259,8 @@ where
     }
 }
 
-/// Options of one episode for N joints (the N-joint [`EpisodeOptions`] without trajectory
-/// recording and plant choice: the plant is a type parameter of [`simulate_on`]).
+/// Options of one episode for N joints. The 2-link [`EpisodeOptions`] is these plus the plant
+/// choice, which here is a type parameter of [`simulate_on`]/[`episode_on`] instead.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EpisodeOptionsN<const N: usize, const NX: usize> {
     pub t_end: f64,
@@ -265,23 +273,35 @@ pub struct EpisodeOptionsN<const N: usize, const NX: usize> {
     pub perturbation: f64,
     pub learning_rate: f64,
     /// Integrator options; [`Method::Auto`] runs DP5 on tasks 1–2 and the DP5-to-Rodas5P
-    /// switch on task 3, as [`crate::closed_loop::simulate`] does.
+    /// switch on task 3 (why: [`EpisodeOptions::integrator`]).
     pub integrator: IntegratorOptions,
+    /// Keep the trajectory on the output grid ([`episode_on`]; [`simulate_on`] never keeps it).
+    pub record_trajectory: bool,
 }
 
 impl<const N: usize, const NX: usize> EpisodeOptionsN<N, NX> {
-    /// The paper's options for model `M`: X0 = M's equilibrium, U0 = 0.1 on every joint, the
-    /// rest [`EpisodeOptions::default`].
+    /// The paper's options ("Implementation details") for model `M`: t_end = 5 s, dt = 0.05 s,
+    /// X0 = M's equilibrium, U0 = 0.1 on every joint, ΔT = 0, γ = 1, MATLAB ode45's tolerances.
+    /// [`EpisodeOptions::default`] is this for the 2-link arm.
     pub fn paper<M, const NP: usize, const NZ: usize>() -> Self
     where
         M: ArmModel<N, NX, NP, NZ>,
     {
-        Self::from_common::<M, NP, NZ>(&EpisodeOptions::default())
+        Self {
+            t_end: 5.0,
+            dt: 0.05,
+            x0: M::equilibrium_state(),
+            u0: SVector::repeat(0.1),
+            perturbation: 0.0,
+            learning_rate: 1.0,
+            integrator: IntegratorOptions::default(),
+            record_trajectory: false,
+        }
     }
 
-    /// `common`'s horizon, grid, perturbation, learning rate and integrator, with model `M`'s
-    /// equilibrium as X0 and U0 = `common.u0[0]` on every joint (0.1 by default). `common.x0`,
-    /// `common.plant` and `common.record_trajectory` are not used.
+    /// `common`'s horizon, grid, perturbation, learning rate, integrator and recording, with
+    /// model `M`'s equilibrium as X0 and U0 = `common.u0[0]` on every joint (0.1 by default).
+    /// `common.x0` and `common.plant` are not used.
     pub fn from_common<M, const NP: usize, const NZ: usize>(common: &EpisodeOptions) -> Self
     where
         M: ArmModel<N, NX, NP, NZ>,
@@ -294,13 +314,13 @@ impl<const N: usize, const NX: usize> EpisodeOptionsN<N, NX> {
             perturbation: common.perturbation,
             learning_rate: common.learning_rate,
             integrator: common.integrator,
+            record_trajectory: common.record_trajectory,
         }
     }
 }
 
 impl From<&EpisodeOptions> for EpisodeOptionsN<2, 4> {
-    /// The 2-link options as they are (X0 and U0 included); `plant` and `record_trajectory` are
-    /// not used.
+    /// The 2-link options as they are (X0 and U0 included); `plant` is not used.
     fn from(o: &EpisodeOptions) -> Self {
         Self {
             t_end: o.t_end,
@@ -310,7 +330,65 @@ impl From<&EpisodeOptions> for EpisodeOptionsN<2, 4> {
             perturbation: o.perturbation,
             learning_rate: o.learning_rate,
             integrator: o.integrator,
+            record_trajectory: o.record_trajectory,
         }
+    }
+}
+
+/// What one episode measures.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Metrics {
+    /// Σ over all grid samples (t = 0 included) of the task's weighted error.
+    pub task_error: f64,
+    /// ∫F dt (eq. free_energy with the task's terms and −ln|Π^U|), trapezoidal on the grid.
+    pub free_energy: f64,
+    /// ∫J dt: the same without the confidence term.
+    pub cost_j: f64,
+    /// ln|Π^U|.
+    pub logdet: f64,
+    /// Right-hand-side evaluations of the closed loop.
+    pub rhs_evals: usize,
+    /// Accepted and rejected integrator steps.
+    pub steps: usize,
+    pub rejected_steps: usize,
+    /// Jacobian evaluations and LU factorisations (0 unless the stiff method ran).
+    pub jacobian_evals: usize,
+    pub factorisations: usize,
+    /// ∫|U|² dt, trapezoidal on the grid (the controller's torque, without ΔT).
+    pub control_effort: f64,
+}
+
+/// The trajectory on the output grid.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TrajectoryN<const N: usize> {
+    pub t: Vec<f64>,
+    pub theta: Vec<SVector<f64, N>>,
+    pub theta_dot: Vec<SVector<f64, N>>,
+    /// The plant's θ̈ = f(X, U + ΔT), what the controller observes.
+    pub theta_ddot: Vec<SVector<f64, N>>,
+    pub u: Vec<SVector<f64, N>>,
+}
+
+/// One episode's metrics and, if [`EpisodeOptionsN::record_trajectory`], its trajectory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EpisodeN<const N: usize> {
+    pub metrics: Metrics,
+    pub trajectory: Option<TrajectoryN<N>>,
+}
+
+/// Why an episode failed, before the tool is named: each runtime's public error names the tool
+/// its own way ([`ModelSimulationError`] as `model(m1=… …)`, the 2-link
+/// [`crate::closed_loop::SimulationError`] as `arm m1=… …`), with the same time and reason.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum EpisodeFailure {
+    Input(Error),
+    Integration(IntegrationError),
+    Diverged { t: f64, magnitude: f64 },
+}
+
+impl From<Error> for EpisodeFailure {
+    fn from(e: Error) -> Self {
+        EpisodeFailure::Input(e)
     }
 }
 
@@ -342,9 +420,24 @@ impl ModelSimulationError {
             ModelSimulationError::Diverged { t, .. } => Some(*t),
         }
     }
+
+    fn named(failure: EpisodeFailure, tool: impl FnOnce() -> String) -> Self {
+        match failure {
+            EpisodeFailure::Input(e) => ModelSimulationError::Input(e),
+            EpisodeFailure::Integration(source) => ModelSimulationError::Integration {
+                tool: tool(),
+                source,
+            },
+            EpisodeFailure::Diverged { t, magnitude } => ModelSimulationError::Diverged {
+                tool: tool(),
+                t,
+                magnitude,
+            },
+        }
+    }
 }
 
-/// One episode of `tool` on `task`, the plant being the tool's own model.
+/// The metrics of one episode of `tool` on `task`, the plant being the tool's own model.
 pub fn simulate<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
     tool: &ToolN<M, N, NX, NP, NZ>,
     task: &TaskN<N>,
@@ -356,12 +449,62 @@ where
     simulate_on::<M, M, N, NX, NP, NZ>(tool, task, options)
 }
 
-/// One episode of `tool` (controller model `M`) on `task`, simulated on plant model `P`.
+/// The metrics of one episode of `tool` (controller model `M`) on `task`, simulated on plant
+/// model `P`; the trajectory is not kept whatever `options.record_trajectory` says.
 pub fn simulate_on<M, P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
     tool: &ToolN<M, N, NX, NP, NZ>,
     task: &TaskN<N>,
     options: &EpisodeOptionsN<N, NX>,
 ) -> Result<Metrics, ModelSimulationError>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+    P: ArmModel<N, NX, NP, NZ>,
+{
+    let options = EpisodeOptionsN {
+        record_trajectory: false,
+        ..*options
+    };
+    episode_on::<M, P, N, NX, NP, NZ>(tool, task, &options).map(|e| e.metrics)
+}
+
+/// One episode of `tool` on `task` (metrics and, if asked for, the trajectory), the plant being
+/// the tool's own model.
+pub fn episode<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    tool: &ToolN<M, N, NX, NP, NZ>,
+    task: &TaskN<N>,
+    options: &EpisodeOptionsN<N, NX>,
+) -> Result<EpisodeN<N>, ModelSimulationError>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    episode_on::<M, M, N, NX, NP, NZ>(tool, task, options)
+}
+
+/// One episode of `tool` (controller model `M`) on `task`, simulated on plant model `P`.
+pub fn episode_on<M, P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    tool: &ToolN<M, N, NX, NP, NZ>,
+    task: &TaskN<N>,
+    options: &EpisodeOptionsN<N, NX>,
+) -> Result<EpisodeN<N>, ModelSimulationError>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+    P: ArmModel<N, NX, NP, NZ>,
+{
+    run_episode::<M, P, N, NX, NP, NZ>(tool, task, options)
+        .map_err(|f| ModelSimulationError::named(f, || format!("{}({tool})", M::NAME)))
+}
+
+/// The episode: the closed loop integrated on the output grid, the metrics accumulated (and the
+/// trajectory kept) at every grid point.
+///
+/// The joint state is Z = [X; U]. The plant is the nonlinear Ẋ = f_P(X, U + ΔT) with a constant
+/// torque perturbation ΔT on every joint; the controller observes θ, θ̇ and the plant's θ̈ and
+/// updates U̇ = −γ ∂F/∂U (eq. U_dot_deriv).
+pub(crate) fn run_episode<M, P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    tool: &ToolN<M, N, NX, NP, NZ>,
+    task: &TaskN<N>,
+    options: &EpisodeOptionsN<N, NX>,
+) -> Result<EpisodeN<N>, EpisodeFailure>
 where
     M: ArmModel<N, NX, NP, NZ>,
     P: ArmModel<N, NX, NP, NZ>,
@@ -379,18 +522,23 @@ where
     z0.fixed_rows_mut::<NX>(0).copy_from(&options.x0);
     z0.fixed_rows_mut::<N>(NX).copy_from(&options.u0);
 
+    let mut trajectory = options.record_trajectory.then(|| TrajectoryN {
+        t: Vec::with_capacity(grid.len()),
+        ..TrajectoryN::default()
+    });
     let mut task_error = 0.0;
     let (mut int_f, mut int_j, mut effort) = (0.0, 0.0, 0.0);
+    // (t, F, J, |U|²) at the previous grid point, for the trapezoidal rule.
     let mut previous: Option<(f64, f64, f64, f64)> = None;
     let mut divergence: Option<(f64, f64)> = None;
 
     let rhs = |_t: f64, z: &SVector<f64, NZ>| system.rhs(z);
+    // The closed loop is autonomous: ∂Ż/∂t = 0.
     let jacobian = |_t: f64, z: &SVector<f64, NZ>| (system.jacobian(z), SVector::zeros());
     let mut integrator = options.integrator;
     if integrator.method == Method::Auto && task.kind != TaskKind::Acceleration {
         integrator.method = Method::Explicit;
     }
-    let describe = || format!("{}({tool})", M::NAME);
     let stats = solve_grid_with_jacobian(rhs, jacobian, &z0, &grid, &integrator, |_, t, z| {
         let (_, theta_ddot) = system.rhs_and_acceleration(z);
         let theta = z.fixed_rows::<N>(0).into_owned();
@@ -411,18 +559,18 @@ where
             effort += 0.5 * h * (e + e_prev);
         }
         previous = Some((t, f, j, e));
+        if let Some(tr) = trajectory.as_mut() {
+            tr.t.push(t);
+            tr.theta.push(theta);
+            tr.theta_dot.push(theta_dot);
+            tr.theta_ddot.push(theta_ddot);
+            tr.u.push(u);
+        }
     })
-    .map_err(|source| ModelSimulationError::Integration {
-        tool: describe(),
-        source,
-    })?;
+    .map_err(EpisodeFailure::Integration)?;
 
     if let Some((t, magnitude)) = divergence {
-        return Err(ModelSimulationError::Diverged {
-            tool: describe(),
-            t,
-            magnitude,
-        });
+        return Err(EpisodeFailure::Diverged { t, magnitude });
     }
     let metrics = Metrics {
         task_error,
@@ -440,18 +588,18 @@ where
         .iter()
         .all(|v| v.is_finite())
     {
-        return Err(ModelSimulationError::Diverged {
-            tool: describe(),
+        return Err(EpisodeFailure::Diverged {
             t: options.t_end,
             magnitude: f64::INFINITY,
         });
     }
-    Ok(metrics)
+    Ok(EpisodeN {
+        metrics,
+        trajectory,
+    })
 }
 
-pub(crate) fn check_options<const N: usize, const NX: usize>(
-    o: &EpisodeOptionsN<N, NX>,
-) -> Result<(), Error> {
+fn check_options<const N: usize, const NX: usize>(o: &EpisodeOptionsN<N, NX>) -> Result<(), Error> {
     let positive = |name, value: f64| {
         if value.is_finite() && value > 0.0 {
             Ok(())

@@ -1,17 +1,27 @@
 //! The MPC baseline on the same nonlinear plant as the active-inference loop: the controller
 //! sees the state every control period and holds its torque (zero-order hold) while the plant
 //! Ẋ = f(X, U + ΔT) is integrated; metrics are those of the active-inference episode.
+//!
+//! [`simulate_mpc_on`] is the implementation for any [`ArmModel`]; [`simulate_mpc`] is the
+//! 2-link façade (the paper's `Arm`/`Task`, the run-time [`crate::closed_loop::Plant`], errors
+//! naming `arm m1=…`).
 
 use std::time::Duration;
 
-use super::{Mpc, MpcError, MpcOptions};
-use crate::closed_loop::{ActiveInference, EpisodeOptions, Trajectory};
+use nalgebra::SVector;
+
+use super::{MpcError, MpcN, MpcOptions};
+use crate::closed_loop::{EpisodeOptions, Plant};
 use crate::integrate::{solve_grid, IntegrationError};
-use crate::{Arm, Error, State, Task, Vector2};
+use crate::model::{
+    ActiveInferenceN, Arm2, Arm2Exact, Arm2Tool, ArmModel, EpisodeOptionsN, TaskN, ToolN,
+    TrajectoryN,
+};
+use crate::{Arm, Error, Task};
 
 /// What an MPC episode measures: the active-inference episode's metrics where they apply.
 #[derive(Debug, Clone, PartialEq)]
-pub struct MpcMetrics {
+pub struct MpcMetricsN<const N: usize> {
     /// Σ over the output grid of the task's weighted error (as for the active-inference loop).
     pub task_error: f64,
     /// ∫J dt, trapezoidal on the output grid: the cost the MPC achieves (objective J*).
@@ -33,13 +43,34 @@ pub struct MpcMetrics {
     /// `Solved`, or the first other accepted status (`AlmostSolved`).
     pub worst_status: String,
     /// The disturbance observer's final estimate d̂ [N m] (zero without the observer).
-    pub disturbance_estimate: Vector2,
+    pub disturbance_estimate: SVector<f64, N>,
 }
 
+/// The 2-link MPC metrics.
+pub type MpcMetrics = MpcMetricsN<2>;
+
 #[derive(Debug, Clone, PartialEq)]
-pub struct MpcEpisode {
-    pub metrics: MpcMetrics,
-    pub trajectory: Option<Trajectory>,
+pub struct MpcEpisodeN<const N: usize> {
+    pub metrics: MpcMetricsN<N>,
+    pub trajectory: Option<TrajectoryN<N>>,
+}
+
+/// The 2-link MPC episode.
+pub type MpcEpisode = MpcEpisodeN<2>;
+
+/// Why an MPC episode failed, before the tool is named (each public error names it its own
+/// way, with the same time and reason).
+enum MpcFailure {
+    Input(Error),
+    Setup(MpcError),
+    Controller { t: f64, source: MpcError },
+    Integration(IntegrationError),
+}
+
+impl From<Error> for MpcFailure {
+    fn from(e: Error) -> Self {
+        MpcFailure::Input(e)
+    }
 }
 
 /// Why an MPC episode failed, naming the tool and time.
@@ -55,16 +86,108 @@ pub enum MpcEpisodeError {
     Integration { arm: Arm, source: IntegrationError },
 }
 
-/// Runs the MPC baseline for one episode with the same options (horizon, grid, initial state,
-/// perturbation, integrator) as the active-inference episode. The output grid spacing must be a
-/// whole number of control periods. The paper's U0 is not used: the MPC chooses U at t = 0.
+impl MpcEpisodeError {
+    fn named(failure: MpcFailure, arm: Arm) -> Self {
+        match failure {
+            MpcFailure::Input(e) => MpcEpisodeError::Input(e),
+            MpcFailure::Setup(source) => MpcEpisodeError::Setup { arm, source },
+            MpcFailure::Controller { t, source } => MpcEpisodeError::Controller { arm, t, source },
+            MpcFailure::Integration(source) => MpcEpisodeError::Integration { arm, source },
+        }
+    }
+}
+
+/// Why an MPC episode of the generic runtime failed ([`MpcEpisodeError`] with the tool named as
+/// `model(m1=… …)`).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MpcSimulationError {
+    #[error(transparent)]
+    Input(#[from] Error),
+    #[error("MPC for {tool}: {source}")]
+    Setup { tool: String, source: MpcError },
+    #[error("MPC for {tool} failed at t = {t} s: {source}")]
+    Controller {
+        tool: String,
+        t: f64,
+        source: MpcError,
+    },
+    #[error("simulation of {tool} under MPC failed: {source}")]
+    Integration {
+        tool: String,
+        source: IntegrationError,
+    },
+}
+
+impl MpcSimulationError {
+    fn named(failure: MpcFailure, tool: impl FnOnce() -> String) -> Self {
+        match failure {
+            MpcFailure::Input(e) => MpcSimulationError::Input(e),
+            MpcFailure::Setup(source) => MpcSimulationError::Setup {
+                tool: tool(),
+                source,
+            },
+            MpcFailure::Controller { t, source } => MpcSimulationError::Controller {
+                tool: tool(),
+                t,
+                source,
+            },
+            MpcFailure::Integration(source) => MpcSimulationError::Integration {
+                tool: tool(),
+                source,
+            },
+        }
+    }
+}
+
+/// Runs the MPC baseline for one episode of the paper's 2-DOF arm, on the plant
+/// `options.plant` chooses (matched once here), with the same options (horizon, grid, initial
+/// state, perturbation, integrator) as the active-inference episode. The output grid spacing
+/// must be a whole number of control periods. The paper's U0 is not used: the MPC chooses U at
+/// t = 0.
 pub fn simulate_mpc(
     arm: &Arm,
     task: &Task,
     options: &EpisodeOptions,
     mpc_options: &MpcOptions,
 ) -> Result<MpcEpisode, MpcEpisodeError> {
-    let metrics_of = ActiveInference::new(arm, task, 1.0)?;
+    let tool = Arm2Tool::from(arm);
+    let task = TaskN::from(task);
+    let generic = EpisodeOptionsN::from(options);
+    match options.plant {
+        Plant::Paper => run::<Arm2, Arm2, 2, 4, 4, 6>(&tool, &task, &generic, mpc_options),
+        Plant::Exact => run::<Arm2, Arm2Exact, 2, 4, 4, 6>(&tool, &task, &generic, mpc_options),
+    }
+    .map_err(|failure| MpcEpisodeError::named(failure, *arm))
+}
+
+/// The MPC episode of `tool` (prediction model `M`) on `task`, simulated on plant model `P`
+/// (`P = M` normally), with the same options as the active-inference episode
+/// ([`crate::model::episode_on`]); as [`simulate_mpc`], U0 is not used.
+pub fn simulate_mpc_on<M, P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    tool: &ToolN<M, N, NX, NP, NZ>,
+    task: &TaskN<N>,
+    options: &EpisodeOptionsN<N, NX>,
+    mpc_options: &MpcOptions,
+) -> Result<MpcEpisodeN<N>, MpcSimulationError>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+    P: ArmModel<N, NX, NP, NZ>,
+{
+    run::<M, P, N, NX, NP, NZ>(tool, task, options, mpc_options)
+        .map_err(|f| MpcSimulationError::named(f, || format!("{}({tool})", M::NAME)))
+}
+
+fn run<M, P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    tool: &ToolN<M, N, NX, NP, NZ>,
+    task: &TaskN<N>,
+    options: &EpisodeOptionsN<N, NX>,
+    mpc_options: &MpcOptions,
+) -> Result<MpcEpisodeN<N>, MpcFailure>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+    P: ArmModel<N, NX, NP, NZ>,
+{
+    let metrics_of = ActiveInferenceN::new(tool, task, 1.0)?;
     let period = mpc_options.period;
     let steps = whole_ratio(options.t_end, period).ok_or(Error::InvalidOption {
         name: "end time t_end (not a whole number of MPC periods)",
@@ -81,23 +204,21 @@ pub fn simulate_mpc(
         }
         .into());
     }
-    let mut mpc = Mpc::new(arm, task, mpc_options)
-        .map_err(|source| MpcEpisodeError::Setup { arm: *arm, source })?;
-    let params = arm.params();
-    let perturbation = Vector2::repeat(options.perturbation);
+    let mut mpc = MpcN::new(tool, task, mpc_options).map_err(MpcFailure::Setup)?;
+    let params = tool.params();
+    let perturbation = SVector::<f64, N>::repeat(options.perturbation);
     let logdet = metrics_of.logdet;
 
     let mut solve_times = Vec::with_capacity(steps + 1);
     let mut qp_iterations = 0u64;
     let mut worst_status = String::from("Solved");
-    let mut control = |mpc: &mut Mpc, x: &State, t: f64| -> Result<Vector2, MpcEpisodeError> {
+    let mut control = |mpc: &mut MpcN<M, N, NX, NP, NZ>,
+                       x: &SVector<f64, NX>,
+                       t: f64|
+     -> Result<SVector<f64, N>, MpcFailure> {
         let u = mpc
             .control(x)
-            .map_err(|source| MpcEpisodeError::Controller {
-                arm: *arm,
-                t,
-                source,
-            })?;
+            .map_err(|source| MpcFailure::Controller { t, source })?;
         let info = mpc.last_solve();
         solve_times.push(info.solve_time);
         qp_iterations += u64::from(info.iterations);
@@ -107,17 +228,15 @@ pub fn simulate_mpc(
         Ok(u)
     };
 
-    let mut trajectory = options.record_trajectory.then(Trajectory::default);
+    let mut trajectory = options.record_trajectory.then(TrajectoryN::default);
     let (mut task_error, mut int_j, mut effort) = (0.0, 0.0, 0.0);
     let mut previous: Option<(f64, f64, f64)> = None;
-    let mut sample = |t: f64, x: &State, u: &Vector2| {
-        let theta_ddot = options
-            .plant
-            .dynamics(x, &(u + perturbation), &params)
-            .fixed_rows::<2>(2)
+    let mut sample = |t: f64, x: &SVector<f64, NX>, u: &SVector<f64, N>| {
+        let theta_ddot = P::dynamics(x, &(u + perturbation), &params)
+            .fixed_rows::<N>(N)
             .into_owned();
-        let theta = x.fixed_rows::<2>(0).into_owned();
-        let theta_dot = x.fixed_rows::<2>(2).into_owned();
+        let theta = x.fixed_rows::<N>(0).into_owned();
+        let theta_dot = x.fixed_rows::<N>(N).into_owned();
         task_error += metrics_of.task_error(&theta, &theta_dot, &theta_ddot);
         let j = metrics_of.cost_j(&theta, &theta_dot, &theta_ddot, u);
         let e = u.norm_squared();
@@ -144,7 +263,7 @@ pub fn simulate_mpc(
         let held = u + perturbation;
         let mut next = x;
         let stats = solve_grid(
-            |_, x: &State| options.plant.dynamics(x, &held, &params),
+            |_, x: &SVector<f64, NX>| P::dynamics(x, &held, &params),
             &x,
             &[t0, t1],
             &options.integrator,
@@ -154,7 +273,7 @@ pub fn simulate_mpc(
                 }
             },
         )
-        .map_err(|source| MpcEpisodeError::Integration { arm: *arm, source })?;
+        .map_err(MpcFailure::Integration)?;
         rhs_evals += stats.rhs_evals;
         x = next;
         u = control(&mut mpc, &x, t1)?;
@@ -164,7 +283,7 @@ pub fn simulate_mpc(
     }
 
     solve_times.sort_unstable();
-    let metrics = MpcMetrics {
+    let metrics = MpcMetricsN {
         task_error,
         cost_j: int_j,
         free_energy: int_j - 0.5 * options.t_end * logdet,
@@ -178,7 +297,7 @@ pub fn simulate_mpc(
         worst_status,
         disturbance_estimate: mpc.disturbance_estimate(),
     };
-    Ok(MpcEpisode {
+    Ok(MpcEpisodeN {
         metrics,
         trajectory,
     })

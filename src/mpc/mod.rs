@@ -1,6 +1,12 @@
 //! MPC baseline: the paper's cost J (no confidence term) minimised over a receding horizon on
 //! a linear(ised) arm model, solved as a sparse QP with Clarabel.
 //!
+//! The controller ([`MpcN`]) and its episode ([`simulate_mpc_on`]) are generic over the arm
+//! model ([`crate::model::ArmModel`]), like the active-inference runtime; [`Mpc`] and
+//! [`simulate_mpc`] are the 2-link façade (the paper's `Arm`, `Task` and run-time `Plant`).
+//! The sizes quoted below (6×6 stage blocks, four x_0 rows, the 7×7 exponential) are the 2-link
+//! arm's; for an arm with n joints (state 2n) they are 3n×3n, 2n and 3n + 1.
+//!
 //! # Models ([`MpcModel`])
 //!
 //! - [`MpcModel::Equilibrium`], the specification: the paper's linearisation
@@ -53,7 +59,7 @@
 //! reduced Hessian in u (B₃₄ᵀP^θ̈B₃₄) definite, so the optimum is unique and Clarabel solves it.
 //!
 //! Constraints: the dynamics as equalities (Clarabel's zero cone) and, if the torque limit is
-//! finite, |u_k,j| ≤ L as 4N rows in the non-negative cone.
+//! finite, |u_k,j| ≤ L as 4N rows (2nN for n joints) in the non-negative cone.
 //!
 //! # One solver, updated in place
 //!
@@ -77,7 +83,7 @@
 //! Clarabel runs with default tolerances otherwise. Each solve starts from Clarabel's default
 //! point, so the original linear MPC's answer depends only on the state; with the local model
 //! or the observer it also depends on the previous call (state, control, d̂) until
-//! [`Mpc::reset`]. Without the torque bound the QP has only equalities and Clarabel solves it
+//! [`MpcN::reset`]. Without the torque bound the QP has only equalities and Clarabel solves it
 //! in one KKT solve (0 iterations).
 //!
 //! Speed: Clarabel's solver is generic, so it is compiled into this crate at this crate's
@@ -157,17 +163,25 @@ mod episode;
 mod lqr;
 mod qp;
 
+use std::marker::PhantomData;
+use std::ops::{Deref, DerefMut};
 use std::time::{Duration, Instant};
 
 use clarabel::solver::SolverStatus;
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 
 pub use discretise::{discretise, Discretised};
-pub use episode::{simulate_mpc, MpcEpisode, MpcEpisodeError, MpcMetrics};
+pub use episode::{
+    simulate_mpc, simulate_mpc_on, MpcEpisode, MpcEpisodeError, MpcEpisodeN, MpcMetrics,
+    MpcMetricsN, MpcSimulationError,
+};
 use qp::{QpSolver, StageCost};
 
-use crate::generated::arm2;
-use crate::{Arm, InputMatrix, State, StateMatrix, Task, Vector2};
+use crate::model::{Arm2, Arm2Tool, ArmModel, TaskN, ToolN};
+use crate::{Arm, Task};
+// The 2-link names the unit tests below use (through `use super::*`).
+#[cfg(test)]
+use crate::{generated::arm2, State, Vector2};
 
 /// The linear model the QP plans with.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -277,7 +291,8 @@ pub enum MpcError {
     /// The task or the QP could not be set up.
     #[error("MPC setup failed: {reason}")]
     Setup { reason: String },
-    /// The solver did not return a solution at the `step`-th call (0-based) of [`Mpc::control`].
+    /// The solver did not return a solution at the `step`-th call (0-based) of
+    /// [`MpcN::control`].
     #[error("MPC solve failed at control step {step}: {status}")]
     Solve { status: String, step: usize },
 }
@@ -297,52 +312,62 @@ pub struct SolveInfo {
 
 /// A continuous affine model ẋ = a x + b u + c.
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct Affine {
-    a: StateMatrix,
-    b: InputMatrix,
-    c: State,
+struct Affine<const N: usize, const NX: usize> {
+    a: SMatrix<f64, NX, NX>,
+    b: SMatrix<f64, NX, N>,
+    c: SVector<f64, NX>,
 }
 
-/// A receding-horizon controller for one (arm, task, options); see the module docs.
+/// A receding-horizon controller for one (tool, task, options) of any [`ArmModel`]; see the
+/// module docs. [`Mpc`] is the 2-link one.
 ///
 /// With [`MpcModel::Local`] or the disturbance observer the controller has memory (the last
 /// state and control, the estimate d̂): a call's answer depends on the calls before it, until
-/// [`Mpc::reset`].
-pub struct Mpc {
-    qp: QpSolver,
+/// [`MpcN::reset`].
+pub struct MpcN<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> {
+    qp: QpSolver<N, NX, NZ>,
     horizon: usize,
     options: MpcOptions,
-    task: Task,
-    params: SVector<f64, 4>,
+    task: TaskN<N>,
+    params: SVector<f64, NP>,
     /// The continuous model of the current plan, without the disturbance estimate.
-    model: Affine,
+    model: Affine<N, NX>,
     /// Its zero-order-hold discretisation (also without the estimate).
-    discrete: Discretised<4, 2>,
+    discrete: Discretised<NX, N>,
     /// d̂, the estimated constant input disturbance [N m].
-    estimate: Vector2,
+    estimate: SVector<f64, N>,
     /// The state measured and the control returned at the last successful call.
-    previous: Option<(State, Vector2)>,
-    plan: Vec<Vector2>,
+    previous: Option<(SVector<f64, NX>, SVector<f64, N>)>,
+    plan: Vec<SVector<f64, N>>,
     calls: usize,
     info: SolveInfo,
+    /// The prediction model's equations.
+    arm_model: PhantomData<M>,
 }
 
-impl Mpc {
-    /// Discretises the arm's model at the equilibrium, builds the QP and sets up Clarabel once.
+impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> MpcN<M, N, NX, NP, NZ>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    /// Discretises the tool's model at the equilibrium, builds the QP and sets up Clarabel once.
     /// (With [`MpcModel::Local`], the first call re-linearises at its state.)
-    pub fn new(arm: &Arm, task: &Task, options: &MpcOptions) -> Result<Self, MpcError> {
+    pub fn new(
+        tool: &ToolN<M, N, NX, NP, NZ>,
+        task: &TaskN<N>,
+        options: &MpcOptions,
+    ) -> Result<Self, MpcError> {
         let horizon = options.horizon_steps()?;
         task.validate().map_err(|e| MpcError::Setup {
             reason: e.to_string(),
         })?;
         let (a, b, xe) = (
-            arm.state_matrix(),
-            arm.input_matrix(),
-            Arm::equilibrium_state(),
+            tool.state_matrix(),
+            tool.input_matrix(),
+            M::equilibrium_state(),
         );
         let model = Affine { a, b, c: -a * xe };
         let discrete = discretise(&a, &b, &model.c, options.period);
-        let cost = StageCost::new(&a, &b, &model.c, task, options.period);
+        let cost = StageCost::of(&a, &b, &model.c, task, options.period);
         let qp = QpSolver::new(&discrete, &cost, horizon, options.torque_limit)
             .map_err(|reason| MpcError::Setup { reason })?;
         let info = SolveInfo {
@@ -355,24 +380,25 @@ impl Mpc {
             horizon,
             options: *options,
             task: *task,
-            params: arm.params(),
+            params: tool.params(),
             model,
             discrete,
-            estimate: Vector2::zeros(),
+            estimate: SVector::zeros(),
             previous: None,
             plan: Vec::with_capacity(horizon),
             calls: 0,
             info,
+            arm_model: PhantomData,
         })
     }
 
-    /// Solves the QP from the measured state x = [θ1 θ2 θ̇1 θ̇2] and returns the first control
-    /// move u_0, which the caller is expected to apply (zero-order hold) until the next call:
-    /// the observer and the local model use it. `AlmostSolved` (Clarabel's reduced-accuracy
-    /// solution) is accepted and visible in [`Mpc::last_solve`]; any other non-`Solved` status
+    /// Solves the QP from the measured state x = [θ; θ̇] and returns the first control move
+    /// u_0, which the caller is expected to apply (zero-order hold) until the next call: the
+    /// observer and the local model use it. `AlmostSolved` (Clarabel's reduced-accuracy
+    /// solution) is accepted and visible in [`MpcN::last_solve`]; any other non-`Solved` status
     /// is an error, clears the plan and forgets the last control (the next call then neither
     /// updates d̂ nor knows the torque to linearise at, and uses d̂ alone).
-    pub fn control(&mut self, x: &State) -> Result<Vector2, MpcError> {
+    pub fn control(&mut self, x: &SVector<f64, NX>) -> Result<SVector<f64, N>, MpcError> {
         let step = self.calls;
         self.calls += 1;
         self.plan.clear();
@@ -391,7 +417,7 @@ impl Mpc {
         }
         let relinearise = self.options.model == MpcModel::Local;
         if relinearise {
-            let u_applied = previous.map_or(Vector2::zeros(), |(_, u)| u) + self.estimate;
+            let u_applied = previous.map_or(SVector::zeros(), |(_, u)| u) + self.estimate;
             self.linearise(x, &u_applied);
         }
         if relinearise || self.options.disturbance_observer {
@@ -424,7 +450,12 @@ impl Mpc {
 
     /// The disturbance observer: e = x − (Ad x_prev + Bd (u_prev + d̂) + cd) with last step's
     /// model, d̂ ← d̂ + L (BdᵀBd)⁻¹Bdᵀ e.
-    fn observe(&mut self, x_prev: &State, u_prev: &Vector2, x: &State) {
+    fn observe(
+        &mut self,
+        x_prev: &SVector<f64, NX>,
+        u_prev: &SVector<f64, N>,
+        x: &SVector<f64, NX>,
+    ) {
         let d = &self.discrete;
         let error = x - (d.ad * x_prev + d.bd * (u_prev + self.estimate) + d.cd);
         if let Some(gram) = (d.bd.transpose() * d.bd).cholesky() {
@@ -436,9 +467,9 @@ impl Mpc {
     }
 
     /// A = ∂f/∂X, B = ∂f/∂U at (x, u), c = f(x, u) − A x − B u, and its ZOH discretisation.
-    fn linearise(&mut self, x: &State, u: &Vector2) {
-        let (a, b) = arm2::dynamics_jacobian(x, u, &self.params);
-        let c = arm2::dynamics(x, u, &self.params) - a * x - b * u;
+    fn linearise(&mut self, x: &SVector<f64, NX>, u: &SVector<f64, N>) {
+        let (a, b) = M::dynamics_jacobian(x, u, &self.params);
+        let c = M::dynamics(x, u, &self.params) - a * x - b * u;
         self.model = Affine { a, b, c };
         self.discrete = discretise(&a, &b, &c, self.options.period);
     }
@@ -448,7 +479,7 @@ impl Mpc {
     /// `matrices`, q and b always.
     fn write_model(&mut self, matrices: bool) -> Result<(), String> {
         let Affine { a, b, c } = self.model;
-        let cost = StageCost::new(
+        let cost = StageCost::of(
             &a,
             &b,
             &(c + b * self.estimate),
@@ -466,12 +497,12 @@ impl Mpc {
     /// call counter that errors report keeps counting).
     pub fn reset(&mut self) {
         self.previous = None;
-        self.estimate = Vector2::zeros();
+        self.estimate = SVector::zeros();
     }
 
     /// d̂, the current estimate of the constant input disturbance [N m] (zero without the
     /// observer).
-    pub fn disturbance_estimate(&self) -> Vector2 {
+    pub fn disturbance_estimate(&self) -> SVector<f64, N> {
         self.estimate
     }
 
@@ -486,8 +517,36 @@ impl Mpc {
 
     /// The optimal open-loop controls u_0..u_{N−1} of the last successful solve (empty after a
     /// failed one or before the first).
-    pub fn last_plan(&self) -> &[Vector2] {
+    pub fn last_plan(&self) -> &[SVector<f64, N>] {
         &self.plan
+    }
+}
+
+/// The MPC of the paper's 2-DOF arm: [`MpcN`] with [`Arm2`], built from an [`Arm`] and a
+/// [`Task`]. A newtype only so that [`Mpc::new`] keeps its 2-link signature; `control`,
+/// `reset`, `disturbance_estimate`, `last_solve`, `horizon_steps` and `last_plan` are
+/// [`MpcN`]'s, through `Deref`/`DerefMut`.
+pub struct Mpc(MpcN<Arm2, 2, 4, 4, 6>);
+
+impl Mpc {
+    /// Discretises the arm's model at the equilibrium, builds the QP and sets up Clarabel once.
+    /// (With [`MpcModel::Local`], the first call re-linearises at its state.)
+    pub fn new(arm: &Arm, task: &Task, options: &MpcOptions) -> Result<Self, MpcError> {
+        MpcN::new(&Arm2Tool::from(arm), &TaskN::from(task), options).map(Self)
+    }
+}
+
+impl Deref for Mpc {
+    type Target = MpcN<Arm2, 2, 4, 4, 6>;
+
+    fn deref(&self) -> &Self::Target {
+        &self.0
+    }
+}
+
+impl DerefMut for Mpc {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut self.0
     }
 }
 

@@ -1,7 +1,8 @@
-//! The MPC quadratic programme in Clarabel's form, min ½zᵀPz + qᵀz s.t. Az + s = b, s ∈ K.
+//! The MPC quadratic programme in Clarabel's form, min ½zᵀPz + qᵀz s.t. Az + s = b, s ∈ K,
+//! for any arm with N joints and state dimension NX = 2N (NZ = NX + N entries per stage).
 //!
 //! The sparsity pattern of P and A is fixed when the solver is built: every entry a model
-//! could ever fill (the whole 6×6 upper triangle of each stage's Hessian, the whole Ad and Bd
+//! could ever fill (the whole NZ×NZ upper triangle of each stage's Hessian, the whole Ad and Bd
 //! blocks) is stored, even when its value is 0, so that a new model only overwrites values
 //! ([`QpSolver::update`]) and never needs a new factorisation pattern.
 
@@ -15,56 +16,65 @@ use clarabel::solver::{
 use nalgebra::{SMatrix, SVector};
 
 use super::discretise::Discretised;
-use crate::{InputMatrix, State, StateMatrix, Task, Vector2};
+use crate::model::TaskN;
+// The 2-link names the unit tests below use (through `use super::*`).
+#[cfg(test)]
+use crate::{State, Task, Vector2};
 
 /// The paper's J per stage, times the period, as a quadratic in w = [x; u]:
 /// ½wᵀ hessian w + linearᵀw (+ a constant that does not move the optimum).
 ///
 /// The terminal cost keeps the state-only terms (θ and θ̇); θ̈ needs a control, and there is
-/// no u_N.
+/// no u_N. The defaults are the 2-link sizes.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct StageCost {
-    pub hessian: SMatrix<f64, 6, 6>,
-    pub linear: SVector<f64, 6>,
-    pub terminal_hessian: SMatrix<f64, 4, 4>,
-    pub terminal_linear: SVector<f64, 4>,
+pub(crate) struct StageCost<const N: usize = 2, const NX: usize = 4, const NZ: usize = 6> {
+    pub hessian: SMatrix<f64, NZ, NZ>,
+    pub linear: SVector<f64, NZ>,
+    pub terminal_hessian: SMatrix<f64, NX, NX>,
+    pub terminal_linear: SVector<f64, NX>,
 }
 
-impl StageCost {
-    /// For the affine model ẋ = a x + b u + c, θ̈ = a₃₄x + b₃₄u + c₃₄ (rows 3–4), so every term
-    /// of J is a residual M w − r with M = [C D] and the cost is
+impl<const N: usize, const NX: usize, const NZ: usize> StageCost<N, NX, NZ> {
+    /// For the affine model ẋ = a x + b u + c, θ̈ = a_θ̈ x + b_θ̈ u + c_θ̈ (the last N rows), so
+    /// every term of J is a residual M w − r with M = [C D] and the cost is
     /// ½ T (Mw − r)ᵀW(Mw − r) + ½ T uᵀPᵁu. The paper's linearisation at X^e is c = −A X^e.
-    pub fn new(a: &StateMatrix, b: &InputMatrix, c: &State, task: &Task, period: f64) -> Self {
-        let mut m = SMatrix::<f64, 6, 6>::zeros();
-        m.fixed_view_mut::<4, 4>(0, 0).fill_with_identity();
-        m.fixed_view_mut::<2, 4>(4, 0)
-            .copy_from(&a.fixed_view::<2, 4>(2, 0));
-        m.fixed_view_mut::<2, 2>(4, 4)
-            .copy_from(&b.fixed_view::<2, 2>(2, 0));
-        let mut r = SVector::<f64, 6>::zeros();
-        r.fixed_rows_mut::<2>(0).copy_from(&task.goal_theta);
-        r.fixed_rows_mut::<2>(2).copy_from(&task.goal_theta_dot);
-        r.fixed_rows_mut::<2>(4)
-            .copy_from(&(task.goal_theta_ddot - c.fixed_rows::<2>(2)));
-        let mut w = SMatrix::<f64, 6, 6>::zeros();
-        w.fixed_view_mut::<2, 2>(0, 0)
+    pub fn of(
+        a: &SMatrix<f64, NX, NX>,
+        b: &SMatrix<f64, NX, N>,
+        c: &SVector<f64, NX>,
+        task: &TaskN<N>,
+        period: f64,
+    ) -> Self {
+        let mut m = SMatrix::<f64, NZ, NZ>::zeros();
+        m.fixed_view_mut::<NX, NX>(0, 0).fill_with_identity();
+        m.fixed_view_mut::<N, NX>(NX, 0)
+            .copy_from(&a.fixed_view::<N, NX>(N, 0));
+        m.fixed_view_mut::<N, N>(NX, NX)
+            .copy_from(&b.fixed_view::<N, N>(N, 0));
+        let mut r = SVector::<f64, NZ>::zeros();
+        r.fixed_rows_mut::<N>(0).copy_from(&task.goal_theta);
+        r.fixed_rows_mut::<N>(N).copy_from(&task.goal_theta_dot);
+        r.fixed_rows_mut::<N>(NX)
+            .copy_from(&(task.goal_theta_ddot - c.fixed_rows::<N>(N)));
+        let mut w = SMatrix::<f64, NZ, NZ>::zeros();
+        w.fixed_view_mut::<N, N>(0, 0)
             .copy_from(&task.precision_theta);
-        w.fixed_view_mut::<2, 2>(2, 2)
+        w.fixed_view_mut::<N, N>(N, N)
             .copy_from(&task.precision_theta_dot);
-        w.fixed_view_mut::<2, 2>(4, 4)
+        w.fixed_view_mut::<N, N>(NX, NX)
             .copy_from(&task.precision_theta_ddot);
 
         let mut hessian = m.transpose() * w * m;
-        let mut uu = hessian.fixed_view_mut::<2, 2>(4, 4);
+        let mut uu = hessian.fixed_view_mut::<N, N>(NX, NX);
         uu += task.precision_u;
         // Clarabel reads only the upper triangle, the Riccati reference the whole matrix:
         // make them the same matrix.
         let hessian = (hessian + hessian.transpose()) * (0.5 * period);
         let linear = -(m.transpose() * w * r) * period;
 
-        let terminal_weight = w.fixed_view::<4, 4>(0, 0).into_owned();
+        let terminal_weight = w.fixed_view::<NX, NX>(0, 0).into_owned();
         let terminal_hessian = terminal_weight * period;
-        let terminal_linear = -(terminal_weight * r.fixed_rows::<4>(0)) * period;
+        let terminal_linear = -(terminal_weight * r.fixed_rows::<NX>(0)) * period;
         Self {
             hessian,
             linear,
@@ -74,62 +84,84 @@ impl StageCost {
     }
 }
 
-/// Where x_k and u_k sit in z = (x_0, …, x_N, u_0, …, u_{N−1}).
+#[cfg(test)]
+impl StageCost {
+    /// [`StageCost::of`] for the 2-link arm and its [`Task`].
+    pub fn new(
+        a: &crate::StateMatrix,
+        b: &crate::InputMatrix,
+        c: &State,
+        task: &Task,
+        period: f64,
+    ) -> Self {
+        Self::of(a, b, c, &TaskN::from(task), period)
+    }
+}
+
+/// Where x_k and u_k sit in z = (x_0, …, x_N, u_0, …, u_{N−1}), for states of `nx` and
+/// controls of `nu` entries.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Layout {
     pub horizon: usize,
+    nx: usize,
+    nu: usize,
 }
 
 impl Layout {
     pub fn x(self, k: usize) -> usize {
-        4 * k
+        self.nx * k
     }
     pub fn u(self, k: usize) -> usize {
-        4 * (self.horizon + 1) + 2 * k
+        self.nx * (self.horizon + 1) + self.nu * k
     }
     pub fn variables(self) -> usize {
-        6 * self.horizon + 4
+        (self.nx + self.nu) * self.horizon + self.nx
     }
     /// Position in z of entry i of w_k = [x_k; u_k].
     fn w(self, k: usize, i: usize) -> usize {
-        if i < 4 {
+        if i < self.nx {
             self.x(k) + i
         } else {
-            self.u(k) + i - 4
+            self.u(k) + i - self.nx
         }
     }
     /// First row of the dynamics x_{k+1} − Ad x_k − Bd u_k = cd in A and b.
-    fn dynamics_row(k: usize) -> usize {
-        4 * (k + 1)
+    fn dynamics_row(self, k: usize) -> usize {
+        self.nx * (k + 1)
     }
 }
 
-/// The (i, j), i ≤ j, of a stage Hessian's upper triangle, in the order values are written.
-/// Since every u index in z exceeds every x index, i ≤ j is also the upper triangle of P.
-fn stage_upper() -> impl Iterator<Item = (usize, usize)> {
-    (0..6).flat_map(|i| (i..6).map(move |j| (i, j)))
+/// The (i, j), i ≤ j, of a stage Hessian's upper triangle (NZ×NZ), in the order values are
+/// written. Since every u index in z exceeds every x index, i ≤ j is also the upper triangle
+/// of P.
+fn stage_upper<const NZ: usize>() -> impl Iterator<Item = (usize, usize)> {
+    (0..NZ).flat_map(|i| (i..NZ).map(move |j| (i, j)))
 }
 
 /// The (row, column) of the model in a dynamics block, relative to (dynamics_row(k), ·): the
-/// 4×4 −Ad on x_k then the 4×2 −Bd on u_k, in the order values are written.
-fn dynamics_entries() -> impl Iterator<Item = (usize, usize)> {
-    (0..4)
-        .flat_map(|i| (0..4).map(move |j| (i, j)))
-        .chain((0..4).flat_map(|i| (4..6).map(move |j| (i, j))))
+/// NX×NX −Ad on x_k then the NX×N −Bd on u_k, in the order values are written.
+fn dynamics_entries<const N: usize, const NX: usize>() -> impl Iterator<Item = (usize, usize)> {
+    (0..NX)
+        .flat_map(|i| (0..NX).map(move |j| (i, j)))
+        .chain((0..NX).flat_map(|i| (NX..NX + N).map(move |j| (i, j))))
 }
 
 /// The values matching [`stage_upper`].
-fn stage_values(cost: &StageCost) -> impl Iterator<Item = f64> + '_ {
-    stage_upper().map(|(i, j)| cost.hessian[(i, j)])
+fn stage_values<const N: usize, const NX: usize, const NZ: usize>(
+    cost: &StageCost<N, NX, NZ>,
+) -> impl Iterator<Item = f64> + '_ {
+    stage_upper::<NZ>().map(|(i, j)| cost.hessian[(i, j)])
 }
 
 /// The values matching [`dynamics_entries`].
-fn dynamics_values(model: &Discretised<4, 2>) -> impl Iterator<Item = f64> + '_ {
-    dynamics_entries().map(|(i, j)| {
-        if j < 4 {
+fn dynamics_values<const N: usize, const NX: usize>(
+    model: &Discretised<NX, N>,
+) -> impl Iterator<Item = f64> + '_ {
+    dynamics_entries::<N, NX>().map(|(i, j)| {
+        if j < NX {
             -model.ad[(i, j)]
         } else {
-            -model.bd[(i, j - 4)]
+            -model.bd[(i, j - NX)]
         }
     })
 }
@@ -175,9 +207,10 @@ pub(crate) fn default_settings() -> DefaultSettings<f64> {
         .expect("valid Clarabel settings")
 }
 
-/// A Clarabel solver holding the whole QP. Between solves b[0..4] (= x_0) changes, and
+/// A Clarabel solver holding the whole QP. Between solves b[0..NX] (= x_0) changes, and
 /// [`QpSolver::update`] can overwrite the model-dependent values of P, q, A and b in place.
-pub(crate) struct QpSolver {
+/// The defaults are the 2-link sizes.
+pub(crate) struct QpSolver<const N: usize = 2, const NX: usize = 4, const NZ: usize = 6> {
     solver: DefaultSolver<f64>,
     layout: Layout,
     /// Positions in P's non-zero values of each stage's [`stage_upper`] entries, stage by stage.
@@ -192,10 +225,10 @@ pub(crate) struct QpSolver {
     values: Vec<f64>,
 }
 
-impl QpSolver {
+impl<const N: usize, const NX: usize, const NZ: usize> QpSolver<N, NX, NZ> {
     pub fn new(
-        model: &Discretised<4, 2>,
-        cost: &StageCost,
+        model: &Discretised<NX, N>,
+        cost: &StageCost<N, NX, NZ>,
         horizon: usize,
         torque_limit: f64,
     ) -> Result<Self, String> {
@@ -203,24 +236,28 @@ impl QpSolver {
     }
 
     pub fn with_settings(
-        model: &Discretised<4, 2>,
-        cost: &StageCost,
+        model: &Discretised<NX, N>,
+        cost: &StageCost<N, NX, NZ>,
         horizon: usize,
         torque_limit: f64,
         settings: DefaultSettings<f64>,
     ) -> Result<Self, String> {
-        let layout = Layout { horizon };
+        let layout = Layout {
+            horizon,
+            nx: NX,
+            nu: N,
+        };
         let n = layout.variables();
 
         let mut p = Triplets::default();
         for k in 0..horizon {
-            for ((i, j), value) in zip(stage_upper(), stage_values(cost)) {
+            for ((i, j), value) in zip(stage_upper::<NZ>(), stage_values(cost)) {
                 p.push(layout.w(k, i), layout.w(k, j), value);
             }
         }
         let terminal = layout.x(horizon);
-        for i in 0..4 {
-            for j in i..4 {
+        for i in 0..NX {
+            for j in i..NX {
                 p.push(terminal + i, terminal + j, cost.terminal_hessian[(i, j)]);
             }
         }
@@ -228,17 +265,17 @@ impl QpSolver {
         // Equalities: x_0 = measured state (b filled in by `solve`), then the dynamics
         // x_{k+1} − Ad x_k − Bd u_k = cd.
         let mut a = Triplets::default();
-        let mut b = vec![0.0; 4 * (horizon + 1)];
-        for i in 0..4 {
+        let mut b = vec![0.0; NX * (horizon + 1)];
+        for i in 0..NX {
             a.push(i, layout.x(0) + i, 1.0);
         }
         for k in 0..horizon {
-            let row = Layout::dynamics_row(k);
-            for i in 0..4 {
+            let row = layout.dynamics_row(k);
+            for i in 0..NX {
                 a.push(row + i, layout.x(k + 1) + i, 1.0);
                 b[row + i] = model.cd[i];
             }
-            for ((i, j), value) in zip(dynamics_entries(), dynamics_values(model)) {
+            for ((i, j), value) in zip(dynamics_entries::<N, NX>(), dynamics_values(model)) {
                 a.push(row + i, layout.w(k, j), value);
             }
         }
@@ -248,29 +285,30 @@ impl QpSolver {
         if torque_limit.is_finite() {
             let first = b.len();
             for k in 0..horizon {
-                for j in 0..2 {
-                    a.push(first + 4 * k + j, layout.u(k) + j, 1.0);
-                    a.push(first + 4 * k + 2 + j, layout.u(k) + j, -1.0);
+                for j in 0..N {
+                    a.push(first + 2 * N * k + j, layout.u(k) + j, 1.0);
+                    a.push(first + 2 * N * k + N + j, layout.u(k) + j, -1.0);
                 }
             }
-            b.resize(first + 4 * horizon, torque_limit);
-            cones.push(NonnegativeConeT(4 * horizon));
+            b.resize(first + 2 * N * horizon, torque_limit);
+            cones.push(NonnegativeConeT(2 * N * horizon));
         }
 
         let p = p.into_csc(n, n);
         let a = a.into_csc(b.len(), n);
         let p_index = (0..horizon)
-            .flat_map(|k| stage_upper().map(move |(i, j)| (layout.w(k, i), layout.w(k, j))))
+            .flat_map(|k| stage_upper::<NZ>().map(move |(i, j)| (layout.w(k, i), layout.w(k, j))))
             .map(|(row, col)| nz_index(&p, row, col))
             .collect();
         let a_index = (0..horizon)
             .flat_map(|k| {
-                dynamics_entries().map(move |(i, j)| (Layout::dynamics_row(k) + i, layout.w(k, j)))
+                dynamics_entries::<N, NX>()
+                    .map(move |(i, j)| (layout.dynamics_row(k) + i, layout.w(k, j)))
             })
             .map(|(row, col)| nz_index(&a, row, col))
             .collect();
         let b_index = (0..horizon)
-            .flat_map(|k| (0..4).map(move |i| Layout::dynamics_row(k) + i))
+            .flat_map(|k| (0..NX).map(move |i| layout.dynamics_row(k) + i))
             .collect();
         let mut q = vec![0.0; n];
         write_q(&mut q, layout, cost);
@@ -287,7 +325,7 @@ impl QpSolver {
             a_index,
             b_index,
             q,
-            values: Vec::with_capacity(24 * horizon),
+            values: Vec::with_capacity((NZ * (NZ + 1) / 2).max(NX * NZ) * horizon),
         })
     }
 
@@ -297,8 +335,8 @@ impl QpSolver {
     /// Clarabel re-applies the equilibration it computed at setup to the new values.
     pub fn update(
         &mut self,
-        model: &Discretised<4, 2>,
-        cost: &StageCost,
+        model: &Discretised<NX, N>,
+        cost: &StageCost<N, NX, NZ>,
         matrices: bool,
     ) -> Result<(), String> {
         let horizon = self.layout.horizon;
@@ -333,10 +371,10 @@ impl QpSolver {
     }
 
     /// Solves for the initial state `x0`; the caller checks the status.
-    pub fn solve(&mut self, x0: &State) -> Result<(), String> {
-        const X0_ROWS: [usize; 4] = [0, 1, 2, 3];
+    pub fn solve(&mut self, x0: &SVector<f64, NX>) -> Result<(), String> {
+        let x0_rows: [usize; NX] = std::array::from_fn(|i| i);
         self.solver
-            .update_b(&zip(X0_ROWS.iter(), x0.as_slice().iter()))
+            .update_b(&zip(x0_rows.iter(), x0.as_slice().iter()))
             .map_err(|e| format!("Clarabel update_b: {e}"))?;
         self.solver.solve();
         Ok(())
@@ -347,23 +385,29 @@ impl QpSolver {
     }
 
     /// u_0, …, u_{N−1} of the last solve.
-    pub fn plan(&self) -> impl Iterator<Item = Vector2> + '_ {
+    pub fn plan(&self) -> impl Iterator<Item = SVector<f64, N>> + '_ {
         let z = &self.solver.solution.x;
-        (0..self.layout.horizon)
-            .map(move |k| Vector2::new(z[self.layout.u(k)], z[self.layout.u(k) + 1]))
+        (0..self.layout.horizon).map(move |k| {
+            let first = self.layout.u(k);
+            SVector::from_fn(|j, _| z[first + j])
+        })
     }
 }
 
 /// q: each stage's linear term at its x_k, u_k, and the terminal one at x_N.
-fn write_q(q: &mut [f64], layout: Layout, cost: &StageCost) {
+fn write_q<const N: usize, const NX: usize, const NZ: usize>(
+    q: &mut [f64],
+    layout: Layout,
+    cost: &StageCost<N, NX, NZ>,
+) {
     q.fill(0.0);
     for k in 0..layout.horizon {
-        for i in 0..6 {
+        for i in 0..NZ {
             q[layout.w(k, i)] += cost.linear[i];
         }
     }
     let terminal = layout.x(layout.horizon);
-    for i in 0..4 {
+    for i in 0..NX {
         q[terminal + i] += cost.terminal_linear[i];
     }
 }
