@@ -10,8 +10,7 @@
 //! below); larger or non-finite arguments go to libm.
 #![allow(clippy::excessive_precision)]
 
-/// 2/π.
-const INV_PIO2: f64 = 6.36619772367581382433e-01;
+const INV_PIO2: f64 = std::f64::consts::FRAC_2_PI;
 /// π/2 = PIO2_1 + PIO2_1T, with PIO2_1 of 33 bits so that n·PIO2_1 is exact for |n| < 2^20;
 /// PIO2_2 (+ PIO2_2T) and PIO2_3 (+ PIO2_3T) continue the expansion for the rare arguments
 /// close to a multiple of π/2, where the first difference cancels (musl's `__rem_pio2`).
@@ -57,7 +56,7 @@ fn next_part(hi: f64, n: f64, part: f64, tail: f64) -> (f64, f64, f64) {
 /// (sin x, cos x).
 #[inline(always)]
 pub fn sin_cos(x: f64) -> (f64, f64) {
-    if !(x.abs() < REDUCTION_LIMIT) {
+    if x.is_nan() || x.abs() >= REDUCTION_LIMIT {
         return x.sin_cos();
     }
     // x = n·π/2 + (r + tail), |r| ≤ π/4 (musl's medium-size `__rem_pio2`).
