@@ -1,5 +1,6 @@
-//! The closed loop: one right-hand-side evaluation, one episode per task at the paper's defaults
-//! on a fixed arm (one thread), and 1000 task-1 episodes on all cores via `select::evaluate`.
+//! The closed loop: one right-hand-side evaluation, the latency of a chain of dependent ones,
+//! one episode per task at the paper's defaults on a fixed arm (one thread), and 1000 task-1
+//! episodes on all cores via `select::evaluate`.
 //!
 //! `cargo bench --bench episode`; target: a task-1 episode ≤ 25 µs on one core.
 
@@ -22,6 +23,29 @@ fn rhs(c: &mut Criterion) {
         let system = ClosedLoop::new(&arm, &Task::paper(kind), 1.0, 0.0).unwrap();
         let z = JointState::from([-1.2, -1.9, 0.7, -0.4, 0.3, -0.2]);
         group.bench_function(kind.name(), |b| b.iter(|| system.rhs(black_box(&z))));
+    }
+    group.finish();
+}
+
+/// 1000 evaluations, each on the previous one's result (z ← z + h·Ż, as a Runge–Kutta stage
+/// waits for the one before): the time per element is the latency of one RHS plus a stage
+/// combination, the floor of an episode's time per evaluation (docs/performance.md).
+fn rhs_chain(c: &mut Criterion) {
+    let arm = arm();
+    let mut group = c.benchmark_group("rhs_chain");
+    group.throughput(Throughput::Elements(1000));
+    for kind in [TaskKind::Position] {
+        let system = ClosedLoop::new(&arm, &Task::paper(kind), 1.0, 0.0).unwrap();
+        let z0 = JointState::from([-1.2, -1.9, 0.7, -0.4, 0.3, -0.2]);
+        group.bench_function(kind.name(), |b| {
+            b.iter(|| {
+                let mut z = black_box(z0);
+                for _ in 0..1000 {
+                    z += system.rhs(&z) * 1e-4;
+                }
+                z
+            })
+        });
     }
     group.finish();
 }
@@ -56,5 +80,5 @@ fn batch(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, rhs, episode, batch);
+criterion_group!(benches, rhs, rhs_chain, episode, batch);
 criterion_main!(benches);
