@@ -5,8 +5,10 @@
 //! * `checked_1000_tools`: the API over 1000 random tools (per tool: the time / 1000, printed as
 //!   throughput);
 //! * `validated`, `validated_1000_tools`: the ranking path, the task checked once
-//!   ([`TaskN::validated`]) and then [`ValidatedTaskN::control_confidence`] per tool (which
-//!   still checks that Π^U is positive definite).
+//!   ([`TaskN::validated`]) and then [`ValidatedTaskN::control_confidence`] per tool (Π^U, the
+//!   positive-definiteness check and ln|Π^U|);
+//! * `pi_u_1000_tools`: Π^U alone per tool ([`ValidatedTaskN::pi_u`]), summed as its
+//!   determinant so that every entry is used.
 //!
 //! `cargo bench --bench confidence`; target ≤ 20 ns per tool on one core.
 
@@ -52,6 +54,18 @@ fn confidence(c: &mut Criterion) {
                 black_box(&generic_tools)
                     .iter()
                     .map(|t| v.control_confidence(t).unwrap().logdet)
+                    .sum::<f64>()
+            })
+        });
+        group.bench_function(format!("{kind}/pi_u_1000_tools"), |b| {
+            b.iter(|| {
+                let v = black_box(&validated);
+                black_box(&generic_tools)
+                    .iter()
+                    .map(|t| {
+                        let p = v.pi_u(t);
+                        p[(0, 0)] * p[(1, 1)] - p[(0, 1)] * p[(1, 0)]
+                    })
                     .sum::<f64>()
             })
         });

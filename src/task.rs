@@ -92,4 +92,10 @@ impl Task {
     pub fn validate(&self) -> Result<(), Error> {
         crate::model::TaskN::from(self).validate()
     }
+
+    /// The task checked once, for ranking many tools by confidence
+    /// ([`crate::model::ValidatedTaskN::control_confidence`], with `Arm2Tool::from(&arm)`).
+    pub fn validated(&self) -> Result<crate::model::ValidatedTaskN<2>, Error> {
+        crate::model::TaskN::from(self).validated()
+    }
 }

@@ -472,3 +472,29 @@ fn cli_mixed_selection_json_and_text() {
     let bad = toolconf(&["select", "--task", "velocity", "--models", "arm7"]);
     assert_eq!(bad.status.code(), Some(2));
 }
+
+/// The validate-once ranking path gives exactly `control_confidence` for every tool and task, and
+/// refuses an invalid task up front with the same error.
+#[test]
+fn validated_task_gives_the_same_confidence_as_the_checked_api() {
+    for kind in TaskKind::ALL {
+        let task = Task::paper(kind);
+        let validated = task.validated().unwrap();
+        for arm in draw_tools(200, 9) {
+            let checked = toolconf::control_confidence(&arm, &task).unwrap();
+            let fast = validated.control_confidence(&Arm2Tool::from(&arm)).unwrap();
+            assert_eq!(checked.logdet.to_bits(), fast.logdet.to_bits());
+            assert_eq!(checked.pi_u, fast.pi_u);
+        }
+        let three = TaskN::paper::<Arm3, 6, 6, 9>(kind).validated().unwrap();
+        let tool = Arm3Tool::new([0.3, 0.4, 0.2, 0.5, 0.2, 0.3]).unwrap();
+        assert_eq!(
+            three.control_confidence(&tool).unwrap(),
+            control_confidence(&tool, three.task()).unwrap()
+        );
+    }
+    let mut bad = Task::paper(TaskKind::Position);
+    bad.precision_u[(0, 1)] = 5.0;
+    let expected = bad.validate().unwrap_err().to_string();
+    assert_eq!(bad.validated().unwrap_err().to_string(), expected);
+}

@@ -177,6 +177,7 @@ macro_rules! arm_model {
                 generated::$module::dynamics_jacobian(x, u, p)
             }
 
+            #[inline]
             fn state_matrix(
                 p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
             ) -> SMatrix<f64, { generated::$module::STATE_DIM }, { generated::$module::STATE_DIM }>
@@ -184,12 +185,14 @@ macro_rules! arm_model {
                 generated::$module::state_matrix(p)
             }
 
+            #[inline]
             fn input_matrix(
                 p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
             ) -> SMatrix<f64, { generated::$module::STATE_DIM }, { generated::$module::DOF }> {
                 generated::$module::input_matrix(p)
             }
 
+            #[inline]
             fn sensitivities(
                 kind: TaskKind,
                 p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
@@ -221,6 +224,7 @@ macro_rules! arm_model {
                 }
             }
 
+            #[inline]
             fn pi_u(
                 task: &TaskN<{ generated::$module::DOF }>,
                 p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
@@ -631,6 +635,19 @@ pub struct ValidatedTaskN<const N: usize>(TaskN<N>);
 impl<const N: usize> ValidatedTaskN<N> {
     pub fn task(&self) -> &TaskN<N> {
         &self.0
+    }
+
+    /// Π^U of `tool` (eq. control_conf), the closed form alone: no positive-definiteness check
+    /// and no logarithm (rank by confidence with [`ValidatedTaskN::control_confidence`]).
+    #[inline]
+    pub fn pi_u<M, const NX: usize, const NP: usize, const NZ: usize>(
+        &self,
+        tool: &ToolN<M, N, NX, NP, NZ>,
+    ) -> SMatrix<f64, N, N>
+    where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
+        M::pi_u(&self.0, &tool.params)
     }
 
     /// Π^U and ln|Π^U| of `tool` (eq. control_conf); errors only if Π^U is not positive definite.
