@@ -7,9 +7,12 @@ l1^2 (m1/3 + m2) and l2^2 m2 in the paper's accelerations), so every call would 
 Writing each output entry as sum_i c_i(p) r_i(X, U) moves every c_i into a struct built once per
 tool; what is left per call has no division by a parameter expression at all (arm2).
 
-The split is kept only when it makes the per-call code cheaper (operation count with divisions and
-transcendental calls weighted by their cost), so a model whose accelerations have a state-dependent
-denominator (the Lagrangian planar chains) never gets longer per call.
+An entry with a state-dependent denominator (the Lagrangian planar chains' mass-matrix inverse) is
+not expanded, which would multiply its terms: its maximal parameter-only subexpressions are
+replaced in place. The whole rewrite is kept only when the per-call code gets cheaper (operation
+count after CSE, divisions and transcendental calls weighted by their cost); otherwise the
+coefficients are the parameters themselves, so every model has the same `<name>_with` API
+(arm2: 165 -> 105 weighted operations per call of `dynamics`, arm2_exact 171 -> 121, arm3 547 -> 315).
 """
 
 from __future__ import annotations
