@@ -9,7 +9,7 @@ use serde::Serialize;
 use crate::generated::arm2;
 use crate::{Error, InputMatrix, State, StateMatrix, Vector2};
 
-/// One tool: link masses m1, m2 [kg] and lengths l1, l2 [m], all finite and > 0.
+/// One tool: link masses m1, m2 (kg) and lengths l1, l2 (m), all finite and > 0.
 ///
 /// The fields are private so that every `Arm` in existence has passed [`Arm::new`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

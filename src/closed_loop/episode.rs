@@ -14,9 +14,9 @@ pub use crate::model::Metrics;
 /// ([`EpisodeOptionsN::paper`] for the 2-link arm, on the paper's plant).
 #[derive(Debug, Clone, PartialEq)]
 pub struct EpisodeOptions {
-    /// End time [s] (paper: 5).
+    /// End time (s) (paper: 5).
     pub t_end: f64,
-    /// Output grid spacing [s] (paper: 0.05, 101 points).
+    /// Output grid spacing (s) (paper: 0.05, 101 points).
     pub dt: f64,
     /// Initial state X0 (paper: X^e = [−π/2 −π/2 0 0]).
     pub x0: State,
