@@ -28,7 +28,8 @@ pub fn control_confidence(arm: &Arm, task: &Task) -> Result<ControlConfidence, E
     model::control_confidence(&Arm2Tool::from(arm), &TaskN::from(task))
 }
 
-/// Π^U without validation; the hot path for ranking many tools with one validated task.
+/// Π^U without validating the task. To rank many tools, check the task once with
+/// [`Task::validated`] and use [`crate::model::ValidatedTaskN::pi_u`] or `control_confidence`.
 pub fn pi_u(arm: &Arm, task: &Task) -> Matrix2 {
     Arm2::pi_u(&TaskN::from(task), &arm.params())
 }

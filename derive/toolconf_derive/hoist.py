@@ -50,11 +50,11 @@ class Hoisted:
     entries: list[sp.Expr]
 
 
-def hoist(entries: list[sp.Expr], per_call: list[sp.Symbol], constants: set[sp.Symbol],
-          prefix: str = "k") -> Hoisted | None:
-    """Writes each entry as sum_i c_i(p) r_i(per_call); None if that is not cheaper per call.
-    Numbers and the model's `constants` stay inline; anything else without a per-call symbol is a
-    coefficient."""
+def hoist(entries: list[sp.Expr], per_call: list[sp.Symbol], params: list[sp.Symbol],
+          constants: set[sp.Symbol], prefix: str = "k") -> Hoisted:
+    """Writes each entry as sum_i c_i(p) r_i(per_call). Numbers and the model's `constants` stay
+    inline; anything else without a per-call symbol is a coefficient. If that is not cheaper per
+    call, the coefficients are the `params` themselves."""
     per_call_set = set(per_call)
     values: list[sp.Expr] = []
     index: dict[sp.Expr, sp.Symbol] = {}
@@ -114,5 +114,7 @@ def hoist(entries: list[sp.Expr], per_call: list[sp.Symbol], constants: set[sp.S
         rewritten.append(sp.Add(*[coefficient(groups[r]) * r for r in order if groups[r] != 0]))
 
     if cse_cost(rewritten) >= cse_cost(entries):
-        return None
+        identity = [sp.Symbol(f"{prefix}{i}", real=True) for i in range(len(params))]
+        rename = dict(zip(params, identity))
+        return Hoisted(identity, list(params), [e.xreplace(rename) for e in entries])
     return Hoisted(symbols, values, rewritten)

@@ -9,7 +9,7 @@ import sympy as sp
 
 from .crosscheck import check_against_casadi
 from .functions import Arg, Function
-from .hoist import Hoisted, hoist
+from .hoist import hoist
 from .rust_printer import RustPrinter, float_literal
 from .symbolic import Derivation
 
@@ -128,12 +128,7 @@ def function_ir(fn: Function, d: Derivation, vectors: int) -> dict:
         per_call = [s for a in fn.args if a.name != "params" for s, _, _ in a.reads]
         per_call += [t for q in angles for t in _trig_symbols(q)] + [c for c, _ in compounds]
         params = [a for a in fn.args if a.name == "params"]
-        hoisted = hoist(entries, per_call, set(d.constants))
-        if hoisted is None:
-            # Not cheaper per call: the coefficients are the parameters themselves, so that every
-            # model has the same `<name>_with` API.
-            ks = [sp.Symbol(f"k{i}", real=True) for i in range(len(d.params))]
-            hoisted = Hoisted(ks, list(d.params), [e.xreplace(dict(zip(d.params, ks))) for e in entries])
+        hoisted = hoist(entries, per_call, d.params, set(d.constants))
         k = Arg("coefficients", "", (len(hoisted.symbols), 1), [(s, i, 0) for i, s in enumerate(hoisted.symbols)],
                 False, None)
         coefficient_code = _code(hoisted.values, d, params, declared, "s")

@@ -4,7 +4,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::model::{ActiveInferenceN, Arm2, Arm2Exact, Arm2Tool, ArmModel, ClosedLoopN, TaskN};
+use crate::model::{ActiveInferenceN, Arm2, Arm2Exact, Arm2Tool, ClosedLoopN, TaskN};
 use crate::{Arm, Error, Task, Vector2};
 
 /// The closed-loop state Z = [X; U] = [θ1 θ2 θ̇1 θ̇2 T1 T2].
@@ -32,20 +32,6 @@ impl Plant {
         match self {
             Plant::Paper => "paper",
             Plant::Exact => "exact",
-        }
-    }
-
-    /// Ẋ = f(X, U; p) of this plant.
-    #[inline]
-    pub fn dynamics(
-        self,
-        x: &SVector<f64, 4>,
-        u: &Vector2,
-        p: &SVector<f64, 4>,
-    ) -> SVector<f64, 4> {
-        match self {
-            Plant::Paper => Arm2::dynamics(x, u, p),
-            Plant::Exact => Arm2Exact::dynamics(x, u, p),
         }
     }
 }

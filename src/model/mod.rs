@@ -68,18 +68,24 @@ pub trait ArmModel<const N: usize, const NX: usize, const NP: usize, const NZ: u
         u: &SVector<f64, N>,
         k: &Self::JacobianCoefficients,
     ) -> (SMatrix<f64, NX, NX>, SMatrix<f64, NX, N>);
-    /// Ẋ = f(X, U; p).
+    /// Ẋ = f(X, U; p), for a one-off evaluation (an integrator keeps the coefficients).
+    #[inline]
     fn dynamics(
         x: &SVector<f64, NX>,
         u: &SVector<f64, N>,
         p: &SVector<f64, NP>,
-    ) -> SVector<f64, NX>;
-    /// (∂f/∂X, ∂f/∂U) at any X, U.
+    ) -> SVector<f64, NX> {
+        Self::dynamics_with(x, u, &Self::dynamics_coefficients(p))
+    }
+    /// (∂f/∂X, ∂f/∂U) at any X, U, for a one-off evaluation.
+    #[inline]
     fn dynamics_jacobian(
         x: &SVector<f64, NX>,
         u: &SVector<f64, N>,
         p: &SVector<f64, NP>,
-    ) -> (SMatrix<f64, NX, NX>, SMatrix<f64, NX, N>);
+    ) -> (SMatrix<f64, NX, NX>, SMatrix<f64, NX, N>) {
+        Self::dynamics_jacobian_with(x, u, &Self::jacobian_coefficients(p))
+    }
     /// A = ∂f/∂X at the equilibrium.
     fn state_matrix(p: &SVector<f64, NP>) -> SMatrix<f64, NX, NX>;
     /// B = ∂f/∂U at the equilibrium.
@@ -154,27 +160,6 @@ macro_rules! arm_model {
                 SMatrix<f64, { generated::$module::STATE_DIM }, { generated::$module::DOF }>,
             ) {
                 generated::$module::dynamics_jacobian_with(x, u, k)
-            }
-
-            #[inline]
-            fn dynamics(
-                x: &SVector<f64, { generated::$module::STATE_DIM }>,
-                u: &SVector<f64, { generated::$module::DOF }>,
-                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
-            ) -> SVector<f64, { generated::$module::STATE_DIM }> {
-                generated::$module::dynamics(x, u, p)
-            }
-
-            #[inline]
-            fn dynamics_jacobian(
-                x: &SVector<f64, { generated::$module::STATE_DIM }>,
-                u: &SVector<f64, { generated::$module::DOF }>,
-                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
-            ) -> (
-                SMatrix<f64, { generated::$module::STATE_DIM }, { generated::$module::STATE_DIM }>,
-                SMatrix<f64, { generated::$module::STATE_DIM }, { generated::$module::DOF }>,
-            ) {
-                generated::$module::dynamics_jacobian(x, u, p)
             }
 
             #[inline]
@@ -659,7 +644,7 @@ impl<const N: usize> ValidatedTaskN<N> {
     where
         M: ArmModel<N, NX, NP, NZ>,
     {
-        let pi_u = M::pi_u(&self.0, &tool.params);
+        let pi_u = self.pi_u(tool);
         let logdet = logdet_of(&pi_u)?;
         Ok(ControlConfidenceN { pi_u, logdet })
     }

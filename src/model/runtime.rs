@@ -2,8 +2,6 @@
 //! implementation. The 2-link `crate::closed_loop` (and `crate::confidence`) are façades over it
 //! that keep the paper's `Arm`/`Task`/`Matrix2` API and its error messages.
 
-use std::marker::PhantomData;
-
 use nalgebra::{SMatrix, SVector};
 
 use super::{control_confidence, ArmModel, TaskN, ToolN};
@@ -170,7 +168,6 @@ where
     jacobian: P::JacobianCoefficients,
     pub controller: ActiveInferenceN<N>,
     perturbation: SVector<f64, N>,
-    plant: PhantomData<P>,
 }
 
 impl<P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>
@@ -202,7 +199,6 @@ where
             jacobian: P::jacobian_coefficients(&params),
             controller: ActiveInferenceN::new(tool, task, learning_rate)?,
             perturbation: SVector::repeat(perturbation),
-            plant: PhantomData,
         })
     }
 

@@ -205,7 +205,8 @@ where
         .into());
     }
     let mut mpc = MpcN::new(tool, task, mpc_options).map_err(MpcFailure::Setup)?;
-    let params = tool.params();
+    // The plant's parameter-only factors, once per episode (as the active-inference loop does).
+    let plant = P::dynamics_coefficients(&tool.params());
     let perturbation = SVector::<f64, N>::repeat(options.perturbation);
     let logdet = metrics_of.logdet;
 
@@ -232,7 +233,7 @@ where
     let (mut task_error, mut int_j, mut effort) = (0.0, 0.0, 0.0);
     let mut previous: Option<(f64, f64, f64)> = None;
     let mut sample = |t: f64, x: &SVector<f64, NX>, u: &SVector<f64, N>| {
-        let theta_ddot = P::dynamics(x, &(u + perturbation), &params)
+        let theta_ddot = P::dynamics_with(x, &(u + perturbation), &plant)
             .fixed_rows::<N>(N)
             .into_owned();
         let theta = x.fixed_rows::<N>(0).into_owned();
@@ -263,7 +264,7 @@ where
         let held = u + perturbation;
         let mut next = x;
         let stats = solve_grid(
-            |_, x: &SVector<f64, NX>| P::dynamics(x, &held, &params),
+            |_, x: &SVector<f64, NX>| P::dynamics_with(x, &held, &plant),
             &x,
             &[t0, t1],
             &options.integrator,
