@@ -17,9 +17,10 @@ run:
 bench:
 	cargo bench --bench confidence --bench episode --bench stiff --bench reproduce
 
-## make test: the whole suite, including the checks that `make derive` reproduces generated/ byte
-## for byte, on this CPU and on an imitated older one.
+## make test: the whole suite: `make derive` reproduces generated/ byte for byte (on this CPU and
+## on an imitated older one), the derivation's own tests, then the crate's.
 test: drift-check
+	$(PY) -m unittest discover --start-directory derive/tests
 	cargo test --workspace --quiet
 
 venv: $(PY)
