@@ -21,6 +21,14 @@ pub enum Error {
     /// A numeric option outside its domain.
     #[error("invalid {name} = {value}")]
     InvalidOption { name: &'static str, value: f64 },
+    /// A tool given with the wrong number of parameters for its model.
+    #[error("model {model} takes {expected} parameters ({names}), got {found}")]
+    ParameterCount {
+        model: &'static str,
+        expected: usize,
+        names: String,
+        found: usize,
+    },
     /// A combination of options that is not supported, with the reason.
     #[error("unsupported: {0}")]
     Unsupported(String),

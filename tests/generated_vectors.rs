@@ -99,13 +99,11 @@ macro_rules! evaluator {
     };
 }
 
-evaluator!(evaluate_arm2, arm2);
-evaluator!(evaluate_arm2_exact, arm2_exact);
-evaluator!(evaluate_arm3, arm3);
-
 fn check(model: &str, evaluate: fn(&str, &Value) -> Option<Vec<Vec<f64>>>) {
     let ir = load(&format!("{model}.json"));
-    let vectors_file = ir["test_vectors"]["file"].as_str().expect("IR names its vectors file");
+    let vectors_file = ir["test_vectors"]["file"]
+        .as_str()
+        .expect("IR names its vectors file");
     assert_eq!(vectors_file, format!("{model}.vectors.json"));
     let all_vectors = load(vectors_file);
     let functions = ir["functions"].as_array().expect("functions");
@@ -151,17 +149,21 @@ fn check(model: &str, evaluate: fn(&str, &Value) -> Option<Vec<Vec<f64>>>) {
     assert!(checked >= 1000);
 }
 
-#[test]
-fn arm2_functions_match_casadi_vectors() {
-    check("arm2", evaluate_arm2);
+/// One test per generated model, from the registry: a new model description is checked here
+/// without an edit.
+macro_rules! vector_tests {
+    ($(($marker:ident, $module:ident, $tool:ident, $name:literal, $title:literal)),* $(,)?) => {
+        mod functions_match_casadi_vectors {
+            use super::*;
+            $(
+                #[test]
+                fn $module() {
+                    evaluator!(evaluate, $module);
+                    check($name, evaluate);
+                }
+            )*
+        }
+    };
 }
 
-#[test]
-fn arm2_exact_functions_match_casadi_vectors() {
-    check("arm2_exact", evaluate_arm2_exact);
-}
-
-#[test]
-fn arm3_functions_match_casadi_vectors() {
-    check("arm3", evaluate_arm3);
-}
+toolconf::for_each_model!(vector_tests);
