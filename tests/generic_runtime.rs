@@ -178,7 +178,12 @@ fn invalid_input_gives_typed_errors() {
     );
     assert!(matches!(
         AnyTool::new(ModelKind::Arm3, &[0.3, 0.3, 0.3, 0.3]),
-        Err(Error::InvalidOption { .. })
+        Err(Error::ParameterCount {
+            model: "arm3",
+            expected: 6,
+            found: 4,
+            ..
+        })
     ));
     assert!(matches!(
         AnyTool::new(ModelKind::Arm3, &[0.3, 0.3, 0.3, 0.3, 0.3, f64::INFINITY]),
@@ -318,7 +323,7 @@ fn mixed_evaluation_matches_each_models_own_runtime_and_choices() {
                 let m = simulate(&t, &task, &EpisodeOptionsN::paper::<Arm3, 6, 9>()).unwrap();
                 assert_eq!(bits(&m), bits(r.episode.as_ref().unwrap()));
             }
-            AnyTool::Arm2Exact(_) => unreachable!(),
+            other => unreachable!("{other} was not drawn"),
         }
         let per_joint = r.logdet_per_joint().unwrap();
         assert_eq!(

@@ -30,14 +30,20 @@ def centres(q, lengths, sin, cos):
     return out
 
 
+def tip(q, lengths, sin, cos):
+    """Position (x, y) of the chain's free end, where a payload is held."""
+    return sum(l * cos(theta) for theta, l in zip(q, lengths)), sum(l * sin(theta) for theta, l in zip(q, lengths))
+
+
 def generalised_forces(u):
     """Q_i = U_i - U_{i+1}: joint torque i acts on link i and, in reaction, on link i-1."""
     n = len(u)
     return [u[i] - (u[i + 1] if i + 1 < n else 0) for i in range(n)]
 
 
-def sympy_chain(q, q_dot, u, masses, lengths, g):
-    """Returns (q_ddot, T, V, M, Q) with q_ddot = M^-1 (Q - C(q, q_dot) q_dot - dV/dq), by SymPy."""
+def sympy_chain(q, q_dot, u, masses, lengths, g, payload=None):
+    """Returns (q_ddot, T, V, M, Q) with q_ddot = M^-1 (Q - C(q, q_dot) q_dot - dV/dq), by SymPy.
+    `payload`, if given, is the mass of a point load held at the tip."""
     import sympy as sp
 
     qv, qdv = sp.Matrix(q), sp.Matrix(q_dot)
@@ -46,6 +52,11 @@ def sympy_chain(q, q_dot, u, masses, lengths, g):
         v = sp.Matrix([xc, yc]).jacobian(qv) * qdv
         kinetic += m * (v[0] ** 2 + v[1] ** 2) / 2 + (m * l**2 / 12) * qd**2 / 2
         potential += m * g * yc
+    if payload is not None:
+        xt, yt = tip(q, lengths, sp.sin, sp.cos)
+        v = sp.Matrix([xt, yt]).jacobian(qv) * qdv
+        kinetic += payload * (v[0] ** 2 + v[1] ** 2) / 2
+        potential += payload * g * yt
     kinetic = sp.simplify(sp.expand(kinetic))
     mass = sp.hessian(kinetic, qdv).applyfunc(sp.simplify)
     momentum = mass * qdv
@@ -57,7 +68,7 @@ def sympy_chain(q, q_dot, u, masses, lengths, g):
     return q_ddot, kinetic, potential, mass, forces
 
 
-def casadi_chain(q, q_dot, u, masses, lengths, g):
+def casadi_chain(q, q_dot, u, masses, lengths, g, payload=None):
     """Returns q_ddot as CasADi expressions, differentiating the same Lagrangian by AD."""
     import casadi as ca
 
@@ -67,6 +78,11 @@ def casadi_chain(q, q_dot, u, masses, lengths, g):
         v = ca.jacobian(ca.vertcat(xc, yc), qv) @ qdv
         kinetic += m * ca.sumsqr(v) / 2 + (m * l**2 / 12) * qd**2 / 2
         potential += m * g * yc
+    if payload is not None:
+        xt, yt = tip(q, lengths, ca.sin, ca.cos)
+        v = ca.jacobian(ca.vertcat(xt, yt), qv) @ qdv
+        kinetic += payload * ca.sumsqr(v) / 2
+        potential += payload * g * yt
     mass, _ = ca.hessian(kinetic, qdv)
     bias = ca.jacobian(mass @ qdv, qv) @ qdv - ca.gradient(kinetic, qv) + ca.gradient(potential, qv)
     forces = ca.vertcat(*generalised_forces(u))

@@ -48,6 +48,8 @@ class Model:
     equilibrium_u: list[str]
     links: list[dict] = field(default_factory=list)
     gravity: str = "g"
+    # planar_chain: the parameter that is the mass of a point payload held at the tip, if any.
+    payload: str | None = None
     goals: dict[str, dict[str, list[str]]] = field(default_factory=dict)
     printed_where: str = ""
     printed_a: list[list[str]] | None = None
@@ -146,6 +148,7 @@ def load_model(path: Path) -> Model:
         equilibrium_u=[str(v) for v in _require(eq, "u", f"{path}: [equilibrium]")],
         links=list(dyn.get("links", [])),
         gravity=str(dyn.get("gravity", "g")),
+        payload=dyn.get("payload"),
         goals={task: {term: [str(v) for v in vs] for term, vs in terms.items()}
                for task, terms in raw.get("goals", {}).items()},
         printed_where=printed.get("where", ""),
@@ -185,6 +188,8 @@ def _validate_model(m: Model) -> None:
             for key in ("mass", "length"):
                 if link.get(key) not in known:
                     raise DescriptionError(f"{where}: dynamics.links[{i}].{key} must name a parameter, got {link.get(key)!r}")
+        if m.payload is not None and m.payload not in known:
+            raise DescriptionError(f"{where}: dynamics.payload must name a parameter, got {m.payload!r}")
         if m.gravity not in {c.name for c in m.constants}:
             raise DescriptionError(f"{where}: dynamics.gravity must name a constant, got {m.gravity!r}")
     else:

@@ -47,7 +47,7 @@ class CasadiModel:
             q_ddot = casadi_chain(
                 [names[c.name] for c in model.q], [names[c.name] for c in model.q_dot], [names[c.name] for c in model.u],
                 [names[link["mass"]] for link in model.links], [names[link["length"]] for link in model.links],
-                names[model.gravity],
+                names[model.gravity], names[model.payload] if model.payload else None,
             )
         else:
             q_ddot = [eval(e, {"__builtins__": {}, **functions}, names) for e in model.q_ddot]  # noqa: S307

@@ -132,7 +132,9 @@ def derive(model: Model, tasks: list[Task]) -> Derivation:
     if model.dynamics_kind == "planar_chain":
         masses = [symbols[link["mass"]] for link in model.links]
         lengths = [symbols[link["length"]] for link in model.links]
-        q_ddot, kinetic, potential, mass, forces = sympy_chain(q, q_dot, u, masses, lengths, symbols[model.gravity])
+        payload = symbols[model.payload] if model.payload else None
+        q_ddot, kinetic, potential, mass, forces = sympy_chain(q, q_dot, u, masses, lengths, symbols[model.gravity],
+                                                               payload)
         lagrangian = {"T": kinetic, "V": potential, "M": mass, "Q": forces}
     else:
         q_ddot = sp.Matrix([parse(model, e, symbols, f"dynamics.q_ddot[{i}]") for i, e in enumerate(model.q_ddot)])

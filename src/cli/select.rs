@@ -250,8 +250,10 @@ fn run_mixed(args: &Args) -> Result<(), CliError> {
         args.seed,
         models.join(",")
     );
+    // The model column fits the longest name in this set (at least 10 wide).
+    let w = models.iter().map(|m| m.len()).max().unwrap_or(0).max(10);
     println!(
-        "{:>5}  {:<10} {:>12} {:>12}  {:>14} {:>14} {:>14}  parameters",
+        "{:>5}  {:<w$} {:>12} {:>12}  {:>14} {:>14} {:>14}  parameters",
         "tool", "model", "ln|Pi^U|", "ln|Pi^U|/n", "task error", "int F dt", "int J dt"
     );
     for r in &results {
@@ -273,7 +275,7 @@ fn run_mixed(args: &Args) -> Result<(), CliError> {
             .map(|(name, value)| format!("{name}={value:.4}"))
             .collect();
         println!(
-            "{:>5}  {:<10} {:>12} {:>12}  {}  {}",
+            "{:>5}  {:<w$} {:>12} {:>12}  {}  {}",
             r.index,
             r.model().name(),
             logdet,
