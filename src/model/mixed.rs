@@ -60,6 +60,15 @@ impl ModelKind {
         }
     }
 
+    /// The tool parameters' names, in the order the model takes them.
+    pub fn parameter_names(self) -> &'static [&'static str] {
+        match self {
+            ModelKind::Arm2 => &generated::arm2::PARAMETER_NAMES,
+            ModelKind::Arm2Exact => &generated::arm2_exact::PARAMETER_NAMES,
+            ModelKind::Arm3 => &generated::arm3::PARAMETER_NAMES,
+        }
+    }
+
     /// The control dimension n (joints).
     pub fn dof(self) -> usize {
         match self {
