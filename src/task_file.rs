@@ -190,7 +190,7 @@ impl TaskSpec {
             file: file.into(),
             place: e
                 .span()
-                .map(|s| format!("line {}", 1 + text[..s.start].matches('\n').count()))
+                .map(|s| syntax_place(text, s.start))
                 .unwrap_or_default(),
             message: e.message().trim().replace('\n', " "),
         })?;
@@ -247,7 +247,11 @@ impl TaskSpec {
     /// A short name: the file, or the built-in task's name.
     pub fn label(&self) -> String {
         if self.file.is_empty() {
-            format!("{} (the paper's task {})", self.kind, self.kind.paper_index())
+            format!(
+                "{} (the paper's task {})",
+                self.kind,
+                self.kind.paper_index()
+            )
         } else {
             format!("{} ({})", self.file, self.kind)
         }
@@ -280,12 +284,20 @@ impl TaskSpec {
         };
         if self.kind != TaskKind::Position {
             unused("goal.theta", self.goal_theta.is_some(), "position")?;
-            unused("precision.theta", self.precision_theta.is_some(), "position")?;
+            unused(
+                "precision.theta",
+                self.precision_theta.is_some(),
+                "position",
+            )?;
         }
         if self.kind == TaskKind::Acceleration {
             let used_by = "position and velocity";
             unused("goal.theta_dot", self.goal_theta_dot.is_some(), used_by)?;
-            unused("precision.theta_dot", self.precision_theta_dot.is_some(), used_by)?;
+            unused(
+                "precision.theta_dot",
+                self.precision_theta_dot.is_some(),
+                used_by,
+            )?;
         }
         for (key, v) in [
             ("goal.theta", &self.goal_theta),
@@ -322,17 +334,37 @@ impl TaskSpec {
         let mut task = M::paper_task(self.kind);
         for (key, given, goal) in [
             ("goal.theta", &self.goal_theta, &mut task.goal_theta),
-            ("goal.theta_dot", &self.goal_theta_dot, &mut task.goal_theta_dot),
-            ("goal.theta_ddot", &self.goal_theta_ddot, &mut task.goal_theta_ddot),
+            (
+                "goal.theta_dot",
+                &self.goal_theta_dot,
+                &mut task.goal_theta_dot,
+            ),
+            (
+                "goal.theta_ddot",
+                &self.goal_theta_ddot,
+                &mut task.goal_theta_ddot,
+            ),
         ] {
             if let Some(v) = given {
                 *goal = self.vector::<M, N, NX, NP, NZ>(key, v)?;
             }
         }
         for (key, given, p) in [
-            ("precision.theta", &self.precision_theta, &mut task.precision_theta),
-            ("precision.theta_dot", &self.precision_theta_dot, &mut task.precision_theta_dot),
-            ("precision.theta_ddot", &self.precision_theta_ddot, &mut task.precision_theta_ddot),
+            (
+                "precision.theta",
+                &self.precision_theta,
+                &mut task.precision_theta,
+            ),
+            (
+                "precision.theta_dot",
+                &self.precision_theta_dot,
+                &mut task.precision_theta_dot,
+            ),
+            (
+                "precision.theta_ddot",
+                &self.precision_theta_ddot,
+                &mut task.precision_theta_ddot,
+            ),
             ("precision.u", &self.precision_u, &mut task.precision_u),
         ] {
             if let Some(given) = given {
@@ -465,6 +497,21 @@ impl EpisodeSpec {
     }
 }
 
+/// `line N (text of the line)` for a byte offset into the file.
+fn syntax_place(text: &str, offset: usize) -> String {
+    let Some(before) = text.get(..offset) else {
+        return String::new();
+    };
+    let start = before.rfind('\n').map_or(0, |i| i + 1);
+    let line = text[start..].lines().next().unwrap_or("").trim();
+    let number = 1 + text[..start].matches('\n').count();
+    if line.is_empty() {
+        format!("line {number}")
+    } else {
+        format!("line {number} ({line})")
+    }
+}
+
 fn finite_list(v: &[f64]) -> Result<(), String> {
     if v.is_empty() {
         return Err("is an empty list".into());
@@ -504,9 +551,9 @@ fn per_joint_spec(v: &toml::Value) -> Result<PerJoint, String> {
     if let Some(x) = number(v) {
         return Ok(PerJoint::All(x));
     }
-    numbers(v)
-        .map(PerJoint::Each)
-        .ok_or_else(|| format!("expected a number (every joint) or a list (one per joint); got {v}"))
+    numbers(v).map(PerJoint::Each).ok_or_else(|| {
+        format!("expected a number (every joint) or a list (one per joint); got {v}")
+    })
 }
 
 /// Finite; a matrix square, symmetric (to 1e-12 relative) and positive semi-definite, with the
@@ -579,9 +626,12 @@ perturbation = 0.0
     fn the_issue_example_parses_into_the_task_it_states() {
         let spec = TaskSpec::parse(ISSUE_EXAMPLE, "t.toml").unwrap();
         let task = spec.task::<Arm2, 2, 4, 4, 6>().unwrap();
-        assert_eq!(task.goal_theta, SVector::from([std::f64::consts::FRAC_PI_4, 0.0]));
-        assert_eq!(task.precision_theta, SMatrix::identity() * 80.0);
-        assert_eq!(task.precision_theta_dot, SMatrix::identity() * 50.0);
+        assert_eq!(
+            task.goal_theta,
+            crate::Vector2::new(std::f64::consts::FRAC_PI_4, 0.0)
+        );
+        assert_eq!(task.precision_theta, crate::Matrix2::identity() * 80.0);
+        assert_eq!(task.precision_theta_dot, crate::Matrix2::identity() * 50.0);
         let o = spec.episode::<Arm2, 2, 4, 4, 6>().unwrap();
         assert_eq!((o.t_end, o.dt, o.perturbation), (5.0, 0.05, 0.0));
         assert_eq!(o.x0, Arm2::equilibrium_state());
@@ -593,6 +643,20 @@ perturbation = 0.0
         let e = spec.task::<Arm3, 3, 6, 6, 9>().unwrap_err();
         assert_eq!(e.place, "key goal.theta");
         assert!(e.message.contains("model arm3 has 3 joints"), "{e}");
+    }
+
+    #[test]
+    fn syntax_errors_name_the_line_and_its_text() {
+        let e =
+            TaskSpec::parse("kind = \"position\"\n[goal]\ntheta = 0.5\n", "t.toml").unwrap_err();
+        assert_eq!(e.place, "line 3 (theta = 0.5)");
+        let e = TaskSpec::parse(
+            "kind = \"velocity\"\n[episode]\nperturbation = [0.1, nan]\n",
+            "t.toml",
+        )
+        .unwrap_err();
+        assert_eq!(e.place, "key episode.perturbation");
+        assert!(e.message.contains("NaN"), "{e}");
     }
 
     #[test]

@@ -34,7 +34,9 @@ pub struct ToolRow {
 impl ToolRow {
     /// The name, or `row N` when the file gives none.
     pub fn label(&self) -> String {
-        self.name.clone().unwrap_or_else(|| format!("row {}", self.row))
+        self.name
+            .clone()
+            .unwrap_or_else(|| format!("row {}", self.row))
     }
 }
 
@@ -108,7 +110,11 @@ fn read_csv(
         .map(str::to_string)
         .collect();
     if header.iter().all(String::is_empty) {
-        return Err(error(String::new(), "no tools: the file is empty".into(), false));
+        return Err(error(
+            String::new(),
+            "no tools: the file is empty".into(),
+            false,
+        ));
     }
     check_keys(header.iter().map(String::as_str))
         .map_err(|m| error("line 1 (header)".into(), m, false))?;
@@ -127,17 +133,17 @@ fn read_csv(
                         Some(text) => Cell::Text(text),
                     },
                 };
-                let row = build_row(rows, &cell)
-                    .map_err(|m| error(format!("line {line}"), m, true));
+                let row =
+                    build_row(rows, &cell).map_err(|m| error(format!("line {line}"), m, true));
                 each(row)?;
             }
             Err(e) => {
                 rows += 1;
                 let line = e.position().map_or(0, |p| p.line());
                 let message = match e.kind() {
-                    csv::ErrorKind::UnequalLengths { expected_len, len, .. } => format!(
-                        "the row has {len} cells, the header {expected_len}"
-                    ),
+                    csv::ErrorKind::UnequalLengths {
+                        expected_len, len, ..
+                    } => format!("the row has {len} cells, the header {expected_len}"),
                     _ => e.to_string(),
                 };
                 let row_level = matches!(e.kind(), csv::ErrorKind::UnequalLengths { .. });
@@ -177,10 +183,7 @@ fn check_keys<'a>(keys: impl Iterator<Item = &'a str>) -> Result<(), String> {
     let mut seen = Vec::new();
     for key in keys {
         if !known_key(key) {
-            return Err(format!(
-                "unknown column '{key}' (known: {})",
-                known_keys()
-            ));
+            return Err(format!("unknown column '{key}' (known: {})", known_keys()));
         }
         if seen.contains(&key) {
             return Err(format!("column '{key}' appears twice"));
@@ -299,7 +302,8 @@ fn read_json<R: std::io::Read>(
         stopped: None,
     };
     let mut de = serde_json::Deserializer::from_reader(reader);
-    let parsed = serde::Deserializer::deserialize_seq(&mut de, &mut elements).and_then(|()| de.end());
+    let parsed =
+        serde::Deserializer::deserialize_seq(&mut de, &mut elements).and_then(|()| de.end());
     if let Some(e) = elements.stopped {
         return Err(e);
     }

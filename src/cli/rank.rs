@@ -215,14 +215,22 @@ fn tool_json(rank: usize, r: &RankedTool) -> Value {
 
 fn print_table(results: &[RankedTool], order: &[usize]) {
     let name = |r: &RankedTool| r.row.name.clone().unwrap_or_else(|| "-".into());
-    let w = results.iter().map(|r| name(r).chars().count()).max().unwrap_or(4).max(4);
+    let w = results
+        .iter()
+        .map(|r| name(r).chars().count())
+        .max()
+        .unwrap_or(4)
+        .max(4);
     println!(
         "{:>5} {:>6}  {:<w$} {:<10} {:>12}  {:>14} {:>14} {:>14}  parameters",
         "rank", "row", "name", "model", "ln|Pi^U|", "task error", "int F dt", "int J dt"
     );
     for (k, &i) in order.iter().enumerate() {
         let r = &results[i];
-        let logdet = r.logdet.as_ref().map_or("error".into(), |l| format!("{l:.6}"));
+        let logdet = r
+            .logdet
+            .as_ref()
+            .map_or("error".into(), |l| format!("{l:.6}"));
         let metrics = match &r.episode {
             Ok(m) => format!(
                 "{:>14.6e} {:>14.6e} {:>14.6e}",
@@ -267,7 +275,14 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         Some(path) => {
             let mut header = vec!["row", "name", "model"];
             header.extend(&columns);
-            header.extend(["logdet", "task_error", "free_energy", "cost_j", "rhs_evals", "error"]);
+            header.extend([
+                "logdet",
+                "task_error",
+                "free_energy",
+                "cost_j",
+                "rhs_evals",
+                "error",
+            ]);
             Some(CsvWriter::create(path, &header)?)
         }
         None => None,
@@ -299,7 +314,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
                 .map(|(k, &i)| tool_json(k + 1, &results[i]))
                 .collect::<Vec<_>>(),
         });
-        println!("{}", serde_json::to_string_pretty(&out).expect("finite numbers"));
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&out).expect("finite numbers")
+        );
     } else {
         println!(
             "tools: {}    task: {}    ranked by: {}",

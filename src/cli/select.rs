@@ -3,17 +3,17 @@
 //! With the default `--models arm2` this is the 2-link selection of `toolconf::select`, output
 //! unchanged; with other models the set is drawn and ranked by `toolconf::model::mixed`.
 
+use rayon::prelude::*;
 use serde_json::{json, Value};
+use toolconf::closed_loop::EpisodeOptions;
 use toolconf::model::mixed::{
     draw_mixed_tools, evaluate_mixed, MixedObjective, MixedResult, ModelKind,
 };
+use toolconf::model::Arm2;
+use toolconf::rank::ModelTasks;
 use toolconf::select::{
     choose_by_mpc_cost, draw_tools, evaluate, evaluate_mpc, Objective, ToolResult,
 };
-use rayon::prelude::*;
-use toolconf::closed_loop::EpisodeOptions;
-use toolconf::model::Arm2;
-use toolconf::rank::ModelTasks;
 use toolconf::task_file::TaskSpec;
 use toolconf::Task;
 

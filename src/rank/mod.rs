@@ -93,14 +93,21 @@ impl ModelTasks {
 
     /// ln|Π^U| of `tool` (eq. control_conf): the cheap stage.
     pub fn logdet(&self, tool: &AnyTool) -> Result<f64, Error> {
-        with_model!(self, tool, |t, b| b.task.control_confidence(t).map(|c| c.logdet))
-            .map_err(|e| Error::Unsupported(e.to_string()))?
+        with_model!(self, tool, |t, b| b
+            .task
+            .control_confidence(t)
+            .map(|c| c.logdet))
+        .map_err(|e| Error::Unsupported(e.to_string()))?
     }
 
     /// The episode's metrics.
     pub fn simulate(&self, tool: &AnyTool) -> Result<Metrics, ModelSimulationError> {
-        with_model!(self, tool, |t, b| crate::model::simulate(t, b.task.task(), &b.options))
-            .map_err(|e| ModelSimulationError::Input(Error::Unsupported(e.to_string())))?
+        with_model!(self, tool, |t, b| crate::model::simulate(
+            t,
+            b.task.task(),
+            &b.options
+        ))
+        .map_err(|e| ModelSimulationError::Input(Error::Unsupported(e.to_string())))?
     }
 
     /// The task variable (θ, θ̇ or θ̈ as the task kind says) over time, with its goal.
@@ -142,7 +149,9 @@ where
     };
     Ok(TaskTrace {
         t: tr.t.clone(),
-        value: (0..N).map(|j| series.iter().map(|v| v[j]).collect()).collect(),
+        value: (0..N)
+            .map(|j| series.iter().map(|v| v[j]).collect())
+            .collect(),
         goal: goal.iter().copied().collect(),
     })
 }
@@ -212,7 +221,8 @@ impl Screen {
         self.read += 1;
         if let Err(e) = &candidate.logdet {
             self.without_confidence += 1;
-            self.first_confidence_error.get_or_insert_with(|| e.to_string());
+            self.first_confidence_error
+                .get_or_insert_with(|| e.to_string());
         }
         let Some(k) = self.limit else {
             self.all.push(candidate);
@@ -224,7 +234,11 @@ impl Screen {
         let entry = Screened { logdet, candidate };
         if self.heap.len() < k {
             self.heap.push(Reverse(entry));
-        } else if self.heap.peek().is_some_and(|Reverse(worst)| entry > *worst) {
+        } else if self
+            .heap
+            .peek()
+            .is_some_and(|Reverse(worst)| entry > *worst)
+        {
             self.heap.pop();
             self.heap.push(Reverse(entry));
         }
@@ -324,10 +338,58 @@ mod tests {
     }
 
     #[test]
+    fn failed_episodes_rank_last_in_file_order_and_ties_keep_file_order() {
+        let metrics = |free_energy: f64| Metrics {
+            task_error: 1.0,
+            free_energy,
+            cost_j: 2.0 * free_energy,
+            logdet: -free_energy,
+            rhs_evals: 0,
+            steps: 0,
+            rejected_steps: 0,
+            jacobian_evals: 0,
+            factorisations: 0,
+            control_effort: 0.0,
+        };
+        let failed = Err(ModelSimulationError::Input(Error::Unsupported("x".into())));
+        let results: Vec<RankedTool> = [
+            (1, failed.clone()),
+            (2, Ok(metrics(3.0))),
+            (3, Ok(metrics(1.0))),
+            (4, failed),
+            (5, Ok(metrics(1.0))),
+        ]
+        .into_iter()
+        .map(|(row, episode)| RankedTool {
+            row: candidate(row, Ok(0.0)).row,
+            logdet: Ok(0.0),
+            episode,
+        })
+        .collect();
+        let rows = |o: Objective| -> Vec<usize> {
+            ranking(&results, o)
+                .iter()
+                .map(|&i| results[i].row.row)
+                .collect()
+        };
+        assert_eq!(rows(Objective::FreeEnergy), [3, 5, 2, 1, 4]);
+        assert_eq!(rows(Objective::CostJ), [3, 5, 2, 1, 4]);
+        // Confidence ranks the largest ln|Π^U| (here −F) first.
+        assert_eq!(rows(Objective::Confidence), [3, 5, 2, 1, 4]);
+    }
+
+    #[test]
     fn the_screen_keeps_the_most_confident_and_the_earlier_on_ties() {
         let mut screen = Screen::new(Some(2));
         let bad = Err(Error::NotPositiveDefinite { determinant: 0.0 });
-        for (row, l) in [(1, Ok(1.0)), (2, Ok(3.0)), (3, bad), (4, Ok(2.0)), (5, Ok(3.0)), (6, Ok(0.5))] {
+        for (row, l) in [
+            (1, Ok(1.0)),
+            (2, Ok(3.0)),
+            (3, bad),
+            (4, Ok(2.0)),
+            (5, Ok(3.0)),
+            (6, Ok(0.5)),
+        ] {
             screen.push(candidate(row, l));
         }
         assert_eq!((screen.read, screen.without_confidence), (6, 1));

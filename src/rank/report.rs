@@ -85,7 +85,10 @@ fn introduction(input: &ReportInput) -> Vec<Block> {
         None => format!("All {} tools were simulated.", input.read),
     };
     let skipped = if input.skipped > 0 {
-        format!(" {} bad rows were skipped (`--skip-bad-rows`).", input.skipped)
+        format!(
+            " {} bad rows were skipped (`--skip-bad-rows`).",
+            input.skipped
+        )
     } else {
         String::new()
     };
@@ -143,7 +146,8 @@ fn objective_words(o: Objective) -> &'static str {
 
 fn task_table(input: &ReportInput) -> Vec<Block> {
     let e = &input.spec.episode;
-    let or_default = |v: Option<f64>, d: &str| v.map_or(format!("{d} (default)"), |v| v.to_string());
+    let or_default =
+        |v: Option<f64>, d: &str| v.map_or(format!("{d} (default)"), |v| v.to_string());
     let rows = vec![
         vec!["task kind".into(), input.spec.kind.to_string()],
         vec!["episode length t_end [s]".into(), or_default(e.t_end, "5")],
@@ -192,7 +196,11 @@ fn ranking_table(input: &ReportInput) -> Vec<Block> {
             .collect();
         let logdet = r.logdet.as_ref().map_or("–".into(), |l| number(*l));
         let metrics = match &r.episode {
-            Ok(m) => vec![number(m.task_error), number(m.free_energy), number(m.cost_j)],
+            Ok(m) => vec![
+                number(m.task_error),
+                number(m.free_energy),
+                number(m.cost_j),
+            ],
             Err(e) => vec![format!("failed: {e}"), String::new(), String::new()],
         };
         let mut row = vec![
@@ -216,7 +224,16 @@ fn ranking_table(input: &ReportInput) -> Vec<Block> {
         )));
     }
     blocks.push(Block::table(
-        &["rank", "tool", "model", "parameters", "ln|Π^U|", "task error", "∫F dt", "∫J dt"],
+        &[
+            "rank",
+            "tool",
+            "model",
+            "parameters",
+            "ln|Π^U|",
+            "task error",
+            "∫F dt",
+            "∫J dt",
+        ],
         rows,
     ));
     blocks
@@ -229,7 +246,12 @@ fn confidence_figure(dir: &Path, input: &ReportInput) -> Result<Vec<Block>, Repr
     let points: Vec<(f64, f64)> = input
         .results
         .iter()
-        .filter_map(|r| Some((*r.logdet.as_ref().ok()?, r.episode.as_ref().ok()?.task_error)))
+        .filter_map(|r| {
+            Some((
+                *r.logdet.as_ref().ok()?,
+                r.episode.as_ref().ok()?.task_error,
+            ))
+        })
         .collect();
     let (x, y): (Vec<f64>, Vec<f64>) = points.iter().copied().unzip();
     let panel = XyPanel {
@@ -296,8 +318,16 @@ fn trajectory_figure(dir: &Path, input: &ReportInput) -> Result<Vec<Block>, Repr
         .take(TRACED)
         .collect();
     let (var, axis) = variable(input.spec.kind);
-    const BEST: [Colour; TRACED] = [Colour(0, 90, 200), Colour(60, 150, 230), Colour(120, 190, 240)];
-    const WORST: [Colour; TRACED] = [Colour(200, 30, 30), Colour(230, 110, 60), Colour(240, 170, 110)];
+    const BEST: [Colour; TRACED] = [
+        Colour(0, 90, 200),
+        Colour(60, 150, 230),
+        Colour(120, 190, 240),
+    ];
+    const WORST: [Colour; TRACED] = [
+        Colour(200, 30, 30),
+        Colour(230, 110, 60),
+        Colour(240, 170, 110),
+    ];
     let mut traces: Vec<(String, Colour, bool, TaskTrace)> = Vec::new();
     let mut notes = Vec::new();
     for (group, colours, dashed) in [(&best, BEST, false), (&worst, WORST, true)] {
@@ -320,7 +350,10 @@ fn trajectory_figure(dir: &Path, input: &ReportInput) -> Result<Vec<Block>, Repr
                     let s = Series::new(
                         label.clone(),
                         *colour,
-                        t.t.iter().copied().zip(t.value[j].iter().copied()).collect(),
+                        t.t.iter()
+                            .copied()
+                            .zip(t.value[j].iter().copied())
+                            .collect(),
                     );
                     if *dashed {
                         s.dashed()
@@ -332,8 +365,12 @@ fn trajectory_figure(dir: &Path, input: &ReportInput) -> Result<Vec<Block>, Repr
             if let Some((_, _, _, t)) = traces.iter().find(|t| j < t.3.value.len()) {
                 let end = t.t.last().copied().unwrap_or(0.0);
                 lines.push(
-                    Series::new("goal", plot::GOAL_GREY, vec![(0.0, t.goal[j]), (end, t.goal[j])])
-                        .dashed(),
+                    Series::new(
+                        "goal",
+                        plot::GOAL_GREY,
+                        vec![(0.0, t.goal[j]), (end, t.goal[j])],
+                    )
+                    .dashed(),
                 );
             }
             Panel::Xy(XyPanel {
