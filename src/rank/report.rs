@@ -12,7 +12,7 @@ use crate::experiments::report::{to_html, to_markdown, Block};
 use crate::experiments::{write_atomically, ReproduceError};
 use crate::select::Objective;
 use crate::stats::spearman;
-use crate::task_file::TaskSpec;
+use crate::task_file::{PerJoint, PrecisionSpec, TaskSpec};
 use crate::TaskKind;
 
 /// What the report describes.
@@ -144,26 +144,83 @@ fn objective_words(o: Objective) -> &'static str {
     }
 }
 
+fn per_joint(p: &PerJoint) -> String {
+    match p {
+        PerJoint::All(x) => format!("{x} on every joint"),
+        PerJoint::Each(v) => format!("{v:?} (joint by joint)"),
+    }
+}
+
+fn precision(p: &PrecisionSpec) -> String {
+    match p {
+        PrecisionSpec::Scalar(s) => format!("{s}·I"),
+        PrecisionSpec::Matrix(rows) => format!("{rows:?}"),
+    }
+}
+
+/// What the task sets, in words; what it leaves out is each model's paper value.
 fn task_table(input: &ReportInput) -> Vec<Block> {
-    let e = &input.spec.episode;
-    let or_default =
-        |v: Option<f64>, d: &str| v.map_or(format!("{d} (default)"), |v| v.to_string());
-    let rows = vec![
-        vec!["task kind".into(), input.spec.kind.to_string()],
-        vec!["episode length t_end [s]".into(), or_default(e.t_end, "5")],
-        vec!["output step dt [s]".into(), or_default(e.dt, "0.05")],
-        vec![
-            "torque perturbation ΔT [N m]".into(),
-            e.perturbation
-                .as_ref()
-                .map_or("0 (default)".into(), |p| format!("{p:?}")),
-        ],
-        vec!["learning rate γ".into(), or_default(e.learning_rate, "1")],
-    ];
+    let spec = input.spec;
+    let e = &spec.episode;
+    let paper = "the paper's (per model)";
+    let given = |v: Option<String>, default: &str| v.unwrap_or_else(|| default.to_string());
+    let vector = |v: &Option<Vec<f64>>| v.as_ref().map(|v| format!("{v:?}"));
+    let number = |v: Option<f64>| v.map(|v| v.to_string());
+    let mut rows = vec![vec!["task kind".to_string(), spec.kind.to_string()]];
+    let mut add = |name: &str, value: String| rows.push(vec![name.to_string(), value]);
+    if spec.kind == TaskKind::Position {
+        add("goal θ [rad]", given(vector(&spec.goal_theta), paper));
+        add(
+            "precision P^θ",
+            given(spec.precision_theta.as_ref().map(precision), paper),
+        );
+    }
+    if spec.kind != TaskKind::Acceleration {
+        add("goal θ̇ [rad/s]", given(vector(&spec.goal_theta_dot), paper));
+        add(
+            "precision P^θ̇",
+            given(spec.precision_theta_dot.as_ref().map(precision), paper),
+        );
+    }
+    add(
+        "goal θ̈ [rad/s²]",
+        given(vector(&spec.goal_theta_ddot), paper),
+    );
+    add(
+        "precision P^θ̈",
+        given(spec.precision_theta_ddot.as_ref().map(precision), paper),
+    );
+    add(
+        "precision P^U",
+        given(spec.precision_u.as_ref().map(precision), paper),
+    );
+    add("episode length t_end [s]", given(number(e.t_end), "5"));
+    add("output step dt [s]", given(number(e.dt), "0.05"));
+    add(
+        "constant torque perturbation ΔT [N m]",
+        given(e.perturbation.as_ref().map(per_joint), "0"),
+    );
+    add(
+        "initial joint angles [rad]",
+        given(vector(&e.initial_theta), "hanging straight down"),
+    );
+    add(
+        "initial joint velocities [rad/s]",
+        given(vector(&e.initial_theta_dot), "0"),
+    );
+    add(
+        "initial torque U0 [N m]",
+        given(
+            e.initial_torque.as_ref().map(per_joint),
+            "0.1 on every joint",
+        ),
+    );
+    add("learning rate γ", given(number(e.learning_rate), "1"));
     vec![
         Block::p(
-            "The task's goals and precisions (weights) are those of the task file; what it \
-             leaves out is the paper's value for each tool's model."
+            "The task: a precision P weighs an error term (a larger P means the controller \
+             cares more about it; P·I weighs every joint alike). What the task file leaves out \
+             is the paper's value."
                 .to_string(),
         ),
         Block::table(&["setting", "value"], rows),
