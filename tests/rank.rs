@@ -752,6 +752,22 @@ fn every_bad_task_file_is_refused_naming_file_key_and_value() {
             expected,
         );
     }
+    // Precisions that leave Π^U singular for every tool.
+    let task = write(
+        &dir,
+        "singular.toml",
+        "kind = \"acceleration\"\n[precision]\ntheta_ddot = 0.0\nu = 0.0\n",
+    );
+    assert_refused(
+        &dir,
+        &["rank", "--tools", DRAWER, "--task", &task],
+        &[
+            "singular.toml",
+            "no tool",
+            "has a control confidence",
+            "not positive definite",
+        ],
+    );
     // A two-joint goal for a three-joint tool.
     let task = write(
         &dir,
@@ -877,6 +893,20 @@ fn simulate_confidence_and_select_take_a_task_file() {
     ]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("key goal.theta"));
+    // simulate's 2-link arm with a three-joint goal.
+    let dir = scratch("simulate_file");
+    let task = write(
+        &dir,
+        "three.toml",
+        "kind = \"position\"\n[goal]\ntheta = [0.1, 0.2, 0.3]\n",
+    );
+    let out = toolconf(&["simulate", "--arm", "0.3,0.4,0.5,0.2", "--task-file", &task]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("three.toml, key goal.theta: 3 values"),
+        "{stderr}"
+    );
     // select's 2-link tools carry one ΔT for both joints: a per-joint one is refused, with status 2.
     let out = toolconf(&["select", "--task-file", REACH_TASK, "--tools", "3"]);
     assert_eq!(out.status.code(), Some(2));

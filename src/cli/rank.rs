@@ -122,6 +122,14 @@ fn screen_tools(args: &Args, tasks: &ModelTasks) -> Result<(Screen, usize), CliE
             "{tools_file}: no valid tools (all {skipped} rows were bad)"
         )));
     }
+    if screen.without_confidence == screen.read {
+        // The task's precisions, not the tools, are at fault: say so before simulating.
+        return Err(CliError::Usage(format!(
+            "task {}: no tool of {tools_file} has a control confidence: {}",
+            args.task,
+            screen.first_confidence_error.as_deref().unwrap_or("")
+        )));
+    }
     Ok((screen, skipped))
 }
 

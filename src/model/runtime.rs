@@ -175,7 +175,8 @@ impl<P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>
 where
     P: ArmModel<N, NX, NP, NZ>,
 {
-    /// The closed loop of `tool` (controller model `M`) on plant `P`.
+    /// The closed loop of `tool` (controller model `M`) on plant `P`, with the same ΔT on every
+    /// joint.
     pub fn new<M>(
         tool: &ToolN<M, N, NX, NP, NZ>,
         task: &TaskN<N>,
@@ -185,14 +186,6 @@ where
     where
         M: ArmModel<N, NX, NP, NZ>,
     {
-        #[allow(clippy::let_unit_value)]
-        let () = Dims::<N, NX, NZ>::CHECK;
-        if !perturbation.is_finite() {
-            return Err(Error::InvalidOption {
-                name: "perturbation dT",
-                value: perturbation,
-            });
-        }
         Self::with_perturbation(tool, task, learning_rate, &SVector::repeat(perturbation))
     }
 
