@@ -265,12 +265,23 @@ fn print_table(results: &[RankedTool], order: &[usize]) {
     }
 }
 
+/// What the cheap stage counted, for the output.
+struct Counts {
+    read: usize,
+    skipped: usize,
+    without_confidence: usize,
+}
+
 pub fn run(args: &Args) -> Result<(), CliError> {
     let spec = task_spec(&args.task)?;
     let tasks = ModelTasks::new(&spec);
     let objective = Objective::from(args.objective);
     let (screen, skipped) = screen_tools(args, &tasks)?;
-    let (read, without_confidence) = (screen.read, screen.without_confidence);
+    let counts = Counts {
+        read: screen.read,
+        skipped,
+        without_confidence: screen.without_confidence,
+    };
     let candidates = screen.finish();
     if let Some(dir) = &args.report {
         std::fs::create_dir_all(dir).map_err(|source| CliError::Io {
@@ -278,6 +289,47 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             source,
         })?;
     }
+    let results = simulate_streaming(args, candidates, &tasks)?;
+    let order = ranking(&results, objective);
+    if args.json {
+        print_json(args, &spec, objective, &counts, &results, &order);
+    } else {
+        print_text(args, &spec, objective, &counts, &results, &order);
+    }
+    if let Some(dir) = &args.report {
+        let command: Vec<String> = std::env::args().collect();
+        let input = ReportInput {
+            command: &command.join(" "),
+            tools_file: &args.tools.display().to_string(),
+            spec: &spec,
+            tasks: &tasks,
+            objective,
+            read: counts.read,
+            skipped: counts.skipped,
+            screen: args.screen.map(|k| k as usize),
+            results: &results,
+            order: &order,
+        };
+        let files = write_report(dir, &input)?;
+        if !args.json {
+            println!("report: {}", files[1].display());
+        }
+    }
+    if results.iter().all(|r| r.episode.is_err()) {
+        return Err(CliError::Failed(format!(
+            "every one of the {} simulated tools failed",
+            results.len()
+        )));
+    }
+    Ok(())
+}
+
+/// The expensive stage, each result written to `--csv` (file order) as its chunk finishes.
+fn simulate_streaming(
+    args: &Args,
+    candidates: Vec<Candidate>,
+    tasks: &ModelTasks,
+) -> Result<Vec<RankedTool>, CliError> {
     let columns = parameter_columns(&candidates);
     let mut csv = match &args.csv {
         Some(path) => {
@@ -296,7 +348,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         None => None,
     };
     let bar = progress(candidates.len());
-    let results = simulate_all(candidates, &tasks, |r| {
+    let results = simulate_all(candidates, tasks, |r| {
         bar.inc(1);
         match csv.as_mut() {
             Some(w) => w.row(csv_cells(r, &columns)),
@@ -304,70 +356,64 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         }
     })?;
     bar.finish_and_clear();
-    let order = ranking(&results, objective);
-    if args.json {
-        let out = json!({
-            "task": spec.kind,
-            "task_file": (!spec.file.is_empty()).then_some(&spec.file),
-            "tools_file": args.tools,
-            "objective": objective.name(),
-            "tools_read": read,
-            "skipped_rows": skipped,
-            "screen": args.screen,
-            "without_confidence": without_confidence,
-            "simulated": results.len(),
-            "tools": order
-                .iter()
-                .enumerate()
-                .map(|(k, &i)| tool_json(k + 1, &results[i]))
-                .collect::<Vec<_>>(),
-        });
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&out).expect("finite numbers")
-        );
-    } else {
-        println!(
-            "tools: {}    task: {}    ranked by: {}",
-            args.tools.display(),
-            spec.label(),
-            objective.name()
-        );
-        let screened = args.screen.map_or(String::new(), |k| {
-            format!("    screened to the {k} most confident ({without_confidence} without a confidence)")
-        });
-        println!(
-            "read {read} tools    skipped {skipped} bad rows    simulated {}{screened}",
-            results.len()
-        );
-        print_table(&results, &order);
-    }
-    if let Some(dir) = &args.report {
-        let command: Vec<String> = std::env::args().collect();
-        let files = write_report(
-            dir,
-            &ReportInput {
-                command: &command.join(" "),
-                tools_file: &args.tools.display().to_string(),
-                spec: &spec,
-                tasks: &tasks,
-                objective,
-                read,
-                skipped,
-                screen: args.screen.map(|k| k as usize),
-                results: &results,
-                order: &order,
-            },
-        )?;
-        if !args.json {
-            println!("report: {}", files[1].display());
-        }
-    }
-    if results.iter().all(|r| r.episode.is_err()) {
-        return Err(CliError::Failed(format!(
-            "every one of the {} simulated tools failed",
-            results.len()
-        )));
-    }
-    Ok(())
+    Ok(results)
+}
+
+fn print_json(
+    args: &Args,
+    spec: &TaskSpec,
+    objective: Objective,
+    counts: &Counts,
+    results: &[RankedTool],
+    order: &[usize],
+) {
+    let out = json!({
+        "task": spec.kind,
+        "task_file": (!spec.file.is_empty()).then_some(&spec.file),
+        "tools_file": args.tools,
+        "objective": objective.name(),
+        "tools_read": counts.read,
+        "skipped_rows": counts.skipped,
+        "screen": args.screen,
+        "without_confidence": counts.without_confidence,
+        "simulated": results.len(),
+        "tools": order
+            .iter()
+            .enumerate()
+            .map(|(k, &i)| tool_json(k + 1, &results[i]))
+            .collect::<Vec<_>>(),
+    });
+    println!(
+        "{}",
+        serde_json::to_string_pretty(&out).expect("finite numbers")
+    );
+}
+
+fn print_text(
+    args: &Args,
+    spec: &TaskSpec,
+    objective: Objective,
+    counts: &Counts,
+    results: &[RankedTool],
+    order: &[usize],
+) {
+    println!(
+        "tools: {}    task: {}    ranked by: {}",
+        args.tools.display(),
+        spec.label(),
+        objective.name()
+    );
+    let screened = args.screen.map_or(String::new(), |k| {
+        format!(
+            "    screened to the {k} most confident ({} without a confidence)",
+            counts.without_confidence
+        )
+    });
+    println!(
+        "read {} tools    skipped {} bad rows    simulated {}{screened}",
+        counts.read,
+        counts.skipped,
+        results.len()
+    );
+    print_table(results, order);
 }
