@@ -2,8 +2,6 @@
 SHELL := /bin/bash
 VENV := derive/.venv
 PY := $(VENV)/bin/python
-MODELS := $(wildcard derive/models/*.toml)
-IRS := $(patsubst derive/models/%.toml,generated/%.json,$(MODELS))
 # Deterministic derivation: the same inputs give byte-identical generated files.
 export PYTHONHASHSEED := 0
 
@@ -19,8 +17,10 @@ run:
 bench:
 	cargo bench --bench confidence --bench episode --bench stiff --bench reproduce
 
-## make test: the whole suite, including the check that `make derive` leaves generated/ unchanged.
+## make test: the whole suite: `make derive` reproduces generated/ byte for byte (on this CPU and
+## on an imitated older one), the derivation's own tests, then the crate's.
 test: drift-check
+	$(PY) -m unittest discover --start-directory derive/tests
 	cargo test --workspace --quiet
 
 venv: $(PY)
@@ -30,21 +30,16 @@ $(PY): derive/requirements.txt
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r derive/requirements.txt
 	touch $(PY)
 
-## make derive: model descriptions -> SymPy (checked by CasADi) -> JSON IR -> Tera -> rustfmt.
+## make derive: model descriptions -> SymPy (checked by CasADi) -> JSON IR + test vectors -> Tera
+## -> rustfmt, into generated/ (and the renderer's fixture in tests/fixtures/).
 derive: $(PY)
-	@for m in $(MODELS); do \
-	  $(PY) derive/derive.py $$m --out generated/$$(basename $$m .toml).json || exit 1; \
-	done
-	$(PY) derive/derive.py tests/fixtures/pendulum.toml --out tests/fixtures/pendulum.json --vectors 3
-	cargo run --quiet -p toolconf-render -- $(IRS) --templates templates --out generated
+	$(PY) derive/pipeline.py
 
-## make drift-check: regenerate and fail if anything generated differs from what is committed.
-drift-check: derive
-	@if [ -n "$$(git status --porcelain -- generated tests/fixtures)" ]; then \
-	  git status --short -- generated tests/fixtures; git --no-pager diff --stat -- generated tests/fixtures; \
-	  echo "drift-check: make derive changed generated files: commit them (after review)"; exit 1; \
-	fi
-	@echo "drift-check: generated/ is what make derive produces"
+## make drift-check: derive into a temporary folder, twice: as this CPU does, and with numpy's
+## optional kernels (AVX-512, AVX2, ...) and glibc's AVX/FMA variants switched off; fail, naming
+## each file and its first differing line, if either differs from what is committed.
+drift-check: $(PY)
+	$(PY) derive/pipeline.py --check --portability
 
 clean-venv:
 	rm -rf $(VENV)

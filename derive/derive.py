@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Derive a model: read its description, derive it with SymPy, check it against CasADi, and write
-the JSON IR that toolconf-render turns into generated/<model>.rs and generated/<model>.md.
+the JSON IR that toolconf-render turns into generated/<model>.rs and generated/<model>.md, and
+beside it the CasADi test vectors (<name>.vectors.json for --out <name>.json).
 
     derive/.venv/bin/python derive/derive.py derive/models/arm2.toml --out generated/arm2.json
 
@@ -20,40 +21,77 @@ sys.path.insert(0, str(HERE))
 from toolconf_derive.crosscheck import DerivationMismatch  # noqa: E402
 from toolconf_derive.description import DescriptionError, load_model, load_tasks  # noqa: E402
 from toolconf_derive.functions import build_functions  # noqa: E402
-from toolconf_derive.ir import model_ir  # noqa: E402
+from toolconf_derive.exact import ExactEvaluationError  # noqa: E402
+from toolconf_derive.ir import model_ir, vectors_document  # noqa: E402
 from toolconf_derive.numeric import CasadiModel  # noqa: E402
 from toolconf_derive.report import report_data  # noqa: E402
 from toolconf_derive.symbolic import derive  # noqa: E402
+
+
+def shown(path: Path, root: Path) -> str:
+    """A path as the generated files name it: relative to the repository when inside it, so the
+    bytes do not depend on where the checkout is."""
+    resolved = path.resolve()
+    return str(resolved.relative_to(root)) if resolved.is_relative_to(root) else str(path)
+
+
+def vectors_path(out: Path) -> Path:
+    return out.with_name(out.name.removesuffix(".json") + ".vectors.json")
+
+
+def write(path: Path, document: dict) -> None:
+    path.write_text(json.dumps(document, indent=1, ensure_ascii=False) + "\n")
 
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("model", type=Path, help="model description (TOML)")
     ap.add_argument("--tasks", type=Path, default=HERE / "tasks.toml", help="task definitions (TOML)")
-    ap.add_argument("--out", type=Path, required=True, help="where to write the JSON IR")
+    ap.add_argument("--out", type=Path, required=True,
+                    help="where to write the JSON IR (any path ending in .json; the vectors go beside it)")
     ap.add_argument("--vectors", type=int, default=100, help="test vectors per function (default 100)")
     args = ap.parse_args()
     root = HERE.parent
+    if args.out.suffix != ".json":
+        print(f"derive: --out {args.out}: the IR's file name must end in .json", file=sys.stderr)
+        return 2
+    if not args.out.parent.is_dir():
+        print(f"derive: --out {args.out}: the folder {args.out.parent} does not exist", file=sys.stderr)
+        return 2
+    if args.vectors < 1:
+        print(f"derive: --vectors {args.vectors}: need at least one test vector per function", file=sys.stderr)
+        return 2
+    vectors_out = vectors_path(args.out)
     try:
         model = load_model(args.model)
         tasks = load_tasks(args.tasks)
         d = derive(model, tasks)
         functions = build_functions(d, CasadiModel(model))
+        # Names, not the paths written to: the same bytes wherever --out points (the drift check
+        # derives into a temporary folder and compares).
         generator = {
             "command": "make derive",
-            "model": str(args.model.resolve().relative_to(root)),
-            "tasks": str(args.tasks.resolve().relative_to(root)),
-            "ir": str(args.out.resolve().relative_to(root)),
+            "model": shown(args.model, root),
+            "tasks": shown(args.tasks, root),
+            "ir": args.out.name,
+            "vectors": vectors_out.name,
             "derive": "derive/derive.py (SymPy derives, CasADi checks)",
             "render": "derive/render (Tera) + rustfmt",
         }
         ir = model_ir(d, functions, generator, report_data(d), args.vectors)
-    except (DescriptionError, DerivationMismatch) as err:
+        vectors = vectors_document(d, functions, generator, args.vectors)
+    except (DescriptionError, DerivationMismatch, ExactEvaluationError) as err:
         print(f"derive: {err}", file=sys.stderr)
         return 1
-    args.out.write_text(json.dumps(ir, indent=1, ensure_ascii=False) + "\n")
-    checked = sum(len(f["test_vectors"]) for f in ir["functions"])
-    print(f"derive: {model.name}: {len(ir['functions'])} functions, {checked} points checked SymPy = CasADi -> {args.out}")
+    try:
+        write(args.out, ir)
+        write(vectors_out, vectors)
+    except OSError as err:
+        print(f"derive: cannot write {err.filename}: {err.strerror}", file=sys.stderr)
+        return 1
+    checked = sum(len(f["vectors"]) for f in vectors["functions"])
+    print(f"derive: {model.name}: {len(ir['functions'])} functions, {checked} points checked SymPy = CasADi "
+          f"-> {args.out}, {vectors_out}")
     return 0
 
 

@@ -29,6 +29,14 @@ pub enum Error {
         points: f64,
         max: usize,
     },
+    /// A tool given with the wrong number of parameters for its model.
+    #[error("model {model} takes {expected} parameters ({names}), got {found}")]
+    ParameterCount {
+        model: &'static str,
+        expected: usize,
+        names: String,
+        found: usize,
+    },
     /// A combination of options that is not supported, with the reason.
     #[error("unsupported: {0}")]
     Unsupported(String),

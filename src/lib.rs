@@ -15,6 +15,11 @@ pub mod closed_loop;
 pub mod confidence;
 pub mod error;
 pub mod experiments;
+/// The code `make derive` writes into `generated/`, included unchanged: one module per model
+/// (see `generated/<model>.md` for each derivation report) and the registry
+/// [`for_each_model!`]. Nobody edits these files: change a model description or the templates
+/// and run `make derive`.
+#[path = "../generated/mod.rs"]
 pub mod generated;
 pub mod integrate;
 pub mod model;

@@ -1,5 +1,6 @@
-//! The generated functions reproduce the CasADi-evaluated test vectors in generated/<model>.json
-//! (100 random valid points per function) to 1e-12, normwise relative per output:
+//! The generated functions reproduce the CasADi-evaluated test vectors in
+//! generated/<model>.vectors.json (100 random valid points per function, listed by the IR
+//! generated/<model>.json) to 1e-12, normwise relative per output:
 //! max|rust − casadi| ≤ 1e-12 · max|casadi|.
 
 use nalgebra::{SMatrix, SVector};
@@ -7,9 +8,22 @@ use serde_json::Value;
 
 const TOLERANCE: f64 = 1e-12;
 
-fn load(model: &str) -> Value {
-    let path = format!("{}/generated/{model}.json", env!("CARGO_MANIFEST_DIR"));
-    serde_json::from_str(&std::fs::read_to_string(&path).expect("read IR")).expect("parse IR")
+fn load(file: &str) -> Value {
+    let path = format!("{}/generated/{file}", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("read {path}: {e}"));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("parse {path}: {e}"))
+}
+
+/// The test vectors of one function, from the vectors file the IR names.
+fn vectors_of<'a>(vectors: &'a Value, name: &str) -> &'a Vec<Value> {
+    vectors["functions"]
+        .as_array()
+        .expect("functions")
+        .iter()
+        .find(|f| f["name"] == name)
+        .unwrap_or_else(|| panic!("no test vectors for {name}"))["vectors"]
+        .as_array()
+        .expect("vectors")
 }
 
 fn numbers(v: &Value) -> Vec<f64> {
@@ -85,12 +99,13 @@ macro_rules! evaluator {
     };
 }
 
-evaluator!(evaluate_arm2, arm2);
-evaluator!(evaluate_arm2_exact, arm2_exact);
-evaluator!(evaluate_arm3, arm3);
-
 fn check(model: &str, evaluate: fn(&str, &Value) -> Option<Vec<Vec<f64>>>) {
-    let ir = load(model);
+    let ir = load(&format!("{model}.json"));
+    let vectors_file = ir["test_vectors"]["file"]
+        .as_str()
+        .expect("IR names its vectors file");
+    assert_eq!(vectors_file, format!("{model}.vectors.json"));
+    let all_vectors = load(vectors_file);
     let functions = ir["functions"].as_array().expect("functions");
     assert!(
         functions.len() >= 10,
@@ -106,7 +121,7 @@ fn check(model: &str, evaluate: fn(&str, &Value) -> Option<Vec<Vec<f64>>>) {
             .iter()
             .map(|o| o["name"].as_str().unwrap())
             .collect();
-        let vectors = f["test_vectors"].as_array().expect("test vectors");
+        let vectors = vectors_of(&all_vectors, name);
         assert!(
             vectors.len() >= 100,
             "{name}: only {} test vectors",
@@ -134,17 +149,21 @@ fn check(model: &str, evaluate: fn(&str, &Value) -> Option<Vec<Vec<f64>>>) {
     assert!(checked >= 1000);
 }
 
-#[test]
-fn arm2_functions_match_casadi_vectors() {
-    check("arm2", evaluate_arm2);
+/// One test per generated model, from the registry: a new model description is checked here
+/// without an edit.
+macro_rules! vector_tests {
+    ($(($marker:ident, $module:ident, $tool:ident, $name:literal, $title:literal)),* $(,)?) => {
+        mod functions_match_casadi_vectors {
+            use super::*;
+            $(
+                #[test]
+                fn $module() {
+                    evaluator!(evaluate, $module);
+                    check($name, evaluate);
+                }
+            )*
+        }
+    };
 }
 
-#[test]
-fn arm2_exact_functions_match_casadi_vectors() {
-    check("arm2_exact", evaluate_arm2_exact);
-}
-
-#[test]
-fn arm3_functions_match_casadi_vectors() {
-    check("arm3", evaluate_arm3);
-}
+toolconf::for_each_model!(vector_tests);

@@ -4,11 +4,16 @@
 from __future__ import annotations
 
 import hashlib
+import math
 from dataclasses import dataclass
+from fractions import Fraction
 from typing import Callable
 
+import mpmath
 import numpy as np
 import sympy as sp
+
+from .exact import Exact
 
 from .numeric import CasadiModel
 from .symbolic import Derivation
@@ -48,13 +53,15 @@ class Function:
     equation: str
     args: list[Arg]
     outputs: list[Output]
-    casadi: Callable[[dict[str, np.ndarray]], list[np.ndarray]]
+    # CasADi's values at a sample, exactly (see exact.py): what the test vectors record.
+    casadi: Callable[[dict[str, np.ndarray]], list[Exact]]
     # Called ~10^3 times per episode with the same parameters: emit its parameter-only factors as
     # a per-tool coefficient struct and a `<name>_with` that takes it (see hoist.py).
     per_tool_coefficients: bool = False
 
     def rng(self) -> np.random.Generator:
-        """A generator seeded from the function's name, so test vectors are the same on every run."""
+        """A generator seeded from the function's name, so test vectors are the same on every run.
+        Only its integers are used (`integers`), which are the same on every CPU."""
         return np.random.default_rng(int(hashlib.sha256(self.name.encode()).hexdigest()[:16], 16))
 
 
@@ -62,35 +69,68 @@ def _vector_reads(symbols: list[sp.Symbol]) -> list[tuple[sp.Symbol, int, int]]:
     return [(s, i, 0) for i, s in enumerate(symbols)]
 
 
+# Test points are exactly representable dyadic rationals built from the seeded generator's
+# integers alone: no transcendental function or LAPACK call touches them, so they are the same
+# bits on every CPU (numpy's vectorised exp/log and LAPACK's kernels differ in the last bit
+# between AVX-512, AVX2 and SSE machines).
+GRID = 2.0 ** -16          # states and controls: multiples of 2^-16
+PARAMETER_BITS = 24         # parameters: 24 significant bits
+
+
+def _grid_uniform(rng: np.random.Generator, lo: float, hi: float, n: int, step: float = GRID) -> np.ndarray:
+    """n multiples of `step` drawn uniformly from [lo, hi]."""
+    return rng.integers(math.ceil(lo / step), math.floor(hi / step), size=n, endpoint=True) * step
+
+
+def _log_uniform(rng: np.random.Generator, lo: float, hi: float, n: int) -> np.ndarray:
+    """n values log-uniform in [lo, hi]: exp of a uniform 2^-32 grid point, in 30-digit integer
+    arithmetic (mpmath), rounded to PARAMETER_BITS significant bits."""
+    with mpmath.workdps(30):
+        a, b = mpmath.log(mpmath.mpf(lo)), mpmath.log(mpmath.mpf(hi))
+        values = []
+        for k in rng.integers(0, 2**32, size=n, endpoint=True):
+            v = mpmath.exp(a + (b - a) * mpmath.mpf(int(k)) / 2**32)
+            e = int(mpmath.floor(mpmath.log(v, 2))) - PARAMETER_BITS + 1
+            values.append(math.ldexp(int(mpmath.nint(mpmath.ldexp(v, -e))), e))
+    return np.array(values)
+
+
 def _sample_parameters(k: int):
     # Half the points in the paper's domain [0.1, 0.6], half log-uniform over [0.02, 5] so the
     # closed forms are exercised well outside it.
     def sample(rng: np.random.Generator) -> np.ndarray:
-        if rng.random() < 0.5:
-            v = rng.uniform(0.1, 0.6, k)
+        if rng.integers(0, 2) == 0:
+            v = _grid_uniform(rng, 0.1, 0.6, k, 2.0 ** -PARAMETER_BITS)
         else:
-            v = np.exp(rng.uniform(np.log(0.02), np.log(5.0), k))
+            v = _log_uniform(rng, 0.02, 5.0, k)
         return v.reshape(k, 1)
     return sample
 
 
 def _sample_state(n: int):
     def sample(rng: np.random.Generator) -> np.ndarray:
-        return np.concatenate([rng.uniform(-np.pi, np.pi, n), rng.uniform(-3.0, 3.0, n)]).reshape(2 * n, 1)
+        return np.concatenate([_grid_uniform(rng, -math.pi, math.pi, n),
+                               _grid_uniform(rng, -3.0, 3.0, n)]).reshape(2 * n, 1)
     return sample
 
 
 def _sample_control(n: int):
-    return lambda rng: rng.uniform(-2.0, 2.0, (n, 1))
+    return lambda rng: _grid_uniform(rng, -2.0, 2.0, n).reshape(n, 1)
 
 
 def _sample_precision(n: int):
-    # A random symmetric positive-definite matrix with eigenvalues log-uniform in [1e-2, 1e2].
+    """A random symmetric positive-definite matrix P = L D L^T, exactly: L unit lower triangular
+    with entries k/8 (|k| <= 12), D diagonal with entries 2^e (e in [-7, 7], eigenvalues spread over
+    ~[1e-2, 1e2] like the precisions users give). Products and sums of these few-bit dyadics are
+    exact in double precision, which the sampler asserts."""
     def sample(rng: np.random.Generator) -> np.ndarray:
-        q, _ = np.linalg.qr(rng.normal(size=(n, n)))
-        lam = np.exp(rng.uniform(np.log(1e-2), np.log(1e2), n))
-        m = q @ np.diag(lam) @ q.T
-        return 0.5 * (m + m.T)
+        lower = [[Fraction(int(rng.integers(-12, 12, endpoint=True)), 8) if j < i else Fraction(int(i == j))
+                  for j in range(n)] for i in range(n)]
+        d = [Fraction(2) ** int(rng.integers(-7, 7, endpoint=True)) for _ in range(n)]
+        p = [[sum(lower[i][k] * d[k] * lower[j][k] for k in range(n)) for j in range(n)] for i in range(n)]
+        out = np.array([[float(x) for x in row] for row in p])
+        assert all(Fraction(out[i, j]) == p[i][j] for i in range(n) for j in range(n)), "inexact precision"
+        return out
     return sample
 
 
@@ -105,35 +145,32 @@ def build_functions(d: Derivation, cm: CasadiModel) -> list[Function]:
             _vector_reads(d.params), False, _sample_parameters(k))
     eqs = ", ".join(m.equations)
 
-    def flat(a: np.ndarray) -> np.ndarray:
-        return a.reshape(-1)
-
     fns = [
         Function(
             "dynamics",
             "The generative process X_dot = f(X, U; p): joint rates and the nonlinear joint accelerations.",
             eqs, [x, u, p], [Output("x_dot", "X_dot", d.f)],
-            lambda v: [np.array(cm.dynamics(flat(v["x"]), flat(v["u"]), flat(v["params"])))],
+            lambda v: cm.dynamics.checked(v["x"], v["u"], v["params"]),
             per_tool_coefficients=True,
         ),
         Function(
             "dynamics_jacobian",
             "Jacobians (df/dX, df/dU) of the generative process at any state and control.",
             eqs, [x, u, p], [Output("f_x", "df/dX", d.f_x), Output("f_u", "df/dU", d.f_u)],
-            lambda v: [np.array(j) for j in cm.jacobian(flat(v["x"]), flat(v["u"]), flat(v["params"]))],
+            lambda v: cm.jacobian.checked(v["x"], v["u"], v["params"]),
             per_tool_coefficients=True,
         ),
         Function(
             "state_matrix",
             "A = df/dX at the equilibrium (X^e, U^e): the generative model's state matrix.",
             "eq. (LTI)", [p], [Output("a", "A", d.a)],
-            lambda v: [np.array(cm.linearisation(flat(v["params"]))[0])],
+            lambda v: [cm.linearisation(v["params"])[0]],
         ),
         Function(
             "input_matrix",
             "B = df/dU at the equilibrium (X^e, U^e): the generative model's input matrix.",
             "eq. (LTI)", [p], [Output("b", "B", d.b)],
-            lambda v: [np.array(cm.linearisation(flat(v["params"]))[1])],
+            lambda v: [cm.linearisation(v["params"])[1]],
         ),
     ]
 
@@ -142,7 +179,7 @@ def build_functions(d: Derivation, cm: CasadiModel) -> list[Function]:
         terms = task.sensitivity_terms
 
         def sens_eval(v, task=task, terms=terms):
-            s = cm.sensitivity(task, flat(v["params"]))
+            s = cm.sensitivity_exact(task, v["params"])
             return [s[t] for t in terms]
 
         fns.append(Function(
@@ -162,7 +199,7 @@ def build_functions(d: Derivation, cm: CasadiModel) -> list[Function]:
 
         def conf_eval(v, task=task, terms=terms):
             prec = {t: v[f"p_{t}"] for t in terms + ["u"]}
-            return [cm.control_confidence(task, flat(v["params"]), prec)]
+            return [cm.control_confidence(task, v["params"], prec)]
 
         fns.append(Function(
             f"{task.name}_control_confidence",

@@ -13,7 +13,7 @@ from .hoist import hoist
 from .rust_printer import RustPrinter, float_literal
 from .symbolic import Derivation
 
-IR_SCHEMA = 2
+IR_SCHEMA = 3
 
 
 def _rust_type(shape: tuple[int, int]) -> str:
@@ -106,7 +106,7 @@ def _struct_name(function: str) -> str:
     return "".join(w.capitalize() for w in function.split("_")) + "Coefficients"
 
 
-def function_ir(fn: Function, d: Derivation, vectors: int) -> dict:
+def function_ir(fn: Function, d: Derivation) -> dict:
     declared = {s.name for s in d.params + list(d.constants) + d.x + d.u}
     for arg in fn.args:
         declared |= {s.name for s, _, _ in arg.reads}
@@ -178,16 +178,17 @@ def function_ir(fn: Function, d: Derivation, vectors: int) -> dict:
         "trig": code["trig"],
         "compounds": code["compounds"],
         "temporaries": code["temporaries"],
-        "test_vectors": test_vectors(fn, d, vectors),
     }
 
 
 def test_vectors(fn: Function, d: Derivation, count: int) -> list[dict]:
     """`count` random valid inputs and CasADi's outputs for them (row-major), after checking
-    that SymPy's closed forms give the same numbers: the derivation stops if they do not."""
+    that SymPy's closed forms give the same numbers: the derivation stops if they do not.
+    Inputs are exact dyadics and outputs CasADi's exact values rounded once to double, so the
+    numbers are the same on every machine (exact.py)."""
     rng = fn.rng()
     samples = [{a.name: a.sample(rng) for a in fn.args} for _ in range(count)]
-    reference = [[np.asarray(o, dtype=float) for o in fn.casadi(v)] for v in samples]
+    reference = [[o.to_numpy() for o in fn.casadi(v)] for v in samples]
     check_against_casadi(fn, d, samples, reference)
     return [
         {
@@ -199,7 +200,20 @@ def test_vectors(fn: Function, d: Derivation, count: int) -> list[dict]:
     ]
 
 
+def vectors_document(d: Derivation, functions: list[Function], generator: dict, count: int) -> dict:
+    """The test vectors file (generated/<model>.vectors.json), kept out of the IR so that a change
+    to a derivation reads as an IR and code diff, not as thousands of changed numbers."""
+    return {
+        "schema": IR_SCHEMA,
+        "generator": generator,
+        "model": d.model.name,
+        "tolerance": "max|rust - casadi| <= 1e-12 max|casadi| per output (tests/generated_vectors.rs)",
+        "functions": [{"name": fn.name, "vectors": test_vectors(fn, d, count)} for fn in functions],
+    }
+
+
 def model_ir(d: Derivation, functions: list[Function], generator: dict, report: dict, vectors: int) -> dict:
+    """The IR; `vectors` is the number of test vectors per function, which live in their own file."""
     m = d.model
     printer = RustPrinter()
     return {
@@ -233,6 +247,7 @@ def model_ir(d: Derivation, functions: list[Function], generator: dict, report: 
             }
             for t in d.tasks
         ],
-        "functions": [function_ir(fn, d, vectors) for fn in functions],
+        "functions": [function_ir(fn, d) for fn in functions],
+        "test_vectors": {"file": generator["vectors"], "per_function": vectors},
         "report": report,
     }

@@ -31,9 +31,13 @@ pub struct Args {
     /// Seed of the tool stream: the same seed draws the same tools.
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Models the tools are drawn from, comma-separated (arm2, arm2_exact, arm3). Per tool a
-    /// model is drawn, then its parameters; each tool runs its own model's version of the task.
-    #[arg(long, value_delimiter = ',', default_value = "arm2", value_parser = parse_model)]
+    /// Models the tools are drawn from, comma-separated (any generated model; the list is in
+    /// `--help`). Per tool a model is drawn, then its parameters; each tool runs its own model's
+    /// version of the task.
+    #[arg(long, value_delimiter = ',', default_value = "arm2", value_parser = parse_model,
+          long_help = format!("Models the tools are drawn from, comma-separated: any of {}. Per tool a \
+              model is drawn, then its parameters; each tool runs its own model's version of the task.",
+              toolconf::generated::MODEL_NAMES.join(", ")))]
     models: Vec<ModelKind>,
     #[command(flatten)]
     episode: EpisodeArgs,

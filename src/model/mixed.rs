@@ -28,56 +28,100 @@ use rand::{RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use super::{
-    control_confidence, simulate, simulate_on, Arm2, Arm2ExactTool, Arm2Tool, Arm3, Arm3Tool,
-    ArmModel, EpisodeOptionsN, ModelSimulationError, TaskN, ToolN,
-};
+use super::*;
 use crate::closed_loop::{EpisodeOptions, Metrics, Plant};
 use crate::generated;
 use crate::select::PARAMETER_RANGE;
 use crate::{Error, TaskKind};
 
-/// The models a mixed set can draw from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum ModelKind {
-    /// The paper's 2-DOF arm.
-    Arm2,
-    /// The exact 2-link Lagrangian arm.
-    Arm2Exact,
-    /// The 3-link Lagrangian arm.
-    Arm3,
+/// The mixed-set types over every generated model ([`crate::for_each_model!`]): [`ModelKind`]
+/// names a model, [`AnyTool`] holds a tool of any of them, and each dispatches by model.
+macro_rules! mixed_models {
+    ($(($marker:ident, $module:ident, $tool:ident, $name:literal, $title:literal)),* $(,)?) => {
+        /// The models a mixed set can draw from: every generated model.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        pub enum ModelKind {
+            $(#[doc = $title] $marker,)*
+        }
+
+        impl ModelKind {
+            pub const ALL: [ModelKind; generated::MODEL_NAMES.len()] = [$(ModelKind::$marker,)*];
+
+            /// The generated module's name.
+            pub fn name(self) -> &'static str {
+                match self { $(ModelKind::$marker => generated::$module::NAME,)* }
+            }
+
+            /// The control dimension n (joints).
+            pub fn dof(self) -> usize {
+                match self { $(ModelKind::$marker => generated::$module::DOF,)* }
+            }
+
+            /// The tool parameters' names, in the order a tool takes them.
+            pub fn parameter_names(self) -> &'static [&'static str] {
+                match self { $(ModelKind::$marker => &generated::$module::PARAMETER_NAMES,)* }
+            }
+        }
+
+        /// A tool of any model.
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        pub enum AnyTool {
+            $($marker($tool),)*
+        }
+
+        impl AnyTool {
+            pub fn model(&self) -> ModelKind {
+                match self { $(AnyTool::$marker(_) => ModelKind::$marker,)* }
+            }
+
+            /// (name, value) of every parameter, in the model's order.
+            pub fn named_parameters(&self) -> Vec<(&'static str, f64)> {
+                match self { $(AnyTool::$marker(t) => t.named_parameters().to_vec(),)* }
+            }
+
+            /// Builds a validated tool of `model` from its parameters in the model's order.
+            pub fn new(model: ModelKind, params: &[f64]) -> Result<Self, Error> {
+                let count = || Error::ParameterCount {
+                    model: model.name(),
+                    expected: model.parameter_names().len(),
+                    names: model.parameter_names().join(","),
+                    found: params.len(),
+                };
+                Ok(match model {
+                    $(ModelKind::$marker => {
+                        AnyTool::$marker(ToolN::new(params.try_into().map_err(|_| count())?)?)
+                    })*
+                })
+            }
+
+            /// ln|Π^U| and the episode on the tool's own paper-style `kind` task.
+            fn evaluate(&self, kind: TaskKind, common: &EpisodeOptions) -> Evaluation {
+                match self { $(AnyTool::$marker(t) => evaluate_one(t, kind, common),)* }
+            }
+        }
+
+        impl fmt::Display for AnyTool {
+            /// `model(m1=… m2=… …)`.
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                match self { $(AnyTool::$marker(t) => write!(f, "{t:?}"),)* }
+            }
+        }
+
+        impl MixedSampler {
+            fn draw(&mut self, model: ModelKind) -> AnyTool {
+                let valid = "parameters drawn from [0.1, 0.6) are valid";
+                match model {
+                    $(ModelKind::$marker => AnyTool::$marker(ToolN::new(self.parameters()).expect(valid)),)*
+                }
+            }
+        }
+    };
 }
 
-impl ModelKind {
-    pub const ALL: [ModelKind; 3] = [ModelKind::Arm2, ModelKind::Arm2Exact, ModelKind::Arm3];
+crate::for_each_model!(mixed_models);
 
-    /// The generated module's name.
-    pub fn name(self) -> &'static str {
-        match self {
-            ModelKind::Arm2 => generated::arm2::NAME,
-            ModelKind::Arm2Exact => generated::arm2_exact::NAME,
-            ModelKind::Arm3 => generated::arm3::NAME,
-        }
-    }
-
-    /// The tool parameters' names, in the order the model takes them.
-    pub fn parameter_names(self) -> &'static [&'static str] {
-        match self {
-            ModelKind::Arm2 => &generated::arm2::PARAMETER_NAMES,
-            ModelKind::Arm2Exact => &generated::arm2_exact::PARAMETER_NAMES,
-            ModelKind::Arm3 => &generated::arm3::PARAMETER_NAMES,
-        }
-    }
-
-    /// The control dimension n (joints).
-    pub fn dof(self) -> usize {
-        match self {
-            ModelKind::Arm2 => generated::arm2::DOF,
-            ModelKind::Arm2Exact => generated::arm2_exact::DOF,
-            ModelKind::Arm3 => generated::arm3::DOF,
-        }
-    }
-}
+/// ln|Π^U| and the episode's metrics of one tool.
+type Evaluation = (Result<f64, Error>, Result<Metrics, ModelSimulationError>);
 
 impl fmt::Display for ModelKind {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -93,62 +137,12 @@ impl FromStr for ModelKind {
         ModelKind::ALL
             .into_iter()
             .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown model '{s}': expected arm2, arm2_exact or arm3"))
-    }
-}
-
-/// A tool of any model.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum AnyTool {
-    Arm2(Arm2Tool),
-    Arm2Exact(Arm2ExactTool),
-    Arm3(Arm3Tool),
-}
-
-impl AnyTool {
-    pub fn model(&self) -> ModelKind {
-        match self {
-            AnyTool::Arm2(_) => ModelKind::Arm2,
-            AnyTool::Arm2Exact(_) => ModelKind::Arm2Exact,
-            AnyTool::Arm3(_) => ModelKind::Arm3,
-        }
-    }
-
-    /// (name, value) of every parameter, in the model's order.
-    pub fn named_parameters(&self) -> Vec<(&'static str, f64)> {
-        match self {
-            AnyTool::Arm2(t) => t.named_parameters().to_vec(),
-            AnyTool::Arm2Exact(t) => t.named_parameters().to_vec(),
-            AnyTool::Arm3(t) => t.named_parameters().to_vec(),
-        }
-    }
-
-    /// Builds a validated tool of `model` from its parameters in the model's order.
-    pub fn new(model: ModelKind, params: &[f64]) -> Result<Self, Error> {
-        fn array<const NP: usize>(model: ModelKind, params: &[f64]) -> Result<[f64; NP], Error> {
-            params.try_into().map_err(|_| Error::InvalidOption {
-                name: match model {
-                    ModelKind::Arm3 => "parameter count (arm3 takes 6)",
-                    _ => "parameter count (arm2 takes 4)",
-                },
-                value: params.len() as f64,
+            .ok_or_else(|| {
+                format!(
+                    "unknown model '{s}': expected one of {}",
+                    generated::MODEL_NAMES.join(", ")
+                )
             })
-        }
-        Ok(match model {
-            ModelKind::Arm2 => AnyTool::Arm2(ToolN::new(array(model, params)?)?),
-            ModelKind::Arm2Exact => AnyTool::Arm2Exact(ToolN::new(array(model, params)?)?),
-            ModelKind::Arm3 => AnyTool::Arm3(ToolN::new(array(model, params)?)?),
-        })
-    }
-}
-
-impl fmt::Display for AnyTool {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            AnyTool::Arm2(t) => write!(f, "{}({t})", Arm2::NAME),
-            AnyTool::Arm2Exact(t) => write!(f, "{t:?}"),
-            AnyTool::Arm3(t) => write!(f, "{}({t})", Arm3::NAME),
-        }
     }
 }
 
@@ -195,12 +189,7 @@ impl MixedSampler {
             let i = ((k as f64) * self.uniform()) as usize;
             self.models[i.min(k - 1)]
         };
-        let valid = "parameters drawn from [0.1, 0.6) are valid";
-        match model {
-            ModelKind::Arm2 => AnyTool::Arm2(ToolN::new(self.parameters()).expect(valid)),
-            ModelKind::Arm2Exact => AnyTool::Arm2Exact(ToolN::new(self.parameters()).expect(valid)),
-            ModelKind::Arm3 => AnyTool::Arm3(ToolN::new(self.parameters()).expect(valid)),
-        }
+        self.draw(model)
     }
 
     pub fn tools(&mut self, n: usize) -> Vec<AnyTool> {
@@ -241,7 +230,7 @@ fn evaluate_one<M, const N: usize, const NX: usize, const NP: usize, const NZ: u
     tool: &ToolN<M, N, NX, NP, NZ>,
     kind: TaskKind,
     common: &EpisodeOptions,
-) -> (Result<f64, Error>, Result<Metrics, ModelSimulationError>)
+) -> Evaluation
 where
     M: ArmModel<N, NX, NP, NZ>,
 {
@@ -276,9 +265,7 @@ pub fn evaluate_mixed(
                         simulate_on::<Arm2, super::Arm2Exact, 2, 4, 4, 6>(t, &task, &options),
                     )
                 }
-                AnyTool::Arm2(t) => evaluate_one(t, kind, common),
-                AnyTool::Arm2Exact(t) => evaluate_one(t, kind, common),
-                AnyTool::Arm3(t) => evaluate_one(t, kind, common),
+                other => other.evaluate(kind, common),
             };
             MixedResult {
                 index,

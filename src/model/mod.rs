@@ -6,8 +6,9 @@
 //! `Plant`, errors naming `arm m1=…`): they convert and delegate, so the math lives here once and
 //! nothing outside the generated 2-link model assumes 2×2.
 //!
-//! * [`ArmModel`] is implemented for the marker types [`Arm2`], [`Arm2Exact`] and [`Arm3`] by one
-//!   `arm_model!` line each, forwarding to the generated module (adding a model = one line).
+//! * [`ArmModel`] is implemented for one marker type per generated model ([`Arm2`],
+//!   [`Arm2Exact`], [`Arm3`], ...), forwarding to the generated module; the list comes from the
+//!   generated registry ([`crate::for_each_model!`]), so a new model description needs no edit here.
 //! * [`ToolN`] (validated parameters), [`TaskN`] (goals and precisions), [`control_confidence`]
 //!   (Π^U and ln|Π^U|), [`ActiveInferenceN`], [`ClosedLoopN`], [`simulate`]/[`simulate_on`]
 //!   (metrics) and [`episode`]/[`episode_on`] (metrics and trajectory). With [`Arm2`] they are
@@ -285,25 +286,27 @@ macro_rules! arm_model {
     };
 }
 
-arm_model!(
-    /// The paper's 2-DOF arm (`generated::arm2`).
-    Arm2 => arm2
-);
-arm_model!(
-    /// The exact 2-link Lagrangian arm (`generated::arm2_exact`).
-    Arm2Exact => arm2_exact
-);
-arm_model!(
-    /// The 3-link Lagrangian arm (`generated::arm3`).
-    Arm3 => arm3
-);
+/// One marker type, its [`ArmModel`] implementation and its tool alias per generated model.
+macro_rules! arm_models {
+    ($(($marker:ident, $module:ident, $tool:ident, $name:literal, $title:literal)),* $(,)?) => {
+        $(
+            arm_model!(
+                #[doc = concat!($title, " (`generated::", $name, "`).")]
+                $marker => $module
+            );
+            #[doc = concat!("A tool of the `", $name, "` model.")]
+            pub type $tool = ToolN<
+                $marker,
+                { generated::$module::DOF },
+                { generated::$module::STATE_DIM },
+                { generated::$module::PARAMETER_COUNT },
+                { generated::$module::STATE_DIM + generated::$module::DOF },
+            >;
+        )*
+    };
+}
 
-/// A tool of the paper's 2-DOF model.
-pub type Arm2Tool = ToolN<Arm2, 2, 4, 4, 6>;
-/// A tool of the exact 2-link model.
-pub type Arm2ExactTool = ToolN<Arm2Exact, 2, 4, 4, 6>;
-/// A tool of the 3-link model.
-pub type Arm3Tool = ToolN<Arm3, 3, 6, 6, 9>;
+crate::for_each_model!(arm_models);
 
 /// The sensitivities ∂(task variable)/∂U that a task's controller uses (eq. U_dot_deriv); a term
 /// the task does not use is `None` ([`crate::Sensitivities`] is the 2-link one).

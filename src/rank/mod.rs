@@ -17,10 +17,10 @@ use std::collections::BinaryHeap;
 
 use rayon::prelude::*;
 
+use crate::generated;
 use crate::model::mixed::{AnyTool, ModelKind};
 use crate::model::{
-    episode, Arm2, Arm2Exact, Arm3, ArmModel, EpisodeOptionsN, Metrics, ModelSimulationError,
-    ToolN, ValidatedTaskN,
+    episode, ArmModel, EpisodeOptionsN, Metrics, ModelSimulationError, ToolN, ValidatedTaskN,
 };
 use crate::select::Objective;
 use crate::task_file::{TaskFileError, TaskSpec};
@@ -32,16 +32,6 @@ use crate::{Error, TaskKind};
 pub struct Bound<const N: usize, const NX: usize> {
     pub task: ValidatedTaskN<N>,
     pub options: EpisodeOptionsN<N, NX>,
-}
-
-/// The task bound to every model. A task that does not fit a model (a goal of the wrong
-/// length) is an error only once a tool of that model turns up ([`ModelTasks::check`]).
-#[derive(Debug, Clone)]
-pub struct ModelTasks {
-    pub kind: TaskKind,
-    arm2: Result<Bound<2, 4>, TaskFileError>,
-    arm2_exact: Result<Bound<2, 4>, TaskFileError>,
-    arm3: Result<Bound<3, 6>, TaskFileError>,
 }
 
 fn bind<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
@@ -60,61 +50,79 @@ where
     Ok(Bound { task, options })
 }
 
-/// Runs `$body` with `$t` the typed tool and `$b` its model's bound task.
-macro_rules! with_model {
-    ($self:ident, $tool:expr, |$t:ident, $b:ident| $body:expr) => {
-        match $tool {
-            AnyTool::Arm2($t) => $self.arm2.as_ref().map(|$b| $body),
-            AnyTool::Arm2Exact($t) => $self.arm2_exact.as_ref().map(|$b| $body),
-            AnyTool::Arm3($t) => $self.arm3.as_ref().map(|$b| $body),
+/// [`ModelTasks`] with one binding per generated model ([`crate::for_each_model!`]).
+macro_rules! model_tasks {
+    ($(($marker:ident, $module:ident, $tool:ident, $name:literal, $title:literal)),* $(,)?) => {
+        /// The task bound to every model. A task that does not fit a model (a goal of the
+        /// wrong length) is an error only once a tool of that model turns up
+        /// ([`ModelTasks::check`]).
+        #[derive(Debug, Clone)]
+        pub struct ModelTasks {
+            pub kind: TaskKind,
+            $($module: Result<
+                Bound<{ generated::$module::DOF }, { generated::$module::STATE_DIM }>,
+                TaskFileError,
+            >,)*
+        }
+
+        impl ModelTasks {
+            pub fn new(spec: &TaskSpec) -> Self {
+                Self {
+                    kind: spec.kind,
+                    $($module: bind::<
+                        crate::model::$marker,
+                        { generated::$module::DOF },
+                        { generated::$module::STATE_DIM },
+                        { generated::$module::PARAMETER_COUNT },
+                        { generated::$module::STATE_DIM + generated::$module::DOF },
+                    >(spec),)*
+                }
+            }
+
+            /// Whether the task fits `model`.
+            pub fn check(&self, model: ModelKind) -> Result<(), TaskFileError> {
+                match model {
+                    $(ModelKind::$marker => self.$module.as_ref().map(|_| ()).map_err(Clone::clone),)*
+                }
+            }
+
+            /// ln|Π^U| of `tool` (eq. control_conf): the cheap stage.
+            pub fn logdet(&self, tool: &AnyTool) -> Result<f64, Error> {
+                match tool {
+                    $(AnyTool::$marker(t) => match &self.$module {
+                        Ok(b) => b.task.control_confidence(t).map(|c| c.logdet),
+                        Err(e) => Err(Error::Unsupported(e.to_string())),
+                    },)*
+                }
+            }
+
+            /// The episode's metrics.
+            pub fn simulate(&self, tool: &AnyTool) -> Result<Metrics, ModelSimulationError> {
+                match tool {
+                    $(AnyTool::$marker(t) => match &self.$module {
+                        Ok(b) => crate::model::simulate(t, b.task.task(), &b.options),
+                        Err(e) => Err(unfit(e)),
+                    },)*
+                }
+            }
+
+            /// The task variable (θ, θ̇ or θ̈ as the task kind says) over time, with its goal.
+            pub fn trace(&self, tool: &AnyTool) -> Result<TaskTrace, ModelSimulationError> {
+                match tool {
+                    $(AnyTool::$marker(t) => match &self.$module {
+                        Ok(b) => trace_of(t, b, self.kind),
+                        Err(e) => Err(unfit(e)),
+                    },)*
+                }
+            }
         }
     };
 }
 
-impl ModelTasks {
-    pub fn new(spec: &TaskSpec) -> Self {
-        Self {
-            kind: spec.kind,
-            arm2: bind::<Arm2, 2, 4, 4, 6>(spec),
-            arm2_exact: bind::<Arm2Exact, 2, 4, 4, 6>(spec),
-            arm3: bind::<Arm3, 3, 6, 6, 9>(spec),
-        }
-    }
+crate::for_each_model!(model_tasks);
 
-    /// Whether the task fits `model`.
-    pub fn check(&self, model: ModelKind) -> Result<(), TaskFileError> {
-        let unit = |r: Result<(), &TaskFileError>| r.map_err(Clone::clone);
-        match model {
-            ModelKind::Arm2 => unit(self.arm2.as_ref().map(|_| ())),
-            ModelKind::Arm2Exact => unit(self.arm2_exact.as_ref().map(|_| ())),
-            ModelKind::Arm3 => unit(self.arm3.as_ref().map(|_| ())),
-        }
-    }
-
-    /// ln|Π^U| of `tool` (eq. control_conf): the cheap stage.
-    pub fn logdet(&self, tool: &AnyTool) -> Result<f64, Error> {
-        with_model!(self, tool, |t, b| b
-            .task
-            .control_confidence(t)
-            .map(|c| c.logdet))
-        .map_err(|e| Error::Unsupported(e.to_string()))?
-    }
-
-    /// The episode's metrics.
-    pub fn simulate(&self, tool: &AnyTool) -> Result<Metrics, ModelSimulationError> {
-        with_model!(self, tool, |t, b| crate::model::simulate(
-            t,
-            b.task.task(),
-            &b.options
-        ))
-        .map_err(|e| ModelSimulationError::Input(Error::Unsupported(e.to_string())))?
-    }
-
-    /// The task variable (θ, θ̇ or θ̈ as the task kind says) over time, with its goal.
-    pub fn trace(&self, tool: &AnyTool) -> Result<TaskTrace, ModelSimulationError> {
-        with_model!(self, tool, |t, b| trace_of(t, b, self.kind))
-            .map_err(|e| ModelSimulationError::Input(Error::Unsupported(e.to_string())))?
-    }
+fn unfit(e: &TaskFileError) -> ModelSimulationError {
+    ModelSimulationError::Input(Error::Unsupported(e.to_string()))
 }
 
 /// The task variable of one episode on the output grid, per joint, with the goal.

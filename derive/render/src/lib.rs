@@ -1,8 +1,10 @@
 //! Renders a toolconf derivation IR (the JSON that `derive/derive.py` writes) through the Tera
 //! templates in `templates/` into the files under `generated/`.
 //!
-//! A template named `<kind>.<ext>.tera` renders to `<model>.<ext>`; Rust output goes through
-//! rustfmt so that the checked-in code is exactly what `make derive` produces.
+//! A template named `<kind>.<ext>.tera` renders to `<model>.<ext>`, once per model; a template in
+//! `templates/registry/` named `<file>.tera` renders once over all models to `<file>` (the
+//! generated model registry, `generated/mod.rs`). Rust output goes through rustfmt so that the
+//! checked-in code is exactly what `make derive` produces.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -12,7 +14,7 @@ use serde_json::Value;
 use tera::{Context, Tera};
 
 /// The IR schema this renderer understands (`schema` in the JSON).
-pub const IR_SCHEMA: u64 = 2;
+pub const IR_SCHEMA: u64 = 3;
 
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
@@ -125,6 +127,70 @@ pub fn render(ir: &Value, templates: &[(String, String)]) -> Result<Vec<Rendered
         });
     }
     Ok(out)
+}
+
+/// The registry's view of one model: what the runtime needs to name and size it. The Rust names
+/// are decided here, not in the templates: the marker type is the model's name in CamelCase
+/// (`arm2_exact` → `Arm2Exact`), its tool type that plus `Tool`, and the title a Rust literal.
+fn registry_entry(ir: &Value) -> Result<Value, RenderError> {
+    let model = ir.get("model").ok_or(RenderError::NoModelName)?;
+    let name = model
+        .get("name")
+        .and_then(Value::as_str)
+        .ok_or(RenderError::NoModelName)?;
+    let marker: String = name
+        .split('_')
+        .map(|w| {
+            let mut c = w.chars();
+            c.next()
+                .map(|f| f.to_ascii_uppercase().to_string() + c.as_str())
+                .unwrap_or_default()
+        })
+        .collect();
+    let mut entry = model.clone();
+    entry["marker"] = Value::from(marker.clone());
+    entry["tool"] = Value::from(marker + "Tool");
+    entry["description"] = ir["generator"]["model"].clone();
+    // A Rust string literal (quotes escaped) for the macro's arguments.
+    let title = model.get("title").and_then(Value::as_str).unwrap_or(name);
+    entry["title_literal"] = Value::from(format!("{title:?}"));
+    entry["tasks"] = ir["tasks"].clone();
+    Ok(entry)
+}
+
+/// Renders the registry templates once over all models (in the order given).
+pub fn render_registry(
+    irs: &[Value],
+    templates: &[(String, String)],
+) -> Result<Vec<Rendered>, RenderError> {
+    let models = irs
+        .iter()
+        .map(registry_entry)
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut tera = Tera::default();
+    tera.autoescape_on(vec![]);
+    tera.add_raw_templates(templates.iter().map(|(n, t)| (n.as_str(), t.as_str())))
+        .map_err(|e| RenderError::Template(chain(&e)))?;
+    let mut context = Context::new();
+    context.insert("models", &models);
+    templates
+        .iter()
+        .map(|(name, _)| {
+            let file_name = name.trim_end_matches(".tera").to_string();
+            let text = tera
+                .render(name, &context)
+                .map_err(|e| RenderError::Template(chain(&e)))?;
+            let contents = if file_name.ends_with(".rs") {
+                rustfmt(&text)?
+            } else {
+                text
+            };
+            Ok(Rendered {
+                file_name,
+                contents,
+            })
+        })
+        .collect()
 }
 
 /// Formats Rust source with the toolchain's rustfmt (edition 2021, default style).

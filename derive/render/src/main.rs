@@ -1,10 +1,25 @@
 //! `toolconf-render IR.json... --templates templates --out generated`: renders each IR through
-//! every template and writes the results (see the library docs for the naming rule).
+//! every template, then all of them through `templates/registry/` (the model registry), and
+//! writes the results (see the library docs for the naming rule).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use toolconf_render::{load_templates, read_ir, render, RenderError};
+use toolconf_render::{load_templates, read_ir, render, render_registry, RenderError, Rendered};
+
+fn write(
+    out: &std::path::Path,
+    source: &std::path::Path,
+    file: Rendered,
+) -> Result<(), RenderError> {
+    let target = out.join(&file.file_name);
+    std::fs::write(&target, file.contents).map_err(|source| RenderError::Io {
+        path: target.clone(),
+        source,
+    })?;
+    println!("render: {} -> {}", source.display(), target.display());
+    Ok(())
+}
 
 fn run(args: &[String]) -> Result<(), RenderError> {
     let mut irs = Vec::new();
@@ -18,17 +33,18 @@ fn run(args: &[String]) -> Result<(), RenderError> {
             _ => irs.push(PathBuf::from(a)),
         }
     }
+    let registry_templates = load_templates(&templates.join("registry"))?;
     let templates = load_templates(&templates)?;
-    for path in irs {
-        let ir = read_ir(&path)?;
+    let mut all = Vec::new();
+    for path in &irs {
+        let ir = read_ir(path)?;
         for file in render(&ir, &templates)? {
-            let target = out.join(&file.file_name);
-            std::fs::write(&target, file.contents).map_err(|source| RenderError::Io {
-                path: target.clone(),
-                source,
-            })?;
-            println!("render: {} -> {}", path.display(), target.display());
+            write(&out, path, file)?;
         }
+        all.push(ir);
+    }
+    for file in render_registry(&all, &registry_templates)? {
+        write(&out, std::path::Path::new("templates/registry"), file)?;
     }
     Ok(())
 }

@@ -1,0 +1,172 @@
+#!/usr/bin/env python3
+"""The whole derivation chain: every model description -> derive.py (SymPy, checked by CasADi) ->
+IR + test vectors -> toolconf-render (Tera + rustfmt) -> generated/, and the renderer's fixture.
+
+    derive/.venv/bin/python derive/pipeline.py                    # update generated/ (make derive)
+    derive/.venv/bin/python derive/pipeline.py --check            # drift check
+    derive/.venv/bin/python derive/pipeline.py --check --portability   # and on an imitated older CPU
+
+--check derives into a temporary folder and compares it byte for byte with generated/ and the
+fixtures: it names every differing, missing or stale file and its first differing line, and
+never touches the working tree (no git needed). --portability derives a second time with
+numpy's optional CPU kernels switched off (NPY_DISABLE_CPU_FEATURES: every dispatchable feature
+numpy finds on this machine, AVX-512 and AVX2 included) and glibc's libm held to its baseline
+(GLIBC_TUNABLES), imitating an older CPU: the committed bytes must come out all the same. Both
+derivations share the machine's cores (make test runs them together).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+import tomllib
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+MODELS = ROOT / "derive" / "models"
+GENERATED = ROOT / "generated"
+FIXTURES = ROOT / "tests" / "fixtures"
+# The renderer's fixture: a small model with few vectors, pinned by tests/render_snapshot.rs.
+FIXTURE_MODELS = [("pendulum", 3)]
+# glibc's x86 features whose ifunc variants (libm's sin, cos, exp, log, pow...) depend on them.
+GLIBC_OFF = ["AVX512F", "AVX512DQ", "AVX512BW", "AVX512VL", "AVX2", "FMA", "FMA4", "AVX"]
+
+
+def restricted_environment(base: dict[str, str]) -> dict[str, str]:
+    """The environment of an older CPU: numpy's dispatch reduced to its baseline, libm's to SSE2."""
+    probe = ("from numpy._core import _multiarray_umath as m;"
+             "print(','.join(f for f in m.__cpu_dispatch__ if m.__cpu_features__.get(f)))")
+    found = subprocess.run([sys.executable, "-c", probe], check=True, capture_output=True, text=True).stdout.strip()
+    env = dict(base)
+    if found:
+        env["NPY_DISABLE_CPU_FEATURES"] = found
+    env["GLIBC_TUNABLES"] = "glibc.cpu.hwcaps=" + ",".join("-" + f for f in GLIBC_OFF)
+    check = ("from numpy._core import _multiarray_umath as m;"
+             "print(' '.join(f for f in m.__cpu_dispatch__ if m.__cpu_features__.get(f)))")
+    still = subprocess.run([sys.executable, "-c", check], env=env, check=True, capture_output=True,
+                           text=True).stdout.strip()
+    if still:
+        raise SystemExit(f"pipeline: NPY_DISABLE_CPU_FEATURES did not switch off numpy's {still}")
+    print(f"pipeline: restricted CPU: numpy's optional kernels off ({found or 'none found'}), "
+          f"glibc hwcaps {env['GLIBC_TUNABLES'].split('=', 1)[1]}")
+    return env
+
+
+@dataclass
+class Run:
+    """One derivation of every model into `generated` and `fixtures` under `env`."""
+    env: dict[str, str]
+    generated: Path
+    fixtures: Path
+
+    def jobs(self) -> list[tuple[Path, Path, int]]:
+        jobs = [(m, self.generated / f"{m.stem}.json", 100) for m in sorted(MODELS.glob("*.toml"))]
+        return jobs + [(FIXTURES / f"{name}.toml", self.fixtures / f"{name}.json", n) for name, n in FIXTURE_MODELS]
+
+
+def _cost(model: Path) -> int:
+    """The derivation's cost grows steeply with the degrees of freedom: start the largest first."""
+    with model.open("rb") as f:
+        return int(tomllib.load(f).get("model", {}).get("dof", 1))
+
+
+def derive_all(runs: list[Run]) -> None:
+    """Runs derive.py for every model of every run (as many at once as there are cores, largest
+    models first), then the renderer for each run's generated/."""
+    jobs = sorted(((run, *job) for run in runs for job in run.jobs()), key=lambda j: -_cost(j[1]))
+
+    def derive(job):
+        run, model, out, vectors = job
+        cmd = [sys.executable, str(ROOT / "derive" / "derive.py"), str(model.relative_to(ROOT)),
+               "--out", str(out), "--vectors", str(vectors)]
+        return subprocess.run(cmd, cwd=ROOT, env=run.env, capture_output=True, text=True)
+
+    with ThreadPoolExecutor(max_workers=max(1, min(len(jobs), os.cpu_count() or 1))) as pool:
+        results = list(pool.map(derive, jobs))
+    for r in results:
+        sys.stdout.write(r.stdout)
+        sys.stderr.write(r.stderr)
+    if any(r.returncode for r in results):
+        raise SystemExit(1)
+    for run in runs:
+        irs = [str(out) for _, out, _ in run.jobs()[:-len(FIXTURE_MODELS)]]
+        render = ["cargo", "run", "--quiet", "-p", "toolconf-render", "--", *irs,
+                  "--templates", str(ROOT / "templates"), "--out", str(run.generated)]
+        if subprocess.run(render, cwd=ROOT, env=run.env).returncode:
+            raise SystemExit(1)
+
+
+def first_difference(a: bytes, b: bytes) -> str:
+    la, lb = a.decode(errors="replace").splitlines(), b.decode(errors="replace").splitlines()
+    for i, (x, y) in enumerate(zip(la, lb)):
+        if x != y:
+            return f"line {i + 1}:\n    committed: {x.strip()[:160]}\n    derived:   {y.strip()[:160]}"
+    return f"line {min(len(la), len(lb)) + 1}: one file ends there ({len(la)} vs {len(lb)} lines)"
+
+
+def compare(derived: Path, committed: Path, whole_folder: bool) -> list[str]:
+    """Problems found comparing `derived` with `committed` (relative to the repository). With
+    `whole_folder`, a committed file that the derivation no longer produces is stale too."""
+    problems = []
+    made = {p.name for p in derived.iterdir()}
+    for name in sorted(made):
+        target = committed / name
+        where = target.relative_to(ROOT)
+        if not target.exists():
+            problems.append(f"{where}: make derive produces it, but it is not there")
+            continue
+        a, b = target.read_bytes(), (derived / name).read_bytes()
+        if a != b:
+            problems.append(f"{where} differs from what make derive produces, first at {first_difference(a, b)}")
+    if whole_folder:
+        for p in sorted(committed.iterdir()):
+            if p.is_file() and p.name not in made:
+                problems.append(f"{p.relative_to(ROOT)}: make derive no longer produces it (stale)")
+    return problems
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--check", action="store_true", help="derive into a temporary folder and compare")
+    ap.add_argument("--portability", action="store_true",
+                    help="with --check: also derive on an imitated CPU without AVX/AVX2/AVX-512/FMA and compare")
+    args = ap.parse_args()
+    env = dict(os.environ)
+    env.setdefault("PYTHONHASHSEED", "0")
+    if not args.check:
+        derive_all([Run(env, GENERATED, FIXTURES)])
+        return 0
+    checks = [("drift check", env)]
+    if args.portability:
+        checks.append(("restricted-CPU derivation", restricted_environment(env)))
+    with tempfile.TemporaryDirectory(prefix="toolconf-derive-") as tmp:
+        runs = []
+        for k, (_, e) in enumerate(checks):
+            run = Run(e, Path(tmp, str(k), "generated"), Path(tmp, str(k), "fixtures"))
+            run.generated.mkdir(parents=True)
+            run.fixtures.mkdir(parents=True)
+            runs.append(run)
+        derive_all(runs)
+        failed = False
+        for (what, _), run in zip(checks, runs):
+            problems = compare(run.generated, GENERATED, True) + compare(run.fixtures, FIXTURES, False)
+            if problems:
+                failed = True
+                print(f"{what}: the committed generated files are not what make derive produces:", file=sys.stderr)
+                for p in problems:
+                    print(f"  {p}", file=sys.stderr)
+            else:
+                print(f"{what}: generated/ and tests/fixtures/ are byte for byte what make derive produces")
+    if failed:
+        print("run `make derive`, review the diff, and commit it", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
