@@ -21,6 +21,14 @@ pub enum Error {
     /// A numeric option outside its domain.
     #[error("invalid {name} = {value}")]
     InvalidOption { name: &'static str, value: f64 },
+    /// An episode whose output grid would have more points than can be kept in memory.
+    #[error("episode too long: t_end = {t_end} s at dt = {dt} s is {points:e} output points, more than the {max} an episode may have; shorten t_end or enlarge dt")]
+    GridTooLarge {
+        t_end: f64,
+        dt: f64,
+        points: f64,
+        max: usize,
+    },
     /// A tool given with the wrong number of parameters for its model.
     #[error("model {model} takes {expected} parameters ({names}), got {found}")]
     ParameterCount {

@@ -24,9 +24,12 @@ pub mod generated;
 pub mod integrate;
 pub mod model;
 pub mod mpc;
+pub mod rank;
 pub mod select;
 pub mod stats;
 pub mod task;
+pub mod task_file;
+pub mod tools_file;
 pub mod trig;
 
 pub use arm::Arm;

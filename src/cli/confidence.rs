@@ -1,28 +1,31 @@
 //! `toolconf confidence --arm M1,M2,L1,L2 --task T [--json]`.
 
 use serde_json::json;
-use toolconf::{control_confidence, sensitivities, Arm, Task, TaskKind};
+use toolconf::model::Arm2;
+use toolconf::{control_confidence, sensitivities, Arm, Task};
 
+use super::episode_args::TaskArgs;
 use super::output::{matrix_rows, print_matrix, CliError};
-use super::{parse_arm, parse_task};
+use super::parse_arm;
 
 #[derive(clap::Args)]
 pub struct Args {
     /// The tool: link masses and lengths M1,M2,L1,L2 (kg, m), all > 0.
     #[arg(long, value_parser = parse_arm, allow_hyphen_values = true)]
     arm: Arm,
-    /// The task: position, velocity or acceleration (or the paper's 1, 2, 3).
-    #[arg(long, value_parser = parse_task)]
-    task: TaskKind,
+    #[command(flatten)]
+    task: TaskArgs,
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
 }
 
 pub fn run(args: &Args) -> Result<(), CliError> {
-    let task = Task::paper(args.task);
+    let spec = args.task.spec()?;
+    let kind = spec.kind;
+    let task = Task::from(&spec.task::<Arm2, 2, 4, 4, 6>()?);
     let confidence = control_confidence(&args.arm, &task)?;
-    let s = sensitivities(&args.arm, args.task);
+    let s = sensitivities(&args.arm, kind);
     let a = args.arm.state_matrix();
     let b = args.arm.input_matrix();
     if args.json {
@@ -36,27 +39,25 @@ pub fn run(args: &Args) -> Result<(), CliError> {
                 sens.insert(name.into(), matrix_rows(&m));
             }
         }
-        let out = json!({
+        let mut out = json!({
             "arm": args.arm,
-            "task": args.task,
+            "task": kind,
             "a": matrix_rows(&a),
             "b": matrix_rows(&b),
             "sensitivities": sens,
             "pi_u": matrix_rows(&confidence.pi_u),
             "logdet": confidence.logdet,
         });
+        if let Some(path) = &args.task.task_file {
+            out["task_file"] = json!(path);
+        }
         println!(
             "{}",
             serde_json::to_string_pretty(&out).expect("JSON of finite numbers")
         );
         return Ok(());
     }
-    println!(
-        "arm: {}    task: {} (task {})",
-        args.arm,
-        args.task,
-        args.task.paper_index()
-    );
+    println!("arm: {}    task: {}", args.arm, spec.label());
     print_matrix("A = df/dX at the equilibrium", &a);
     print_matrix("B = df/dU at the equilibrium", &b);
     for (name, m) in [

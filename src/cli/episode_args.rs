@@ -1,28 +1,60 @@
-//! Episode options shared by the commands that simulate (defaults: the paper's).
+//! Episode options shared by the commands that simulate (defaults: the paper's), and the task
+//! choice: a built-in task name or a task file.
+
+use std::path::PathBuf;
 
 use toolconf::closed_loop::{EpisodeOptions, Plant};
-use toolconf::Error;
+use toolconf::model::EpisodeOptionsN;
+use toolconf::task_file::{EpisodeSpec, PerJoint, TaskSpec};
+use toolconf::{Error, TaskKind};
 
+use super::output::CliError;
+use super::parse_task;
+
+/// The task: `--task NAME` or `--task-file FILE` (exactly one).
+#[derive(clap::Args, Debug, Clone)]
+pub struct TaskArgs {
+    /// The task: position, velocity or acceleration (or the paper's 1, 2, 3).
+    #[arg(long, value_parser = parse_task, required_unless_present = "task_file", conflicts_with = "task_file")]
+    pub task: Option<TaskKind>,
+    /// A task file (TOML: kind, [goal], [precision], [episode]; see the README) instead of a
+    /// built-in task. Episode flags given on the command line override its [episode].
+    #[arg(long)]
+    pub task_file: Option<PathBuf>,
+}
+
+impl TaskArgs {
+    /// The task as a spec (a built-in task is a spec with nothing overridden).
+    pub fn spec(&self) -> Result<TaskSpec, CliError> {
+        match (&self.task_file, self.task) {
+            (Some(path), _) => Ok(TaskSpec::from_file(path)?),
+            (None, Some(kind)) => Ok(TaskSpec::builtin(kind)),
+            (None, None) => Err(CliError::Usage("give --task or --task-file".into())),
+        }
+    }
+}
+
+/// Episode flags; a flag left out is the task file's value, else the paper's default.
 #[derive(clap::Args, Debug, Clone)]
 pub struct EpisodeArgs {
-    /// Constant torque perturbation ΔT on both joints [N m].
-    #[arg(long = "perturb", default_value_t = 0.0, allow_hyphen_values = true)]
-    pub perturbation: f64,
-    /// End time of the episode [s].
-    #[arg(long, default_value_t = 5.0, allow_hyphen_values = true)]
-    pub t_end: f64,
-    /// Output grid spacing [s].
-    #[arg(long, default_value_t = 0.05, allow_hyphen_values = true)]
-    pub dt: f64,
-    /// Learning rate γ of the controller.
-    #[arg(long = "gamma", default_value_t = 1.0, allow_hyphen_values = true)]
-    pub learning_rate: f64,
-    /// Integrator relative tolerance (ode45 default 1e-3).
-    #[arg(long, default_value_t = 1e-3, allow_hyphen_values = true)]
-    pub rtol: f64,
-    /// Integrator absolute tolerance (ode45 default 1e-6).
-    #[arg(long, default_value_t = 1e-6, allow_hyphen_values = true)]
-    pub atol: f64,
+    /// Constant torque perturbation ΔT on every joint [N m] (default 0).
+    #[arg(long = "perturb", allow_hyphen_values = true)]
+    pub perturbation: Option<f64>,
+    /// End time of the episode [s] (default 5).
+    #[arg(long, allow_hyphen_values = true)]
+    pub t_end: Option<f64>,
+    /// Output grid spacing [s] (default 0.05).
+    #[arg(long, allow_hyphen_values = true)]
+    pub dt: Option<f64>,
+    /// Learning rate γ of the controller (default 1).
+    #[arg(long = "gamma", allow_hyphen_values = true)]
+    pub learning_rate: Option<f64>,
+    /// Integrator relative tolerance (default 1e-3, ode45's).
+    #[arg(long, allow_hyphen_values = true)]
+    pub rtol: Option<f64>,
+    /// Integrator absolute tolerance (default 1e-6, ode45's).
+    #[arg(long, allow_hyphen_values = true)]
+    pub atol: Option<f64>,
     /// Plant: the paper's generative process, or the exact Lagrangian 2-link dynamics.
     #[arg(long, value_enum, default_value_t = PlantArg::Paper)]
     pub plant: PlantArg,
@@ -47,24 +79,76 @@ impl From<PlantArg> for Plant {
     }
 }
 
-impl EpisodeArgs {
-    pub fn options(&self, record_trajectory: bool) -> Result<EpisodeOptions, Error> {
-        for (name, value) in [("rtol", self.rtol), ("atol", self.atol)] {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(Error::InvalidOption { name, value });
-            }
+fn check_tolerances(rtol: f64, atol: f64) -> Result<(), Error> {
+    for (name, value) in [("rtol", rtol), ("atol", atol)] {
+        if !(value.is_finite() && value > 0.0) {
+            return Err(Error::InvalidOption { name, value });
         }
+    }
+    Ok(())
+}
+
+impl EpisodeArgs {
+    /// The 2-link options of a built-in task: the flags over the paper's defaults.
+    pub fn options(&self, record_trajectory: bool) -> Result<EpisodeOptions, Error> {
+        let d = EpisodeOptions::default();
         let mut o = EpisodeOptions {
-            t_end: self.t_end,
-            dt: self.dt,
-            perturbation: self.perturbation,
-            learning_rate: self.learning_rate,
+            t_end: self.t_end.unwrap_or(d.t_end),
+            dt: self.dt.unwrap_or(d.dt),
+            perturbation: self.perturbation.unwrap_or(d.perturbation),
+            learning_rate: self.learning_rate.unwrap_or(d.learning_rate),
             record_trajectory,
             plant: self.plant.into(),
-            ..EpisodeOptions::default()
+            ..d
         };
-        o.integrator.rtol = self.rtol;
-        o.integrator.atol = self.atol;
+        o.integrator.rtol = self.rtol.unwrap_or(d.integrator.rtol);
+        o.integrator.atol = self.atol.unwrap_or(d.integrator.atol);
+        check_tolerances(o.integrator.rtol, o.integrator.atol)?;
         Ok(o)
     }
+
+    /// Puts the flags that were given over a task file's `[episode]`.
+    pub fn apply(&self, e: &mut EpisodeSpec) -> Result<(), Error> {
+        let set = |slot: &mut Option<f64>, v: Option<f64>| {
+            if v.is_some() {
+                *slot = v;
+            }
+        };
+        set(&mut e.t_end, self.t_end);
+        set(&mut e.dt, self.dt);
+        set(&mut e.learning_rate, self.learning_rate);
+        set(&mut e.rtol, self.rtol);
+        set(&mut e.atol, self.atol);
+        if let Some(p) = self.perturbation {
+            e.perturbation = Some(PerJoint::All(p));
+        }
+        check_tolerances(e.rtol.unwrap_or(1e-3), e.atol.unwrap_or(1e-6))
+    }
+}
+
+/// A task file's 2-link options as the paper's-arm [`EpisodeOptions`], which carries one ΔT
+/// for both joints: a perturbation that differs between the joints is refused with `why`.
+pub fn two_link_options(
+    o: &EpisodeOptionsN<2, 4>,
+    plant: Plant,
+    why: &str,
+) -> Result<EpisodeOptions, Error> {
+    let dt = o.total_perturbation();
+    if dt[0] != dt[1] {
+        return Err(Error::Unsupported(format!(
+            "a perturbation that differs between the joints ({} and {} N m) {why}",
+            dt[0], dt[1]
+        )));
+    }
+    Ok(EpisodeOptions {
+        t_end: o.t_end,
+        dt: o.dt,
+        x0: o.x0,
+        u0: o.u0,
+        perturbation: dt[0],
+        learning_rate: o.learning_rate,
+        integrator: o.integrator,
+        record_trajectory: o.record_trajectory,
+        plant,
+    })
 }

@@ -4,6 +4,7 @@
 mod confidence;
 mod episode_args;
 mod output;
+mod rank;
 mod reproduce;
 mod select;
 mod simulate;
@@ -29,6 +30,8 @@ enum Command {
     Simulate(simulate::Args),
     /// Draw random tools, simulate each, and choose by ∫F, ∫J and confidence.
     Select(select::Args),
+    /// Rank your own tools (a CSV or JSON file) on a built-in task or a task file.
+    Rank(rank::Args),
     /// Run every experiment of the paper's Results section: CSVs, SVG figures, report.
     Reproduce(reproduce::Args),
 }
@@ -47,6 +50,7 @@ pub fn run() -> ExitCode {
         Command::Confidence(args) => confidence::run(&args),
         Command::Simulate(args) => simulate::run(&args),
         Command::Select(args) => select::run(&args),
+        Command::Rank(args) => rank::run(&args),
         Command::Reproduce(args) => reproduce::run(&args),
     };
     match result {

@@ -35,6 +35,20 @@ pub enum CliError {
         path: std::path::PathBuf,
         source: std::io::Error,
     },
+    #[error(transparent)]
+    TaskFile(#[from] toolconf::task_file::TaskFileError),
+    #[error(transparent)]
+    ToolsFile(#[from] toolconf::tools_file::ToolFileError),
+    #[error(transparent)]
+    Model(#[from] toolconf::model::ModelSimulationError),
+    #[error(transparent)]
+    Output(#[from] toolconf::experiments::ReproduceError),
+    /// Bad input that is none of the above, in words.
+    #[error("{0}")]
+    Usage(String),
+    /// A run that failed as a whole, in words.
+    #[error("{0}")]
+    Failed(String),
 }
 
 impl CliError {
@@ -43,8 +57,17 @@ impl CliError {
         match self {
             CliError::Input(_)
             | CliError::Simulation(SimulationError::Input(_))
-            | CliError::Mpc(toolconf::mpc::MpcEpisodeError::Input(_)) => 2,
-            CliError::Simulation(_) | CliError::Mpc(_) | CliError::Io { .. } => 1,
+            | CliError::Mpc(toolconf::mpc::MpcEpisodeError::Input(_))
+            | CliError::Model(toolconf::model::ModelSimulationError::Input(_))
+            | CliError::TaskFile(_)
+            | CliError::ToolsFile(_)
+            | CliError::Usage(_) => 2,
+            CliError::Simulation(_)
+            | CliError::Mpc(_)
+            | CliError::Model(_)
+            | CliError::Io { .. }
+            | CliError::Output(_)
+            | CliError::Failed(_) => 1,
         }
     }
 }

@@ -3,25 +3,28 @@
 //! With the default `--models arm2` this is the 2-link selection of `toolconf::select`, output
 //! unchanged; with other models the set is drawn and ranked by `toolconf::model::mixed`.
 
+use rayon::prelude::*;
 use serde_json::{json, Value};
+use toolconf::closed_loop::EpisodeOptions;
 use toolconf::model::mixed::{
     draw_mixed_tools, evaluate_mixed, MixedObjective, MixedResult, ModelKind,
 };
+use toolconf::model::Arm2;
+use toolconf::rank::ModelTasks;
 use toolconf::select::{
     choose_by_mpc_cost, draw_tools, evaluate, evaluate_mpc, Objective, ToolResult,
 };
-use toolconf::{Task, TaskKind};
+use toolconf::task_file::TaskSpec;
+use toolconf::Task;
 
-use super::episode_args::EpisodeArgs;
+use super::episode_args::{two_link_options, EpisodeArgs, PlantArg, TaskArgs};
 use super::output::CliError;
-use super::parse_task;
 use super::simulate::MpcArgs;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// The task: position, velocity or acceleration (or 1, 2, 3).
-    #[arg(long, value_parser = parse_task)]
-    task: TaskKind,
+    #[command(flatten)]
+    task: TaskArgs,
     /// How many random tools to draw (parameters uniform on [0.1, 0.6]).
     #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u64).range(1..=10_000_000))]
     tools: u64,
@@ -80,8 +83,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         }
         return run_mixed(args);
     }
-    let task = Task::paper(args.task);
-    let options = args.episode.options(false)?;
+    let (task, options) = two_link_task(args)?;
+    let kind = task.kind;
     let tools = draw_tools(args.tools as usize, args.seed);
     let results = evaluate(&tools, &task, &options);
     let choices: Vec<(Objective, Option<usize>)> = Objective::ALL
@@ -114,9 +117,9 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             }
         }
         let out = json!({
-            "task": args.task,
+            "task": kind,
             "seed": args.seed,
-            "perturb": args.episode.perturbation,
+            "perturb": options.perturbation,
             "tools": tools_json,
             "choice": choice,
         });
@@ -128,8 +131,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     }
     println!(
         "task: {} (task {})    tools: {}    seed: {}",
-        args.task,
-        args.task.paper_index(),
+        kind,
+        kind.paper_index(),
         args.tools,
         args.seed
     );
@@ -186,6 +189,57 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     Ok(())
 }
 
+/// The 2-link task and options: the paper's task with the flags, or the task file's with the
+/// flags over its [episode].
+fn two_link_task(args: &Args) -> Result<(Task, EpisodeOptions), CliError> {
+    let spec = args.task.spec()?;
+    if args.task.task_file.is_none() {
+        return Ok((Task::paper(spec.kind), args.episode.options(false)?));
+    }
+    let spec = with_flags(args, spec)?;
+    let task = Task::from(&spec.task::<Arm2, 2, 4, 4, 6>()?);
+    let why = "is not supported by select's 2-link tools; use rank with a tools file";
+    let options = two_link_options(
+        &spec.episode::<Arm2, 2, 4, 4, 6>()?,
+        args.episode.plant.into(),
+        why,
+    )?;
+    Ok((task, options))
+}
+
+fn with_flags(args: &Args, mut spec: TaskSpec) -> Result<TaskSpec, CliError> {
+    args.episode.apply(&mut spec.episode)?;
+    Ok(spec)
+}
+
+/// Every tool on the task file's task bound to its own model (the file's goals and
+/// precisions must fit each model drawn).
+fn evaluate_on_file(
+    args: &Args,
+    spec: TaskSpec,
+    tools: &[toolconf::model::mixed::AnyTool],
+) -> Result<Vec<MixedResult>, CliError> {
+    if args.episode.plant != PlantArg::Paper {
+        return Err(CliError::Usage(
+            "--plant exact with --task-file and --models: draw arm2_exact tools instead".into(),
+        ));
+    }
+    let tasks = ModelTasks::new(&with_flags(args, spec)?);
+    for model in &args.models {
+        tasks.check(*model)?;
+    }
+    Ok(tools
+        .par_iter()
+        .enumerate()
+        .map(|(index, tool)| MixedResult {
+            index,
+            tool: *tool,
+            logdet: tasks.logdet(tool),
+            episode: tasks.simulate(tool),
+        })
+        .collect())
+}
+
 fn mixed_tool_json(r: &MixedResult) -> Value {
     let params: serde_json::Map<String, Value> = r
         .tool
@@ -215,9 +269,14 @@ fn mixed_tool_json(r: &MixedResult) -> Value {
 
 /// Selection over tools of several models (each on its own model's paper-style task).
 fn run_mixed(args: &Args) -> Result<(), CliError> {
+    let spec = args.task.spec()?;
+    let kind = spec.kind;
     let options = args.episode.options(false)?;
     let tools = draw_mixed_tools(&args.models, args.tools as usize, args.seed)?;
-    let results = evaluate_mixed(&tools, args.task, &options);
+    let results = match args.task.task_file {
+        None => evaluate_mixed(&tools, kind, &options),
+        Some(_) => evaluate_on_file(args, spec, &tools)?,
+    };
     let choices: Vec<(MixedObjective, Option<usize>)> = MixedObjective::ALL
         .iter()
         .map(|o| (*o, o.choose(&results)))
@@ -229,9 +288,9 @@ fn run_mixed(args: &Args) -> Result<(), CliError> {
             choice.insert(o.name().into(), json!(c));
         }
         let out = json!({
-            "task": args.task,
+            "task": kind,
             "seed": args.seed,
-            "perturb": args.episode.perturbation,
+            "perturb": options.perturbation,
             "models": models,
             "tools": results.iter().map(mixed_tool_json).collect::<Vec<_>>(),
             "choice": choice,
@@ -244,8 +303,8 @@ fn run_mixed(args: &Args) -> Result<(), CliError> {
     }
     println!(
         "task: {} (task {})    tools: {}    seed: {}    models: {}",
-        args.task,
-        args.task.paper_index(),
+        kind,
+        kind.paper_index(),
         args.tools,
         args.seed,
         models.join(",")

@@ -2,23 +2,24 @@
 
 use std::path::PathBuf;
 
-use serde_json::json;
-use toolconf::closed_loop::{simulate, Trajectory};
+use serde_json::{json, Value};
+use toolconf::closed_loop::{simulate, Episode, Plant, Trajectory};
+use toolconf::model::{episode_on, Arm2, Arm2Exact, Arm2Tool};
 use toolconf::mpc::{simulate_mpc, MpcModel, MpcOptions};
-use toolconf::{Arm, Error, Task, TaskKind};
+use toolconf::task_file::TaskSpec;
+use toolconf::{Arm, Error, Task};
 
-use super::episode_args::EpisodeArgs;
+use super::episode_args::{two_link_options, EpisodeArgs, TaskArgs};
 use super::output::{write_atomically, CliError};
-use super::{parse_arm, parse_task};
+use super::parse_arm;
 
 #[derive(clap::Args)]
 pub struct Args {
     /// The tool: link masses and lengths M1,M2,L1,L2 (kg, m), all > 0.
     #[arg(long, value_parser = parse_arm, allow_hyphen_values = true)]
     arm: Arm,
-    /// The task: position, velocity or acceleration (or 1, 2, 3).
-    #[arg(long, value_parser = parse_task)]
-    task: TaskKind,
+    #[command(flatten)]
+    task: TaskArgs,
     #[command(flatten)]
     episode: EpisodeArgs,
     /// Print one JSON object instead of text.
@@ -109,21 +110,28 @@ impl MpcArgs {
 }
 
 pub fn run(args: &Args) -> Result<(), CliError> {
+    let spec = args.task.spec()?;
     if args.controller == Controller::Mpc {
-        return run_mpc(args);
+        return run_mpc(args, spec);
     }
-    let task = Task::paper(args.task);
-    let options = args.episode.options(args.csv.is_some())?;
-    let episode = simulate(&args.arm, &task, &options)?;
+    let (episode, perturb) = match args.task.task_file {
+        None => {
+            let task = Task::paper(spec.kind);
+            let options = args.episode.options(args.csv.is_some())?;
+            let episode = simulate(&args.arm, &task, &options)?;
+            (episode, json!(options.perturbation))
+        }
+        Some(_) => from_task_file(args, spec.clone())?,
+    };
     let m = episode.metrics;
     if let (Some(path), Some(tr)) = (&args.csv, &episode.trajectory) {
         write_atomically(path, &trajectory_csv(tr))?;
     }
     if args.json {
-        let out = json!({
+        let mut out = json!({
             "arm": args.arm,
-            "task": args.task,
-            "perturb": args.episode.perturbation,
+            "task": spec.kind,
+            "perturb": perturb,
             "task_error": m.task_error,
             "free_energy": m.free_energy,
             "cost_j": m.cost_j,
@@ -132,17 +140,18 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             "steps": m.steps,
             "rejected_steps": m.rejected_steps,
         });
+        if let Some(path) = &args.task.task_file {
+            out["task_file"] = json!(path);
+        }
         println!(
             "{}",
             serde_json::to_string_pretty(&out).expect("finite numbers")
         );
     } else {
         println!(
-            "arm: {}    task: {} (task {})    perturbation: {} N m",
+            "arm: {}    task: {}    perturbation: {perturb} N m",
             args.arm,
-            args.task,
-            args.task.paper_index(),
-            args.episode.perturbation
+            spec.label(),
         );
         println!("task error     {:.9e}", m.task_error);
         println!("integral F dt  {:.9e}", m.free_energy);
@@ -159,9 +168,42 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     Ok(())
 }
 
-fn run_mpc(args: &Args) -> Result<(), CliError> {
-    let task = Task::paper(args.task);
-    let options = args.episode.options(args.csv.is_some())?;
+/// One episode of the task file's task: the generic 2-link runtime, which takes the file's
+/// initial state, initial torque and per-joint perturbation as they are.
+fn from_task_file(args: &Args, mut spec: TaskSpec) -> Result<(Episode, Value), CliError> {
+    args.episode.apply(&mut spec.episode)?;
+    let task = spec.task::<Arm2, 2, 4, 4, 6>()?;
+    let mut options = spec.episode::<Arm2, 2, 4, 4, 6>()?;
+    options.record_trajectory = args.csv.is_some();
+    let tool = Arm2Tool::from(&args.arm);
+    let episode = match Plant::from(args.episode.plant) {
+        Plant::Paper => episode_on::<Arm2, Arm2, 2, 4, 4, 6>(&tool, &task, &options)?,
+        Plant::Exact => episode_on::<Arm2, Arm2Exact, 2, 4, 4, 6>(&tool, &task, &options)?,
+    };
+    let dt = options.total_perturbation();
+    let perturb = if dt[0] == dt[1] {
+        json!(dt[0])
+    } else {
+        json!([dt[0], dt[1]])
+    };
+    Ok((episode, perturb))
+}
+
+fn run_mpc(args: &Args, mut spec: TaskSpec) -> Result<(), CliError> {
+    let (task, options) = match args.task.task_file {
+        None => (
+            Task::paper(spec.kind),
+            args.episode.options(args.csv.is_some())?,
+        ),
+        Some(_) => {
+            args.episode.apply(&mut spec.episode)?;
+            let task = Task::from(&spec.task::<Arm2, 2, 4, 4, 6>()?);
+            let mut o = spec.episode::<Arm2, 2, 4, 4, 6>()?;
+            o.record_trajectory = args.csv.is_some();
+            let why = "is not supported by the MPC baseline";
+            (task, two_link_options(&o, args.episode.plant.into(), why)?)
+        }
+    };
     let episode = simulate_mpc(&args.arm, &task, &options, &args.mpc.options()?)?;
     let m = &episode.metrics;
     if let (Some(path), Some(tr)) = (&args.csv, &episode.trajectory) {
@@ -170,9 +212,9 @@ fn run_mpc(args: &Args) -> Result<(), CliError> {
     if args.json {
         let out = json!({
             "arm": args.arm,
-            "task": args.task,
+            "task": spec.kind,
             "controller": "mpc",
-            "perturb": args.episode.perturbation,
+            "perturb": options.perturbation,
             "task_error": m.task_error,
             "free_energy": m.free_energy,
             "cost_j": m.cost_j,
@@ -191,11 +233,10 @@ fn run_mpc(args: &Args) -> Result<(), CliError> {
         );
     } else {
         println!(
-            "arm: {}    task: {} (task {})    controller: MPC    perturbation: {} N m",
+            "arm: {}    task: {}    controller: MPC    perturbation: {} N m",
             args.arm,
-            args.task,
-            args.task.paper_index(),
-            args.episode.perturbation
+            spec.label(),
+            options.perturbation
         );
         println!("task error       {:.9e}", m.task_error);
         println!(

@@ -26,7 +26,7 @@
 //! [`objectives::decision_rules`], which the selection experiments (Figs. 6 and 7) iterate over.
 
 pub mod batch;
-mod common;
+pub(crate) mod common;
 pub mod csv;
 mod exact_plant;
 mod fig2_confidence_vs_error;

@@ -35,7 +35,7 @@ pub(crate) mod runtime;
 
 pub use runtime::{
     episode, episode_on, simulate, simulate_on, ActiveInferenceN, ClosedLoopN, EpisodeN,
-    EpisodeOptionsN, Metrics, ModelSimulationError, TrajectoryN,
+    EpisodeOptionsN, Metrics, ModelSimulationError, TrajectoryN, MAX_GRID_POINTS,
 };
 
 /// The equations and closed forms of one generated model, with N joints, state dimension NX,

@@ -175,7 +175,8 @@ impl<P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>
 where
     P: ArmModel<N, NX, NP, NZ>,
 {
-    /// The closed loop of `tool` (controller model `M`) on plant `P`.
+    /// The closed loop of `tool` (controller model `M`) on plant `P`, with the same ΔT on every
+    /// joint.
     pub fn new<M>(
         tool: &ToolN<M, N, NX, NP, NZ>,
         task: &TaskN<N>,
@@ -185,12 +186,25 @@ where
     where
         M: ArmModel<N, NX, NP, NZ>,
     {
+        Self::with_perturbation(tool, task, learning_rate, &SVector::repeat(perturbation))
+    }
+
+    /// The closed loop with a constant torque perturbation ΔT_i of its own on each joint.
+    pub fn with_perturbation<M>(
+        tool: &ToolN<M, N, NX, NP, NZ>,
+        task: &TaskN<N>,
+        learning_rate: f64,
+        perturbation: &SVector<f64, N>,
+    ) -> Result<Self, Error>
+    where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
         #[allow(clippy::let_unit_value)]
         let () = Dims::<N, NX, NZ>::CHECK;
-        if !perturbation.is_finite() {
+        if let Some(&value) = perturbation.iter().find(|v| !v.is_finite()) {
             return Err(Error::InvalidOption {
                 name: "perturbation dT",
-                value: perturbation,
+                value,
             });
         }
         let params = tool.params();
@@ -198,7 +212,7 @@ where
             dynamics: P::dynamics_coefficients(&params),
             jacobian: P::jacobian_coefficients(&params),
             controller: ActiveInferenceN::new(tool, task, learning_rate)?,
-            perturbation: SVector::repeat(perturbation),
+            perturbation: *perturbation,
         })
     }
 
@@ -267,6 +281,9 @@ pub struct EpisodeOptionsN<const N: usize, const NX: usize> {
     pub u0: SVector<f64, N>,
     /// Constant torque perturbation ΔT on every joint [N m].
     pub perturbation: f64,
+    /// A constant torque perturbation of each joint's own, added to `perturbation` [N m]
+    /// (zero unless a task file gives one per joint).
+    pub joint_perturbation: SVector<f64, N>,
     pub learning_rate: f64,
     /// Integrator options; [`Method::Auto`] runs DP5 on tasks 1–2 and the DP5-to-Rodas5P
     /// switch on task 3 (why: [`EpisodeOptions::integrator`]).
@@ -289,6 +306,7 @@ impl<const N: usize, const NX: usize> EpisodeOptionsN<N, NX> {
             x0: M::equilibrium_state(),
             u0: SVector::repeat(0.1),
             perturbation: 0.0,
+            joint_perturbation: SVector::zeros(),
             learning_rate: 1.0,
             integrator: IntegratorOptions::default(),
             record_trajectory: false,
@@ -308,10 +326,18 @@ impl<const N: usize, const NX: usize> EpisodeOptionsN<N, NX> {
             x0: M::equilibrium_state(),
             u0: SVector::repeat(common.u0[0]),
             perturbation: common.perturbation,
+            joint_perturbation: SVector::zeros(),
             learning_rate: common.learning_rate,
             integrator: common.integrator,
             record_trajectory: common.record_trajectory,
         }
+    }
+}
+
+impl<const N: usize, const NX: usize> EpisodeOptionsN<N, NX> {
+    /// ΔT on each joint: `perturbation` on all of them plus `joint_perturbation`.
+    pub fn total_perturbation(&self) -> SVector<f64, N> {
+        SVector::repeat(self.perturbation) + self.joint_perturbation
     }
 }
 
@@ -324,6 +350,7 @@ impl From<&EpisodeOptions> for EpisodeOptionsN<2, 4> {
             x0: o.x0,
             u0: o.u0,
             perturbation: o.perturbation,
+            joint_perturbation: SVector::zeros(),
             learning_rate: o.learning_rate,
             integrator: o.integrator,
             record_trajectory: o.record_trajectory,
@@ -506,11 +533,11 @@ where
     P: ArmModel<N, NX, NP, NZ>,
 {
     check_options(options)?;
-    let system = ClosedLoopN::<P, N, NX, NP, NZ>::new(
+    let system = ClosedLoopN::<P, N, NX, NP, NZ>::with_perturbation(
         tool,
         task,
         options.learning_rate,
-        options.perturbation,
+        &options.total_perturbation(),
     )?;
     let controller = &system.controller;
     let grid = uniform_grid(0.0, options.t_end, options.dt);
@@ -611,6 +638,7 @@ fn check_options<const N: usize, const NX: usize>(o: &EpisodeOptionsN<N, NX>) ->
             value: o.dt,
         });
     }
+    check_grid(o.t_end, o.dt)?;
     for &v in o.x0.iter() {
         if !v.is_finite() {
             return Err(Error::InvalidOption {
@@ -627,10 +655,31 @@ fn check_options<const N: usize, const NX: usize>(o: &EpisodeOptionsN<N, NX>) ->
             });
         }
     }
-    if !o.perturbation.is_finite() {
-        return Err(Error::InvalidOption {
-            name: "perturbation dT",
-            value: o.perturbation,
+    for &v in o.total_perturbation().iter() {
+        if !v.is_finite() {
+            return Err(Error::InvalidOption {
+                name: "perturbation dT",
+                value: v,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The most points an episode's output grid may have. Each point is kept in memory (the grid,
+/// and the trajectory when it is recorded), so a horizon like t_end = 1e9 s at dt = 0.05 s
+/// (2·10¹⁰ points, 160 GB for the grid alone) is refused here rather than aborting the process.
+pub const MAX_GRID_POINTS: usize = 1_000_000;
+
+/// [`Error::GridTooLarge`] when t_end/dt + 1 exceeds [`MAX_GRID_POINTS`].
+pub(crate) fn check_grid(t_end: f64, dt: f64) -> Result<(), Error> {
+    let points = (t_end / dt).floor() + 1.0;
+    if points > MAX_GRID_POINTS as f64 {
+        return Err(Error::GridTooLarge {
+            t_end,
+            dt,
+            points,
+            max: MAX_GRID_POINTS,
         });
     }
     Ok(())

@@ -188,6 +188,12 @@ where
     P: ArmModel<N, NX, NP, NZ>,
 {
     let metrics_of = ActiveInferenceN::new(tool, task, 1.0)?;
+    // The QP log holds one entry per control period: refuse horizons too long to keep.
+    for step in [options.dt, mpc_options.period] {
+        if step > 0.0 {
+            crate::model::runtime::check_grid(options.t_end, step)?;
+        }
+    }
     let period = mpc_options.period;
     let steps = whole_ratio(options.t_end, period).ok_or(Error::InvalidOption {
         name: "end time t_end (not a whole number of MPC periods)",
@@ -197,17 +203,17 @@ where
         name: "output step dt (not a whole number of MPC periods)",
         value: options.dt,
     })?;
-    if !options.perturbation.is_finite() {
+    let perturbation = options.total_perturbation();
+    if let Some(&value) = perturbation.iter().find(|v| !v.is_finite()) {
         return Err(Error::InvalidOption {
             name: "perturbation dT",
-            value: options.perturbation,
+            value,
         }
         .into());
     }
     let mut mpc = MpcN::new(tool, task, mpc_options).map_err(MpcFailure::Setup)?;
     // The plant's parameter-only factors, once per episode (as the active-inference loop does).
     let plant = P::dynamics_coefficients(&tool.params());
-    let perturbation = SVector::<f64, N>::repeat(options.perturbation);
     let logdet = metrics_of.logdet;
 
     let mut solve_times = Vec::with_capacity(steps + 1);

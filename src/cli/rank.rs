@@ -1,0 +1,419 @@
+//! `toolconf rank --tools FILE --task NAME|FILE [--screen K] [--objective O] [--json]
+//! [--csv OUT] [--report DIR] [--skip-bad-rows]`: the user's tools on the user's task.
+//!
+//! The whole tools file is read and checked (and every tool's confidence computed) before any
+//! output is created, so bad input leaves nothing half-written.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+
+use indicatif::{ProgressBar, ProgressStyle};
+use serde_json::{json, Map, Value};
+use toolconf::experiments::csv::{format_number, Cell, CsvWriter};
+use toolconf::model::mixed::ModelKind;
+use toolconf::rank::report::{write_report, ReportInput};
+use toolconf::rank::{ranking, simulate_all, Candidate, ModelTasks, RankedTool, Screen};
+use toolconf::select::Objective;
+use toolconf::task_file::TaskSpec;
+use toolconf::tools_file::{read_tools, ToolFileError};
+use toolconf::TaskKind;
+
+use super::output::CliError;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// The tools: a CSV or JSON file, one tool per row (columns name, model, and the model's
+    /// parameters, e.g. m1,m2,l1,l2; see the README).
+    #[arg(long)]
+    tools: PathBuf,
+    /// The task: a built-in name (position, velocity, acceleration or 1, 2, 3) or a task file.
+    #[arg(long)]
+    task: String,
+    /// Simulate only the K most confident tools (largest ln|Pi^U|, computed without simulating).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    screen: Option<u64>,
+    /// What to rank by: free-energy (the paper's ∫F dt), cost-j (∫J dt) or confidence (ln|Pi^U|).
+    #[arg(long, value_enum, default_value_t = ObjectiveArg::FreeEnergy)]
+    objective: ObjectiveArg,
+    /// Print one JSON object instead of the table.
+    #[arg(long)]
+    json: bool,
+    /// Write one row per simulated tool to this CSV, in file order, as episodes finish.
+    #[arg(long)]
+    csv: Option<PathBuf>,
+    /// Write a report (report.md, report.html with the figures inline, SVGs) into this folder.
+    #[arg(long)]
+    report: Option<PathBuf>,
+    /// Report a bad row on stderr and go on without it, instead of stopping.
+    #[arg(long)]
+    skip_bad_rows: bool,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum ObjectiveArg {
+    FreeEnergy,
+    CostJ,
+    Confidence,
+}
+
+impl From<ObjectiveArg> for Objective {
+    fn from(o: ObjectiveArg) -> Self {
+        match o {
+            ObjectiveArg::FreeEnergy => Objective::FreeEnergy,
+            ObjectiveArg::CostJ => Objective::CostJ,
+            ObjectiveArg::Confidence => Objective::Confidence,
+        }
+    }
+}
+
+/// A built-in task name, else a task file.
+fn task_spec(task: &str) -> Result<TaskSpec, CliError> {
+    if let Ok(kind) = task.parse::<TaskKind>() {
+        return Ok(TaskSpec::builtin(kind));
+    }
+    if !Path::new(task).exists() {
+        return Err(CliError::Usage(format!(
+            "--task {task}: neither a built-in task (position, velocity, acceleration or 1, 2, \
+             3) nor an existing task file"
+        )));
+    }
+    Ok(TaskSpec::from_file(Path::new(task))?)
+}
+
+/// The cheap stage: every row read, checked and given its confidence; the screen keeps what
+/// will be simulated. Returns the screen and the number of rows skipped.
+fn screen_tools(args: &Args, tasks: &ModelTasks) -> Result<(Screen, usize), CliError> {
+    let mut screen = Screen::new(args.screen.map(|k| k as usize));
+    let mut skipped = 0;
+    let mut misfit: Option<CliError> = None;
+    let tools_file = args.tools.display().to_string();
+    let read = read_tools(&args.tools, |row| match row {
+        Ok(row) => {
+            if let Err(e) = tasks.check(row.tool.model()) {
+                misfit = Some(CliError::Usage(format!(
+                    "{e} (tool '{}' of {tools_file} is a {} tool)",
+                    row.label(),
+                    row.tool.model()
+                )));
+                return Err(ToolFileError {
+                    file: tools_file.clone(),
+                    place: String::new(),
+                    message: "stopped".into(),
+                    row_level: false,
+                });
+            }
+            let logdet = tasks.logdet(&row.tool);
+            screen.push(Candidate { row, logdet });
+            Ok(())
+        }
+        Err(bad) if args.skip_bad_rows && bad.row_level => {
+            eprintln!("toolconf: skipping {bad}");
+            skipped += 1;
+            Ok(())
+        }
+        Err(bad) => Err(bad),
+    });
+    if let Some(e) = misfit {
+        return Err(e);
+    }
+    read?;
+    if screen.read == 0 {
+        return Err(CliError::Usage(format!(
+            "{tools_file}: no valid tools (all {skipped} rows were bad)"
+        )));
+    }
+    if screen.without_confidence == screen.read {
+        // The task's precisions, not the tools, are at fault: say so before simulating.
+        return Err(CliError::Usage(format!(
+            "task {}: no tool of {tools_file} has a control confidence: {}",
+            args.task,
+            screen.first_confidence_error.as_deref().unwrap_or("")
+        )));
+    }
+    Ok((screen, skipped))
+}
+
+fn progress(total: usize) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(total as u64);
+    if let Ok(style) = ProgressStyle::with_template(
+        "{elapsed_precise} [{bar:40}] {pos}/{len} episodes ({per_sec}, eta {eta})",
+    ) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar
+}
+
+/// The parameter columns of the models present, in the models' order.
+fn parameter_columns(candidates: &[Candidate]) -> Vec<&'static str> {
+    let mut columns = Vec::new();
+    for model in ModelKind::ALL {
+        if candidates.iter().any(|c| c.row.tool.model() == model) {
+            for p in model.parameter_names() {
+                if !columns.contains(p) {
+                    columns.push(*p);
+                }
+            }
+        }
+    }
+    columns
+}
+
+fn csv_cells(r: &RankedTool, columns: &[&str]) -> Vec<Cell> {
+    let params = r.row.tool.named_parameters();
+    let mut cells = vec![
+        Cell::from(r.row.row),
+        r.row.name.clone().map_or(Cell::Empty, Cell::from),
+        Cell::from(r.row.tool.model().name()),
+    ];
+    for c in columns {
+        cells.push(Cell::from(
+            params.iter().find(|(n, _)| n == c).map(|(_, v)| *v),
+        ));
+    }
+    cells.push(Cell::from(r.logdet.as_ref().ok().copied()));
+    match &r.episode {
+        Ok(m) => {
+            for v in [m.task_error, m.free_energy, m.cost_j] {
+                cells.push(Cell::from(v));
+            }
+            cells.push(Cell::from(m.rhs_evals));
+            cells.push(Cell::Empty);
+        }
+        Err(e) => {
+            cells.extend([Cell::Empty, Cell::Empty, Cell::Empty, Cell::Empty]);
+            cells.push(Cell::from(e.to_string()));
+        }
+    }
+    cells
+}
+
+fn tool_json(rank: usize, r: &RankedTool) -> Value {
+    let params: Map<String, Value> = r
+        .row
+        .tool
+        .named_parameters()
+        .into_iter()
+        .map(|(n, v)| (n.to_string(), json!(v)))
+        .collect();
+    let mut v = json!({
+        "rank": rank,
+        "row": r.row.row,
+        "name": r.row.name,
+        "model": r.row.tool.model().name(),
+        "parameters": params,
+    });
+    match &r.logdet {
+        Ok(l) => v["logdet"] = json!(l),
+        Err(e) => v["logdet_error"] = json!(e.to_string()),
+    }
+    match &r.episode {
+        Ok(m) => {
+            v["task_error"] = json!(m.task_error);
+            v["free_energy"] = json!(m.free_energy);
+            v["cost_j"] = json!(m.cost_j);
+            v["rhs_evals"] = json!(m.rhs_evals);
+        }
+        Err(e) => v["error"] = json!(e.to_string()),
+    }
+    v
+}
+
+fn print_table(results: &[RankedTool], order: &[usize]) {
+    let name = |r: &RankedTool| r.row.name.clone().unwrap_or_else(|| "-".into());
+    let w = results
+        .iter()
+        .map(|r| name(r).chars().count())
+        .max()
+        .unwrap_or(4)
+        .max(4);
+    println!(
+        "{:>5} {:>6}  {:<w$} {:<10} {:>12}  {:>14} {:>14} {:>14}  parameters",
+        "rank", "row", "name", "model", "ln|Pi^U|", "task error", "int F dt", "int J dt"
+    );
+    for (k, &i) in order.iter().enumerate() {
+        let r = &results[i];
+        let logdet = r
+            .logdet
+            .as_ref()
+            .map_or("error".into(), |l| format!("{l:.6}"));
+        let metrics = match &r.episode {
+            Ok(m) => format!(
+                "{:>14.6e} {:>14.6e} {:>14.6e}",
+                m.task_error, m.free_energy, m.cost_j
+            ),
+            Err(e) => format!("failed: {e}"),
+        };
+        let params: Vec<String> = r
+            .row
+            .tool
+            .named_parameters()
+            .iter()
+            .map(|(n, v)| format!("{n}={}", format_number(*v)))
+            .collect();
+        println!(
+            "{:>5} {:>6}  {:<w$} {:<10} {:>12}  {metrics}  {}",
+            k + 1,
+            r.row.row,
+            name(r),
+            r.row.tool.model().name(),
+            logdet,
+            params.join(" ")
+        );
+    }
+}
+
+/// What the cheap stage counted, for the output.
+struct Counts {
+    read: usize,
+    skipped: usize,
+    without_confidence: usize,
+}
+
+pub fn run(args: &Args) -> Result<(), CliError> {
+    let spec = task_spec(&args.task)?;
+    let tasks = ModelTasks::new(&spec);
+    let objective = Objective::from(args.objective);
+    let (screen, skipped) = screen_tools(args, &tasks)?;
+    let counts = Counts {
+        read: screen.read,
+        skipped,
+        without_confidence: screen.without_confidence,
+    };
+    let candidates = screen.finish();
+    if let Some(dir) = &args.report {
+        std::fs::create_dir_all(dir).map_err(|source| CliError::Io {
+            path: dir.clone(),
+            source,
+        })?;
+    }
+    let results = simulate_streaming(args, candidates, &tasks)?;
+    let order = ranking(&results, objective);
+    if args.json {
+        print_json(args, &spec, objective, &counts, &results, &order);
+    } else {
+        print_text(args, &spec, objective, &counts, &results, &order);
+    }
+    if let Some(dir) = &args.report {
+        let command: Vec<String> = std::env::args().collect();
+        let input = ReportInput {
+            command: &command.join(" "),
+            tools_file: &args.tools.display().to_string(),
+            spec: &spec,
+            tasks: &tasks,
+            objective,
+            read: counts.read,
+            skipped: counts.skipped,
+            screen: args.screen.map(|k| k as usize),
+            results: &results,
+            order: &order,
+        };
+        let files = write_report(dir, &input)?;
+        if !args.json {
+            println!("report: {}", files[1].display());
+        }
+    }
+    if results.iter().all(|r| r.episode.is_err()) {
+        return Err(CliError::Failed(format!(
+            "every one of the {} simulated tools failed",
+            results.len()
+        )));
+    }
+    Ok(())
+}
+
+/// The expensive stage, each result written to `--csv` (file order) as its chunk finishes.
+fn simulate_streaming(
+    args: &Args,
+    candidates: Vec<Candidate>,
+    tasks: &ModelTasks,
+) -> Result<Vec<RankedTool>, CliError> {
+    let columns = parameter_columns(&candidates);
+    let mut csv = match &args.csv {
+        Some(path) => {
+            let mut header = vec!["row", "name", "model"];
+            header.extend(&columns);
+            header.extend([
+                "logdet",
+                "task_error",
+                "free_energy",
+                "cost_j",
+                "rhs_evals",
+                "error",
+            ]);
+            Some(CsvWriter::create(path, &header)?)
+        }
+        None => None,
+    };
+    let bar = progress(candidates.len());
+    let results = simulate_all(candidates, tasks, |r| {
+        bar.inc(1);
+        match csv.as_mut() {
+            Some(w) => w.row(csv_cells(r, &columns)),
+            None => Ok(()),
+        }
+    })?;
+    bar.finish_and_clear();
+    Ok(results)
+}
+
+fn print_json(
+    args: &Args,
+    spec: &TaskSpec,
+    objective: Objective,
+    counts: &Counts,
+    results: &[RankedTool],
+    order: &[usize],
+) {
+    let out = json!({
+        "task": spec.kind,
+        "task_file": (!spec.file.is_empty()).then_some(&spec.file),
+        "tools_file": args.tools,
+        "objective": objective.name(),
+        "tools_read": counts.read,
+        "skipped_rows": counts.skipped,
+        "screen": args.screen,
+        "without_confidence": counts.without_confidence,
+        "simulated": results.len(),
+        "tools": order
+            .iter()
+            .enumerate()
+            .map(|(k, &i)| tool_json(k + 1, &results[i]))
+            .collect::<Vec<_>>(),
+    });
+    println!(
+        "{}",
+        serde_json::to_string_pretty(&out).expect("finite numbers")
+    );
+}
+
+fn print_text(
+    args: &Args,
+    spec: &TaskSpec,
+    objective: Objective,
+    counts: &Counts,
+    results: &[RankedTool],
+    order: &[usize],
+) {
+    println!(
+        "tools: {}    task: {}    ranked by: {}",
+        args.tools.display(),
+        spec.label(),
+        objective.name()
+    );
+    let screened = args.screen.map_or(String::new(), |k| {
+        format!(
+            "    screened to the {k} most confident ({} without a confidence)",
+            counts.without_confidence
+        )
+    });
+    println!(
+        "read {} tools    skipped {} bad rows    simulated {}{screened}",
+        counts.read,
+        counts.skipped,
+        results.len()
+    );
+    print_table(results, order);
+}

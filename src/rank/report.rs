@@ -1,0 +1,466 @@
+//! The report of a ranking (`toolconf rank --report DIR`): `report.md` and `report.html` (the
+//! same text, figures inline), written for a reader who has not read the paper, with two
+//! figures: confidence against task error, and the best and worst tools over time.
+
+use std::path::{Path, PathBuf};
+
+use super::{score, ModelTasks, RankedTool, TaskTrace};
+use crate::experiments::common::wants_log;
+use crate::experiments::csv::format_number;
+use crate::experiments::plot::{self, Colour, Legend, Panel, Series, XyPanel};
+use crate::experiments::report::{to_html, to_markdown, Block};
+use crate::experiments::{write_atomically, ReproduceError};
+use crate::select::Objective;
+use crate::stats::spearman;
+use crate::task_file::{PerJoint, PrecisionSpec, TaskSpec};
+use crate::TaskKind;
+
+/// What the report describes.
+pub struct ReportInput<'a> {
+    pub command: &'a str,
+    pub tools_file: &'a str,
+    pub spec: &'a TaskSpec,
+    pub tasks: &'a ModelTasks,
+    pub objective: Objective,
+    /// Tools read, rows skipped as bad, and the screen's K (if any).
+    pub read: usize,
+    pub skipped: usize,
+    pub screen: Option<usize>,
+    /// Simulated tools in file order, and their order from best to worst.
+    pub results: &'a [RankedTool],
+    pub order: &'a [usize],
+}
+
+/// How many tools the report lists, and how many of the best and worst it plots over time.
+const LISTED: usize = 50;
+const TRACED: usize = 3;
+
+/// Writes the report into `dir` (created if needed); returns the files written.
+pub fn write_report(dir: &Path, input: &ReportInput) -> Result<Vec<PathBuf>, ReproduceError> {
+    std::fs::create_dir_all(dir).map_err(ReproduceError::io(dir))?;
+    let mut doc = introduction(input);
+    doc.extend(ranking_table(input));
+    doc.extend(confidence_figure(dir, input)?);
+    doc.extend(trajectory_figure(dir, input)?);
+    doc.push(Block::Heading(2, "How this was made".into()));
+    doc.push(Block::p(format!(
+        "Command: `{}`. Every episode is deterministic: the same files give the same numbers \
+         whatever the number of threads.",
+        input.command
+    )));
+    let md = dir.join("report.md");
+    let html = dir.join("report.html");
+    write_atomically(&md, &to_markdown(&doc))?;
+    write_atomically(&html, &to_html(&doc))?;
+    Ok(vec![
+        md,
+        html,
+        dir.join(CONFIDENCE_SVG),
+        dir.join(TRAJECTORY_SVG),
+    ])
+}
+
+fn variable(kind: TaskKind) -> (&'static str, &'static str) {
+    match kind {
+        TaskKind::Position => ("θ", "joint angle θ [rad]"),
+        TaskKind::Velocity => ("θ̇", "joint velocity θ̇ [rad/s]"),
+        TaskKind::Acceleration => ("θ̈", "joint acceleration θ̈ [rad/s²]"),
+    }
+}
+
+fn introduction(input: &ReportInput) -> Vec<Block> {
+    let spec = input.spec;
+    let (var, _) = variable(spec.kind);
+    let goal = match spec.kind {
+        TaskKind::Position => "reach and hold a goal configuration",
+        TaskKind::Velocity => "move the joints at a goal velocity",
+        TaskKind::Acceleration => "hold a goal joint acceleration",
+    };
+    let screened = match input.screen {
+        Some(k) => format!(
+            "Only the {} most confident of the {} tools were simulated (`--screen {k}`).",
+            input.results.len(),
+            input.read
+        ),
+        None => format!("All {} tools were simulated.", input.read),
+    };
+    let skipped = if input.skipped > 0 {
+        format!(
+            " {} bad rows were skipped (`--skip-bad-rows`).",
+            input.skipped
+        )
+    } else {
+        String::new()
+    };
+    vec![
+        Block::Heading(1, format!("Ranking the tools of {}", input.tools_file)),
+        Block::p(format!(
+            "Each tool is a robot arm, given by its link masses and lengths, that an \
+             active-inference controller drives to do one task: **{}**, that is to {goal}{}. \
+             The controller changes its torque U to lower a free energy F, a weighted sum of \
+             squared errors (how far the arm is from the goal, how much torque it uses). \
+             Following Anil Meera & Lanillos, *Confidence-Aware Decision-Making and Control \
+             for Tool Selection*, each tool is judged by four numbers:",
+            spec.label(),
+            spec.description
+                .as_ref()
+                .map_or(String::new(), |d| format!(" ({d})"))
+        )),
+        Block::Bullets(vec![
+            "**Control confidence ln|Π^U|**: Π^U = ∂²F/∂U² says how sharply the free energy \
+             reacts to the torque, i.e. how precisely the controller can steer this arm for this \
+             task. It depends only on the arm and the task's weights, so it costs microseconds \
+             and needs no simulation. Higher is more confident."
+                .into(),
+            format!(
+                "**Task error**: the weighted squared distance of {var} from its goal, \
+                 (x − x_goal)ᵀ P (x − x_goal), summed over every output time of a simulated \
+                 episode. Lower is better."
+            ),
+            "**∫F dt** (free energy): the controller's whole objective over the episode, \
+             errors and torque minus ½ ln|Π^U|: good tools reach the goal cheaply *and* are \
+             confident. This is the paper's criterion. Lower is better."
+                .into(),
+            "**∫J dt**: the same without the confidence term, the classic optimal-control \
+             cost. Lower is better."
+                .into(),
+        ]),
+        Block::p(format!(
+            "The ranking below is by **{}**. {screened}{skipped} A tool whose simulation \
+             failed keeps its error message and is listed last.",
+            objective_words(input.objective)
+        )),
+    ]
+    .into_iter()
+    .chain(task_table(input))
+    .collect()
+}
+
+fn objective_words(o: Objective) -> &'static str {
+    match o {
+        Objective::FreeEnergy => "∫F dt, lowest first",
+        Objective::CostJ => "∫J dt, lowest first",
+        Objective::Confidence => "control confidence ln|Π^U|, highest first",
+    }
+}
+
+fn per_joint(p: &PerJoint) -> String {
+    match p {
+        PerJoint::All(x) => format!("{x} on every joint"),
+        PerJoint::Each(v) => format!("{v:?} (joint by joint)"),
+    }
+}
+
+fn precision(p: &PrecisionSpec) -> String {
+    match p {
+        PrecisionSpec::Scalar(s) => format!("{s}·I"),
+        PrecisionSpec::Matrix(rows) => format!("{rows:?}"),
+    }
+}
+
+/// What the task sets, in words; what it leaves out is each model's paper value.
+fn task_table(input: &ReportInput) -> Vec<Block> {
+    let spec = input.spec;
+    let e = &spec.episode;
+    let paper = "the paper's (per model)";
+    let given = |v: Option<String>, default: &str| v.unwrap_or_else(|| default.to_string());
+    let vector = |v: &Option<Vec<f64>>| v.as_ref().map(|v| format!("{v:?}"));
+    let number = |v: Option<f64>| v.map(|v| v.to_string());
+    let mut rows = vec![vec!["task kind".to_string(), spec.kind.to_string()]];
+    let mut add = |name: &str, value: String| rows.push(vec![name.to_string(), value]);
+    if spec.kind == TaskKind::Position {
+        add("goal θ [rad]", given(vector(&spec.goal_theta), paper));
+        add(
+            "precision P^θ",
+            given(spec.precision_theta.as_ref().map(precision), paper),
+        );
+    }
+    if spec.kind != TaskKind::Acceleration {
+        add("goal θ̇ [rad/s]", given(vector(&spec.goal_theta_dot), paper));
+        add(
+            "precision P^θ̇",
+            given(spec.precision_theta_dot.as_ref().map(precision), paper),
+        );
+    }
+    add(
+        "goal θ̈ [rad/s²]",
+        given(vector(&spec.goal_theta_ddot), paper),
+    );
+    add(
+        "precision P^θ̈",
+        given(spec.precision_theta_ddot.as_ref().map(precision), paper),
+    );
+    add(
+        "precision P^U",
+        given(spec.precision_u.as_ref().map(precision), paper),
+    );
+    add("episode length t_end [s]", given(number(e.t_end), "5"));
+    add("output step dt [s]", given(number(e.dt), "0.05"));
+    add(
+        "constant torque perturbation ΔT [N m]",
+        given(e.perturbation.as_ref().map(per_joint), "0"),
+    );
+    add(
+        "initial joint angles [rad]",
+        given(vector(&e.initial_theta), "hanging straight down"),
+    );
+    add(
+        "initial joint velocities [rad/s]",
+        given(vector(&e.initial_theta_dot), "0"),
+    );
+    add(
+        "initial torque U0 [N m]",
+        given(
+            e.initial_torque.as_ref().map(per_joint),
+            "0.1 on every joint",
+        ),
+    );
+    add("learning rate γ", given(number(e.learning_rate), "1"));
+    vec![
+        Block::p(
+            "The task: a precision P weighs an error term (a larger P means the controller \
+             cares more about it; P·I weighs every joint alike). What the task file leaves out \
+             is the paper's value."
+                .to_string(),
+        ),
+        Block::table(&["setting", "value"], rows),
+    ]
+}
+
+fn number(v: f64) -> String {
+    format!("{v:.6}")
+}
+
+fn ranking_table(input: &ReportInput) -> Vec<Block> {
+    let mut rows = Vec::new();
+    let failed: Vec<usize> = input
+        .order
+        .iter()
+        .copied()
+        .filter(|&i| input.results[i].episode.is_err())
+        .collect();
+    for (rank, &i) in input.order.iter().enumerate() {
+        let r = &input.results[i];
+        if rank >= LISTED && r.episode.is_ok() {
+            continue;
+        }
+        let params: Vec<String> = r
+            .row
+            .tool
+            .named_parameters()
+            .iter()
+            .map(|(n, v)| format!("{n}={}", format_number(*v)))
+            .collect();
+        let logdet = r.logdet.as_ref().map_or("–".into(), |l| number(*l));
+        let metrics = match &r.episode {
+            Ok(m) => vec![
+                number(m.task_error),
+                number(m.free_energy),
+                number(m.cost_j),
+            ],
+            Err(e) => vec![format!("failed: {e}"), String::new(), String::new()],
+        };
+        let mut row = vec![
+            (rank + 1).to_string(),
+            r.row.label(),
+            r.row.tool.model().name().to_string(),
+            params.join(" "),
+            logdet,
+        ];
+        row.extend(metrics);
+        rows.push(row);
+    }
+    let shown = input.order.len().min(LISTED).max(rows.len());
+    let mut blocks = vec![Block::Heading(2, "Ranking".into())];
+    if input.order.len() > shown || (input.order.len() > LISTED) {
+        blocks.push(Block::p(format!(
+            "The best {LISTED} of {} simulated tools (and every failed one, {}); the full list \
+             is in the JSON or CSV output.",
+            input.order.len(),
+            failed.len()
+        )));
+    }
+    blocks.push(Block::table(
+        &[
+            "rank",
+            "tool",
+            "model",
+            "parameters",
+            "ln|Π^U|",
+            "task error",
+            "∫F dt",
+            "∫J dt",
+        ],
+        rows,
+    ));
+    blocks
+}
+
+const CONFIDENCE_SVG: &str = "confidence_vs_task_error.svg";
+const TRAJECTORY_SVG: &str = "best_and_worst.svg";
+
+fn confidence_figure(dir: &Path, input: &ReportInput) -> Result<Vec<Block>, ReproduceError> {
+    let points: Vec<(f64, f64)> = input
+        .results
+        .iter()
+        .filter_map(|r| {
+            Some((
+                *r.logdet.as_ref().ok()?,
+                r.episode.as_ref().ok()?.task_error,
+            ))
+        })
+        .collect();
+    let (x, y): (Vec<f64>, Vec<f64>) = points.iter().copied().unzip();
+    let panel = XyPanel {
+        title: format!("{} simulated tools", points.len()),
+        x_label: "control confidence ln|Π^U|".into(),
+        y_label: "task error".into(),
+        dots: vec![Series::new("tools", Colour(0, 114, 178), points.clone())],
+        lines: Vec::new(),
+        log_y: wants_log(&y),
+        legend: Legend::UpperRight,
+        headroom: 0.1,
+    };
+    let svg = plot::save(&dir.join(CONFIDENCE_SVG), &[Panel::Xy(panel)], (640, 420))?;
+    let verdict = match spearman(&x, &y) {
+        Ok(rho) => format!(
+            "Spearman's rank correlation between confidence and task error is ρ = {rho:.3} \
+             over {} tools. {}",
+            points.len(),
+            if rho <= -0.3 {
+                "Here, as the paper found, the more confident tools tend to do the task \
+                 better: confidence alone is a useful first screen."
+            } else if rho < 0.0 {
+                "More confident tools do the task slightly better here, but confidence alone \
+                 is a weak guide for this tool set."
+            } else {
+                "Here confidence does not predict the task error: rank these tools by \
+                 simulation, not by confidence alone."
+            }
+        ),
+        Err(e) => format!("The rank correlation cannot be computed here: {e}."),
+    };
+    Ok(vec![
+        Block::Heading(2, "Does confidence predict the task error?".into()),
+        Block::p(
+            "Confidence costs nothing to compute, the task error needs a simulation. If the \
+             two agree (points falling from left to right), confidence can pick good tools \
+             from a large set before anything is simulated (`--screen K`)."
+                .to_string(),
+        ),
+        Block::Figure {
+            file: CONFIDENCE_SVG.into(),
+            caption: "Each dot is a simulated tool: its control confidence ln|Π^U| against \
+                      its task error."
+                .into(),
+            svg,
+        },
+        Block::p(verdict),
+    ])
+}
+
+fn trajectory_figure(dir: &Path, input: &ReportInput) -> Result<Vec<Block>, ReproduceError> {
+    let ok: Vec<usize> = input
+        .order
+        .iter()
+        .copied()
+        .filter(|&i| score(input.objective, &input.results[i]).is_some())
+        .collect();
+    let best: Vec<usize> = ok.iter().copied().take(TRACED).collect();
+    let worst: Vec<usize> = ok
+        .iter()
+        .rev()
+        .copied()
+        .filter(|i| !best.contains(i))
+        .take(TRACED)
+        .collect();
+    let (var, axis) = variable(input.spec.kind);
+    const BEST: [Colour; TRACED] = [
+        Colour(0, 90, 200),
+        Colour(60, 150, 230),
+        Colour(120, 190, 240),
+    ];
+    const WORST: [Colour; TRACED] = [
+        Colour(200, 30, 30),
+        Colour(230, 110, 60),
+        Colour(240, 170, 110),
+    ];
+    let mut traces: Vec<(String, Colour, bool, TaskTrace)> = Vec::new();
+    let mut notes = Vec::new();
+    for (group, colours, dashed) in [(&best, BEST, false), (&worst, WORST, true)] {
+        for (k, &i) in group.iter().enumerate() {
+            let r = &input.results[i];
+            let rank = input.order.iter().position(|&j| j == i).unwrap_or(0) + 1;
+            match input.tasks.trace(&r.row.tool) {
+                Ok(t) => traces.push((format!("#{rank} {}", r.row.label()), colours[k], dashed, t)),
+                Err(e) => notes.push(format!("#{rank} {}: {e}", r.row.label())),
+            }
+        }
+    }
+    let joints = traces.iter().map(|t| t.3.value.len()).max().unwrap_or(0);
+    let panels: Vec<Panel> = (0..joints.max(1))
+        .map(|j| {
+            let mut lines: Vec<Series> = traces
+                .iter()
+                .filter(|t| j < t.3.value.len())
+                .map(|(label, colour, dashed, t)| {
+                    let s = Series::new(
+                        label.clone(),
+                        *colour,
+                        t.t.iter()
+                            .copied()
+                            .zip(t.value[j].iter().copied())
+                            .collect(),
+                    );
+                    if *dashed {
+                        s.dashed()
+                    } else {
+                        s
+                    }
+                })
+                .collect();
+            if let Some((_, _, _, t)) = traces.iter().find(|t| j < t.3.value.len()) {
+                let end = t.t.last().copied().unwrap_or(0.0);
+                lines.push(
+                    Series::new(
+                        "goal",
+                        plot::GOAL_GREY,
+                        vec![(0.0, t.goal[j]), (end, t.goal[j])],
+                    )
+                    .dashed(),
+                );
+            }
+            Panel::Xy(XyPanel {
+                title: format!("joint {}", j + 1),
+                x_label: "time t [s]".into(),
+                y_label: axis.into(),
+                dots: Vec::new(),
+                lines,
+                log_y: false,
+                legend: Legend::LowerRight,
+                headroom: 0.35,
+            })
+        })
+        .collect();
+    let svg = plot::save(&dir.join(TRAJECTORY_SVG), &panels, (560, 420))?;
+    let mut blocks = vec![
+        Block::Heading(2, "The best and the worst tools over time".into()),
+        Block::p(format!(
+            "The task variable {var} of the {} best (solid, blue) and {} worst (dashed, red) \
+             tools by {}, one panel per joint; the grey dashed line is the goal. A good tool \
+             gets to the goal quickly and stays there.",
+            best.len(),
+            worst.len(),
+            objective_words(input.objective)
+        )),
+        Block::Figure {
+            file: TRAJECTORY_SVG.into(),
+            caption: format!("{var} over one episode; #k is the tool's rank."),
+            svg,
+        },
+    ];
+    if !notes.is_empty() {
+        blocks.push(Block::Bullets(notes));
+    }
+    Ok(blocks)
+}

@@ -1,0 +1,668 @@
+//! Task files: a task of the user's own, in TOML, for any model.
+//!
+//! ```toml
+//! kind = "position"              # position | velocity | acceleration: the paper's three task structures
+//! description = "reach 45°"      # optional, shown in reports
+//! [goal]                         # optional, each key defaulting to the model's paper goal
+//! theta = [0.7853981633974483, 0.0]
+//! [precision]                    # a scalar is that multiple of I; a matrix is given row by row
+//! theta = 80.0
+//! theta_dot = [[50.0, 0.0], [0.0, 50.0]]
+//! [episode]                      # optional; the paper's defaults otherwise
+//! t_end = 5.0
+//! dt = 0.05
+//! perturbation = 0.0             # ΔT on every joint, or one value per joint: [0.2, -0.1]
+//! learning_rate = 1.0            # γ
+//! initial_theta = [-1.5707963267948966, -1.5707963267948966]   # default: the hanging equilibrium
+//! initial_theta_dot = [0.0, 0.0]
+//! initial_torque = 0.1           # U0 on every joint, or one value per joint
+//! rtol = 1e-3                    # integrator tolerances (MATLAB ode45's by default)
+//! atol = 1e-6
+//! ```
+//!
+//! Parsing checks everything that does not depend on the model (unknown keys, shapes, finite
+//! numbers, symmetric positive semi-definite precisions, episode options); [`TaskSpec::task`] and
+//! [`TaskSpec::episode`] then check sizes against one model and fill what the file leaves out
+//! from that model's paper-style task. Every error names the file and the key (or the line, for
+//! TOML syntax) and the value.
+
+use std::fmt;
+use std::path::Path;
+
+use nalgebra::{DMatrix, SMatrix, SVector};
+use serde::Deserialize;
+
+use crate::model::runtime::check_grid;
+use crate::model::{ArmModel, EpisodeOptionsN, TaskN};
+use crate::TaskKind;
+
+/// A bad task file: the file, where in it (a key or a line), and what is wrong.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub struct TaskFileError {
+    pub file: String,
+    /// `key goal.theta`, `line 4`, or empty when the whole file is meant.
+    pub place: String,
+    pub message: String,
+}
+
+impl fmt::Display for TaskFileError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.place.is_empty() {
+            write!(f, "{}: {}", self.file, self.message)
+        } else {
+            write!(f, "{}, {}: {}", self.file, self.place, self.message)
+        }
+    }
+}
+
+/// A precision as written: `s` means s·I, or a full matrix.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PrecisionSpec {
+    Scalar(f64),
+    Matrix(Vec<Vec<f64>>),
+}
+
+/// A per-joint quantity as written: one value for every joint, or one per joint.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PerJoint {
+    All(f64),
+    Each(Vec<f64>),
+}
+
+impl PerJoint {
+    /// The value on every joint, if it is the same on all of them.
+    pub fn uniform(&self) -> Option<f64> {
+        match self {
+            PerJoint::All(v) => Some(*v),
+            PerJoint::Each(v) if v.windows(2).all(|w| w[0] == w[1]) => v.first().copied(),
+            PerJoint::Each(_) => None,
+        }
+    }
+}
+
+/// The `[episode]` table; `None` is the paper's default.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct EpisodeSpec {
+    pub t_end: Option<f64>,
+    pub dt: Option<f64>,
+    pub perturbation: Option<PerJoint>,
+    pub learning_rate: Option<f64>,
+    pub initial_theta: Option<Vec<f64>>,
+    pub initial_theta_dot: Option<Vec<f64>>,
+    pub initial_torque: Option<PerJoint>,
+    pub rtol: Option<f64>,
+    pub atol: Option<f64>,
+}
+
+/// A task: one of the paper's built-in tasks, or a task file's, not yet bound to a model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TaskSpec {
+    /// The file it came from ("" for a built-in task).
+    pub file: String,
+    pub kind: TaskKind,
+    pub description: Option<String>,
+    pub goal_theta: Option<Vec<f64>>,
+    pub goal_theta_dot: Option<Vec<f64>>,
+    pub goal_theta_ddot: Option<Vec<f64>>,
+    pub precision_theta: Option<PrecisionSpec>,
+    pub precision_theta_dot: Option<PrecisionSpec>,
+    pub precision_theta_ddot: Option<PrecisionSpec>,
+    pub precision_u: Option<PrecisionSpec>,
+    pub episode: EpisodeSpec,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTask {
+    kind: String,
+    description: Option<String>,
+    #[serde(default)]
+    goal: RawGoal,
+    #[serde(default)]
+    precision: RawPrecision,
+    #[serde(default)]
+    episode: RawEpisode,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawGoal {
+    theta: Option<Vec<f64>>,
+    theta_dot: Option<Vec<f64>>,
+    theta_ddot: Option<Vec<f64>>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawPrecision {
+    theta: Option<toml::Value>,
+    theta_dot: Option<toml::Value>,
+    theta_ddot: Option<toml::Value>,
+    u: Option<toml::Value>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawEpisode {
+    t_end: Option<f64>,
+    dt: Option<f64>,
+    perturbation: Option<toml::Value>,
+    learning_rate: Option<f64>,
+    initial_theta: Option<Vec<f64>>,
+    initial_theta_dot: Option<Vec<f64>>,
+    initial_torque: Option<toml::Value>,
+    rtol: Option<f64>,
+    atol: Option<f64>,
+}
+
+impl TaskSpec {
+    /// The paper's task `kind`: every model's own paper-style task, with the paper's episode.
+    pub fn builtin(kind: TaskKind) -> Self {
+        Self {
+            file: String::new(),
+            kind,
+            description: None,
+            goal_theta: None,
+            goal_theta_dot: None,
+            goal_theta_ddot: None,
+            precision_theta: None,
+            precision_theta_dot: None,
+            precision_theta_ddot: None,
+            precision_u: None,
+            episode: EpisodeSpec::default(),
+        }
+    }
+
+    /// Reads and checks a task file.
+    pub fn from_file(path: &Path) -> Result<Self, TaskFileError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| TaskFileError {
+            file: file.clone(),
+            place: String::new(),
+            message: format!("cannot read the task file: {e}"),
+        })?;
+        Self::parse(&text, &file)
+    }
+
+    /// Parses and checks task-file text; `file` names it in errors.
+    pub fn parse(text: &str, file: &str) -> Result<Self, TaskFileError> {
+        let raw: RawTask = toml::from_str(text).map_err(|e| TaskFileError {
+            file: file.into(),
+            place: e
+                .span()
+                .map(|s| syntax_place(text, s.start))
+                .unwrap_or_default(),
+            message: e.message().trim().replace('\n', " "),
+        })?;
+        let err = |key: &str, message: String| TaskFileError {
+            file: file.into(),
+            place: format!("key {key}"),
+            message,
+        };
+        let kind: TaskKind = raw.kind.parse().map_err(|_| {
+            err(
+                "kind",
+                format!(
+                    "'{}' is not a task kind: expected position, velocity or acceleration",
+                    raw.kind
+                ),
+            )
+        })?;
+        let precision = |key: &str, v: Option<toml::Value>| {
+            v.map(|v| precision_spec(&v).map_err(|m| err(key, m)))
+                .transpose()
+        };
+        let per_joint = |key: &str, v: Option<toml::Value>| {
+            v.map(|v| per_joint_spec(&v).map_err(|m| err(key, m)))
+                .transpose()
+        };
+        let e = raw.episode;
+        let spec = TaskSpec {
+            file: file.into(),
+            kind,
+            description: raw.description,
+            goal_theta: raw.goal.theta,
+            goal_theta_dot: raw.goal.theta_dot,
+            goal_theta_ddot: raw.goal.theta_ddot,
+            precision_theta: precision("precision.theta", raw.precision.theta)?,
+            precision_theta_dot: precision("precision.theta_dot", raw.precision.theta_dot)?,
+            precision_theta_ddot: precision("precision.theta_ddot", raw.precision.theta_ddot)?,
+            precision_u: precision("precision.u", raw.precision.u)?,
+            episode: EpisodeSpec {
+                t_end: e.t_end,
+                dt: e.dt,
+                perturbation: per_joint("episode.perturbation", e.perturbation)?,
+                learning_rate: e.learning_rate,
+                initial_theta: e.initial_theta,
+                initial_theta_dot: e.initial_theta_dot,
+                initial_torque: per_joint("episode.initial_torque", e.initial_torque)?,
+                rtol: e.rtol,
+                atol: e.atol,
+            },
+        };
+        spec.check().map_err(|(key, m)| err(&key, m))?;
+        Ok(spec)
+    }
+
+    /// A short name: the file, or the built-in task's name.
+    pub fn label(&self) -> String {
+        if self.file.is_empty() {
+            format!(
+                "{} (the paper's task {})",
+                self.kind,
+                self.kind.paper_index()
+            )
+        } else {
+            format!("{} ({})", self.file, self.kind)
+        }
+    }
+
+    fn error(&self, key: &str, message: String) -> TaskFileError {
+        TaskFileError {
+            file: if self.file.is_empty() {
+                format!("task {}", self.kind)
+            } else {
+                self.file.clone()
+            },
+            place: format!("key {key}"),
+            message,
+        }
+    }
+
+    /// The checks that need no model: terms the task uses, finite numbers, precisions symmetric
+    /// positive semi-definite, episode options in range. Returns (key, message).
+    fn check(&self) -> Result<(), (String, String)> {
+        let unused = |key: &str, given: bool, used_by: &str| {
+            if given {
+                Err((
+                    key.to_string(),
+                    format!("a {} task does not use it ({used_by} only)", self.kind),
+                ))
+            } else {
+                Ok(())
+            }
+        };
+        if self.kind != TaskKind::Position {
+            unused("goal.theta", self.goal_theta.is_some(), "position")?;
+            unused(
+                "precision.theta",
+                self.precision_theta.is_some(),
+                "position",
+            )?;
+        }
+        if self.kind == TaskKind::Acceleration {
+            let used_by = "position and velocity";
+            unused("goal.theta_dot", self.goal_theta_dot.is_some(), used_by)?;
+            unused(
+                "precision.theta_dot",
+                self.precision_theta_dot.is_some(),
+                used_by,
+            )?;
+        }
+        for (key, v) in [
+            ("goal.theta", &self.goal_theta),
+            ("goal.theta_dot", &self.goal_theta_dot),
+            ("goal.theta_ddot", &self.goal_theta_ddot),
+            ("episode.initial_theta", &self.episode.initial_theta),
+            ("episode.initial_theta_dot", &self.episode.initial_theta_dot),
+        ] {
+            if let Some(v) = v {
+                finite_list(v).map_err(|m| (key.to_string(), m))?;
+            }
+        }
+        for (key, p) in [
+            ("precision.theta", &self.precision_theta),
+            ("precision.theta_dot", &self.precision_theta_dot),
+            ("precision.theta_ddot", &self.precision_theta_ddot),
+            ("precision.u", &self.precision_u),
+        ] {
+            if let Some(p) = p {
+                check_precision(p).map_err(|m| (key.to_string(), m))?;
+            }
+        }
+        self.episode.check().map_err(|(k, m)| (k.to_string(), m))
+    }
+
+    /// The task for model `M`: the file's goals and precisions, the rest from `M`'s paper-style
+    /// task. Errors when a goal or precision has the wrong size for `M`.
+    pub fn task<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+        &self,
+    ) -> Result<TaskN<N>, TaskFileError>
+    where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
+        let mut task = M::paper_task(self.kind);
+        for (key, given, goal) in [
+            ("goal.theta", &self.goal_theta, &mut task.goal_theta),
+            (
+                "goal.theta_dot",
+                &self.goal_theta_dot,
+                &mut task.goal_theta_dot,
+            ),
+            (
+                "goal.theta_ddot",
+                &self.goal_theta_ddot,
+                &mut task.goal_theta_ddot,
+            ),
+        ] {
+            if let Some(v) = given {
+                *goal = self.vector::<M, N, NX, NP, NZ>(key, v)?;
+            }
+        }
+        for (key, given, p) in [
+            (
+                "precision.theta",
+                &self.precision_theta,
+                &mut task.precision_theta,
+            ),
+            (
+                "precision.theta_dot",
+                &self.precision_theta_dot,
+                &mut task.precision_theta_dot,
+            ),
+            (
+                "precision.theta_ddot",
+                &self.precision_theta_ddot,
+                &mut task.precision_theta_ddot,
+            ),
+            ("precision.u", &self.precision_u, &mut task.precision_u),
+        ] {
+            if let Some(given) = given {
+                *p = match given {
+                    PrecisionSpec::Scalar(s) => SMatrix::identity() * *s,
+                    PrecisionSpec::Matrix(rows) => {
+                        if rows.len() != N {
+                            return Err(self.error(
+                                key,
+                                format!(
+                                    "a {0}×{0} matrix, but model {1} has {N} joints",
+                                    rows.len(),
+                                    M::NAME
+                                ),
+                            ));
+                        }
+                        SMatrix::from_fn(|i, j| rows[i][j])
+                    }
+                };
+            }
+        }
+        task.validate()
+            .map_err(|e| self.error("precision", e.to_string()))?;
+        Ok(task)
+    }
+
+    /// The episode options for model `M`: the file's `[episode]`, the rest the paper's.
+    pub fn episode<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+        &self,
+    ) -> Result<EpisodeOptionsN<N, NX>, TaskFileError>
+    where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
+        let e = &self.episode;
+        let mut o = EpisodeOptionsN::<N, NX>::paper::<M, NP, NZ>();
+        o.t_end = e.t_end.unwrap_or(o.t_end);
+        o.dt = e.dt.unwrap_or(o.dt);
+        o.learning_rate = e.learning_rate.unwrap_or(o.learning_rate);
+        o.integrator.rtol = e.rtol.unwrap_or(o.integrator.rtol);
+        o.integrator.atol = e.atol.unwrap_or(o.integrator.atol);
+        if let Some(v) = &e.initial_theta {
+            let theta = self.vector::<M, N, NX, NP, NZ>("episode.initial_theta", v)?;
+            o.x0.fixed_rows_mut::<N>(0).copy_from(&theta);
+        }
+        if let Some(v) = &e.initial_theta_dot {
+            let theta_dot = self.vector::<M, N, NX, NP, NZ>("episode.initial_theta_dot", v)?;
+            o.x0.fixed_rows_mut::<N>(N).copy_from(&theta_dot);
+        }
+        if let Some(u0) = &e.initial_torque {
+            o.u0 = self.per_joint::<M, N, NX, NP, NZ>("episode.initial_torque", u0)?;
+        }
+        match &e.perturbation {
+            Some(PerJoint::All(v)) => o.perturbation = *v,
+            Some(each @ PerJoint::Each(_)) => {
+                o.joint_perturbation =
+                    self.per_joint::<M, N, NX, NP, NZ>("episode.perturbation", each)?;
+            }
+            None => {}
+        }
+        Ok(o)
+    }
+
+    fn vector<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+        &self,
+        key: &str,
+        v: &[f64],
+    ) -> Result<SVector<f64, N>, TaskFileError>
+    where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
+        if v.len() != N {
+            return Err(self.error(
+                key,
+                format!(
+                    "{} values {v:?}, but model {} has {N} joints",
+                    v.len(),
+                    M::NAME
+                ),
+            ));
+        }
+        Ok(SVector::from_column_slice(v))
+    }
+
+    fn per_joint<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+        &self,
+        key: &str,
+        v: &PerJoint,
+    ) -> Result<SVector<f64, N>, TaskFileError>
+    where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
+        match v {
+            PerJoint::All(x) => Ok(SVector::repeat(*x)),
+            PerJoint::Each(v) => self.vector::<M, N, NX, NP, NZ>(key, v),
+        }
+    }
+}
+
+impl EpisodeSpec {
+    fn check(&self) -> Result<(), (&'static str, String)> {
+        let positive = |key: &'static str, v: Option<f64>| match v {
+            Some(x) if !(x.is_finite() && x > 0.0) => {
+                Err((key, format!("{x} must be a finite number > 0")))
+            }
+            _ => Ok(()),
+        };
+        positive("episode.t_end", self.t_end)?;
+        positive("episode.dt", self.dt)?;
+        positive("episode.learning_rate", self.learning_rate)?;
+        positive("episode.rtol", self.rtol)?;
+        positive("episode.atol", self.atol)?;
+        let (t_end, dt) = (self.t_end.unwrap_or(5.0), self.dt.unwrap_or(0.05));
+        if dt > t_end {
+            return Err(("episode.dt", format!("{dt} is larger than t_end = {t_end}")));
+        }
+        check_grid(t_end, dt).map_err(|e| ("episode.t_end", e.to_string()))?;
+        for (key, v) in [
+            ("episode.perturbation", &self.perturbation),
+            ("episode.initial_torque", &self.initial_torque),
+        ] {
+            match v {
+                Some(PerJoint::All(x)) if !x.is_finite() => {
+                    return Err((key, format!("{x} is not a finite number")))
+                }
+                Some(PerJoint::Each(v)) => finite_list(v).map_err(|m| (key, m))?,
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `line N (text of the line)` for a byte offset into the file.
+fn syntax_place(text: &str, offset: usize) -> String {
+    let Some(before) = text.get(..offset) else {
+        return String::new();
+    };
+    let start = before.rfind('\n').map_or(0, |i| i + 1);
+    let line = text[start..].lines().next().unwrap_or("").trim();
+    let number = 1 + text[..start].matches('\n').count();
+    if line.is_empty() {
+        format!("line {number}")
+    } else {
+        format!("line {number} ({line})")
+    }
+}
+
+fn finite_list(v: &[f64]) -> Result<(), String> {
+    if v.is_empty() {
+        return Err("is an empty list".into());
+    }
+    match v.iter().find(|x| !x.is_finite()) {
+        Some(x) => Err(format!("{x} in {v:?} is not a finite number")),
+        None => Ok(()),
+    }
+}
+
+fn number(v: &toml::Value) -> Option<f64> {
+    match v {
+        toml::Value::Float(x) => Some(*x),
+        toml::Value::Integer(i) => Some(*i as f64),
+        _ => None,
+    }
+}
+
+fn numbers(v: &toml::Value) -> Option<Vec<f64>> {
+    v.as_array()?.iter().map(number).collect()
+}
+
+fn precision_spec(v: &toml::Value) -> Result<PrecisionSpec, String> {
+    let shape = "expected a number (that multiple of I) or a matrix given row by row, \
+                 e.g. [[80.0, 0.0], [0.0, 80.0]]";
+    if let Some(x) = number(v) {
+        return Ok(PrecisionSpec::Scalar(x));
+    }
+    let rows: Option<Vec<Vec<f64>>> = v
+        .as_array()
+        .and_then(|rows| rows.iter().map(numbers).collect());
+    rows.map(PrecisionSpec::Matrix)
+        .ok_or_else(|| format!("{shape}; got {v}"))
+}
+
+fn per_joint_spec(v: &toml::Value) -> Result<PerJoint, String> {
+    if let Some(x) = number(v) {
+        return Ok(PerJoint::All(x));
+    }
+    numbers(v).map(PerJoint::Each).ok_or_else(|| {
+        format!("expected a number (every joint) or a list (one per joint); got {v}")
+    })
+}
+
+/// Finite; a matrix square, symmetric (to 1e-12 relative) and positive semi-definite, with the
+/// tolerances [`TaskN::validate`] applies once the model is known.
+fn check_precision(p: &PrecisionSpec) -> Result<(), String> {
+    let rows = match p {
+        PrecisionSpec::Scalar(s) if !(s.is_finite() && *s >= 0.0) => {
+            return Err(format!("{s} must be a finite number ≥ 0"))
+        }
+        PrecisionSpec::Scalar(_) => return Ok(()),
+        PrecisionSpec::Matrix(rows) => rows,
+    };
+    let n = rows.len();
+    if n == 0 || rows.iter().any(|r| r.len() != n) {
+        let lengths: Vec<usize> = rows.iter().map(Vec::len).collect();
+        return Err(format!(
+            "a matrix must be square, given row by row; got rows of lengths {lengths:?}"
+        ));
+    }
+    let m = DMatrix::from_fn(n, n, |i, j| rows[i][j]);
+    if let Some(x) = m.iter().find(|x| !x.is_finite()) {
+        return Err(format!("{x} in {rows:?} is not a finite number"));
+    }
+    let scale = m.amax().max(1.0);
+    for i in 0..n {
+        for j in (i + 1)..n {
+            if (m[(i, j)] - m[(j, i)]).abs() > 1e-12 * scale {
+                return Err(format!(
+                    "{rows:?} is not symmetric: entry ({}, {}) = {} but ({}, {}) = {}",
+                    i + 1,
+                    j + 1,
+                    m[(i, j)],
+                    j + 1,
+                    i + 1,
+                    m[(j, i)]
+                ));
+            }
+        }
+    }
+    let smallest = m.symmetric_eigenvalues().min();
+    if smallest < -1e-12 * scale {
+        return Err(format!(
+            "{rows:?} is not positive semi-definite (smallest eigenvalue {smallest:e})"
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{Arm2, Arm3};
+
+    const ISSUE_EXAMPLE: &str = r#"
+kind = "position"
+[goal]
+theta = [0.7853981633974483, 0.0]
+[precision]
+theta = 80.0
+theta_dot = 50.0
+theta_ddot = 1.0
+u = 1.0
+[episode]
+t_end = 5.0
+dt = 0.05
+perturbation = 0.0
+"#;
+
+    #[test]
+    fn the_issue_example_parses_into_the_task_it_states() {
+        let spec = TaskSpec::parse(ISSUE_EXAMPLE, "t.toml").unwrap();
+        let task = spec.task::<Arm2, 2, 4, 4, 6>().unwrap();
+        assert_eq!(
+            task.goal_theta,
+            crate::Vector2::new(std::f64::consts::FRAC_PI_4, 0.0)
+        );
+        assert_eq!(task.precision_theta, crate::Matrix2::identity() * 80.0);
+        assert_eq!(task.precision_theta_dot, crate::Matrix2::identity() * 50.0);
+        let o = spec.episode::<Arm2, 2, 4, 4, 6>().unwrap();
+        assert_eq!((o.t_end, o.dt, o.perturbation), (5.0, 0.05, 0.0));
+        assert_eq!(o.x0, Arm2::equilibrium_state());
+    }
+
+    #[test]
+    fn a_two_joint_goal_does_not_fit_three_joints() {
+        let spec = TaskSpec::parse(ISSUE_EXAMPLE, "t.toml").unwrap();
+        let e = spec.task::<Arm3, 3, 6, 6, 9>().unwrap_err();
+        assert_eq!(e.place, "key goal.theta");
+        assert!(e.message.contains("model arm3 has 3 joints"), "{e}");
+    }
+
+    #[test]
+    fn syntax_errors_name_the_line_and_its_text() {
+        let e =
+            TaskSpec::parse("kind = \"position\"\n[goal]\ntheta = 0.5\n", "t.toml").unwrap_err();
+        assert_eq!(e.place, "line 3 (theta = 0.5)");
+        let e = TaskSpec::parse(
+            "kind = \"velocity\"\n[episode]\nperturbation = [0.1, nan]\n",
+            "t.toml",
+        )
+        .unwrap_err();
+        assert_eq!(e.place, "key episode.perturbation");
+        assert!(e.message.contains("NaN"), "{e}");
+    }
+
+    #[test]
+    fn per_joint_values_are_uniform_only_when_equal() {
+        assert_eq!(PerJoint::Each(vec![0.2, 0.2]).uniform(), Some(0.2));
+        assert_eq!(PerJoint::Each(vec![0.2, 0.1]).uniform(), None);
+        assert_eq!(PerJoint::All(-0.8).uniform(), Some(-0.8));
+    }
+}

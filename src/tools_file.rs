@@ -1,0 +1,317 @@
+//! Tool files: the user's own tools, one per row, read as a stream.
+//!
+//! CSV (any extension but `.json`): a header row, then one tool per row. Columns: `model`
+//! (optional; an empty cell or no column means `arm2`), `name` (optional), and the parameter
+//! names of the models used (`m1,m2,l1,l2` for arm2 and arm2_exact, `m1,m2,m3,l1,l2,l3` for
+//! arm3). Rows of different models share the file; a row leaves the columns its model does not
+//! have empty.
+//!
+//! JSON (`.json`): an array of objects with the same keys, e.g.
+//! `[{"name": "hammer", "model": "arm2", "m1": 0.3, "m2": 0.4, "l1": 0.5, "l2": 0.2}]`.
+//!
+//! Rows are handed to a callback one at a time, so a file of 10⁷ tools is never held in memory.
+//! A bad row is an error naming the file, the line (CSV) or tool number (JSON), the key and the
+//! value; the callback decides whether it stops the read or is skipped.
+
+use std::fs::File;
+use std::io::BufReader;
+use std::path::Path;
+
+use serde::de::{Error as _, SeqAccess, Visitor};
+use serde_json::{Map, Value};
+
+use crate::model::mixed::{AnyTool, ModelKind};
+
+/// One tool read from a file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ToolRow {
+    /// 1-based position among the file's tools (header and blank lines not counted).
+    pub row: usize,
+    pub name: Option<String>,
+    pub tool: AnyTool,
+}
+
+impl ToolRow {
+    /// The name, or `row N` when the file gives none.
+    pub fn label(&self) -> String {
+        self.name
+            .clone()
+            .unwrap_or_else(|| format!("row {}", self.row))
+    }
+}
+
+/// A bad tools file or row.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{file}{}: {message}", if place.is_empty() { String::new() } else { format!(", {place}") })]
+pub struct ToolFileError {
+    pub file: String,
+    /// `line 7`, `tool 3`, or empty for the whole file.
+    pub place: String,
+    pub message: String,
+    /// A bad row that can be skipped; otherwise the file cannot be read on.
+    pub row_level: bool,
+}
+
+/// What a row holds under one key.
+enum Cell<'a> {
+    Absent,
+    Text(&'a str),
+    Number(f64),
+    Other(String),
+}
+
+/// Reads `path` and hands every row to `each`, in file order; returns the number of rows.
+/// `each` gets bad rows as `Err` (with `row_level` set) and stops the read by returning `Err`.
+/// A file without any row is an error.
+pub fn read_tools(
+    path: &Path,
+    mut each: impl FnMut(Result<ToolRow, ToolFileError>) -> Result<(), ToolFileError>,
+) -> Result<usize, ToolFileError> {
+    let file_name = path.display().to_string();
+    let fatal = |message: String| ToolFileError {
+        file: file_name.clone(),
+        place: String::new(),
+        message,
+        row_level: false,
+    };
+    let file = File::open(path).map_err(|e| fatal(format!("cannot open the tools file: {e}")))?;
+    let is_json = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    let rows = if is_json {
+        read_json(BufReader::new(file), &file_name, &mut each)?
+    } else {
+        read_csv(file, &file_name, &mut each)?
+    };
+    if rows == 0 {
+        return Err(fatal("no tools: the file has no rows".into()));
+    }
+    Ok(rows)
+}
+
+fn read_csv(
+    file: File,
+    file_name: &str,
+    each: &mut impl FnMut(Result<ToolRow, ToolFileError>) -> Result<(), ToolFileError>,
+) -> Result<usize, ToolFileError> {
+    let error = |place: String, message: String, row_level| ToolFileError {
+        file: file_name.into(),
+        place,
+        message,
+        row_level,
+    };
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(BufReader::new(file));
+    let header: Vec<String> = reader
+        .headers()
+        .map_err(|e| error("line 1".into(), e.to_string(), false))?
+        .iter()
+        .map(str::to_string)
+        .collect();
+    if header.iter().all(String::is_empty) {
+        return Err(error(
+            String::new(),
+            "no tools: the file is empty".into(),
+            false,
+        ));
+    }
+    check_keys(header.iter().map(String::as_str))
+        .map_err(|m| error("line 1 (header)".into(), m, false))?;
+    let mut record = csv::StringRecord::new();
+    let mut rows = 0;
+    loop {
+        match reader.read_record(&mut record) {
+            Ok(false) => break,
+            Ok(true) => {
+                rows += 1;
+                let line = record.position().map_or(0, |p| p.line());
+                let cell = |key: &str| match header.iter().position(|h| h == key) {
+                    None => Cell::Absent,
+                    Some(i) => match record.get(i) {
+                        None | Some("") => Cell::Absent,
+                        Some(text) => Cell::Text(text),
+                    },
+                };
+                let row =
+                    build_row(rows, &cell).map_err(|m| error(format!("line {line}"), m, true));
+                each(row)?;
+            }
+            Err(e) => {
+                rows += 1;
+                let line = e.position().map_or(0, |p| p.line());
+                let message = match e.kind() {
+                    csv::ErrorKind::UnequalLengths {
+                        expected_len, len, ..
+                    } => format!("the row has {len} cells, the header {expected_len}"),
+                    _ => e.to_string(),
+                };
+                let row_level = matches!(e.kind(), csv::ErrorKind::UnequalLengths { .. });
+                let e = error(format!("line {line}"), message, row_level);
+                if !row_level {
+                    return Err(e);
+                }
+                each(Err(e))?;
+            }
+        }
+    }
+    Ok(rows)
+}
+
+/// Keys a row may have: `name`, `model`, and every model's parameter names.
+fn known_key(key: &str) -> bool {
+    key == "name"
+        || key == "model"
+        || ModelKind::ALL
+            .iter()
+            .any(|m| m.parameter_names().contains(&key))
+}
+
+fn known_keys() -> String {
+    let mut keys = vec!["name", "model"];
+    for m in ModelKind::ALL {
+        for p in m.parameter_names() {
+            if !keys.contains(p) {
+                keys.push(p);
+            }
+        }
+    }
+    keys.join(", ")
+}
+
+fn check_keys<'a>(keys: impl Iterator<Item = &'a str>) -> Result<(), String> {
+    let mut seen = Vec::new();
+    for key in keys {
+        if !known_key(key) {
+            return Err(format!("unknown column '{key}' (known: {})", known_keys()));
+        }
+        if seen.contains(&key) {
+            return Err(format!("column '{key}' appears twice"));
+        }
+        seen.push(key);
+    }
+    Ok(())
+}
+
+/// One row's tool from its cells: the model, then each of its parameters, each a finite
+/// number > 0; a parameter of another model must be empty.
+fn build_row<'a>(row: usize, cell: &dyn Fn(&str) -> Cell<'a>) -> Result<ToolRow, String> {
+    let name = match cell("name") {
+        Cell::Absent => None,
+        Cell::Text(t) => Some(t.to_string()),
+        Cell::Number(x) => Some(x.to_string()),
+        Cell::Other(v) => return Err(format!("name = {v} is not text")),
+    };
+    let who = name
+        .as_ref()
+        .map_or(String::new(), |n| format!(" (tool '{n}')"));
+    let model = match cell("model") {
+        Cell::Absent => ModelKind::Arm2,
+        Cell::Text(t) => t.parse().map_err(|e: String| format!("{e}{who}"))?,
+        Cell::Number(x) => return Err(format!("model = {x} is not a model name{who}")),
+        Cell::Other(v) => return Err(format!("model = {v} is not a model name{who}")),
+    };
+    let names = model.parameter_names();
+    let mut params = Vec::with_capacity(names.len());
+    for &key in names {
+        let value = match cell(key) {
+            Cell::Absent => return Err(format!("{key} is missing (model {model} needs it){who}")),
+            Cell::Number(x) => x,
+            Cell::Text(t) => t
+                .parse::<f64>()
+                .map_err(|_| format!("{key} = '{t}' is not a number{who}"))?,
+            Cell::Other(v) => return Err(format!("{key} = {v} is not a number{who}")),
+        };
+        if !(value.is_finite() && value > 0.0) {
+            return Err(format!("{key} = {value} must be a finite number > 0{who}"));
+        }
+        params.push(value);
+    }
+    for other in ModelKind::ALL {
+        for &key in other.parameter_names() {
+            if !names.contains(&key) && !matches!(cell(key), Cell::Absent) {
+                return Err(format!(
+                    "{key} is given, but model {model} has no parameter {key} (it takes {}){who}",
+                    names.join(", ")
+                ));
+            }
+        }
+    }
+    let tool = AnyTool::new(model, &params).map_err(|e| format!("{e}{who}"))?;
+    Ok(ToolRow { row, name, tool })
+}
+
+/// Visits the top-level array one element at a time.
+struct Elements<'f, F> {
+    file: &'f str,
+    each: &'f mut F,
+    rows: usize,
+    stopped: Option<ToolFileError>,
+}
+
+impl<'de, F> Visitor<'de> for &mut Elements<'_, F>
+where
+    F: FnMut(Result<ToolRow, ToolFileError>) -> Result<(), ToolFileError>,
+{
+    type Value = ();
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("an array of tools (objects)")
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<(), A::Error> {
+        while let Some(object) = seq.next_element::<Map<String, Value>>()? {
+            self.rows += 1;
+            let row = self.rows;
+            let result = check_keys(object.keys().map(String::as_str))
+                .and_then(|()| build_row(row, &|key| json_cell(&object, key)))
+                .map_err(|message| ToolFileError {
+                    file: self.file.into(),
+                    place: format!("tool {row}"),
+                    message,
+                    row_level: true,
+                });
+            if let Err(e) = (self.each)(result) {
+                self.stopped = Some(e);
+                return Err(A::Error::custom("stopped"));
+            }
+        }
+        Ok(())
+    }
+}
+
+fn json_cell<'a>(object: &'a Map<String, Value>, key: &str) -> Cell<'a> {
+    match object.get(key) {
+        None | Some(Value::Null) => Cell::Absent,
+        Some(Value::String(s)) if s.is_empty() => Cell::Absent,
+        Some(Value::String(s)) => Cell::Text(s),
+        Some(Value::Number(n)) => n.as_f64().map_or(Cell::Other(n.to_string()), Cell::Number),
+        Some(other) => Cell::Other(other.to_string()),
+    }
+}
+
+fn read_json<R: std::io::Read>(
+    reader: R,
+    file_name: &str,
+    each: &mut impl FnMut(Result<ToolRow, ToolFileError>) -> Result<(), ToolFileError>,
+) -> Result<usize, ToolFileError> {
+    let mut elements = Elements {
+        file: file_name,
+        each,
+        rows: 0,
+        stopped: None,
+    };
+    let mut de = serde_json::Deserializer::from_reader(reader);
+    let parsed =
+        serde::Deserializer::deserialize_seq(&mut de, &mut elements).and_then(|()| de.end());
+    if let Some(e) = elements.stopped {
+        return Err(e);
+    }
+    parsed.map_err(|e| ToolFileError {
+        file: file_name.into(),
+        place: format!("line {}", e.line()),
+        message: format!("not a JSON array of tools: {e}"),
+        row_level: false,
+    })?;
+    Ok(elements.rows)
+}

@@ -1,0 +1,942 @@
+//! `toolconf rank`, tool files and task files, as a user runs them: the README's example, the
+//! paper's task written as a file against `simulate`, a custom task against an independent
+//! fine-step integration, determinism across thread counts, and every kind of bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+use toolconf::model::{Arm2, Arm2Tool, ClosedLoopN, TaskN};
+use toolconf::TaskKind;
+
+const DRAWER: &str = "examples/tools/drawer.csv";
+const PAPER_TASK: &str = "examples/tasks/paper_position.toml";
+const REACH_TASK: &str = "examples/tasks/reach_45.toml";
+
+fn run(args: &[&str], threads: Option<&str>) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_toolconf"));
+    cmd.args(args).current_dir(env!("CARGO_MANIFEST_DIR"));
+    if let Some(t) = threads {
+        cmd.env("RAYON_NUM_THREADS", t);
+    }
+    cmd.output().expect("run toolconf")
+}
+
+fn toolconf(args: &[&str]) -> Output {
+    run(args, None)
+}
+
+fn json_of(out: &Output) -> Value {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("JSON on stdout")
+}
+
+/// A fresh folder for one test's files.
+fn scratch(test: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("rank")
+        .join(test);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path.display().to_string()
+}
+
+fn f(v: &Value, key: &str) -> f64 {
+    v[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{key} missing in {v}"))
+}
+
+#[test]
+fn the_readme_example_ranks_every_tool_by_free_energy() {
+    let v = json_of(&toolconf(&[
+        "rank", "--tools", DRAWER, "--task", REACH_TASK, "--json",
+    ]));
+    let tools = v["tools"].as_array().unwrap();
+    assert_eq!(tools.len(), 12);
+    assert_eq!(v["tools_read"], 12);
+    assert_eq!(v["objective"], "free_energy");
+    let mut models: Vec<&str> = tools.iter().map(|t| t["model"].as_str().unwrap()).collect();
+    models.sort_unstable();
+    models.dedup();
+    assert_eq!(models, ["arm2", "arm2_exact"]);
+    for (k, t) in tools.iter().enumerate() {
+        assert_eq!(t["rank"], k + 1);
+        assert!(
+            t["name"].is_string() && t["parameters"]["l2"].is_f64(),
+            "{t}"
+        );
+        for key in ["logdet", "task_error", "free_energy", "cost_j"] {
+            assert!(f(t, key).is_finite());
+        }
+    }
+    let free_energy: Vec<f64> = tools.iter().map(|t| f(t, "free_energy")).collect();
+    assert!(
+        free_energy.windows(2).all(|w| w[0] <= w[1]),
+        "{free_energy:?}"
+    );
+
+    // The text table lists the same tools in the same order.
+    let out = toolconf(&["rank", "--tools", DRAWER, "--task", REACH_TASK]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    let first = tools[0]["name"].as_str().unwrap();
+    let line = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("1 "))
+        .unwrap();
+    assert!(line.contains(first), "{line} vs {first}");
+}
+
+/// The paper's task 1 written as a task file gives, tool by tool, exactly what `simulate
+/// --task position --json` gives for the same arm (and what the built-in `--task position`
+/// gives for every tool, arm2_exact ones included).
+#[test]
+fn the_paper_task_as_a_file_equals_simulate_for_every_tool() {
+    let from_file = json_of(&toolconf(&[
+        "rank", "--tools", DRAWER, "--task", PAPER_TASK, "--json",
+    ]));
+    let builtin = json_of(&toolconf(&[
+        "rank", "--tools", DRAWER, "--task", "position", "--json",
+    ]));
+    assert_eq!(from_file["tools"], builtin["tools"]);
+    let mut compared = 0;
+    for t in from_file["tools"].as_array().unwrap() {
+        if t["model"] != "arm2" {
+            continue;
+        }
+        let p = &t["parameters"];
+        let arm = format!("{},{},{},{}", p["m1"], p["m2"], p["l1"], p["l2"]);
+        let s = json_of(&toolconf(&[
+            "simulate", "--arm", &arm, "--task", "position", "--json",
+        ]));
+        for key in ["task_error", "free_energy", "cost_j", "logdet"] {
+            assert_eq!(f(t, key), f(&s, key), "{key} of {arm}");
+        }
+        compared += 1;
+    }
+    assert_eq!(compared, 8);
+}
+
+const CUSTOM_TASK: &str = r#"
+kind = "position"
+[goal]
+theta = [0.9, -0.3]
+[precision]
+theta = [[90.0, 15.0], [15.0, 40.0]]
+theta_dot = 30.0
+theta_ddot = 0.5
+u = 2.0
+[episode]
+t_end = 3.0
+dt = 0.05
+perturbation = [0.2, -0.1]
+initial_theta = [-1.4, -1.6]
+initial_torque = [0.05, 0.15]
+learning_rate = 1.5
+"#;
+
+/// The custom task's task error by classical RK4 with a fixed step of 1e-4 s on the closed
+/// loop's right-hand side, the task written out by hand: Σ over the grid of
+/// (θ − θ^g)ᵀ P^θ (θ − θ^g).
+fn fine_step_task_error(arm: [f64; 4]) -> f64 {
+    let p = |s: f64| nalgebra::Matrix2::identity() * s;
+    let task = TaskN::<2> {
+        kind: TaskKind::Position,
+        goal_theta: nalgebra::Vector2::new(0.9, -0.3),
+        goal_theta_dot: nalgebra::Vector2::zeros(),
+        goal_theta_ddot: nalgebra::Vector2::zeros(),
+        precision_theta: nalgebra::Matrix2::new(90.0, 15.0, 15.0, 40.0),
+        precision_theta_dot: p(30.0),
+        precision_theta_ddot: p(0.5),
+        precision_u: p(2.0),
+    };
+    let tool = Arm2Tool::new(arm).unwrap();
+    let system = ClosedLoopN::<Arm2, 2, 4, 4, 6>::with_perturbation(
+        &tool,
+        &task,
+        1.5,
+        &nalgebra::Vector2::new(0.2, -0.1),
+    )
+    .unwrap();
+    let mut z = nalgebra::SVector::<f64, 6>::from([-1.4, -1.6, 0.0, 0.0, 0.05, 0.15]);
+    let error = |z: &nalgebra::SVector<f64, 6>| {
+        let e = nalgebra::Vector2::new(z[0] - 0.9, z[1] + 0.3);
+        e.dot(&(task.precision_theta * e))
+    };
+    let (steps_per_output, outputs, h) = (500, 60, 1e-4);
+    let mut sum = error(&z);
+    for _ in 0..outputs {
+        for _ in 0..steps_per_output {
+            let k1 = system.rhs(&z);
+            let k2 = system.rhs(&(z + k1 * (h / 2.0)));
+            let k3 = system.rhs(&(z + k2 * (h / 2.0)));
+            let k4 = system.rhs(&(z + k3 * h));
+            z += (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h / 6.0);
+        }
+        sum += error(&z);
+    }
+    sum
+}
+
+#[test]
+fn a_custom_goal_and_precision_agree_with_a_fine_step_integration() {
+    let dir = scratch("custom");
+    let tools = write(
+        &dir,
+        "tools.csv",
+        "name,m1,m2,l1,l2\na,0.3,0.4,0.5,0.2\nb,0.2,0.5,0.3,0.35\n",
+    );
+    let tight = CUSTOM_TASK.replace(
+        "learning_rate = 1.5",
+        "learning_rate = 1.5\nrtol = 1e-10\natol = 1e-12",
+    );
+    for (file, text, tolerance) in [
+        // The requested relative tolerance bounds the difference (measured: ~4e-14; RK4 at
+        // 1e-4 s is accurate far below it).
+        ("tight.toml", tight.as_str(), 1e-10),
+        // ode45's tolerances, what `rank` runs by default: within its rtol of 1e-3 (measured:
+        // ~6e-7).
+        ("default.toml", CUSTOM_TASK, 1e-3),
+    ] {
+        let task = write(&dir, file, text);
+        let v = json_of(&toolconf(&[
+            "rank", "--tools", &tools, "--task", &task, "--json",
+        ]));
+        for t in v["tools"].as_array().unwrap() {
+            let p = &t["parameters"];
+            let arm = ["m1", "m2", "l1", "l2"].map(|k| p[k].as_f64().unwrap());
+            let reference = fine_step_task_error(arm);
+            let got = f(t, "task_error");
+            let relative = (got - reference).abs() / reference;
+            eprintln!(
+                "{file} {arm:?}: task error {got}, fine-step {reference}, relative {relative:e}"
+            );
+            assert!(
+                relative < tolerance,
+                "{file} {arm:?}: task error {got} vs fine-step {reference} (relative {relative:e})"
+            );
+        }
+    }
+}
+
+#[test]
+fn results_do_not_depend_on_the_number_of_threads() {
+    let dir = scratch("threads");
+    // 90 tools: more than one parallel chunk, in a fixed pseudo-random pattern.
+    let mut text = String::from("name,model,m1,m2,m3,l1,l2,l3\n");
+    for i in 0..90u32 {
+        let u = |k: u32| 0.1 + 0.5 * (((i * 7919 + k * 104_729) % 1000) as f64 / 1000.0);
+        if i % 5 == 4 {
+            text += &format!(
+                "t{i},arm3,{},{},{},{},{},{}\n",
+                u(1),
+                u(2),
+                u(3),
+                u(4),
+                u(5),
+                u(6)
+            );
+        } else {
+            text += &format!("t{i},arm2,{},{},,{},{},\n", u(1), u(2), u(4), u(5));
+        }
+    }
+    let tools = write(&dir, "many.csv", &text);
+    let outputs: Vec<(Vec<u8>, Vec<u8>)> = ["1", "2"]
+        .iter()
+        .map(|threads| {
+            let csv = dir.join(format!("out{threads}.csv"));
+            let out = run(
+                &[
+                    "rank",
+                    "--tools",
+                    &tools,
+                    "--task",
+                    "velocity",
+                    "--screen",
+                    "70",
+                    "--json",
+                    "--csv",
+                    csv.to_str().unwrap(),
+                ],
+                Some(threads),
+            );
+            assert!(
+                out.status.success(),
+                "{}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            (out.stdout, std::fs::read(&csv).unwrap())
+        })
+        .collect();
+    assert_eq!(
+        outputs[0].0, outputs[1].0,
+        "JSON differs between 1 and 2 threads"
+    );
+    assert_eq!(
+        outputs[0].1, outputs[1].1,
+        "CSV differs between 1 and 2 threads"
+    );
+    let v: Value = serde_json::from_slice(&outputs[0].0).unwrap();
+    assert_eq!(v["tools"].as_array().unwrap().len(), 70);
+    let csv = String::from_utf8(outputs[0].1.clone()).unwrap();
+    assert_eq!(csv.lines().count(), 71);
+    assert!(
+        csv.starts_with("row,name,model,m1,m2,l1,l2,m3,l3,logdet,"),
+        "{csv}"
+    );
+}
+
+/// `--screen K` simulates the K tools with the largest ln|Π^U|, which `confidence` computes.
+#[test]
+fn the_screen_keeps_the_most_confident_tools() {
+    let all = json_of(&toolconf(&[
+        "rank",
+        "--tools",
+        DRAWER,
+        "--task",
+        "velocity",
+        "--json",
+        "--objective",
+        "confidence",
+    ]));
+    let screened = json_of(&toolconf(&[
+        "rank",
+        "--tools",
+        DRAWER,
+        "--task",
+        "velocity",
+        "--json",
+        "--screen",
+        "4",
+        "--objective",
+        "confidence",
+    ]));
+    let names = |v: &Value, n: usize| -> Vec<Value> {
+        v["tools"].as_array().unwrap()[..n]
+            .iter()
+            .map(|t| t["name"].clone())
+            .collect()
+    };
+    assert_eq!(names(&screened, 4), names(&all, 4));
+    let logdets: Vec<f64> = all["tools"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| f(t, "logdet"))
+        .collect();
+    assert!(logdets.windows(2).all(|w| w[0] >= w[1]));
+    let top = &all["tools"][0];
+    let p = &top["parameters"];
+    if top["model"] == "arm2" {
+        let arm = format!("{},{},{},{}", p["m1"], p["m2"], p["l1"], p["l2"]);
+        let c = json_of(&toolconf(&[
+            "confidence",
+            "--arm",
+            &arm,
+            "--task",
+            "velocity",
+            "--json",
+        ]));
+        assert_eq!(f(&c, "logdet"), f(top, "logdet"));
+    }
+}
+
+#[test]
+fn a_json_tools_file_gives_what_the_same_csv_gives() {
+    let dir = scratch("json");
+    let csv = write(
+        &dir,
+        "t.csv",
+        "name,model,m1,m2,m3,l1,l2,l3\nx,arm2,0.3,0.4,,0.5,0.2,\ny,arm3,0.3,0.25,0.2,0.4,0.35,0.3\n",
+    );
+    let json = write(
+        &dir,
+        "t.json",
+        r#"[{"name": "x", "m1": 0.3, "m2": 0.4, "l1": 0.5, "l2": 0.2},
+            {"name": "y", "model": "arm3", "m1": 0.3, "m2": 0.25, "m3": 0.2, "l1": 0.4, "l2": 0.35, "l3": 0.3}]"#,
+    );
+    let a = json_of(&toolconf(&[
+        "rank",
+        "--tools",
+        &csv,
+        "--task",
+        "acceleration",
+        "--json",
+    ]));
+    let b = json_of(&toolconf(&[
+        "rank",
+        "--tools",
+        &json,
+        "--task",
+        "acceleration",
+        "--json",
+    ]));
+    assert_eq!(a["tools"], b["tools"]);
+    assert_eq!(a["tools"].as_array().unwrap().len(), 2);
+}
+
+#[test]
+fn the_report_has_markdown_html_and_inline_figures() {
+    let dir = scratch("report");
+    let report = dir.join("report");
+    let out = toolconf(&[
+        "rank",
+        "--tools",
+        DRAWER,
+        "--task",
+        REACH_TASK,
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let md = std::fs::read_to_string(report.join("report.md")).unwrap();
+    let html = std::fs::read_to_string(report.join("report.html")).unwrap();
+    for part in [
+        "Control confidence",
+        "Task error",
+        "## Ranking",
+        "best_and_worst.svg",
+    ] {
+        assert!(md.contains(part), "report.md lacks {part}");
+    }
+    assert_eq!(html.matches("<svg").count(), 2, "both figures inline");
+    assert!(html.contains("short hammer"));
+    assert!(!md.contains("NaN") && !html.contains("NaN"));
+}
+
+#[test]
+fn a_failed_tool_keeps_its_error_and_goes_last() {
+    let dir = scratch("failed");
+    // Links of 1e200 m overflow the model's coefficients: that tool fails, the batch goes on.
+    let tools = write(
+        &dir,
+        "t.csv",
+        "name,m1,m2,l1,l2\nok,0.3,0.3,0.3,0.3\ngiant,0.3,0.3,1e200,1e200\nok2,0.2,0.4,0.3,0.3\n",
+    );
+    let v = json_of(&toolconf(&[
+        "rank", "--tools", &tools, "--task", "position", "--json",
+    ]));
+    let tools_json = v["tools"].as_array().unwrap();
+    assert_eq!(tools_json.len(), 3);
+    assert_eq!(tools_json[2]["name"], "giant");
+    assert_eq!(tools_json[2]["rank"], 3);
+    assert!(tools_json[2]["error"]
+        .as_str()
+        .unwrap()
+        .contains("not positive definite"));
+    assert!(tools_json[..2].iter().all(|t| t.get("error").is_none()));
+
+    // When every episode fails (here each starts with a non-finite right-hand side), each row
+    // still gets its error, and the run as a whole exits with 1.
+    let task = write(
+        &dir,
+        "wild.toml",
+        "kind = \"position\"\n[episode]\ninitial_theta_dot = [1e200, 1e200]\n",
+    );
+    let csv = dir.join("out.csv");
+    let out = toolconf(&[
+        "rank",
+        "--tools",
+        DRAWER,
+        "--task",
+        &task,
+        "--json",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let all = v["tools"].as_array().unwrap();
+    assert_eq!(all.len(), 12);
+    assert!(all
+        .iter()
+        .all(|t| t["error"].as_str().unwrap().contains("non-finite")));
+    let rows: Vec<u64> = all.iter().map(|t| t["row"].as_u64().unwrap()).collect();
+    assert_eq!(
+        rows,
+        (1..=12).collect::<Vec<_>>(),
+        "failed tools keep file order"
+    );
+    let text = std::fs::read_to_string(csv).unwrap();
+    assert_eq!(text.lines().count(), 13);
+    assert!(text.lines().skip(1).all(|l| l.contains("non-finite")));
+}
+
+#[test]
+fn skip_bad_rows_reports_each_and_ranks_the_rest() {
+    let dir = scratch("skip");
+    let tools = write(
+        &dir,
+        "t.csv",
+        "name,m1,m2,l1,l2\ngood,0.3,0.4,0.5,0.2\nbad,0.3,x,0.5,0.2\nalso good,0.2,0.2,0.3,0.3\nneg,0.3,0.4,-1,0.2\n",
+    );
+    let out = toolconf(&[
+        "rank",
+        "--tools",
+        &tools,
+        "--task",
+        "position",
+        "--json",
+        "--skip-bad-rows",
+    ]);
+    let v = json_of(&out);
+    assert_eq!(v["tools"].as_array().unwrap().len(), 2);
+    assert_eq!(v["skipped_rows"], 2);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(stderr.lines().count(), 2, "{stderr}");
+    assert!(
+        stderr.contains("line 3") && stderr.contains("m2 = 'x'"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("line 5") && stderr.contains("l1 = -1"),
+        "{stderr}"
+    );
+}
+
+/// Runs `args` (with `--csv` and `--report` into `dir`) and checks: exit status 2, one line on
+/// stderr holding every `expected` fragment, no panic, and no output file created.
+fn assert_refused(dir: &Path, args: &[&str], expected: &[&str]) {
+    let csv = dir.join("out.csv");
+    let report = dir.join("report");
+    let mut all: Vec<&str> = args.to_vec();
+    all.extend([
+        "--csv",
+        csv.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    let out = toolconf(&all);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: {stderr}");
+    for e in expected {
+        assert!(stderr.contains(e), "{args:?}: {stderr:?} lacks {e:?}");
+    }
+    assert!(!stderr.contains("panicked"));
+    assert!(
+        out.stdout.is_empty(),
+        "{args:?} printed {}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    assert!(
+        !csv.exists() && !report.exists(),
+        "{args:?} left output behind"
+    );
+}
+
+#[test]
+fn every_bad_tools_file_is_refused_naming_file_line_and_value() {
+    let dir = scratch("bad_tools");
+    let header = "name,model,m1,m2,l1,l2\n";
+    let cases: &[(&str, &str, &[&str])] = &[
+        (
+            "missing.csv",
+            "name,model,m1,m2,l1,l2\nok,arm2,0.3,0.4,0.5,0.2\nhole,arm2,0.3,,0.5,0.2\n",
+            &["missing.csv", "line 3", "m2 is missing", "hole"],
+        ),
+        (
+            "text.csv",
+            "name,model,m1,m2,l1,l2\nw,arm2,0.3,heavy,0.5,0.2\n",
+            &["text.csv", "line 2", "m2 = 'heavy' is not a number"],
+        ),
+        (
+            "nan.csv",
+            "name,model,m1,m2,l1,l2\nw,arm2,NaN,0.4,0.5,0.2\n",
+            &["nan.csv", "line 2", "m1 = NaN", "finite number > 0"],
+        ),
+        (
+            "zero.csv",
+            "name,model,m1,m2,l1,l2\nw,arm2,0.3,0.4,0,0.2\n",
+            &["zero.csv", "line 2", "l1 = 0 must be"],
+        ),
+        (
+            "negative.csv",
+            "name,model,m1,m2,l1,l2\nw,arm2,0.3,0.4,0.5,-0.2\n",
+            &["negative.csv", "line 2", "l2 = -0.2"],
+        ),
+        (
+            "model.csv",
+            "name,model,m1,m2,l1,l2\nw,arm7,0.3,0.4,0.5,0.2\n",
+            &["model.csv", "line 2", "unknown model 'arm7'"],
+        ),
+        (
+            "no_m3.csv",
+            "name,model,m1,m2,l1,l2\nw,arm3,0.3,0.4,0.5,0.2\n",
+            &["no_m3.csv", "line 2", "m3 is missing", "arm3"],
+        ),
+        (
+            "extra.csv",
+            "name,model,m1,m2,m3,l1,l2\nw,arm2,0.3,0.4,0.1,0.5,0.2\n",
+            &["extra.csv", "line 2", "m3 is given", "arm2"],
+        ),
+        (
+            "column.csv",
+            "name,mass1,m2,l1,l2\nw,0.3,0.4,0.5,0.2\n",
+            &["column.csv", "line 1", "unknown column 'mass1'"],
+        ),
+        (
+            "short.csv",
+            "name,model,m1,m2,l1,l2\nw,arm2,0.3,0.4\n",
+            &["short.csv", "line 2", "4 cells", "header 6"],
+        ),
+        ("empty.csv", "", &["empty.csv", "no tools"]),
+        ("header.csv", header, &["header.csv", "no tools"]),
+        ("empty.json", "[]", &["empty.json", "no tools"]),
+        (
+            "row.json",
+            r#"[{"m1": 0.3, "m2": "a", "l1": 0.5, "l2": 0.2}]"#,
+            &["row.json", "tool 1", "m2 = 'a' is not a number"],
+        ),
+        (
+            "key.json",
+            r#"[{"m1": 0.3, "m2": 0.4, "l1": 0.5, "l2": 0.2, "colour": 1}]"#,
+            &["key.json", "tool 1", "unknown column 'colour'"],
+        ),
+        (
+            "object.json",
+            r#"{"m1": 0.3}"#,
+            &["object.json", "line 1", "not a JSON array"],
+        ),
+    ];
+    for (file, text, expected) in cases {
+        let tools = write(&dir, file, text);
+        assert_refused(
+            &dir,
+            &["rank", "--tools", &tools, "--task", "position"],
+            expected,
+        );
+    }
+    // Skipping does not rescue a file with no valid row, nor one that cannot be parsed.
+    let tools = write(&dir, "all_bad.csv", "m1,m2,l1,l2\n0.3,0.4,0.5,-1\n");
+    let out = toolconf(&[
+        "rank",
+        "--tools",
+        &tools,
+        "--task",
+        "position",
+        "--skip-bad-rows",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no valid tools"));
+    assert_refused(
+        &dir,
+        &["rank", "--tools", "no/such.csv", "--task", "position"],
+        &["no/such.csv", "cannot open"],
+    );
+}
+
+#[test]
+fn every_bad_task_file_is_refused_naming_file_key_and_value() {
+    let dir = scratch("bad_tasks");
+    let arm3 = write(
+        &dir,
+        "arm3.csv",
+        "model,m1,m2,m3,l1,l2,l3\narm3,0.3,0.25,0.2,0.4,0.35,0.3\n",
+    );
+    let cases: &[(&str, &str, &[&str])] = &[
+        (
+            "unknown.toml",
+            "kind = \"position\"\ncolour = 3\n",
+            &["unknown.toml", "line 2", "unknown field `colour`"],
+        ),
+        (
+            "unknown_episode.toml",
+            "kind = \"position\"\n[episode]\nt_stop = 3.0\n",
+            &["unknown_episode.toml", "line 3", "t_stop"],
+        ),
+        (
+            "kind.toml",
+            "kind = \"grasp\"\n",
+            &["kind.toml", "key kind", "'grasp'"],
+        ),
+        (
+            "no_kind.toml",
+            "[goal]\ntheta = [0.1, 0.2]\n",
+            &["no_kind.toml", "kind"],
+        ),
+        (
+            "shape.toml",
+            "kind = \"position\"\n[precision]\ntheta = \"high\"\n",
+            &["shape.toml", "key precision.theta", "\"high\""],
+        ),
+        (
+            "goal_shape.toml",
+            "kind = \"position\"\n[goal]\ntheta = 0.5\n",
+            &["goal_shape.toml", "line 3"],
+        ),
+        (
+            "ragged.toml",
+            "kind = \"position\"\n[precision]\ntheta = [[1.0, 0.0], [0.0]]\n",
+            &["ragged.toml", "key precision.theta", "square"],
+        ),
+        (
+            "asym.toml",
+            "kind = \"position\"\n[precision]\ntheta = [[80.0, 5.0], [1.0, 80.0]]\n",
+            &["asym.toml", "key precision.theta", "not symmetric", "5"],
+        ),
+        (
+            "indefinite.toml",
+            "kind = \"position\"\n[precision]\ntheta = [[1.0, 3.0], [3.0, 1.0]]\n",
+            &[
+                "indefinite.toml",
+                "key precision.theta",
+                "not positive semi-definite",
+            ],
+        ),
+        (
+            "negative.toml",
+            "kind = \"velocity\"\n[precision]\nu = -1.0\n",
+            &["negative.toml", "key precision.u", "-1"],
+        ),
+        (
+            "nan.toml",
+            "kind = \"position\"\n[goal]\ntheta = [nan, 0.0]\n",
+            &["nan.toml", "key goal.theta", "NaN"],
+        ),
+        (
+            "unused.toml",
+            "kind = \"velocity\"\n[goal]\ntheta = [0.1, 0.2]\n",
+            &[
+                "unused.toml",
+                "key goal.theta",
+                "velocity task does not use it",
+            ],
+        ),
+        (
+            "dt.toml",
+            "kind = \"position\"\n[episode]\ndt = 0.0\n",
+            &["dt.toml", "key episode.dt", "0 must be"],
+        ),
+        (
+            "long.toml",
+            "kind = \"position\"\n[episode]\nt_end = 1e9\n",
+            &[
+                "long.toml",
+                "key episode.t_end",
+                "episode too long",
+                "1000000000",
+            ],
+        ),
+        (
+            "joints.toml",
+            "kind = \"position\"\n[episode]\nperturbation = [0.1, 0.2, 0.3]\n",
+            &[
+                "joints.toml",
+                "key episode.perturbation",
+                "3 values",
+                "2 joints",
+            ],
+        ),
+    ];
+    for (file, text, expected) in cases {
+        let task = write(&dir, file, text);
+        assert_refused(
+            &dir,
+            &["rank", "--tools", DRAWER, "--task", &task],
+            expected,
+        );
+    }
+    // Precisions that leave Π^U singular for every tool.
+    let task = write(
+        &dir,
+        "singular.toml",
+        "kind = \"acceleration\"\n[precision]\ntheta_ddot = 0.0\nu = 0.0\n",
+    );
+    assert_refused(
+        &dir,
+        &["rank", "--tools", DRAWER, "--task", &task],
+        &[
+            "singular.toml",
+            "no tool",
+            "has a control confidence",
+            "not positive definite",
+        ],
+    );
+    // A two-joint goal for a three-joint tool.
+    let task = write(
+        &dir,
+        "two.toml",
+        "kind = \"position\"\n[goal]\ntheta = [0.1, 0.2]\n",
+    );
+    assert_refused(
+        &dir,
+        &["rank", "--tools", &arm3, "--task", &task],
+        &[
+            "two.toml",
+            "key goal.theta",
+            "model arm3 has 3 joints",
+            "[0.1, 0.2]",
+        ],
+    );
+    // Neither a task name nor a file.
+    assert_refused(
+        &dir,
+        &["rank", "--tools", DRAWER, "--task", "grasping"],
+        &["grasping", "neither a built-in task"],
+    );
+}
+
+#[test]
+fn simulate_confidence_and_select_take_a_task_file() {
+    let p = json_of(&toolconf(&[
+        "simulate",
+        "--arm",
+        "0.3,0.4,0.5,0.2",
+        "--task-file",
+        PAPER_TASK,
+        "--json",
+    ]));
+    let q = json_of(&toolconf(&[
+        "simulate",
+        "--arm",
+        "0.3,0.4,0.5,0.2",
+        "--task",
+        "position",
+        "--json",
+    ]));
+    for key in ["task_error", "free_energy", "cost_j", "logdet"] {
+        assert_eq!(f(&p, key), f(&q, key), "{key}");
+    }
+    let c = json_of(&toolconf(&[
+        "confidence",
+        "--arm",
+        "0.3,0.4,0.5,0.2",
+        "--task-file",
+        REACH_TASK,
+        "--json",
+    ]));
+    // Π^U of the file's precisions differs from the paper's task 1 (P^θ is not 100·I).
+    let paper = json_of(&toolconf(&[
+        "confidence",
+        "--arm",
+        "0.3,0.4,0.5,0.2",
+        "--task",
+        "position",
+        "--json",
+    ]));
+    assert_ne!(c["logdet"], paper["logdet"]);
+    // A command-line flag overrides the file's [episode].
+    let shorter = json_of(&toolconf(&[
+        "simulate",
+        "--arm",
+        "0.3,0.4,0.5,0.2",
+        "--task-file",
+        REACH_TASK,
+        "--t-end",
+        "1",
+        "--json",
+    ]));
+    let full = json_of(&toolconf(&[
+        "simulate",
+        "--arm",
+        "0.3,0.4,0.5,0.2",
+        "--task-file",
+        REACH_TASK,
+        "--json",
+    ]));
+    assert!(f(&shorter, "rhs_evals") < f(&full, "rhs_evals"));
+    assert_eq!(full["perturb"], serde_json::json!([0.3, -0.2]));
+    let s = json_of(&toolconf(&[
+        "select",
+        "--task-file",
+        PAPER_TASK,
+        "--tools",
+        "3",
+        "--json",
+    ]));
+    let t = json_of(&toolconf(&[
+        "select", "--task", "position", "--tools", "3", "--json",
+    ]));
+    assert_eq!(s["tools"], t["tools"]);
+    // Drawn tools of several models each run the file's task bound to their model...
+    let mixed = json_of(&toolconf(&[
+        "select",
+        "--task-file",
+        REACH_TASK,
+        "--models",
+        "arm2,arm2_exact",
+        "--tools",
+        "4",
+        "--json",
+    ]));
+    assert_eq!(mixed["tools"].as_array().unwrap().len(), 4);
+    assert!(mixed["tools"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|t| t["task_error"].is_f64()));
+    // ...and a goal that does not fit one of them is refused.
+    let out = toolconf(&[
+        "select",
+        "--task-file",
+        REACH_TASK,
+        "--models",
+        "arm2,arm3",
+        "--tools",
+        "4",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("key goal.theta"));
+    // simulate's 2-link arm with a three-joint goal.
+    let dir = scratch("simulate_file");
+    let task = write(
+        &dir,
+        "three.toml",
+        "kind = \"position\"\n[goal]\ntheta = [0.1, 0.2, 0.3]\n",
+    );
+    let out = toolconf(&["simulate", "--arm", "0.3,0.4,0.5,0.2", "--task-file", &task]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("three.toml, key goal.theta: 3 values"),
+        "{stderr}"
+    );
+    // select's 2-link tools carry one ΔT for both joints: a per-joint one is refused, with status 2.
+    let out = toolconf(&["select", "--task-file", REACH_TASK, "--tools", "3"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("differs between the joints"));
+}
+
+#[test]
+fn an_episode_too_long_to_hold_is_refused_up_front() {
+    for extra in [
+        &[][..],
+        &["--controller", "mpc"][..],
+        &["--csv", "/dev/null"][..],
+    ] {
+        let mut args = vec![
+            "simulate",
+            "--arm",
+            "0.3,0.4,0.5,0.2",
+            "--task",
+            "position",
+            "--t-end",
+            "1e9",
+        ];
+        args.extend(extra);
+        let out = toolconf(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains("episode too long") && stderr.contains("t_end = 1000000000"),
+            "{stderr}"
+        );
+        assert_eq!(stderr.trim_end().lines().count(), 1);
+    }
+}
