@@ -80,7 +80,11 @@ def main() -> int:
         }
         ir = model_ir(d, functions, generator, report_data(d), args.vectors)
         vectors = vectors_document(d, functions, generator, args.vectors)
-    except (DescriptionError, DerivationMismatch, ExactEvaluationError) as err:
+    except DescriptionError as err:
+        # Bad input: one line naming the file, the key and the problem.
+        print(f"derive: {err}", file=sys.stderr)
+        return 2
+    except (DerivationMismatch, ExactEvaluationError) as err:
         print(f"derive: {err}", file=sys.stderr)
         return 1
     try:

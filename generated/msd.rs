@@ -99,6 +99,8 @@ pub struct DynamicsCoefficients {
 
 impl DynamicsCoefficients {
     /// - `params`: tool parameters [m k c]
+    ///
+    /// Cost, once per tool: 5 operations, weighted 12 (1 DIV, 2 MUL, 2 NEG) (derive/toolconf_derive/cost.py).
     #[inline]
     #[must_use]
     pub fn new(params: &SVector<f64, 3>) -> Self {
@@ -119,6 +121,10 @@ impl DynamicsCoefficients {
 /// - `x`: state X = [z z_dot]
 /// - `u`: control U = [force]
 /// - `params`: tool parameters [m k c]
+///
+/// Cost per call: 10 operations, weighted 17: [`DynamicsCoefficients::new`] (5, weighted 12), then [`dynamics_with`] (5, weighted 5). Build the coefficients once per tool and call [`dynamics_with`] where it is called often.
+/// The same closed form with the parameters inline (not hoisted) would take 5 operations, weighted 12 (1 DIV, 2 MUL, 2 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
 pub fn dynamics(
@@ -130,6 +136,8 @@ pub fn dynamics(
 }
 
 /// [`dynamics`] with the tool's [`DynamicsCoefficients`] computed beforehand.
+///
+/// Cost per call: 5 operations, weighted 5 (2 ADD, 3 MUL) (derive/toolconf_derive/cost.py).
 #[inline]
 #[must_use]
 pub fn dynamics_with(
@@ -159,6 +167,8 @@ pub struct DynamicsJacobianCoefficients {
 
 impl DynamicsJacobianCoefficients {
     /// - `params`: tool parameters [m k c]
+    ///
+    /// Cost, once per tool: 5 operations, weighted 12 (1 DIV, 2 MUL, 2 NEG) (derive/toolconf_derive/cost.py).
     #[inline]
     #[must_use]
     pub fn new(params: &SVector<f64, 3>) -> Self {
@@ -179,6 +189,10 @@ impl DynamicsJacobianCoefficients {
 /// - `x`: state X = [z z_dot]
 /// - `u`: control U = [force]
 /// - `params`: tool parameters [m k c]
+///
+/// Cost per call: 5 operations, weighted 12: [`DynamicsJacobianCoefficients::new`] (5, weighted 12), then [`dynamics_jacobian_with`] (0, weighted 0). Build the coefficients once per tool and call [`dynamics_jacobian_with`] where it is called often.
+/// The same closed form with the parameters inline (not hoisted) would take 5 operations, weighted 12 (1 DIV, 2 MUL, 2 NEG).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
 pub fn dynamics_jacobian(
@@ -190,6 +204,8 @@ pub fn dynamics_jacobian(
 }
 
 /// [`dynamics_jacobian`] with the tool's [`DynamicsJacobianCoefficients`] computed beforehand.
+///
+/// Cost per call: 0 operations, weighted 0 (derive/toolconf_derive/cost.py).
 #[inline]
 #[must_use]
 pub fn dynamics_jacobian_with(
@@ -216,6 +232,9 @@ pub fn dynamics_jacobian_with(
 /// From eq. (LTI).
 ///
 /// - `params`: tool parameters [m k c]
+///
+/// Cost per call: 5 operations, weighted 12 (1 DIV, 2 MUL, 2 NEG).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
 pub fn state_matrix(params: &SVector<f64, 3>) -> SMatrix<f64, 2, 2> {
@@ -236,6 +255,9 @@ pub fn state_matrix(params: &SVector<f64, 3>) -> SMatrix<f64, 2, 2> {
 /// From eq. (LTI).
 ///
 /// - `params`: tool parameters [m k c]
+///
+/// Cost per call: 1 operation, weighted 8 (1 DIV).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
 pub fn input_matrix(params: &SVector<f64, 3>) -> SVector<f64, 2> {
@@ -251,6 +273,9 @@ pub fn input_matrix(params: &SVector<f64, 3>) -> SVector<f64, 2> {
 /// From appendix "Task specific controllers".
 ///
 /// - `params`: tool parameters [m k c]
+///
+/// Cost per call: 4 operations, weighted 11 (1 ADD, 1 DIV, 1 NEG, 1 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
 pub fn position_sensitivity(
@@ -280,6 +305,9 @@ pub fn position_sensitivity(
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+///
+/// Cost per call: 9 operations, weighted 18 (4 ADD, 1 DIV, 1 MUL, 2 POW, 1 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
 pub fn position_control_confidence(
@@ -308,6 +336,9 @@ pub fn position_control_confidence(
 /// From appendix "Task specific controllers".
 ///
 /// - `params`: tool parameters [m k c]
+///
+/// Cost per call: 1 operation, weighted 8 (1 DIV).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
 pub fn velocity_sensitivity(params: &SVector<f64, 3>) -> (SVector<f64, 1>, SVector<f64, 1>) {
@@ -329,6 +360,9 @@ pub fn velocity_sensitivity(params: &SVector<f64, 3>) -> (SVector<f64, 1>, SVect
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+///
+/// Cost per call: 4 operations, weighted 12 (2 ADD, 1 DIV, 1 POW).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
 pub fn velocity_control_confidence(
@@ -352,6 +386,9 @@ pub fn velocity_control_confidence(
 /// From appendix "Task specific controllers".
 ///
 /// - `params`: tool parameters [m k c]
+///
+/// Cost per call: 0 operations, weighted 0.
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
 pub fn acceleration_sensitivity(_params: &SVector<f64, 3>) -> SVector<f64, 1> {
@@ -368,6 +405,9 @@ pub fn acceleration_sensitivity(_params: &SVector<f64, 3>) -> SVector<f64, 1> {
 /// - `params`: tool parameters [m k c]
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+///
+/// Cost per call: 1 operation, weighted 1 (1 ADD).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
 pub fn acceleration_control_confidence(

@@ -12,7 +12,17 @@ from pathlib import Path
 
 
 class DescriptionError(ValueError):
-    """A model or task description that cannot be used, with the offending key named."""
+    """A model or task description that cannot be used: one line naming the file, the key and
+    the problem (derive.py prints it and exits with status 2)."""
+
+    def __init__(self, path: Path | str, key: str, problem: str):
+        self.path, self.key, self.problem = str(path), key, problem
+        # One line whatever the problem quotes (equations may span lines in the TOML).
+        super().__init__(one_line(f"{path}: {key}: {problem}" if key else f"{path}: {problem}"))
+
+
+def one_line(text: str) -> str:
+    return " ".join(text.split())
 
 
 @dataclass(frozen=True)
@@ -81,6 +91,9 @@ class Task:
     sensitivity: dict[str, str]
     remarks: list[Remark] = field(default_factory=list)
     default_precision: dict[str, float] = field(default_factory=dict)
+    # Where the task is defined, for messages: the file and its key (task[0]).
+    path: Path | str = ""
+    key: str = ""
 
     @property
     def sensitivity_terms(self) -> list[str]:
@@ -89,68 +102,147 @@ class Task:
 
 
 KNOWN_TERMS = ("theta", "theta_dot", "theta_ddot", "u")
+KINEMATIC_TERMS = ("theta", "theta_dot", "theta_ddot")
+
+# The keys each table may have, as serde's deny_unknown_fields: a misspelt key is an error, not a
+# silently ignored setting. (name, type, required); types are checked by _TYPES.
+NAMED = (("name", "string", True), ("latex", "string", False), ("unit", "string", False), ("doc", "string", False))
+MODEL_KEYS = {
+    "model": (("name", "string", True), ("title", "string", False), ("source", "string", False),
+              ("dof", "integer", True)),
+    "constant": (("value", "number", True), ("latex", "string", False), ("unit", "string", False),
+                 ("doc", "string", False)),
+    "coordinates": (("q", "tables", True), ("q_dot", "tables", True), ("u", "tables", True)),
+    "dynamics": (("kind", "string", True), ("equations", "strings", False), ("q_ddot", "strings", False),
+                 ("links", "tables", False), ("gravity", "string", False), ("payload", "string", False)),
+    "link": (("mass", "string", True), ("length", "string", True)),
+    "equilibrium": (("q", "values", True), ("q_dot", "values", True), ("u", "values", True)),
+    "printed": (("where", "string", False), ("A", "matrix", False), ("B", "matrix", False)),
+}
+TOP_KEYS = (("model", "table", True), ("parameters", "tables", True), ("constants", "table", False),
+            ("coordinates", "table", True), ("dynamics", "table", True), ("equilibrium", "table", True),
+            ("goals", "table", False), ("printed", "table", False))
+TASK_KEYS = (("name", "string", True), ("index", "integer", True), ("title", "string", False),
+             ("doc", "string", False), ("terms", "strings", True), ("sensitivity", "table", True),
+             ("defaults", "table", False), ("remarks", "tables", False))
+DEFAULTS_KEYS = (("precision", "table", True),)
+REMARK_KEYS = (("term", "string", True), ("alternative", "string", True), ("text", "string", True))
 
 
-def _require(table: dict, key: str, where: str):
-    if key not in table:
-        raise DescriptionError(f"{where}: missing key '{key}'")
-    return table[key]
+def _is_matrix(v) -> bool:
+    return isinstance(v, list) and all(isinstance(r, list) and all(isinstance(x, str) for x in r) for r in v)
 
 
-def _named(entry: dict, where: str) -> Named:
-    return Named(
-        name=_require(entry, "name", where),
-        latex=entry.get("latex", entry["name"]),
-        unit=entry.get("unit", ""),
-        doc=entry.get("doc", ""),
-    )
+_TYPES = {
+    "string": ("a string", lambda v: isinstance(v, str)),
+    "integer": ("an integer", lambda v: isinstance(v, int) and not isinstance(v, bool)),
+    "number": ("a number", lambda v: isinstance(v, (int, float)) and not isinstance(v, bool)),
+    "table": ("a table", lambda v: isinstance(v, dict)),
+    "tables": ("an array of tables", lambda v: isinstance(v, list) and all(isinstance(x, dict) for x in v)),
+    "strings": ("an array of strings", lambda v: isinstance(v, list) and all(isinstance(x, str) for x in v)),
+    "values": ("an array of numbers or expression strings",
+               lambda v: isinstance(v, list) and all(isinstance(x, (str, int, float)) and not isinstance(x, bool)
+                                                     for x in v)),
+    "matrix": ("an array of rows of expression strings", _is_matrix),
+}
 
 
-def _check_identifier(name: str, where: str) -> None:
-    if not name.isidentifier() or name != name.lower():
-        raise DescriptionError(f"{where}: '{name}' must be a lower-case identifier (it becomes a Rust name)")
+class _Table:
+    """One TOML table being read: unknown keys, missing keys and wrong types stop the derivation
+    with the file and the key's full name (e.g. `coordinates.q[1].latex`)."""
+
+    def __init__(self, path: Path, key: str, raw, spec: tuple):
+        self.path, self.key = path, key
+        if not isinstance(raw, dict):
+            raise DescriptionError(path, key, "must be a table")
+        known = [k for k, _, _ in spec]
+        for k in raw:
+            if k not in known:
+                raise DescriptionError(path, self.sub(k), f"unknown key (known here: {', '.join(known)})")
+        for k, kind, required in spec:
+            if k not in raw:
+                if required:
+                    raise DescriptionError(path, self.sub(k), "missing (required)")
+                continue
+            name, ok = _TYPES[kind]
+            if not ok(raw[k]):
+                raise DescriptionError(path, self.sub(k), f"must be {name}, got {raw[k]!r}")
+        self.raw = raw
+
+    def sub(self, k: str) -> str:
+        return f"{self.key}.{k}" if self.key else k
+
+    def get(self, k: str, default=None):
+        return self.raw.get(k, default)
+
+    def table(self, k: str, spec: tuple) -> "_Table":
+        return _Table(self.path, self.sub(k), self.raw.get(k, {}), spec)
+
+    def tables(self, k: str, spec: tuple) -> list["_Table"]:
+        return [_Table(self.path, f"{self.sub(k)}[{i}]", t, spec) for i, t in enumerate(self.raw.get(k, []))]
+
+
+def read_toml(path: Path) -> dict:
+    """The parsed file; a missing file or a TOML syntax error is a DescriptionError."""
+    try:
+        return tomllib.loads(path.read_text())
+    except OSError as err:
+        raise DescriptionError(path, "", f"cannot read: {err.strerror}") from err
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
+        raise DescriptionError(path, "", f"not valid TOML: {err}") from err
+
+
+def _named(t: _Table) -> Named:
+    return Named(name=t.get("name"), latex=t.get("latex", t.get("name")), unit=t.get("unit", ""), doc=t.get("doc", ""))
+
+
+def _constants(top: _Table) -> list[Constant]:
+    table = top.table("constants", tuple((k, "table", True) for k in top.get("constants", {})))
+    out = []
+    for name in table.raw:
+        c = table.table(name, MODEL_KEYS["constant"])
+        out.append(Constant(name=name, latex=c.get("latex", name), unit=c.get("unit", ""), doc=c.get("doc", ""),
+                            value=float(c.get("value"))))
+    return out
+
+
+def _goals(top: _Table) -> dict[str, dict[str, list[str]]]:
+    goals = top.table("goals", tuple((k, "table", True) for k in top.get("goals", {})))
+    out = {}
+    for task in goals.raw:
+        terms = goals.table(task, tuple((t, "values", False) for t in KINEMATIC_TERMS))
+        out[task] = {term: [str(v) for v in values] for term, values in terms.raw.items()}
+    return out
 
 
 def load_model(path: Path) -> Model:
-    raw = tomllib.loads(path.read_text())
-    m = _require(raw, "model", str(path))
-    dof = int(_require(m, "dof", f"{path}: [model]"))
-    coords = _require(raw, "coordinates", str(path))
-    dyn = _require(raw, "dynamics", str(path))
-    eq = _require(raw, "equilibrium", str(path))
-    printed = raw.get("printed", {})
-
-    params = [_named(p, f"{path}: [[parameters]]") for p in _require(raw, "parameters", str(path))]
-    constants = [
-        Constant(name=k, latex=v.get("latex", k), unit=v.get("unit", ""), doc=v.get("doc", ""), value=float(v["value"]))
-        for k, v in raw.get("constants", {}).items()
-    ]
-    q = [_named(c, f"{path}: coordinates.q") for c in _require(coords, "q", f"{path}: [coordinates]")]
-    q_dot = [_named(c, f"{path}: coordinates.q_dot") for c in _require(coords, "q_dot", f"{path}: [coordinates]")]
-    u = [_named(c, f"{path}: coordinates.u") for c in _require(coords, "u", f"{path}: [coordinates]")]
-
+    top = _Table(path, "", read_toml(path), TOP_KEYS)
+    m = top.table("model", MODEL_KEYS["model"])
+    coords = top.table("coordinates", MODEL_KEYS["coordinates"])
+    dyn = top.table("dynamics", MODEL_KEYS["dynamics"])
+    eq = top.table("equilibrium", MODEL_KEYS["equilibrium"])
+    printed = top.table("printed", MODEL_KEYS["printed"])
     model = Model(
         path=path,
-        name=_require(m, "name", f"{path}: [model]"),
+        name=m.get("name"),
         title=m.get("title", ""),
         source=m.get("source", ""),
-        dof=dof,
-        parameters=params,
-        constants=constants,
-        q=q,
-        q_dot=q_dot,
-        u=u,
-        dynamics_kind=_require(dyn, "kind", f"{path}: [dynamics]"),
+        dof=m.get("dof"),
+        parameters=[_named(p) for p in top.tables("parameters", NAMED)],
+        constants=_constants(top),
+        q=[_named(c) for c in coords.tables("q", NAMED)],
+        q_dot=[_named(c) for c in coords.tables("q_dot", NAMED)],
+        u=[_named(c) for c in coords.tables("u", NAMED)],
+        dynamics_kind=dyn.get("kind"),
         equations=dyn.get("equations", []),
         q_ddot=list(dyn.get("q_ddot", [])),
-        equilibrium_q=[str(v) for v in _require(eq, "q", f"{path}: [equilibrium]")],
-        equilibrium_q_dot=[str(v) for v in _require(eq, "q_dot", f"{path}: [equilibrium]")],
-        equilibrium_u=[str(v) for v in _require(eq, "u", f"{path}: [equilibrium]")],
-        links=list(dyn.get("links", [])),
-        gravity=str(dyn.get("gravity", "g")),
+        equilibrium_q=[str(v) for v in eq.get("q")],
+        equilibrium_q_dot=[str(v) for v in eq.get("q_dot")],
+        equilibrium_u=[str(v) for v in eq.get("u")],
+        links=[link.raw for link in dyn.tables("links", MODEL_KEYS["link"])],
+        gravity=dyn.get("gravity", "g"),
         payload=dyn.get("payload"),
-        goals={task: {term: [str(v) for v in vs] for term, vs in terms.items()}
-               for task, terms in raw.get("goals", {}).items()},
+        goals=_goals(top),
         printed_where=printed.get("where", ""),
         printed_a=printed.get("A"),
         printed_b=printed.get("B"),
@@ -159,78 +251,102 @@ def load_model(path: Path) -> Model:
     return model
 
 
-def _validate_model(m: Model) -> None:
-    where = str(m.path)
-    _check_identifier(m.name, f"{where}: model.name")
-    names = [n.name for n in m.parameters + m.constants + m.q + m.q_dot + m.u]
-    for n in names:
-        _check_identifier(n, where)
-    dupes = sorted({n for n in names if names.count(n) > 1})
-    if dupes:
-        raise DescriptionError(f"{where}: names used twice: {', '.join(dupes)}")
-    for label, seq in (("coordinates.q", m.q), ("coordinates.q_dot", m.q_dot), ("coordinates.u", m.u),
-                       ("equilibrium.q", m.equilibrium_q), ("equilibrium.q_dot", m.equilibrium_q_dot),
-                       ("equilibrium.u", m.equilibrium_u)):
-        if len(seq) != m.dof:
-            raise DescriptionError(f"{where}: {label} has {len(seq)} entries, model.dof is {m.dof}")
+def _check_identifier(name: str, path: Path, key: str) -> None:
+    if not name.isidentifier() or name != name.lower():
+        raise DescriptionError(path, key, f"'{name}' must be a lower-case identifier (it becomes a Rust name)")
+
+
+def _validate_names(m: Model) -> None:
+    path = m.path
+    _check_identifier(m.name, path, "model.name")
+    if m.dof < 1:
+        raise DescriptionError(path, "model.dof", f"must be at least 1, got {m.dof}")
+    groups = (("parameters", m.parameters), ("constants", m.constants), ("coordinates.q", m.q),
+              ("coordinates.q_dot", m.q_dot), ("coordinates.u", m.u))
+    seen: dict[str, str] = {}
+    for label, entries in groups:
+        for i, n in enumerate(entries):
+            key = f"constants.{n.name}" if label == "constants" else f"{label}[{i}].name"
+            _check_identifier(n.name, path, key)
+            if n.name in seen:
+                raise DescriptionError(path, key, f"'{n.name}' is already the name of {seen[n.name]}")
+            seen[n.name] = key
+
+
+def _check_length(path: Path, key: str, seq: list, want: int, what: str) -> None:
+    if len(seq) != want:
+        raise DescriptionError(path, key, f"has {len(seq)} entries, {what} is {want}")
+
+
+def _validate_shapes(m: Model) -> None:
+    path, n, n2 = m.path, m.dof, 2 * m.dof
+    for key, seq in (("coordinates.q", m.q), ("coordinates.q_dot", m.q_dot), ("coordinates.u", m.u),
+                     ("equilibrium.q", m.equilibrium_q), ("equilibrium.q_dot", m.equilibrium_q_dot),
+                     ("equilibrium.u", m.equilibrium_u)):
+        _check_length(path, key, seq, n, "model.dof")
     for task, terms in m.goals.items():
         for term, values in terms.items():
-            if term not in ("theta", "theta_dot", "theta_ddot") or len(values) != m.dof:
-                raise DescriptionError(f"{where}: goals.{task}.{term} must be a known term with {m.dof} entries")
+            _check_length(path, f"goals.{task}.{term}", values, n, "model.dof")
+    for label, matrix, cols in (("A", m.printed_a, n2), ("B", m.printed_b, n)):
+        if matrix is not None and (len(matrix) != n2 or any(len(r) != cols for r in matrix)):
+            shape = f"{len(matrix)} rows of {sorted({len(r) for r in matrix})} entries"
+            raise DescriptionError(path, f"printed.{label}", f"must be {n2}x{cols} for model.dof = {n}, got {shape}")
+
+
+def _validate_dynamics(m: Model) -> None:
+    path = m.path
     if m.dynamics_kind == "explicit":
-        if len(m.q_ddot) != m.dof:
-            raise DescriptionError(f"{where}: dynamics.q_ddot has {len(m.q_ddot)} entries, model.dof is {m.dof}")
+        _check_length(path, "dynamics.q_ddot", m.q_ddot, m.dof, "model.dof")
     elif m.dynamics_kind == "planar_chain":
-        if len(m.links) != m.dof:
-            raise DescriptionError(f"{where}: dynamics.links has {len(m.links)} links, model.dof is {m.dof}")
+        _check_length(path, "dynamics.links", m.links, m.dof, "model.dof")
         known = {p.name for p in m.parameters}
         for i, link in enumerate(m.links):
             for key in ("mass", "length"):
-                if link.get(key) not in known:
-                    raise DescriptionError(f"{where}: dynamics.links[{i}].{key} must name a parameter, got {link.get(key)!r}")
+                if link[key] not in known:
+                    raise DescriptionError(path, f"dynamics.links[{i}].{key}",
+                                           f"must name a parameter, got {link[key]!r}")
         if m.payload is not None and m.payload not in known:
-            raise DescriptionError(f"{where}: dynamics.payload must name a parameter, got {m.payload!r}")
+            raise DescriptionError(path, "dynamics.payload", f"must name a parameter, got {m.payload!r}")
         if m.gravity not in {c.name for c in m.constants}:
-            raise DescriptionError(f"{where}: dynamics.gravity must name a constant, got {m.gravity!r}")
+            raise DescriptionError(path, "dynamics.gravity", f"must name a constant, got {m.gravity!r}")
     else:
-        raise DescriptionError(f"{where}: dynamics.kind '{m.dynamics_kind}' is not known (known: explicit, planar_chain)")
-    n2 = 2 * m.dof
-    if m.printed_a is not None and (len(m.printed_a) != n2 or any(len(r) != n2 for r in m.printed_a)):
-        raise DescriptionError(f"{where}: printed.A must be {n2}x{n2}")
-    if m.printed_b is not None and (len(m.printed_b) != n2 or any(len(r) != m.dof for r in m.printed_b)):
-        raise DescriptionError(f"{where}: printed.B must be {n2}x{m.dof}")
+        raise DescriptionError(path, "dynamics.kind", f"'{m.dynamics_kind}' is not known (known: explicit, planar_chain)")
+
+
+def _validate_model(m: Model) -> None:
+    _validate_names(m)
+    _validate_shapes(m)
+    _validate_dynamics(m)
+
+
+def _task(path: Path, t: _Table) -> Task:
+    terms = list(t.get("terms"))
+    for i, term in enumerate(terms):
+        if term not in KNOWN_TERMS:
+            raise DescriptionError(path, t.sub(f"terms[{i}]"), f"unknown term '{term}' (known: {', '.join(KNOWN_TERMS)})")
+    used = [s for s in KINEMATIC_TERMS if s in terms]
+    # Only the task's kinematic terms have a sensitivity; an extra one is an unknown key.
+    sens = t.table("sensitivity", tuple((s, "string", True) for s in used))
+    defaults = t.table("defaults", DEFAULTS_KEYS) if "defaults" in t.raw else None
+    precision = defaults.table("precision", tuple((s, "number", True) for s in terms)) if defaults else None
+    if precision is None:
+        raise DescriptionError(path, t.sub("defaults.precision"), f"missing: a precision for each of {terms}")
+    remarks = []
+    for r in t.tables("remarks", REMARK_KEYS):
+        if r.get("term") not in used:
+            raise DescriptionError(path, r.sub("term"), f"'{r.get('term')}' is not a term with a sensitivity in this task")
+        remarks.append(Remark(**r.raw))
+    _check_identifier(t.get("name"), path, t.sub("name"))
+    return Task(name=t.get("name"), index=t.get("index"), title=t.get("title", ""), doc=t.get("doc", ""),
+                terms=terms, sensitivity=dict(sens.raw), remarks=remarks,
+                default_precision={k: float(v) for k, v in precision.raw.items()}, path=path, key=t.key)
 
 
 def load_tasks(path: Path) -> list[Task]:
-    raw = tomllib.loads(path.read_text())
-    tasks = []
-    for i, t in enumerate(_require(raw, "task", str(path))):
-        where = f"{path}: task[{i}]"
-        terms = list(_require(t, "terms", where))
-        for term in terms:
-            if term not in KNOWN_TERMS:
-                raise DescriptionError(f"{where}: unknown term '{term}' (known: {', '.join(KNOWN_TERMS)})")
-        sens = dict(_require(t, "sensitivity", where))
-        task = Task(
-            name=_require(t, "name", where),
-            index=int(_require(t, "index", where)),
-            title=t.get("title", ""),
-            doc=t.get("doc", ""),
-            terms=terms,
-            sensitivity=sens,
-            remarks=[Remark(**r) for r in t.get("remarks", [])],
-            default_precision={k: float(v) for k, v in t.get("defaults", {}).get("precision", {}).items()},
-        )
-        if set(task.default_precision) != set(task.terms):
-            raise DescriptionError(f"{where}: defaults.precision must give a precision for each of {task.terms}")
-        for r in task.remarks:
-            if r.term not in task.sensitivity_terms:
-                raise DescriptionError(f"{where}: a remark is about '{r.term}', which the task does not use")
-        missing = [s for s in task.sensitivity_terms if s not in sens]
-        extra = [s for s in sens if s not in task.sensitivity_terms]
-        if missing or extra:
-            raise DescriptionError(f"{where}: sensitivity must define exactly the task's kinematic terms "
-                                   f"(missing: {missing}, not used: {extra})")
-        _check_identifier(task.name, where)
-        tasks.append(task)
+    top = _Table(path, "", read_toml(path), (("task", "tables", True),))
+    tasks = [_task(path, t) for t in top.tables("task", TASK_KEYS)]
+    names = [t.name for t in tasks]
+    for t in tasks:
+        if names.count(t.name) > 1:
+            raise DescriptionError(path, f"{t.key}.name", f"'{t.name}' names two tasks")
     return tasks

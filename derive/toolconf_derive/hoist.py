@@ -9,11 +9,10 @@ tool; what is left per call has no division by a parameter expression at all (ar
 
 An entry with a state-dependent denominator (the Lagrangian planar chains' mass-matrix inverse) is
 not expanded, which would multiply its terms: its maximal parameter-only subexpressions are
-replaced in place. The whole rewrite is kept only when the per-call code gets cheaper (operation
-count after CSE, divisions and transcendental calls weighted by their cost); otherwise the
-coefficients are the parameters themselves, so every model has the same `<name>_with` API
-(weighted operations per call of `dynamics` besides the joints' sin_cos, ir.joint_trigonometry:
-arm2 84 -> 24, arm2_exact 90 -> 40, arm3 363 -> 131).
+replaced in place. The whole rewrite is kept only when the per-call code gets cheaper (weighted
+operation count after CSE, cost.py); otherwise the coefficients are the parameters themselves, so
+every model has the same `<name>_with` API. The counts before and after are stated in each
+generated function's documentation.
 """
 
 from __future__ import annotations
@@ -22,32 +21,17 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-# Rough relative costs (latency on x86-64) of the operations count_ops reports.
-WEIGHTS = {"DIV": 8, "POW": 2, "SIN": 20, "COS": 20, "SQRT": 8, "EXP": 20, "LOG": 20}
-
-
-def weighted_ops(exprs: list[sp.Expr]) -> int:
-    total = 0
-    for e in exprs:
-        visual = sp.count_ops(e, visual=True)
-        if visual == 0:
-            continue
-        subs = {s: WEIGHTS.get(s.name, 1) for s in visual.free_symbols}
-        total += int(visual.subs(subs))
-    return total
-
-
-def cse_cost(entries: list[sp.Expr]) -> int:
-    replacements, reduced = sp.cse(entries, order="canonical")
-    return weighted_ops([e for _, e in replacements] + list(reduced))
+from .cost import cse_cost
 
 
 @dataclass
 class Hoisted:
-    """`entries` rewritten over the coefficient symbols `symbols[i]` = `values[i]`(p)."""
+    """`entries` rewritten over the coefficient symbols `symbols[i]` = `values[i]`(p);
+    `unhoisted` is the cost (cost.py) of the entries as given, with the parameters inline."""
     symbols: list[sp.Symbol]
     values: list[sp.Expr]
     entries: list[sp.Expr]
+    unhoisted: dict
 
 
 def hoist(entries: list[sp.Expr], per_call: list[sp.Symbol], params: list[sp.Symbol],
@@ -113,8 +97,9 @@ def hoist(entries: list[sp.Expr], per_call: list[sp.Symbol], params: list[sp.Sym
             groups[r] += c
         rewritten.append(sp.Add(*[coefficient(groups[r]) * r for r in order if groups[r] != 0]))
 
-    if cse_cost(rewritten) >= cse_cost(entries):
+    before = cse_cost(entries)
+    if cse_cost(rewritten)["weighted"] >= before["weighted"]:
         identity = [sp.Symbol(f"{prefix}{i}", real=True) for i in range(len(params))]
         rename = dict(zip(params, identity))
-        return Hoisted(identity, list(params), [e.xreplace(rename) for e in entries])
-    return Hoisted(symbols, values, rewritten)
+        return Hoisted(identity, list(params), [e.xreplace(rename) for e in entries], before)
+    return Hoisted(symbols, values, rewritten, before)

@@ -7,13 +7,15 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
+from .cost import cost, total
 from .crosscheck import check_against_casadi
 from .functions import Arg, Function
 from .hoist import hoist
 from .rust_printer import RustPrinter, float_literal
 from .symbolic import Derivation
 
-IR_SCHEMA = 3
+# 4: each function carries its cost (cost.py).
+IR_SCHEMA = 4
 
 
 def _rust_type(shape: tuple[int, int]) -> str:
@@ -60,7 +62,7 @@ def joint_trigonometry(entries: list[sp.Expr], angles: list[sp.Symbol]):
 def _code(entries: list[sp.Expr], d: Derivation, args: list, declared: set[str], prefix: str,
           angles: list[sp.Symbol] = (), compounds: list[tuple[sp.Symbol, sp.Expr]] = ()) -> dict:
     """CSE'd Rust for `entries`: the constants and argument elements it reads, the joint angles'
-    sin_cos it needs, its temporaries and the reduced entries."""
+    sin_cos it needs, its temporaries, the reduced entries and what they cost per call."""
     replacements, reduced = sp.cse(entries, symbols=_temporaries(prefix), order="canonical")
     clash = declared & {str(t) for t, _ in replacements}
     if clash:
@@ -71,11 +73,12 @@ def _code(entries: list[sp.Expr], d: Derivation, args: list, declared: set[str],
     for e in reduced:
         used |= e.free_symbols
     printer = RustPrinter()
-    compound_code = []
+    compound_code, compound_definitions = [], []
     for symbol, definition in compounds:
         if symbol in used:
             used |= definition.free_symbols
             compound_code.append({"name": symbol.name, "rust": printer(definition)})
+            compound_definitions.append(definition)
     trig = []
     for q in angles:
         s, c = _trig_symbols(q)
@@ -99,6 +102,8 @@ def _code(entries: list[sp.Expr], d: Derivation, args: list, declared: set[str],
         "compounds": compound_code,
         "temporaries": [{"name": str(t), "rust": printer(e)} for t, e in replacements],
         "reduced": [printer(e) for e in reduced],
+        "cost": cost(compound_definitions + [e for _, e in replacements] + list(reduced)) | {"sin_cos": len(trig)},
+        "compound_cost": cost(compound_definitions),
     }
 
 
@@ -139,10 +144,16 @@ def function_ir(fn: Function, d: Derivation) -> dict:
             "bindings": coefficient_code["bindings"],
             "temporaries": coefficient_code["temporaries"],
             "values": coefficient_code["reduced"],
+            "cost": coefficient_code["cost"],
         }
         entries = hoisted.entries
         call_args = [a for a in fn.args if a.name != "params"] + [k]
     code = _code(entries, d, call_args, declared, "t", angles, compounds)
+    unhoisted = None
+    if coefficients is not None:
+        # What one call of `name(x, u, params)` would take with the parameters inline (the same
+        # sin_cos and angle sums), to set against the coefficients' once-per-tool cost.
+        unhoisted = total(hoisted.unhoisted, code["compound_cost"]) | {"sin_cos": code["cost"]["sin_cos"]}
 
     outputs = []
     for out in fn.outputs:
@@ -172,6 +183,8 @@ def function_ir(fn: Function, d: Derivation) -> dict:
             for a in fn.args
         ],
         "coefficients": coefficients,
+        "cost": code["cost"],
+        "unhoisted_cost": unhoisted,
         "outputs": outputs,
         "constants": code["constants"],
         "bindings": code["bindings"],

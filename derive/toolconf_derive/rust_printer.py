@@ -37,6 +37,8 @@ class RustPrinter:
             return self.names.get(e, e.name), ATOM
         if e is sp.pi:
             return "PI", ATOM
+        if e is sp.E:
+            return "std::f64::consts::E", ATOM
         if isinstance(e, sp.Integer):
             v = int(e)
             return (f"{v}.0", ATOM) if v >= 0 else (f"-{-v}.0", UNARY)
@@ -53,8 +55,17 @@ class RustPrinter:
         if isinstance(e, sp.Pow):
             return self.print_pow(e)
         if isinstance(e, sp.Function) and e.func in FUNCTIONS and len(e.args) == 1:
-            return f"{self.wrap(self.print(e.args[0]), POSTFIX)}.{FUNCTIONS[e.func]}()", POSTFIX
+            return f"{self.receiver(e.args[0])}.{FUNCTIONS[e.func]}()", POSTFIX
         raise NotImplementedError(f"the Rust printer does not know {type(e).__name__}: {e}")
+
+    def receiver(self, e: sp.Expr) -> str:
+        """`e` as the receiver of a method call (`e.sin()`, `e.powf(..)`). A bare number needs the
+        `_f64` suffix (`2.0.sin()` is an ambiguous numeric type), and a negative one brackets,
+        as the method call binds tighter than the minus (`-2.0_f64.powf(n)` is -(2^n))."""
+        if e.is_Number:
+            literal = f"{float_literal(e)}_f64"
+            return f"({literal})" if e.is_negative else literal
+        return self.wrap(self.print(e), POSTFIX)
 
     def print_add(self, e: sp.Add) -> tuple[str, int]:
         out = ""
@@ -95,8 +106,7 @@ class RustPrinter:
 
     def print_pow(self, e: sp.Pow) -> tuple[str, int]:
         base, exp = e.base, e.exp
-        # A bare float literal cannot take a method call in Rust without its type suffix.
-        b = f"{float_literal(base)}_f64" if base.is_Number else self.wrap(self.print(base), POSTFIX)
+        b = self.receiver(base)
         if exp == sp.Rational(1, 2):
             return f"{b}.sqrt()", POSTFIX
         if exp == -sp.Rational(1, 2):

@@ -7,6 +7,7 @@ matrices are only read in paper.py, for comparison.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import sympy as sp
@@ -31,13 +32,47 @@ def tidy_matrix(m: sp.Matrix) -> sp.Matrix:
     return m.applyfunc(tidy)
 
 
-def parse(model: Model, text: str, symbols: dict[str, sp.Symbol], where: str) -> sp.Expr:
-    namespace = dict(symbols)
-    namespace.update({"sin": sp.sin, "cos": sp.cos, "sqrt": sp.sqrt, "pi": sp.pi})
+# What an expression in a description may use besides the model's declared names.
+BUILTINS = {"sin": sp.sin, "cos": sp.cos, "sqrt": sp.sqrt, "pi": sp.pi}
+OPENING, CLOSING = "([{", ")]}"
+# A name in an expression: not part of a number (the e of 1e-3) nor of another name.
+NAME = re.compile(r"(?<![\w.])[A-Za-z_]\w*")
+
+
+def bracket_problem(text: str) -> str | None:
+    """Why the brackets of `text` do not balance (positions count characters from 1), or None."""
+    stack: list[tuple[str, int]] = []
+    for i, ch in enumerate(text, 1):
+        if ch in OPENING:
+            stack.append((ch, i))
+        elif ch in CLOSING:
+            if not stack:
+                return f"unbalanced brackets: '{ch}' at character {i} closes nothing"
+            opened, at = stack.pop()
+            if OPENING.index(opened) != CLOSING.index(ch):
+                return f"unbalanced brackets: '{ch}' at character {i} closes '{opened}' from character {at}"
+    if stack:
+        opened, at = stack[-1]
+        return f"unbalanced brackets: '{opened}' at character {at} is never closed"
+    return None
+
+
+def parse(model: Model, text: str, symbols: dict[str, sp.Symbol], key: str) -> sp.Expr:
+    """`text` as a SymPy expression over `symbols` and BUILTINS; anything else is an error naming
+    the description's `key`. Names are checked before SymPy sees the text, as SymPy would read an
+    unknown name as a new symbol and a few (E, I, N, S, gamma...) as its own objects."""
+    problem = bracket_problem(text)
+    if problem:
+        raise DescriptionError(model.path, key, f"{problem} in '{text}'")
+    for name in NAME.findall(text):
+        if name not in symbols and name not in BUILTINS:
+            known = ", ".join(list(symbols) + list(BUILTINS))
+            raise DescriptionError(model.path, key, f"'{name}' is not defined (known here: {known}) in '{text}'")
     try:
-        return sp.sympify(text, locals=namespace, rational=True)
-    except (sp.SympifyError, SyntaxError, TypeError) as err:
-        raise DescriptionError(f"{model.path}: {where}: cannot parse '{text}': {err}") from err
+        return sp.sympify(text, locals={**symbols, **BUILTINS}, rational=True)
+    except (sp.SympifyError, SyntaxError, TypeError, ValueError) as err:
+        reason = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+        raise DescriptionError(model.path, key, f"cannot parse '{text}': {reason}") from err
 
 
 def symmetric_matrix(name: str, n: int) -> tuple[sp.Matrix, list[tuple[sp.Symbol, int, int]]]:
@@ -64,11 +99,11 @@ def task_namespace(a: sp.Matrix, b: sp.Matrix, n: int, inv) -> dict:
     }
 
 
-def evaluate_formula(formula: str, namespace: dict, where: str):
+def evaluate_formula(formula: str, namespace: dict, task: Task, key: str):
     try:
         return eval(formula, {"__builtins__": {}}, dict(namespace))  # noqa: S307 - formulas come from tasks.toml
     except Exception as err:  # any error in a formula is a description error
-        raise DescriptionError(f"{where}: cannot evaluate '{formula}': {err}") from err
+        raise DescriptionError(task.path, f"{task.key}.{key}", f"cannot evaluate '{formula}': {err}") from err
 
 
 @dataclass
@@ -138,53 +173,68 @@ def derive(model: Model, tasks: list[Task]) -> Derivation:
         lagrangian = {"T": kinetic, "V": potential, "M": mass, "Q": forces}
     else:
         q_ddot = sp.Matrix([parse(model, e, symbols, f"dynamics.q_ddot[{i}]") for i, e in enumerate(model.q_ddot)])
-    stray = set().union(*(e.free_symbols for e in q_ddot)) - set(symbols.values())
-    if stray:
-        raise DescriptionError(f"{model.path}: dynamics use undeclared names: {sorted(map(str, stray))}")
 
     x = q + q_dot
     f = sp.Matrix.vstack(sp.Matrix(q_dot), q_ddot)
     f_x = f.jacobian(x)
     f_u = f.jacobian(u)
 
-    x_e = sp.Matrix([parse(model, v, {}, "equilibrium") for v in model.equilibrium_q + model.equilibrium_q_dot])
-    u_e = sp.Matrix([parse(model, v, {}, "equilibrium.u") for v in model.equilibrium_u])
+    x_e, u_e = equilibrium(model)
     at_e = dict(zip(x, x_e)) | dict(zip(u, u_e))
     residual = tidy_matrix(f.subs(at_e))
     if any(r != 0 for r in residual):
-        raise DescriptionError(f"{model.path}: f(X^e, U^e) = {list(residual)} is not zero: not an equilibrium")
+        raise DescriptionError(model.path, "equilibrium",
+                               f"not an equilibrium: f(X^e, U^e) = {list(residual)} is not zero")
 
     a = tidy_matrix(f_x.subs(at_e))
     b = tidy_matrix(f_u.subs(at_e))
     if a.det() == 0:
-        raise DescriptionError(f"{model.path}: A is singular at the equilibrium; the task sensitivities need A^-1")
-
-    n = model.dof
-
-    def inv(m: sp.Matrix) -> sp.Matrix:
-        return tidy_matrix(m.inv())
-
-    ns = task_namespace(a, b, n, inv)
-    derived_tasks = []
-    for task in tasks:
-        sens = {}
-        for term in task.sensitivity_terms:
-            value = evaluate_formula(task.sensitivity[term], ns, f"task {task.name}: sensitivity.{term}")
-            sens[term] = tidy_matrix(sp.Matrix(value))
-            if sens[term].shape != (n, n):
-                raise DescriptionError(f"task {task.name}: sensitivity.{term} is {sens[term].shape}, not {n}x{n}")
-        precision, reads = {}, {}
-        for term in task.sensitivity_terms + ["u"]:
-            precision[term], reads[term] = symmetric_matrix(f"p_{term}", n)
-        confidence = precision["u"]
-        for term in task.sensitivity_terms:
-            s = sens[term]
-            confidence = confidence + s.T @ precision[term] @ s
-        remarks = []
-        for r in task.remarks:
-            alt = tidy_matrix(sp.Matrix(evaluate_formula(r.alternative, ns, f"task {task.name}: remark")))
-            remarks.append({"remark": r, "alternative": alt, "used": sens[r.term]})
-        derived_tasks.append(TaskDerivation(task, sens, precision, reads, confidence, remarks))
-
+        raise DescriptionError(model.path, "equilibrium", "A is singular there; the task sensitivities need A^-1")
+    check_goals(model, tasks)
+    ns = task_namespace(a, b, model.dof, lambda m: tidy_matrix(m.inv()))
+    derived_tasks = [derive_task(task, ns, model.dof) for task in tasks]
     return Derivation(model, params, consts, q, q_dot, u, q_ddot, f, f_x, f_u, x_e, u_e, a, b, derived_tasks, lagrangian)
 
+
+def equilibrium(model: Model) -> tuple[sp.Matrix, sp.Matrix]:
+    """X^e and U^e: numbers (pi, sqrt... allowed), not expressions in the parameters."""
+    def values(label: str, texts: list[str]) -> list[sp.Expr]:
+        return [parse(model, v, {}, f"equilibrium.{label}[{i}]") for i, v in enumerate(texts)]
+    x_e = sp.Matrix(values("q", model.equilibrium_q) + values("q_dot", model.equilibrium_q_dot))
+    return x_e, sp.Matrix(values("u", model.equilibrium_u))
+
+
+def check_goals(model: Model, tasks: list[Task]) -> None:
+    """Goals name a task of tasks.toml and term that task uses, and are numbers."""
+    by_name = {t.name: t for t in tasks}
+    for name, terms in model.goals.items():
+        if name not in by_name:
+            raise DescriptionError(model.path, f"goals.{name}",
+                                   f"no task is named '{name}' (tasks: {', '.join(by_name)})")
+        for term, values in terms.items():
+            if term not in by_name[name].sensitivity_terms:
+                raise DescriptionError(model.path, f"goals.{name}.{term}", f"task '{name}' does not use {term}")
+            for i, v in enumerate(values):
+                parse(model, v, {}, f"goals.{name}.{term}[{i}]")
+
+
+def derive_task(task: Task, ns: dict, n: int) -> TaskDerivation:
+    sens = {}
+    for term in task.sensitivity_terms:
+        key = f"sensitivity.{term}"
+        sens[term] = tidy_matrix(sp.Matrix(evaluate_formula(task.sensitivity[term], ns, task, key)))
+        if sens[term].shape != (n, n):
+            raise DescriptionError(task.path, f"{task.key}.{key}",
+                                   f"is {sens[term].shape[0]}x{sens[term].shape[1]}, not {n}x{n}")
+    precision, reads = {}, {}
+    for term in task.sensitivity_terms + ["u"]:
+        precision[term], reads[term] = symmetric_matrix(f"p_{term}", n)
+    confidence = precision["u"]
+    for term in task.sensitivity_terms:
+        s = sens[term]
+        confidence = confidence + s.T @ precision[term] @ s
+    remarks = []
+    for i, r in enumerate(task.remarks):
+        alt = tidy_matrix(sp.Matrix(evaluate_formula(r.alternative, ns, task, f"remarks[{i}].alternative")))
+        remarks.append({"remark": r, "alternative": alt, "used": sens[r.term]})
+    return TaskDerivation(task, sens, precision, reads, confidence, remarks)

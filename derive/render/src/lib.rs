@@ -14,7 +14,7 @@ use serde_json::Value;
 use tera::{Context, Tera};
 
 /// The IR schema this renderer understands (`schema` in the JSON).
-pub const IR_SCHEMA: u64 = 3;
+pub const IR_SCHEMA: u64 = 4;
 
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {

@@ -1,0 +1,161 @@
+"""A malformed model or task description stops derive.py with one line on stderr naming the file,
+the key and the problem, and exit status 2 (bad input): each case breaks one thing in a copy of
+tests/fixtures/pendulum.toml (or derive/tasks.toml) and runs derive.py on it.
+
+    derive/.venv/bin/python -m unittest discover -s derive/tests      (part of make test)
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import tempfile
+import unittest
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+DERIVE = ROOT / "derive" / "derive.py"
+PENDULUM = (ROOT / "tests" / "fixtures" / "pendulum.toml").read_text()
+TASKS = (ROOT / "derive" / "tasks.toml").read_text()
+
+
+def edit(text: str, old: str, new: str) -> str:
+    # The edit must apply: a fixture that changed under a test would otherwise test nothing.
+    if old not in text:
+        raise AssertionError(f"the fixture no longer contains {old!r}")
+    return text.replace(old, new, 1)
+
+
+class BrokenDescription(unittest.TestCase):
+    def derive(self, model: str = PENDULUM, tasks: str = TASKS) -> tuple[subprocess.CompletedProcess, Path, Path]:
+        tmp = Path(self.enterContext(tempfile.TemporaryDirectory()))
+        model_path, tasks_path = tmp / "broken.toml", tmp / "tasks.toml"
+        model_path.write_text(model)
+        tasks_path.write_text(tasks)
+        r = subprocess.run([sys.executable, str(DERIVE), str(model_path), "--tasks", str(tasks_path),
+                            "--out", str(tmp / "broken.json"), "--vectors", "1"], capture_output=True, text=True)
+        return r, model_path, tasks_path
+
+    def assert_stops(self, r: subprocess.CompletedProcess, path: Path, key: str, problem: str) -> None:
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertNotIn("Traceback", r.stderr)
+        lines = r.stderr.splitlines()
+        self.assertEqual(len(lines), 1, r.stderr)
+        self.assertTrue(lines[0].startswith(f"derive: {path}: {key}: "), lines[0])
+        self.assertIn(problem, lines[0])
+        self.assertEqual(r.stdout, "")
+
+    def model_stops(self, model: str, key: str, problem: str) -> None:
+        r, path, _ = self.derive(model=model)
+        self.assert_stops(r, path, key, problem)
+
+    def tasks_stop(self, tasks: str, key: str, problem: str) -> None:
+        r, _, path = self.derive(tasks=tasks)
+        self.assert_stops(r, path, key, problem)
+
+    # Unknown keys, in every kind of table (a misspelt key must not be silently ignored).
+    def test_unknown_top_level_table(self):
+        self.model_stops(PENDULUM + "\n[extras]\nfoo = 1\n", "extras", "unknown key")
+
+    def test_unknown_key_in_an_array_of_tables(self):
+        self.model_stops(edit(PENDULUM, 'unit = "kg"', 'units = "kg"'), "parameters[0].units", "unknown key")
+
+    def test_unknown_key_in_a_coordinate(self):
+        self.model_stops(edit(PENDULUM, '{ name = "torque", latex = "T" }', '{ name = "torque", latx = "T" }'),
+                         "coordinates.u[0].latx", "unknown key")
+
+    def test_unknown_key_in_a_constant(self):
+        self.model_stops(edit(PENDULUM, "g = { value = 9.81,", "g = { valu = 9.81,"), "constants.g.valu", "unknown key")
+
+    def test_unknown_term_in_goals(self):
+        self.model_stops(edit(PENDULUM, 'theta = ["pi/4"]', 'angle = ["pi/4"]'), "goals.position.angle", "unknown key")
+
+    # Missing fields and wrong types.
+    def test_missing_dynamics_kind(self):
+        self.model_stops(edit(PENDULUM, 'kind = "explicit"\n', ""), "dynamics.kind", "missing")
+
+    def test_missing_parameter_name(self):
+        self.model_stops(edit(PENDULUM, 'name = "m"\n', ""), "parameters[0].name", "missing")
+
+    def test_missing_equilibrium_table(self):
+        self.model_stops(edit(PENDULUM, '[equilibrium]\nq = ["-pi/2"]\nq_dot = ["0"]\nu = ["0"]\n', ""),
+                         "equilibrium", "missing")
+
+    def test_dof_that_is_not_an_integer(self):
+        self.model_stops(edit(PENDULUM, "dof = 1", 'dof = "one"'), "model.dof", "must be an integer")
+
+    # Names in equations.
+    def test_undefined_symbol_in_an_equation(self):
+        self.model_stops(edit(PENDULUM, "3/(m*l**2)", "3/(mass*l**2)"), "dynamics.q_ddot[0]", "'mass' is not defined")
+
+    def test_sympy_names_are_not_silently_taken(self):
+        # SymPy would read E as Euler's number and I as the imaginary unit.
+        self.model_stops(edit(PENDULUM, "(torque - ", "(I*torque - "), "dynamics.q_ddot[0]", "'I' is not defined")
+
+    def test_a_parameter_in_the_equilibrium(self):
+        self.model_stops(edit(PENDULUM, 'q_dot = ["0"]', 'q_dot = ["l"]'), "equilibrium.q_dot[0]", "'l' is not defined")
+
+    # Unbalanced brackets.
+    def test_bracket_never_closed(self):
+        self.model_stops(edit(PENDULUM, "cos(theta)/2)", "cos(theta/2)"), "dynamics.q_ddot[0]",
+                         "'(' at character 14 is never closed")
+
+    def test_bracket_that_closes_nothing(self):
+        self.model_stops(edit(PENDULUM, 'q = ["-pi/2"]', 'q = ["-pi/2)"]'), "equilibrium.q[0]",
+                         "')' at character 6 closes nothing")
+
+    def test_mismatched_brackets(self):
+        self.model_stops(edit(PENDULUM, "cos(theta)/2)", "cos(theta]/2)"), "dynamics.q_ddot[0]",
+                         "']' at character 39 closes '(' from character 33")
+
+    # Shapes.
+    def test_printed_a_of_the_wrong_shape(self):
+        self.model_stops(PENDULUM + '\n[printed]\nA = [["0", "1"]]\n', "printed.A", "must be 2x2")
+
+    def test_printed_b_of_the_wrong_shape(self):
+        self.model_stops(PENDULUM + '\n[printed]\nB = [["0"], ["1"], ["2"]]\n', "printed.B", "must be 2x1")
+
+    def test_goal_of_the_wrong_length(self):
+        self.model_stops(edit(PENDULUM, 'theta = ["pi/4"]', 'theta = ["pi/4", "0"]'), "goals.position.theta",
+                         "has 2 entries, model.dof is 1")
+
+    def test_equilibrium_of_the_wrong_length(self):
+        self.model_stops(edit(PENDULUM, 'u = ["0"]', 'u = ["0", "0"]'), "equilibrium.u", "has 2 entries")
+
+    def test_goal_for_a_task_that_does_not_exist(self):
+        self.model_stops(edit(PENDULUM, "[goals.position]", "[goals.posture]"), "goals.posture", "no task is named")
+
+    # The equilibrium must be one.
+    def test_not_an_equilibrium(self):
+        # Hanging straight down is; lying horizontally (theta = 0) gravity turns the rod.
+        self.model_stops(edit(PENDULUM, 'q = ["-pi/2"]', 'q = ["0"]'), "equilibrium", "not an equilibrium")
+
+    def test_not_valid_toml(self):
+        r, path, _ = self.derive(model=edit(PENDULUM, "dof = 1", "dof = "))
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertEqual(len(r.stderr.splitlines()), 1, r.stderr)
+        self.assertIn(f"{path}: not valid TOML", r.stderr)
+
+    # tasks.toml.
+    def test_unknown_key_in_a_task(self):
+        self.tasks_stop(edit(TASKS, "index = 2\n", "index = 2\nweight = 3\n"), "task[1].weight", "unknown key")
+
+    def test_missing_sensitivity_of_a_used_term(self):
+        self.tasks_stop(edit(TASKS, 'sensitivity.theta_dot = "-IO @ inv(A) @ B"\n', ""),
+                        "task[1].sensitivity.theta_dot", "missing")
+
+    def test_unbalanced_bracket_in_a_task_formula(self):
+        self.tasks_stop(edit(TASKS, 'sensitivity.theta_ddot = "IO @ (A @ A', 'sensitivity.theta_ddot = "IO @ ((A @ A'),
+                        "task[2].sensitivity.theta_ddot", "was never closed")
+
+    def test_task_formula_of_the_wrong_shape(self):
+        self.tasks_stop(edit(TASKS, 'sensitivity.theta_dot = "-IO @ inv(A) @ B"', 'sensitivity.theta_dot = "IO"'),
+                        "task[1].sensitivity.theta_dot", "is 1x2, not 1x1")
+
+    def test_unknown_term_in_a_task(self):
+        self.tasks_stop(edit(TASKS, 'terms = ["theta_ddot", "u"]', 'terms = ["theta_ddot", "jerk"]'),
+                        "task[2].terms[1]", "unknown term 'jerk'")
+
+
+if __name__ == "__main__":
+    unittest.main()
