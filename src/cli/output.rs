@@ -21,6 +21,29 @@ pub fn print_matrix<const R: usize, const C: usize>(title: &str, m: &SMatrix<f64
     }
 }
 
+/// Adds a tool's confidence and episode outcome to its JSON object: `logdet` (or
+/// `logdet_error`), then `task_error`, `free_energy`, `cost_j`, `rhs_evals` (or `error`), the keys
+/// `select` and `rank` share.
+pub fn add_outcome<E: std::fmt::Display, F: std::fmt::Display>(
+    v: &mut Value,
+    logdet: &Result<f64, E>,
+    episode: &Result<toolconf::closed_loop::Metrics, F>,
+) {
+    match logdet {
+        Ok(l) => v["logdet"] = Value::from(*l),
+        Err(e) => v["logdet_error"] = Value::from(e.to_string()),
+    }
+    match episode {
+        Ok(m) => {
+            v["task_error"] = Value::from(m.task_error);
+            v["free_energy"] = Value::from(m.free_energy);
+            v["cost_j"] = Value::from(m.cost_j);
+            v["rhs_evals"] = Value::from(m.rhs_evals);
+        }
+        Err(e) => v["error"] = Value::from(e.to_string()),
+    }
+}
+
 /// What a command can fail with; `exit_code` maps bad input to 2 and failed work to 1.
 #[derive(Debug, thiserror::Error)]
 pub enum CliError {

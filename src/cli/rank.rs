@@ -18,7 +18,7 @@ use toolconf::task_file::TaskSpec;
 use toolconf::tools_file::{read_tools, ToolFileError};
 use toolconf::TaskKind;
 
-use super::output::CliError;
+use super::output::{add_outcome, CliError};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -205,19 +205,7 @@ fn tool_json(rank: usize, r: &RankedTool) -> Value {
         "model": r.row.tool.model().name(),
         "parameters": params,
     });
-    match &r.logdet {
-        Ok(l) => v["logdet"] = json!(l),
-        Err(e) => v["logdet_error"] = json!(e.to_string()),
-    }
-    match &r.episode {
-        Ok(m) => {
-            v["task_error"] = json!(m.task_error);
-            v["free_energy"] = json!(m.free_energy);
-            v["cost_j"] = json!(m.cost_j);
-            v["rhs_evals"] = json!(m.rhs_evals);
-        }
-        Err(e) => v["error"] = json!(e.to_string()),
-    }
+    add_outcome(&mut v, &r.logdet, &r.episode);
     v
 }
 

@@ -18,7 +18,7 @@ use toolconf::task_file::TaskSpec;
 use toolconf::Task;
 
 use super::episode_args::{two_link_options, EpisodeArgs, PlantArg, TaskArgs};
-use super::output::CliError;
+use super::output::{add_outcome, CliError};
 use super::simulate::MpcArgs;
 
 #[derive(clap::Args)]
@@ -53,19 +53,7 @@ pub struct Args {
 
 fn tool_json(r: &ToolResult) -> Value {
     let mut v = json!({ "index": r.index, "arm": r.arm });
-    match &r.logdet {
-        Ok(l) => v["logdet"] = json!(l),
-        Err(e) => v["logdet_error"] = json!(e.to_string()),
-    }
-    match &r.episode {
-        Ok(m) => {
-            v["task_error"] = json!(m.task_error);
-            v["free_energy"] = json!(m.free_energy);
-            v["cost_j"] = json!(m.cost_j);
-            v["rhs_evals"] = json!(m.rhs_evals);
-        }
-        Err(e) => v["error"] = json!(e.to_string()),
-    }
+    add_outcome(&mut v, &r.logdet, &r.episode);
     v
 }
 
@@ -248,21 +236,9 @@ fn mixed_tool_json(r: &MixedResult) -> Value {
         .map(|(name, value)| (name.to_string(), json!(value)))
         .collect();
     let mut v = json!({ "index": r.index, "model": r.model().name(), "arm": params });
-    match &r.logdet {
-        Ok(l) => {
-            v["logdet"] = json!(l);
-            v["logdet_per_joint"] = json!(r.logdet_per_joint());
-        }
-        Err(e) => v["logdet_error"] = json!(e.to_string()),
-    }
-    match &r.episode {
-        Ok(m) => {
-            v["task_error"] = json!(m.task_error);
-            v["free_energy"] = json!(m.free_energy);
-            v["cost_j"] = json!(m.cost_j);
-            v["rhs_evals"] = json!(m.rhs_evals);
-        }
-        Err(e) => v["error"] = json!(e.to_string()),
+    add_outcome(&mut v, &r.logdet, &r.episode);
+    if r.logdet.is_ok() {
+        v["logdet_per_joint"] = json!(r.logdet_per_joint());
     }
     v
 }
