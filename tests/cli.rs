@@ -304,3 +304,30 @@ fn select_ranks_by_the_mpc_cost_when_asked() {
     ]);
     assert_eq!(mixed.status.code(), Some(2));
 }
+
+#[test]
+fn a_reader_that_stops_early_ends_the_run_quietly() {
+    // `toolconf select … | head`: the closed pipe ends the process (SIGPIPE), not a panic.
+    use std::io::Read;
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_toolconf"))
+        .args([
+            "select",
+            "--task",
+            "acceleration",
+            "--tools",
+            "1000",
+            "--json",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = [0u8; 16];
+    child.stdout.take().unwrap().read_exact(&mut first).unwrap();
+    // The read end is dropped here, with far more than a pipe buffer of JSON still to come.
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(!out.status.success());
+}
