@@ -35,10 +35,6 @@ def shown(path: Path, root: Path) -> str:
     return str(resolved.relative_to(root)) if resolved.is_relative_to(root) else str(path)
 
 
-def vectors_path(out: Path) -> Path:
-    return out.with_name(out.name.removesuffix(".json") + ".vectors.json")
-
-
 def write(path: Path, document: dict) -> None:
     path.write_text(json.dumps(document, indent=1, ensure_ascii=False) + "\n")
 
@@ -61,7 +57,7 @@ def main() -> int:
     if args.vectors < 1:
         print(f"derive: --vectors {args.vectors}: need at least one test vector per function", file=sys.stderr)
         return 2
-    vectors_out = vectors_path(args.out)
+    vectors_out = args.out.with_suffix(".vectors.json")
     try:
         model = load_model(args.model)
         tasks = load_tasks(args.tasks)

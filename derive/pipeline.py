@@ -37,22 +37,25 @@ FIXTURE_MODELS = [("pendulum", 3)]
 GLIBC_OFF = ["AVX512F", "AVX512DQ", "AVX512BW", "AVX512VL", "AVX2", "FMA", "FMA4", "AVX"]
 
 
+def _numpy_optional_features(env: dict[str, str]) -> list[str]:
+    """The dispatchable CPU features numpy uses under `env` (its baseline is not among them)."""
+    probe = ("from numpy._core import _multiarray_umath as m;"
+             "print(' '.join(f for f in m.__cpu_dispatch__ if m.__cpu_features__.get(f)))")
+    return subprocess.run([sys.executable, "-c", probe], env=env, check=True, capture_output=True,
+                          text=True).stdout.split()
+
+
 def restricted_environment(base: dict[str, str]) -> dict[str, str]:
     """The environment of an older CPU: numpy's dispatch reduced to its baseline, libm's to SSE2."""
-    probe = ("from numpy._core import _multiarray_umath as m;"
-             "print(','.join(f for f in m.__cpu_dispatch__ if m.__cpu_features__.get(f)))")
-    found = subprocess.run([sys.executable, "-c", probe], check=True, capture_output=True, text=True).stdout.strip()
+    found = _numpy_optional_features(base)
     env = dict(base)
     if found:
-        env["NPY_DISABLE_CPU_FEATURES"] = found
+        env["NPY_DISABLE_CPU_FEATURES"] = ",".join(found)
     env["GLIBC_TUNABLES"] = "glibc.cpu.hwcaps=" + ",".join("-" + f for f in GLIBC_OFF)
-    check = ("from numpy._core import _multiarray_umath as m;"
-             "print(' '.join(f for f in m.__cpu_dispatch__ if m.__cpu_features__.get(f)))")
-    still = subprocess.run([sys.executable, "-c", check], env=env, check=True, capture_output=True,
-                           text=True).stdout.strip()
+    still = _numpy_optional_features(env)
     if still:
-        raise SystemExit(f"pipeline: NPY_DISABLE_CPU_FEATURES did not switch off numpy's {still}")
-    print(f"pipeline: restricted CPU: numpy's optional kernels off ({found or 'none found'}), "
+        raise SystemExit(f"pipeline: NPY_DISABLE_CPU_FEATURES did not switch off numpy's {' '.join(still)}")
+    print(f"pipeline: restricted CPU: numpy's optional kernels off ({','.join(found) or 'none found'}), "
           f"glibc hwcaps {env['GLIBC_TUNABLES'].split('=', 1)[1]}")
     return env
 
@@ -64,9 +67,14 @@ class Run:
     generated: Path
     fixtures: Path
 
+    def model_jobs(self) -> list[tuple[Path, Path, int]]:
+        """(description, IR to write, vectors per function) for every model under derive/models."""
+        return [(m, self.generated / f"{m.stem}.json", 100) for m in sorted(MODELS.glob("*.toml"))]
+
     def jobs(self) -> list[tuple[Path, Path, int]]:
-        jobs = [(m, self.generated / f"{m.stem}.json", 100) for m in sorted(MODELS.glob("*.toml"))]
-        return jobs + [(FIXTURES / f"{name}.toml", self.fixtures / f"{name}.json", n) for name, n in FIXTURE_MODELS]
+        """The models' jobs and the renderer's fixtures'."""
+        return self.model_jobs() + [(FIXTURES / f"{name}.toml", self.fixtures / f"{name}.json", n)
+                                    for name, n in FIXTURE_MODELS]
 
 
 def _cost(model: Path) -> int:
@@ -94,7 +102,7 @@ def derive_all(runs: list[Run]) -> None:
     if any(r.returncode for r in results):
         raise SystemExit(1)
     for run in runs:
-        irs = [str(out) for _, out, _ in run.jobs()[:-len(FIXTURE_MODELS)]]
+        irs = [str(out) for _, out, _ in run.model_jobs()]
         render = ["cargo", "run", "--quiet", "-p", "toolconf-render", "--", *irs,
                   "--templates", str(ROOT / "templates"), "--out", str(run.generated)]
         if subprocess.run(render, cwd=ROOT, env=run.env).returncode:

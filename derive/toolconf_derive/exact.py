@@ -70,7 +70,7 @@ class ExactFunction:
                 raise ExactEvaluationError(f"{f.name()}: CasADi operation {op} has no exact evaluation")
 
     def __call__(self, *args) -> list["Exact"]:
-        """Evaluates at `args` (numpy arrays of exactly representable doubles, or `Exact`)."""
+        """Evaluates at `args`, arrays of doubles (each taken exactly)."""
         with mpmath.workdps(DIGITS):
             inputs = [self._input_nonzeros(i, a) for i, a in enumerate(args)]
             outputs = [mpmath.zeros(r, c) for r, c in self.out_shapes]
@@ -90,18 +90,15 @@ class ExactFunction:
             return [Exact(o) for o in outputs]
 
     def _input_nonzeros(self, i: int, a) -> list:
-        m = a.m if isinstance(a, Exact) else None
-        if m is None:
-            a = np.asarray(a, dtype=float).reshape(self.f.size1_in(i), self.f.size2_in(i))
-            return [mpmath.mpf(float(a[r, c])) for r, c in self.in_nz[i]]
-        return [m[r, c] for r, c in self.in_nz[i]]
+        a = np.asarray(a, dtype=float).reshape(self.f.size1_in(i), self.f.size2_in(i))
+        return [mpmath.mpf(float(a[r, c])) for r, c in self.in_nz[i]]
 
     def checked(self, *args) -> list["Exact"]:
         """Evaluates exactly and checks the result against CasADi's own double evaluation
         (normwise relative per output): a check of this interpreter. CasADi's doubles are only
         compared, never returned."""
         exact = self(*args)
-        doubles = self.f(*[a.to_numpy() if isinstance(a, Exact) else np.asarray(a, dtype=float) for a in args])
+        doubles = self.f(*[np.asarray(a, dtype=float) for a in args])
         doubles = [doubles] if self.f.n_out() == 1 else doubles
         for k, (ours, theirs) in enumerate(zip(exact, doubles)):
             ours, theirs = ours.to_numpy(), np.array(theirs, dtype=float)

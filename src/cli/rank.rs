@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::{json, Map, Value};
-use toolconf::experiments::csv::{format_number, Cell, CsvWriter};
+use toolconf::experiments::csv::{Cell, CsvWriter};
 use toolconf::model::mixed::ModelKind;
 use toolconf::rank::report::{write_report, ReportInput};
 use toolconf::rank::{ranking, simulate_all, Candidate, ModelTasks, RankedTool, Screen};
@@ -234,13 +234,6 @@ fn print_table(results: &[RankedTool], order: &[usize]) {
             ),
             Err(e) => format!("failed: {e}"),
         };
-        let params: Vec<String> = r
-            .row
-            .tool
-            .named_parameters()
-            .iter()
-            .map(|(n, v)| format!("{n}={}", format_number(*v)))
-            .collect();
         println!(
             "{:>5} {:>6}  {:<w$} {:<10} {:>12}  {metrics}  {}",
             k + 1,
@@ -248,7 +241,7 @@ fn print_table(results: &[RankedTool], order: &[usize]) {
             name(r),
             r.row.tool.model().name(),
             logdet,
-            params.join(" ")
+            r.parameters_text()
         );
     }
 }

@@ -275,6 +275,20 @@ pub struct RankedTool {
     pub episode: Result<Metrics, ModelSimulationError>,
 }
 
+impl RankedTool {
+    /// `m1=0.3 m2=0.4 …`, each value as the CSVs write it: the table's and the report's column.
+    pub fn parameters_text(&self) -> String {
+        let params: Vec<String> = self
+            .row
+            .tool
+            .named_parameters()
+            .iter()
+            .map(|(n, v)| format!("{n}={}", crate::experiments::csv::format_number(*v)))
+            .collect();
+        params.join(" ")
+    }
+}
+
 /// How many episodes run in parallel before their results are handed on, in file order.
 const CHUNK: usize = 64;
 

@@ -6,7 +6,6 @@ use std::path::{Path, PathBuf};
 
 use super::{score, ModelTasks, RankedTool, TaskTrace};
 use crate::experiments::common::wants_log;
-use crate::experiments::csv::format_number;
 use crate::experiments::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use crate::experiments::report::{to_html, to_markdown, Block};
 use crate::experiments::{write_atomically, ReproduceError};
@@ -244,13 +243,6 @@ fn ranking_table(input: &ReportInput) -> Vec<Block> {
         if rank >= LISTED && r.episode.is_ok() {
             continue;
         }
-        let params: Vec<String> = r
-            .row
-            .tool
-            .named_parameters()
-            .iter()
-            .map(|(n, v)| format!("{n}={}", format_number(*v)))
-            .collect();
         let logdet = r.logdet.as_ref().map_or("–".into(), |l| number(*l));
         let metrics = match &r.episode {
             Ok(m) => vec![
@@ -264,7 +256,7 @@ fn ranking_table(input: &ReportInput) -> Vec<Block> {
             (rank + 1).to_string(),
             r.row.label(),
             r.row.tool.model().name().to_string(),
-            params.join(" "),
+            r.parameters_text(),
             logdet,
         ];
         row.extend(metrics);

@@ -95,16 +95,43 @@ pub fn load_templates(dir: &Path) -> Result<Vec<(String, String)>, RenderError> 
         .collect()
 }
 
+/// A Tera engine over the templates, with no HTML escaping (the outputs are Rust and Markdown).
+fn engine(templates: &[(String, String)]) -> Result<Tera, RenderError> {
+    let mut tera = Tera::default();
+    tera.autoescape_on(vec![]);
+    tera.add_raw_templates(templates.iter().map(|(n, t)| (n.as_str(), t.as_str())))
+        .map_err(|e| RenderError::Template(chain(&e)))?;
+    Ok(tera)
+}
+
+/// Renders one template to `file_name`; a `.rs` file goes through rustfmt.
+fn render_one(
+    tera: &Tera,
+    template: &str,
+    context: &Context,
+    file_name: String,
+) -> Result<Rendered, RenderError> {
+    let text = tera
+        .render(template, context)
+        .map_err(|e| RenderError::Template(chain(&e)))?;
+    let contents = if file_name.ends_with(".rs") {
+        rustfmt(&text)?
+    } else {
+        text
+    };
+    Ok(Rendered {
+        file_name,
+        contents,
+    })
+}
+
 /// Renders the IR through each template; Rust outputs are formatted with rustfmt.
 pub fn render(ir: &Value, templates: &[(String, String)]) -> Result<Vec<Rendered>, RenderError> {
     let model = ir
         .pointer("/model/name")
         .and_then(Value::as_str)
         .ok_or(RenderError::NoModelName)?;
-    let mut tera = Tera::default();
-    tera.autoescape_on(vec![]);
-    tera.add_raw_templates(templates.iter().map(|(n, t)| (n.as_str(), t.as_str())))
-        .map_err(|e| RenderError::Template(chain(&e)))?;
+    let tera = engine(templates)?;
     let context = Context::from_value(ir.clone()).map_err(|e| RenderError::Template(chain(&e)))?;
     let mut out: Vec<Rendered> = Vec::new();
     for (name, _) in templates {
@@ -117,14 +144,7 @@ pub fn render(ir: &Value, templates: &[(String, String)]) -> Result<Vec<Rendered
         if out.iter().any(|r| r.file_name == file_name) {
             return Err(RenderError::Clash(file_name));
         }
-        let text = tera
-            .render(name, &context)
-            .map_err(|e| RenderError::Template(chain(&e)))?;
-        let contents = if ext == "rs" { rustfmt(&text)? } else { text };
-        out.push(Rendered {
-            file_name,
-            contents,
-        });
+        out.push(render_one(&tera, name, &context, file_name)?);
     }
     Ok(out)
 }
@@ -154,7 +174,6 @@ fn registry_entry(ir: &Value) -> Result<Value, RenderError> {
     // A Rust string literal (quotes escaped) for the macro's arguments.
     let title = model.get("title").and_then(Value::as_str).unwrap_or(name);
     entry["title_literal"] = Value::from(format!("{title:?}"));
-    entry["tasks"] = ir["tasks"].clone();
     Ok(entry)
 }
 
@@ -167,28 +186,14 @@ pub fn render_registry(
         .iter()
         .map(registry_entry)
         .collect::<Result<Vec<_>, _>>()?;
-    let mut tera = Tera::default();
-    tera.autoescape_on(vec![]);
-    tera.add_raw_templates(templates.iter().map(|(n, t)| (n.as_str(), t.as_str())))
-        .map_err(|e| RenderError::Template(chain(&e)))?;
+    let tera = engine(templates)?;
     let mut context = Context::new();
     context.insert("models", &models);
     templates
         .iter()
         .map(|(name, _)| {
             let file_name = name.trim_end_matches(".tera").to_string();
-            let text = tera
-                .render(name, &context)
-                .map_err(|e| RenderError::Template(chain(&e)))?;
-            let contents = if file_name.ends_with(".rs") {
-                rustfmt(&text)?
-            } else {
-                text
-            };
-            Ok(Rendered {
-                file_name,
-                contents,
-            })
+            render_one(&tera, name, &context, file_name)
         })
         .collect()
 }
