@@ -93,6 +93,101 @@ pub mod acceleration {
     pub const PRECISION_U: f64 = 0.0;
 }
 
+/// The default goals and precisions of `task` for this model (the modules above); zero for a
+/// term the task does not use.
+#[must_use]
+pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
+    match task {
+        super::TaskKind::Position => super::TaskDefaults {
+            goal_theta: position::GOAL_THETA,
+            goal_theta_dot: position::GOAL_THETA_DOT,
+            goal_theta_ddot: position::GOAL_THETA_DDOT,
+            precision_theta: position::PRECISION_THETA,
+            precision_theta_dot: position::PRECISION_THETA_DOT,
+            precision_theta_ddot: position::PRECISION_THETA_DDOT,
+            precision_u: position::PRECISION_U,
+        },
+        super::TaskKind::Velocity => super::TaskDefaults {
+            goal_theta: [0.0; DOF],
+            goal_theta_dot: velocity::GOAL_THETA_DOT,
+            goal_theta_ddot: velocity::GOAL_THETA_DDOT,
+            precision_theta: 0.0,
+            precision_theta_dot: velocity::PRECISION_THETA_DOT,
+            precision_theta_ddot: velocity::PRECISION_THETA_DDOT,
+            precision_u: velocity::PRECISION_U,
+        },
+        super::TaskKind::Acceleration => super::TaskDefaults {
+            goal_theta: [0.0; DOF],
+            goal_theta_dot: [0.0; DOF],
+            goal_theta_ddot: acceleration::GOAL_THETA_DDOT,
+            precision_theta: 0.0,
+            precision_theta_dot: 0.0,
+            precision_theta_ddot: acceleration::PRECISION_THETA_DDOT,
+            precision_u: acceleration::PRECISION_U,
+        },
+    }
+}
+
+/// The sensitivities of `task`'s controller for a tool (each task's `<task>_sensitivity`
+/// below); `None` for a term the task does not use.
+#[inline]
+#[must_use]
+pub fn task_sensitivities(
+    task: super::TaskKind,
+    params: &SVector<f64, PARAMETER_COUNT>,
+) -> super::TaskSensitivities<DOF> {
+    match task {
+        super::TaskKind::Position => {
+            let (d_theta_du, d_theta_dot_du, d_theta_ddot_du) = position_sensitivity(params);
+            super::TaskSensitivities {
+                d_theta_du: Some(d_theta_du),
+                d_theta_dot_du: Some(d_theta_dot_du),
+                d_theta_ddot_du: Some(d_theta_ddot_du),
+            }
+        }
+        super::TaskKind::Velocity => {
+            let (d_theta_dot_du, d_theta_ddot_du) = velocity_sensitivity(params);
+            super::TaskSensitivities {
+                d_theta_du: None,
+                d_theta_dot_du: Some(d_theta_dot_du),
+                d_theta_ddot_du: Some(d_theta_ddot_du),
+            }
+        }
+        super::TaskKind::Acceleration => {
+            let d_theta_ddot_du = acceleration_sensitivity(params);
+            super::TaskSensitivities {
+                d_theta_du: None,
+                d_theta_dot_du: None,
+                d_theta_ddot_du: Some(d_theta_ddot_du),
+            }
+        }
+    }
+}
+
+/// The control confidence Π^U of `task` for a tool (each task's `<task>_control_confidence`
+/// below), given the precisions of all four terms; a task reads only its own terms' ones.
+#[inline]
+#[must_use]
+#[allow(unused_variables)]
+pub fn task_control_confidence(
+    task: super::TaskKind,
+    params: &SVector<f64, PARAMETER_COUNT>,
+    p_theta: &SMatrix<f64, DOF, DOF>,
+    p_theta_dot: &SMatrix<f64, DOF, DOF>,
+    p_theta_ddot: &SMatrix<f64, DOF, DOF>,
+    p_u: &SMatrix<f64, DOF, DOF>,
+) -> SMatrix<f64, DOF, DOF> {
+    match task {
+        super::TaskKind::Position => {
+            position_control_confidence(params, p_theta, p_theta_dot, p_theta_ddot, p_u)
+        }
+        super::TaskKind::Velocity => {
+            velocity_control_confidence(params, p_theta_dot, p_theta_ddot, p_u)
+        }
+        super::TaskKind::Acceleration => acceleration_control_confidence(params, p_theta_ddot, p_u),
+    }
+}
+
 /// The parameter-only factors of [`dynamics`], computed once per tool: [`dynamics_with`]
 /// then only combines them with the state and control (derive/toolconf_derive/hoist.py).
 #[derive(Debug, Clone, Copy, PartialEq)]

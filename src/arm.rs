@@ -104,3 +104,15 @@ impl FromStr for Arm {
         }
     }
 }
+
+impl From<&Arm> for crate::model::Arm2Tool {
+    fn from(arm: &Arm) -> Self {
+        Self::from_checked(arm.params())
+    }
+}
+
+impl From<&Arm> for crate::model::Arm2ExactTool {
+    fn from(arm: &Arm) -> Self {
+        Self::from_checked(arm.params())
+    }
+}

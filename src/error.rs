@@ -9,8 +9,8 @@ pub enum Error {
     /// An arm given in text that is not four comma-separated numbers.
     #[error("invalid arm '{text}': expected M1,M2,L1,L2 (four comma-separated numbers), {reason}")]
     ArmSyntax { text: String, reason: String },
-    /// A task name that is not one of the paper's tasks.
-    #[error("unknown task '{0}': expected position, velocity or acceleration (or 1, 2, 3)")]
+    /// A task name that is not one of `derive/tasks.toml`'s.
+    #[error("unknown task '{0}': expected {names}", names = crate::task::task_choices())]
     UnknownTask(String),
     /// A goal that is not finite.
     #[error("invalid goal {name} = {value}: must be finite")]

@@ -35,7 +35,7 @@ pub mod trig;
 pub use arm::Arm;
 pub use confidence::{control_confidence, sensitivities, ControlConfidence, Sensitivities};
 pub use error::Error;
-pub use task::{Task, TaskKind};
+pub use task::{Task, TaskKind, Term};
 
 /// 2-vector of joint quantities (θ, θ̇, θ̈, U) of the paper's 2-DOF arm.
 pub type Vector2 = nalgebra::SVector<f64, 2>;

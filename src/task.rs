@@ -5,44 +5,12 @@ use std::str::FromStr;
 
 use serde::Serialize;
 
+use crate::model::TaskN;
 use crate::{Error, Matrix2, Vector2};
 
-/// Which task-specific controller (appendix "Task specific controllers").
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum TaskKind {
-    /// Task 1: reach a goal configuration θ^g.
-    Position,
-    /// Task 2: hold a goal joint velocity θ̇^g.
-    Velocity,
-    /// Task 3: hold a goal joint acceleration θ̈^g.
-    Acceleration,
-}
-
-impl TaskKind {
-    pub const ALL: [TaskKind; 3] = [
-        TaskKind::Position,
-        TaskKind::Velocity,
-        TaskKind::Acceleration,
-    ];
-
-    /// The task's number in the paper (1, 2, 3).
-    pub fn paper_index(self) -> u8 {
-        match self {
-            TaskKind::Position => 1,
-            TaskKind::Velocity => 2,
-            TaskKind::Acceleration => 3,
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            TaskKind::Position => "position",
-            TaskKind::Velocity => "velocity",
-            TaskKind::Acceleration => "acceleration",
-        }
-    }
-}
+/// Which task-specific controller: generated from `derive/tasks.toml` (a task added there appears
+/// after `make derive`), with its name, number, terms and error term.
+pub use crate::generated::{TaskKind, Term};
 
 impl fmt::Display for TaskKind {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -53,14 +21,43 @@ impl fmt::Display for TaskKind {
 impl FromStr for TaskKind {
     type Err = Error;
 
-    /// Accepts the name (`position`, `velocity`, `acceleration`) or the paper's number.
+    /// Accepts a task's name (`position`, `velocity`, ...) or its number (`1`, `2`, ...).
     fn from_str(s: &str) -> Result<Self, Error> {
-        match s.trim().to_ascii_lowercase().as_str() {
-            "position" | "1" => Ok(TaskKind::Position),
-            "velocity" | "2" => Ok(TaskKind::Velocity),
-            "acceleration" | "3" => Ok(TaskKind::Acceleration),
-            _ => Err(Error::UnknownTask(s.to_string())),
-        }
+        let key = s.trim().to_ascii_lowercase();
+        TaskKind::ALL
+            .into_iter()
+            .find(|k| k.name() == key || k.paper_index().to_string() == key)
+            .ok_or_else(|| Error::UnknownTask(s.to_string()))
+    }
+}
+
+/// The task names and numbers a command line accepts, for messages and `--help`:
+/// "position, velocity or acceleration (or 1, 2, 3)".
+pub fn task_choices() -> String {
+    let names: Vec<&str> = TaskKind::ALL.iter().map(|k| k.name()).collect();
+    let numbers: Vec<String> = TaskKind::ALL
+        .iter()
+        .map(|k| k.paper_index().to_string())
+        .collect();
+    let names = match names.split_last() {
+        Some((last, [])) => last.to_string(),
+        Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+        None => String::new(),
+    };
+    format!("{names} (or {})", numbers.join(", "))
+}
+
+impl Serialize for TaskKind {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.name())
+    }
+}
+
+impl TaskKind {
+    /// Whether the task's controller uses `term` (the others have precision zero).
+    #[must_use]
+    pub fn uses(self, term: Term) -> bool {
+        self.terms().contains(&term)
     }
 }
 
@@ -97,5 +94,35 @@ impl Task {
     /// ([`crate::model::ValidatedTaskN::control_confidence`], with `Arm2Tool::from(&arm)`).
     pub fn validated(&self) -> Result<crate::model::ValidatedTaskN<2>, Error> {
         crate::model::TaskN::from(self).validated()
+    }
+}
+
+impl From<&Task> for TaskN<2> {
+    fn from(t: &Task) -> Self {
+        Self {
+            kind: t.kind,
+            goal_theta: t.goal_theta,
+            goal_theta_dot: t.goal_theta_dot,
+            goal_theta_ddot: t.goal_theta_ddot,
+            precision_theta: t.precision_theta,
+            precision_theta_dot: t.precision_theta_dot,
+            precision_theta_ddot: t.precision_theta_ddot,
+            precision_u: t.precision_u,
+        }
+    }
+}
+
+impl From<&TaskN<2>> for Task {
+    fn from(t: &TaskN<2>) -> Self {
+        Self {
+            kind: t.kind,
+            goal_theta: t.goal_theta,
+            goal_theta_dot: t.goal_theta_dot,
+            goal_theta_ddot: t.goal_theta_ddot,
+            precision_theta: t.precision_theta,
+            precision_theta_dot: t.precision_theta_dot,
+            precision_theta_ddot: t.precision_theta_ddot,
+            precision_u: t.precision_u,
+        }
     }
 }

@@ -34,7 +34,7 @@ use serde::Deserialize;
 
 use crate::model::runtime::check_grid;
 use crate::model::{ArmModel, EpisodeOptionsN, TaskN};
-use crate::TaskKind;
+use crate::{TaskKind, Term};
 
 /// A bad task file: the file, where in it (a key or a line), and what is wrong.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -203,8 +203,9 @@ impl TaskSpec {
             err(
                 "kind",
                 format!(
-                    "'{}' is not a task kind: expected position, velocity or acceleration",
-                    raw.kind
+                    "'{}' is not a task kind: expected {}",
+                    raw.kind,
+                    crate::task::task_choices()
                 ),
             )
         })?;
@@ -272,32 +273,43 @@ impl TaskSpec {
     /// The checks that need no model: terms the task uses, finite numbers, precisions symmetric
     /// positive semi-definite, episode options in range. Returns (key, message).
     fn check(&self) -> Result<(), (String, String)> {
-        let unused = |key: &str, given: bool, used_by: &str| {
-            if given {
-                Err((
-                    key.to_string(),
-                    format!("a {} task does not use it ({used_by} only)", self.kind),
-                ))
-            } else {
-                Ok(())
-            }
-        };
-        if self.kind != TaskKind::Position {
-            unused("goal.theta", self.goal_theta.is_some(), "position")?;
-            unused(
-                "precision.theta",
+        for (term, goal, precision) in [
+            (
+                Term::Theta,
+                self.goal_theta.is_some(),
                 self.precision_theta.is_some(),
-                "position",
-            )?;
-        }
-        if self.kind == TaskKind::Acceleration {
-            let used_by = "position and velocity";
-            unused("goal.theta_dot", self.goal_theta_dot.is_some(), used_by)?;
-            unused(
-                "precision.theta_dot",
+            ),
+            (
+                Term::ThetaDot,
+                self.goal_theta_dot.is_some(),
                 self.precision_theta_dot.is_some(),
-                used_by,
-            )?;
+            ),
+            (
+                Term::ThetaDdot,
+                self.goal_theta_ddot.is_some(),
+                self.precision_theta_ddot.is_some(),
+            ),
+        ] {
+            if self.kind.uses(term) {
+                continue;
+            }
+            let name = term.name();
+            let key = match (goal, precision) {
+                (true, _) => format!("goal.{name}"),
+                (false, true) => format!("precision.{name}"),
+                (false, false) => continue,
+            };
+            let used_by: Vec<&str> = TaskKind::ALL
+                .iter()
+                .filter(|k| k.uses(term))
+                .map(|k| k.name())
+                .collect();
+            let message = format!(
+                "a {} task does not use it ({} only)",
+                self.kind,
+                used_by.join(" and ")
+            );
+            return Err((key, message));
         }
         for (key, v) in [
             ("goal.theta", &self.goal_theta),

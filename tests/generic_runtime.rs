@@ -8,13 +8,12 @@ use nalgebra::SMatrix;
 use proptest::prelude::*;
 use serde_json::Value;
 use toolconf::closed_loop::{self, EpisodeOptions, Metrics, Plant};
-use toolconf::model::mixed::{
-    draw_mixed_tools, evaluate_mixed, AnyTool, MixedObjective, MixedResult, ModelKind,
-};
+use toolconf::model::mixed::{AnyTool, ModelKind};
 use toolconf::model::{
     self, control_confidence, simulate, simulate_on, Arm2, Arm2Exact, Arm2Tool, Arm3, Arm3Tool,
     ArmModel, EpisodeOptionsN, TaskN,
 };
+use toolconf::select::mixed::{draw_mixed_tools, evaluate_mixed, MixedObjective, MixedResult};
 use toolconf::select::{draw_tools, PARAMETER_RANGE};
 use toolconf::{Arm, Error, Task, TaskKind};
 

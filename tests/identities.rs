@@ -59,7 +59,7 @@ proptest! {
     fn task3_acceleration_sensitivity_is_the_identity(arm in arm_strategy()) {
         // [I O](A² A⁻¹(E − B) + AB) = [I O] A E = I for every arm: task 3's confidence is the
         // same for every tool, as the paper finds.
-        let s = sensitivities(&arm, TaskKind::Acceleration).d_theta_ddot_du;
+        let s = sensitivities(&arm, TaskKind::Acceleration).d_theta_ddot_du.expect("task 3 uses θ̈");
         prop_assert_eq!(s, Matrix2::identity());
         let task = Task::paper(TaskKind::Acceleration);
         let c = control_confidence(&arm, &task).unwrap();

@@ -38,7 +38,7 @@ fn linearisation_sensitivities_and_confidence_table() {
             for (name, m) in [
                 ("dtheta/dU", s.d_theta_du),
                 ("dthetadot/dU", s.d_theta_dot_du),
-                ("dthetaddot/dU", Some(s.d_theta_ddot_du)),
+                ("dthetaddot/dU", s.d_theta_ddot_du),
             ] {
                 if let Some(m) = m {
                     out += &row(name, m.transpose().iter().copied());

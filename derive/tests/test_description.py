@@ -156,6 +156,18 @@ class BrokenDescription(unittest.TestCase):
         self.tasks_stop(edit(TASKS, 'terms = ["theta_ddot", "u"]', 'terms = ["theta_ddot", "jerk"]'),
                         "task[2].terms[1]", "unknown term 'jerk'")
 
+    def test_error_term_the_task_does_not_use(self):
+        self.tasks_stop(edit(TASKS, 'error = "theta_dot"', 'error = "theta"'),
+                        "task[1].error", "is not one of the task's kinematic terms")
+
+    def test_missing_error_term(self):
+        self.tasks_stop(edit(TASKS, 'error = "theta_ddot"\n', ""), "task[2].error", "missing")
+
+    def test_model_name_taken_by_the_registry(self):
+        name = PENDULUM.split('name = "', 1)[1].split('"', 1)[0]
+        self.model_stops(edit(PENDULUM, f'name = "{name}"', 'name = "tasks"'), "model.name",
+                         "taken by the generated registry")
+
 
 if __name__ == "__main__":
     unittest.main()

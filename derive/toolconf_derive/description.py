@@ -88,6 +88,8 @@ class Task:
     title: str
     doc: str
     terms: list[str]
+    # The kinematic term whose distance to its goal is the task's error (eq. task_error).
+    error: str
     sensitivity: dict[str, str]
     remarks: list[Remark] = field(default_factory=list)
     default_precision: dict[str, float] = field(default_factory=dict)
@@ -100,8 +102,20 @@ class Task:
         """The kinematic terms (theta, theta_dot, theta_ddot) this task's controller uses, in order."""
         return [t for t in ("theta", "theta_dot", "theta_ddot") if t in self.terms]
 
+    @property
+    def sensitivity_function(self) -> str:
+        """The generated function that returns this task's sensitivities."""
+        return f"{self.name}_sensitivity"
+
+    @property
+    def confidence_function(self) -> str:
+        """The generated function that returns this task's control confidence Pi^U."""
+        return f"{self.name}_control_confidence"
+
 
 KNOWN_TERMS = ("theta", "theta_dot", "theta_ddot", "u")
+# generated/<model>.rs must not clash with the registry's own files (templates/registry/).
+RESERVED_MODEL_NAMES = ("mod", "tasks")
 KINEMATIC_TERMS = ("theta", "theta_dot", "theta_ddot")
 
 # The keys each table may have, as serde's deny_unknown_fields: a misspelt key is an error, not a
@@ -123,7 +137,8 @@ TOP_KEYS = (("model", "table", True), ("parameters", "tables", True), ("constant
             ("coordinates", "table", True), ("dynamics", "table", True), ("equilibrium", "table", True),
             ("goals", "table", False), ("printed", "table", False))
 TASK_KEYS = (("name", "string", True), ("index", "integer", True), ("title", "string", False),
-             ("doc", "string", False), ("terms", "strings", True), ("sensitivity", "table", True),
+             ("doc", "string", False), ("terms", "strings", True), ("error", "string", True),
+             ("sensitivity", "table", True),
              ("defaults", "table", False), ("remarks", "tables", False))
 DEFAULTS_KEYS = (("precision", "table", True),)
 REMARK_KEYS = (("term", "string", True), ("alternative", "string", True), ("text", "string", True))
@@ -259,6 +274,9 @@ def _check_identifier(name: str, path: Path, key: str) -> None:
 def _validate_names(m: Model) -> None:
     path = m.path
     _check_identifier(m.name, path, "model.name")
+    if m.name in RESERVED_MODEL_NAMES:
+        raise DescriptionError(path, "model.name", f"'{m.name}' is taken by the generated registry "
+                                                   f"({', '.join(n + '.rs' for n in RESERVED_MODEL_NAMES)})")
     if m.dof < 1:
         raise DescriptionError(path, "model.dof", f"must be at least 1, got {m.dof}")
     groups = (("parameters", m.parameters), ("constants", m.constants), ("coordinates.q", m.q),
@@ -325,6 +343,8 @@ def _task(path: Path, t: _Table) -> Task:
         if term not in KNOWN_TERMS:
             raise DescriptionError(path, t.sub(f"terms[{i}]"), f"unknown term '{term}' (known: {', '.join(KNOWN_TERMS)})")
     used = [s for s in KINEMATIC_TERMS if s in terms]
+    if t.get("error") not in used:
+        raise DescriptionError(path, t.sub("error"), f"'{t.get('error')}' is not one of the task's kinematic terms {used}")
     # Only the task's kinematic terms have a sensitivity; an extra one is an unknown key.
     sens = t.table("sensitivity", tuple((s, "string", True) for s in used))
     defaults = t.table("defaults", DEFAULTS_KEYS) if "defaults" in t.raw else None
@@ -338,7 +358,7 @@ def _task(path: Path, t: _Table) -> Task:
         remarks.append(Remark(**r.raw))
     _check_identifier(t.get("name"), path, t.sub("name"))
     return Task(name=t.get("name"), index=t.get("index"), title=t.get("title", ""), doc=t.get("doc", ""),
-                terms=terms, sensitivity=dict(sens.raw), remarks=remarks,
+                terms=terms, error=t.get("error"), sensitivity=dict(sens.raw), remarks=remarks,
                 default_precision={k: float(v) for k, v in precision.raw.items()}, path=path, key=t.key)
 
 

@@ -183,7 +183,7 @@ def build_functions(d: Derivation, cm: CasadiModel) -> list[Function]:
             return [s[t] for t in terms]
 
         fns.append(Function(
-            f"{task.name}_sensitivity",
+            task.sensitivity_function,
             f"{task.title}: the sensitivities d(task variable)/dU the controller uses, "
             f"in the order ({', '.join('d_' + t + '_du' for t in terms)}).",
             "appendix \"Task specific controllers\"", [p],
@@ -202,7 +202,7 @@ def build_functions(d: Derivation, cm: CasadiModel) -> list[Function]:
             return [cm.control_confidence(task, v["params"], prec)]
 
         fns.append(Function(
-            f"{task.name}_control_confidence",
+            task.confidence_function,
             f"{task.title}: the control confidence Pi^U = d2F/dU2 = "
             + " + ".join(f"S_{t}^T P_{t} S_{t}" for t in terms) + " + P_u.",
             "eq. (control_conf) and the closed forms after it", [p] + prec_args,

@@ -251,7 +251,9 @@ def model_ir(d: Derivation, functions: list[Function], generator: dict, report: 
         "tasks": [
             {
                 "name": t.task.name, "index": t.task.index, "title": t.task.title, "doc": t.task.doc,
-                "terms": t.task.terms, "sensitivity_terms": t.task.sensitivity_terms,
+                "terms": t.task.terms, "sensitivity_terms": t.task.sensitivity_terms, "error": t.task.error,
+                "sensitivity_function": t.task.sensitivity_function,
+                "confidence_function": t.task.confidence_function,
                 "goals": [{"term": term, "rust": [printer(sp.sympify(v)) for v in
                                                   m.goals.get(t.task.name, {}).get(term, ["0"] * m.dof)]}
                           for term in t.task.sensitivity_terms],

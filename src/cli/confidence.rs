@@ -33,7 +33,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         for (name, m) in [
             ("d_theta_du", s.d_theta_du),
             ("d_theta_dot_du", s.d_theta_dot_du),
-            ("d_theta_ddot_du", Some(s.d_theta_ddot_du)),
+            ("d_theta_ddot_du", s.d_theta_ddot_du),
         ] {
             if let Some(m) = m {
                 sens.insert(name.into(), matrix_rows(&m));
@@ -63,7 +63,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     for (name, m) in [
         ("dtheta/dU", s.d_theta_du),
         ("dtheta_dot/dU", s.d_theta_dot_du),
-        ("dtheta_ddot/dU", Some(s.d_theta_ddot_du)),
+        ("dtheta_ddot/dU", s.d_theta_ddot_du),
     ] {
         if let Some(m) = m {
             print_matrix(name, &m);

@@ -14,8 +14,8 @@ use super::parse_task;
 /// The task: `--task NAME` or `--task-file FILE` (exactly one).
 #[derive(clap::Args, Debug, Clone)]
 pub struct TaskArgs {
-    /// The task: position, velocity or acceleration (or the paper's 1, 2, 3).
-    #[arg(long, value_parser = parse_task, required_unless_present = "task_file", conflicts_with = "task_file")]
+    /// The task (from derive/tasks.toml).
+    #[arg(long, help = format!("The task: {}", toolconf::task::task_choices()), value_parser = parse_task, required_unless_present = "task_file", conflicts_with = "task_file")]
     pub task: Option<TaskKind>,
     /// A task file (TOML: kind, [goal], [precision], [episode]; see the README) instead of a
     /// built-in task. Episode flags given on the command line override its [episode].

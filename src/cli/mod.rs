@@ -40,6 +40,10 @@ pub(crate) fn parse_arm(s: &str) -> Result<Arm, String> {
     s.parse().map_err(|e: Error| e.to_string())
 }
 
+pub(crate) fn parse_model(s: &str) -> Result<toolconf::model::mixed::ModelKind, String> {
+    s.parse()
+}
+
 pub(crate) fn parse_task(s: &str) -> Result<TaskKind, String> {
     s.parse().map_err(|e: Error| e.to_string())
 }

@@ -26,8 +26,8 @@ pub struct Args {
     /// parameters, e.g. m1,m2,l1,l2; see the README).
     #[arg(long)]
     tools: PathBuf,
-    /// The task: a built-in name (position, velocity, acceleration or 1, 2, 3) or a task file.
-    #[arg(long)]
+    /// The task: a built-in name or a task file.
+    #[arg(long, help = format!("The task: a built-in name ({}) or a task file", toolconf::task::task_choices()))]
     task: String,
     /// Simulate only the K most confident tools (largest ln|Pi^U|, computed without simulating).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
@@ -73,8 +73,8 @@ fn task_spec(task: &str) -> Result<TaskSpec, CliError> {
     }
     if !Path::new(task).exists() {
         return Err(CliError::Usage(format!(
-            "--task {task}: neither a built-in task (position, velocity, acceleration or 1, 2, \
-             3) nor an existing task file"
+            "--task {task}: neither a built-in task ({}) nor an existing task file",
+            toolconf::task::task_choices()
         )));
     }
     Ok(TaskSpec::from_file(Path::new(task))?)

@@ -1,16 +1,15 @@
 //! `toolconf select --task T --tools N --seed S [--models arm2,arm3] [--json]`.
 //!
 //! With the default `--models arm2` this is the 2-link selection of `toolconf::select`, output
-//! unchanged; with other models the set is drawn and ranked by `toolconf::model::mixed`.
+//! unchanged; with other models the set is drawn and ranked by `toolconf::select::mixed`.
 
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use toolconf::closed_loop::EpisodeOptions;
-use toolconf::model::mixed::{
-    draw_mixed_tools, evaluate_mixed, MixedObjective, MixedResult, ModelKind,
-};
+use toolconf::model::mixed::ModelKind;
 use toolconf::model::Arm2;
 use toolconf::rank::ModelTasks;
+use toolconf::select::mixed::{draw_mixed_tools, evaluate_mixed, MixedObjective, MixedResult};
 use toolconf::select::{
     choose_by_mpc_cost, draw_tools, evaluate, evaluate_mpc, Objective, ToolResult,
 };
@@ -19,6 +18,7 @@ use toolconf::Task;
 
 use super::episode_args::{two_link_options, EpisodeArgs, PlantArg, TaskArgs};
 use super::output::{add_outcome, CliError};
+use super::parse_model;
 use super::simulate::MpcArgs;
 
 #[derive(clap::Args)]
@@ -55,10 +55,6 @@ fn tool_json(r: &ToolResult) -> Value {
     let mut v = json!({ "index": r.index, "arm": r.arm });
     add_outcome(&mut v, &r.logdet, &r.episode);
     v
-}
-
-fn parse_model(s: &str) -> Result<ModelKind, String> {
-    s.parse()
 }
 
 pub fn run(args: &Args) -> Result<(), CliError> {

@@ -4,20 +4,32 @@ use std::path::PathBuf;
 
 use serde_json::{json, Value};
 use toolconf::closed_loop::{simulate, Episode, Plant, Trajectory};
+use toolconf::model::mixed::{AnyTool, ModelKind};
 use toolconf::model::{episode_on, Arm2, Arm2Exact, Arm2Tool};
 use toolconf::mpc::{simulate_mpc, MpcModel, MpcOptions};
+use toolconf::rank::ModelTasks;
 use toolconf::task_file::TaskSpec;
 use toolconf::{Arm, Error, Task};
 
-use super::episode_args::{two_link_options, EpisodeArgs, TaskArgs};
+use super::episode_args::{two_link_options, EpisodeArgs, PlantArg, TaskArgs};
 use super::output::{write_atomically, CliError};
-use super::parse_arm;
+use super::{parse_arm, parse_model};
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// The tool: link masses and lengths M1,M2,L1,L2 (kg, m), all > 0.
-    #[arg(long, value_parser = parse_arm, allow_hyphen_values = true)]
-    arm: Arm,
+    /// The tool: link masses and lengths M1,M2,L1,L2 (kg, m), all > 0, of the paper's arm.
+    #[arg(long, value_parser = parse_arm, allow_hyphen_values = true,
+          required_unless_present = "model", conflicts_with_all = ["model", "params"])]
+    arm: Option<Arm>,
+    /// A tool of any generated model instead of --arm (with --params).
+    #[arg(long, value_parser = parse_model, requires = "params", help = format!(
+        "A tool of any generated model instead of --arm: {} (with --params)",
+        toolconf::generated::MODEL_NAMES.join(", ")))]
+    model: Option<ModelKind>,
+    /// The model's parameters in its order, comma-separated (e.g. m1,m2,l1,l2,mp for
+    /// arm2_payload; `toolconf select --help` lists every model's).
+    #[arg(long, requires = "model", allow_hyphen_values = true)]
+    params: Option<String>,
     #[command(flatten)]
     task: TaskArgs,
     #[command(flatten)]
@@ -111,17 +123,22 @@ impl MpcArgs {
 
 pub fn run(args: &Args) -> Result<(), CliError> {
     let spec = args.task.spec()?;
+    let arm = match (args.arm, args.model) {
+        (Some(arm), _) => arm,
+        (None, Some(model)) => return run_model(args, model, spec),
+        (None, None) => return Err(CliError::Usage("give --arm or --model".into())),
+    };
     if args.controller == Controller::Mpc {
-        return run_mpc(args, spec);
+        return run_mpc(args, &arm, spec);
     }
     let (episode, perturb) = match args.task.task_file {
         None => {
             let task = Task::paper(spec.kind);
             let options = args.episode.options(args.csv.is_some())?;
-            let episode = simulate(&args.arm, &task, &options)?;
+            let episode = simulate(&arm, &task, &options)?;
             (episode, json!(options.perturbation))
         }
-        Some(_) => from_task_file(args, spec.clone())?,
+        Some(_) => from_task_file(args, &arm, spec.clone())?,
     };
     let m = episode.metrics;
     if let (Some(path), Some(tr)) = (&args.csv, &episode.trajectory) {
@@ -129,7 +146,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     }
     if args.json {
         let mut out = json!({
-            "arm": args.arm,
+            "arm": arm,
             "task": spec.kind,
             "perturb": perturb,
             "task_error": m.task_error,
@@ -150,7 +167,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     } else {
         println!(
             "arm: {}    task: {}    perturbation: {perturb} N m",
-            args.arm,
+            arm,
             spec.label(),
         );
         println!("task error     {:.9e}", m.task_error);
@@ -170,12 +187,16 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 
 /// One episode of the task file's task: the generic 2-link runtime, which takes the file's
 /// initial state, initial torque and per-joint perturbation as they are.
-fn from_task_file(args: &Args, mut spec: TaskSpec) -> Result<(Episode, Value), CliError> {
+fn from_task_file(
+    args: &Args,
+    arm: &Arm,
+    mut spec: TaskSpec,
+) -> Result<(Episode, Value), CliError> {
     args.episode.apply(&mut spec.episode)?;
     let task = spec.task::<Arm2, 2, 4, 4, 6>()?;
     let mut options = spec.episode::<Arm2, 2, 4, 4, 6>()?;
     options.record_trajectory = args.csv.is_some();
-    let tool = Arm2Tool::from(&args.arm);
+    let tool = Arm2Tool::from(arm);
     let episode = match Plant::from(args.episode.plant) {
         Plant::Paper => episode_on::<Arm2, Arm2, 2, 4, 4, 6>(&tool, &task, &options)?,
         Plant::Exact => episode_on::<Arm2, Arm2Exact, 2, 4, 4, 6>(&tool, &task, &options)?,
@@ -189,7 +210,7 @@ fn from_task_file(args: &Args, mut spec: TaskSpec) -> Result<(Episode, Value), C
     Ok((episode, perturb))
 }
 
-fn run_mpc(args: &Args, mut spec: TaskSpec) -> Result<(), CliError> {
+fn run_mpc(args: &Args, arm: &Arm, mut spec: TaskSpec) -> Result<(), CliError> {
     let (task, options) = match args.task.task_file {
         None => (
             Task::paper(spec.kind),
@@ -204,14 +225,14 @@ fn run_mpc(args: &Args, mut spec: TaskSpec) -> Result<(), CliError> {
             (task, two_link_options(&o, args.episode.plant.into(), why)?)
         }
     };
-    let episode = simulate_mpc(&args.arm, &task, &options, &args.mpc.options()?)?;
+    let episode = simulate_mpc(arm, &task, &options, &args.mpc.options()?)?;
     let m = &episode.metrics;
     if let (Some(path), Some(tr)) = (&args.csv, &episode.trajectory) {
         write_atomically(path, &trajectory_csv(tr))?;
     }
     if args.json {
         let out = json!({
-            "arm": args.arm,
+            "arm": arm,
             "task": spec.kind,
             "controller": "mpc",
             "perturb": options.perturbation,
@@ -234,7 +255,7 @@ fn run_mpc(args: &Args, mut spec: TaskSpec) -> Result<(), CliError> {
     } else {
         println!(
             "arm: {}    task: {}    controller: MPC    perturbation: {} N m",
-            args.arm,
+            arm,
             spec.label(),
             options.perturbation
         );
@@ -263,6 +284,85 @@ fn run_mpc(args: &Args, mut spec: TaskSpec) -> Result<(), CliError> {
         );
         if let Some(path) = &args.csv {
             println!("trajectory       {}", path.display());
+        }
+    }
+    Ok(())
+}
+
+/// One episode of a tool of any generated model (`--model M --params …`) on a built-in task or
+/// a task file, through the model-generic runtime: the same numbers `toolconf rank` gives it.
+fn run_model(args: &Args, model: ModelKind, mut spec: TaskSpec) -> Result<(), CliError> {
+    if args.controller == Controller::Mpc {
+        return Err(CliError::Usage(
+            "--controller mpc runs the paper's arm only: give --arm".into(),
+        ));
+    }
+    if args.episode.plant != PlantArg::Paper {
+        return Err(CliError::Usage(
+            "--plant exact is the paper's arm's exact dynamics: give --arm (or --model arm2_exact)"
+                .into(),
+        ));
+    }
+    let text = args.params.as_deref().unwrap_or_default();
+    let params = text
+        .split(',')
+        .map(|v| {
+            v.trim()
+                .parse::<f64>()
+                .map_err(|_| CliError::Usage(format!("--params {text}: '{v}' is not a number")))
+        })
+        .collect::<Result<Vec<f64>, _>>()?;
+    let tool = AnyTool::new(model, &params)?;
+    args.episode.apply(&mut spec.episode)?;
+    let tasks = ModelTasks::new(&spec);
+    tasks.check(model)?;
+    let episode = tasks.episode(&tool, args.csv.is_some())?;
+    let m = &episode.metrics;
+    if let (Some(path), Some(tr)) = (&args.csv, &episode.trajectory) {
+        write_atomically(path, &tr.to_csv())?;
+    }
+    let named: serde_json::Map<String, Value> = tool
+        .named_parameters()
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), json!(v)))
+        .collect();
+    if args.json {
+        let mut out = json!({
+            "model": model.name(),
+            "params": named,
+            "task": spec.kind,
+            "perturb": episode.perturbation,
+            "task_error": m.task_error,
+            "free_energy": m.free_energy,
+            "cost_j": m.cost_j,
+            "logdet": m.logdet,
+            "rhs_evals": m.rhs_evals,
+            "steps": m.steps,
+            "rejected_steps": m.rejected_steps,
+        });
+        if let Some(path) = &args.task.task_file {
+            out["task_file"] = json!(path);
+        }
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&out).expect("finite numbers")
+        );
+    } else {
+        println!(
+            "tool: {tool}    task: {}    perturbation: {:?} N m",
+            spec.label(),
+            episode.perturbation
+        );
+        println!("task error     {:.9e}", m.task_error);
+        println!("integral F dt  {:.9e}", m.free_energy);
+        println!("integral J dt  {:.9e}", m.cost_j);
+        println!("ln|Pi^U|       {:.9e}", m.logdet);
+        println!(
+            "rhs evals      {} ({} steps, {} rejected)",
+            m.rhs_evals, m.steps, m.rejected_steps
+        );
+        if let Some(path) = &args.csv {
+            println!("trajectory     {}", path.display());
         }
     }
     Ok(())

@@ -111,3 +111,20 @@ pub fn simulate(
     }
     .map_err(|failure| SimulationError::named(failure, *arm))
 }
+
+impl From<&EpisodeOptions> for EpisodeOptionsN<2, 4> {
+    /// The 2-link options as they are (X0 and U0 included); `plant` is not used.
+    fn from(o: &EpisodeOptions) -> Self {
+        Self {
+            t_end: o.t_end,
+            dt: o.dt,
+            x0: o.x0,
+            u0: o.u0,
+            perturbation: o.perturbation,
+            joint_perturbation: nalgebra::SVector::zeros(),
+            learning_rate: o.learning_rate,
+            integrator: o.integrator,
+            record_trajectory: o.record_trajectory,
+        }
+    }
+}

@@ -28,7 +28,8 @@ use std::marker::PhantomData;
 use nalgebra::{SMatrix, SVector};
 
 use crate::generated;
-use crate::{Arm, Error, Task, TaskKind};
+use crate::generated::TaskKind;
+use crate::Error;
 
 pub mod mixed;
 pub(crate) mod runtime;
@@ -183,31 +184,7 @@ macro_rules! arm_model {
                 kind: TaskKind,
                 p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
             ) -> SensitivitiesN<{ generated::$module::DOF }> {
-                match kind {
-                    TaskKind::Position => {
-                        let (d_theta, d_theta_dot, d_theta_ddot) =
-                            generated::$module::position_sensitivity(p);
-                        SensitivitiesN {
-                            d_theta_du: Some(d_theta),
-                            d_theta_dot_du: Some(d_theta_dot),
-                            d_theta_ddot_du: d_theta_ddot,
-                        }
-                    }
-                    TaskKind::Velocity => {
-                        let (d_theta_dot, d_theta_ddot) =
-                            generated::$module::velocity_sensitivity(p);
-                        SensitivitiesN {
-                            d_theta_du: None,
-                            d_theta_dot_du: Some(d_theta_dot),
-                            d_theta_ddot_du: d_theta_ddot,
-                        }
-                    }
-                    TaskKind::Acceleration => SensitivitiesN {
-                        d_theta_du: None,
-                        d_theta_dot_du: None,
-                        d_theta_ddot_du: generated::$module::acceleration_sensitivity(p),
-                    },
-                }
+                generated::$module::task_sensitivities(kind, p)
             }
 
             #[inline]
@@ -215,72 +192,18 @@ macro_rules! arm_model {
                 task: &TaskN<{ generated::$module::DOF }>,
                 p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
             ) -> SMatrix<f64, { generated::$module::DOF }, { generated::$module::DOF }> {
-                match task.kind {
-                    TaskKind::Position => generated::$module::position_control_confidence(
-                        p,
-                        &task.precision_theta,
-                        &task.precision_theta_dot,
-                        &task.precision_theta_ddot,
-                        &task.precision_u,
-                    ),
-                    TaskKind::Velocity => generated::$module::velocity_control_confidence(
-                        p,
-                        &task.precision_theta_dot,
-                        &task.precision_theta_ddot,
-                        &task.precision_u,
-                    ),
-                    TaskKind::Acceleration => generated::$module::acceleration_control_confidence(
-                        p,
-                        &task.precision_theta_ddot,
-                        &task.precision_u,
-                    ),
-                }
+                generated::$module::task_control_confidence(
+                    task.kind,
+                    p,
+                    &task.precision_theta,
+                    &task.precision_theta_dot,
+                    &task.precision_theta_ddot,
+                    &task.precision_u,
+                )
             }
 
             fn paper_task(kind: TaskKind) -> TaskN<{ generated::$module::DOF }> {
-                let eye = SMatrix::identity();
-                let zero = SVector::zeros();
-                match kind {
-                    TaskKind::Position => {
-                        use generated::$module::position as p;
-                        TaskN {
-                            kind,
-                            goal_theta: SVector::from(p::GOAL_THETA),
-                            goal_theta_dot: SVector::from(p::GOAL_THETA_DOT),
-                            goal_theta_ddot: SVector::from(p::GOAL_THETA_DDOT),
-                            precision_theta: eye * p::PRECISION_THETA,
-                            precision_theta_dot: eye * p::PRECISION_THETA_DOT,
-                            precision_theta_ddot: eye * p::PRECISION_THETA_DDOT,
-                            precision_u: eye * p::PRECISION_U,
-                        }
-                    }
-                    TaskKind::Velocity => {
-                        use generated::$module::velocity as p;
-                        TaskN {
-                            kind,
-                            goal_theta: zero,
-                            goal_theta_dot: SVector::from(p::GOAL_THETA_DOT),
-                            goal_theta_ddot: SVector::from(p::GOAL_THETA_DDOT),
-                            precision_theta: SMatrix::zeros(),
-                            precision_theta_dot: eye * p::PRECISION_THETA_DOT,
-                            precision_theta_ddot: eye * p::PRECISION_THETA_DDOT,
-                            precision_u: eye * p::PRECISION_U,
-                        }
-                    }
-                    TaskKind::Acceleration => {
-                        use generated::$module::acceleration as p;
-                        TaskN {
-                            kind,
-                            goal_theta: zero,
-                            goal_theta_dot: zero,
-                            goal_theta_ddot: SVector::from(p::GOAL_THETA_DDOT),
-                            precision_theta: SMatrix::zeros(),
-                            precision_theta_dot: SMatrix::zeros(),
-                            precision_theta_ddot: eye * p::PRECISION_THETA_DDOT,
-                            precision_u: eye * p::PRECISION_U,
-                        }
-                    }
-                }
+                TaskN::from_defaults(kind, &generated::$module::task_defaults(kind))
             }
         }
     };
@@ -308,17 +231,12 @@ macro_rules! arm_models {
 
 crate::for_each_model!(arm_models);
 
-/// The sensitivities ∂(task variable)/∂U that a task's controller uses (eq. U_dot_deriv); a term
-/// the task does not use is `None` ([`crate::Sensitivities`] is the 2-link one).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SensitivitiesN<const N: usize> {
-    /// ∂θ/∂U (task 1 only): [I O]A⁻¹(∂Ẋ/∂U − B) with ∂Ẋ/∂U = [I; I].
-    pub d_theta_du: Option<SMatrix<f64, N, N>>,
-    /// ∂θ̇/∂U: [O I]A⁻¹(∂Ẋ/∂U − B) = I in task 1; −[I O]A⁻¹B in task 2, as the paper prints it.
-    pub d_theta_dot_du: Option<SMatrix<f64, N, N>>,
-    /// ∂θ̈/∂U: I in tasks 1–2 (zero jerk); [I O](A²∂X/∂U + AB) in task 3, which is I too.
-    pub d_theta_ddot_du: SMatrix<f64, N, N>,
-}
+/// The sensitivities ∂θ/∂U, ∂θ̇/∂U, ∂θ̈/∂U that a task's controller uses (eq. U_dot_deriv), `None`
+/// for a term the task does not use ([`crate::Sensitivities`] is the 2-link one). Task 1's ∂θ/∂U
+/// is [I O]A⁻¹(∂Ẋ/∂U − B) with ∂Ẋ/∂U = [I; I]; ∂θ̇/∂U is [O I]A⁻¹(∂Ẋ/∂U − B) = I in task 1 and
+/// −[I O]A⁻¹B in task 2, as the paper prints it; ∂θ̈/∂U is I in every task (zero jerk in tasks
+/// 1–2, [I O](A²∂X/∂U + AB) = I in task 3). The formulas are `derive/tasks.toml`'s.
+pub type SensitivitiesN<const N: usize> = generated::TaskSensitivities<N>;
 
 /// One tool of model `M`: its parameters, each finite and > 0.
 ///
@@ -365,6 +283,16 @@ where
             params: SVector::from(params),
             model: PhantomData,
         })
+    }
+
+    /// A tool from parameters a caller has already checked (finite, > 0), such as an
+    /// [`crate::Arm`]'s: no second check on the 2-link façade's hot path.
+    pub(crate) fn from_checked(params: SVector<f64, NP>) -> Self {
+        debug_assert!(params.iter().all(|v| v.is_finite() && *v > 0.0));
+        Self {
+            params,
+            model: PhantomData,
+        }
     }
 
     /// The parameter vector p the generated functions take.
@@ -430,24 +358,6 @@ where
     }
 }
 
-impl From<&Arm> for Arm2Tool {
-    fn from(arm: &Arm) -> Self {
-        Self {
-            params: arm.params(),
-            model: PhantomData,
-        }
-    }
-}
-
-impl From<&Arm> for Arm2ExactTool {
-    fn from(arm: &Arm) -> Self {
-        Self {
-            params: arm.params(),
-            model: PhantomData,
-        }
-    }
-}
-
 /// A task for N joints: goals and prior precisions (the N-joint [`Task`]). A term the task's
 /// controller does not use has precision zero.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -467,6 +377,21 @@ impl<const N: usize> TaskN<N> {
     pub fn validated(&self) -> Result<ValidatedTaskN<N>, Error> {
         self.validate()?;
         Ok(ValidatedTaskN(*self))
+    }
+
+    /// The task with a model's generated defaults (goals; precisions P = value · I).
+    pub fn from_defaults(kind: TaskKind, d: &generated::TaskDefaults<N>) -> Self {
+        let eye = SMatrix::<f64, N, N>::identity();
+        TaskN {
+            kind,
+            goal_theta: SVector::from(d.goal_theta),
+            goal_theta_dot: SVector::from(d.goal_theta_dot),
+            goal_theta_ddot: SVector::from(d.goal_theta_ddot),
+            precision_theta: eye * d.precision_theta,
+            precision_theta_dot: eye * d.precision_theta_dot,
+            precision_theta_ddot: eye * d.precision_theta_ddot,
+            precision_u: eye * d.precision_u,
+        }
     }
 
     /// Model `M`'s paper-style task ([`ArmModel::paper_task`]).
@@ -501,36 +426,6 @@ impl<const N: usize> TaskN<N> {
             check_precision(name, p)?;
         }
         Ok(())
-    }
-}
-
-impl From<&Task> for TaskN<2> {
-    fn from(t: &Task) -> Self {
-        Self {
-            kind: t.kind,
-            goal_theta: t.goal_theta,
-            goal_theta_dot: t.goal_theta_dot,
-            goal_theta_ddot: t.goal_theta_ddot,
-            precision_theta: t.precision_theta,
-            precision_theta_dot: t.precision_theta_dot,
-            precision_theta_ddot: t.precision_theta_ddot,
-            precision_u: t.precision_u,
-        }
-    }
-}
-
-impl From<&TaskN<2>> for Task {
-    fn from(t: &TaskN<2>) -> Self {
-        Self {
-            kind: t.kind,
-            goal_theta: t.goal_theta,
-            goal_theta_dot: t.goal_theta_dot,
-            goal_theta_ddot: t.goal_theta_ddot,
-            precision_theta: t.precision_theta,
-            precision_theta_dot: t.precision_theta_dot,
-            precision_theta_ddot: t.precision_theta_ddot,
-            precision_u: t.precision_u,
-        }
     }
 }
 

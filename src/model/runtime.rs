@@ -5,11 +5,11 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::{control_confidence, ArmModel, TaskN, ToolN};
-use crate::closed_loop::EpisodeOptions;
+use crate::generated::Term;
 use crate::integrate::{
     solve_grid_with_jacobian, uniform_grid, IntegrationError, Method, Options as IntegratorOptions,
 };
-use crate::{Error, TaskKind};
+use crate::Error;
 
 /// A grid state whose magnitude passes this is a diverging simulation, not a result.
 pub(crate) const DIVERGENCE_BOUND: f64 = 1e6;
@@ -67,7 +67,7 @@ impl<const N: usize> ActiveInferenceN<N> {
             learning_rate,
             gain_theta: gain(s.d_theta_du, &task.precision_theta),
             gain_theta_dot: gain(s.d_theta_dot_du, &task.precision_theta_dot),
-            gain_theta_ddot: gain(Some(s.d_theta_ddot_du), &task.precision_theta_ddot),
+            gain_theta_ddot: gain(s.d_theta_ddot_du, &task.precision_theta_ddot),
             logdet: confidence.logdet,
         })
     }
@@ -112,12 +112,18 @@ impl<const N: usize> ActiveInferenceN<N> {
     ) -> f64 {
         let t = &self.task;
         let q = |e: SVector<f64, N>, p: &SMatrix<f64, N, N>| e.dot(&(p * e));
-        let mut sum = q(*theta_ddot - t.goal_theta_ddot, &t.precision_theta_ddot)
-            + u.dot(&(t.precision_u * u));
-        if t.kind != TaskKind::Acceleration {
+        // The terms in a fixed order (θ̈, U, θ̇, θ), each only if the task uses it.
+        let mut sum = 0.0;
+        if t.kind.uses(Term::ThetaDdot) {
+            sum += q(*theta_ddot - t.goal_theta_ddot, &t.precision_theta_ddot);
+        }
+        if t.kind.uses(Term::U) {
+            sum += u.dot(&(t.precision_u * u));
+        }
+        if t.kind.uses(Term::ThetaDot) {
             sum += q(*theta_dot - t.goal_theta_dot, &t.precision_theta_dot);
         }
-        if t.kind == TaskKind::Position {
+        if t.kind.uses(Term::Theta) {
             sum += q(*theta - t.goal_theta, &t.precision_theta);
         }
         0.5 * sum
@@ -136,19 +142,22 @@ impl<const N: usize> ActiveInferenceN<N> {
     }
 
     /// The task's own weighted error at one instant, the summand of the paper's task error:
-    /// task 1 (θ−θ^g)ᵀP^θ(θ−θ^g), task 2 on θ̇, task 3 on θ̈.
+    /// (e − e^g)ᵀP(e − e^g) on the task's error term e ([`TaskKind::error_term`]): θ in task 1,
+    /// θ̇ in task 2, θ̈ in task 3.
     #[inline]
     pub fn task_error(
         &self,
         theta: &SVector<f64, N>,
         theta_dot: &SVector<f64, N>,
         theta_ddot: &SVector<f64, N>,
+        u: &SVector<f64, N>,
     ) -> f64 {
         let t = &self.task;
-        let (e, p) = match t.kind {
-            TaskKind::Position => (theta - t.goal_theta, &t.precision_theta),
-            TaskKind::Velocity => (theta_dot - t.goal_theta_dot, &t.precision_theta_dot),
-            TaskKind::Acceleration => (theta_ddot - t.goal_theta_ddot, &t.precision_theta_ddot),
+        let (e, p) = match t.kind.error_term() {
+            Term::Theta => (theta - t.goal_theta, &t.precision_theta),
+            Term::ThetaDot => (theta_dot - t.goal_theta_dot, &t.precision_theta_dot),
+            Term::ThetaDdot => (theta_ddot - t.goal_theta_ddot, &t.precision_theta_ddot),
+            Term::U => (*u, &t.precision_u),
         };
         e.dot(&(p * e))
     }
@@ -286,7 +295,7 @@ pub struct EpisodeOptionsN<const N: usize, const NX: usize> {
     pub joint_perturbation: SVector<f64, N>,
     pub learning_rate: f64,
     /// Integrator options; [`Method::Auto`] runs DP5 on tasks 1–2 and the DP5-to-Rodas5P
-    /// switch on task 3 (why: [`EpisodeOptions::integrator`]).
+    /// switch on task 3, any task whose error term is θ̈ (why: [`EpisodeOptions::integrator`]).
     pub integrator: IntegratorOptions,
     /// Keep the trajectory on the output grid ([`episode_on`]; [`simulate_on`] never keeps it).
     pub record_trajectory: bool,
@@ -312,49 +321,12 @@ impl<const N: usize, const NX: usize> EpisodeOptionsN<N, NX> {
             record_trajectory: false,
         }
     }
-
-    /// `common`'s horizon, grid, perturbation, learning rate, integrator and recording, with
-    /// model `M`'s equilibrium as X0 and U0 = `common.u0[0]` on every joint (0.1 by default).
-    /// `common.x0` and `common.plant` are not used.
-    pub fn from_common<M, const NP: usize, const NZ: usize>(common: &EpisodeOptions) -> Self
-    where
-        M: ArmModel<N, NX, NP, NZ>,
-    {
-        Self {
-            t_end: common.t_end,
-            dt: common.dt,
-            x0: M::equilibrium_state(),
-            u0: SVector::repeat(common.u0[0]),
-            perturbation: common.perturbation,
-            joint_perturbation: SVector::zeros(),
-            learning_rate: common.learning_rate,
-            integrator: common.integrator,
-            record_trajectory: common.record_trajectory,
-        }
-    }
 }
 
 impl<const N: usize, const NX: usize> EpisodeOptionsN<N, NX> {
     /// ΔT on each joint: `perturbation` on all of them plus `joint_perturbation`.
     pub fn total_perturbation(&self) -> SVector<f64, N> {
         SVector::repeat(self.perturbation) + self.joint_perturbation
-    }
-}
-
-impl From<&EpisodeOptions> for EpisodeOptionsN<2, 4> {
-    /// The 2-link options as they are (X0 and U0 included); `plant` is not used.
-    fn from(o: &EpisodeOptions) -> Self {
-        Self {
-            t_end: o.t_end,
-            dt: o.dt,
-            x0: o.x0,
-            u0: o.u0,
-            perturbation: o.perturbation,
-            joint_perturbation: SVector::zeros(),
-            learning_rate: o.learning_rate,
-            integrator: o.integrator,
-            record_trajectory: o.record_trajectory,
-        }
     }
 }
 
@@ -559,7 +531,9 @@ where
     // The closed loop is autonomous: ∂Ż/∂t = 0.
     let jacobian = |_t: f64, z: &SVector<f64, NZ>| (system.jacobian(z), SVector::zeros());
     let mut integrator = options.integrator;
-    if integrator.method == Method::Auto && task.kind != TaskKind::Acceleration {
+    // Auto switches only on acceleration-control tasks (θ̈ feedback makes them stiff); elsewhere
+    // it stays DP5 so the paper's ode45 runs keep their numbers (see EpisodeOptions::integrator).
+    if integrator.method == Method::Auto && task.kind.error_term() != Term::ThetaDdot {
         integrator.method = Method::Explicit;
     }
     let stats = solve_grid_with_jacobian(rhs, jacobian, &z0, &grid, &integrator, |_, t, z| {
@@ -571,7 +545,7 @@ where
         if divergence.is_none() && magnitude > DIVERGENCE_BOUND {
             divergence = Some((t, magnitude));
         }
-        task_error += controller.task_error(&theta, &theta_dot, &theta_ddot);
+        task_error += controller.task_error(&theta, &theta_dot, &theta_ddot, &u);
         let j = controller.cost_j(&theta, &theta_dot, &theta_ddot, &u);
         let f = j - 0.5 * controller.logdet;
         let e = u.norm_squared();

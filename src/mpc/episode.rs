@@ -244,7 +244,7 @@ where
             .into_owned();
         let theta = x.fixed_rows::<N>(0).into_owned();
         let theta_dot = x.fixed_rows::<N>(N).into_owned();
-        task_error += metrics_of.task_error(&theta, &theta_dot, &theta_ddot);
+        task_error += metrics_of.task_error(&theta, &theta_dot, &theta_ddot, u);
         let j = metrics_of.cost_j(&theta, &theta_dot, &theta_ddot, u);
         let e = u.norm_squared();
         if let Some((t0, j0, e0)) = previous {

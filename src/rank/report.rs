@@ -12,7 +12,7 @@ use crate::experiments::{write_atomically, ReproduceError};
 use crate::select::Objective;
 use crate::stats::spearman;
 use crate::task_file::{PerJoint, PrecisionSpec, TaskSpec};
-use crate::TaskKind;
+use crate::{TaskKind, Term};
 
 /// What the report describes.
 pub struct ReportInput<'a> {
@@ -59,22 +59,20 @@ pub fn write_report(dir: &Path, input: &ReportInput) -> Result<Vec<PathBuf>, Rep
     ])
 }
 
+/// The task's error term, as a symbol and an axis label.
 fn variable(kind: TaskKind) -> (&'static str, &'static str) {
-    match kind {
-        TaskKind::Position => ("θ", "joint angle θ [rad]"),
-        TaskKind::Velocity => ("θ̇", "joint velocity θ̇ [rad/s]"),
-        TaskKind::Acceleration => ("θ̈", "joint acceleration θ̈ [rad/s²]"),
+    match kind.error_term() {
+        Term::Theta => ("θ", "joint angle θ [rad]"),
+        Term::ThetaDot => ("θ̇", "joint velocity θ̇ [rad/s]"),
+        Term::ThetaDdot => ("θ̈", "joint acceleration θ̈ [rad/s²]"),
+        Term::U => ("U", "torque U [N m]"),
     }
 }
 
 fn introduction(input: &ReportInput) -> Vec<Block> {
     let spec = input.spec;
     let (var, _) = variable(spec.kind);
-    let goal = match spec.kind {
-        TaskKind::Position => "reach and hold a goal configuration",
-        TaskKind::Velocity => "move the joints at a goal velocity",
-        TaskKind::Acceleration => "hold a goal joint acceleration",
-    };
+    let goal = spec.kind.doc();
     let screened = match input.screen {
         Some(k) => format!(
             "Only the {} most confident of the {} tools were simulated (`--screen {k}`).",
@@ -95,8 +93,7 @@ fn introduction(input: &ReportInput) -> Vec<Block> {
         Block::Heading(1, format!("Ranking the tools of {}", input.tools_file)),
         Block::p(format!(
             "Each tool is a robot arm, given by its link masses and lengths, that an \
-             active-inference controller drives to do one task: **{}**, that is to {goal}{}. \
-             The controller changes its torque U to lower a free energy F, a weighted sum of \
+             active-inference controller drives to do one task: **{}**{}. {goal} The controller changes its torque U to lower a free energy F, a weighted sum of \
              squared errors (how far the arm is from the goal, how much torque it uses). \
              Following Anil Meera & Lanillos, *Confidence-Aware Decision-Making and Control \
              for Tool Selection*, each tool is judged by four numbers:",
@@ -167,14 +164,14 @@ fn task_table(input: &ReportInput) -> Vec<Block> {
     let number = |v: Option<f64>| v.map(|v| v.to_string());
     let mut rows = vec![vec!["task kind".to_string(), spec.kind.to_string()]];
     let mut add = |name: &str, value: String| rows.push(vec![name.to_string(), value]);
-    if spec.kind == TaskKind::Position {
+    if spec.kind.uses(Term::Theta) {
         add("goal θ [rad]", given(vector(&spec.goal_theta), paper));
         add(
             "precision P^θ",
             given(spec.precision_theta.as_ref().map(precision), paper),
         );
     }
-    if spec.kind != TaskKind::Acceleration {
+    if spec.kind.uses(Term::ThetaDot) {
         add("goal θ̇ [rad/s]", given(vector(&spec.goal_theta_dot), paper));
         add(
             "precision P^θ̇",

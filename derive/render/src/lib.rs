@@ -13,6 +13,8 @@ use std::process::{Command, Stdio};
 use serde_json::Value;
 use tera::{Context, Tera};
 
+mod tasks;
+
 /// The IR schema this renderer understands (`schema` in the JSON).
 pub const IR_SCHEMA: u64 = 4;
 
@@ -36,6 +38,8 @@ pub enum RenderError {
     Template(String),
     #[error("two templates render to the same file {0}")]
     Clash(String),
+    #[error("task: {0}")]
+    Task(String),
     #[error("rustfmt failed: {0}")]
     Rustfmt(String),
 }
@@ -132,7 +136,9 @@ pub fn render(ir: &Value, templates: &[(String, String)]) -> Result<Vec<Rendered
         .and_then(Value::as_str)
         .ok_or(RenderError::NoModelName)?;
     let tera = engine(templates)?;
-    let context = Context::from_value(ir.clone()).map_err(|e| RenderError::Template(chain(&e)))?;
+    let mut ir = ir.clone();
+    ir["tasks"] = Value::from(tasks::tasks_with_rust(&ir)?);
+    let context = Context::from_value(ir).map_err(|e| RenderError::Template(chain(&e)))?;
     let mut out: Vec<Rendered> = Vec::new();
     for (name, _) in templates {
         let ext = name
@@ -158,15 +164,7 @@ fn registry_entry(ir: &Value) -> Result<Value, RenderError> {
         .get("name")
         .and_then(Value::as_str)
         .ok_or(RenderError::NoModelName)?;
-    let marker: String = name
-        .split('_')
-        .map(|w| {
-            let mut c = w.chars();
-            c.next()
-                .map(|f| f.to_ascii_uppercase().to_string() + c.as_str())
-                .unwrap_or_default()
-        })
-        .collect();
+    let marker = tasks::camel_case(name);
     let mut entry = model.clone();
     entry["marker"] = Value::from(marker.clone());
     entry["tool"] = Value::from(marker + "Tool");
@@ -189,6 +187,7 @@ pub fn render_registry(
     let tera = engine(templates)?;
     let mut context = Context::new();
     context.insert("models", &models);
+    context.insert("tasks", &tasks::task_list(irs)?);
     templates
         .iter()
         .map(|(name, _)| {

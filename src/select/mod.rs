@@ -8,6 +8,8 @@
 //! any parallel work and every episode is independent and deterministic, so results are identical
 //! whatever the number of threads.
 
+pub mod mixed;
+
 use rand::{RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;

@@ -1,0 +1,256 @@
+//! Tool sets that mix models: a seeded draw, parallel evaluation, and choices by ∫F, ∫J, ln|Π^U|
+//! and the normalised confidence ln|Π^U|/n (docs/mixed-tools.md).
+//!
+//! # The stream
+//!
+//! The draws extend [`crate::select::ToolSampler`]'s documented mapping: ChaCha8
+//! (`ChaCha8Rng::seed_from_u64(seed)`), each draw u = (next_u64 >> 11)·2⁻⁵³ ∈ [0, 1). Per tool,
+//! first the model: with k models in the set, index min(⌊k·u⌋, k − 1) into the set as given
+//! (no draw when k = 1, so a set of only `arm2` is exactly `select::draw_tools`); then the
+//! model's parameters, each 0.1 + 0.5·u, in the model's parameter order (arm2: m1 m2 l1 l2;
+//! arm3: m1 m2 m3 l1 l2 l3). Draws happen before any parallel work, so results do not depend on
+//! the number of threads.
+//!
+//! # The task
+//!
+//! Each tool runs its own model's paper-style task ([`ArmModel::paper_task`]): the paper's
+//! precisions (P = value·I of the model's size) and the model's goals from
+//! `derive/models/<model>.toml`. arm2 and arm2_exact use the paper's goals; arm3's extend them
+//! (position θ^g = [π/3, π/3, π/6]: the end joint keeps the 2-link end goal π/6 and the middle
+//! joint follows link 1; velocity θ̇^g = [0, 0, 2] and acceleration θ̈^g = [0, 0, 0.1] on the
+//! last joint). Every episode starts at its model's hanging equilibrium with U0 = 0.1 on every
+//! joint.
+
+use rand::{RngCore, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+
+use super::PARAMETER_RANGE;
+use crate::closed_loop::{EpisodeOptions, Metrics, Plant};
+use crate::model::mixed::{AnyTool, ModelKind};
+use crate::model::{
+    control_confidence, simulate, simulate_on, Arm2, Arm2Exact, ArmModel, EpisodeOptionsN,
+    ModelSimulationError, TaskN, ToolN,
+};
+use crate::{Error, TaskKind};
+
+/// ln|Π^U| and the episode's metrics of one tool.
+type Evaluation = (Result<f64, Error>, Result<Metrics, ModelSimulationError>);
+
+/// [`evaluate`] over every generated model ([`crate::for_each_model!`]).
+macro_rules! evaluate_any {
+    ($(($marker:ident, $module:ident, $tool:ident, $name:literal, $title:literal)),* $(,)?) => {
+        /// ln|Π^U| and the episode of `tool` on its own model's paper-style `kind` task.
+        fn evaluate(tool: &AnyTool, kind: TaskKind, common: &EpisodeOptions) -> Evaluation {
+            match tool { $(AnyTool::$marker(t) => evaluate_one(t, kind, common),)* }
+        }
+    };
+}
+
+crate::for_each_model!(evaluate_any);
+
+/// A seeded stream of tools of several models (see the module docs for the mapping).
+pub struct MixedSampler {
+    rng: ChaCha8Rng,
+    models: Vec<ModelKind>,
+}
+
+impl MixedSampler {
+    /// Errors if `models` is empty.
+    pub fn new(models: &[ModelKind], seed: u64) -> Result<Self, Error> {
+        if models.is_empty() {
+            return Err(Error::InvalidOption {
+                name: "number of models",
+                value: 0.0,
+            });
+        }
+        Ok(Self {
+            rng: ChaCha8Rng::seed_from_u64(seed),
+            models: models.to_vec(),
+        })
+    }
+
+    fn uniform(&mut self) -> f64 {
+        (self.rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+
+    /// A tool of `model`, its parameters drawn in the model's order.
+    fn draw(&mut self, model: ModelKind) -> AnyTool {
+        let (lo, hi) = PARAMETER_RANGE;
+        let p: Vec<f64> = model
+            .parameter_names()
+            .iter()
+            .map(|_| lo + (hi - lo) * self.uniform())
+            .collect();
+        AnyTool::new(model, &p).expect("parameters drawn from [0.1, 0.6) are valid")
+    }
+
+    /// The next tool: its model (if the set has more than one), then its parameters.
+    pub fn next_tool(&mut self) -> AnyTool {
+        let k = self.models.len();
+        let model = if k == 1 {
+            self.models[0]
+        } else {
+            let i = ((k as f64) * self.uniform()) as usize;
+            self.models[i.min(k - 1)]
+        };
+        self.draw(model)
+    }
+
+    pub fn tools(&mut self, n: usize) -> Vec<AnyTool> {
+        (0..n).map(|_| self.next_tool()).collect()
+    }
+}
+
+/// `n` tools of the given models drawn from `seed`.
+pub fn draw_mixed_tools(models: &[ModelKind], n: usize, seed: u64) -> Result<Vec<AnyTool>, Error> {
+    Ok(MixedSampler::new(models, seed)?.tools(n))
+}
+
+/// One tool's evaluation in a mixed set.
+#[derive(Debug, Clone)]
+pub struct MixedResult {
+    pub index: usize,
+    pub tool: AnyTool,
+    /// ln|Π^U| on the tool's own task.
+    pub logdet: Result<f64, Error>,
+    pub episode: Result<Metrics, ModelSimulationError>,
+}
+
+impl MixedResult {
+    pub fn model(&self) -> ModelKind {
+        self.tool.model()
+    }
+
+    /// ln|Π^U|/n, n the tool's control dimension: the comparable confidence.
+    pub fn logdet_per_joint(&self) -> Option<f64> {
+        self.logdet
+            .as_ref()
+            .ok()
+            .map(|l| l / self.model().dof() as f64)
+    }
+}
+
+/// `common`'s horizon, grid, perturbation, learning rate, integrator and recording, with model
+/// `M`'s equilibrium as X0 and U0 = `common.u0[0]` on every joint (0.1 by default).
+/// `common.x0` and `common.plant` are not used.
+fn options_for<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    common: &EpisodeOptions,
+) -> EpisodeOptionsN<N, NX>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    EpisodeOptionsN {
+        t_end: common.t_end,
+        dt: common.dt,
+        x0: M::equilibrium_state(),
+        u0: nalgebra::SVector::repeat(common.u0[0]),
+        perturbation: common.perturbation,
+        joint_perturbation: nalgebra::SVector::zeros(),
+        learning_rate: common.learning_rate,
+        integrator: common.integrator,
+        record_trajectory: common.record_trajectory,
+    }
+}
+
+fn evaluate_one<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    tool: &ToolN<M, N, NX, NP, NZ>,
+    kind: TaskKind,
+    common: &EpisodeOptions,
+) -> Evaluation
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let task = TaskN::paper::<M, NX, NP, NZ>(kind);
+    let options = options_for::<M, N, NX, NP, NZ>(common);
+    (
+        control_confidence(tool, &task).map(|c| c.logdet),
+        simulate(tool, &task, &options),
+    )
+}
+
+/// Evaluates every tool on its own model's paper-style `kind` task, in parallel; the result
+/// order is the tools' order. `common` gives the horizon, grid, perturbation, learning rate and
+/// integrator ([`options_for`]); `common.plant == Plant::Exact` simulates the
+/// arm2 tools on the exact 2-link dynamics (as `--plant exact` does for 2-link selection), other
+/// models always on their own dynamics.
+pub fn evaluate_mixed(
+    tools: &[AnyTool],
+    kind: TaskKind,
+    common: &EpisodeOptions,
+) -> Vec<MixedResult> {
+    tools
+        .par_iter()
+        .enumerate()
+        .map(|(index, tool)| {
+            let (logdet, episode) = match tool {
+                AnyTool::Arm2(t) if common.plant == Plant::Exact => {
+                    let task = TaskN::paper::<Arm2, 4, 4, 6>(kind);
+                    let options = options_for::<Arm2, 2, 4, 4, 6>(common);
+                    (
+                        control_confidence(t, &task).map(|c| c.logdet),
+                        simulate_on::<Arm2, Arm2Exact, 2, 4, 4, 6>(t, &task, &options),
+                    )
+                }
+                other => evaluate(other, kind, common),
+            };
+            MixedResult {
+                index,
+                tool: *tool,
+                logdet,
+                episode,
+            }
+        })
+        .collect()
+}
+
+/// An objective that ranks tools of a mixed set.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum MixedObjective {
+    /// argmin ∫F dt.
+    FreeEnergy,
+    /// argmin ∫J dt.
+    CostJ,
+    /// argmax ln|Π^U| (raw: favours more joints, see docs/mixed-tools.md).
+    Confidence,
+    /// argmax ln|Π^U|/n, the per-joint (geometric-mean) confidence.
+    NormalisedConfidence,
+}
+
+impl MixedObjective {
+    pub const ALL: [MixedObjective; 4] = [
+        MixedObjective::FreeEnergy,
+        MixedObjective::CostJ,
+        MixedObjective::Confidence,
+        MixedObjective::NormalisedConfidence,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            MixedObjective::FreeEnergy => "free_energy",
+            MixedObjective::CostJ => "cost_j",
+            MixedObjective::Confidence => "confidence",
+            MixedObjective::NormalisedConfidence => "normalised_confidence",
+        }
+    }
+
+    /// The value to minimise for a tool, if the tool has one.
+    pub fn score(self, r: &MixedResult) -> Option<f64> {
+        match self {
+            MixedObjective::FreeEnergy => r.episode.as_ref().ok().map(|m| m.free_energy),
+            MixedObjective::CostJ => r.episode.as_ref().ok().map(|m| m.cost_j),
+            MixedObjective::Confidence => r.logdet.as_ref().ok().map(|l| -l),
+            MixedObjective::NormalisedConfidence => r.logdet_per_joint().map(|l| -l),
+        }
+    }
+
+    /// The index of the chosen tool; ties go to the earlier tool, failed tools are skipped
+    /// (as [`crate::select::Objective::choose`]).
+    pub fn choose(self, results: &[MixedResult]) -> Option<usize> {
+        super::first_argmin(
+            results
+                .iter()
+                .filter_map(|r| self.score(r).map(|s| (r.index, s))),
+        )
+    }
+}
