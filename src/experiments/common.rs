@@ -5,6 +5,14 @@ use crate::{Arm, TaskKind};
 use super::csv::Cell;
 use super::report::Block;
 
+/// The paper's three tasks, which its Results section runs (a task added to
+/// `derive/tasks.toml` is everywhere else, but not in the paper's figures).
+pub const PAPER_TASKS: [TaskKind; 3] = [
+    TaskKind::Position,
+    TaskKind::Velocity,
+    TaskKind::Acceleration,
+];
+
 /// "task 1 (position)".
 pub fn task_label(kind: TaskKind) -> String {
     format!("task {} ({})", kind.paper_index(), kind.name())

@@ -9,7 +9,7 @@ use crate::stats::{fit_exponential, summary};
 use crate::{Task, TaskKind};
 
 use super::batch::{map_ordered, run_tool, ToolRuns};
-use super::common::{arm_cells, files_block, task_label, wants_log};
+use super::common::{arm_cells, files_block, task_label, wants_log, PAPER_TASKS};
 use super::csv::{Cell, CsvWriter};
 use super::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use super::report::{Block, Outcome, Section, Verdict};
@@ -59,244 +59,50 @@ impl Experiment for Fig2 {
     fn run(&self, ctx: &Context) -> Result<Section, ReproduceError> {
         let plan = ctx.plan;
         let tools = draw_tools(plan.fig2_tools, ctx.seed_for(self, "tools"));
-        let items: Vec<(TaskKind, usize)> = TaskKind::ALL
-            .iter()
-            .flat_map(|&k| (0..tools.len()).map(move |i| (k, i)))
-            .collect();
-        let mut csv = CsvWriter::create(&ctx.path(CSV), &HEADER)?;
-        let options = [ctx.options.clone()];
-        let results = map_ordered(
-            &items,
-            ctx.progress,
-            1,
-            |&(kind, i)| (kind, i, run_tool(&tools[i], &Task::paper(kind), &options)),
-            |(kind, i, r)| {
-                let m = r.metrics(0);
-                let mut row = vec![Cell::from(kind.name()), Cell::from(*i)];
-                row.extend(arm_cells(&r.arm));
-                row.extend([
-                    Cell::from(r.logdet()),
-                    Cell::from(m.map(|m| m.task_error)),
-                    Cell::from(m.map(|m| m.free_energy)),
-                    Cell::from(m.map(|m| m.cost_j)),
-                    m.map_or(Cell::Empty, |m| Cell::from(m.rhs_evals)),
-                    Cell::from(r.error()),
-                ]);
-                csv.row(row)
-            },
-        )?;
-
-        let mut blocks = vec![Block::p(format!(
-            "{} random tools (m1, m2, l1, l2 uniform on [0.1, 0.6)), each simulated on the three \
-             tasks without perturbation. For each task: Spearman's ρ between ln|Π^U| and the task \
-             error with a {}% percentile-bootstrap interval ({} resamples), and the least-squares \
-             fit task error = a·exp(b·ln|Π^U|) that the paper draws.",
-            tools.len(),
-            (plan.level * 100.0).round(),
-            plan.bootstrap_resamples
-        ))];
-        let mut panels = Vec::new();
-        let mut rows = Vec::new();
-        let mut verdicts = Vec::new();
-        let mut failed_total = 0;
-        let jobs: Vec<(Vec<f64>, Vec<f64>, u64)> = TaskKind::ALL
-            .iter()
-            .map(|&kind| {
-                let (x, y) = results
-                    .iter()
-                    .filter(|r| r.0 == kind)
-                    .filter_map(|r| Some((r.2.logdet()?, r.2.task_error(0)?)))
-                    .unzip();
-                (
-                    x,
-                    y,
-                    ctx.seed_for(self, &format!("bootstrap/{}", kind.name())),
-                )
-            })
-            .collect();
-        let corrs = Correlation::compute_all(&jobs, plan.bootstrap_resamples, plan.level);
-        for (t, kind) in TaskKind::ALL.into_iter().enumerate() {
-            let runs: Vec<&ToolRuns> = results
+        let results = simulate_every_task(ctx, &tools)?;
+        let runs_of = |kind: TaskKind| -> Vec<&ToolRuns> {
+            results
                 .iter()
                 .filter(|r| r.0 == kind)
                 .map(|r| &r.2)
-                .collect();
-            let ok: Vec<(f64, f64)> = runs
-                .iter()
-                .filter_map(|r| Some((r.logdet()?, r.task_error(0)?)))
-                .collect();
-            let failed = runs.len() - ok.len();
-            failed_total += failed;
-            let (x, y): (Vec<f64>, Vec<f64>) = ok.iter().copied().unzip();
-            let corr = &corrs[t];
-            let fit = fit_exponential(&x, &y);
-            let x_range = x
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
-                    (l.min(v), h.max(v))
-                });
-            let spread = x_range.1 - x_range.0;
-            let error_summary = summary(&y);
-            let cv = error_summary
-                .as_ref()
-                .ok()
-                .filter(|s| s.mean > 0.0)
-                .map(|s| s.sd / s.mean);
-            rows.push(vec![
-                task_label(kind),
-                ok.len().to_string(),
-                failed.to_string(),
-                if x.is_empty() {
-                    "-".into()
-                } else {
-                    format!("[{}, {}]", num(x_range.0), num(x_range.1))
-                },
-                error_summary.as_ref().map_or("-".into(), |s| {
-                    format!("{} [{}, {}]", num(s.median), num(s.min), num(s.max))
-                }),
-                cv.map_or("-".into(), num),
-                corr.rho_cell(),
-                corr.ci_cell(),
-                match &fit {
-                    Ok(f) => format!(
-                        "a = {}, b = {}, R² = {}, RMSE = {}",
-                        num(f.a),
-                        num(f.b),
-                        num(f.r_squared),
-                        num(f.rmse)
-                    ),
-                    Err(e) => format!("no fit: {e}"),
-                },
-            ]);
+                .collect()
+        };
+        let stats: Vec<TaskStats> = PAPER_TASKS
+            .iter()
+            .map(|&k| TaskStats::new(&runs_of(k)))
+            .collect();
+        let jobs: Vec<(Vec<f64>, Vec<f64>, u64)> = PAPER_TASKS
+            .iter()
+            .zip(&stats)
+            .map(|(kind, st)| {
+                let seed = ctx.seed_for(self, &format!("bootstrap/{}", kind.name()));
+                (st.x.clone(), st.y.clone(), seed)
+            })
+            .collect();
+        let corrs = Correlation::compute_all(&jobs, plan.bootstrap_resamples, plan.level);
 
-            let mut lines = Vec::new();
-            if let Ok(f) = &fit {
-                let curve = (0..=100)
-                    .map(|k| {
-                        let v = x_range.0 + spread * f64::from(k) / 100.0;
-                        (v, f.a * (f.b * v).exp())
-                    })
-                    .collect();
-                lines.push(Series::new(
-                    format!("{}·exp({}·x)", num(f.a), num(f.b)),
-                    Colour(0, 0, 0),
-                    curve,
-                ));
-            }
-            let title = match &corr.rho {
-                Ok(r) => format!(
-                    "Task {} ({}): ρ = {}",
-                    kind.paper_index(),
-                    kind.name(),
-                    num(*r)
-                ),
-                Err(_) if !x.is_empty() && spread == 0.0 => format!(
-                    "Task {} ({}): ln|Π^U| = {} for every tool",
-                    kind.paper_index(),
-                    kind.name(),
-                    num(x[0])
-                ),
-                Err(_) => format!("Task {} ({}): ρ undefined", kind.paper_index(), kind.name()),
-            };
-            panels.push(Panel::Xy(XyPanel {
-                title,
-                x_label: "control confidence ln|Π^U|".into(),
-                y_label: "task error".into(),
-                dots: vec![Series::new("tools", COLOURS[t], ok.clone())],
-                lines,
-                log_y: wants_log(&y),
-                legend: Legend::UpperRight,
-                headroom: 0.15,
-            }));
-
-            let label = format!("C1, {}", task_label(kind));
-            let extra = if failed > 0 {
-                format!(" ({failed} failed episode(s) left out)")
-            } else {
-                String::new()
-            };
+        let mut rows = Vec::new();
+        let mut panels = Vec::new();
+        let mut verdicts = Vec::new();
+        for (t, kind) in PAPER_TASKS.into_iter().enumerate() {
+            let (st, corr) = (&stats[t], &corrs[t]);
+            rows.push(st.table_row(kind, corr));
+            panels.push(st.panel(kind, corr, COLOURS[t]));
             verdicts.push(match kind {
-                TaskKind::Position | TaskKind::Velocity => Verdict {
-                    claim: label,
-                    statement: format!(
-                        "\"On average, the tools with higher control confidence performs better \
-                         at the task than the tools with lower control confidence\" ({}): a clear \
-                         negative correlation between ln|Π^U| and task error.",
-                        task_label(kind)
-                    ),
-                    outcome: corr.negative_outcome(),
-                    evidence: format!("{}{extra}.", corr.describe()),
-                    rule: negative_correlation_rule(plan.level),
-                },
-                TaskKind::Acceleration => {
-                    let constant = !x.is_empty() && spread <= 1e-9 * x_range.0.abs().max(1.0);
-                    let similar = cv.map(|c| c <= SIMILAR_CV);
-                    let outcome = match (constant, similar) {
-                        (_, None) if x.is_empty() => Outcome::NotJudged,
-                        (true, Some(true)) => Outcome::Holds,
-                        (true, _) | (false, Some(true)) => Outcome::Partly,
-                        (false, _) => Outcome::DoesNotHold,
-                    };
-                    Verdict {
-                        claim: label,
-                        statement: "\"For task 3, the controller has the same confidence on all \
-                                    tools, which is in line with similar task errors for all \
-                                    tools.\""
-                            .into(),
-                        outcome,
-                        evidence: format!(
-                            "ln|Π^U| ranges over [{}, {}] ({}); task error median {}, range \
-                             [{}, {}], coefficient of variation {} ({}){extra}. {}.",
-                            num(x_range.0),
-                            num(x_range.1),
-                            if constant {
-                                "identical for every tool"
-                            } else {
-                                "not constant"
-                            },
-                            error_summary.as_ref().map_or("-".into(), |s| num(s.median)),
-                            error_summary.as_ref().map_or("-".into(), |s| num(s.min)),
-                            error_summary.as_ref().map_or("-".into(), |s| num(s.max)),
-                            cv.map_or("undefined".into(), num),
-                            match similar {
-                                Some(true) => "similar",
-                                Some(false) => "not similar",
-                                None => "undefined",
-                            },
-                            corr.describe()
-                        ),
-                        rule: format!(
-                            "two parts: equal confidence (max − min of ln|Π^U| ≤ 1e-9 relative) \
-                             and similar task errors (coefficient of variation sd/mean ≤ \
-                             {SIMILAR_CV}); holds if both, partly holds if one, does not hold if \
-                             neither. Spearman's ρ is undefined when the confidence is constant \
-                             and is reported only for completeness."
-                        ),
-                    }
-                }
+                TaskKind::Acceleration => st.equal_confidence_verdict(kind, corr),
+                _ => st.correlation_verdict(kind, corr, plan.level),
             });
         }
+        let failed_total = stats.iter().map(|st| st.failed).sum();
         let svg = plot::save(&ctx.path(SVG), &panels, (500, 420))?;
+        let mut blocks = vec![introduction(tools.len(), plan)];
         blocks.push(files_block(
             &[CSV.into(), SVG.into()],
             results.len(),
             failed_total,
             "rows, one per task and tool",
         ));
-        blocks.push(Block::table(
-            &[
-                "task",
-                "n",
-                "failed",
-                "ln|Π^U| range",
-                "task error median [min, max]",
-                "CV",
-                "Spearman ρ",
-                "bootstrap CI",
-                "exponential fit (task error = a·exp(b·ln|Π^U|))",
-            ],
-            rows,
-        ));
+        blocks.push(Block::table(&TABLE_HEADER, rows));
         blocks.push(Block::Figure {
             file: SVG.into(),
             caption: format!(
@@ -314,5 +120,251 @@ impl Experiment for Fig2 {
             episodes: results.len() as u64,
             rhs_evals: results.iter().map(|r| r.2.rhs_evals()).sum(),
         })
+    }
+}
+
+const TABLE_HEADER: [&str; 9] = [
+    "task",
+    "n",
+    "failed",
+    "ln|Π^U| range",
+    "task error median [min, max]",
+    "CV",
+    "Spearman ρ",
+    "bootstrap CI",
+    "exponential fit (task error = a·exp(b·ln|Π^U|))",
+];
+
+/// Every tool on every paper task, without perturbation; one CSV row per (task, tool) as the
+/// episodes finish, results in (task, tool) order.
+fn simulate_every_task(
+    ctx: &Context,
+    tools: &[crate::Arm],
+) -> Result<Vec<(TaskKind, usize, ToolRuns)>, ReproduceError> {
+    let items: Vec<(TaskKind, usize)> = PAPER_TASKS
+        .iter()
+        .flat_map(|&k| (0..tools.len()).map(move |i| (k, i)))
+        .collect();
+    let mut csv = CsvWriter::create(&ctx.path(CSV), &HEADER)?;
+    let options = [ctx.options.clone()];
+    map_ordered(
+        &items,
+        ctx.progress,
+        1,
+        |&(kind, i)| (kind, i, run_tool(&tools[i], &Task::paper(kind), &options)),
+        |(kind, i, r)| {
+            let m = r.metrics(0);
+            let mut row = vec![Cell::from(kind.name()), Cell::from(*i)];
+            row.extend(arm_cells(&r.arm));
+            row.extend([
+                Cell::from(r.logdet()),
+                Cell::from(m.map(|m| m.task_error)),
+                Cell::from(m.map(|m| m.free_energy)),
+                Cell::from(m.map(|m| m.cost_j)),
+                m.map_or(Cell::Empty, |m| Cell::from(m.rhs_evals)),
+                Cell::from(r.error()),
+            ]);
+            csv.row(row)
+        },
+    )
+}
+
+fn introduction(tools: usize, plan: &Plan) -> Block {
+    Block::p(format!(
+        "{} random tools (m1, m2, l1, l2 uniform on [0.1, 0.6)), each simulated on the three \
+         tasks without perturbation. For each task: Spearman's ρ between ln|Π^U| and the task \
+         error with a {}% percentile-bootstrap interval ({} resamples), and the least-squares \
+         fit task error = a·exp(b·ln|Π^U|) that the paper draws.",
+        tools,
+        (plan.level * 100.0).round(),
+        plan.bootstrap_resamples
+    ))
+}
+
+/// One task's tools that finished: (ln|Π^U|, task error) points and their summaries.
+struct TaskStats {
+    ok: Vec<(f64, f64)>,
+    failed: usize,
+    x: Vec<f64>,
+    y: Vec<f64>,
+    /// (min, max) of ln|Π^U|.
+    x_range: (f64, f64),
+    spread: f64,
+    error_summary: Result<crate::stats::Summary, crate::stats::StatsError>,
+    /// Coefficient of variation sd/mean of the task errors.
+    cv: Option<f64>,
+    fit: Result<crate::stats::ExpFit, crate::stats::StatsError>,
+}
+
+impl TaskStats {
+    fn new(runs: &[&ToolRuns]) -> Self {
+        let ok: Vec<(f64, f64)> = runs
+            .iter()
+            .filter_map(|r| Some((r.logdet()?, r.task_error(0)?)))
+            .collect();
+        let (x, y): (Vec<f64>, Vec<f64>) = ok.iter().copied().unzip();
+        let x_range = x
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+                (l.min(v), h.max(v))
+            });
+        let error_summary = summary(&y);
+        let cv = error_summary
+            .as_ref()
+            .ok()
+            .filter(|s| s.mean > 0.0)
+            .map(|s| s.sd / s.mean);
+        TaskStats {
+            failed: runs.len() - ok.len(),
+            fit: fit_exponential(&x, &y),
+            spread: x_range.1 - x_range.0,
+            ok,
+            x,
+            y,
+            x_range,
+            error_summary,
+            cv,
+        }
+    }
+
+    fn table_row(&self, kind: TaskKind, corr: &Correlation) -> Vec<String> {
+        vec![
+            task_label(kind),
+            self.ok.len().to_string(),
+            self.failed.to_string(),
+            if self.x.is_empty() {
+                "-".into()
+            } else {
+                format!("[{}, {}]", num(self.x_range.0), num(self.x_range.1))
+            },
+            self.error_summary.as_ref().map_or("-".into(), |s| {
+                format!("{} [{}, {}]", num(s.median), num(s.min), num(s.max))
+            }),
+            self.cv.map_or("-".into(), num),
+            corr.rho_cell(),
+            corr.ci_cell(),
+            match &self.fit {
+                Ok(f) => format!(
+                    "a = {}, b = {}, R² = {}, RMSE = {}",
+                    num(f.a),
+                    num(f.b),
+                    num(f.r_squared),
+                    num(f.rmse)
+                ),
+                Err(e) => format!("no fit: {e}"),
+            },
+        ]
+    }
+
+    /// The task's scatter with the fitted exponential.
+    fn panel(&self, kind: TaskKind, corr: &Correlation, colour: Colour) -> Panel {
+        let mut lines = Vec::new();
+        if let Ok(f) = &self.fit {
+            let curve = (0..=100)
+                .map(|k| {
+                    let v = self.x_range.0 + self.spread * f64::from(k) / 100.0;
+                    (v, f.a * (f.b * v).exp())
+                })
+                .collect();
+            lines.push(Series::new(
+                format!("{}·exp({}·x)", num(f.a), num(f.b)),
+                Colour(0, 0, 0),
+                curve,
+            ));
+        }
+        let (i, name) = (kind.paper_index(), kind.name());
+        let title = match &corr.rho {
+            Ok(r) => format!("Task {i} ({name}): ρ = {}", num(*r)),
+            Err(_) if !self.x.is_empty() && self.spread == 0.0 => format!(
+                "Task {i} ({name}): ln|Π^U| = {} for every tool",
+                num(self.x[0])
+            ),
+            Err(_) => format!("Task {i} ({name}): ρ undefined"),
+        };
+        Panel::Xy(XyPanel {
+            title,
+            x_label: "control confidence ln|Π^U|".into(),
+            y_label: "task error".into(),
+            dots: vec![Series::new("tools", colour, self.ok.clone())],
+            lines,
+            log_y: wants_log(&self.y),
+            legend: Legend::UpperRight,
+            headroom: 0.15,
+        })
+    }
+
+    fn failed_note(&self) -> String {
+        if self.failed > 0 {
+            format!(" ({} failed episode(s) left out)", self.failed)
+        } else {
+            String::new()
+        }
+    }
+
+    /// C1 on tasks 1–2: higher confidence, lower task error.
+    fn correlation_verdict(&self, kind: TaskKind, corr: &Correlation, level: f64) -> Verdict {
+        Verdict {
+            claim: format!("C1, {}", task_label(kind)),
+            statement: format!(
+                "\"On average, the tools with higher control confidence performs better \
+                 at the task than the tools with lower control confidence\" ({}): a clear \
+                 negative correlation between ln|Π^U| and task error.",
+                task_label(kind)
+            ),
+            outcome: corr.negative_outcome(),
+            evidence: format!("{}{}.", corr.describe(), self.failed_note()),
+            rule: negative_correlation_rule(level),
+        }
+    }
+
+    /// C1 on task 3: the same confidence for every tool, and similar task errors.
+    fn equal_confidence_verdict(&self, kind: TaskKind, corr: &Correlation) -> Verdict {
+        let (x_range, cv) = (self.x_range, self.cv);
+        let constant = !self.x.is_empty() && self.spread <= 1e-9 * x_range.0.abs().max(1.0);
+        let similar = cv.map(|c| c <= SIMILAR_CV);
+        let outcome = match (constant, similar) {
+            (_, None) if self.x.is_empty() => Outcome::NotJudged,
+            (true, Some(true)) => Outcome::Holds,
+            (true, _) | (false, Some(true)) => Outcome::Partly,
+            (false, _) => Outcome::DoesNotHold,
+        };
+        let errors = self.error_summary.as_ref();
+        Verdict {
+            claim: format!("C1, {}", task_label(kind)),
+            statement: "\"For task 3, the controller has the same confidence on all \
+                        tools, which is in line with similar task errors for all \
+                        tools.\""
+                .into(),
+            outcome,
+            evidence: format!(
+                "ln|Π^U| ranges over [{}, {}] ({}); task error median {}, range \
+                 [{}, {}], coefficient of variation {} ({}){}. {}.",
+                num(x_range.0),
+                num(x_range.1),
+                if constant {
+                    "identical for every tool"
+                } else {
+                    "not constant"
+                },
+                errors.map_or("-".into(), |s| num(s.median)),
+                errors.map_or("-".into(), |s| num(s.min)),
+                errors.map_or("-".into(), |s| num(s.max)),
+                cv.map_or("undefined".into(), num),
+                match similar {
+                    Some(true) => "similar",
+                    Some(false) => "not similar",
+                    None => "undefined",
+                },
+                self.failed_note(),
+                corr.describe()
+            ),
+            rule: format!(
+                "two parts: equal confidence (max − min of ln|Π^U| ≤ 1e-9 relative) \
+                 and similar task errors (coefficient of variation sd/mean ≤ \
+                 {SIMILAR_CV}); holds if both, partly holds if one, does not hold if \
+                 neither. Spearman's ρ is undefined when the confidence is constant \
+                 and is reported only for completeness."
+            ),
+        }
     }
 }

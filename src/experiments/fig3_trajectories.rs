@@ -7,7 +7,7 @@
 use crate::closed_loop::{simulate, Metrics, Trajectory};
 use crate::confidence::control_confidence;
 use crate::select::draw_tools;
-use crate::{Task, TaskKind};
+use crate::{Arm, Task, TaskKind};
 
 use super::batch::map_ordered;
 use super::common::{arm_cells, dt_label, ARM_COLUMNS};
@@ -90,158 +90,282 @@ impl Experiment for Fig3 {
             .iter()
             .map(|a| control_confidence(a, &task).ok().map(|c| c.logdet))
             .collect();
-        let pick = |better: fn(f64, f64) -> bool| {
-            logdets
-                .iter()
-                .enumerate()
-                .filter_map(|(i, l)| Some((i, (*l)?)))
-                .fold(None, |best: Option<(usize, f64)>, (i, l)| match best {
-                    Some((_, b)) if !better(l, b) => best,
-                    _ => Some((i, l)),
-                })
-        };
-        let (Some(high), Some(low)) = (pick(|a, b| a > b), pick(|a, b| a < b)) else {
+        let (Some(high), Some(low)) = (
+            extreme(&logdets, |a, b| a > b),
+            extreme(&logdets, |a, b| a < b),
+        ) else {
             return Err(ReproduceError::Experiment {
                 id: self.id(),
                 reason: "no tool of the sample has a control confidence".into(),
             });
         };
-        let mut tools_csv = CsvWriter::create(&ctx.path(TOOLS_CSV), &TOOLS_HEADER)?;
-        for (i, arm) in tools.iter().enumerate() {
-            let role = if i == high.0 {
-                "high"
-            } else if i == low.0 {
-                "low"
-            } else {
-                ""
-            };
-            let mut row = vec![Cell::from(i)];
-            row.extend(arm_cells(arm));
-            row.extend([Cell::from(logdets[i]), Cell::from(role)]);
-            tools_csv.row(row)?;
-        }
-
-        let items: Vec<(&'static str, (usize, f64), f64)> = [("high", high), ("low", low)]
-            .into_iter()
-            .flat_map(|(role, tool)| [0.0, plan.perturbation].map(|dt| (role, tool, dt)))
-            .collect();
-        let mut csv = CsvWriter::create(&ctx.path(CSV), &HEADER)?;
-        let runs = map_ordered(
-            &items,
-            ctx.progress,
-            1,
-            |&(role, (tool, logdet), dt)| {
-                let mut options = ctx.perturbed(dt);
-                options.record_trajectory = true;
-                let result = simulate(&tools[tool], &task, &options)
-                    .map(|e| (e.metrics, e.trajectory.expect("trajectory was requested")))
-                    .map_err(|e| e.to_string());
-                Run {
-                    role,
-                    tool,
-                    logdet,
-                    perturbation: dt,
-                    result,
-                }
+        write_sample(ctx, &tools, &logdets, high.0, low.0)?;
+        let runs = Runs {
+            runs: simulate_pair(ctx, &tools, &task, high, low)?,
+            goal,
+            perturbation: plan.perturbation,
+        };
+        let svg = runs.figure(ctx, tools.len())?;
+        let failed = runs.runs.iter().filter(|r| r.result.is_err()).count();
+        let blocks = vec![
+            Block::p(format!(
+                "{} random tools on task 1 (position); the one with the highest ln|Π^U| (tool {}, \
+                 {}) and the one with the lowest (tool {}, {}) are each simulated without \
+                 perturbation and with a constant ΔT = {} N m on both joints. Settling time: the \
+                 time from which |θ2 − π/6| stays within {}% of its initial distance 2π/3 (i.e. \
+                 {} rad) until t = 5 s.",
+                tools.len(),
+                high.0,
+                num(high.1),
+                low.0,
+                num(low.1),
+                dt_label(plan.perturbation),
+                BAND * 100.0,
+                num(BAND * 2.0 * std::f64::consts::FRAC_PI_3),
+            )),
+            Block::p(format!(
+                "Data: `{TOOLS_CSV}` (the sample, columns {}, logdet, role), `{CSV}` (the four \
+                 trajectories on the 0.05 s grid; {failed} failed run(s)), `{SVG}`.",
+                ARM_COLUMNS.join(", ")
+            )),
+            Block::table(&TABLE_HEADER, runs.table_rows()),
+            Block::Figure {
+                file: SVG.into(),
+                caption: "θ2 over time for the highest-confidence tool (yellow: ΔT = 0, purple: \
+                          perturbed) and the lowest-confidence tool (red: ΔT = 0, blue: \
+                          perturbed); the goal π/6 dotted in black. Compare with the paper's \
+                          Fig. 3."
+                    .into(),
+                svg,
             },
-            |run| {
-                let lead = [
-                    Cell::from(run.role),
-                    Cell::from(run.tool),
-                    Cell::from(run.logdet),
-                    Cell::from(run.perturbation),
-                ];
-                match &run.result {
-                    Ok((_, tr)) => {
-                        for k in 0..tr.t.len() {
-                            let mut row = lead.to_vec();
-                            row.extend(
-                                [
-                                    tr.t[k],
-                                    tr.theta[k][0],
-                                    tr.theta[k][1],
-                                    tr.theta_dot[k][0],
-                                    tr.theta_dot[k][1],
-                                    tr.u[k][0],
-                                    tr.u[k][1],
-                                ]
-                                .map(Cell::from),
-                            );
-                            row.push(Cell::Empty);
-                            csv.row(row)?;
-                        }
-                        Ok(())
-                    }
-                    Err(e) => {
-                        let mut row = lead.to_vec();
-                        row.extend(std::iter::repeat(Cell::Empty).take(7));
-                        row.push(Cell::from(e.as_str()));
-                        csv.row(row)
-                    }
-                }
-            },
-        )?;
+            Block::Verdict(runs.settling_verdict()),
+            Block::Verdict(runs.variability_verdict()),
+        ];
+        Ok(Section {
+            id: self.id(),
+            title: self.title().into(),
+            blocks,
+            episodes: runs.runs.len() as u64,
+            rhs_evals: runs
+                .runs
+                .iter()
+                .filter_map(|r| r.result.as_ref().ok())
+                .map(|(m, _)| m.rhs_evals as u64)
+                .sum(),
+        })
+    }
+}
 
-        // Summary numbers per run.
-        let find = |role: &str, dt: f64| {
-            runs.iter()
-                .find(|r| r.role == role && r.perturbation == dt)
-                .expect("all four runs exist")
+const TABLE_HEADER: [&str; 7] = [
+    "run",
+    "ln|Π^U|",
+    "ΔT [N m]",
+    "task error",
+    "settling time",
+    "final |θ2 − π/6| [rad]",
+    "max |θ2 − θ2 (ΔT = 0)| [rad]",
+];
+
+/// (tool, ln|Π^U|) of the tool whose confidence is `better` than every other's (the first on ties).
+fn extreme(logdets: &[Option<f64>], better: fn(f64, f64) -> bool) -> Option<(usize, f64)> {
+    logdets
+        .iter()
+        .enumerate()
+        .filter_map(|(i, l)| Some((i, (*l)?)))
+        .fold(None, |best: Option<(usize, f64)>, (i, l)| match best {
+            Some((_, b)) if !better(l, b) => best,
+            _ => Some((i, l)),
+        })
+}
+
+/// The sample with each tool's confidence and its role (high, low or none), to `TOOLS_CSV`.
+fn write_sample(
+    ctx: &Context,
+    tools: &[Arm],
+    logdets: &[Option<f64>],
+    high: usize,
+    low: usize,
+) -> Result<(), ReproduceError> {
+    let mut tools_csv = CsvWriter::create(&ctx.path(TOOLS_CSV), &TOOLS_HEADER)?;
+    for (i, arm) in tools.iter().enumerate() {
+        let role = if i == high {
+            "high"
+        } else if i == low {
+            "low"
+        } else {
+            ""
         };
-        let settle = |r: &Run| traj(r).and_then(|tr| settling_time(tr, goal));
-        let final_error =
-            |r: &Run| traj(r).and_then(|tr| tr.theta.last().map(|th| (th[1] - goal).abs()));
-        let deviation = |r: &Run| {
-            let base = traj(find(r.role, 0.0))?;
-            let tr = traj(r)?;
-            Some(
-                tr.theta
-                    .iter()
-                    .zip(&base.theta)
-                    .map(|(a, b)| (a[1] - b[1]).abs())
-                    .fold(0.0, f64::max),
-            )
-        };
-        let change = |role: &str| {
-            let e0 = find(role, 0.0).result.as_ref().ok()?.0.task_error;
-            let e1 = find(role, plan.perturbation)
-                .result
-                .as_ref()
-                .ok()?
-                .0
-                .task_error;
-            Some((e1 - e0).abs())
-        };
-        let mut rows = Vec::new();
-        for r in &runs {
-            let mut row = vec![
-                format!("{} (tool {})", r.role, r.tool),
-                num(r.logdet),
-                dt_label(r.perturbation),
-            ];
-            match &r.result {
-                Ok((m, _)) => row.extend([
-                    num(m.task_error),
-                    settle(r).map_or("not within 5 s".into(), |t| format!("{t:.2}")),
-                    final_error(r).map_or("-".into(), num),
-                    if r.perturbation == 0.0 {
-                        "-".into()
-                    } else {
-                        deviation(r).map_or("-".into(), num)
-                    },
-                ]),
-                Err(e) => row.extend([format!("failed: {e}"), "-".into(), "-".into(), "-".into()]),
+        let mut row = vec![Cell::from(i)];
+        row.extend(arm_cells(arm));
+        row.extend([Cell::from(logdets[i]), Cell::from(role)]);
+        tools_csv.row(row)?;
+    }
+    Ok(())
+}
+
+/// The two tools without and with the perturbation, trajectories recorded and written to `CSV`
+/// as each run finishes.
+fn simulate_pair(
+    ctx: &Context,
+    tools: &[Arm],
+    task: &Task,
+    high: (usize, f64),
+    low: (usize, f64),
+) -> Result<Vec<Run>, ReproduceError> {
+    let items: Vec<(&'static str, (usize, f64), f64)> = [("high", high), ("low", low)]
+        .into_iter()
+        .flat_map(|(role, tool)| [0.0, ctx.plan.perturbation].map(|dt| (role, tool, dt)))
+        .collect();
+    let mut csv = CsvWriter::create(&ctx.path(CSV), &HEADER)?;
+    map_ordered(
+        &items,
+        ctx.progress,
+        1,
+        |&(role, (tool, logdet), dt)| {
+            let mut options = ctx.perturbed(dt);
+            options.record_trajectory = true;
+            let result = simulate(&tools[tool], task, &options)
+                .map(|e| (e.metrics, e.trajectory.expect("trajectory was requested")))
+                .map_err(|e| e.to_string());
+            Run {
+                role,
+                tool,
+                logdet,
+                perturbation: dt,
+                result,
             }
-            rows.push(row);
-        }
+        },
+        |run| write_run(&mut csv, run),
+    )
+}
 
+/// One run's trajectory rows (or its error).
+fn write_run(csv: &mut CsvWriter, run: &Run) -> Result<(), ReproduceError> {
+    let lead = [
+        Cell::from(run.role),
+        Cell::from(run.tool),
+        Cell::from(run.logdet),
+        Cell::from(run.perturbation),
+    ];
+    match &run.result {
+        Ok((_, tr)) => {
+            for k in 0..tr.t.len() {
+                let mut row = lead.to_vec();
+                row.extend(
+                    [
+                        tr.t[k],
+                        tr.theta[k][0],
+                        tr.theta[k][1],
+                        tr.theta_dot[k][0],
+                        tr.theta_dot[k][1],
+                        tr.u[k][0],
+                        tr.u[k][1],
+                    ]
+                    .map(Cell::from),
+                );
+                row.push(Cell::Empty);
+                csv.row(row)?;
+            }
+            Ok(())
+        }
+        Err(e) => {
+            let mut row = lead.to_vec();
+            row.extend(std::iter::repeat(Cell::Empty).take(7));
+            row.push(Cell::from(e.as_str()));
+            csv.row(row)
+        }
+    }
+}
+
+/// The four runs and what the report says of them.
+struct Runs {
+    runs: Vec<Run>,
+    /// θ2^g.
+    goal: f64,
+    /// The perturbed runs' ΔT.
+    perturbation: f64,
+}
+
+impl Runs {
+    fn find(&self, role: &str, dt: f64) -> &Run {
+        self.runs
+            .iter()
+            .find(|r| r.role == role && r.perturbation == dt)
+            .expect("all four runs exist")
+    }
+
+    fn settle(&self, r: &Run) -> Option<f64> {
+        traj(r).and_then(|tr| settling_time(tr, self.goal))
+    }
+
+    fn settle_text(&self, r: &Run) -> String {
+        self.settle(r)
+            .map_or("not within 5 s".into(), |t| format!("{t:.2} s"))
+    }
+
+    fn final_error(&self, r: &Run) -> Option<f64> {
+        traj(r).and_then(|tr| tr.theta.last().map(|th| (th[1] - self.goal).abs()))
+    }
+
+    /// The largest |θ2 − θ2 of the same tool without perturbation|.
+    fn deviation(&self, r: &Run) -> Option<f64> {
+        let base = traj(self.find(r.role, 0.0))?;
+        let tr = traj(r)?;
+        Some(
+            tr.theta
+                .iter()
+                .zip(&base.theta)
+                .map(|(a, b)| (a[1] - b[1]).abs())
+                .fold(0.0, f64::max),
+        )
+    }
+
+    /// |task error with ΔT − task error without| of one tool.
+    fn change(&self, role: &str) -> Option<f64> {
+        let error = |dt| Some(self.find(role, dt).result.as_ref().ok()?.0.task_error);
+        Some((error(self.perturbation)? - error(0.0)?).abs())
+    }
+
+    fn table_rows(&self) -> Vec<Vec<String>> {
+        self.runs
+            .iter()
+            .map(|r| {
+                let mut row = vec![
+                    format!("{} (tool {})", r.role, r.tool),
+                    num(r.logdet),
+                    dt_label(r.perturbation),
+                ];
+                match &r.result {
+                    Ok((m, _)) => row.extend([
+                        num(m.task_error),
+                        self.settle(r)
+                            .map_or("not within 5 s".into(), |t| format!("{t:.2}")),
+                        self.final_error(r).map_or("-".into(), num),
+                        if r.perturbation == 0.0 {
+                            "-".into()
+                        } else {
+                            self.deviation(r).map_or("-".into(), num)
+                        },
+                    ]),
+                    Err(e) => {
+                        row.extend([format!("failed: {e}"), "-".into(), "-".into(), "-".into()])
+                    }
+                }
+                row
+            })
+            .collect()
+    }
+
+    /// θ2 over time of the four runs, with the goal.
+    fn figure(&self, ctx: &Context, sample: usize) -> Result<String, ReproduceError> {
         let colour = |role: &str, dt: f64| match (role, dt == 0.0) {
             ("high", true) => Colour(230, 159, 0),
             ("high", false) => Colour(120, 60, 160),
             (_, true) => Colour(200, 30, 30),
             (_, false) => Colour(30, 80, 200),
         };
-        let mut lines: Vec<Series> = runs
+        let mut lines: Vec<Series> = self
+            .runs
             .iter()
             .filter_map(|r| {
                 let tr = traj(r)?;
@@ -265,16 +389,15 @@ impl Experiment for Fig3 {
             Series::new(
                 "goal θ2 = π/6",
                 Colour(0, 0, 0),
-                vec![(0.0, goal), (ctx.options.t_end, goal)],
+                vec![(0.0, self.goal), (ctx.options.t_end, self.goal)],
             )
             .dashed(),
         );
-        let svg = plot::save(
+        Ok(plot::save(
             &ctx.path(SVG),
             &[Panel::Xy(XyPanel {
                 title: format!(
-                    "Task 1: θ2 of the highest- and lowest-confidence of {} tools",
-                    tools.len()
+                    "Task 1: θ2 of the highest- and lowest-confidence of {sample} tools"
                 ),
                 x_label: "time t [s]".into(),
                 y_label: "θ2 [rad]".into(),
@@ -285,34 +408,60 @@ impl Experiment for Fig3 {
                 headroom: 0.0,
             })],
             (860, 480),
-        )?;
+        )?)
+    }
 
-        let failed = runs.iter().filter(|r| r.result.is_err()).count();
-        let (hp, lp) = (
-            find("high", plan.perturbation),
-            find("low", plan.perturbation),
-        );
-        let (h0, l0) = (find("high", 0.0), find("low", 0.0));
-        let faster = |h: &Run, l: &Run| -> Option<bool> {
-            h.result.as_ref().ok()?;
-            l.result.as_ref().ok()?;
-            match (settle(h), settle(l)) {
-                (Some(a), Some(b)) => Some(a < b),
-                (Some(_), None) => Some(true),
-                (None, _) => Some(false),
-            }
-        };
-        let settle_text =
-            |r: &Run| settle(r).map_or("not within 5 s".into(), |t| format!("{t:.2} s"));
-        let settling_outcome = match (faster(h0, l0), faster(hp, lp)) {
+    /// Whether the high-confidence tool settles first (`None` if either run failed).
+    fn high_settles_first(&self, dt: f64) -> Option<bool> {
+        let (h, l) = (self.find("high", dt), self.find("low", dt));
+        h.result.as_ref().ok()?;
+        l.result.as_ref().ok()?;
+        match (self.settle(h), self.settle(l)) {
+            (Some(a), Some(b)) => Some(a < b),
+            (Some(_), None) => Some(true),
+            (None, _) => Some(false),
+        }
+    }
+
+    fn settling_verdict(&self) -> Verdict {
+        let dt = self.perturbation;
+        let outcome = match (self.high_settles_first(0.0), self.high_settles_first(dt)) {
             (Some(true), Some(true)) => Outcome::Holds,
             (Some(a), Some(b)) if a || b => Outcome::Partly,
             (Some(_), Some(_)) => Outcome::DoesNotHold,
             _ => Outcome::NotJudged,
         };
-        let (ch, cl) = (change("high"), change("low"));
-        let (dh, dl) = (deviation(hp), deviation(lp));
-        let variability_outcome = match (ch.zip(cl), dh.zip(dl)) {
+        Verdict {
+            claim: "C2 (Fig. 3), settling".into(),
+            statement: "\"High confident tool settles near the goal θ2^g faster than the low \
+                        confident tool.\""
+                .into(),
+            outcome,
+            evidence: format!(
+                "settling time without perturbation: high {}, low {}; with ΔT = {}: high {}, \
+                 low {}.",
+                self.settle_text(self.find("high", 0.0)),
+                self.settle_text(self.find("low", 0.0)),
+                dt_label(dt),
+                self.settle_text(self.find("high", dt)),
+                self.settle_text(self.find("low", dt))
+            ),
+            rule: "holds if the high-confidence tool settles earlier both without and with \
+                   the perturbation (a tool that never settles counts as slower), partly \
+                   holds if in one of the two, does not hold if in neither. One pair of \
+                   tools is an illustration, not a statistic; Fig. 4 tests the trend."
+                .into(),
+        }
+    }
+
+    fn variability_verdict(&self) -> Verdict {
+        let (ch, cl) = (self.change("high"), self.change("low"));
+        let dt = self.perturbation;
+        let (dh, dl) = (
+            self.deviation(self.find("high", dt)),
+            self.deviation(self.find("low", dt)),
+        );
+        let outcome = match (ch.zip(cl), dh.zip(dl)) {
             (Some((a, b)), Some((c, d))) => match (b > a, d > c) {
                 (true, true) => Outcome::Holds,
                 (false, false) => Outcome::DoesNotHold,
@@ -320,101 +469,26 @@ impl Experiment for Fig3 {
             },
             _ => Outcome::NotJudged,
         };
-        let blocks = vec![
-            Block::p(format!(
-                "{} random tools on task 1 (position); the one with the highest ln|Π^U| (tool {}, \
-                 {}) and the one with the lowest (tool {}, {}) are each simulated without \
-                 perturbation and with a constant ΔT = {} N m on both joints. Settling time: the \
-                 time from which |θ2 − π/6| stays within {}% of its initial distance 2π/3 (i.e. \
-                 {} rad) until t = 5 s.",
-                tools.len(),
-                high.0,
-                num(high.1),
-                low.0,
-                num(low.1),
-                dt_label(plan.perturbation),
-                BAND * 100.0,
-                num(BAND * 2.0 * std::f64::consts::FRAC_PI_3),
-            )),
-            Block::p(format!(
-                "Data: `{TOOLS_CSV}` (the sample, columns {}, logdet, role), `{CSV}` (the four \
-                 trajectories on the 0.05 s grid; {failed} failed run(s)), `{SVG}`.",
-                ARM_COLUMNS.join(", ")
-            )),
-            Block::table(
-                &[
-                    "run",
-                    "ln|Π^U|",
-                    "ΔT [N m]",
-                    "task error",
-                    "settling time",
-                    "final |θ2 − π/6| [rad]",
-                    "max |θ2 − θ2 (ΔT = 0)| [rad]",
-                ],
-                rows,
+        Verdict {
+            claim: "C2 (Fig. 3), variability".into(),
+            statement: "\"The low-confident tool shows more variability in performance than \
+                        the high-confident tool under a constant control perturbation of \
+                        ΔT = −0.8 N m.\""
+                .into(),
+            outcome,
+            evidence: format!(
+                "|change of task error| under the perturbation: high {}, low {}; largest \
+                 deviation of θ2 from its unperturbed path: high {} rad, low {} rad.",
+                ch.map_or("-".into(), num),
+                cl.map_or("-".into(), num),
+                dh.map_or("-".into(), num),
+                dl.map_or("-".into(), num)
             ),
-            Block::Figure {
-                file: SVG.into(),
-                caption: "θ2 over time for the highest-confidence tool (yellow: ΔT = 0, purple: \
-                          perturbed) and the lowest-confidence tool (red: ΔT = 0, blue: \
-                          perturbed); the goal π/6 dotted in black. Compare with the paper's \
-                          Fig. 3."
-                    .into(),
-                svg,
-            },
-            Block::Verdict(Verdict {
-                claim: "C2 (Fig. 3), settling".into(),
-                statement: "\"High confident tool settles near the goal θ2^g faster than the low \
-                            confident tool.\""
-                    .into(),
-                outcome: settling_outcome,
-                evidence: format!(
-                    "settling time without perturbation: high {}, low {}; with ΔT = {}: high {}, \
-                     low {}.",
-                    settle_text(h0),
-                    settle_text(l0),
-                    dt_label(plan.perturbation),
-                    settle_text(hp),
-                    settle_text(lp)
-                ),
-                rule: "holds if the high-confidence tool settles earlier both without and with \
-                       the perturbation (a tool that never settles counts as slower), partly \
-                       holds if in one of the two, does not hold if in neither. One pair of \
-                       tools is an illustration, not a statistic; Fig. 4 tests the trend."
-                    .into(),
-            }),
-            Block::Verdict(Verdict {
-                claim: "C2 (Fig. 3), variability".into(),
-                statement: "\"The low-confident tool shows more variability in performance than \
-                            the high-confident tool under a constant control perturbation of \
-                            ΔT = −0.8 N m.\""
-                    .into(),
-                outcome: variability_outcome,
-                evidence: format!(
-                    "|change of task error| under the perturbation: high {}, low {}; largest \
-                     deviation of θ2 from its unperturbed path: high {} rad, low {} rad.",
-                    ch.map_or("-".into(), num),
-                    cl.map_or("-".into(), num),
-                    dh.map_or("-".into(), num),
-                    dl.map_or("-".into(), num)
-                ),
-                rule: "holds if the low-confidence tool has both the larger |change of task \
-                       error| and the larger largest deviation of θ2, partly holds if one of the \
-                       two, does not hold if neither."
-                    .into(),
-            }),
-        ];
-        Ok(Section {
-            id: self.id(),
-            title: self.title().into(),
-            blocks,
-            episodes: runs.len() as u64,
-            rhs_evals: runs
-                .iter()
-                .filter_map(|r| r.result.as_ref().ok())
-                .map(|(m, _)| m.rhs_evals as u64)
-                .sum(),
-        })
+            rule: "holds if the low-confidence tool has both the larger |change of task \
+                   error| and the larger largest deviation of θ2, partly holds if one of the \
+                   two, does not hold if neither."
+                .into(),
+        }
     }
 }
 

@@ -68,223 +68,21 @@ impl Experiment for Fig5 {
 
     fn run(&self, ctx: &Context) -> Result<Section, ReproduceError> {
         let plan = ctx.plan;
-        let task = Task::paper(TaskKind::Velocity);
         let sweep = sweep(plan);
-        let mut listed: Vec<f64> = plan.fig5_perturbations.clone();
-        if !listed.contains(&0.0) {
-            listed.insert(0, 0.0);
-        }
-        let options: Vec<_> = std::iter::once(0.0)
-            .chain(sweep.iter().copied())
-            .map(|d| ctx.perturbed(d))
-            .collect();
         let tools = draw_tools(plan.fig5_tools, ctx.seed_for(self, "tools"));
-        let indices: Vec<usize> = (0..tools.len()).collect();
-        let mut csv = CsvWriter::create(&ctx.path(CSV), &HEADER)?;
-        // The sink sees the tools in order, so a counter names them.
-        let mut next = 0usize;
-        let results: Vec<ToolRuns> = map_ordered(
-            &indices,
-            ctx.progress,
-            options.len() as u64,
-            |&i| run_tool(&tools[i], &task, &options),
-            |r| {
-                let i = next;
-                next += 1;
-                for &dt in &listed {
-                    let k = episode_of(&sweep, dt);
-                    let mut row = vec![Cell::from(i)];
-                    row.extend(arm_cells(&r.arm));
-                    row.extend([
-                        Cell::from(r.logdet()),
-                        Cell::from(dt),
-                        Cell::from(r.task_error(k)),
-                        Cell::from(r.task_error(0)),
-                        Cell::from(r.abs_change(k)),
-                        Cell::from(r.error_of(&[0, k])),
-                    ]);
-                    csv.row(row)?;
-                }
-                Ok(())
-            },
-        )?;
-
-        // Per ΔT: correlation of confidence with variability.
-        let mut rows = Vec::new();
-        let mut outcomes = Vec::new();
-        let mut dots = Vec::new();
+        let (results, rows_per_tool) = simulate_sweep(ctx, &tools, &sweep)?;
         let jobs: Vec<(Vec<f64>, Vec<f64>, u64)> = sweep
             .iter()
             .enumerate()
             .map(|(k, dt)| {
-                let (x, y) = results
-                    .iter()
-                    .filter_map(|r| Some((r.logdet()?, r.abs_change(k + 1)?)))
-                    .unzip();
+                let (x, y) = variability_points(&results, k + 1).into_iter().unzip();
                 (x, y, ctx.seed_for(self, &format!("bootstrap/{dt:+.1}")))
             })
             .collect();
         let corrs = Correlation::compute_all(&jobs, plan.bootstrap_resamples, plan.level);
-        for (k, &dt) in sweep.iter().enumerate() {
-            let ok: Vec<(f64, f64)> = results
-                .iter()
-                .filter_map(|r| Some((r.logdet()?, r.abs_change(k + 1)?)))
-                .collect();
-            let y: Vec<f64> = ok.iter().map(|p| p.1).collect();
-            let corr = &corrs[k];
-            let outcome = corr.negative_outcome();
-            outcomes.push((dt, outcome));
-            rows.push(vec![
-                dt_label(dt),
-                ok.len().to_string(),
-                (tools.len() - ok.len()).to_string(),
-                mean_sd(&y),
-                corr.rho_cell(),
-                corr.ci_cell(),
-                outcome.words().into(),
-            ]);
-            dots.push(Series::new(
-                format!("ΔT = {}", dt_label(dt)),
-                diverging(dt / sweep.iter().fold(0.0, |m: f64, d| m.max(d.abs()))),
-                ok,
-            ));
-        }
-
-        // Negative against positive ΔT of the same magnitude.
-        let magnitudes: Vec<f64> = sweep
-            .iter()
-            .copied()
-            .filter(|&d| d > 0.0 && sweep.contains(&-d))
-            .collect();
-        let change = |r: &ToolRuns, dt: f64| r.abs_change(episode_of(&sweep, dt));
-        let mut sign_rows = Vec::new();
-        let mut every_magnitude = !magnitudes.is_empty();
-        for &m in &magnitudes {
-            let neg: Vec<Option<f64>> = results.iter().map(|r| change(r, -m)).collect();
-            let pos: Vec<Option<f64>> = results.iter().map(|r| change(r, m)).collect();
-            let c = Comparison::compute(&neg, &pos);
-            let more = neg
-                .iter()
-                .zip(&pos)
-                .filter_map(|(a, b)| Some((*a)? > (*b)?))
-                .collect::<Vec<_>>();
-            every_magnitude &= c.mean_difference().is_some_and(|d| d > 0.0);
-            sign_rows.push(vec![
-                format!("{m:.1}"),
-                c.mean_a.map_or("-".into(), num),
-                c.mean_b.map_or("-".into(), num),
-                format!("{} of {}", more.iter().filter(|&&b| b).count(), more.len()),
-                c.p().map_or("-".into(), p_value),
-            ]);
-        }
-        let per_tool = |sign: f64| -> Vec<Option<f64>> {
-            results
-                .iter()
-                .map(|r| {
-                    let v: Option<Vec<f64>> =
-                        magnitudes.iter().map(|&m| change(r, sign * m)).collect();
-                    let v = v?;
-                    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
-                })
-                .collect()
-        };
-        let pooled = Comparison::compute(&per_tool(-1.0), &per_tool(1.0));
-        let pooled_greater = pooled.a_greater(plan.alpha);
-        let sign_outcome = match (pooled_greater, every_magnitude) {
-            (None, _) => Outcome::NotJudged,
-            (Some(true), true) => Outcome::Holds,
-            (Some(true), false) | (Some(false), true) => Outcome::Partly,
-            (Some(false), false) => Outcome::DoesNotHold,
-        };
-        let judged: Vec<Outcome> = outcomes
-            .iter()
-            .map(|o| o.1)
-            .filter(|o| *o != Outcome::NotJudged)
-            .collect();
-        let range_outcome = if judged.is_empty() {
-            Outcome::NotJudged
-        } else if judged.len() == outcomes.len() && judged.iter().all(|o| *o == Outcome::Holds) {
-            Outcome::Holds
-        } else if judged.iter().any(|o| *o != Outcome::DoesNotHold) {
-            Outcome::Partly
-        } else {
-            Outcome::DoesNotHold
-        };
-        let count = |o: Outcome| outcomes.iter().filter(|x| x.1 == o).count();
-
-        // Right panel: mean variability per ΔT for the least and most confident third.
-        let mut ranked: Vec<&ToolRuns> = results.iter().filter(|r| r.logdet().is_some()).collect();
-        ranked.sort_by(|a, b| {
-            a.logdet()
-                .unwrap_or(0.0)
-                .total_cmp(&b.logdet().unwrap_or(0.0))
-        });
-        let third = ranked.len() / 3;
-        let group_line = |group: &[&ToolRuns]| -> Vec<(f64, f64)> {
-            sweep
-                .iter()
-                .filter_map(|&dt| {
-                    let v: Vec<f64> = group.iter().filter_map(|r| change(r, dt)).collect();
-                    Some((dt, summary(&v).ok()?.mean))
-                })
-                .collect()
-        };
-        let mut lines = Vec::new();
-        if third >= 2 {
-            lines.push(Series::new(
-                format!("lowest-confidence third ({third} tools)"),
-                Colour(200, 30, 30),
-                group_line(&ranked[..third]),
-            ));
-            lines.push(Series::new(
-                format!("highest-confidence third ({third} tools)"),
-                Colour(30, 80, 200),
-                group_line(&ranked[ranked.len() - third..]),
-            ));
-        }
-        lines.push(Series::new(
-            "all tools",
-            Colour(60, 60, 60),
-            group_line(&ranked),
-        ));
-        let all_y: Vec<f64> = dots
-            .iter()
-            .flat_map(|s| s.points.iter().map(|p| p.1))
-            .collect();
-        let line_y: Vec<f64> = lines
-            .iter()
-            .flat_map(|s| s.points.iter().map(|p| p.1))
-            .collect();
-        let svg = plot::save(
-            &ctx.path(SVG),
-            &[
-                Panel::Xy(XyPanel {
-                    title: "Velocity task: variability against confidence, by ΔT".into(),
-                    x_label: "control confidence ln|Π^U|".into(),
-                    y_label: "|task error(ΔT) − task error(0)|".into(),
-                    dots,
-                    lines: vec![],
-                    log_y: wants_log(&all_y),
-                    legend: Legend::UpperRight,
-                    headroom: 0.8,
-                }),
-                Panel::Xy(XyPanel {
-                    title: "Mean variability per ΔT (negative ΔT opposes the controller)".into(),
-                    x_label: "perturbation ΔT [N m]".into(),
-                    y_label: "mean |change of task error|".into(),
-                    dots: lines
-                        .iter()
-                        .map(|s| Series::new("", s.colour, s.points.clone()))
-                        .collect(),
-                    lines,
-                    log_y: wants_log(&line_y),
-                    legend: Legend::UpperRight,
-                    headroom: 0.3,
-                }),
-            ],
-            (640, 480),
-        )?;
-
+        let by_dt = ByPerturbation::new(&results, &sweep, &corrs, tools.len());
+        let signs = SignComparison::new(&results, &sweep);
+        let svg = figure(ctx, &results, &sweep, by_dt.dots.clone())?;
         let failed = results.iter().filter(|r| !r.error().is_empty()).count();
         let blocks =
             vec![
@@ -297,36 +95,16 @@ impl Experiment for Fig5 {
             )),
                 files_block(
                     &[CSV.into(), SVG.into()],
-                    results.len() * listed.len(),
+                    results.len() * rows_per_tool,
                     failed,
                     "rows, one per tool and ΔT (ΔT = 0 is the reference)",
                 ),
-                Block::table(
-                    &[
-                        "ΔT [N m]",
-                        "n",
-                        "failed",
-                        "variability mean ± sd",
-                        "Spearman ρ",
-                        "bootstrap CI",
-                        "verdict for this ΔT",
-                    ],
-                    rows,
-                ),
+                Block::table(&BY_DT_HEADER, by_dt.rows.clone()),
                 Block::p(
                     "Negative against positive perturbations of the same size (per tool; Wilcoxon \
                  signed-rank p, two-sided):",
                 ),
-                Block::table(
-                    &[
-                        "|ΔT| [N m]",
-                        "mean variability, ΔT < 0",
-                        "mean variability, ΔT > 0",
-                        "tools with more variability at ΔT < 0",
-                        "p",
-                    ],
-                    sign_rows,
-                ),
+                Block::table(&SIGN_HEADER, signs.rows.clone()),
                 Block::Figure {
                     file: SVG.into(),
                     caption:
@@ -337,60 +115,351 @@ impl Experiment for Fig5 {
                             .into(),
                     svg,
                 },
-                Block::Verdict(Verdict {
-                    claim: "C2 (Fig. 5), range of ΔT".into(),
-                    statement:
-                        "\"The trend remains the same for a range of perturbations\": tools \
-                            with low control confidence show high variability, tools with high \
-                            confidence low variability, for every ΔT."
-                            .into(),
-                    outcome: range_outcome,
-                    evidence: format!(
-                        "of {} perturbations, the negative correlation holds for {}, partly holds \
-                     for {}, does not hold for {}, cannot be judged for {} (table above).",
-                        outcomes.len(),
-                        count(Outcome::Holds),
-                        count(Outcome::Partly),
-                        count(Outcome::DoesNotHold),
-                        count(Outcome::NotJudged)
-                    ),
-                    rule: format!(
-                        "per ΔT the correlation rule: {} Overall: holds if it holds for every ΔT, \
-                     partly holds if it holds or partly holds for at least one, does not hold \
-                     otherwise.",
-                        negative_correlation_rule(plan.level)
-                    ),
-                }),
-                Block::Verdict(Verdict {
-                    claim: "C2 (Fig. 5), sign of ΔT".into(),
-                    statement: "\"Higher variability when the perturbation resists the controller \
-                            (perturbing torque is negative and opposes the controller torque).\""
-                        .into(),
-                    outcome: sign_outcome,
-                    evidence: format!(
-                    "per-tool mean variability over |ΔT| ∈ {{{}}}: ΔT < 0 {} against ΔT > 0 {}; \
-                     {}. Mean variability larger for ΔT < 0 at every |ΔT|: {}.",
-                    magnitudes.iter().map(|m| format!("{m:.1}")).collect::<Vec<_>>().join(", "),
-                    pooled.mean_a.map_or("-".into(), num),
-                    pooled.mean_b.map_or("-".into(), num),
-                    pooled.describe(),
-                    if every_magnitude { "yes" } else { "no" }
-                ),
-                    rule: format!(
-                    "holds if the per-tool variability is significantly larger for negative ΔT \
-                     (Wilcoxon p < {} with a positive mean difference) and the mean is larger \
-                     for the negative ΔT at every |ΔT|; partly holds if only one of the two; \
-                     does not hold if neither.",
-                    plan.alpha
-                ),
-                }),
+                Block::Verdict(by_dt.verdict(plan.level)),
+                Block::Verdict(signs.verdict(plan.alpha)),
             ];
         Ok(Section {
             id: self.id(),
             title: self.title().into(),
             blocks,
-            episodes: (results.len() * options.len()) as u64,
+            episodes: (results.len() * (1 + sweep.len())) as u64,
             rhs_evals: results.iter().map(ToolRuns::rhs_evals).sum(),
         })
     }
+}
+
+const BY_DT_HEADER: [&str; 7] = [
+    "ΔT [N m]",
+    "n",
+    "failed",
+    "variability mean ± sd",
+    "Spearman ρ",
+    "bootstrap CI",
+    "verdict for this ΔT",
+];
+
+const SIGN_HEADER: [&str; 5] = [
+    "|ΔT| [N m]",
+    "mean variability, ΔT < 0",
+    "mean variability, ΔT > 0",
+    "tools with more variability at ΔT < 0",
+    "p",
+];
+
+/// Every tool without and with each ΔT of the sweep; CSV rows (one per tool and listed ΔT, the
+/// reference ΔT = 0 included) as each tool finishes. Returns the runs and the rows per tool.
+fn simulate_sweep(
+    ctx: &Context,
+    tools: &[crate::Arm],
+    sweep: &[f64],
+) -> Result<(Vec<ToolRuns>, usize), ReproduceError> {
+    let task = Task::paper(TaskKind::Velocity);
+    let mut listed: Vec<f64> = ctx.plan.fig5_perturbations.clone();
+    if !listed.contains(&0.0) {
+        listed.insert(0, 0.0);
+    }
+    let options: Vec<_> = std::iter::once(0.0)
+        .chain(sweep.iter().copied())
+        .map(|d| ctx.perturbed(d))
+        .collect();
+    let indices: Vec<usize> = (0..tools.len()).collect();
+    let mut csv = CsvWriter::create(&ctx.path(CSV), &HEADER)?;
+    // The sink sees the tools in order, so a counter names them.
+    let mut next = 0usize;
+    let results = map_ordered(
+        &indices,
+        ctx.progress,
+        options.len() as u64,
+        |&i| run_tool(&tools[i], &task, &options),
+        |r| {
+            let i = next;
+            next += 1;
+            for &dt in &listed {
+                let k = episode_of(sweep, dt);
+                let mut row = vec![Cell::from(i)];
+                row.extend(arm_cells(&r.arm));
+                row.extend([
+                    Cell::from(r.logdet()),
+                    Cell::from(dt),
+                    Cell::from(r.task_error(k)),
+                    Cell::from(r.task_error(0)),
+                    Cell::from(r.abs_change(k)),
+                    Cell::from(r.error_of(&[0, k])),
+                ]);
+                csv.row(row)?;
+            }
+            Ok(())
+        },
+    )?;
+    Ok((results, listed.len()))
+}
+
+/// (ln|Π^U|, variability) of every tool with both, for episode `k`.
+fn variability_points(results: &[ToolRuns], k: usize) -> Vec<(f64, f64)> {
+    results
+        .iter()
+        .filter_map(|r| Some((r.logdet()?, r.abs_change(k)?)))
+        .collect()
+}
+
+/// Confidence against variability for each ΔT: the table rows, the verdicts, the dots.
+struct ByPerturbation {
+    rows: Vec<Vec<String>>,
+    outcomes: Vec<(f64, Outcome)>,
+    dots: Vec<Series>,
+}
+
+impl ByPerturbation {
+    fn new(results: &[ToolRuns], sweep: &[f64], corrs: &[Correlation], tools: usize) -> Self {
+        let mut out = ByPerturbation {
+            rows: Vec::new(),
+            outcomes: Vec::new(),
+            dots: Vec::new(),
+        };
+        let largest = sweep.iter().fold(0.0, |m: f64, d| m.max(d.abs()));
+        for (k, &dt) in sweep.iter().enumerate() {
+            let ok = variability_points(results, k + 1);
+            let y: Vec<f64> = ok.iter().map(|p| p.1).collect();
+            let corr = &corrs[k];
+            let outcome = corr.negative_outcome();
+            out.outcomes.push((dt, outcome));
+            out.rows.push(vec![
+                dt_label(dt),
+                ok.len().to_string(),
+                (tools - ok.len()).to_string(),
+                mean_sd(&y),
+                corr.rho_cell(),
+                corr.ci_cell(),
+                outcome.words().into(),
+            ]);
+            out.dots.push(Series::new(
+                format!("ΔT = {}", dt_label(dt)),
+                diverging(dt / largest),
+                ok,
+            ));
+        }
+        out
+    }
+
+    fn count(&self, o: Outcome) -> usize {
+        self.outcomes.iter().filter(|x| x.1 == o).count()
+    }
+
+    fn verdict(&self, level: f64) -> Verdict {
+        let judged: Vec<Outcome> = self
+            .outcomes
+            .iter()
+            .map(|o| o.1)
+            .filter(|o| *o != Outcome::NotJudged)
+            .collect();
+        let outcome = if judged.is_empty() {
+            Outcome::NotJudged
+        } else if judged.len() == self.outcomes.len() && judged.iter().all(|o| *o == Outcome::Holds)
+        {
+            Outcome::Holds
+        } else if judged.iter().any(|o| *o != Outcome::DoesNotHold) {
+            Outcome::Partly
+        } else {
+            Outcome::DoesNotHold
+        };
+        Verdict {
+            claim: "C2 (Fig. 5), range of ΔT".into(),
+            statement: "\"The trend remains the same for a range of perturbations\": tools \
+                        with low control confidence show high variability, tools with high \
+                        confidence low variability, for every ΔT."
+                .into(),
+            outcome,
+            evidence: format!(
+                "of {} perturbations, the negative correlation holds for {}, partly holds \
+                 for {}, does not hold for {}, cannot be judged for {} (table above).",
+                self.outcomes.len(),
+                self.count(Outcome::Holds),
+                self.count(Outcome::Partly),
+                self.count(Outcome::DoesNotHold),
+                self.count(Outcome::NotJudged)
+            ),
+            rule: format!(
+                "per ΔT the correlation rule: {} Overall: holds if it holds for every ΔT, \
+                 partly holds if it holds or partly holds for at least one, does not hold \
+                 otherwise.",
+                negative_correlation_rule(level)
+            ),
+        }
+    }
+}
+
+/// A tool's variability at perturbation `dt` of the sweep.
+fn change(r: &ToolRuns, sweep: &[f64], dt: f64) -> Option<f64> {
+    r.abs_change(episode_of(sweep, dt))
+}
+
+/// Negative against positive ΔT of the same magnitude: per magnitude and pooled per tool.
+struct SignComparison {
+    magnitudes: Vec<f64>,
+    rows: Vec<Vec<String>>,
+    /// Whether the mean variability is larger for ΔT < 0 at every magnitude.
+    every_magnitude: bool,
+    pooled: Comparison,
+}
+
+impl SignComparison {
+    fn new(results: &[ToolRuns], sweep: &[f64]) -> Self {
+        let magnitudes: Vec<f64> = sweep
+            .iter()
+            .copied()
+            .filter(|&d| d > 0.0 && sweep.contains(&-d))
+            .collect();
+        let mut rows = Vec::new();
+        let mut every_magnitude = !magnitudes.is_empty();
+        for &m in &magnitudes {
+            let neg: Vec<Option<f64>> = results.iter().map(|r| change(r, sweep, -m)).collect();
+            let pos: Vec<Option<f64>> = results.iter().map(|r| change(r, sweep, m)).collect();
+            let c = Comparison::compute(&neg, &pos);
+            let more = neg
+                .iter()
+                .zip(&pos)
+                .filter_map(|(a, b)| Some((*a)? > (*b)?))
+                .collect::<Vec<_>>();
+            every_magnitude &= c.mean_difference().is_some_and(|d| d > 0.0);
+            rows.push(vec![
+                format!("{m:.1}"),
+                c.mean_a.map_or("-".into(), num),
+                c.mean_b.map_or("-".into(), num),
+                format!("{} of {}", more.iter().filter(|&&b| b).count(), more.len()),
+                c.p().map_or("-".into(), p_value),
+            ]);
+        }
+        let per_tool = |sign: f64| -> Vec<Option<f64>> {
+            results
+                .iter()
+                .map(|r| {
+                    let v: Option<Vec<f64>> = magnitudes
+                        .iter()
+                        .map(|&m| change(r, sweep, sign * m))
+                        .collect();
+                    let v = v?;
+                    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+                })
+                .collect()
+        };
+        let pooled = Comparison::compute(&per_tool(-1.0), &per_tool(1.0));
+        SignComparison {
+            magnitudes,
+            rows,
+            every_magnitude,
+            pooled,
+        }
+    }
+
+    fn verdict(&self, alpha: f64) -> Verdict {
+        let outcome = match (self.pooled.a_greater(alpha), self.every_magnitude) {
+            (None, _) => Outcome::NotJudged,
+            (Some(true), true) => Outcome::Holds,
+            (Some(true), false) | (Some(false), true) => Outcome::Partly,
+            (Some(false), false) => Outcome::DoesNotHold,
+        };
+        let magnitudes: Vec<String> = self.magnitudes.iter().map(|m| format!("{m:.1}")).collect();
+        Verdict {
+            claim: "C2 (Fig. 5), sign of ΔT".into(),
+            statement: "\"Higher variability when the perturbation resists the controller \
+                        (perturbing torque is negative and opposes the controller torque).\""
+                .into(),
+            outcome,
+            evidence: format!(
+                "per-tool mean variability over |ΔT| ∈ {{{}}}: ΔT < 0 {} against ΔT > 0 {}; \
+                 {}. Mean variability larger for ΔT < 0 at every |ΔT|: {}.",
+                magnitudes.join(", "),
+                self.pooled.mean_a.map_or("-".into(), num),
+                self.pooled.mean_b.map_or("-".into(), num),
+                self.pooled.describe(),
+                if self.every_magnitude { "yes" } else { "no" }
+            ),
+            rule: format!(
+                "holds if the per-tool variability is significantly larger for negative ΔT \
+                 (Wilcoxon p < {alpha} with a positive mean difference) and the mean is larger \
+                 for the negative ΔT at every |ΔT|; partly holds if only one of the two; \
+                 does not hold if neither."
+            ),
+        }
+    }
+}
+
+/// Left: variability against confidence per ΔT (`dots`); right: mean variability per ΔT for
+/// the least and most confident third of the tools and for all.
+fn figure(
+    ctx: &Context,
+    results: &[ToolRuns],
+    sweep: &[f64],
+    dots: Vec<Series>,
+) -> Result<String, ReproduceError> {
+    let mut ranked: Vec<&ToolRuns> = results.iter().filter(|r| r.logdet().is_some()).collect();
+    ranked.sort_by(|a, b| {
+        a.logdet()
+            .unwrap_or(0.0)
+            .total_cmp(&b.logdet().unwrap_or(0.0))
+    });
+    let third = ranked.len() / 3;
+    let group_line = |group: &[&ToolRuns]| -> Vec<(f64, f64)> {
+        sweep
+            .iter()
+            .filter_map(|&dt| {
+                let v: Vec<f64> = group.iter().filter_map(|r| change(r, sweep, dt)).collect();
+                Some((dt, summary(&v).ok()?.mean))
+            })
+            .collect()
+    };
+    let mut lines = Vec::new();
+    if third >= 2 {
+        lines.push(Series::new(
+            format!("lowest-confidence third ({third} tools)"),
+            Colour(200, 30, 30),
+            group_line(&ranked[..third]),
+        ));
+        lines.push(Series::new(
+            format!("highest-confidence third ({third} tools)"),
+            Colour(30, 80, 200),
+            group_line(&ranked[ranked.len() - third..]),
+        ));
+    }
+    lines.push(Series::new(
+        "all tools",
+        Colour(60, 60, 60),
+        group_line(&ranked),
+    ));
+    let ys = |series: &[Series]| -> Vec<f64> {
+        series
+            .iter()
+            .flat_map(|s| s.points.iter().map(|p| p.1))
+            .collect()
+    };
+    let (all_y, line_y) = (ys(&dots), ys(&lines));
+    Ok(plot::save(
+        &ctx.path(SVG),
+        &[
+            Panel::Xy(XyPanel {
+                title: "Velocity task: variability against confidence, by ΔT".into(),
+                x_label: "control confidence ln|Π^U|".into(),
+                y_label: "|task error(ΔT) − task error(0)|".into(),
+                dots,
+                lines: vec![],
+                log_y: wants_log(&all_y),
+                legend: Legend::UpperRight,
+                headroom: 0.8,
+            }),
+            Panel::Xy(XyPanel {
+                title: "Mean variability per ΔT (negative ΔT opposes the controller)".into(),
+                x_label: "perturbation ΔT [N m]".into(),
+                y_label: "mean |change of task error|".into(),
+                dots: lines
+                    .iter()
+                    .map(|s| Series::new("", s.colour, s.points.clone()))
+                    .collect(),
+                lines,
+                log_y: wants_log(&line_y),
+                legend: Legend::UpperRight,
+                headroom: 0.3,
+            }),
+        ],
+        (640, 480),
+    )?)
 }

@@ -11,7 +11,7 @@ use crate::{Arm, Task, TaskKind};
 use super::batch::map_ordered;
 use super::common::{arm_cells, files_block, ARM_COLUMNS};
 use super::csv::{Cell, CsvWriter};
-use super::objectives::{choices, decision_rules, Trial};
+use super::objectives::{choices, decision_rules, DecisionRule, Trial};
 use super::plot::{self, Colour, GridPanel, Panel};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::num;
@@ -65,115 +65,10 @@ impl Experiment for Fig6 {
 
     fn run(&self, ctx: &Context) -> Result<Section, ReproduceError> {
         let plan = ctx.plan;
-        let task = Task::paper(TASK);
         let rules = decision_rules();
-        let trials: Vec<usize> = (0..plan.fig6_trials).collect();
-        let header = header();
-        let header: Vec<&str> = header.iter().map(String::as_str).collect();
-        let mut csv = CsvWriter::create(&ctx.path(CSV), &header)?;
-        let mut next = 0usize;
-        let done = map_ordered(
-            &trials,
-            ctx.progress,
-            plan.fig6_tools as u64,
-            |&k| {
-                let tools = draw_tools(plan.fig6_tools, ctx.seed_for(self, &format!("trial/{k}")));
-                let results = evaluate(&tools, &task, &ctx.options);
-                let chosen = choices(
-                    &rules,
-                    &Trial {
-                        task: &task,
-                        tools: &tools,
-                        results: &results,
-                        options: &ctx.options,
-                    },
-                );
-                TrialResult {
-                    tools,
-                    results,
-                    chosen,
-                }
-            },
-            |t| {
-                let k = next;
-                next += 1;
-                for r in &t.results {
-                    let m = r.episode.as_ref().ok();
-                    let mut row = vec![Cell::from(k), Cell::from(r.index)];
-                    row.extend(arm_cells(&t.tools[r.index]));
-                    row.extend([
-                        Cell::from(r.logdet.as_ref().ok().copied()),
-                        Cell::from(m.map(|m| m.task_error)),
-                        Cell::from(m.map(|m| m.free_energy)),
-                        Cell::from(m.map(|m| m.cost_j)),
-                    ]);
-                    row.extend(t.chosen.iter().map(|c| Cell::from(*c == Some(r.index))));
-                    let error = match (&r.logdet, &r.episode) {
-                        (Err(e), _) => e.to_string(),
-                        (_, Err(e)) => e.to_string(),
-                        _ => String::new(),
-                    };
-                    row.push(Cell::from(error));
-                    csv.row(row)?;
-                }
-                Ok(())
-            },
-        )?;
-
-        // The grid: rows are tools, columns trials; F is rule 0, J rule 1.
-        let cells: Vec<Vec<usize>> = (0..plan.fig6_tools)
-            .map(|i| {
-                done.iter()
-                    .map(|t| {
-                        usize::from(t.chosen[0] == Some(i))
-                            + 2 * usize::from(t.chosen[1] == Some(i))
-                    })
-                    .collect()
-            })
-            .collect();
-        let (f, j) = (&rules[0], &rules[1]);
-        let svg = plot::save(
-            &ctx.path(SVG),
-            &[Panel::Grid(GridPanel {
-                title: format!(
-                    "Tool selected by {} and {} in {} trials of {} random tools (task 2, velocity)",
-                    f.label(),
-                    j.label(),
-                    done.len(),
-                    plan.fig6_tools
-                ),
-                x_label: "trial".into(),
-                y_label: "tool".into(),
-                cells,
-                categories: vec![
-                    ("not selected".into(), Colour(255, 255, 255)),
-                    (format!("selected by {}", f.label()), Colour(205, 205, 205)),
-                    (format!("selected by {}", j.label()), Colour(105, 105, 105)),
-                    ("selected by both".into(), Colour(0, 0, 0)),
-                ],
-            })],
-            (1000, 380),
-        )?;
-
-        // Disagreements between every pair of rules.
-        let mut pair_rows = Vec::new();
-        let mut fj = (0, 0);
-        for a in 0..rules.len() {
-            for b in a + 1..rules.len() {
-                let both: Vec<bool> = done
-                    .iter()
-                    .filter_map(|t| Some(t.chosen[a]? != t.chosen[b]?))
-                    .collect();
-                let differ = both.iter().filter(|&&d| d).count();
-                if (a, b) == (0, 1) {
-                    fj = (differ, both.len());
-                }
-                pair_rows.push(vec![
-                    format!("{} vs {}", rules[a].label(), rules[b].label()),
-                    format!("{differ} of {}", both.len()),
-                ]);
-            }
-        }
+        let done = self.run_trials(ctx, &rules)?;
+        let svg = grid_figure(ctx, &done, &rules)?;
+        let (pair_rows, (differ, judged)) = disagreements(&done, &rules);
         // ∫F − ∫J = −(t_end/2)·ln|Π^U| for every tool: F is J plus a confidence bonus.
         let half = 0.5 * ctx.options.t_end;
         let identity = done
@@ -189,14 +84,6 @@ impl Experiment for Fig6 {
             .flat_map(|t| &t.results)
             .filter(|r| r.episode.is_err() || r.logdet.is_err())
             .count();
-        let (differ, judged) = fj;
-        let outcome = if judged == 0 {
-            Outcome::NotJudged
-        } else if differ > 0 {
-            Outcome::Holds
-        } else {
-            Outcome::DoesNotHold
-        };
         let blocks = vec![
             Block::p(format!(
                 "{} trials, each of {} random tools on task 2 (velocity; the paper's Fig. 6 does \
@@ -230,26 +117,7 @@ impl Experiment for Fig6 {
                     .into(),
                 svg,
             },
-            Block::Verdict(Verdict {
-                claim: "C3".into(),
-                statement: "\"Both objectives can produce different decision outcomes, i.e., \
-                            different tool selections\": F and J do not always select the same \
-                            tool."
-                    .into(),
-                outcome,
-                evidence: format!(
-                    "F and J chose different tools in {differ} of {judged} trials ({}%).",
-                    if judged > 0 {
-                        num(100.0 * differ as f64 / judged as f64)
-                    } else {
-                        "-".into()
-                    }
-                ),
-                rule: "holds if F and J choose different tools in at least one trial (the \
-                       paper's claim is existential: grey blocks exist), does not hold if they \
-                       always agree."
-                    .into(),
-            }),
+            Block::Verdict(verdict(differ, judged)),
         ];
         Ok(Section {
             id: self.id(),
@@ -263,5 +131,172 @@ impl Experiment for Fig6 {
                 .map(|m| m.rhs_evals as u64)
                 .sum(),
         })
+    }
+}
+
+impl Fig6 {
+    /// Every trial: draw the tools, simulate them, let every rule choose; one CSV row per trial
+    /// and tool as each trial finishes.
+    fn run_trials(
+        &self,
+        ctx: &Context,
+        rules: &[Box<dyn DecisionRule>],
+    ) -> Result<Vec<TrialResult>, ReproduceError> {
+        let plan = ctx.plan;
+        let task = Task::paper(TASK);
+        let trials: Vec<usize> = (0..plan.fig6_trials).collect();
+        let header = header();
+        let header: Vec<&str> = header.iter().map(String::as_str).collect();
+        let mut csv = CsvWriter::create(&ctx.path(CSV), &header)?;
+        let mut next = 0usize;
+        map_ordered(
+            &trials,
+            ctx.progress,
+            plan.fig6_tools as u64,
+            |&k| {
+                let tools = draw_tools(plan.fig6_tools, ctx.seed_for(self, &format!("trial/{k}")));
+                let results = evaluate(&tools, &task, &ctx.options);
+                let trial = Trial {
+                    task: &task,
+                    tools: &tools,
+                    results: &results,
+                    options: &ctx.options,
+                };
+                let chosen = choices(rules, &trial);
+                TrialResult {
+                    tools,
+                    results,
+                    chosen,
+                }
+            },
+            |t| {
+                let k = next;
+                next += 1;
+                write_trial(&mut csv, k, t)
+            },
+        )
+    }
+}
+
+/// Trial `k`'s rows: each tool's numbers and which rules chose it.
+fn write_trial(csv: &mut CsvWriter, k: usize, t: &TrialResult) -> Result<(), ReproduceError> {
+    for r in &t.results {
+        let m = r.episode.as_ref().ok();
+        let mut row = vec![Cell::from(k), Cell::from(r.index)];
+        row.extend(arm_cells(&t.tools[r.index]));
+        row.extend([
+            Cell::from(r.logdet.as_ref().ok().copied()),
+            Cell::from(m.map(|m| m.task_error)),
+            Cell::from(m.map(|m| m.free_energy)),
+            Cell::from(m.map(|m| m.cost_j)),
+        ]);
+        row.extend(t.chosen.iter().map(|c| Cell::from(*c == Some(r.index))));
+        let error = match (&r.logdet, &r.episode) {
+            (Err(e), _) => e.to_string(),
+            (_, Err(e)) => e.to_string(),
+            _ => String::new(),
+        };
+        row.push(Cell::from(error));
+        csv.row(row)?;
+    }
+    Ok(())
+}
+
+/// The grid: rows are tools, columns trials; F is rule 0, J rule 1.
+fn grid_figure(
+    ctx: &Context,
+    done: &[TrialResult],
+    rules: &[Box<dyn DecisionRule>],
+) -> Result<String, ReproduceError> {
+    let tools = ctx.plan.fig6_tools;
+    let cells: Vec<Vec<usize>> = (0..tools)
+        .map(|i| {
+            done.iter()
+                .map(|t| {
+                    usize::from(t.chosen[0] == Some(i)) + 2 * usize::from(t.chosen[1] == Some(i))
+                })
+                .collect()
+        })
+        .collect();
+    let (f, j) = (&rules[0], &rules[1]);
+    Ok(plot::save(
+        &ctx.path(SVG),
+        &[Panel::Grid(GridPanel {
+            title: format!(
+                "Tool selected by {} and {} in {} trials of {} random tools (task 2, velocity)",
+                f.label(),
+                j.label(),
+                done.len(),
+                tools
+            ),
+            x_label: "trial".into(),
+            y_label: "tool".into(),
+            cells,
+            categories: vec![
+                ("not selected".into(), Colour(255, 255, 255)),
+                (format!("selected by {}", f.label()), Colour(205, 205, 205)),
+                (format!("selected by {}", j.label()), Colour(105, 105, 105)),
+                ("selected by both".into(), Colour(0, 0, 0)),
+            ],
+        })],
+        (1000, 380),
+    )?)
+}
+
+/// For every pair of rules, in how many trials they chose differently (table rows), and that
+/// count with the number of trials both chose in for F and J (rules 0 and 1).
+fn disagreements(
+    done: &[TrialResult],
+    rules: &[Box<dyn DecisionRule>],
+) -> (Vec<Vec<String>>, (usize, usize)) {
+    let mut pair_rows = Vec::new();
+    let mut fj = (0, 0);
+    for a in 0..rules.len() {
+        for b in a + 1..rules.len() {
+            let both: Vec<bool> = done
+                .iter()
+                .filter_map(|t| Some(t.chosen[a]? != t.chosen[b]?))
+                .collect();
+            let differ = both.iter().filter(|&&d| d).count();
+            if (a, b) == (0, 1) {
+                fj = (differ, both.len());
+            }
+            pair_rows.push(vec![
+                format!("{} vs {}", rules[a].label(), rules[b].label()),
+                format!("{differ} of {}", both.len()),
+            ]);
+        }
+    }
+    (pair_rows, fj)
+}
+
+/// C3: F and J do not always choose the same tool.
+fn verdict(differ: usize, judged: usize) -> Verdict {
+    let outcome = if judged == 0 {
+        Outcome::NotJudged
+    } else if differ > 0 {
+        Outcome::Holds
+    } else {
+        Outcome::DoesNotHold
+    };
+    Verdict {
+        claim: "C3".into(),
+        statement: "\"Both objectives can produce different decision outcomes, i.e., \
+                    different tool selections\": F and J do not always select the same \
+                    tool."
+            .into(),
+        outcome,
+        evidence: format!(
+            "F and J chose different tools in {differ} of {judged} trials ({}%).",
+            if judged > 0 {
+                num(100.0 * differ as f64 / judged as f64)
+            } else {
+                "-".into()
+            }
+        ),
+        rule: "holds if F and J choose different tools in at least one trial (the \
+               paper's claim is existential: grey blocks exist), does not hold if they \
+               always agree."
+            .into(),
     }
 }

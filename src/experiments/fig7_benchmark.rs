@@ -143,16 +143,94 @@ impl Experiment for Fig7 {
 
     fn run(&self, ctx: &Context) -> Result<Section, ReproduceError> {
         let plan = ctx.plan;
-        let task = Task::paper(TASK);
         let rules = self.rules(plan);
+        let done = self.run_trials(ctx, &rules)?;
+        let values = ChosenValues::new(&done, &rules);
+        let svg = values.figure(ctx, &rules)?;
+        let failed = done
+            .iter()
+            .map(|t| {
+                (0..t.tools.len())
+                    .filter(|&i| !t.error(i).is_empty())
+                    .count()
+            })
+            .sum();
+        let labels: Vec<&str> = rules.iter().map(|r| r.label()).collect();
+        let mut blocks = vec![
+            Block::p(format!(
+                "{} trials, each of {} random tools on task 2 (velocity). Every tool is simulated \
+                 without and with ΔT = {} N m; each rule picks a tool from the unperturbed \
+                 episodes ({}), and the chosen tools are compared on control confidence, task \
+                 error and sensitivity |task error(ΔT) − task error(0)|. Paired tests pair the \
+                 rules' tools trial by trial (a trial where both rules chose the same tool is a \
+                 zero difference).",
+                done.len(),
+                plan.fig7_tools,
+                dt_label(plan.perturbation),
+                labels.join(", ")
+            )),
+            files_block(
+                &[CSV.into(), CHOICES_CSV.into(), SVG.into()],
+                done.len() * plan.fig7_tools,
+                failed,
+                "tool rows, two episodes each, and one choice row per trial and rule",
+            ),
+            Block::table(
+                &["measure", "rule", "n", "mean ± sd", "median [q1, q3]"],
+                values.summary_rows(&rules),
+            ),
+            Block::table(
+                &["measure", "difference", "paired tests"],
+                values.test_rows(&rules),
+            ),
+            Block::Figure {
+                file: SVG.into(),
+                caption: "The tools chosen by each rule: box plots (median, quartiles, whiskers \
+                          at 1.5 IQR, outliers as rings) with mean ± sd (triangle and bar) beside \
+                          each box. Compare with the paper's Fig. 7."
+                    .into(),
+                svg,
+            },
+        ];
+        let compare = |m: usize, a: usize, b: usize| values.compare(m, a, b);
+        blocks.extend(
+            verdicts(&rules, &compare, plan.alpha)
+                .into_iter()
+                .map(Block::Verdict),
+        );
+        Ok(Section {
+            id: self.id(),
+            title: self.title().into(),
+            blocks,
+            episodes: 2 * (done.len() * plan.fig7_tools) as u64,
+            rhs_evals: done
+                .iter()
+                .flat_map(|t| t.results.iter().chain(&t.perturbed))
+                .filter_map(|r| r.episode.as_ref().ok())
+                .map(|m| m.rhs_evals as u64)
+                .sum(),
+        })
+    }
+}
+
+impl Fig7 {
+    /// Every trial: draw the tools, simulate each without and with ΔT, let every rule choose;
+    /// the tool rows and the choices are written as each trial finishes.
+    fn run_trials(
+        &self,
+        ctx: &Context,
+        rules: &[Box<dyn DecisionRule>],
+    ) -> Result<Vec<TrialResult>, ReproduceError> {
+        let plan = ctx.plan;
+        let task = Task::paper(TASK);
         let perturbed = ctx.perturbed(plan.perturbation);
         let trials: Vec<usize> = (0..plan.fig7_trials).collect();
-        let header = header(&rules);
+        let header = header(rules);
         let header: Vec<&str> = header.iter().map(String::as_str).collect();
         let mut csv = CsvWriter::create(&ctx.path(CSV), &header)?;
         let mut choices_csv = CsvWriter::create(&ctx.path(CHOICES_CSV), &CHOICES_HEADER)?;
         let mut next = 0usize;
-        let done = map_ordered(
+        map_ordered(
             &trials,
             ctx.progress,
             2 * plan.fig7_tools as u64,
@@ -160,15 +238,13 @@ impl Experiment for Fig7 {
                 let tools = draw_tools(plan.fig7_tools, ctx.seed_for(self, &format!("trial/{k}")));
                 let results = evaluate(&tools, &task, &ctx.options);
                 let perturbed = evaluate(&tools, &task, &perturbed);
-                let chosen = choices(
-                    &rules,
-                    &Trial {
-                        task: &task,
-                        tools: &tools,
-                        results: &results,
-                        options: &ctx.options,
-                    },
-                );
+                let trial = Trial {
+                    task: &task,
+                    tools: &tools,
+                    results: &results,
+                    options: &ctx.options,
+                };
+                let chosen = choices(rules, &trial);
                 TrialResult {
                     tools,
                     results,
@@ -179,39 +255,58 @@ impl Experiment for Fig7 {
             |t| {
                 let k = next;
                 next += 1;
-                for (i, r) in t.results.iter().enumerate() {
-                    let m = r.episode.as_ref().ok();
-                    let mut row = vec![Cell::from(k), Cell::from(i)];
-                    row.extend(arm_cells(&t.tools[i]));
-                    row.extend([
-                        Cell::from(t.logdet(i)),
-                        Cell::from(t.task_error(i)),
-                        Cell::from(m.map(|m| m.free_energy)),
-                        Cell::from(m.map(|m| m.cost_j)),
-                        Cell::from(t.perturbed_error(i)),
-                        Cell::from(t.abs_change(i)),
-                    ]);
-                    row.extend(t.chosen.iter().map(|c| Cell::from(*c == Some(i))));
-                    row.push(Cell::from(t.error(i)));
-                    csv.row(row)?;
-                }
-                for (rule, c) in rules.iter().zip(&t.chosen) {
-                    let at = |m: usize| c.and_then(|i| metric(t, m, i));
-                    choices_csv.row(vec![
-                        Cell::from(k),
-                        Cell::from(rule.id()),
-                        c.map_or(Cell::Empty, Cell::from),
-                        Cell::from(at(0)),
-                        Cell::from(at(1)),
-                        Cell::from(at(2)),
-                    ])?;
-                }
-                Ok(())
+                write_trial(&mut csv, &mut choices_csv, rules, k, t)
             },
-        )?;
+        )
+    }
+}
 
-        // values[m][r][k]: measure m of the tool rule r chose in trial k.
-        let values: Vec<Vec<Vec<Option<f64>>>> = (0..METRICS.len())
+/// Trial `k`'s tool rows (with which rules chose each) and one choice row per rule.
+fn write_trial(
+    csv: &mut CsvWriter,
+    choices_csv: &mut CsvWriter,
+    rules: &[Box<dyn DecisionRule>],
+    k: usize,
+    t: &TrialResult,
+) -> Result<(), ReproduceError> {
+    for (i, r) in t.results.iter().enumerate() {
+        let m = r.episode.as_ref().ok();
+        let mut row = vec![Cell::from(k), Cell::from(i)];
+        row.extend(arm_cells(&t.tools[i]));
+        row.extend([
+            Cell::from(t.logdet(i)),
+            Cell::from(t.task_error(i)),
+            Cell::from(m.map(|m| m.free_energy)),
+            Cell::from(m.map(|m| m.cost_j)),
+            Cell::from(t.perturbed_error(i)),
+            Cell::from(t.abs_change(i)),
+        ]);
+        row.extend(t.chosen.iter().map(|c| Cell::from(*c == Some(i))));
+        row.push(Cell::from(t.error(i)));
+        csv.row(row)?;
+    }
+    for (rule, c) in rules.iter().zip(&t.chosen) {
+        let at = |m: usize| c.and_then(|i| metric(t, m, i));
+        choices_csv.row(vec![
+            Cell::from(k),
+            Cell::from(rule.id()),
+            c.map_or(Cell::Empty, Cell::from),
+            Cell::from(at(0)),
+            Cell::from(at(1)),
+            Cell::from(at(2)),
+        ])?;
+    }
+    Ok(())
+}
+
+/// `values[m][r][k]`: measure m ([`METRICS`]) of the tool rule r chose in trial k.
+struct ChosenValues {
+    values: Vec<Vec<Vec<Option<f64>>>>,
+}
+
+impl ChosenValues {
+    fn new(done: &[TrialResult], rules: &[Box<dyn DecisionRule>]) -> Self {
+        let values = (0..METRICS.len())
             .map(|m| {
                 (0..rules.len())
                     .map(|r| {
@@ -222,13 +317,23 @@ impl Experiment for Fig7 {
                     .collect()
             })
             .collect();
-        let present = |v: &[Option<f64>]| -> Vec<f64> { v.iter().flatten().copied().collect() };
+        ChosenValues { values }
+    }
 
-        let mut summary_rows = Vec::new();
+    fn present(&self, m: usize, r: usize) -> Vec<f64> {
+        self.values[m][r].iter().flatten().copied().collect()
+    }
+
+    fn compare(&self, m: usize, a: usize, b: usize) -> Comparison {
+        Comparison::compute(&self.values[m][a], &self.values[m][b])
+    }
+
+    fn summary_rows(&self, rules: &[Box<dyn DecisionRule>]) -> Vec<Vec<String>> {
+        let mut rows = Vec::new();
         for (m, (name, _)) in METRICS.iter().enumerate() {
             for (r, rule) in rules.iter().enumerate() {
-                let v = present(&values[m][r]);
-                summary_rows.push(match summary(&v) {
+                let v = self.present(m, r);
+                rows.push(match summary(&v) {
                     Ok(s) => vec![
                         name.to_string(),
                         rule.label().into(),
@@ -246,22 +351,32 @@ impl Experiment for Fig7 {
                 });
             }
         }
-        let compare =
-            |m: usize, a: usize, b: usize| Comparison::compute(&values[m][a], &values[m][b]);
-        let mut test_rows = Vec::new();
+        rows
+    }
+
+    /// Paired tests of every pair of rules on every measure.
+    fn test_rows(&self, rules: &[Box<dyn DecisionRule>]) -> Vec<Vec<String>> {
+        let mut rows = Vec::new();
         for (m, (name, _)) in METRICS.iter().enumerate() {
             for a in 0..rules.len() {
                 for b in a + 1..rules.len() {
-                    let c = compare(m, a, b);
-                    test_rows.push(vec![
+                    rows.push(vec![
                         name.to_string(),
                         format!("{} − {}", rules[a].label(), rules[b].label()),
-                        c.describe(),
+                        self.compare(m, a, b).describe(),
                     ]);
                 }
             }
         }
+        rows
+    }
 
+    /// One box panel per measure, one box per rule.
+    fn figure(
+        &self,
+        ctx: &Context,
+        rules: &[Box<dyn DecisionRule>],
+    ) -> Result<String, ReproduceError> {
         let panels: Vec<Panel> = METRICS
             .iter()
             .enumerate()
@@ -269,81 +384,19 @@ impl Experiment for Fig7 {
                 Panel::Boxes(BoxPanel {
                     title: format!("{name} of the chosen tool"),
                     y_label: if m == 2 {
-                        format!("{axis} = {} N m", dt_label(plan.perturbation))
+                        format!("{axis} = {} N m", dt_label(ctx.plan.perturbation))
                     } else {
                         axis.to_string()
                     },
                     groups: rules
                         .iter()
                         .enumerate()
-                        .map(|(r, rule)| {
-                            (short(rule.as_ref()), rule.colour(), present(&values[m][r]))
-                        })
+                        .map(|(r, rule)| (short(rule.as_ref()), rule.colour(), self.present(m, r)))
                         .collect(),
                 })
             })
             .collect();
-        let svg = plot::save(&ctx.path(SVG), &panels, (440, 440))?;
-
-        let verdicts = verdicts(&rules, &compare, plan.alpha);
-        let failed = done
-            .iter()
-            .map(|t| {
-                (0..t.tools.len())
-                    .filter(|&i| !t.error(i).is_empty())
-                    .count()
-            })
-            .sum();
-        let mut blocks = vec![
-            Block::p(format!(
-                "{} trials, each of {} random tools on task 2 (velocity). Every tool is simulated \
-                 without and with ΔT = {} N m; each rule picks a tool from the unperturbed \
-                 episodes ({}), and the chosen tools are compared on control confidence, task \
-                 error and sensitivity |task error(ΔT) − task error(0)|. Paired tests pair the \
-                 rules' tools trial by trial (a trial where both rules chose the same tool is a \
-                 zero difference).",
-                done.len(),
-                plan.fig7_tools,
-                dt_label(plan.perturbation),
-                rules
-                    .iter()
-                    .map(|r| r.label())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )),
-            files_block(
-                &[CSV.into(), CHOICES_CSV.into(), SVG.into()],
-                done.len() * plan.fig7_tools,
-                failed,
-                "tool rows, two episodes each, and one choice row per trial and rule",
-            ),
-            Block::table(
-                &["measure", "rule", "n", "mean ± sd", "median [q1, q3]"],
-                summary_rows,
-            ),
-            Block::table(&["measure", "difference", "paired tests"], test_rows),
-            Block::Figure {
-                file: SVG.into(),
-                caption: "The tools chosen by each rule: box plots (median, quartiles, whiskers \
-                          at 1.5 IQR, outliers as rings) with mean ± sd (triangle and bar) beside \
-                          each box. Compare with the paper's Fig. 7."
-                    .into(),
-                svg,
-            },
-        ];
-        blocks.extend(verdicts.into_iter().map(Block::Verdict));
-        Ok(Section {
-            id: self.id(),
-            title: self.title().into(),
-            blocks,
-            episodes: 2 * (done.len() * plan.fig7_tools) as u64,
-            rhs_evals: done
-                .iter()
-                .flat_map(|t| t.results.iter().chain(&t.perturbed))
-                .filter_map(|r| r.episode.as_ref().ok())
-                .map(|m| m.rhs_evals as u64)
-                .sum(),
-        })
+        Ok(plot::save(&ctx.path(SVG), &panels, (440, 440))?)
     }
 }
 

@@ -15,7 +15,7 @@ use crate::stats::summary;
 use crate::{Arm, Task, TaskKind};
 
 use super::batch::map_ordered;
-use super::common::{arm_cells, files_block, task_label};
+use super::common::{arm_cells, files_block, task_label, PAPER_TASKS};
 use super::csv::{Cell, CsvWriter};
 use super::report::{Block, Section};
 use super::verdict::{num, Correlation};
@@ -89,184 +89,52 @@ impl Experiment for MpcComparison {
     fn run(&self, ctx: &Context) -> Result<Section, ReproduceError> {
         let plan = ctx.plan;
         let tools = draw_tools(plan.mpc_tools, ctx.seed_for(self, "tools"));
-        let mpc = MpcOptions::default();
-        let dts = [0.0, plan.perturbation];
-        let items: Vec<(TaskKind, usize)> = TaskKind::ALL
-            .iter()
-            .flat_map(|&k| (0..tools.len()).map(move |i| (k, i)))
-            .collect();
-        let mut csv = CsvWriter::create(&ctx.path(CSV), &HEADER)?;
-        let results = map_ordered(
-            &items,
-            ctx.progress,
-            4,
-            |&(kind, i)| {
-                let task = Task::paper(kind);
-                let arm = tools[i];
-                let run = |controller: usize, dt: f64| {
-                    let options = ctx.perturbed(dt);
-                    let (values, time) = if controller == 0 {
-                        timed(|| {
-                            simulate(&arm, &task, &options)
-                                .map(|e| {
-                                    let m = e.metrics;
-                                    [m.task_error, m.cost_j, m.control_effort, m.free_energy]
-                                })
-                                .map_err(|e| e.to_string())
-                        })
-                    } else {
-                        timed(|| {
-                            simulate_mpc(&arm, &task, &options, &mpc)
-                                .map(|e| {
-                                    let m = e.metrics;
-                                    [m.task_error, m.cost_j, m.control_effort, m.free_energy]
-                                })
-                                .map_err(|e| e.to_string())
-                        })
-                    };
-                    Run { values, time }
-                };
-                Item {
-                    kind,
-                    tool: i,
-                    arm,
-                    logdet: crate::confidence::control_confidence(&arm, &task)
-                        .ok()
-                        .map(|c| c.logdet),
-                    runs: [
-                        [run(0, dts[0]), run(0, dts[1])],
-                        [run(1, dts[0]), run(1, dts[1])],
-                    ],
-                }
-            },
-            |item| {
-                for (c, name) in ["aic", "mpc"].iter().enumerate() {
-                    for (d, dt) in dts.iter().enumerate() {
-                        let r = &item.runs[c][d];
-                        let mut row = vec![Cell::from(item.kind.name()), Cell::from(item.tool)];
-                        row.extend(arm_cells(&item.arm));
-                        row.extend([Cell::from(item.logdet), Cell::from(*dt), Cell::from(*name)]);
-                        match &r.values {
-                            Ok(v) => row.extend([
-                                Cell::from(v[0]),
-                                Cell::from(v[1]),
-                                Cell::from(v[2]),
-                                Cell::from(""),
-                            ]),
-                            Err(e) => row.extend([
-                                Cell::Empty,
-                                Cell::Empty,
-                                Cell::Empty,
-                                Cell::from(e.as_str()),
-                            ]),
-                        }
-                        csv.row(row)?;
-                    }
-                }
-                Ok(())
-            },
-        )?;
-
-        let mut blocks = vec![Block::p(format!(
-            "The same {} random tools run each task under the paper's controller and under the MPC \
-             baseline (re-linearised at every step, offset-free disturbance observer, 1 s horizon, \
-             ±5 N m, control period 0.05 s), both on the paper's nonlinear plant, without and with a \
-             constant perturbation ΔT = {} N m. J* is the ∫J dt the MPC achieves; |Δ task error| is \
-             the change of task error under ΔT. Compute time is the wall time of one episode on one \
-             core (medians).",
-            tools.len(),
-            plan.perturbation
-        ))];
+        let results = run_both_controllers(ctx, &tools)?;
         let mut rows = Vec::new();
         let mut ranking = Vec::new();
         let mut episodes = 0u64;
-        for kind in TaskKind::ALL {
+        for kind in PAPER_TASKS {
             let of: Vec<&Item> = results.iter().filter(|r| r.kind == kind).collect();
             for (c, name) in ["active inference", "MPC (J*)"].iter().enumerate() {
-                let ok: Vec<&Item> = of
-                    .iter()
-                    .copied()
-                    .filter(|r| r.runs[c][0].values.is_ok())
-                    .collect();
-                let pick = |d: usize, k: usize| -> Vec<f64> {
-                    of.iter()
-                        .filter_map(|r| r.runs[c][d].values.as_ref().ok().map(|v| v[k]))
-                        .collect()
-                };
-                let change: Vec<f64> = of
-                    .iter()
-                    .filter_map(|r| match (&r.runs[c][0].values, &r.runs[c][1].values) {
-                        (Ok(a), Ok(b)) => Some((b[0] - a[0]).abs()),
-                        _ => None,
-                    })
-                    .collect();
-                let times: Vec<f64> = of
-                    .iter()
-                    .map(|r| r.runs[c][0].time.as_secs_f64() * 1e3)
-                    .collect();
-                let median = |v: &[f64]| {
-                    summary(v)
-                        .map(|s| num(s.median))
-                        .unwrap_or_else(|_| "n/a".into())
-                };
                 episodes += 2 * of.len() as u64;
-                rows.push(vec![
-                    task_label(kind),
-                    name.to_string(),
-                    format!("{}/{}", ok.len(), of.len()),
-                    median(&pick(0, 0)),
-                    median(&pick(0, 1)),
-                    median(&pick(0, 2)),
-                    median(&change),
-                    median(&times),
-                ]);
+                rows.push(controller_row(kind, name, c, &of));
             }
-            // Do ∫F (AIC, with confidence) and J* (MPC) rank the tools alike?
-            let pairs: Vec<(f64, f64)> = of
-                .iter()
-                .filter_map(|r| match (&r.runs[0][0].values, &r.runs[1][0].values) {
-                    (Ok(a), Ok(m)) => Some((a[3], m[1])),
-                    _ => None,
-                })
-                .collect();
-            let (x, y): (Vec<f64>, Vec<f64>) = pairs.into_iter().unzip();
             let seed = ctx.seed_for(self, &format!("bootstrap/{}", kind.name()));
-            let corr = Correlation::compute(&x, &y, plan.bootstrap_resamples, plan.level, seed);
             ranking.push(format!(
                 "{}: ∫F (AIC) against J* (MPC): {}",
                 task_label(kind),
-                corr.describe()
+                rank_agreement(&of, plan, seed).describe()
             ));
         }
-        blocks.push(Block::table(
-            &[
-                "task",
-                "controller",
-                "succeeded",
-                "median task error",
-                "median ∫J dt",
-                "median ∫|U|² dt",
-                "median |Δ task error|",
-                "median time per episode [ms]",
-            ],
-            rows,
-        ));
-        blocks.push(Block::p(
-            "Do the confidence-aware objective and the optimal-control baseline rank tools alike? \
-             Spearman's ρ between each tool's ∫F dt under active inference and its J* under MPC:",
-        ));
-        blocks.push(Block::Bullets(ranking));
         let failed = results
             .iter()
             .flat_map(|r| r.runs.iter().flatten())
             .filter(|r| r.values.is_err())
             .count();
-        blocks.push(files_block(
-            &[CSV.into()],
-            4 * results.len(),
-            failed,
-            "rows, one per task, tool, controller and ΔT",
-        ));
+        let blocks = vec![
+            Block::p(format!(
+                "The same {} random tools run each task under the paper's controller and under the MPC \
+                 baseline (re-linearised at every step, offset-free disturbance observer, 1 s horizon, \
+                 ±5 N m, control period 0.05 s), both on the paper's nonlinear plant, without and with a \
+                 constant perturbation ΔT = {} N m. J* is the ∫J dt the MPC achieves; |Δ task error| is \
+                 the change of task error under ΔT. Compute time is the wall time of one episode on one \
+                 core (medians).",
+                tools.len(),
+                plan.perturbation
+            )),
+            Block::table(&TABLE_HEADER, rows),
+            Block::p(
+                "Do the confidence-aware objective and the optimal-control baseline rank tools alike? \
+                 Spearman's ρ between each tool's ∫F dt under active inference and its J* under MPC:",
+            ),
+            Block::Bullets(ranking),
+            files_block(
+                &[CSV.into()],
+                4 * results.len(),
+                failed,
+                "rows, one per task, tool, controller and ΔT",
+            ),
+        ];
         Ok(Section {
             id: self.id(),
             title: self.title().into(),
@@ -275,4 +143,149 @@ impl Experiment for MpcComparison {
             rhs_evals: 0,
         })
     }
+}
+
+const TABLE_HEADER: [&str; 8] = [
+    "task",
+    "controller",
+    "succeeded",
+    "median task error",
+    "median ∫J dt",
+    "median ∫|U|² dt",
+    "median |Δ task error|",
+    "median time per episode [ms]",
+];
+
+/// Every tool on every paper task under both controllers, without and with ΔT; four CSV rows
+/// per (task, tool) as each finishes.
+fn run_both_controllers(ctx: &Context, tools: &[Arm]) -> Result<Vec<Item>, ReproduceError> {
+    let dts = [0.0, ctx.plan.perturbation];
+    let items: Vec<(TaskKind, usize)> = PAPER_TASKS
+        .iter()
+        .flat_map(|&k| (0..tools.len()).map(move |i| (k, i)))
+        .collect();
+    let mut csv = CsvWriter::create(&ctx.path(CSV), &HEADER)?;
+    map_ordered(
+        &items,
+        ctx.progress,
+        4,
+        |&(kind, i)| {
+            let task = Task::paper(kind);
+            let arm = tools[i];
+            let run = |controller: usize, dt: f64| run_one(ctx, &arm, &task, controller, dt);
+            Item {
+                kind,
+                tool: i,
+                arm,
+                logdet: crate::confidence::control_confidence(&arm, &task)
+                    .ok()
+                    .map(|c| c.logdet),
+                runs: [
+                    [run(0, dts[0]), run(0, dts[1])],
+                    [run(1, dts[0]), run(1, dts[1])],
+                ],
+            }
+        },
+        |item| write_item(&mut csv, item, &dts),
+    )
+}
+
+/// One timed episode: controller 0 is active inference, 1 the MPC baseline.
+fn run_one(ctx: &Context, arm: &Arm, task: &Task, controller: usize, dt: f64) -> Run {
+    let options = ctx.perturbed(dt);
+    let (values, time) = if controller == 0 {
+        timed(|| {
+            simulate(arm, task, &options)
+                .map(|e| {
+                    let m = e.metrics;
+                    [m.task_error, m.cost_j, m.control_effort, m.free_energy]
+                })
+                .map_err(|e| e.to_string())
+        })
+    } else {
+        timed(|| {
+            simulate_mpc(arm, task, &options, &MpcOptions::default())
+                .map(|e| {
+                    let m = e.metrics;
+                    [m.task_error, m.cost_j, m.control_effort, m.free_energy]
+                })
+                .map_err(|e| e.to_string())
+        })
+    };
+    Run { values, time }
+}
+
+fn write_item(csv: &mut CsvWriter, item: &Item, dts: &[f64; 2]) -> Result<(), ReproduceError> {
+    for (c, name) in ["aic", "mpc"].iter().enumerate() {
+        for (d, dt) in dts.iter().enumerate() {
+            let r = &item.runs[c][d];
+            let mut row = vec![Cell::from(item.kind.name()), Cell::from(item.tool)];
+            row.extend(arm_cells(&item.arm));
+            row.extend([Cell::from(item.logdet), Cell::from(*dt), Cell::from(*name)]);
+            match &r.values {
+                Ok(v) => row.extend([
+                    Cell::from(v[0]),
+                    Cell::from(v[1]),
+                    Cell::from(v[2]),
+                    Cell::from(""),
+                ]),
+                Err(e) => row.extend([
+                    Cell::Empty,
+                    Cell::Empty,
+                    Cell::Empty,
+                    Cell::from(e.as_str()),
+                ]),
+            }
+            csv.row(row)?;
+        }
+    }
+    Ok(())
+}
+
+/// One task's row for controller `c`: successes and medians.
+fn controller_row(kind: TaskKind, name: &str, c: usize, of: &[&Item]) -> Vec<String> {
+    let ok = of.iter().filter(|r| r.runs[c][0].values.is_ok()).count();
+    let pick = |d: usize, k: usize| -> Vec<f64> {
+        of.iter()
+            .filter_map(|r| r.runs[c][d].values.as_ref().ok().map(|v| v[k]))
+            .collect()
+    };
+    let change: Vec<f64> = of
+        .iter()
+        .filter_map(|r| match (&r.runs[c][0].values, &r.runs[c][1].values) {
+            (Ok(a), Ok(b)) => Some((b[0] - a[0]).abs()),
+            _ => None,
+        })
+        .collect();
+    let times: Vec<f64> = of
+        .iter()
+        .map(|r| r.runs[c][0].time.as_secs_f64() * 1e3)
+        .collect();
+    let median = |v: &[f64]| {
+        summary(v)
+            .map(|s| num(s.median))
+            .unwrap_or_else(|_| "n/a".into())
+    };
+    vec![
+        task_label(kind),
+        name.to_string(),
+        format!("{ok}/{}", of.len()),
+        median(&pick(0, 0)),
+        median(&pick(0, 1)),
+        median(&pick(0, 2)),
+        median(&change),
+        median(&times),
+    ]
+}
+
+/// Do ∫F (active inference, with confidence) and J* (MPC) rank the tools alike?
+fn rank_agreement(of: &[&Item], plan: &Plan, seed: u64) -> Correlation {
+    let (x, y): (Vec<f64>, Vec<f64>) = of
+        .iter()
+        .filter_map(|r| match (&r.runs[0][0].values, &r.runs[1][0].values) {
+            (Ok(a), Ok(m)) => Some((a[3], m[1])),
+            _ => None,
+        })
+        .unzip();
+    Correlation::compute(&x, &y, plan.bootstrap_resamples, plan.level, seed)
 }
