@@ -248,11 +248,7 @@ impl TaskSpec {
     /// A short name: the file, or the built-in task's name.
     pub fn label(&self) -> String {
         if self.file.is_empty() {
-            format!(
-                "{} (the paper's task {})",
-                self.kind,
-                self.kind.paper_index()
-            )
+            format!("{} (task {})", self.kind, self.kind.paper_index())
         } else {
             format!("{} ({})", self.file, self.kind)
         }
