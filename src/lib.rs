@@ -11,6 +11,7 @@
 //! Flow: model description → derivation → JSON IR → templates → generated code → this runtime.
 
 pub mod arm;
+pub mod design;
 pub mod closed_loop;
 pub mod confidence;
 pub mod error;

@@ -93,6 +93,30 @@ macro_rules! evaluator {
                         &matrix(i, "p_u"),
                     ))]
                 }
+                "position_logdet_gradient" => vec![m::position_logdet_gradient(
+                    &p(),
+                    &matrix(i, "p_theta"),
+                    &matrix(i, "p_theta_dot"),
+                    &matrix(i, "p_theta_ddot"),
+                    &matrix(i, "p_u"),
+                )
+                .as_slice()
+                .to_vec()],
+                "velocity_logdet_gradient" => vec![m::velocity_logdet_gradient(
+                    &p(),
+                    &matrix(i, "p_theta_dot"),
+                    &matrix(i, "p_theta_ddot"),
+                    &matrix(i, "p_u"),
+                )
+                .as_slice()
+                .to_vec()],
+                "acceleration_logdet_gradient" => vec![m::acceleration_logdet_gradient(
+                    &p(),
+                    &matrix(i, "p_theta_ddot"),
+                    &matrix(i, "p_u"),
+                )
+                .as_slice()
+                .to_vec()],
                 _ => return None,
             })
         }
