@@ -19,20 +19,39 @@ use toolconf::task_file::TaskSpec;
 use toolconf::TaskKind;
 
 fn design(c: &mut Criterion) {
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/design/reach_and_budget.toml")).unwrap();
-    let spec = DesignSpec::parse(&text, "reach_and_budget.toml", ModelKind::Arm2.parameter_names()).unwrap();
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/design/reach_and_budget.toml"
+    ))
+    .unwrap();
+    let spec = DesignSpec::parse(
+        &text,
+        "reach_and_budget.toml",
+        ModelKind::Arm2.parameter_names(),
+    )
+    .unwrap();
     let task = TaskSpec::builtin(TaskKind::Velocity);
     let tasks = ModelTasks::new(&task);
-    let setting = Setting { model: ModelKind::Arm2, task: &task, tasks: &tasks };
+    let setting = Setting {
+        model: ModelKind::Arm2,
+        task: &task,
+        tasks: &tasks,
+    };
     let polytope = Polytope::new(&spec);
     let tool = AnyTool::new(ModelKind::Arm2, &[0.3, 0.2, 0.4, 0.3]).unwrap();
     let mut group = c.benchmark_group("design");
     group.sample_size(20);
-    group.bench_function("optimum", |b| b.iter(|| confidence_optimum(black_box(&spec), &setting).unwrap()));
-    group.bench_function("random_100k", |b| {
-        b.iter(|| verify::random_tools(&polytope, ModelKind::Arm2, &tasks, 100_000, 5, black_box(1)))
+    group.bench_function("optimum", |b| {
+        b.iter(|| confidence_optimum(black_box(&spec), &setting).unwrap())
     });
-    group.bench_function("gradient", |b| b.iter(|| tasks.logdet_and_gradient(black_box(&tool)).unwrap()));
+    group.bench_function("random_100k", |b| {
+        b.iter(|| {
+            verify::random_tools(&polytope, ModelKind::Arm2, &tasks, 100_000, 5, black_box(1))
+        })
+    });
+    group.bench_function("gradient", |b| {
+        b.iter(|| tasks.logdet_and_gradient(black_box(&tool)).unwrap())
+    });
     group.finish();
 }
 

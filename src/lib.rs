@@ -11,9 +11,9 @@
 //! Flow: model description → derivation → JSON IR → templates → generated code → this runtime.
 
 pub mod arm;
-pub mod design;
 pub mod closed_loop;
 pub mod confidence;
+pub mod design;
 pub mod error;
 pub mod experiments;
 /// The code `make derive` writes into `generated/`, included unchanged: one module per model

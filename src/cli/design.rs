@@ -47,14 +47,26 @@ impl From<DesignError> for CliError {
 }
 
 pub fn run(args: &Args) -> Result<(), CliError> {
-    let model: ModelKind = args.model.parse().map_err(|e| CliError::Usage(format!("--model: {e}")))?;
+    let model: ModelKind = args
+        .model
+        .parse()
+        .map_err(|e| CliError::Usage(format!("--model: {e}")))?;
     let task = task_spec(&args.task)?;
     let tasks = ModelTasks::new(&task);
     tasks.check(model)?;
     let names: Vec<&'static str> = model.parameter_names().to_vec();
     let spec = DesignSpec::from_file(&args.design, &names)?;
-    let sweep = args.sweep.as_deref().map(|s| parse_sweep(s, &names)).transpose().map_err(CliError::Usage)?;
-    let setting = Setting { model, task: &task, tasks: &tasks };
+    let sweep = args
+        .sweep
+        .as_deref()
+        .map(|s| parse_sweep(s, &names))
+        .transpose()
+        .map_err(CliError::Usage)?;
+    let setting = Setting {
+        model,
+        task: &task,
+        tasks: &tasks,
+    };
     let started = Instant::now();
     let result = design(&spec, &setting)?;
     let elapsed = started.elapsed();
@@ -68,7 +80,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             model,
             args.task,
             args.design.display(),
-            args.sweep.as_ref().map(|s| format!(" --sweep '{s}'")).unwrap_or_default()
+            args.sweep
+                .as_ref()
+                .map(|s| format!(" --sweep '{s}'"))
+                .unwrap_or_default()
         );
         let input = ReportInput {
             command: &command,
@@ -100,7 +115,11 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             println!("\ntrade-off, {} b:", s.label);
             for p in points {
                 match &p.outcome {
-                    Ok((params, logdet, _)) => println!("  b = {:<8} ln|Pi^U| = {logdet:.6}  {}", p.value, parameters_text(&names, params)),
+                    Ok((params, logdet, _)) => println!(
+                        "  b = {:<8} ln|Pi^U| = {logdet:.6}  {}",
+                        p.value,
+                        parameters_text(&names, params)
+                    ),
                     Err(e) => println!("  b = {:<8} {e}", p.value),
                 }
             }
@@ -110,11 +129,23 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 }
 
 fn named(names: &[&str], values: &[f64]) -> Value {
-    Value::Object(names.iter().zip(values).map(|(n, v)| (n.to_string(), Value::from(*v))).collect::<Map<_, _>>())
+    Value::Object(
+        names
+            .iter()
+            .zip(values)
+            .map(|(n, v)| (n.to_string(), Value::from(*v)))
+            .collect::<Map<_, _>>(),
+    )
 }
 
 fn to_json(spec: &DesignSpec, r: &DesignResult) -> Value {
-    let free: Vec<&str> = spec.names.iter().zip(&spec.fixed).filter(|(_, f)| f.is_none()).map(|(n, _)| *n).collect();
+    let free: Vec<&str> = spec
+        .names
+        .iter()
+        .zip(&spec.fixed)
+        .filter(|(_, f)| f.is_none())
+        .map(|(n, _)| *n)
+        .collect();
     let o = &r.confidence_optimum;
     let verification: Vec<Value> = r
         .checks
@@ -157,24 +188,49 @@ fn to_json(spec: &DesignSpec, r: &DesignResult) -> Value {
 
 fn print_text(spec: &DesignSpec, r: &DesignResult, seconds: f64) {
     let o = &r.confidence_optimum;
-    println!("design ({}): {}", r.objective.name(), parameters_text(&spec.names, &r.params));
+    println!(
+        "design ({}): {}",
+        r.objective.name(),
+        parameters_text(&spec.names, &r.params)
+    );
     println!("  ln|Pi^U| = {:.6}   KKT residual {:.2e}   {} SQP iterations from start {}   gradient vs central differences {:.1e}", r.logdet, o.kkt_residual, o.iterations, o.start, r.gradient_check);
     if r.free_energy_evaluations > 0 {
-        println!("  free-energy search: {} episodes from the confidence optimum", r.free_energy_evaluations);
+        println!(
+            "  free-energy search: {} episodes from the confidence optimum",
+            r.free_energy_evaluations
+        );
     }
     println!("  time (design, random comparison and episodes): {seconds:.3} s");
     println!(
         "best of {} random feasible tools ({} draws): ln|Pi^U| = {}",
         r.random.feasible,
         r.random.drawn,
-        r.random.top.first().map_or("-".into(), |b| format!("{:.6}", b.1))
+        r.random
+            .top
+            .first()
+            .map_or("-".into(), |b| format!("{:.6}", b.1))
     );
-    println!("\n{:<10} {:>11} {:>14} {:>14} {:>14}  parameters", "tool", "ln|Pi^U|", "task error", "int F dt", format!("sens. dT={}", spec.search.perturbation));
+    println!(
+        "\n{:<10} {:>11} {:>14} {:>14} {:>14}  parameters",
+        "tool",
+        "ln|Pi^U|",
+        "task error",
+        "int F dt",
+        format!("sens. dT={}", spec.search.perturbation)
+    );
     for c in &r.checks {
         let cells = match &c.simulated {
-            Ok(m) => format!("{:>14.6e} {:>14.6e} {:>14.6e}", m.task_error, m.free_energy, m.sensitivity),
+            Ok(m) => format!(
+                "{:>14.6e} {:>14.6e} {:>14.6e}",
+                m.task_error, m.free_energy, m.sensitivity
+            ),
             Err(e) => format!("episode failed: {e}"),
         };
-        println!("{:<10} {:>11.6} {cells}  {}", c.label, c.logdet, parameters_text(&spec.names, &c.params));
+        println!(
+            "{:<10} {:>11.6} {cells}  {}",
+            c.label,
+            c.logdet,
+            parameters_text(&spec.names, &c.params)
+        );
     }
 }

@@ -118,7 +118,10 @@ fn parse_side(side: &str, names: &[&str]) -> Result<(Vec<f64>, f64), String> {
         match name {
             Some(name) => {
                 let k = names.iter().position(|n| *n == name).ok_or_else(|| {
-                    format!("unknown parameter '{name}' (parameters: {})", names.join(", "))
+                    format!(
+                        "unknown parameter '{name}' (parameters: {})",
+                        names.join(", ")
+                    )
                 })?;
                 coefficients[k] += sign * factor;
             }
@@ -196,7 +199,9 @@ fn tokenize(s: &str) -> Result<Vec<Token>, String> {
                 && (chars[i].is_ascii_digit()
                     || chars[i] == '.'
                     || ((chars[i] == 'e' || chars[i] == 'E')
-                        && chars.get(i + 1).is_some_and(|d| d.is_ascii_digit() || *d == '-' || *d == '+'))
+                        && chars
+                            .get(i + 1)
+                            .is_some_and(|d| d.is_ascii_digit() || *d == '-' || *d == '+'))
                     || ((chars[i] == '-' || chars[i] == '+') && matches!(chars[i - 1], 'e' | 'E')))
             {
                 i += 1;

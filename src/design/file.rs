@@ -108,8 +108,9 @@ impl DesignSpec {
     /// Reads and checks a design file for a model with parameters `names`.
     pub fn from_file(path: &Path, names: &[&'static str]) -> Result<Self, DesignError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| DesignError::input(&file, "", format!("cannot read the design file: {e}")))?;
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            DesignError::input(&file, "", format!("cannot read the design file: {e}"))
+        })?;
         Self::parse(&text, &file, names)
     }
 
@@ -120,7 +121,8 @@ impl DesignSpec {
             let place = line.map(|l| format!("line {l}")).unwrap_or_default();
             DesignError::input(file, &place, e.message().trim().replace('\n', " "))
         })?;
-        let err = |key: &str, message: String| DesignError::input(file, &format!("key {key}"), message);
+        let err =
+            |key: &str, message: String| DesignError::input(file, &format!("key {key}"), message);
         let objective = match raw.objective.as_deref() {
             None | Some("confidence") => DesignObjective::Confidence,
             Some("free_energy") | Some("free-energy") => DesignObjective::FreeEnergy,
@@ -133,14 +135,23 @@ impl DesignSpec {
         };
         let known = |key: String, name: &str| -> Result<usize, DesignError> {
             names.iter().position(|n| *n == name).ok_or_else(|| {
-                err(&key, format!("unknown parameter '{name}' (parameters: {})", names.join(", ")))
+                err(
+                    &key,
+                    format!(
+                        "unknown parameter '{name}' (parameters: {})",
+                        names.join(", ")
+                    ),
+                )
             })
         };
         let mut fixed = vec![None; names.len()];
         for (name, &value) in &raw.fixed {
             let k = known(format!("fixed.{name}"), name)?;
             if !(value.is_finite() && value > 0.0) {
-                return Err(err(&format!("fixed.{name}"), format!("{value} is not a positive number")));
+                return Err(err(
+                    &format!("fixed.{name}"),
+                    format!("{value} is not a positive number"),
+                ));
             }
             fixed[k] = Some(value);
         }
@@ -149,7 +160,10 @@ impl DesignSpec {
             let key = format!("bounds.{name}");
             let k = known(key.clone(), name)?;
             if fixed[k].is_some() {
-                return Err(err(&key, format!("'{name}' is also fixed; give one of the two")));
+                return Err(err(
+                    &key,
+                    format!("'{name}' is also fixed; give one of the two"),
+                ));
             }
             bounds[k] = Some(check_bounds(range).map_err(|m| err(&key, m))?);
         }
@@ -171,7 +185,8 @@ impl DesignSpec {
             .iter()
             .enumerate()
             .map(|(i, c)| {
-                parse_constraint(c, names).map_err(|m| err(&format!("constraints[{i}]"), format!("'{c}': {m}")))
+                parse_constraint(c, names)
+                    .map_err(|m| err(&format!("constraints[{i}]"), format!("'{c}': {m}")))
             })
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
@@ -181,7 +196,8 @@ impl DesignSpec {
             fixed,
             bounds: out,
             constraints,
-            search: search_settings(&raw.search).map_err(|(k, m)| err(&format!("search.{k}"), m))?,
+            search: search_settings(&raw.search)
+                .map_err(|(k, m)| err(&format!("search.{k}"), m))?,
         })
     }
 }

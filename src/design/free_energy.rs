@@ -27,14 +27,25 @@ pub struct FreeEnergyOptimum {
 
 fn free_energy(setting: &Setting, polytope: &Polytope, x: &[f64]) -> Option<f64> {
     let tool = AnyTool::new(setting.model, &polytope.full(x)).ok()?;
-    setting.tasks.simulate(&tool).ok().map(|m| m.free_energy).filter(|v| v.is_finite())
+    setting
+        .tasks
+        .simulate(&tool)
+        .ok()
+        .map(|m| m.free_energy)
+        .filter(|v| v.is_finite())
 }
 
 /// Compass search for the smallest ∫F dt from `start` (feasible).
-pub fn minimise(polytope: &Polytope, setting: &Setting, start: &[f64]) -> Result<FreeEnergyOptimum, DesignError> {
+pub fn minimise(
+    polytope: &Polytope,
+    setting: &Setting,
+    start: &[f64],
+) -> Result<FreeEnergyOptimum, DesignError> {
     let mut x = start.to_vec();
     let mut best = free_energy(setting, polytope, &x).ok_or_else(|| {
-        DesignError::Failed("the confidence optimum's episode fails, so ∫F dt cannot be searched from it".into())
+        DesignError::Failed(
+            "the confidence optimum's episode fails, so ∫F dt cannot be searched from it".into(),
+        )
     })?;
     let mut simulations = 1;
     let mut step = INITIAL_STEP;
@@ -49,7 +60,10 @@ pub fn minimise(polytope: &Polytope, setting: &Setting, start: &[f64]) -> Result
             .filter(|t| polytope.contains(t))
             .collect();
         simulations += trials.len();
-        let values: Vec<Option<f64>> = trials.par_iter().map(|t| free_energy(setting, polytope, t)).collect();
+        let values: Vec<Option<f64>> = trials
+            .par_iter()
+            .map(|t| free_energy(setting, polytope, t))
+            .collect();
         let improvement = values
             .iter()
             .enumerate()
@@ -67,5 +81,9 @@ pub fn minimise(polytope: &Polytope, setting: &Setting, start: &[f64]) -> Result
             None => step *= 0.5,
         }
     }
-    Ok(FreeEnergyOptimum { x, free_energy: best, simulations })
+    Ok(FreeEnergyOptimum {
+        x,
+        free_energy: best,
+        simulations,
+    })
 }

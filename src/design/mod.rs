@@ -71,7 +71,10 @@ impl<'a> Setting<'a> {
 
 /// The confidence optimum over the feasible set, from the centre and `search.starts` seeded
 /// random feasible starts.
-pub fn confidence_optimum(spec: &DesignSpec, setting: &Setting) -> Result<(Polytope, Optimum), DesignError> {
+pub fn confidence_optimum(
+    spec: &DesignSpec,
+    setting: &Setting,
+) -> Result<(Polytope, Optimum), DesignError> {
     let polytope = Polytope::new(spec);
     let mut starts = vec![polytope.centre(&spec.file)?];
     let mut sampler = FeasibleSampler::new(&polytope, spec.search.seed);
@@ -104,7 +107,8 @@ pub fn gradient_check(setting: &Setting, polytope: &Polytope, optimum: &Optimum)
         };
         if let (Some(plus), Some(minus)) = (at(h), at(-h)) {
             let fd = (plus - minus) / (2.0 * h);
-            worst = worst.max((optimum.gradient[j] - fd).abs() / optimum.gradient[j].abs().max(1.0));
+            worst =
+                worst.max((optimum.gradient[j] - fd).abs() / optimum.gradient[j].abs().max(1.0));
         }
     }
     worst
@@ -135,12 +139,21 @@ pub fn design(spec: &DesignSpec, setting: &Setting) -> Result<DesignResult, Desi
         DesignObjective::Confidence => (optimum.x.clone(), optimum.value, 0),
         DesignObjective::FreeEnergy => {
             let found = free_energy::minimise(&polytope, setting, &optimum.x)?;
-            let logdet = setting.confidence(&polytope, &found.x).map_or(f64::NAN, |v| v.0);
+            let logdet = setting
+                .confidence(&polytope, &found.x)
+                .map_or(f64::NAN, |v| v.0);
             (found.x, logdet, found.simulations)
         }
     };
     let s = &spec.search;
-    let random = verify::random_tools(&polytope, setting.model, setting.tasks, s.samples, s.simulate, s.seed ^ 0x9e37_79b9_7f4a_7c15);
+    let random = verify::random_tools(
+        &polytope,
+        setting.model,
+        setting.tasks,
+        s.samples,
+        s.simulate,
+        s.seed ^ 0x9e37_79b9_7f4a_7c15,
+    );
     let mut tools = vec![("design".to_string(), polytope.full(&x), logdet)];
     for (k, (xr, l)) in random.top.iter().enumerate().take(s.simulate) {
         tools.push((format!("random #{}", k + 1), polytope.full(xr), *l));

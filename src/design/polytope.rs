@@ -30,7 +30,9 @@ pub struct Polytope {
 
 impl Polytope {
     pub fn new(spec: &DesignSpec) -> Self {
-        let free: Vec<usize> = (0..spec.names.len()).filter(|&k| spec.fixed[k].is_none()).collect();
+        let free: Vec<usize> = (0..spec.names.len())
+            .filter(|&k| spec.fixed[k].is_none())
+            .collect();
         let base: Vec<f64> = spec.bounds.iter().map(|b| b.0).collect();
         let (mut g, mut h, mut text) = (Vec::new(), Vec::new(), Vec::new());
         for c in &spec.constraints {
@@ -133,7 +135,9 @@ impl Polytope {
                 }
             }
             QpOutcome::Infeasible => Err(self.infeasible(file)),
-            QpOutcome::Failed(m) => Err(DesignError::Failed(format!("finding a feasible design: {m}"))),
+            QpOutcome::Failed(m) => Err(DesignError::Failed(format!(
+                "finding a feasible design: {m}"
+            ))),
         }
     }
 

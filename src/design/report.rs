@@ -27,7 +27,12 @@ pub struct ReportInput<'a> {
 
 /// `m1=0.1 m2=0.4 …`.
 pub fn parameters_text(names: &[&str], params: &[f64]) -> String {
-    names.iter().zip(params).map(|(n, v)| format!("{n}={v:.6}")).collect::<Vec<_>>().join(" ")
+    names
+        .iter()
+        .zip(params)
+        .map(|(n, v)| format!("{n}={v:.6}"))
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 /// Writes the report into `dir` (created if needed); returns the files written.
@@ -91,7 +96,10 @@ pub fn write_report(dir: &Path, input: &ReportInput) -> Result<Vec<PathBuf>, Rep
         files.extend([dir.join(SWEEP_CSV), dir.join(SWEEP_SVG)]);
     }
     doc.push(Block::Heading(2, "How this was made".into()));
-    doc.push(Block::p(format!("Command: `{}`. The same file and seed give the same design.", input.command)));
+    doc.push(Block::p(format!(
+        "Command: `{}`. The same file and seed give the same design.",
+        input.command
+    )));
     write_atomically(&md, &to_markdown(&doc))?;
     write_atomically(&html, &to_html(&doc))?;
     Ok(files)
@@ -112,9 +120,17 @@ pub fn sweep_csv(names: &[&str], points: &[SweepPoint]) -> String {
     out
 }
 
-fn sweep_section(dir: &Path, spec: &DesignSpec, sweep: &Sweep, points: &[SweepPoint]) -> Result<Vec<Block>, ReproduceError> {
+fn sweep_section(
+    dir: &Path,
+    spec: &DesignSpec,
+    sweep: &Sweep,
+    points: &[SweepPoint],
+) -> Result<Vec<Block>, ReproduceError> {
     write_atomically(&dir.join(SWEEP_CSV), &sweep_csv(&spec.names, points))?;
-    let front: Vec<(f64, f64)> = points.iter().filter_map(|p| p.outcome.as_ref().ok().map(|o| (p.value, o.1))).collect();
+    let front: Vec<(f64, f64)> = points
+        .iter()
+        .filter_map(|p| p.outcome.as_ref().ok().map(|o| (p.value, o.1)))
+        .collect();
     let panel = XyPanel {
         title: format!("best confidence against the budget {} b", sweep.label),
         x_label: format!("b in {} b", sweep.label),

@@ -39,7 +39,11 @@ pub struct Optimum {
 
 /// The best local maximum over `starts` (ties: the earlier start), or None if φ is undefined at
 /// every start.
-pub fn maximise(polytope: &Polytope, starts: &[Vec<f64>], objective: &mut Objective) -> Option<Optimum> {
+pub fn maximise(
+    polytope: &Polytope,
+    starts: &[Vec<f64>],
+    objective: &mut Objective,
+) -> Option<Optimum> {
     let mut best: Option<Optimum> = None;
     for (k, x0) in starts.iter().enumerate() {
         if let Some(mut o) = climb(polytope, x0, objective) {
@@ -60,17 +64,40 @@ pub fn climb(polytope: &Polytope, x0: &[f64], objective: &mut Objective) -> Opti
     let mut x = x0.to_vec();
     let mut evaluations = 1;
     if n == 0 {
-        return Some(Optimum { x, value, gradient: grad, iterations: 0, evaluations, kkt_residual: 0.0, start: 0 });
+        return Some(Optimum {
+            x,
+            value,
+            gradient: grad,
+            iterations: 0,
+            evaluations,
+            kkt_residual: 0.0,
+            start: 0,
+        });
     }
-    let width = (0..n).map(|j| polytope.hi[j] - polytope.lo[j]).fold(0.0, f64::max).max(1e-12);
-    let mut b = identity(n, grad.iter().fold(0.0_f64, |m, v| m.max(v.abs())).max(1.0) / width);
+    let width = (0..n)
+        .map(|j| polytope.hi[j] - polytope.lo[j])
+        .fold(0.0, f64::max)
+        .max(1e-12);
+    let mut b = identity(
+        n,
+        grad.iter().fold(0.0_f64, |m, v| m.max(v.abs())).max(1.0) / width,
+    );
     let mut kkt = f64::INFINITY;
     let mut iterations = 0;
     while iterations < MAX_ITERATIONS {
         iterations += 1;
-        let slack: Vec<f64> = g_rows.iter().zip(&h).map(|(r, hi)| hi - dot(r, &x)).collect();
+        let slack: Vec<f64> = g_rows
+            .iter()
+            .zip(&h)
+            .map(|(r, hi)| hi - dot(r, &x))
+            .collect();
         let q: Vec<f64> = grad.iter().map(|v| -v).collect();
-        let (d, z) = match qp::solve(Some(&b), &q, &g_rows, &slack.iter().map(|s| s.max(0.0)).collect::<Vec<_>>()) {
+        let (d, z) = match qp::solve(
+            Some(&b),
+            &q,
+            &g_rows,
+            &slack.iter().map(|s| s.max(0.0)).collect::<Vec<_>>(),
+        ) {
             QpOutcome::Solved { x: d, z } => (d, z),
             _ => break,
         };
@@ -105,7 +132,15 @@ pub fn climb(polytope: &Polytope, x0: &[f64], objective: &mut Objective) -> Opti
             break;
         }
     }
-    Some(Optimum { x, value, gradient: grad, iterations, evaluations, kkt_residual: kkt, start: 0 })
+    Some(Optimum {
+        x,
+        value,
+        gradient: grad,
+        iterations,
+        evaluations,
+        kkt_residual: kkt,
+        start: 0,
+    })
 }
 
 /// max(‖∇φ − Gᵀz‖∞, max_i |z_i·slack_i|): stationarity and complementarity of the maximum.
@@ -113,15 +148,26 @@ fn kkt_residual(grad: &[f64], g_rows: &[Vec<f64>], z: &[f64], slack: &[f64]) -> 
     let n = grad.len();
     let mut stationarity = 0.0_f64;
     for j in 0..n {
-        let r = grad[j] - g_rows.iter().zip(z).map(|(row, zi)| row[j] * zi).sum::<f64>();
+        let r = grad[j]
+            - g_rows
+                .iter()
+                .zip(z)
+                .map(|(row, zi)| row[j] * zi)
+                .sum::<f64>();
         stationarity = stationarity.max(r.abs());
     }
-    let complementarity = z.iter().zip(slack).map(|(zi, s)| (zi * s).abs()).fold(0.0, f64::max);
+    let complementarity = z
+        .iter()
+        .zip(slack)
+        .map(|(zi, s)| (zi * s).abs())
+        .fold(0.0, f64::max);
     stationarity.max(complementarity)
 }
 
 fn identity(n: usize, scale: f64) -> Vec<Vec<f64>> {
-    (0..n).map(|i| (0..n).map(|j| if i == j { scale } else { 0.0 }).collect()).collect()
+    (0..n)
+        .map(|i| (0..n).map(|j| if i == j { scale } else { 0.0 }).collect())
+        .collect()
 }
 
 /// Powell's damped BFGS update of B with step s and gradient change y (of the minimised
@@ -134,8 +180,14 @@ fn damped_bfgs(b: &mut [Vec<f64>], s: &[f64], y: &[f64]) {
         return;
     }
     let sy = dot(s, y);
-    let theta = if sy >= 0.2 * sbs { 1.0 } else { 0.8 * sbs / (sbs - sy) };
-    let r: Vec<f64> = (0..n).map(|i| theta * y[i] + (1.0 - theta) * bs[i]).collect();
+    let theta = if sy >= 0.2 * sbs {
+        1.0
+    } else {
+        0.8 * sbs / (sbs - sy)
+    };
+    let r: Vec<f64> = (0..n)
+        .map(|i| theta * y[i] + (1.0 - theta) * bs[i])
+        .collect();
     let sr = dot(s, &r);
     if sr <= 1e-300 {
         return;
@@ -166,7 +218,10 @@ mod tests {
             text: vec!["x + 2y + 4z <= 1".into()],
         };
         let mut f = |x: &[f64]| -> Option<(f64, Vec<f64>)> {
-            Some((x.iter().map(|v| v.ln()).sum(), x.iter().map(|v| 1.0 / v).collect()))
+            Some((
+                x.iter().map(|v| v.ln()).sum(),
+                x.iter().map(|v| 1.0 / v).collect(),
+            ))
         };
         let start = polytope.centre("test").unwrap();
         let o = maximise(&polytope, &[start], &mut f).unwrap();

@@ -54,17 +54,28 @@ pub fn random_tools(
     let mut top: Vec<(Vec<f64>, f64)> = Vec::with_capacity(keep + 1);
     let mut feasible = 0;
     while feasible < n {
-        let Some(x) = sampler.next_point(max_draws) else { break };
+        let Some(x) = sampler.next_point(max_draws) else {
+            break;
+        };
         feasible += 1;
-        let Ok(tool) = AnyTool::new(model, &polytope.full(&x)) else { continue };
-        let Ok(logdet) = tasks.logdet(&tool) else { continue };
+        let Ok(tool) = AnyTool::new(model, &polytope.full(&x)) else {
+            continue;
+        };
+        let Ok(logdet) = tasks.logdet(&tool) else {
+            continue;
+        };
         let at = top.partition_point(|(_, v)| *v >= logdet);
         if at < keep.max(1) {
             top.insert(at, (x, logdet));
             top.truncate(keep.max(1));
         }
     }
-    RandomTools { requested: n, feasible, drawn: sampler.drawn, top }
+    RandomTools {
+        requested: n,
+        feasible,
+        drawn: sampler.drawn,
+        top,
+    }
 }
 
 /// The task with a constant torque ΔT added on every joint.
@@ -104,7 +115,9 @@ fn simulate(
 ) -> Result<Simulated, String> {
     let tool = AnyTool::new(model, params).map_err(|e| e.to_string())?;
     let m = nominal.simulate(&tool).map_err(|e| e.to_string())?;
-    let p = under_perturbation.simulate(&tool).map_err(|e| format!("under ΔT: {e}"))?;
+    let p = under_perturbation
+        .simulate(&tool)
+        .map_err(|e| format!("under ΔT: {e}"))?;
     Ok(Simulated {
         task_error: m.task_error,
         free_energy: m.free_energy,
