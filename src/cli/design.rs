@@ -169,6 +169,7 @@ fn to_json(spec: &DesignSpec, r: &DesignResult) -> Value {
         "objective": r.objective.name(),
         "params": named(&spec.names, &r.params),
         "logdet": r.logdet,
+        "confidence_optimum": {"params": named(&spec.names, &spec_params(spec, o)), "logdet": o.value},
         "gradient": named(&free, &o.gradient),
         "gradient_check": r.gradient_check,
         "kkt_residual": o.kkt_residual,
@@ -186,6 +187,11 @@ fn to_json(spec: &DesignSpec, r: &DesignResult) -> Value {
     })
 }
 
+/// The confidence optimum's full parameters (fixed ones in place).
+fn spec_params(spec: &DesignSpec, o: &toolconf::design::solver::Optimum) -> Vec<f64> {
+    toolconf::design::polytope::Polytope::new(spec).full(&o.x)
+}
+
 fn print_text(spec: &DesignSpec, r: &DesignResult, seconds: f64) {
     let o = &r.confidence_optimum;
     println!(
@@ -193,13 +199,16 @@ fn print_text(spec: &DesignSpec, r: &DesignResult, seconds: f64) {
         r.objective.name(),
         parameters_text(&spec.names, &r.params)
     );
-    println!("  ln|Pi^U| = {:.6}   KKT residual {:.2e}   {} SQP iterations from start {}   gradient vs central differences {:.1e}", r.logdet, o.kkt_residual, o.iterations, o.start, r.gradient_check);
+    println!("  ln|Pi^U| = {:.6}", r.logdet);
     if r.free_energy_evaluations > 0 {
         println!(
-            "  free-energy search: {} episodes from the confidence optimum",
-            r.free_energy_evaluations
+            "  free-energy search: {} episodes from the confidence optimum, {} (ln|Pi^U| = {:.6})",
+            r.free_energy_evaluations,
+            parameters_text(&spec.names, &spec_params(spec, o)),
+            o.value
         );
     }
+    println!("  confidence optimum: KKT residual {:.2e}, {} SQP iterations from start {}, gradient vs central differences {:.1e}", o.kkt_residual, o.iterations, o.start, r.gradient_check);
     println!("  time (design, random comparison and episodes): {seconds:.3} s");
     println!(
         "best of {} random feasible tools ({} draws): ln|Pi^U| = {}",
