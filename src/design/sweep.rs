@@ -49,8 +49,9 @@ pub fn parse_sweep(text: &str, names: &[&str]) -> Result<Sweep, String> {
     if !(2..=1000).contains(&k) {
         return Err(bad("K must be between 2 and 1000"));
     }
+    // Rounded to 12 decimals so that 0.3..0.9:7 gives 0.6, not 0.6000000000000001.
     let values: Vec<f64> = (0..k)
-        .map(|i| a + (b - a) * i as f64 / (k - 1) as f64)
+        .map(|i| ((a + (b - a) * i as f64 / (k - 1) as f64) * 1e12).round() / 1e12)
         .collect();
     let texts: Vec<String> = values
         .iter()
