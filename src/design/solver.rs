@@ -132,6 +132,32 @@ pub fn climb(polytope: &Polytope, x0: &[f64], objective: &mut Objective) -> Opti
             break;
         }
     }
+    // The QP's interior-point solution sits ~1e-14 inside an active bound: put it on the
+    // bound, so a design at the box's corner reads 0.1, not 0.10000000000000249.
+    let snapped: Vec<f64> = x
+        .iter()
+        .enumerate()
+        .map(|(j, &v)| {
+            let near = 1e-9 * width;
+            if (v - polytope.lo[j]).abs() <= near {
+                polytope.lo[j]
+            } else if (v - polytope.hi[j]).abs() <= near {
+                polytope.hi[j]
+            } else {
+                v
+            }
+        })
+        .collect();
+    if snapped != x && polytope.contains(&snapped) {
+        if let Some((v, g)) = objective(&snapped) {
+            evaluations += 1;
+            if v >= value - 1e-9 * value.abs().max(1.0) {
+                x = snapped;
+                value = v;
+                grad = g;
+            }
+        }
+    }
     Some(Optimum {
         x,
         value,
