@@ -188,6 +188,30 @@ pub fn task_control_confidence(
     }
 }
 
+/// d ln|Π^U| / dp of `task` for a tool (each task's `<task>_logdet_gradient` below), given
+/// the precisions of all four terms; a task reads only its own terms' ones.
+#[inline]
+#[must_use]
+#[allow(unused_variables)]
+pub fn task_logdet_gradient(
+    task: super::TaskKind,
+    params: &SVector<f64, PARAMETER_COUNT>,
+    p_theta: &SMatrix<f64, DOF, DOF>,
+    p_theta_dot: &SMatrix<f64, DOF, DOF>,
+    p_theta_ddot: &SMatrix<f64, DOF, DOF>,
+    p_u: &SMatrix<f64, DOF, DOF>,
+) -> SVector<f64, PARAMETER_COUNT> {
+    match task {
+        super::TaskKind::Position => {
+            position_logdet_gradient(params, p_theta, p_theta_dot, p_theta_ddot, p_u)
+        }
+        super::TaskKind::Velocity => {
+            velocity_logdet_gradient(params, p_theta_dot, p_theta_ddot, p_u)
+        }
+        super::TaskKind::Acceleration => acceleration_logdet_gradient(params, p_theta_ddot, p_u),
+    }
+}
+
 /// The parameter-only factors of [`dynamics`], computed once per tool: [`dynamics_with`]
 /// then only combines them with the state and control (derive/toolconf_derive/hoist.py).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -565,6 +589,181 @@ pub fn position_control_confidence(
     pi_u
 }
 
+/// Task 1 (position control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
+/// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
+/// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+///
+/// Cost per call: 380 operations, weighted 634 (34 ADD, 35 DIV, 244 MUL, 9 NEG, 9 POW, 49 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn position_logdet_gradient(
+    params: &SVector<f64, 4>,
+    p_theta: &SMatrix<f64, 2, 2>,
+    p_theta_dot: &SMatrix<f64, 2, 2>,
+    p_theta_ddot: &SMatrix<f64, 2, 2>,
+    p_u: &SMatrix<f64, 2, 2>,
+) -> SVector<f64, 4> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let l1 = params[2];
+    let l2 = params[3];
+    let p_theta_00 = p_theta[(0, 0)];
+    let p_theta_01 = p_theta[(0, 1)];
+    let p_theta_11 = p_theta[(1, 1)];
+    let p_theta_dot_00 = p_theta_dot[(0, 0)];
+    let p_theta_dot_01 = p_theta_dot[(0, 1)];
+    let p_theta_dot_11 = p_theta_dot[(1, 1)];
+    let p_theta_ddot_00 = p_theta_ddot[(0, 0)];
+    let p_theta_ddot_01 = p_theta_ddot[(0, 1)];
+    let p_theta_ddot_11 = p_theta_ddot[(1, 1)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_11 = p_u[(1, 1)];
+    let t0 = 1.0 / g;
+    let t1 = p_theta_01 * t0;
+    let t2 = 1.0 / m2;
+    let t3 = (2.0 / 3.0) * t2;
+    let t4 = 1.0 / l2;
+    let t5 = l2.powi(2);
+    let t6 = m2 * t5 - 3.0;
+    let t7 = t4 * t6;
+    let t8 = t3 * t7;
+    let t9 = m1 + 2.0 * m2;
+    let t10 = 1.0 / t9;
+    let t11 = t0 * t10;
+    let t12 = 1.0 / l1;
+    let t13 = l1 * m2;
+    let t14 = l2 * t13 + 2.0;
+    let t15 = t12 * t14;
+    let t16 = t11 * t15;
+    let t17 = -p_theta_00 * t16 - t1 * t8;
+    let t18 = t11 * t17;
+    let t19 = l1.powi(2);
+    let t20 = m1 * t19 + 3.0 * m2 * t19 - 3.0;
+    let t21 = (2.0 / 3.0) * t12;
+    let t22 = t20 * t21;
+    let t23 = p_theta_ddot_01 + p_theta_dot_01 + p_u_01;
+    let t24 = -t18 * t22 + t23;
+    let t25 = t9.powi(-2);
+    let t26 = t20 * t25;
+    let t27 = 1.0 / t19;
+    let t28 = g.powi(-2);
+    let t29 = p_theta_00 * t28;
+    let t30 = t27 * t29;
+    let t31 = (2.0 / 3.0) * t14;
+    let t32 = t30 * t31;
+    let t33 = p_theta_01 * t28;
+    let t34 = t10 * t33;
+    let t35 = t20 * t34;
+    let t36 = t12 * t35;
+    let t37 = (4.0 / 9.0) * t2;
+    let t38 = t37 * t7;
+    let t39 = t23 + t26 * t32 + t36 * t38;
+    let t40 = t20.powi(2);
+    let t41 = t25 * t40;
+    let t42 = (4.0 / 9.0) * t30;
+    let t43 = p_theta_ddot_00 + p_theta_dot_00 + p_u_00 + t41 * t42;
+    let t44 = t0 * t8;
+    let t45 = -p_theta_01 * t16 - p_theta_11 * t44;
+    let t46 = p_theta_ddot_11 + p_theta_dot_11 + p_u_11 - t16 * t17 - t44 * t45;
+    let t47 = 1.0 / (-t24 * t39 + t43 * t46);
+    let t48 = t9.powi(-3);
+    let t49 = t30 * t48;
+    let t50 = (8.0 / 9.0) * t29;
+    let t51 = -t24;
+    let t52 = t25 * t29;
+    let t53 = l1 * t34;
+    let t54 = t20 * t49;
+    let t55 = t14 * t54;
+    let t56 = t12 * t26 * t33;
+    let t57 = -t39;
+    let t58 = l1 * t18;
+    let t59 = t26 * t29;
+    let t60 = l2 * t3;
+    let t61 = l2 * p_theta_00;
+    let t62 = t11 * t61;
+    let t63 = m2.powi(-2);
+    let t64 = 2.0 * p_theta_00 * t0 * t12 * t14 * t25
+        + (2.0 / 3.0) * p_theta_01 * t0 * t4 * t6 * t63
+        - t1 * t60
+        - t62;
+    let t65 = t11 * t22;
+    let t66 = t2 * t7;
+    let t67 = t28 * t61;
+    let t68 = t36 * t37;
+    let t69 = t0 * t60;
+    let t70 = l2 * t11;
+    let t71 = t17 * t70;
+    let t72 = p_theta_01 * t70;
+    let t73 = l1.powi(-3);
+    let t74 = l1 * m1;
+    let t75 = 6.0 * t13 + 2.0 * t74;
+    let t76 = m2 * t12;
+    let t77 = p_theta_00 * t0 * t10 * t14 * t27 - t62 * t76;
+    let t78 = (4.0 / 3.0) * t0;
+    let t79 = m2 * t11;
+    let t80 = 1.0 / t5;
+    let t81 = -p_theta_00 * t79 + (2.0 / 3.0) * p_theta_01 * t0 * t2 * t6 * t80 - p_theta_01 * t78;
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 4>>::zeros();
+    gradient[0] = t47
+        * (t43 * (t0 * t12 * t14 * t17 * t25 - t14.powi(2) * t49 - t15 * t25 * t33 * t8)
+            + t46 * (t26 * t50 - t27 * t40 * t48 * t50)
+            + t51 * (t31 * t52 + t38 * t53 - t38 * t56 - (4.0 / 3.0) * t55)
+            + t57 * ((2.0 / 3.0) * t0 * t12 * t17 * t20 * t25 - t31 * t54 - (2.0 / 3.0) * t58));
+    gradient[1] = t47
+        * (t43
+            * (2.0 * t0 * t12 * t14 * t17 * t25 + (2.0 / 3.0) * t0 * t4 * t45 * t6 * t63
+                - t16 * t64
+                - t44
+                    * (2.0 * p_theta_01 * t0 * t12 * t14 * t25
+                        + (2.0 / 3.0) * p_theta_11 * t0 * t4 * t6 * t63
+                        - p_theta_11 * t69
+                        - t72)
+                - t45 * t69
+                - t71)
+            + t46 * (-(16.0 / 9.0) * t40 * t49 + (8.0 / 3.0) * t59)
+            + t51
+                * (l2 * t68 + 2.0 * t14 * t52 + t21 * t26 * t67 - (4.0 / 9.0) * t36 * t63 * t7
+                    + (4.0 / 3.0) * t53 * t66
+                    - (8.0 / 3.0) * t55
+                    - (8.0 / 9.0) * t56 * t66)
+            + t57 * ((4.0 / 3.0) * t0 * t12 * t17 * t20 * t25 - 2.0 * t58 - t64 * t65));
+    gradient[2] = t47
+        * (t43
+            * (t0 * t10 * t14 * t17 * t27
+                - t16 * t77
+                - t44 * (p_theta_01 * t0 * t10 * t14 * t27 - t72 * t76)
+                - t71 * t76)
+            + t46 * (t26 * t42 * (12.0 * t13 + 4.0 * t74) - t41 * t50 * t73)
+            + t51
+                * ((2.0 / 3.0) * m2 * t26 * t27 * t67 + t12 * t34 * t38 * t75
+                    - (4.0 / 3.0) * t14 * t59 * t73
+                    + t25 * t32 * t75
+                    - t27 * t35 * t38)
+            + t57 * ((2.0 / 3.0) * t0 * t10 * t17 * t20 * t27 - t18 * t21 * t75 - t65 * t77));
+    gradient[3] = t47
+        * (t43
+            * ((2.0 / 3.0) * t0 * t2 * t45 * t6 * t80
+                - t16 * t81
+                - t17 * t79
+                - t44
+                    * (-p_theta_01 * t79 + (2.0 / 3.0) * p_theta_11 * t0 * t2 * t6 * t80
+                        - p_theta_11 * t78)
+                - t45 * t78)
+            + t51 * (m2 * t21 * t59 + (8.0 / 9.0) * t36 - t6 * t68 * t80)
+            - t57 * t65 * t81);
+    gradient
+}
+
 /// Task 2 (velocity control): the sensitivities d(task variable)/dU the controller uses, in the order (d_theta_dot_du, d_theta_ddot_du).
 ///
 /// From appendix "Task specific controllers".
@@ -647,6 +846,122 @@ pub fn velocity_control_confidence(
     pi_u
 }
 
+/// Task 2 (velocity control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
+/// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+///
+/// Cost per call: 171 operations, weighted 228 (15 ADD, 7 DIV, 107 MUL, 9 NEG, 8 POW, 25 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn velocity_logdet_gradient(
+    params: &SVector<f64, 4>,
+    p_theta_dot: &SMatrix<f64, 2, 2>,
+    p_theta_ddot: &SMatrix<f64, 2, 2>,
+    p_u: &SMatrix<f64, 2, 2>,
+) -> SVector<f64, 4> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let l1 = params[2];
+    let l2 = params[3];
+    let p_theta_dot_00 = p_theta_dot[(0, 0)];
+    let p_theta_dot_01 = p_theta_dot[(0, 1)];
+    let p_theta_dot_11 = p_theta_dot[(1, 1)];
+    let p_theta_ddot_00 = p_theta_ddot[(0, 0)];
+    let p_theta_ddot_01 = p_theta_ddot[(0, 1)];
+    let p_theta_ddot_11 = p_theta_ddot[(1, 1)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_11 = p_u[(1, 1)];
+    let t0 = m1 + 2.0 * m2;
+    let t1 = t0.powi(-2);
+    let t2 = 4.0 * t1;
+    let t3 = g.powi(-2);
+    let t4 = l1.powi(-2);
+    let t5 = p_theta_dot_00 * t3 * t4;
+    let t6 = t2 * t5;
+    let t7 = 1.0 / l1;
+    let t8 = 1.0 / t0;
+    let t9 = t7 * t8;
+    let t10 = 4.0 * t3;
+    let t11 = 1.0 / l2;
+    let t12 = 1.0 / m2;
+    let t13 = p_theta_dot_01 * t12;
+    let t14 = t11 * t13;
+    let t15 = t10 * t14;
+    let t16 = p_theta_ddot_01 + p_u_01;
+    let t17 = t15 * t9 + t16 - t6;
+    let t18 = 1.0 / g;
+    let t19 = 2.0 * t18;
+    let t20 = t11 * t19;
+    let t21 = t19 * t9;
+    let t22 = -p_theta_dot_00 * t21 + t13 * t20;
+    let t23 = t21 * t22;
+    let t24 = t16 + t23;
+    let t25 = p_theta_ddot_00 + p_u_00 + t6;
+    let t26 = t12 * t20;
+    let t27 = -p_theta_dot_01 * t21 + p_theta_dot_11 * t26;
+    let t28 = p_theta_ddot_11 + p_u_11 - t23 + t26 * t27;
+    let t29 = 1.0 / (-t17 * t24 + t25 * t28);
+    let t30 = t0.powi(-3);
+    let t31 = t2 * t3;
+    let t32 = t14 * t7;
+    let t33 = t31 * t32;
+    let t34 = -t24;
+    let t35 = t30 * t5;
+    let t36 = t22 * t7;
+    let t37 = t1 * t19 * t36 - 4.0 * t35;
+    let t38 = -t17;
+    let t39 = m2.powi(-2);
+    let t40 = t10 * t39;
+    let t41 = 8.0 * t1 * t3;
+    let t42 = t18 * t2 * t36;
+    let t43 = t20 * t39;
+    let t44 = t21 * (4.0 * p_theta_dot_00 * t1 * t18 * t7 - p_theta_dot_01 * t43);
+    let t45 = l1.powi(-3);
+    let t46 = t4 * t8;
+    let t47 = t15 * t46;
+    let t48 = p_theta_dot_00 * t45;
+    let t49 = t19 * t22 * t46 - t31 * t48;
+    let t50 = l2.powi(-2);
+    let t51 = t10 * t13 * t50 * t9;
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 4>>::zeros();
+    gradient[0] = t29
+        * (t25 * (t33 + t37) - 8.0 * t28 * t35
+            + t34 * (8.0 * p_theta_dot_00 * t3 * t30 * t4 - t33)
+            - t37 * t38);
+    gradient[1] = t29
+        * (t25
+            * (t26 * (4.0 * p_theta_dot_01 * t1 * t18 * t7 - p_theta_dot_11 * t43) - t27 * t43
+                + t42
+                - t44)
+            - 16.0 * t28 * t35
+            + t34
+                * (16.0 * p_theta_dot_00 * t3 * t30 * t4
+                    - p_theta_dot_01 * t11 * t40 * t9
+                    - t32 * t41)
+            + t38 * (-t42 + t44));
+    gradient[2] = t29
+        * (t25 * (t47 + t49) - t28 * t41 * t48
+            + t34 * (8.0 * p_theta_dot_00 * t1 * t3 * t45 - t47)
+            - t38 * t49);
+    gradient[3] = t29
+        * (t25
+            * (4.0 * p_theta_dot_01 * t12 * t3 * t50 * t7 * t8
+                - t12 * t19 * t27 * t50
+                - p_theta_dot_11 * t40 / l2.powi(3))
+            - t34 * t51
+            - t38 * t51);
+    gradient
+}
+
 /// Task 3 (acceleration control): the sensitivities d(task variable)/dU the controller uses, in the order (d_theta_ddot_du).
 ///
 /// From appendix "Task specific controllers".
@@ -695,4 +1010,26 @@ pub fn acceleration_control_confidence(
     pi_u[(1, 1)] = p_theta_ddot_11 + p_u_11;
     pi_u[(1, 0)] = pi_u[(0, 1)];
     pi_u
+}
+
+/// Task 3 (acceleration control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+///
+/// Cost per call: 0 operations, weighted 0.
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn acceleration_logdet_gradient(
+    _params: &SVector<f64, 4>,
+    _p_theta_ddot: &SMatrix<f64, 2, 2>,
+    _p_u: &SMatrix<f64, 2, 2>,
+) -> SVector<f64, 4> {
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let gradient = <SVector<f64, 4>>::zeros();
+    gradient
 }

@@ -188,6 +188,30 @@ pub fn task_control_confidence(
     }
 }
 
+/// d ln|Π^U| / dp of `task` for a tool (each task's `<task>_logdet_gradient` below), given
+/// the precisions of all four terms; a task reads only its own terms' ones.
+#[inline]
+#[must_use]
+#[allow(unused_variables)]
+pub fn task_logdet_gradient(
+    task: super::TaskKind,
+    params: &SVector<f64, PARAMETER_COUNT>,
+    p_theta: &SMatrix<f64, DOF, DOF>,
+    p_theta_dot: &SMatrix<f64, DOF, DOF>,
+    p_theta_ddot: &SMatrix<f64, DOF, DOF>,
+    p_u: &SMatrix<f64, DOF, DOF>,
+) -> SVector<f64, PARAMETER_COUNT> {
+    match task {
+        super::TaskKind::Position => {
+            position_logdet_gradient(params, p_theta, p_theta_dot, p_theta_ddot, p_u)
+        }
+        super::TaskKind::Velocity => {
+            velocity_logdet_gradient(params, p_theta_dot, p_theta_ddot, p_u)
+        }
+        super::TaskKind::Acceleration => acceleration_logdet_gradient(params, p_theta_ddot, p_u),
+    }
+}
+
 /// The parameter-only factors of [`dynamics`], computed once per tool: [`dynamics_with`]
 /// then only combines them with the state and control (derive/toolconf_derive/hoist.py).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -638,6 +662,178 @@ pub fn position_control_confidence(
     pi_u
 }
 
+/// Task 1 (position control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
+/// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
+/// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+///
+/// Cost per call: 448 operations, weighted 721 (25 ADD, 38 DIV, 290 MUL, 10 NEG, 7 POW, 78 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn position_logdet_gradient(
+    params: &SVector<f64, 4>,
+    p_theta: &SMatrix<f64, 2, 2>,
+    p_theta_dot: &SMatrix<f64, 2, 2>,
+    p_theta_ddot: &SMatrix<f64, 2, 2>,
+    p_u: &SMatrix<f64, 2, 2>,
+) -> SVector<f64, 4> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let l1 = params[2];
+    let l2 = params[3];
+    let p_theta_00 = p_theta[(0, 0)];
+    let p_theta_01 = p_theta[(0, 1)];
+    let p_theta_11 = p_theta[(1, 1)];
+    let p_theta_dot_00 = p_theta_dot[(0, 0)];
+    let p_theta_dot_01 = p_theta_dot[(0, 1)];
+    let p_theta_dot_11 = p_theta_dot[(1, 1)];
+    let p_theta_ddot_00 = p_theta_ddot[(0, 0)];
+    let p_theta_ddot_01 = p_theta_ddot[(0, 1)];
+    let p_theta_ddot_11 = p_theta_ddot[(1, 1)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_11 = p_u[(1, 1)];
+    let t0 = 1.0 / g;
+    let t1 = p_theta_11 * t0;
+    let t2 = m1 + 2.0 * m2;
+    let t3 = 1.0 / t2;
+    let t4 = 1.0 / l1;
+    let t5 = p_theta_01 * t0;
+    let t6 = t4 * t5;
+    let t7 = l1.powi(2);
+    let t8 = m1 * t7 + 3.0 * m2 * t7 - 3.0;
+    let t9 = (2.0 / 3.0) * t8;
+    let t10 = -l1 * t1 - t3 * t6 * t9;
+    let t11 = t0 * t10;
+    let t12 = l1 * t5;
+    let t13 = p_theta_00 * t3;
+    let t14 = t0 * t4;
+    let t15 = t14 * t9;
+    let t16 = -t12 - t13 * t15;
+    let t17 = t16 * t3;
+    let t18 = -l1 * t11 + p_theta_ddot_00 + p_theta_dot_00 + p_u_00 - t15 * t17;
+    let t19 = 1.0 / m2;
+    let t20 = (2.0 / 3.0) * t19;
+    let t21 = 1.0 / l2;
+    let t22 = l2.powi(2);
+    let t23 = m2 * t22 - 3.0;
+    let t24 = t20 * t21 * t23;
+    let t25 = l1 * m2;
+    let t26 = l2 * t25 + 2.0;
+    let t27 = -t1 * t24 - t26 * t3 * t6;
+    let t28 = t0 * t27;
+    let t29 = t14 * t26;
+    let t30 = -t13 * t29 - t24 * t5;
+    let t31 = t29 * t3;
+    let t32 = p_theta_ddot_11 + p_theta_dot_11 + p_u_11 - t24 * t28 - t30 * t31;
+    let t33 = p_theta_ddot_01 + p_theta_dot_01 + p_u_01;
+    let t34 = -t11 * t24 - t16 * t31 + t33;
+    let t35 = t3 * t30;
+    let t36 = -l1 * t28 - t15 * t35 + t33;
+    let t37 = 1.0 / (t18 * t32 - t34 * t36);
+    let t38 = g.powi(-2);
+    let t39 = 1.0 / t7;
+    let t40 = p_theta_00 * t38 * t39 / t2.powi(3);
+    let t41 = t2.powi(-2);
+    let t42 = p_theta_01 * t26 * t38 * t41;
+    let t43 = -t34;
+    let t44 = l1 * t0;
+    let t45 = (2.0 / 3.0) * t44;
+    let t46 = t3 * t45;
+    let t47 = -t36;
+    let t48 = t12 * t3;
+    let t49 = (2.0 / 3.0) * p_theta_01 * t0 * t4 * t41 * t8 - (2.0 / 3.0) * t48;
+    let t50 = t0 * t24;
+    let t51 = (2.0 / 3.0) * p_theta_00 * t0 * t4 * t41 * t8 - t13 * t45;
+    let t52 = t15 * t3;
+    let t53 = (4.0 / 3.0) * p_theta_01 * t0 * t4 * t41 * t8 - 2.0 * t48;
+    let t54 = 2.0 * t44;
+    let t55 = (4.0 / 3.0) * p_theta_00 * t0 * t4 * t41 * t8 - t13 * t54;
+    let t56 = l2 * t20;
+    let t57 = l2 * t3;
+    let t58 = t5 * t57;
+    let t59 = m2.powi(-2);
+    let t60 = 2.0 * p_theta_01 * t0 * t26 * t4 * t41
+        + (2.0 / 3.0) * p_theta_11 * t0 * t21 * t23 * t59
+        - t1 * t56
+        - t58;
+    let t61 = t0 * t57;
+    let t62 = p_theta_00 * t61;
+    let t63 = 2.0 * p_theta_00 * t0 * t26 * t4 * t41
+        + (2.0 / 3.0) * p_theta_01 * t0 * t21 * t23 * t59
+        - t5 * t56
+        - t62;
+    let t64 = t16 * t61;
+    let t65 = t30 * t61;
+    let t66 = m2 * t4;
+    let t67 = p_theta_01 * t0 * t26 * t3 * t39 - t58 * t66;
+    let t68 = p_theta_00 * t0 * t26 * t3 * t39 - t62 * t66;
+    let t69 = (4.0 / 3.0) * l1 * m1 + 4.0 * t25;
+    let t70 = (2.0 / 3.0) * p_theta_01 * t0 * t3 * t39 * t8 - t1 - t3 * t6 * t69;
+    let t71 = t14 * t69;
+    let t72 = (2.0 / 3.0) * p_theta_00 * t0 * t3 * t39 * t8 - t13 * t71 - t5;
+    let t73 = m2 * t3;
+    let t74 = 1.0 / t22;
+    let t75 = (2.0 / 3.0) * p_theta_11 * t0 * t19 * t23 * t74 - (4.0 / 3.0) * t1 - t5 * t73;
+    let t76 = t0 * t73;
+    let t77 =
+        -p_theta_00 * t76 + (2.0 / 3.0) * p_theta_01 * t0 * t19 * t23 * t74 - (4.0 / 3.0) * t5;
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 4>>::zeros();
+    gradient[0] = t37
+        * (t18 * (t0 * t26 * t30 * t4 * t41 - t24 * t4 * t42 - t26.powi(2) * t40)
+            + t32 * ((2.0 / 3.0) * t0 * t16 * t4 * t41 * t8 - t16 * t46 - t44 * t49 - t51 * t52)
+            + t43 * ((2.0 / 3.0) * t0 * t30 * t4 * t41 * t8 - t26 * t40 * t9 - t30 * t46 - t42)
+            + t47 * (t0 * t16 * t26 * t4 * t41 - t31 * t51 - t49 * t50));
+    gradient[1] = t37
+        * (t18
+            * ((2.0 / 3.0) * t0 * t21 * t23 * t27 * t59 + 2.0 * t0 * t26 * t30 * t4 * t41
+                - t28 * t56
+                - t31 * t63
+                - t50 * t60
+                - t65)
+            + t32 * ((4.0 / 3.0) * t0 * t16 * t4 * t41 * t8 - t17 * t54 - t44 * t53 - t52 * t55)
+            + t43 * ((4.0 / 3.0) * t0 * t30 * t4 * t41 * t8 - t35 * t54 - t44 * t60 - t52 * t63)
+            + t47
+                * ((2.0 / 3.0) * t0 * t10 * t21 * t23 * t59 + 2.0 * t0 * t16 * t26 * t4 * t41
+                    - t11 * t56
+                    - t31 * t55
+                    - t50 * t53
+                    - t64));
+    gradient[2] = t37
+        * (t18 * (t0 * t26 * t3 * t30 * t39 - t31 * t68 - t50 * t67 - t65 * t66)
+            + t32
+                * ((2.0 / 3.0) * t0 * t16 * t3 * t39 * t8
+                    - t11
+                    - t17 * t71
+                    - t44 * t70
+                    - t52 * t72)
+            + t43
+                * ((2.0 / 3.0) * t0 * t3 * t30 * t39 * t8
+                    - t28
+                    - t35 * t71
+                    - t44 * t67
+                    - t52 * t68)
+            + t47 * (t0 * t16 * t26 * t3 * t39 - t31 * t72 - t50 * t70 - t64 * t66));
+    gradient[3] = t37
+        * (t18
+            * ((2.0 / 3.0) * t0 * t19 * t23 * t27 * t74
+                - (4.0 / 3.0) * t28
+                - t30 * t76
+                - t31 * t77
+                - t50 * t75)
+            + t43 * (-t44 * t75 - t52 * t77)
+            + t47 * ((2.0 / 3.0) * t0 * t10 * t19 * t23 * t74 - (4.0 / 3.0) * t11 - t16 * t76));
+    gradient
+}
+
 /// Task 2 (velocity control): the sensitivities d(task variable)/dU the controller uses, in the order (d_theta_dot_du, d_theta_ddot_du).
 ///
 /// From appendix "Task specific controllers".
@@ -720,6 +916,122 @@ pub fn velocity_control_confidence(
     pi_u
 }
 
+/// Task 2 (velocity control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
+/// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+///
+/// Cost per call: 171 operations, weighted 228 (15 ADD, 7 DIV, 107 MUL, 9 NEG, 8 POW, 25 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn velocity_logdet_gradient(
+    params: &SVector<f64, 4>,
+    p_theta_dot: &SMatrix<f64, 2, 2>,
+    p_theta_ddot: &SMatrix<f64, 2, 2>,
+    p_u: &SMatrix<f64, 2, 2>,
+) -> SVector<f64, 4> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let l1 = params[2];
+    let l2 = params[3];
+    let p_theta_dot_00 = p_theta_dot[(0, 0)];
+    let p_theta_dot_01 = p_theta_dot[(0, 1)];
+    let p_theta_dot_11 = p_theta_dot[(1, 1)];
+    let p_theta_ddot_00 = p_theta_ddot[(0, 0)];
+    let p_theta_ddot_01 = p_theta_ddot[(0, 1)];
+    let p_theta_ddot_11 = p_theta_ddot[(1, 1)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_11 = p_u[(1, 1)];
+    let t0 = m1 + 2.0 * m2;
+    let t1 = t0.powi(-2);
+    let t2 = 4.0 * t1;
+    let t3 = g.powi(-2);
+    let t4 = l1.powi(-2);
+    let t5 = p_theta_dot_00 * t3 * t4;
+    let t6 = t2 * t5;
+    let t7 = 1.0 / l1;
+    let t8 = 1.0 / t0;
+    let t9 = t7 * t8;
+    let t10 = 4.0 * t3;
+    let t11 = 1.0 / l2;
+    let t12 = 1.0 / m2;
+    let t13 = p_theta_dot_01 * t12;
+    let t14 = t11 * t13;
+    let t15 = t10 * t14;
+    let t16 = p_theta_ddot_01 + p_u_01;
+    let t17 = t15 * t9 + t16 - t6;
+    let t18 = 1.0 / g;
+    let t19 = 2.0 * t18;
+    let t20 = t11 * t19;
+    let t21 = t19 * t9;
+    let t22 = -p_theta_dot_00 * t21 + t13 * t20;
+    let t23 = t21 * t22;
+    let t24 = t16 + t23;
+    let t25 = p_theta_ddot_00 + p_u_00 + t6;
+    let t26 = t12 * t20;
+    let t27 = -p_theta_dot_01 * t21 + p_theta_dot_11 * t26;
+    let t28 = p_theta_ddot_11 + p_u_11 - t23 + t26 * t27;
+    let t29 = 1.0 / (-t17 * t24 + t25 * t28);
+    let t30 = t0.powi(-3);
+    let t31 = t2 * t3;
+    let t32 = t14 * t7;
+    let t33 = t31 * t32;
+    let t34 = -t24;
+    let t35 = t30 * t5;
+    let t36 = t22 * t7;
+    let t37 = t1 * t19 * t36 - 4.0 * t35;
+    let t38 = -t17;
+    let t39 = m2.powi(-2);
+    let t40 = t10 * t39;
+    let t41 = 8.0 * t1 * t3;
+    let t42 = t18 * t2 * t36;
+    let t43 = t20 * t39;
+    let t44 = t21 * (4.0 * p_theta_dot_00 * t1 * t18 * t7 - p_theta_dot_01 * t43);
+    let t45 = l1.powi(-3);
+    let t46 = t4 * t8;
+    let t47 = t15 * t46;
+    let t48 = p_theta_dot_00 * t45;
+    let t49 = t19 * t22 * t46 - t31 * t48;
+    let t50 = l2.powi(-2);
+    let t51 = t10 * t13 * t50 * t9;
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 4>>::zeros();
+    gradient[0] = t29
+        * (t25 * (t33 + t37) - 8.0 * t28 * t35
+            + t34 * (8.0 * p_theta_dot_00 * t3 * t30 * t4 - t33)
+            - t37 * t38);
+    gradient[1] = t29
+        * (t25
+            * (t26 * (4.0 * p_theta_dot_01 * t1 * t18 * t7 - p_theta_dot_11 * t43) - t27 * t43
+                + t42
+                - t44)
+            - 16.0 * t28 * t35
+            + t34
+                * (16.0 * p_theta_dot_00 * t3 * t30 * t4
+                    - p_theta_dot_01 * t11 * t40 * t9
+                    - t32 * t41)
+            + t38 * (-t42 + t44));
+    gradient[2] = t29
+        * (t25 * (t47 + t49) - t28 * t41 * t48
+            + t34 * (8.0 * p_theta_dot_00 * t1 * t3 * t45 - t47)
+            - t38 * t49);
+    gradient[3] = t29
+        * (t25
+            * (4.0 * p_theta_dot_01 * t12 * t3 * t50 * t7 * t8
+                - t12 * t19 * t27 * t50
+                - p_theta_dot_11 * t40 / l2.powi(3))
+            - t34 * t51
+            - t38 * t51);
+    gradient
+}
+
 /// Task 3 (acceleration control): the sensitivities d(task variable)/dU the controller uses, in the order (d_theta_ddot_du).
 ///
 /// From appendix "Task specific controllers".
@@ -768,4 +1080,26 @@ pub fn acceleration_control_confidence(
     pi_u[(1, 1)] = p_theta_ddot_11 + p_u_11;
     pi_u[(1, 0)] = pi_u[(0, 1)];
     pi_u
+}
+
+/// Task 3 (acceleration control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+///
+/// Cost per call: 0 operations, weighted 0.
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn acceleration_logdet_gradient(
+    _params: &SVector<f64, 4>,
+    _p_theta_ddot: &SMatrix<f64, 2, 2>,
+    _p_u: &SMatrix<f64, 2, 2>,
+) -> SVector<f64, 4> {
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let gradient = <SVector<f64, 4>>::zeros();
+    gradient
 }

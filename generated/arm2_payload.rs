@@ -188,6 +188,30 @@ pub fn task_control_confidence(
     }
 }
 
+/// d ln|Π^U| / dp of `task` for a tool (each task's `<task>_logdet_gradient` below), given
+/// the precisions of all four terms; a task reads only its own terms' ones.
+#[inline]
+#[must_use]
+#[allow(unused_variables)]
+pub fn task_logdet_gradient(
+    task: super::TaskKind,
+    params: &SVector<f64, PARAMETER_COUNT>,
+    p_theta: &SMatrix<f64, DOF, DOF>,
+    p_theta_dot: &SMatrix<f64, DOF, DOF>,
+    p_theta_ddot: &SMatrix<f64, DOF, DOF>,
+    p_u: &SMatrix<f64, DOF, DOF>,
+) -> SVector<f64, PARAMETER_COUNT> {
+    match task {
+        super::TaskKind::Position => {
+            position_logdet_gradient(params, p_theta, p_theta_dot, p_theta_ddot, p_u)
+        }
+        super::TaskKind::Velocity => {
+            velocity_logdet_gradient(params, p_theta_dot, p_theta_ddot, p_u)
+        }
+        super::TaskKind::Acceleration => acceleration_logdet_gradient(params, p_theta_ddot, p_u),
+    }
+}
+
 /// The parameter-only factors of [`dynamics`], computed once per tool: [`dynamics_with`]
 /// then only combines them with the state and control (derive/toolconf_derive/hoist.py).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -719,6 +743,201 @@ pub fn position_control_confidence(
     pi_u
 }
 
+/// Task 1 (position control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters [m1 m2 l1 l2 mp]
+/// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
+/// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
+/// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+///
+/// Cost per call: 541 operations, weighted 842 (34 ADD, 42 DIV, 346 MUL, 15 NEG, 7 POW, 97 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn position_logdet_gradient(
+    params: &SVector<f64, 5>,
+    p_theta: &SMatrix<f64, 2, 2>,
+    p_theta_dot: &SMatrix<f64, 2, 2>,
+    p_theta_ddot: &SMatrix<f64, 2, 2>,
+    p_u: &SMatrix<f64, 2, 2>,
+) -> SVector<f64, 5> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let l1 = params[2];
+    let l2 = params[3];
+    let mp = params[4];
+    let p_theta_00 = p_theta[(0, 0)];
+    let p_theta_01 = p_theta[(0, 1)];
+    let p_theta_11 = p_theta[(1, 1)];
+    let p_theta_dot_00 = p_theta_dot[(0, 0)];
+    let p_theta_dot_01 = p_theta_dot[(0, 1)];
+    let p_theta_dot_11 = p_theta_dot[(1, 1)];
+    let p_theta_ddot_00 = p_theta_ddot[(0, 0)];
+    let p_theta_ddot_01 = p_theta_ddot[(0, 1)];
+    let p_theta_ddot_11 = p_theta_ddot[(1, 1)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_11 = p_u[(1, 1)];
+    let t0 = 1.0 / g;
+    let t1 = p_theta_11 * t0;
+    let t2 = 2.0 * m2;
+    let t3 = 2.0 * mp;
+    let t4 = m1 + t2 + t3;
+    let t5 = 1.0 / t4;
+    let t6 = 1.0 / l1;
+    let t7 = p_theta_01 * t0;
+    let t8 = t6 * t7;
+    let t9 = t5 * t8;
+    let t10 = l1.powi(2);
+    let t11 = 3.0 * t10;
+    let t12 = m1 * t10 + m2 * t11 + mp * t11 - 3.0;
+    let t13 = (2.0 / 3.0) * t12;
+    let t14 = -l1 * t1 - t13 * t9;
+    let t15 = t0 * t14;
+    let t16 = l1 * t7;
+    let t17 = p_theta_00 * t5;
+    let t18 = t0 * t6;
+    let t19 = t13 * t18;
+    let t20 = -t16 - t17 * t19;
+    let t21 = t20 * t5;
+    let t22 = -l1 * t15 + p_theta_ddot_00 + p_theta_dot_00 + p_u_00 - t19 * t21;
+    let t23 = l2 * m2;
+    let t24 = l2 * t3;
+    let t25 = l1 * t23 + l1 * t24 + 2.0;
+    let t26 = (2.0 / 3.0) * t1;
+    let t27 = m2 + t3;
+    let t28 = 1.0 / t27;
+    let t29 = 1.0 / l2;
+    let t30 = l2.powi(2);
+    let t31 = m2 * t30 + 3.0 * mp * t30 - 3.0;
+    let t32 = t28 * t29 * t31;
+    let t33 = -t25 * t5 * t8 - t26 * t32;
+    let t34 = t0 * t33;
+    let t35 = (2.0 / 3.0) * t32;
+    let t36 = t18 * t25;
+    let t37 = -t17 * t36 - t35 * t7;
+    let t38 = t36 * t5;
+    let t39 = p_theta_ddot_11 + p_theta_dot_11 + p_u_11 - t34 * t35 - t37 * t38;
+    let t40 = p_theta_ddot_01 + p_theta_dot_01 + p_u_01;
+    let t41 = -t15 * t35 - t20 * t38 + t40;
+    let t42 = t37 * t5;
+    let t43 = -l1 * t34 - t19 * t42 + t40;
+    let t44 = 1.0 / (t22 * t39 - t41 * t43);
+    let t45 = g.powi(-2);
+    let t46 = 1.0 / t10;
+    let t47 = p_theta_00 * t45 * t46 / t4.powi(3);
+    let t48 = t4.powi(-2);
+    let t49 = p_theta_01 * t25 * t45 * t48;
+    let t50 = -t41;
+    let t51 = l1 * t0;
+    let t52 = (2.0 / 3.0) * t51;
+    let t53 = t5 * t52;
+    let t54 = -t43;
+    let t55 = (2.0 / 3.0) * p_theta_00 * t0 * t12 * t48 * t6 - t17 * t52;
+    let t56 = t16 * t5;
+    let t57 = (2.0 / 3.0) * p_theta_01 * t0 * t12 * t48 * t6 - (2.0 / 3.0) * t56;
+    let t58 = t0 * t35;
+    let t59 = t19 * t5;
+    let t60 = (4.0 / 3.0) * p_theta_01 * t0 * t12 * t48 * t6 - 2.0 * t56;
+    let t61 = 2.0 * t51;
+    let t62 = (4.0 / 3.0) * p_theta_00 * t0 * t12 * t48 * t6 - t17 * t61;
+    let t63 = t39 * ((4.0 / 3.0) * t0 * t12 * t20 * t48 * t6 - t21 * t61 - t51 * t60 - t59 * t62);
+    let t64 = l2 * t28;
+    let t65 = l2 * t5;
+    let t66 = t65 * t7;
+    let t67 = t27.powi(-2);
+    let t68 = -2.0 * p_theta_01 * t0 * t25 * t48 * t6;
+    let t69 = (2.0 / 3.0) * p_theta_11 * t0 * t29 * t31 * t67 - t26 * t64 - t66 - t68;
+    let t70 = (2.0 / 3.0) * t64;
+    let t71 = t0 * t65;
+    let t72 = p_theta_00 * t71;
+    let t73 = -2.0 * p_theta_00 * t0 * t25 * t48 * t6;
+    let t74 = (2.0 / 3.0) * p_theta_01 * t0 * t29 * t31 * t67 - t7 * t70 - t72 - t73;
+    let t75 = -(4.0 / 3.0) * t0 * t12 * t37 * t48 * t6 + t42 * t61;
+    let t76 = t20 * t71;
+    let t77 = -2.0 * t0 * t20 * t25 * t48 * t6 + t38 * t62 + t58 * t60;
+    let t78 = t37 * t71;
+    let t79 = -2.0 * t0 * t25 * t37 * t48 * t6;
+    let t80 = t23 + t24;
+    let t81 = t18 * t80;
+    let t82 = p_theta_00 * t0 * t25 * t46 * t5 - t17 * t81;
+    let t83 = p_theta_01 * t0 * t25 * t46 * t5 - t80 * t9;
+    let t84 = l1 * m2;
+    let t85 = 6.0 * mp;
+    let t86 = (4.0 / 3.0) * l1 * m1 + (2.0 / 3.0) * l1 * t85 + 4.0 * t84;
+    let t87 = t18 * t86;
+    let t88 = (2.0 / 3.0) * p_theta_00 * t0 * t12 * t46 * t5 - t17 * t87 - t7;
+    let t89 = (2.0 / 3.0) * p_theta_01 * t0 * t12 * t46 * t5 - t1 - t86 * t9;
+    let t90 = t29 * (l2 * t2 + l2 * t85);
+    let t91 = l1 * t3 + t84;
+    let t92 = 1.0 / t30;
+    let t93 = (2.0 / 3.0) * p_theta_11 * t0 * t28 * t31 * t92 - t26 * t28 * t90 - t9 * t91;
+    let t94 = (2.0 / 3.0) * t28;
+    let t95 = t18 * t91;
+    let t96 = (2.0 / 3.0) * p_theta_01 * t0 * t28 * t31 * t92 - t17 * t95 - t7 * t90 * t94;
+    let t97 = 2.0 * t64;
+    let t98 = (4.0 / 3.0) * p_theta_11 * t0 * t29 * t31 * t67 - t1 * t97 - 2.0 * t66 - t68;
+    let t99 = (4.0 / 3.0) * p_theta_01 * t0 * t29 * t31 * t67 - t7 * t97 - 2.0 * t72 - t73;
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 5>>::zeros();
+    gradient[0] = t44
+        * (t22 * (t0 * t25 * t37 * t48 * t6 - t25.powi(2) * t47 - t35 * t49 * t6)
+            + t39 * ((2.0 / 3.0) * t0 * t12 * t20 * t48 * t6 - t20 * t53 - t51 * t57 - t55 * t59)
+            + t50 * ((2.0 / 3.0) * t0 * t12 * t37 * t48 * t6 - t13 * t25 * t47 - t37 * t53 - t49)
+            + t54 * (t0 * t20 * t25 * t48 * t6 - t38 * t55 - t57 * t58));
+    gradient[1] = t44
+        * (t22
+            * ((2.0 / 3.0) * t0 * t29 * t31 * t33 * t67
+                - t34 * t70
+                - t38 * t74
+                - t58 * t69
+                - t78
+                - t79)
+            + t50 * (-t51 * t69 - t59 * t74 - t75)
+            + t54 * ((2.0 / 3.0) * t0 * t14 * t29 * t31 * t67 - t15 * t70 - t76 - t77)
+            + t63);
+    gradient[2] = t44
+        * (t22 * (t0 * t25 * t37 * t46 * t5 - t38 * t82 - t42 * t81 - t58 * t83)
+            + t39
+                * ((2.0 / 3.0) * t0 * t12 * t20 * t46 * t5
+                    - t15
+                    - t21 * t87
+                    - t51 * t89
+                    - t59 * t88)
+            + t50
+                * ((2.0 / 3.0) * t0 * t12 * t37 * t46 * t5
+                    - t34
+                    - t42 * t87
+                    - t51 * t83
+                    - t59 * t82)
+            + t54 * (t0 * t20 * t25 * t46 * t5 - t21 * t81 - t38 * t88 - t58 * t89));
+    gradient[3] = t44
+        * (t22
+            * ((2.0 / 3.0) * t0 * t28 * t31 * t33 * t92
+                - t34 * t90 * t94
+                - t38 * t96
+                - t42 * t95
+                - t58 * t93)
+            + t50 * (-t51 * t93 - t59 * t96)
+            + t54 * ((2.0 / 3.0) * t0 * t14 * t28 * t31 * t92 - t15 * t90 * t94 - t21 * t95));
+    gradient[4] = t44
+        * (t22
+            * ((4.0 / 3.0) * t0 * t29 * t31 * t33 * t67
+                - t34 * t97
+                - t38 * t99
+                - t58 * t98
+                - 2.0 * t78
+                - t79)
+            + t50 * (-t51 * t98 - t59 * t99 - t75)
+            + t54 * ((4.0 / 3.0) * t0 * t14 * t29 * t31 * t67 - t15 * t97 - 2.0 * t76 - t77)
+            + t63);
+    gradient
+}
+
 /// Task 2 (velocity control): the sensitivities d(task variable)/dU the controller uses, in the order (d_theta_dot_du, d_theta_ddot_du).
 ///
 /// From appendix "Task specific controllers".
@@ -805,6 +1024,135 @@ pub fn velocity_control_confidence(
     pi_u
 }
 
+/// Task 2 (velocity control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters [m1 m2 l1 l2 mp]
+/// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
+/// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+///
+/// Cost per call: 210 operations, weighted 267 (24 ADD, 7 DIV, 124 MUL, 19 NEG, 8 POW, 28 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn velocity_logdet_gradient(
+    params: &SVector<f64, 5>,
+    p_theta_dot: &SMatrix<f64, 2, 2>,
+    p_theta_ddot: &SMatrix<f64, 2, 2>,
+    p_u: &SMatrix<f64, 2, 2>,
+) -> SVector<f64, 5> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let l1 = params[2];
+    let l2 = params[3];
+    let mp = params[4];
+    let p_theta_dot_00 = p_theta_dot[(0, 0)];
+    let p_theta_dot_01 = p_theta_dot[(0, 1)];
+    let p_theta_dot_11 = p_theta_dot[(1, 1)];
+    let p_theta_ddot_00 = p_theta_ddot[(0, 0)];
+    let p_theta_ddot_01 = p_theta_ddot[(0, 1)];
+    let p_theta_ddot_11 = p_theta_ddot[(1, 1)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_11 = p_u[(1, 1)];
+    let t0 = 2.0 * mp;
+    let t1 = m1 + 2.0 * m2 + t0;
+    let t2 = t1.powi(-2);
+    let t3 = 4.0 * t2;
+    let t4 = g.powi(-2);
+    let t5 = l1.powi(-2);
+    let t6 = p_theta_dot_00 * t4 * t5;
+    let t7 = t3 * t6;
+    let t8 = 1.0 / l1;
+    let t9 = 1.0 / t1;
+    let t10 = t8 * t9;
+    let t11 = t10 * t4;
+    let t12 = 1.0 / l2;
+    let t13 = m2 + t0;
+    let t14 = 1.0 / t13;
+    let t15 = p_theta_dot_01 * t14;
+    let t16 = t12 * t15;
+    let t17 = 4.0 * t16;
+    let t18 = p_theta_ddot_01 + p_u_01;
+    let t19 = t11 * t17 + t18 - t7;
+    let t20 = 1.0 / g;
+    let t21 = 2.0 * t20;
+    let t22 = t12 * t21;
+    let t23 = t10 * t21;
+    let t24 = -p_theta_dot_00 * t23 + t15 * t22;
+    let t25 = t23 * t24;
+    let t26 = t18 + t25;
+    let t27 = p_theta_ddot_00 + p_u_00 + t7;
+    let t28 = t14 * t22;
+    let t29 = -p_theta_dot_01 * t23 + p_theta_dot_11 * t28;
+    let t30 = p_theta_ddot_11 + p_u_11 - t25 + t28 * t29;
+    let t31 = 1.0 / (-t19 * t26 + t27 * t30);
+    let t32 = t1.powi(-3);
+    let t33 = t3 * t4;
+    let t34 = t16 * t8;
+    let t35 = t33 * t34;
+    let t36 = -t26;
+    let t37 = t32 * t6;
+    let t38 = t24 * t8;
+    let t39 = t2 * t21 * t38 - 4.0 * t37;
+    let t40 = -t19;
+    let t41 = -16.0 * t30 * t37;
+    let t42 = t13.powi(-2);
+    let t43 = 4.0 * t42;
+    let t44 = p_theta_dot_01 * t12;
+    let t45 = 8.0 * t4;
+    let t46 = t2 * t45;
+    let t47 = -16.0 * p_theta_dot_00 * t32 * t4 * t5 + t34 * t46;
+    let t48 = t22 * t42;
+    let t49 = -4.0 * p_theta_dot_00 * t2 * t20 * t8;
+    let t50 = t23 * (-p_theta_dot_01 * t48 - t49);
+    let t51 = t20 * t3 * t38;
+    let t52 = -t51;
+    let t53 = -4.0 * p_theta_dot_01 * t2 * t20 * t8;
+    let t54 = l1.powi(-3);
+    let t55 = t5 * t9;
+    let t56 = t17 * t4 * t55;
+    let t57 = p_theta_dot_00 * t54;
+    let t58 = t21 * t24 * t55 - t33 * t57;
+    let t59 = l2.powi(-2);
+    let t60 = 4.0 * t11 * t15 * t59;
+    let t61 = p_theta_dot_11 * t43;
+    let t62 = t12 * t20;
+    let t63 = t43 * t62;
+    let t64 = t23 * (-p_theta_dot_01 * t63 - t49);
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 5>>::zeros();
+    gradient[0] = t31
+        * (t27 * (t35 + t39) - 8.0 * t30 * t37
+            + t36 * (8.0 * p_theta_dot_00 * t32 * t4 * t5 - t35)
+            - t39 * t40);
+    gradient[1] = t31
+        * (t27 * (t28 * (-p_theta_dot_11 * t48 - t53) - t29 * t48 - t50 + t51)
+            + t36 * (-t11 * t43 * t44 - t47)
+            + t40 * (t50 + t52)
+            + t41);
+    gradient[2] = t31
+        * (t27 * (t56 + t58) - t30 * t46 * t57
+            + t36 * (8.0 * p_theta_dot_00 * t2 * t4 * t54 - t56)
+            - t40 * t58);
+    gradient[3] = t31
+        * (t27
+            * (4.0 * p_theta_dot_01 * t14 * t4 * t59 * t8 * t9
+                - t14 * t21 * t29 * t59
+                - t4 * t61 / l2.powi(3))
+            - t36 * t60
+            - t40 * t60);
+    gradient[4] = t31
+        * (t27 * (t28 * (-t53 - t61 * t62) - t29 * t63 + t51 - t64)
+            + t36 * (-t10 * t42 * t44 * t45 - t47)
+            + t40 * (t52 + t64)
+            + t41);
+    gradient
+}
+
 /// Task 3 (acceleration control): the sensitivities d(task variable)/dU the controller uses, in the order (d_theta_ddot_du).
 ///
 /// From appendix "Task specific controllers".
@@ -853,4 +1201,26 @@ pub fn acceleration_control_confidence(
     pi_u[(1, 1)] = p_theta_ddot_11 + p_u_11;
     pi_u[(1, 0)] = pi_u[(0, 1)];
     pi_u
+}
+
+/// Task 3 (acceleration control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters [m1 m2 l1 l2 mp]
+/// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+///
+/// Cost per call: 0 operations, weighted 0.
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn acceleration_logdet_gradient(
+    _params: &SVector<f64, 5>,
+    _p_theta_ddot: &SMatrix<f64, 2, 2>,
+    _p_u: &SMatrix<f64, 2, 2>,
+) -> SVector<f64, 5> {
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let gradient = <SVector<f64, 5>>::zeros();
+    gradient
 }

@@ -195,6 +195,30 @@ pub fn task_control_confidence(
     }
 }
 
+/// d ln|Π^U| / dp of `task` for a tool (each task's `<task>_logdet_gradient` below), given
+/// the precisions of all four terms; a task reads only its own terms' ones.
+#[inline]
+#[must_use]
+#[allow(unused_variables)]
+pub fn task_logdet_gradient(
+    task: super::TaskKind,
+    params: &SVector<f64, PARAMETER_COUNT>,
+    p_theta: &SMatrix<f64, DOF, DOF>,
+    p_theta_dot: &SMatrix<f64, DOF, DOF>,
+    p_theta_ddot: &SMatrix<f64, DOF, DOF>,
+    p_u: &SMatrix<f64, DOF, DOF>,
+) -> SVector<f64, PARAMETER_COUNT> {
+    match task {
+        super::TaskKind::Position => {
+            position_logdet_gradient(params, p_theta, p_theta_dot, p_theta_ddot, p_u)
+        }
+        super::TaskKind::Velocity => {
+            velocity_logdet_gradient(params, p_theta_dot, p_theta_ddot, p_u)
+        }
+        super::TaskKind::Acceleration => acceleration_logdet_gradient(params, p_theta_ddot, p_u),
+    }
+}
+
 /// The parameter-only factors of [`dynamics`], computed once per tool: [`dynamics_with`]
 /// then only combines them with the state and control (derive/toolconf_derive/hoist.py).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -1109,6 +1133,481 @@ pub fn position_control_confidence(
     pi_u
 }
 
+/// Task 1 (position control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters [m1 m2 m3 l1 l2 l3]
+/// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
+/// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
+/// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+///
+/// Cost per call: 1357 operations, weighted 1884 (85 ADD, 74 DIV, 856 MUL, 30 NEG, 9 POW, 303 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn position_logdet_gradient(
+    params: &SVector<f64, 6>,
+    p_theta: &SMatrix<f64, 3, 3>,
+    p_theta_dot: &SMatrix<f64, 3, 3>,
+    p_theta_ddot: &SMatrix<f64, 3, 3>,
+    p_u: &SMatrix<f64, 3, 3>,
+) -> SVector<f64, 6> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let m3 = params[2];
+    let l1 = params[3];
+    let l2 = params[4];
+    let l3 = params[5];
+    let p_theta_00 = p_theta[(0, 0)];
+    let p_theta_01 = p_theta[(0, 1)];
+    let p_theta_02 = p_theta[(0, 2)];
+    let p_theta_11 = p_theta[(1, 1)];
+    let p_theta_12 = p_theta[(1, 2)];
+    let p_theta_22 = p_theta[(2, 2)];
+    let p_theta_dot_00 = p_theta_dot[(0, 0)];
+    let p_theta_dot_01 = p_theta_dot[(0, 1)];
+    let p_theta_dot_02 = p_theta_dot[(0, 2)];
+    let p_theta_dot_11 = p_theta_dot[(1, 1)];
+    let p_theta_dot_12 = p_theta_dot[(1, 2)];
+    let p_theta_dot_22 = p_theta_dot[(2, 2)];
+    let p_theta_ddot_00 = p_theta_ddot[(0, 0)];
+    let p_theta_ddot_01 = p_theta_ddot[(0, 1)];
+    let p_theta_ddot_02 = p_theta_ddot[(0, 2)];
+    let p_theta_ddot_11 = p_theta_ddot[(1, 1)];
+    let p_theta_ddot_12 = p_theta_ddot[(1, 2)];
+    let p_theta_ddot_22 = p_theta_ddot[(2, 2)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_02 = p_u[(0, 2)];
+    let p_u_11 = p_u[(1, 1)];
+    let p_u_12 = p_u[(1, 2)];
+    let p_u_22 = p_u[(2, 2)];
+    let t0 = 1.0 / g;
+    let t1 = p_theta_12 * t0;
+    let t2 = l1 * t1;
+    let t3 = p_theta_22 * t0;
+    let t4 = p_theta_02 * t0;
+    let t5 = 2.0 * m2;
+    let t6 = 2.0 * m3;
+    let t7 = m1 + t5 + t6;
+    let t8 = 1.0 / t7;
+    let t9 = (2.0 / 3.0) * t8;
+    let t10 = 1.0 / l1;
+    let t11 = l1.powi(2);
+    let t12 = 3.0 * m3;
+    let t13 = m1 * t11 + 3.0 * m2 * t11 + t11 * t12 - 3.0;
+    let t14 = t10 * t13;
+    let t15 = t14 * t9;
+    let t16 = -l1 * t3 - t15 * t4 - t2;
+    let t17 = l2 * m2;
+    let t18 = l2 * t6;
+    let t19 = l1 * t17 + l1 * t18 + 2.0;
+    let t20 = p_theta_01 * t0;
+    let t21 = l1 * t20;
+    let t22 = l1 * t4;
+    let t23 = t0 * t15;
+    let t24 = -p_theta_00 * t23 - t21 - t22;
+    let t25 = 1.0 / l2;
+    let t26 = m2 + t6;
+    let t27 = 1.0 / t26;
+    let t28 = l2.powi(2);
+    let t29 = m2 * t28 + t12 * t28 - 3.0;
+    let t30 = p_theta_11 * t0;
+    let t31 = t20 * t8;
+    let t32 = (2.0 / 3.0) * t14;
+    let t33 = -l1 * t30 - t2 - t31 * t32;
+    let t34 = p_theta_ddot_01 + p_theta_dot_01 + p_u_01;
+    let t35 =
+        -l2 * t0 * t16 - t0 * t10 * t19 * t24 * t8 - (2.0 / 3.0) * t0 * t25 * t27 * t29 * t33 + t34;
+    let t36 = l3 * t8;
+    let t37 = t0 * t36;
+    let t38 = p_theta_00 * t37;
+    let t39 = 1.0 / m3;
+    let t40 = 1.0 / l3;
+    let t41 = l3.powi(2);
+    let t42 = m3 * t41 - 3.0;
+    let t43 = (2.0 / 3.0) * t42;
+    let t44 = t40 * t43;
+    let t45 = t39 * t44;
+    let t46 = l2 * m3;
+    let t47 = l3 * t46;
+    let t48 = t47 + 2.0;
+    let t49 = t25 * t48;
+    let t50 = t27 * t49;
+    let t51 = -m3 * t38 - t20 * t50 - t4 * t45;
+    let t52 = t0 * t51;
+    let t53 = t36 * t52;
+    let t54 = t36 * t4;
+    let t55 = t1 * t27;
+    let t56 = -m3 * t54 - t3 * t45 - t49 * t55;
+    let t57 = t0 * t56;
+    let t58 = t39 * t57;
+    let t59 = l3 * t31;
+    let t60 = -m3 * t59 - t1 * t45 - t30 * t50;
+    let t61 = t0 * t60;
+    let t62 = -m3 * t53 + p_theta_ddot_22 + p_theta_dot_22 + p_u_22 - t44 * t58 - t50 * t61;
+    let t63 = l2 * t1;
+    let t64 = t10 * t19;
+    let t65 = (2.0 / 3.0) * t27;
+    let t66 = t25 * t29;
+    let t67 = t65 * t66;
+    let t68 = -t30 * t67 - t31 * t64 - t63;
+    let t69 = t0 * t68;
+    let t70 = t64 * t8;
+    let t71 = (2.0 / 3.0) * t66;
+    let t72 = -l2 * t3 - t4 * t70 - t55 * t71;
+    let t73 = t0 * t72;
+    let t74 = l2 * t4;
+    let t75 = t0 * t70;
+    let t76 = -p_theta_00 * t75 - t20 * t67 - t74;
+    let t77 = -l1 * t69 - l1 * t73 - t23 * t76 + t34;
+    let t78 = p_theta_ddot_02 + p_theta_dot_02 + p_u_02;
+    let t79 = -l1 * t57 - l1 * t61 - t15 * t52 + t78;
+    let t80 = t37 * t76;
+    let t81 = p_theta_ddot_12 + p_theta_dot_12 + p_u_12;
+    let t82 = -m3 * t80 - t45 * t73 - t50 * t69 + t81;
+    let t83 = t62 * t77 - t79 * t82;
+    let t84 = t24 * t37;
+    let t85 = t0 * t33;
+    let t86 = t0 * t16;
+    let t87 = -m3 * t84 - t45 * t86 - t50 * t85 + t78;
+    let t88 = -l2 * t57 - t52 * t70 - t61 * t67 + t81;
+    let t89 = -l2 * t73 + p_theta_ddot_11 + p_theta_dot_11 + p_u_11 - t67 * t69 - t75 * t76;
+    let t90 = t77 * t88 - t79 * t89;
+    let t91 = -l1 * t85 - l1 * t86 + p_theta_ddot_00 + p_theta_dot_00 + p_u_00 - t23 * t24;
+    let t92 = t62 * t89 - t82 * t88;
+    let t93 = 1.0 / (-t35 * t83 + t87 * t90 + t91 * t92);
+    let t94 = m3.powi(2);
+    let t95 = g.powi(-2);
+    let t96 = p_theta_00 * t95 / t7.powi(3);
+    let t97 = t7.powi(-2);
+    let t98 = t95 * t97;
+    let t99 = p_theta_02 * t98;
+    let t100 = l3 * t27;
+    let t101 = p_theta_01 * t98;
+    let t102 = m3 * t100 * t101;
+    let t103 = -t35 * t77 + t89 * t91;
+    let t104 = t19 * t98;
+    let t105 = p_theta_02 * t104;
+    let t106 = t10 * t105;
+    let t107 = 1.0 / t11;
+    let t108 = t107 * t96;
+    let t109 = p_theta_01 * t104;
+    let t110 = t10 * t109;
+    let t111 = t62 * t91 - t79 * t87;
+    let t112 = l3 * m3 * t96;
+    let t113 = t112 * t64;
+    let t114 = t35 * t79 - t88 * t91;
+    let t115 = t77 * t87 - t82 * t91;
+    let t116 = l1 * t0;
+    let t117 = t116 * t9;
+    let t118 = -t35 * t62 + t87 * t88;
+    let t119 = l1 * m3;
+    let t120 = l3 * t119;
+    let t121 = t35 * t82 - t87 * t89;
+    let t122 = (2.0 / 3.0) * p_theta_00 * t0 * t10 * t13 * t97 - p_theta_00 * t117;
+    let t123 = m3 * t37;
+    let t124 = t0 * ((2.0 / 3.0) * p_theta_02 * t0 * t10 * t13 * t97 - t22 * t9);
+    let t125 = (2.0 / 3.0) * p_theta_01 * t0 * t10 * t13 * t97 - t21 * t9;
+    let t126 = t0 * t50;
+    let t127 = t0 * t67;
+    let t128 = -t83;
+    let t129 = l3 * t6;
+    let t130 = p_theta_00 * t0 * t129 * t97;
+    let t131 = t26.powi(-2);
+    let t132 = t131 * t49;
+    let t133 = t132 * t20;
+    let t134 = t130 + t133;
+    let t135 = t129 * t97;
+    let t136 = t135 * t4;
+    let t137 = t1 * t132;
+    let t138 = t136 + t137;
+    let t139 = t0 * t45;
+    let t140 = t135 * t20;
+    let t141 = t132 * t30;
+    let t142 = t140 + t141;
+    let t143 = -2.0 * l3 * m3 * t0 * t51 * t97;
+    let t144 = 2.0 * t8;
+    let t145 = t116 * t144;
+    let t146 = -(4.0 / 3.0) * t0 * t10 * t13 * t51 * t97 + t145 * t51;
+    let t147 = (4.0 / 3.0) * p_theta_00 * t0 * t10 * t13 * t97 - p_theta_00 * t145;
+    let t148 = (4.0 / 3.0) * p_theta_01 * t0 * t10 * t13 * t97 - t144 * t21;
+    let t149 = (4.0 / 3.0) * p_theta_02 * t0 * t10 * t13 * t97 - t144 * t22;
+    let t150 = -2.0 * l3 * m3 * t0 * t24 * t97 + t123 * t147 + t126 * t148 + t139 * t149;
+    let t151 = t92
+        * ((4.0 / 3.0) * t0 * t10 * t13 * t24 * t97
+            - t116 * t148
+            - t116 * t149
+            - t145 * t24
+            - t147 * t23);
+    let t152 = -2.0 * l3 * m3 * t0 * t76 * t97;
+    let t153 = l2 * t65;
+    let t154 = l2 * t0;
+    let t155 = t154 * t8;
+    let t156 = p_theta_00 * t155;
+    let t157 = -2.0 * p_theta_00 * t0 * t10 * t19 * t97;
+    let t158 = (2.0 / 3.0) * p_theta_01 * t0 * t131 * t25 * t29 - t153 * t20 - t156 - t157;
+    let t159 = t74 * t8;
+    let t160 = -2.0 * p_theta_02 * t0 * t10 * t19 * t97;
+    let t161 = (2.0 / 3.0) * p_theta_12 * t0 * t131 * t25 * t29 - t159 - t160 - t63 * t65;
+    let t162 = l2 * t31;
+    let t163 = -2.0 * p_theta_01 * t0 * t10 * t19 * t97;
+    let t164 = (2.0 / 3.0) * p_theta_11 * t0 * t131 * t25 * t29 - t153 * t30 - t162 - t163;
+    let t165 = -(4.0 / 3.0) * t0 * t10 * t13 * t76 * t97 + t145 * t76;
+    let t166 = t155 * t51;
+    let t167 = -2.0 * t0 * t10 * t19 * t51 * t97;
+    let t168 = t155 * t24;
+    let t169 = -2.0 * t0 * t10 * t19 * t24 * t97 + t127 * t148 + t147 * t75 + t149 * t154;
+    let t170 = t155 * t76;
+    let t171 = -2.0 * t0 * t10 * t19 * t76 * t97;
+    let t172 = 2.0 * t27;
+    let t173 = l2 * t172;
+    let t174 = (4.0 / 3.0) * p_theta_11 * t0 * t131 * t25 * t29 - 2.0 * t162 - t163 - t173 * t30;
+    let t175 = (4.0 / 3.0) * p_theta_12 * t0 * t131 * t25 * t29 - 2.0 * t159 - t160 - t172 * t63;
+    let t176 = (4.0 / 3.0) * p_theta_01 * t0 * t131 * t25 * t29 - 2.0 * t156 - t157 - t173 * t20;
+    let t177 = (2.0 / 3.0) * l3;
+    let t178 = t177 * t39;
+    let t179 = t100 * t30;
+    let t180 = 1.0 / t94;
+    let t181 = t180 * t44;
+    let t182 = -t1 * t178 + t1 * t181 + t140 + 2.0 * t141 - t179 - t59;
+    let t183 = t1 * t100;
+    let t184 = t136 + 2.0 * t137 - t178 * t3 + t181 * t3 - t183 - t54;
+    let t185 = t100 * t20;
+    let t186 = t130 + 2.0 * t133 - t178 * t4 + t181 * t4 - t185 - t38;
+    let t187 = t100 * t85;
+    let t188 = t100 * t69;
+    let t189 = t100 * t61;
+    let t190 = t10 * (t17 + t18);
+    let t191 = t52 * t8;
+    let t192 = t0 * t8;
+    let t193 = p_theta_00 * t192;
+    let t194 = p_theta_00 * t0 * t107 * t19 * t8 - t190 * t193;
+    let t195 = t4 * t8;
+    let t196 = p_theta_02 * t0 * t107 * t19 * t8 - t190 * t195;
+    let t197 = p_theta_01 * t0 * t107 * t19 * t8 - t190 * t31;
+    let t198 = l1 * m2;
+    let t199 = t10 * (2.0 * l1 * m1 + 6.0 * t119 + 6.0 * t198);
+    let t200 = t0 * t9;
+    let t201 =
+        (2.0 / 3.0) * p_theta_00 * t0 * t107 * t13 * t8 - p_theta_00 * t199 * t200 - t20 - t4;
+    let t202 = (2.0 / 3.0) * p_theta_02 * t0 * t107 * t13 * t8 - t1 - t199 * t4 * t9 - t3;
+    let t203 =
+        (2.0 / 3.0) * p_theta_01 * t0 * t107 * t13 * t8 - t1 - (2.0 / 3.0) * t199 * t31 - t30;
+    let t204 = t192 * t76;
+    let t205 = t192 * t24;
+    let t206 = m3 * t25;
+    let t207 = 1.0 / t28;
+    let t208 = p_theta_11 * t0 * t207 * t27 * t48 - t179 * t206;
+    let t209 = p_theta_12 * t0 * t207 * t27 * t48 - t183 * t206;
+    let t210 = p_theta_01 * t0 * t207 * t27 * t48 - t185 * t206;
+    let t211 = t25 * (l2 * t5 + 6.0 * t46);
+    let t212 = t211 * t65;
+    let t213 = t10 * (l1 * t6 + t198);
+    let t214 = (2.0 / 3.0) * p_theta_11 * t0 * t207 * t27 * t29 - t1 - t212 * t30 - t213 * t31;
+    let t215 = (2.0 / 3.0) * p_theta_12 * t0 * t207 * t27 * t29
+        - t195 * t213
+        - (2.0 / 3.0) * t211 * t55
+        - t3;
+    let t216 =
+        (2.0 / 3.0) * p_theta_01 * t0 * t207 * t27 * t29 - t193 * t213 - t20 * t211 * t65 - t4;
+    let t217 = m3 * t27;
+    let t218 = m3 * t8;
+    let t219 = 1.0 / t41;
+    let t220 =
+        (2.0 / 3.0) * p_theta_22 * t0 * t219 * t39 * t42 - t1 * t217 - t218 * t4 - (4.0 / 3.0) * t3;
+    let t221 = t0 * t218;
+    let t222 = -p_theta_00 * t221 + (2.0 / 3.0) * p_theta_02 * t0 * t219 * t39 * t42
+        - t20 * t217
+        - (4.0 / 3.0) * t4;
+    let t223 = -m3 * t31 + (2.0 / 3.0) * p_theta_12 * t0 * t219 * t39 * t42
+        - (4.0 / 3.0) * t1
+        - t217 * t30;
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 6>>::zeros();
+    gradient[0] = t93
+        * (t103 * (l3 * m3 * t0 * t51 * t97 - t102 * t49 - t41 * t94 * t96 - t43 * t99)
+            + t111 * (-l2 * t106 + t0 * t10 * t19 * t76 * t97 - t108 * t19.powi(2) - t110 * t67)
+            + t114 * (l3 * m3 * t0 * t76 * t97 - t106 * t45 - t110 * t50 - t113)
+            + t115 * (t0 * t10 * t19 * t51 * t97 - t102 * t71 - t113 - t47 * t99)
+            + t118
+                * ((2.0 / 3.0) * t0 * t10 * t13 * t76 * t97
+                    - t105
+                    - (2.0 / 3.0) * t108 * t13 * t19
+                    - t109
+                    - t117 * t76)
+            + t121
+                * ((2.0 / 3.0) * t0 * t10 * t13 * t51 * t97
+                    - t101 * t120
+                    - t112 * t32
+                    - t117 * t51
+                    - t120 * t99)
+            + t128 * (-l2 * t124 + t0 * t10 * t19 * t24 * t97 - t122 * t75 - t125 * t127)
+            + t90 * (l3 * m3 * t0 * t24 * t97 - t122 * t123 - t124 * t45 - t125 * t126)
+            + t92
+                * (-l1 * t124 + (2.0 / 3.0) * t0 * t10 * t13 * t24 * t97
+                    - t116 * t125
+                    - t117 * t24
+                    - t122 * t23));
+    gradient[1] = t93
+        * (t103 * (t0 * t131 * t25 * t48 * t60 - t123 * t134 - t126 * t142 - t138 * t139 - t143)
+            + t111
+                * ((2.0 / 3.0) * t0 * t131 * t25 * t29 * t68
+                    - t127 * t164
+                    - t153 * t69
+                    - t154 * t161
+                    - t158 * t75
+                    - t170
+                    - t171)
+            + t114
+                * (t0 * t131 * t25 * t48 * t68 - t123 * t158 - t126 * t164 - t139 * t161 - t152)
+            + t115
+                * ((2.0 / 3.0) * t0 * t131 * t25 * t29 * t60
+                    - t127 * t142
+                    - t134 * t75
+                    - t138 * t154
+                    - t153 * t61
+                    - t166
+                    - t167)
+            + t118 * (-t116 * t161 - t116 * t164 - t158 * t23 - t165)
+            + t121 * (-t116 * t138 - t116 * t142 - t134 * t23 - t146)
+            + t128 * ((2.0 / 3.0) * t0 * t131 * t25 * t29 * t33 - t153 * t85 - t168 - t169)
+            + t151
+            + t90 * (t0 * t131 * t25 * t33 * t48 - t150));
+    gradient[2] = t93
+        * (t103
+            * (2.0 * t0 * t131 * t25 * t48 * t60 + (2.0 / 3.0) * t0 * t180 * t40 * t42 * t56
+                - t123 * t186
+                - t126 * t182
+                - t139 * t184
+                - t143
+                - t177 * t58
+                - t189
+                - t53)
+            + t111
+                * ((4.0 / 3.0) * t0 * t131 * t25 * t29 * t68
+                    - t127 * t174
+                    - t154 * t175
+                    - 2.0 * t170
+                    - t171
+                    - t173 * t69
+                    - t176 * t75)
+            + t114
+                * (2.0 * t0 * t131 * t25 * t48 * t68 + (2.0 / 3.0) * t0 * t180 * t40 * t42 * t72
+                    - t123 * t176
+                    - t126 * t174
+                    - t139 * t175
+                    - t152
+                    - t178 * t73
+                    - t188
+                    - t80)
+            + t115
+                * ((4.0 / 3.0) * t0 * t131 * t25 * t29 * t60
+                    - t127 * t182
+                    - t154 * t184
+                    - 2.0 * t166
+                    - t167
+                    - t173 * t61
+                    - t186 * t75)
+            + t118 * (-t116 * t174 - t116 * t175 - t165 - t176 * t23)
+            + t121 * (-t116 * t182 - t116 * t184 - t146 - t186 * t23)
+            + t128 * ((4.0 / 3.0) * t0 * t131 * t25 * t29 * t33 - 2.0 * t168 - t169 - t173 * t85)
+            + t151
+            + t90
+                * (2.0 * t0 * t131 * t25 * t33 * t48 + (2.0 / 3.0) * t0 * t16 * t180 * t40 * t42
+                    - t150
+                    - t178 * t86
+                    - t187
+                    - t84));
+    gradient[3] = t93
+        * (t111
+            * (t0 * t107 * t19 * t76 * t8 - t127 * t197 - t154 * t196 - t190 * t204 - t194 * t75)
+            + t114 * (-t123 * t194 - t126 * t197 - t139 * t196)
+            + t115 * (t0 * t107 * t19 * t51 * t8 - t190 * t191)
+            + t118
+                * ((2.0 / 3.0) * t0 * t107 * t13 * t76 * t8
+                    - t116 * t196
+                    - t116 * t197
+                    - t194 * t23
+                    - t199 * t200 * t76
+                    - t69
+                    - t73)
+            + t121 * ((2.0 / 3.0) * t0 * t107 * t13 * t51 * t8 - t199 * t52 * t9 - t57 - t61)
+            + t128
+                * (t0 * t107 * t19 * t24 * t8
+                    - t127 * t203
+                    - t154 * t202
+                    - t190 * t205
+                    - t201 * t75)
+            + t90 * (-t123 * t201 - t126 * t203 - t139 * t202)
+            + t92
+                * ((2.0 / 3.0) * t0 * t107 * t13 * t24 * t8
+                    - t116 * t202
+                    - t116 * t203
+                    - t199 * t200 * t24
+                    - t201 * t23
+                    - t85
+                    - t86));
+    gradient[4] = t93
+        * (t103
+            * (t0 * t207 * t27 * t48 * t60
+                - t123 * t210
+                - t126 * t208
+                - t139 * t209
+                - t189 * t206)
+            + t111
+                * ((2.0 / 3.0) * t0 * t207 * t27 * t29 * t68
+                    - t127 * t214
+                    - t154 * t215
+                    - t204 * t213
+                    - t212 * t69
+                    - t216 * t75
+                    - t73)
+            + t114
+                * (t0 * t207 * t27 * t48 * t68
+                    - t123 * t216
+                    - t126 * t214
+                    - t139 * t215
+                    - t188 * t206)
+            + t115
+                * ((2.0 / 3.0) * t0 * t207 * t27 * t29 * t60
+                    - t127 * t208
+                    - t154 * t209
+                    - t191 * t213
+                    - t210 * t75
+                    - t212 * t61
+                    - t57)
+            + t118 * (-t116 * t214 - t116 * t215 - t216 * t23)
+            + t121 * (-t116 * t208 - t116 * t209 - t210 * t23)
+            + t128 * ((2.0 / 3.0) * t0 * t207 * t27 * t29 * t33 - t205 * t213 - t212 * t85 - t86)
+            + t90 * (t0 * t207 * t27 * t33 * t48 - t187 * t206));
+    gradient[5] = t93
+        * (t103
+            * ((2.0 / 3.0) * t0 * t219 * t39 * t42 * t56
+                - t123 * t222
+                - t126 * t223
+                - t139 * t220
+                - t217 * t61
+                - t218 * t52
+                - (4.0 / 3.0) * t57)
+            + t114
+                * ((2.0 / 3.0) * t0 * t219 * t39 * t42 * t72
+                    - t217 * t69
+                    - t221 * t76
+                    - (4.0 / 3.0) * t73)
+            + t115 * (-t127 * t223 - t154 * t220 - t222 * t75)
+            + t121 * (-t116 * t220 - t116 * t223 - t222 * t23)
+            + t90
+                * ((2.0 / 3.0) * t0 * t16 * t219 * t39 * t42
+                    - t217 * t85
+                    - t221 * t24
+                    - (4.0 / 3.0) * t86));
+    gradient
+}
+
 /// Task 2 (velocity control): the sensitivities d(task variable)/dU the controller uses, in the order (d_theta_dot_du, d_theta_ddot_du).
 ///
 /// From appendix "Task specific controllers".
@@ -1223,6 +1722,233 @@ pub fn velocity_control_confidence(
     pi_u
 }
 
+/// Task 2 (velocity control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters [m1 m2 m3 l1 l2 l3]
+/// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
+/// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+///
+/// Cost per call: 424 operations, weighted 513 (63 ADD, 11 DIV, 233 MUL, 27 NEG, 12 POW, 78 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn velocity_logdet_gradient(
+    params: &SVector<f64, 6>,
+    p_theta_dot: &SMatrix<f64, 3, 3>,
+    p_theta_ddot: &SMatrix<f64, 3, 3>,
+    p_u: &SMatrix<f64, 3, 3>,
+) -> SVector<f64, 6> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let m3 = params[2];
+    let l1 = params[3];
+    let l2 = params[4];
+    let l3 = params[5];
+    let p_theta_dot_00 = p_theta_dot[(0, 0)];
+    let p_theta_dot_01 = p_theta_dot[(0, 1)];
+    let p_theta_dot_02 = p_theta_dot[(0, 2)];
+    let p_theta_dot_11 = p_theta_dot[(1, 1)];
+    let p_theta_dot_12 = p_theta_dot[(1, 2)];
+    let p_theta_dot_22 = p_theta_dot[(2, 2)];
+    let p_theta_ddot_00 = p_theta_ddot[(0, 0)];
+    let p_theta_ddot_01 = p_theta_ddot[(0, 1)];
+    let p_theta_ddot_02 = p_theta_ddot[(0, 2)];
+    let p_theta_ddot_11 = p_theta_ddot[(1, 1)];
+    let p_theta_ddot_12 = p_theta_ddot[(1, 2)];
+    let p_theta_ddot_22 = p_theta_ddot[(2, 2)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_02 = p_u[(0, 2)];
+    let p_u_11 = p_u[(1, 1)];
+    let p_u_12 = p_u[(1, 2)];
+    let p_u_22 = p_u[(2, 2)];
+    let t0 = g.powi(-2);
+    let t1 = l1.powi(-2);
+    let t2 = 2.0 * m3;
+    let t3 = m1 + 2.0 * m2 + t2;
+    let t4 = t3.powi(-2);
+    let t5 = 1.0 / l1;
+    let t6 = 1.0 / t3;
+    let t7 = t5 * t6;
+    let t8 = 4.0 * t0;
+    let t9 = t7 * t8;
+    let t10 = 1.0 / l2;
+    let t11 = m2 + t2;
+    let t12 = 1.0 / t11;
+    let t13 = p_theta_dot_01 * t12;
+    let t14 = t10 * t13;
+    let t15 = t14 * t9;
+    let t16 = p_theta_ddot_01 + p_u_01;
+    let t17 = -4.0 * p_theta_dot_00 * t0 * t1 * t4 + t15 + t16;
+    let t18 = 1.0 / g;
+    let t19 = 2.0 * t18;
+    let t20 = t10 * t19;
+    let t21 = t13 * t20;
+    let t22 = t19 * t7;
+    let t23 = -p_theta_dot_00 * t22 + t21;
+    let t24 = t22 * t23;
+    let t25 = t16 + t24;
+    let t26 = 1.0 / m3;
+    let t27 = 1.0 / l3;
+    let t28 = t19 * t27;
+    let t29 = t26 * t28;
+    let t30 = t12 * t20;
+    let t31 = p_theta_dot_12 * t30;
+    let t32 = p_theta_dot_22 * t29 - t31;
+    let t33 = p_theta_dot_11 * t30;
+    let t34 = p_theta_dot_12 * t29 - t33;
+    let t35 = t30 * t34;
+    let t36 = p_theta_ddot_22 + p_u_22 + t29 * t32 - t35;
+    let t37 = p_theta_dot_02 * t26;
+    let t38 = -t21 + t28 * t37;
+    let t39 = t22 * t38;
+    let t40 = p_theta_ddot_02 + p_u_02;
+    let t41 = t39 + t40;
+    let t42 = -p_theta_dot_01 * t22 + t33;
+    let t43 = t30 * t42;
+    let t44 = -p_theta_dot_02 * t22 + t31;
+    let t45 = p_theta_ddot_12 + p_u_12;
+    let t46 = t29 * t44 - t43 + t45;
+    let t47 = t25 * t36 - t41 * t46;
+    let t48 = t27 * t37;
+    let t49 = -t15 + t40 + t48 * t9;
+    let t50 = t35 - t39 + t45;
+    let t51 = p_theta_ddot_11 + p_u_11 - t24 + t43;
+    let t52 = t25 * t50 - t41 * t51;
+    let t53 = p_theta_dot_00 * t1;
+    let t54 = t4 * t8;
+    let t55 = p_theta_ddot_00 + p_u_00 + t53 * t54;
+    let t56 = t36 * t51 - t46 * t50;
+    let t57 = 1.0 / (-t17 * t47 + t49 * t52 + t55 * t56);
+    let t58 = t5 * t54;
+    let t59 = t14 * t58;
+    let t60 = t48 * t58 - t59;
+    let t61 = t17 * t41 - t50 * t55;
+    let t62 = t25 * t49 - t46 * t55;
+    let t63 = t4 * t5;
+    let t64 = t19 * t38;
+    let t65 = t63 * t64;
+    let t66 = t3.powi(-3);
+    let t67 = t53 * t66;
+    let t68 = t19 * t23;
+    let t69 = t63 * t68 - t67 * t8;
+    let t70 = t36 * t55 - t41 * t49;
+    let t71 = -t47;
+    let t72 = -t17 * t36 + t49 * t50;
+    let t73 = t17 * t46 - t49 * t51;
+    let t74 = t0 * t67;
+    let t75 = t11.powi(-2);
+    let t76 = t10 * t75;
+    let t77 = p_theta_dot_12 * t8;
+    let t78 = t26 * t27 * t77;
+    let t79 = l2.powi(-2);
+    let t80 = p_theta_dot_11 * t8;
+    let t81 = t20 * t75;
+    let t82 = t34 * t81 - t79 * t80 / t11.powi(3);
+    let t83 = -t17 * t25 + t51 * t55;
+    let t84 = -4.0 * p_theta_dot_02 * t18 * t4 * t5;
+    let t85 = t42 * t81;
+    let t86 = -4.0 * p_theta_dot_01 * t18 * t4 * t5;
+    let t87 = t30 * (-p_theta_dot_11 * t81 - t86);
+    let t88 = -16.0 * p_theta_dot_00 * t0 * t1 * t66;
+    let t89 = p_theta_dot_01 * t76;
+    let t90 = t89 * t9;
+    let t91 = 8.0 * t0;
+    let t92 = t63 * t91;
+    let t93 = t14 * t92;
+    let t94 = t90 + t93;
+    let t95 = 4.0 * t18;
+    let t96 = t63 * t95;
+    let t97 = t38 * t96;
+    let t98 = -t97;
+    let t99 = t48 * t92;
+    let t100 = -4.0 * p_theta_dot_00 * t18 * t4 * t5;
+    let t101 = t22 * (-p_theta_dot_01 * t81 - t100);
+    let t102 = t23 * t96;
+    let t103 = -t102;
+    let t104 = -16.0 * t56 * t74;
+    let t105 = t7 * t89 * t91;
+    let t106 = t76 * t95;
+    let t107 = p_theta_dot_01 * t106;
+    let t108 = t22 * (-t100 - t107);
+    let t109 = m3.powi(-2);
+    let t110 = t109 * t28;
+    let t111 = p_theta_dot_12 * t106;
+    let t112 = t106 * t34;
+    let t113 = p_theta_dot_11 * t106;
+    let t114 = t30 * (-p_theta_dot_12 * t110 + t113);
+    let t115 = t22 * (-p_theta_dot_02 * t110 + t107);
+    let t116 = t106 * t42;
+    let t117 = t30 * (-t113 - t86);
+    let t118 = t109 * t8;
+    let t119 = t1 * t6;
+    let t120 = t119 * t8;
+    let t121 = t120 * t14;
+    let t122 = t120 * t48 - t121;
+    let t123 = t119 * t64;
+    let t124 = l1.powi(-3);
+    let t125 = p_theta_dot_00 * t124;
+    let t126 = t119 * t68 - t125 * t54;
+    let t127 = t12 * t79;
+    let t128 = t127 * t78;
+    let t129 = t127 * t19;
+    let t130 = t75 * t80 / l2.powi(3);
+    let t131 = t129 * t42 + t130;
+    let t132 = t13 * t79 * t9;
+    let t133 = t129 * t34 - t130;
+    let t134 = l3.powi(-2);
+    let t135 = t134 * t26;
+    let t136 = t135 * t19;
+    let t137 = t10 * t12 * t135 * t77;
+    let t138 = t134 * t37 * t9;
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 6>>::zeros();
+    gradient[0] = t57
+        * (-t52 * t60 - 8.0 * t56 * t74 + t60 * t61 + t62 * t65 - t65 * t73 - t69 * t72
+            + t70 * (t59 + t69)
+            + t71 * (8.0 * p_theta_dot_00 * t0 * t1 * t66 - t59));
+    gradient[1] = t57
+        * (t104
+            + t52 * (t94 - t99)
+            + t61 * (t29 * (-p_theta_dot_12 * t81 - t84) + t85 - t87)
+            + t62 * (-t82 - t90 - t98)
+            + t70 * (-t101 + t102 - t85 + t87)
+            + t71 * (-t88 - t94)
+            + t72 * (t101 + t103)
+            + t73 * (t90 - t97)
+            + t83 * (t76 * t78 + t82));
+    gradient[2] = t57
+        * (t104
+            + t52 * (-p_theta_dot_02 * t118 * t27 * t7 + t105 + t93 - t99)
+            + t61 * (-t110 * t44 + t116 - t117 + t29 * (-t111 - t84))
+            + t62 * (-t112 + t114 - t115 + t97)
+            + t70 * (t102 - t108 - t116 + t117)
+            + t71 * (-t105 - t88 - t93)
+            + t72 * (t103 + t108)
+            + t73 * (t115 + t98)
+            + t83 * (-t110 * t32 + t112 - t114 + t29 * (-p_theta_dot_22 * t110 + t111)));
+    gradient[3] = t57
+        * (-t122 * t52 + t122 * t61 + t123 * t62 - t123 * t73 - t125 * t4 * t56 * t91 - t126 * t72
+            + t70 * (t121 + t126)
+            + t71 * (8.0 * p_theta_dot_00 * t0 * t124 * t4 - t121));
+    gradient[4] = t57
+        * (t132 * t52 - t132 * t71 - t132 * t72
+            + t132 * t73
+            + t61 * (-t128 + t131)
+            + t62 * (-t132 - t133)
+            + t70 * (-t131 + t132)
+            + t83 * (t128 + t133));
+    gradient[5] = t57
+        * (-t136 * t44 * t61 - t138 * t52 - t138 * t73
+            + t62 * (4.0 * p_theta_dot_02 * t0 * t134 * t26 * t5 * t6 - t137)
+            + t83 * (-t136 * t32 + t137 - p_theta_dot_22 * t118 / l3.powi(3)));
+    gradient
+}
+
 /// Task 3 (acceleration control): the sensitivities d(task variable)/dU the controller uses, in the order (d_theta_ddot_du).
 ///
 /// From appendix "Task specific controllers".
@@ -1283,4 +2009,26 @@ pub fn acceleration_control_confidence(
     pi_u[(2, 0)] = pi_u[(0, 2)];
     pi_u[(2, 1)] = pi_u[(1, 2)];
     pi_u
+}
+
+/// Task 3 (acceleration control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters [m1 m2 m3 l1 l2 l3]
+/// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+///
+/// Cost per call: 0 operations, weighted 0.
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn acceleration_logdet_gradient(
+    _params: &SVector<f64, 6>,
+    _p_theta_ddot: &SMatrix<f64, 3, 3>,
+    _p_u: &SMatrix<f64, 3, 3>,
+) -> SVector<f64, 6> {
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let gradient = <SVector<f64, 6>>::zeros();
+    gradient
 }

@@ -185,6 +185,30 @@ pub fn task_control_confidence(
     }
 }
 
+/// d ln|Π^U| / dp of `task` for a tool (each task's `<task>_logdet_gradient` below), given
+/// the precisions of all four terms; a task reads only its own terms' ones.
+#[inline]
+#[must_use]
+#[allow(unused_variables)]
+pub fn task_logdet_gradient(
+    task: super::TaskKind,
+    params: &SVector<f64, PARAMETER_COUNT>,
+    p_theta: &SMatrix<f64, DOF, DOF>,
+    p_theta_dot: &SMatrix<f64, DOF, DOF>,
+    p_theta_ddot: &SMatrix<f64, DOF, DOF>,
+    p_u: &SMatrix<f64, DOF, DOF>,
+) -> SVector<f64, PARAMETER_COUNT> {
+    match task {
+        super::TaskKind::Position => {
+            position_logdet_gradient(params, p_theta, p_theta_dot, p_theta_ddot, p_u)
+        }
+        super::TaskKind::Velocity => {
+            velocity_logdet_gradient(params, p_theta_dot, p_theta_ddot, p_u)
+        }
+        super::TaskKind::Acceleration => acceleration_logdet_gradient(params, p_theta_ddot, p_u),
+    }
+}
+
 /// The parameter-only factors of [`dynamics`], computed once per tool: [`dynamics_with`]
 /// then only combines them with the state and control (derive/toolconf_derive/hoist.py).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -426,6 +450,46 @@ pub fn position_control_confidence(
     pi_u
 }
 
+/// Task 1 (position control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters [m k c]
+/// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
+/// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
+/// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+///
+/// Cost per call: 22 operations, weighted 46 (5 ADD, 3 DIV, 8 MUL, 1 NEG, 3 POW, 2 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn position_logdet_gradient(
+    params: &SVector<f64, 3>,
+    p_theta: &SVector<f64, 1>,
+    p_theta_dot: &SVector<f64, 1>,
+    p_theta_ddot: &SVector<f64, 1>,
+    p_u: &SVector<f64, 1>,
+) -> SVector<f64, 3> {
+    let m = params[0];
+    let k = params[1];
+    let c = params[2];
+    let p_theta_00 = p_theta[0];
+    let p_theta_dot_00 = p_theta_dot[0];
+    let p_theta_ddot_00 = p_theta_ddot[0];
+    let p_u_00 = p_u[0];
+    let t0 = (c + m - 1.0).powi(2);
+    let t1 = p_theta_00 / k.powi(2);
+    let t2 = 1.0 / (p_theta_ddot_00 + p_theta_dot_00 + p_u_00 + t0 * t1);
+    let t3 = t1 * t2 * (2.0 * c + 2.0 * m - 2.0);
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 3>>::zeros();
+    gradient[0] = t3;
+    gradient[1] = -2.0 * p_theta_00 * t0 * t2 / k.powi(3);
+    gradient[2] = t3;
+    gradient
+}
+
 /// Task 2 (velocity control): the sensitivities d(task variable)/dU the controller uses, in the order (d_theta_dot_du, d_theta_ddot_du).
 ///
 /// From appendix "Task specific controllers".
@@ -476,6 +540,36 @@ pub fn velocity_control_confidence(
     pi_u
 }
 
+/// Task 2 (velocity control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters [m k c]
+/// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
+/// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+///
+/// Cost per call: 9 operations, weighted 25 (2 ADD, 2 DIV, 2 MUL, 1 NEG, 2 POW).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn velocity_logdet_gradient(
+    params: &SVector<f64, 3>,
+    p_theta_dot: &SVector<f64, 1>,
+    p_theta_ddot: &SVector<f64, 1>,
+    p_u: &SVector<f64, 1>,
+) -> SVector<f64, 3> {
+    let k = params[1];
+    let p_theta_dot_00 = p_theta_dot[0];
+    let p_theta_ddot_00 = p_theta_ddot[0];
+    let p_u_00 = p_u[0];
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 3>>::zeros();
+    gradient[1] = -2.0 * p_theta_dot_00
+        / (k.powi(3) * (p_theta_ddot_00 + p_u_00 + p_theta_dot_00 / k.powi(2)));
+    gradient
+}
+
 /// Task 3 (acceleration control): the sensitivities d(task variable)/dU the controller uses, in the order (d_theta_ddot_du).
 ///
 /// From appendix "Task specific controllers".
@@ -516,4 +610,26 @@ pub fn acceleration_control_confidence(
     let mut pi_u = <SVector<f64, 1>>::zeros();
     pi_u[0] = p_theta_ddot_00 + p_u_00;
     pi_u
+}
+
+/// Task 3 (acceleration control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters [m k c]
+/// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+///
+/// Cost per call: 0 operations, weighted 0.
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn acceleration_logdet_gradient(
+    _params: &SVector<f64, 3>,
+    _p_theta_ddot: &SVector<f64, 1>,
+    _p_u: &SVector<f64, 1>,
+) -> SVector<f64, 3> {
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let gradient = <SVector<f64, 3>>::zeros();
+    gradient
 }

@@ -13,6 +13,7 @@
 pub mod arm;
 pub mod closed_loop;
 pub mod confidence;
+pub mod design;
 pub mod error;
 pub mod experiments;
 /// The code `make derive` writes into `generated/`, included unchanged: one module per model

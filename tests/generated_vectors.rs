@@ -1,7 +1,7 @@
 //! The generated functions reproduce the CasADi-evaluated test vectors in
 //! generated/<model>.vectors.json (100 random valid points per function, listed by the IR
 //! generated/<model>.json) to 1e-12, normwise relative per output:
-//! max|rust − casadi| ≤ 1e-12 · max|casadi|.
+//! max|rust − casadi| ≤ 1e-12 · max|casadi| (for ∂ln|Π^U|/∂p, · max(max|casadi|, 1): see `check`).
 
 use nalgebra::{SMatrix, SVector};
 use serde_json::Value;
@@ -93,6 +93,30 @@ macro_rules! evaluator {
                         &matrix(i, "p_u"),
                     ))]
                 }
+                "position_logdet_gradient" => vec![m::position_logdet_gradient(
+                    &p(),
+                    &matrix(i, "p_theta"),
+                    &matrix(i, "p_theta_dot"),
+                    &matrix(i, "p_theta_ddot"),
+                    &matrix(i, "p_u"),
+                )
+                .as_slice()
+                .to_vec()],
+                "velocity_logdet_gradient" => vec![m::velocity_logdet_gradient(
+                    &p(),
+                    &matrix(i, "p_theta_dot"),
+                    &matrix(i, "p_theta_ddot"),
+                    &matrix(i, "p_u"),
+                )
+                .as_slice()
+                .to_vec()],
+                "acceleration_logdet_gradient" => vec![m::acceleration_logdet_gradient(
+                    &p(),
+                    &matrix(i, "p_theta_ddot"),
+                    &matrix(i, "p_u"),
+                )
+                .as_slice()
+                .to_vec()],
                 _ => return None,
             })
         }
@@ -133,7 +157,17 @@ fn check(model: &str, evaluate: fn(&str, &Value) -> Option<Vec<Vec<f64>>>) {
             for (out, got) in outputs.iter().zip(got) {
                 let want = numbers(&v["outputs"][out]);
                 assert_eq!(got.len(), want.len(), "{name}.{out}: shape");
-                let scale = want.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+                // ∂ln|Π^U|/∂p is compared relative to max(max|g|, 1) per unit of parameter:
+                // task 3's is exactly zero (Π^U = P^θ̈ + P^U for every tool), which the
+                // generated closed form gives, while CasADi's graph, evaluated at the double
+                // nearest −π/2 as the equilibrium, leaves ~1e-47 there; no relative test can
+                // compare those, and 1e-12 absolute is far below anything a design step sees.
+                let floor: f64 = if name.ends_with("_logdet_gradient") {
+                    1.0
+                } else {
+                    0.0
+                };
+                let scale = want.iter().fold(floor, |m, x| m.max(x.abs()));
                 let err = got
                     .iter()
                     .zip(&want)

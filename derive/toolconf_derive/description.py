@@ -112,6 +112,11 @@ class Task:
         """The generated function that returns this task's control confidence Pi^U."""
         return f"{self.name}_control_confidence"
 
+    @property
+    def gradient_function(self) -> str:
+        """The generated function that returns d ln|Pi^U| / dp for this task."""
+        return f"{self.name}_logdet_gradient"
+
 
 KNOWN_TERMS = ("theta", "theta_dot", "theta_ddot", "u")
 # generated/<model>.rs must not clash with the registry's own files (templates/registry/).

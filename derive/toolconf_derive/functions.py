@@ -208,5 +208,19 @@ def build_functions(d: Derivation, cm: CasadiModel) -> list[Function]:
             "eq. (control_conf) and the closed forms after it", [p] + prec_args,
             [Output("pi_u", "Pi^U (symmetric)", td.confidence, symmetric=True)], conf_eval,
         ))
+
+        def gradient_eval(v, task=task, terms=terms):
+            return cm.logdet_gradient(task).checked(v["params"], *[v[f"p_{t}"] for t in terms + ["u"]],
+                                                      cancelling=True)
+
+        fns.append(Function(
+            task.gradient_function,
+            f"{task.title}: the gradient of the confidence term, d ln|Pi^U| / dp = "
+            "tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool "
+            "design search climbs.",
+            "eq. (control_conf) differentiated in the tool parameters", [p] + prec_args,
+            [Output("gradient", "d ln|Pi^U| / dp, one entry per tool parameter", td.logdet_gradient)],
+            gradient_eval,
+        ))
     return fns
 

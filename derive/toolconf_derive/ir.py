@@ -254,6 +254,7 @@ def model_ir(d: Derivation, functions: list[Function], generator: dict, report: 
                 "terms": t.task.terms, "sensitivity_terms": t.task.sensitivity_terms, "error": t.task.error,
                 "sensitivity_function": t.task.sensitivity_function,
                 "confidence_function": t.task.confidence_function,
+                "gradient_function": t.task.gradient_function,
                 "goals": [{"term": term, "rust": [printer(sp.sympify(v)) for v in
                                                   m.goals.get(t.task.name, {}).get(term, ["0"] * m.dof)]}
                           for term in t.task.sensitivity_terms],

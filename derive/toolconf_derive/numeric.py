@@ -88,3 +88,31 @@ class CasadiModel:
         for term in task.sensitivity_terms:
             pi = pi + s[term].T @ Exact.of(precision[term]) @ s[term]
         return pi
+
+    def logdet_gradient(self, task: Task) -> ExactFunction:
+        """d ln|Pi^U| / dp by CasADi's algorithmic differentiation of ln(det(Pi^U)), Pi^U built
+        symbolically in CasADi from its own A(p), B(p) (the AD Jacobian at the equilibrium) and the
+        task formulas, with the precisions as inputs (in the order the task's terms, then u).
+        Nothing here comes from SymPy: it is what the closed form (Jacobi's formula) is checked
+        against. Cached per task, since building the graph is the slow part."""
+        cache = self.__dict__.setdefault("_gradient_cache", {})
+        if task.name in cache:
+            return cache[task.name]
+        n = self.model.dof
+        a, b = self.jacobian.f(ca.DM(self.x_e), ca.DM(self.u_e), self.p)
+        eye, zero = ca.SX.eye(n), ca.SX.zeros(n, n)
+        e = ca.vertcat(eye, eye)
+        ns = {
+            "A": a, "B": b, "inv": ca.inv_minor, "I": eye, "O": zero,
+            "IO": ca.horzcat(eye, zero), "OI": ca.horzcat(zero, eye),
+            "E": e, "dX_dU": ca.inv_minor(a) @ (e - b),
+        }
+        precisions = {t: ca.SX.sym(f"p_{t}", n, n) for t in task.sensitivity_terms + ["u"]}
+        pi = precisions["u"]
+        for term in task.sensitivity_terms:
+            s = eval(task.sensitivity[term], {"__builtins__": {}}, dict(ns))  # noqa: S307
+            pi = pi + s.T @ precisions[term] @ s
+        gradient = ca.gradient(ca.log(ca.det(pi)), self.p)
+        inputs = [self.p] + [precisions[t] for t in task.sensitivity_terms + ["u"]]
+        cache[task.name] = ExactFunction(ca.Function(f"{task.name}_logdet_gradient", inputs, [gradient]))
+        return cache[task.name]

@@ -3,9 +3,13 @@ comparison with what the paper prints. The report template renders this into gen
 
 from __future__ import annotations
 
+import mpmath
 import sympy as sp
 
-from .symbolic import TERM_LATEX, Derivation, parse, tidy
+from .symbolic import TERM_LATEX, Derivation, cofactor_determinant, parse, tidy
+
+# The tool at which the report states d ln|Pi^U|/dp: the middle of the paper's box [0.1, 0.6].
+REFERENCE_PARAMETER = sp.Rational(7, 20)
 
 
 def _latex(d: Derivation, e) -> str:
@@ -42,6 +46,27 @@ def _equations(d: Derivation) -> list[dict]:
         {"lhs": "\\ddot q", "rhs": "M(q)^{-1}\\left(Q - \\frac{\\partial (M \\dot q)}{\\partial q}\\dot q"
          " + \\frac{\\partial T}{\\partial q} - \\frac{\\partial V}{\\partial q}\\right)"},
     ]
+
+
+def _gradient(d: Derivation, t, substitute: dict) -> dict:
+    """d ln|Pi^U|/dp with the default precisions: its values at the reference tool (50-digit
+    mpmath, printed to 6 digits, so the same text on every machine) and, for one joint, the
+    closed form (for more joints it runs to pages; the generated code has it, CSE'd)."""
+    gradient = t.logdet_gradient.subs(substitute).subs(d.constants)
+    evaluate = sp.lambdify(d.params, list(gradient), modules="mpmath")
+    with mpmath.workdps(50):
+        values = evaluate(*[mpmath.mpf(REFERENCE_PARAMETER.p) / REFERENCE_PARAMETER.q] * len(d.params))
+        shown = [mpmath.nstr(mpmath.mpf(v), 6) for v in values]
+    closed = None
+    if d.model.dof == 1:
+        pi = t.confidence.subs(substitute)
+        closed = [{"name": p.name, "latex": _latex(d, tidy(sp.diff(sp.log(cofactor_determinant(pi)), p)))}
+                  for p in d.params]
+    return {
+        "reference": f"{float(REFERENCE_PARAMETER)}",
+        "values": [{"name": p.name, "value": v} for p, v in zip(d.params, shown)],
+        "closed": closed,
+    }
 
 
 def report_data(d: Derivation) -> dict:
@@ -81,6 +106,8 @@ def report_data(d: Derivation) -> dict:
                 for term in task.terms
             ),
             "confidence_default": _latex(d, confidence_default),
+            "gradient": _gradient(d, t, {s: defaults[term][i, j] for term, reads in t.precision_reads.items()
+                                         for s, i, j in reads}),
             "remarks": [
                 {
                     "what": rf"\frac{{\partial {TERM_LATEX[r['remark'].term]}}}{{\partial U}}",

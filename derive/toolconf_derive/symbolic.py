@@ -114,6 +114,8 @@ class TaskDerivation:
     precision_reads: dict[str, list]       # term -> [(symbol, i, j)]
     confidence: sp.Matrix                  # Pi^U, n x n, composed (not expanded)
     remarks: list[dict]
+    # d ln|Pi^U| / dp, k x 1: tr(adj(Pi^U) dPi^U/dp_i) / |Pi^U| (Jacobi's formula), composed.
+    logdet_gradient: sp.Matrix | None = None
 
 
 @dataclass
@@ -193,6 +195,8 @@ def derive(model: Model, tasks: list[Task]) -> Derivation:
     check_goals(model, tasks)
     ns = task_namespace(a, b, model.dof, lambda m: tidy_matrix(m.inv()))
     derived_tasks = [derive_task(task, ns, model.dof) for task in tasks]
+    for t in derived_tasks:
+        t.logdet_gradient = logdet_gradient(t.confidence, params)
     return Derivation(model, params, consts, q, q_dot, u, q_ddot, f, f_x, f_u, x_e, u_e, a, b, derived_tasks, lagrangian)
 
 
@@ -238,3 +242,33 @@ def derive_task(task: Task, ns: dict, n: int) -> TaskDerivation:
         alt = tidy_matrix(sp.Matrix(evaluate_formula(r.alternative, ns, task, f"remarks[{i}].alternative")))
         remarks.append({"remark": r, "alternative": alt, "used": sens[r.term]})
     return TaskDerivation(task, sens, precision, reads, confidence, remarks)
+
+
+def cofactor_determinant(m: sp.Matrix) -> sp.Expr:
+    """|m| by Laplace expansion along the first row, without simplification: SymPy's det methods
+    cancel and factor, which for Pi^U's composed entries takes long and gains nothing before CSE."""
+    n = m.rows
+    if n == 1:
+        return m[0, 0]
+    if n == 2:
+        return m[0, 0] * m[1, 1] - m[0, 1] * m[1, 0]
+    return sum(((-1) ** j) * m[0, j] * cofactor_determinant(m.minor_submatrix(0, j)) for j in range(n))
+
+
+def adjugate(m: sp.Matrix) -> sp.Matrix:
+    """adj(m) = cofactor matrix transposed (m^-1 = adj(m)/|m|), unsimplified like cofactor_determinant."""
+    n = m.rows
+    if n == 1:
+        return sp.Matrix([[1]])
+    return sp.Matrix(n, n, lambda i, j: ((-1) ** (i + j)) * cofactor_determinant(m.minor_submatrix(j, i)))
+
+
+def logdet_gradient(pi: sp.Matrix, params: list[sp.Symbol]) -> sp.Matrix:
+    """d ln|Pi| / dp_i = tr(Pi^-1 dPi/dp_i) = tr(adj(Pi) dPi/dp_i) / |Pi| (Jacobi's formula), for
+    every tool parameter: what a design search climbs (toolconf design)."""
+    adj, det = adjugate(pi), cofactor_determinant(pi)
+    rows = []
+    for p in params:
+        d_pi = pi.diff(p)
+        rows.append(sum(adj[j, i] * d_pi[i, j] for i in range(pi.rows) for j in range(pi.cols)) / det)
+    return sp.Matrix(rows)

@@ -2,6 +2,7 @@
 //! Bad input is a message on stderr and exit status 2; a failed simulation exits with 1.
 
 mod confidence;
+mod design;
 mod episode_args;
 mod output;
 mod rank;
@@ -32,6 +33,8 @@ enum Command {
     Select(select::Args),
     /// Rank your own tools (a CSV or JSON file) on a built-in task or a task file.
     Rank(rank::Args),
+    /// Design a tool: maximise control confidence under bounds and linear constraints.
+    Design(design::Args),
     /// Run every experiment of the paper's Results section: CSVs, SVG figures, report.
     Reproduce(reproduce::Args),
 }
@@ -56,6 +59,7 @@ pub fn run() -> ExitCode {
         Command::Select(args) => select::run(&args),
         Command::Rank(args) => rank::run(&args),
         Command::Reproduce(args) => reproduce::run(&args),
+        Command::Design(args) => design::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -67,7 +67,7 @@ impl From<ObjectiveArg> for Objective {
 }
 
 /// A built-in task name, else a task file.
-fn task_spec(task: &str) -> Result<TaskSpec, CliError> {
+pub(crate) fn task_spec(task: &str) -> Result<TaskSpec, CliError> {
     if let Ok(kind) = task.parse::<TaskKind>() {
         return Ok(TaskSpec::builtin(kind));
     }

@@ -96,6 +96,9 @@ pub trait ArmModel<const N: usize, const NX: usize, const NP: usize, const NZ: u
     fn sensitivities(kind: TaskKind, p: &SVector<f64, NP>) -> SensitivitiesN<N>;
     /// Π^U = Σ Sᵀ P S over the task's terms + P^U, unvalidated (the generated closed form).
     fn pi_u(task: &TaskN<N>, p: &SVector<f64, NP>) -> SMatrix<f64, N, N>;
+    /// ∂ln|Π^U|/∂p = tr((Π^U)⁻¹ ∂Π^U/∂p_i) per tool parameter (Jacobi's formula; the generated
+    /// `<task>_logdet_gradient`): what `toolconf design` climbs. Unvalidated like [`ArmModel::pi_u`].
+    fn logdet_gradient(task: &TaskN<N>, p: &SVector<f64, NP>) -> SVector<f64, NP>;
     /// The model's paper-style task: its own goals (`derive/models/<name>.toml`) and the
     /// paper's precisions (`derive/tasks.toml`).
     fn paper_task(kind: TaskKind) -> TaskN<N>;
@@ -193,6 +196,21 @@ macro_rules! arm_model {
                 p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
             ) -> SMatrix<f64, { generated::$module::DOF }, { generated::$module::DOF }> {
                 generated::$module::task_control_confidence(
+                    task.kind,
+                    p,
+                    &task.precision_theta,
+                    &task.precision_theta_dot,
+                    &task.precision_theta_ddot,
+                    &task.precision_u,
+                )
+            }
+
+            #[inline]
+            fn logdet_gradient(
+                task: &TaskN<{ generated::$module::DOF }>,
+                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
+            ) -> SVector<f64, { generated::$module::PARAMETER_COUNT }> {
+                generated::$module::task_logdet_gradient(
                     task.kind,
                     p,
                     &task.precision_theta,
@@ -531,6 +549,19 @@ impl<const N: usize> ValidatedTaskN<N> {
         M: ArmModel<N, NX, NP, NZ>,
     {
         M::pi_u(&self.0, &tool.params)
+    }
+
+    /// ∂ln|Π^U|/∂p of `tool`, one entry per tool parameter (the generated closed form of
+    /// Jacobi's formula, d ln|Π| = tr(Π⁻¹ dΠ)); meaningful where Π^U is positive definite.
+    #[inline]
+    pub fn logdet_gradient<M, const NX: usize, const NP: usize, const NZ: usize>(
+        &self,
+        tool: &ToolN<M, N, NX, NP, NZ>,
+    ) -> SVector<f64, NP>
+    where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
+        M::logdet_gradient(&self.0, &tool.params)
     }
 
     /// Π^U and ln|Π^U| of `tool` (eq. control_conf); errors only if Π^U is not positive definite.

@@ -82,6 +82,19 @@ macro_rules! model_tasks {
                 }
             }
 
+            /// ln|Π^U| of `tool` and its gradient ∂ln|Π^U|/∂p (the generated closed form),
+            /// in the model's parameter order: what `toolconf design` climbs.
+            pub fn logdet_and_gradient(&self, tool: &AnyTool) -> Result<(f64, Vec<f64>), Error> {
+                match tool {
+                    $(AnyTool::$marker(t) => match &self.$module {
+                        Ok(b) => b.task.control_confidence(t).map(|c| {
+                            (c.logdet, b.task.logdet_gradient(t).as_slice().to_vec())
+                        }),
+                        Err(e) => Err(Error::Unsupported(e.to_string())),
+                    },)*
+                }
+            }
+
             /// The episode's metrics.
             pub fn simulate(&self, tool: &AnyTool) -> Result<Metrics, ModelSimulationError> {
                 match tool {

@@ -1,0 +1,245 @@
+//! The design file (TOML): what may vary, between which bounds, under which linear
+//! constraints, and what to optimise.
+//!
+//! ```toml
+//! objective = "confidence"            # maximise ln|Π^U| (default), or "free_energy": minimise ∫F dt
+//! constraints = ["l1 + l2 >= 0.7", "m1 + m2 <= 0.5"]
+//! [bounds]                            # every parameter not fixed needs bounds, lo > 0
+//! m1 = [0.1, 0.6]
+//! [fixed]                             # optional: parameters held at a value (e.g. a payload mass)
+//! mp = 0.2
+//! [search]                            # optional, defaults shown
+//! seed = 0                            # random starts and the random tools compared with
+//! starts = 8                          # random feasible starts besides the centre
+//! samples = 100000                    # random feasible tools the design is compared with
+//! simulate = 5                        # how many of the most confident of them are simulated
+//! perturbation = -0.8                 # ΔT [N m] for the sensitivity |Δ task error|
+//! ```
+//!
+//! Every mistake is a [`DesignError::Input`] naming the file and the key.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::Deserialize;
+
+use super::constraint::{parse_constraint, LinearConstraint};
+use super::DesignError;
+
+/// What the design optimises.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DesignObjective {
+    /// Maximise ln|Π^U| (closed form with its derived gradient).
+    Confidence,
+    /// Minimise ∫F dt by simulation, started from the confidence optimum.
+    FreeEnergy,
+}
+
+impl DesignObjective {
+    pub fn name(self) -> &'static str {
+        match self {
+            DesignObjective::Confidence => "confidence",
+            DesignObjective::FreeEnergy => "free_energy",
+        }
+    }
+}
+
+/// Search settings ([search] table).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SearchSettings {
+    pub seed: u64,
+    pub starts: usize,
+    pub samples: usize,
+    pub simulate: usize,
+    pub perturbation: f64,
+}
+
+impl Default for SearchSettings {
+    fn default() -> Self {
+        Self {
+            seed: 0,
+            starts: 8,
+            samples: 100_000,
+            simulate: 5,
+            perturbation: -0.8,
+        }
+    }
+}
+
+/// A checked design problem over one model's parameters (in the model's order).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DesignSpec {
+    pub file: String,
+    pub objective: DesignObjective,
+    pub names: Vec<&'static str>,
+    /// Per parameter: `Some(value)` if fixed.
+    pub fixed: Vec<Option<f64>>,
+    /// Per parameter: (lo, hi); a fixed parameter's are (value, value).
+    pub bounds: Vec<(f64, f64)>,
+    pub constraints: Vec<LinearConstraint>,
+    pub search: SearchSettings,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawDesign {
+    objective: Option<String>,
+    #[serde(default)]
+    constraints: Vec<String>,
+    #[serde(default)]
+    bounds: BTreeMap<String, Vec<f64>>,
+    #[serde(default)]
+    fixed: BTreeMap<String, f64>,
+    #[serde(default)]
+    search: RawSearch,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawSearch {
+    seed: Option<u64>,
+    starts: Option<usize>,
+    samples: Option<usize>,
+    simulate: Option<usize>,
+    perturbation: Option<f64>,
+}
+
+impl DesignSpec {
+    /// Reads and checks a design file for a model with parameters `names`.
+    pub fn from_file(path: &Path, names: &[&'static str]) -> Result<Self, DesignError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            DesignError::input(&file, "", format!("cannot read the design file: {e}"))
+        })?;
+        Self::parse(&text, &file, names)
+    }
+
+    /// Parses and checks design-file text; `file` names it in errors.
+    pub fn parse(text: &str, file: &str, names: &[&'static str]) -> Result<Self, DesignError> {
+        let raw: RawDesign = toml::from_str(text).map_err(|e| {
+            let line = e.span().map(|s| 1 + text[..s.start].matches('\n').count());
+            let place = line.map(|l| format!("line {l}")).unwrap_or_default();
+            DesignError::input(file, &place, e.message().trim().replace('\n', " "))
+        })?;
+        let err =
+            |key: &str, message: String| DesignError::input(file, &format!("key {key}"), message);
+        let objective = match raw.objective.as_deref() {
+            None | Some("confidence") => DesignObjective::Confidence,
+            Some("free_energy") | Some("free-energy") => DesignObjective::FreeEnergy,
+            Some(other) => {
+                return Err(err(
+                    "objective",
+                    format!("'{other}' is not an objective (confidence or free_energy)"),
+                ))
+            }
+        };
+        let known = |key: String, name: &str| -> Result<usize, DesignError> {
+            names.iter().position(|n| *n == name).ok_or_else(|| {
+                err(
+                    &key,
+                    format!(
+                        "unknown parameter '{name}' (parameters: {})",
+                        names.join(", ")
+                    ),
+                )
+            })
+        };
+        let mut fixed = vec![None; names.len()];
+        for (name, &value) in &raw.fixed {
+            let k = known(format!("fixed.{name}"), name)?;
+            if !(value.is_finite() && value > 0.0) {
+                return Err(err(
+                    &format!("fixed.{name}"),
+                    format!("{value} is not a positive number"),
+                ));
+            }
+            fixed[k] = Some(value);
+        }
+        let mut bounds = vec![None; names.len()];
+        for (name, range) in &raw.bounds {
+            let key = format!("bounds.{name}");
+            let k = known(key.clone(), name)?;
+            if fixed[k].is_some() {
+                return Err(err(
+                    &key,
+                    format!("'{name}' is also fixed; give one of the two"),
+                ));
+            }
+            bounds[k] = Some(check_bounds(range).map_err(|m| err(&key, m))?);
+        }
+        let mut out = Vec::with_capacity(names.len());
+        for (k, name) in names.iter().enumerate() {
+            match (fixed[k], bounds[k]) {
+                (Some(v), _) => out.push((v, v)),
+                (None, Some(b)) => out.push(b),
+                (None, None) => {
+                    return Err(err(
+                        "bounds",
+                        format!("parameter '{name}' has no bounds: give bounds.{name} = [lo, hi] or fixed.{name} = value"),
+                    ))
+                }
+            }
+        }
+        let constraints = raw
+            .constraints
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                parse_constraint(c, names)
+                    .map_err(|m| err(&format!("constraints[{i}]"), format!("'{c}': {m}")))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Self {
+            file: file.into(),
+            objective,
+            names: names.to_vec(),
+            fixed,
+            bounds: out,
+            constraints,
+            search: search_settings(&raw.search)
+                .map_err(|(k, m)| err(&format!("search.{k}"), m))?,
+        })
+    }
+}
+
+fn check_bounds(range: &[f64]) -> Result<(f64, f64), String> {
+    let &[lo, hi] = range else {
+        return Err(format!("{range:?} is not [lo, hi]"));
+    };
+    if !(lo.is_finite() && hi.is_finite()) {
+        return Err(format!("[{lo}, {hi}] is not finite"));
+    }
+    if lo <= 0.0 {
+        return Err(format!(
+            "[{lo}, {hi}] admits values <= 0; masses and lengths must be > 0 (give lo > 0)"
+        ));
+    }
+    if lo > hi {
+        return Err(format!("[{lo}, {hi}] is empty (lo > hi)"));
+    }
+    Ok((lo, hi))
+}
+
+fn search_settings(raw: &RawSearch) -> Result<SearchSettings, (&'static str, String)> {
+    let d = SearchSettings::default();
+    let s = SearchSettings {
+        seed: raw.seed.unwrap_or(d.seed),
+        starts: raw.starts.unwrap_or(d.starts),
+        samples: raw.samples.unwrap_or(d.samples),
+        simulate: raw.simulate.unwrap_or(d.simulate),
+        perturbation: raw.perturbation.unwrap_or(d.perturbation),
+    };
+    if s.samples > 10_000_000 {
+        return Err(("samples", format!("{} is more than 10^7", s.samples)));
+    }
+    if s.starts > 1000 {
+        return Err(("starts", format!("{} is more than 1000", s.starts)));
+    }
+    if s.simulate > 1000 {
+        return Err(("simulate", format!("{} is more than 1000", s.simulate)));
+    }
+    if !s.perturbation.is_finite() {
+        return Err(("perturbation", format!("{} is not finite", s.perturbation)));
+    }
+    Ok(s)
+}

@@ -1,0 +1,173 @@
+//! Tool design by control confidence (`toolconf design`): which tool to build for a task, under
+//! bounds, linear constraints and fixed parameters from a design file ([`file`]).
+//!
+//! Flow: the design file → the feasible polytope over the free parameters ([`polytope`]) → a
+//! multi-start SQP on ln|Π^U| with the derived gradient ∂ln|Π^U|/∂p = tr((Π^U)⁻¹ ∂Π^U/∂p)
+//! (generated `<task>_logdet_gradient`; [`solver`], QPs by Clarabel) → optionally ∫F dt by
+//! simulation from there ([`free_energy`]) → the design beside the best of N random feasible
+//! tools, simulated with and without a torque perturbation ΔT ([`verify`]). [`sweep`] traces
+//! the confidence–budget trade-off; [`report`] writes it down.
+//!
+//! Determinism: starts and random tools come from seeded ChaCha8 streams drawn sequentially;
+//! the multi-start runs in start order; simulations run in parallel but are collected in input
+//! order. The same file and seed give the same design on any number of threads.
+
+pub mod constraint;
+pub mod file;
+pub mod free_energy;
+pub mod polytope;
+pub mod qp;
+pub mod report;
+pub mod solver;
+pub mod sweep;
+pub mod verify;
+
+use crate::model::mixed::{AnyTool, ModelKind};
+use crate::rank::ModelTasks;
+use crate::task_file::TaskSpec;
+
+use file::{DesignObjective, DesignSpec};
+use polytope::{FeasibleSampler, Polytope};
+use solver::Optimum;
+use verify::{RandomTools, ToolCheck};
+
+/// Why a design could not be made: bad input (exit status 2, infeasible constraints included)
+/// or a failed run (1).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DesignError {
+    #[error("{0}")]
+    Input(String),
+    #[error("{0}")]
+    Infeasible(String),
+    #[error("{0}")]
+    Failed(String),
+}
+
+impl DesignError {
+    pub fn input(file: &str, place: &str, message: String) -> Self {
+        if place.is_empty() {
+            DesignError::Input(format!("{file}: {message}"))
+        } else {
+            DesignError::Input(format!("{file}, {place}: {message}"))
+        }
+    }
+}
+
+/// The model and task a design is for.
+pub struct Setting<'a> {
+    pub model: ModelKind,
+    pub task: &'a TaskSpec,
+    pub tasks: &'a ModelTasks,
+}
+
+impl<'a> Setting<'a> {
+    /// ln|Π^U| and its gradient over the free parameters at free parameters `x`.
+    pub fn confidence(&self, polytope: &Polytope, x: &[f64]) -> Option<(f64, Vec<f64>)> {
+        let tool = AnyTool::new(self.model, &polytope.full(x)).ok()?;
+        let (value, gradient) = self.tasks.logdet_and_gradient(&tool).ok()?;
+        Some((value, polytope.free.iter().map(|&k| gradient[k]).collect()))
+    }
+}
+
+/// The confidence optimum over the feasible set, from the centre and `search.starts` seeded
+/// random feasible starts.
+pub fn confidence_optimum(
+    spec: &DesignSpec,
+    setting: &Setting,
+) -> Result<(Polytope, Optimum), DesignError> {
+    let polytope = Polytope::new(spec);
+    let mut starts = vec![polytope.centre(&spec.file)?];
+    let mut sampler = FeasibleSampler::new(&polytope, spec.search.seed);
+    while starts.len() <= spec.search.starts {
+        match sampler.next_point(100_000) {
+            Some(x) => starts.push(x),
+            None => break,
+        }
+    }
+    let mut objective = |x: &[f64]| setting.confidence(&polytope, x);
+    let optimum = solver::maximise(&polytope, &starts, &mut objective).ok_or_else(|| {
+        DesignError::Input(format!(
+            "{}: ln|Π^U| is undefined at every start (Π^U not positive definite); check the task's precisions",
+            spec.file
+        ))
+    })?;
+    Ok((polytope, optimum))
+}
+
+/// Central differences of ln|Π^U| at the optimum (step 1e-6 of each parameter), for the
+/// report's gradient check: the largest |derived − difference| / max(|derived|, 1).
+pub fn gradient_check(setting: &Setting, polytope: &Polytope, optimum: &Optimum) -> f64 {
+    let mut worst = 0.0_f64;
+    for j in 0..optimum.x.len() {
+        let h = 1e-6 * optimum.x[j];
+        let at = |delta: f64| {
+            let mut x = optimum.x.clone();
+            x[j] += delta;
+            setting.confidence(polytope, &x).map(|v| v.0)
+        };
+        if let (Some(plus), Some(minus)) = (at(h), at(-h)) {
+            let fd = (plus - minus) / (2.0 * h);
+            worst =
+                worst.max((optimum.gradient[j] - fd).abs() / optimum.gradient[j].abs().max(1.0));
+        }
+    }
+    worst
+}
+
+/// Everything `toolconf design` shows.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DesignResult {
+    pub objective: DesignObjective,
+    /// The designed tool's full parameters, in the model's order.
+    pub params: Vec<f64>,
+    pub logdet: f64,
+    /// The confidence optimum (the design itself when the objective is confidence).
+    pub confidence_optimum: Optimum,
+    pub gradient_check: f64,
+    /// Simulations of the ∫F search (0 for the confidence objective).
+    pub free_energy_evaluations: usize,
+    pub random: RandomTools,
+    /// The design first, then the most confident random tools.
+    pub checks: Vec<ToolCheck>,
+}
+
+/// Designs a tool: the optimum, then the verification against random feasible tools.
+pub fn design(spec: &DesignSpec, setting: &Setting) -> Result<DesignResult, DesignError> {
+    let (polytope, optimum) = confidence_optimum(spec, setting)?;
+    let check = gradient_check(setting, &polytope, &optimum);
+    let (x, logdet, evaluations) = match spec.objective {
+        DesignObjective::Confidence => (optimum.x.clone(), optimum.value, 0),
+        DesignObjective::FreeEnergy => {
+            let found = free_energy::minimise(&polytope, setting, &optimum.x)?;
+            let logdet = setting
+                .confidence(&polytope, &found.x)
+                .map_or(f64::NAN, |v| v.0);
+            (found.x, logdet, found.simulations)
+        }
+    };
+    let s = &spec.search;
+    let random = verify::random_tools(
+        &polytope,
+        setting.model,
+        setting.tasks,
+        s.samples,
+        s.simulate,
+        s.seed ^ 0x9e37_79b9_7f4a_7c15,
+    );
+    let mut tools = vec![("design".to_string(), polytope.full(&x), logdet)];
+    for (k, (xr, l)) in random.top.iter().enumerate().take(s.simulate) {
+        tools.push((format!("random #{}", k + 1), polytope.full(xr), *l));
+    }
+    let perturbed = ModelTasks::new(&verify::perturbed(setting.task, s.perturbation));
+    let checks = verify::check_tools(&tools, setting.model, setting.tasks, &perturbed);
+    Ok(DesignResult {
+        objective: spec.objective,
+        params: polytope.full(&x),
+        logdet,
+        confidence_optimum: optimum,
+        gradient_check: check,
+        free_energy_evaluations: evaluations,
+        random,
+        checks,
+    })
+}

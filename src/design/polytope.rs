@@ -1,0 +1,198 @@
+//! The feasible set of a design: the free parameters' box and the linear constraints, with the
+//! fixed parameters moved to the right-hand sides. Everything the solver and the sampler need:
+//! rows G x ≤ h over the free parameters x, the centre (a Chebyshev centre, by an LP), a seeded
+//! uniform sampler, and the map back to the full parameter vector.
+
+use rand::{RngCore, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::constraint::dot;
+use super::file::DesignSpec;
+use super::qp::{self, QpOutcome};
+use super::DesignError;
+
+/// Points within this (absolute, in parameter units) of a constraint count as on it.
+pub const FEASIBILITY_TOLERANCE: f64 = 1e-9;
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Polytope {
+    /// Indices of the free parameters in the model's order.
+    pub free: Vec<usize>,
+    /// The full parameter vector with the fixed values in place (free entries are overwritten).
+    pub base: Vec<f64>,
+    pub lo: Vec<f64>,
+    pub hi: Vec<f64>,
+    /// The linear constraints over the free parameters: `g[i]·x ≤ h[i]`, described by `text[i]`.
+    pub g: Vec<Vec<f64>>,
+    pub h: Vec<f64>,
+    pub text: Vec<String>,
+}
+
+impl Polytope {
+    pub fn new(spec: &DesignSpec) -> Self {
+        let free: Vec<usize> = (0..spec.names.len())
+            .filter(|&k| spec.fixed[k].is_none())
+            .collect();
+        let base: Vec<f64> = spec.bounds.iter().map(|b| b.0).collect();
+        let (mut g, mut h, mut text) = (Vec::new(), Vec::new(), Vec::new());
+        for c in &spec.constraints {
+            let fixed_part: f64 = (0..base.len())
+                .filter(|k| !free.contains(k))
+                .map(|k| c.coefficients[k] * base[k])
+                .sum();
+            g.push(free.iter().map(|&k| c.coefficients[k]).collect());
+            h.push(c.bound - fixed_part);
+            text.push(c.text.clone());
+        }
+        Self {
+            lo: free.iter().map(|&k| spec.bounds[k].0).collect(),
+            hi: free.iter().map(|&k| spec.bounds[k].1).collect(),
+            free,
+            base,
+            g,
+            h,
+            text,
+        }
+    }
+
+    pub fn dim(&self) -> usize {
+        self.free.len()
+    }
+
+    /// The full parameter vector for free parameters `x`.
+    pub fn full(&self, x: &[f64]) -> Vec<f64> {
+        let mut p = self.base.clone();
+        for (&k, &v) in self.free.iter().zip(x) {
+            p[k] = v;
+        }
+        p
+    }
+
+    /// Every row, box included: G x ≤ h with the box as ±x_j ≤ ±bound.
+    pub fn all_rows(&self) -> (Vec<Vec<f64>>, Vec<f64>) {
+        let (mut g, mut h) = (self.g.clone(), self.h.clone());
+        for j in 0..self.dim() {
+            let mut e = vec![0.0; self.dim()];
+            e[j] = 1.0;
+            g.push(e.clone());
+            h.push(self.hi[j]);
+            e[j] = -1.0;
+            g.push(e);
+            h.push(-self.lo[j]);
+        }
+        (g, h)
+    }
+
+    /// The largest violation of any row at `x` (≤ 0 when feasible).
+    pub fn violation(&self, x: &[f64]) -> f64 {
+        let (g, h) = self.all_rows();
+        g.iter()
+            .zip(&h)
+            .map(|(row, b)| dot(row, x) - b)
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    pub fn contains(&self, x: &[f64]) -> bool {
+        self.violation(x) <= FEASIBILITY_TOLERANCE
+    }
+
+    /// A Chebyshev centre (the centre of the largest ball inside, in parameter units): the
+    /// multi-start's first, deterministic start; or [`DesignError::Infeasible`] naming the
+    /// constraints when the set is empty.
+    pub fn centre(&self, file: &str) -> Result<Vec<f64>, DesignError> {
+        let (g, h) = self.all_rows();
+        let n = self.dim();
+        if n == 0 {
+            return if self.violation(&[]) <= FEASIBILITY_TOLERANCE {
+                Ok(Vec::new())
+            } else {
+                Err(self.infeasible(file))
+            };
+        }
+        // Variables [x; r]: maximise r subject to g·x + |g| r ≤ h and r ≥ 0.
+        let mut rows: Vec<Vec<f64>> = g
+            .iter()
+            .map(|row| {
+                let mut r = row.clone();
+                r.push(dot(row, row).sqrt());
+                r
+            })
+            .collect();
+        let mut rhs = h.clone();
+        let mut nonneg = vec![0.0; n + 1];
+        nonneg[n] = -1.0;
+        rows.push(nonneg);
+        rhs.push(0.0);
+        let mut cost = vec![0.0; n + 1];
+        cost[n] = -1.0;
+        match qp::solve(None, &cost, &rows, &rhs) {
+            QpOutcome::Solved { x, .. } => {
+                let x = x[..n].to_vec();
+                if self.violation(&x) <= 1e-7 {
+                    Ok(self.clamp(x))
+                } else {
+                    Err(self.infeasible(file))
+                }
+            }
+            QpOutcome::Infeasible => Err(self.infeasible(file)),
+            QpOutcome::Failed(m) => Err(DesignError::Failed(format!(
+                "finding a feasible design: {m}"
+            ))),
+        }
+    }
+
+    fn clamp(&self, x: Vec<f64>) -> Vec<f64> {
+        x.iter()
+            .enumerate()
+            .map(|(j, v)| v.clamp(self.lo[j], self.hi[j]))
+            .collect()
+    }
+
+    fn infeasible(&self, file: &str) -> DesignError {
+        let constraints = if self.text.is_empty() {
+            "(no constraints)".to_string()
+        } else {
+            self.text.join(", ")
+        };
+        DesignError::Infeasible(format!(
+            "{file}: the constraints are infeasible: no parameters within the bounds satisfy {constraints}"
+        ))
+    }
+}
+
+/// Uniform draws from the polytope by rejection from its box: ChaCha8 seeded with `seed`, each
+/// coordinate lo + (hi − lo)·u with u = (next_u64 >> 11)·2⁻⁵³, a draw kept when it satisfies
+/// every constraint. Sequential, so the same seed gives the same points on any machine.
+pub struct FeasibleSampler<'a> {
+    polytope: &'a Polytope,
+    rng: ChaCha8Rng,
+    pub drawn: u64,
+}
+
+impl<'a> FeasibleSampler<'a> {
+    pub fn new(polytope: &'a Polytope, seed: u64) -> Self {
+        Self {
+            polytope,
+            rng: ChaCha8Rng::seed_from_u64(seed),
+            drawn: 0,
+        }
+    }
+
+    /// The next feasible point, or None after `max_draws` draws in all without one.
+    pub fn next_point(&mut self, max_draws: u64) -> Option<Vec<f64>> {
+        let p = self.polytope;
+        while self.drawn < max_draws {
+            self.drawn += 1;
+            let x: Vec<f64> = (0..p.dim())
+                .map(|j| {
+                    let u = (self.rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
+                    p.lo[j] + (p.hi[j] - p.lo[j]) * u
+                })
+                .collect();
+            if p.g.iter().zip(&p.h).all(|(row, b)| dot(row, &x) <= *b) {
+                return Some(x);
+            }
+        }
+        None
+    }
+}

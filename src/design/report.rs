@@ -1,0 +1,157 @@
+//! The design report (`toolconf design --report DIR`): `report.md` and `report.html` with the
+//! designed tool beside the best random feasible tools, and, with `--sweep`, the trade-off
+//! front as `sweep.csv` and `sweep.svg`.
+
+use std::path::{Path, PathBuf};
+
+use crate::experiments::plot::{self, Colour, Legend, Panel, Series, XyPanel};
+use crate::experiments::report::{to_html, to_markdown, Block};
+use crate::experiments::{write_atomically, ReproduceError};
+
+use super::file::DesignSpec;
+use super::sweep::{Sweep, SweepPoint};
+use super::DesignResult;
+
+pub const SWEEP_CSV: &str = "sweep.csv";
+pub const SWEEP_SVG: &str = "sweep.svg";
+
+/// What the report describes.
+pub struct ReportInput<'a> {
+    pub command: &'a str,
+    pub model: &'a str,
+    pub task: &'a str,
+    pub spec: &'a DesignSpec,
+    pub result: &'a DesignResult,
+    pub sweep: Option<(&'a Sweep, &'a [SweepPoint])>,
+}
+
+/// `m1=0.1 m2=0.4 …`.
+pub fn parameters_text(names: &[&str], params: &[f64]) -> String {
+    names
+        .iter()
+        .zip(params)
+        .map(|(n, v)| format!("{n}={v:.6}"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Writes the report into `dir` (created if needed); returns the files written.
+pub fn write_report(dir: &Path, input: &ReportInput) -> Result<Vec<PathBuf>, ReproduceError> {
+    std::fs::create_dir_all(dir).map_err(ReproduceError::io(dir))?;
+    let r = input.result;
+    let mut doc = vec![
+        Block::Heading(1, format!("Tool design for the {} task ({})", input.task, input.model)),
+        Block::p(format!(
+            "The designed tool maximises the controller's confidence ln|Π^U| (the curvature of its \
+             free energy in the control: a precise, well-conditioned controller) within the bounds \
+             and constraints of `{}`{}. Objective: {}.",
+            input.spec.file,
+            if input.spec.constraints.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    " ({})",
+                    input.spec.constraints.iter().map(|c| c.text.clone()).collect::<Vec<_>>().join(", ")
+                )
+            },
+            r.objective.name()
+        )),
+        Block::p(format!(
+            "Design: {} with ln|Π^U| = {:.6}. The SQP reached it from start {} in {} iterations; \
+             KKT residual {:.2e}; the derived gradient agrees with central differences to {:.1e} \
+             (relative).",
+            parameters_text(&input.spec.names, &r.params),
+            r.logdet,
+            r.confidence_optimum.start,
+            r.confidence_optimum.iterations,
+            r.confidence_optimum.kkt_residual,
+            r.gradient_check
+        )),
+        Block::Heading(2, "The design beside random feasible tools".into()),
+        Block::p(format!(
+            "{} random feasible tools were drawn ({} draws from the bounds); the most confident are \
+             simulated beside the design. Sensitivity is |task error under ΔT = {} N m − task error|: \
+             smaller is more robust.",
+            r.random.feasible, r.random.drawn, input.spec.search.perturbation
+        )),
+        Block::table(
+            &["tool", "ln|Π^U|", "task error", "∫F dt", "sensitivity to ΔT", "parameters"],
+            r.checks
+                .iter()
+                .map(|c| {
+                    let (e, f, s) = match &c.simulated {
+                        Ok(m) => (format!("{:.6e}", m.task_error), format!("{:.6e}", m.free_energy), format!("{:.6e}", m.sensitivity)),
+                        Err(err) => (err.clone(), String::new(), String::new()),
+                    };
+                    vec![c.label.clone(), format!("{:.6}", c.logdet), e, f, s, parameters_text(&input.spec.names, &c.params)]
+                })
+                .collect(),
+        ),
+    ];
+    let md = dir.join("report.md");
+    let html = dir.join("report.html");
+    let mut files = vec![md.clone(), html.clone()];
+    if let Some((sweep, points)) = input.sweep {
+        doc.extend(sweep_section(dir, input.spec, sweep, points)?);
+        files.extend([dir.join(SWEEP_CSV), dir.join(SWEEP_SVG)]);
+    }
+    doc.push(Block::Heading(2, "How this was made".into()));
+    doc.push(Block::p(format!(
+        "Command: `{}`. The same file and seed give the same design.",
+        input.command
+    )));
+    write_atomically(&md, &to_markdown(&doc))?;
+    write_atomically(&html, &to_html(&doc))?;
+    Ok(files)
+}
+
+/// The sweep as CSV text: one row per value, the optimum's parameters and ln|Π^U|.
+pub fn sweep_csv(names: &[&str], points: &[SweepPoint]) -> String {
+    let mut out = format!("budget,logdet,kkt_residual,{},error\n", names.join(","));
+    for p in points {
+        match &p.outcome {
+            Ok((params, logdet, kkt)) => {
+                let values: Vec<String> = params.iter().map(|v| format!("{v}")).collect();
+                out += &format!("{},{logdet},{kkt},{},\n", p.value, values.join(","));
+            }
+            Err(e) => out += &format!("{},,,{},{e}\n", p.value, vec![""; names.len()].join(",")),
+        }
+    }
+    out
+}
+
+fn sweep_section(
+    dir: &Path,
+    spec: &DesignSpec,
+    sweep: &Sweep,
+    points: &[SweepPoint],
+) -> Result<Vec<Block>, ReproduceError> {
+    write_atomically(&dir.join(SWEEP_CSV), &sweep_csv(&spec.names, points))?;
+    let front: Vec<(f64, f64)> = points
+        .iter()
+        .filter_map(|p| p.outcome.as_ref().ok().map(|o| (p.value, o.1)))
+        .collect();
+    let panel = XyPanel {
+        title: format!("best confidence against the budget {} b", sweep.label),
+        x_label: format!("b in {} b", sweep.label),
+        y_label: "best ln|Π^U|".into(),
+        dots: vec![Series::new("optimum", Colour(0, 114, 178), front.clone())],
+        lines: vec![Series::new("", Colour(0, 114, 178), front)],
+        log_y: false,
+        legend: Legend::LowerRight,
+        headroom: 0.1,
+    };
+    let svg = plot::save(&dir.join(SWEEP_SVG), &[Panel::Xy(panel)], (640, 420))?;
+    let infeasible = points.iter().filter(|p| p.outcome.is_err()).count();
+    Ok(vec![
+        Block::Heading(2, "Trade-off".into()),
+        Block::p(format!(
+            "The design re-solved with `{} b` for {} values of b ({} infeasible): how much confidence \
+             each unit of budget buys (`{SWEEP_CSV}`).",
+            sweep.label,
+            points.len(),
+            infeasible
+        )),
+        Block::Figure { file: SWEEP_SVG.into(), caption: "Best ln|Π^U| against the swept budget.".into(), svg },
+    ])
+}

@@ -1,0 +1,127 @@
+//! The design beside the best of N random feasible tools: every random tool's ln|Π^U| in closed
+//! form, the most confident few simulated, and for each simulated tool the task error, ∫F dt and
+//! the sensitivity to a constant torque ΔT, |task error under ΔT − task error| (as Fig. 4).
+
+use rayon::prelude::*;
+
+use crate::model::mixed::{AnyTool, ModelKind};
+use crate::rank::ModelTasks;
+use crate::task_file::{PerJoint, TaskSpec};
+
+use super::polytope::{FeasibleSampler, Polytope};
+
+/// One tool's row of the comparison.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ToolCheck {
+    /// "design" or "random #k" (k-th most confident of the random tools).
+    pub label: String,
+    pub params: Vec<f64>,
+    pub logdet: f64,
+    /// Task error, ∫F dt, task error under ΔT and the sensitivity, or the episode's error.
+    pub simulated: Result<Simulated, String>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Simulated {
+    pub task_error: f64,
+    pub free_energy: f64,
+    pub task_error_perturbed: f64,
+    pub sensitivity: f64,
+}
+
+/// The random comparison: how many were drawn and kept, and the most confident tools.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RandomTools {
+    pub requested: usize,
+    pub feasible: usize,
+    pub drawn: u64,
+    /// (free parameters, ln|Π^U|), most confident first (ties: the earlier draw).
+    pub top: Vec<(Vec<f64>, f64)>,
+}
+
+/// Draws up to `n` feasible tools (rejection from the box, at most 1000·n draws) and keeps the
+/// `keep` most confident. Sequential and seeded: the same tools on every machine.
+pub fn random_tools(
+    polytope: &Polytope,
+    model: ModelKind,
+    tasks: &ModelTasks,
+    n: usize,
+    keep: usize,
+    seed: u64,
+) -> RandomTools {
+    let mut sampler = FeasibleSampler::new(polytope, seed);
+    let max_draws = 1000 * n.max(1) as u64;
+    let mut top: Vec<(Vec<f64>, f64)> = Vec::with_capacity(keep + 1);
+    let mut feasible = 0;
+    while feasible < n {
+        let Some(x) = sampler.next_point(max_draws) else {
+            break;
+        };
+        feasible += 1;
+        let Ok(tool) = AnyTool::new(model, &polytope.full(&x)) else {
+            continue;
+        };
+        let Ok(logdet) = tasks.logdet(&tool) else {
+            continue;
+        };
+        let at = top.partition_point(|(_, v)| *v >= logdet);
+        if at < keep.max(1) {
+            top.insert(at, (x, logdet));
+            top.truncate(keep.max(1));
+        }
+    }
+    RandomTools {
+        requested: n,
+        feasible,
+        drawn: sampler.drawn,
+        top,
+    }
+}
+
+/// The task with a constant torque ΔT added on every joint.
+pub fn perturbed(spec: &TaskSpec, delta: f64) -> TaskSpec {
+    let mut s = spec.clone();
+    s.episode.perturbation = Some(match &spec.episode.perturbation {
+        None => PerJoint::All(delta),
+        Some(PerJoint::All(v)) => PerJoint::All(v + delta),
+        Some(PerJoint::Each(v)) => PerJoint::Each(v.iter().map(|x| x + delta).collect()),
+    });
+    s
+}
+
+/// Simulates each tool on the task and under ΔT, in parallel, results in input order.
+pub fn check_tools(
+    tools: &[(String, Vec<f64>, f64)],
+    model: ModelKind,
+    nominal: &ModelTasks,
+    under_perturbation: &ModelTasks,
+) -> Vec<ToolCheck> {
+    tools
+        .par_iter()
+        .map(|(label, params, logdet)| ToolCheck {
+            label: label.clone(),
+            params: params.clone(),
+            logdet: *logdet,
+            simulated: simulate(model, params, nominal, under_perturbation),
+        })
+        .collect()
+}
+
+fn simulate(
+    model: ModelKind,
+    params: &[f64],
+    nominal: &ModelTasks,
+    under_perturbation: &ModelTasks,
+) -> Result<Simulated, String> {
+    let tool = AnyTool::new(model, params).map_err(|e| e.to_string())?;
+    let m = nominal.simulate(&tool).map_err(|e| e.to_string())?;
+    let p = under_perturbation
+        .simulate(&tool)
+        .map_err(|e| format!("under ΔT: {e}"))?;
+    Ok(Simulated {
+        task_error: m.task_error,
+        free_energy: m.free_energy,
+        task_error_perturbed: p.task_error,
+        sensitivity: (p.task_error - m.task_error).abs(),
+    })
+}

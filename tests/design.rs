@@ -1,0 +1,232 @@
+//! `toolconf design`'s library: the derived gradient against finite differences and against a
+//! hand-derived closed form, a constrained optimum known in closed form, the paper's arm under
+//! the issue's constraints against 10^5 random feasible tools, infeasibility and determinism.
+
+use toolconf::design::file::DesignSpec;
+use toolconf::design::{confidence_optimum, design, DesignError, Setting};
+use toolconf::model::mixed::{AnyTool, ModelKind};
+use toolconf::rank::ModelTasks;
+use toolconf::task_file::TaskSpec;
+use toolconf::TaskKind;
+
+const MINIMAL: &str = r#"
+objective = "confidence"
+constraints = ["l1 + l2 >= 0.7", "m1 + m2 <= 0.5"]
+[bounds]
+m1 = [0.1, 0.6]
+m2 = [0.1, 0.6]
+l1 = [0.1, 0.6]
+l2 = [0.1, 0.6]
+"#;
+
+fn spec(text: &str, model: ModelKind) -> DesignSpec {
+    DesignSpec::parse(text, "test.toml", model.parameter_names()).expect("valid design file")
+}
+
+/// Central difference of ln|Π^U| in parameter j (step 1e-5 relative): O(h²) ≈ 1e-10 truncation.
+fn central_difference(tasks: &ModelTasks, model: ModelKind, p: &[f64], j: usize) -> f64 {
+    let h = 1e-5 * p[j];
+    let at = |d: f64| {
+        let mut q = p.to_vec();
+        q[j] += d;
+        tasks.logdet(&AnyTool::new(model, &q).unwrap()).unwrap()
+    };
+    (at(h) - at(-h)) / (2.0 * h)
+}
+
+#[test]
+fn gradient_agrees_with_finite_differences_for_every_model_and_task() {
+    for model in ModelKind::ALL {
+        for kind in [
+            TaskKind::Position,
+            TaskKind::Velocity,
+            TaskKind::Acceleration,
+        ] {
+            let tasks = ModelTasks::new(&TaskSpec::builtin(kind));
+            let k = model.parameter_names().len();
+            for i in 0..20 {
+                // A deterministic spread of tools over [0.1, 0.6]^k.
+                let p: Vec<f64> = (0..k)
+                    .map(|j| 0.1 + 0.5 * (((i * 7 + j * 3) % 11) as f64 / 10.0))
+                    .collect();
+                let tool = AnyTool::new(model, &p).unwrap();
+                let (_, gradient) = tasks.logdet_and_gradient(&tool).unwrap();
+                for j in 0..k {
+                    let fd = central_difference(&tasks, model, &p, j);
+                    let err = (gradient[j] - fd).abs() / gradient[j].abs().max(1.0);
+                    assert!(
+                        err < 1e-6,
+                        "{model} {kind:?} tool {p:?} d/d{}: derived {} vs {fd}",
+                        model.parameter_names()[j],
+                        gradient[j]
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// msd, position task, paper precisions (100, 50, 1, 1): S_θ = −(c + m − 1)/k (generated/msd.md),
+/// so Π^U = 100 r² + 52 with r = (c + m − 1)/k, and by hand
+/// ∂ln Π/∂m = ∂ln Π/∂c = 200 (c + m − 1)/(k² Π), ∂ln Π/∂k = −200 (c + m − 1)²/(k³ Π).
+#[test]
+fn msd_gradient_has_its_closed_form() {
+    let tasks = ModelTasks::new(&TaskSpec::builtin(TaskKind::Position));
+    for (m, k, c) in [(1.0, 1.0, 2.0), (0.3, 2.5, 0.7), (2.0, 0.4, 0.1)] {
+        let (logdet, g) = tasks
+            .logdet_and_gradient(&AnyTool::new(ModelKind::Msd, &[m, k, c]).unwrap())
+            .unwrap();
+        let s = c + m - 1.0;
+        let pi = 100.0 * s * s / (k * k) + 52.0;
+        assert!((logdet - pi.ln()).abs() < 1e-13);
+        let want = [
+            200.0 * s / (k * k * pi),
+            -200.0 * s * s / (k * k * k * pi),
+            200.0 * s / (k * k * pi),
+        ];
+        for (a, b) in g.iter().zip(want) {
+            assert!(
+                (a - b).abs() <= 1e-13 * b.abs().max(1.0),
+                "{g:?} vs {want:?}"
+            );
+        }
+    }
+}
+
+/// A constrained optimum by hand. msd on the position task with m, c ∈ [1, 3], k ∈ [0.5, 4],
+/// m + c ≤ 3 and k ≥ m: ln Π^U = ln(100 r² + 52) rises with r = (c + m − 1)/k > 0, and
+/// r ≤ (3 − 1)/m ≤ 2 with equality only at m = 1, c = 2, k = 1, where ln Π^U = ln 452.
+#[test]
+fn msd_constrained_optimum_is_the_hand_derived_one() {
+    let text = r#"
+constraints = ["m + c <= 3", "k - m >= 0"]
+[bounds]
+m = [1.0, 3.0]
+c = [1.0, 3.0]
+k = [0.5, 4.0]
+"#;
+    let s = spec(text, ModelKind::Msd);
+    let task = TaskSpec::builtin(TaskKind::Position);
+    let tasks = ModelTasks::new(&task);
+    let setting = Setting {
+        model: ModelKind::Msd,
+        task: &task,
+        tasks: &tasks,
+    };
+    let (polytope, o) = confidence_optimum(&s, &setting).unwrap();
+    let p = polytope.full(&o.x);
+    // Parameter order m, k, c.
+    for (got, want) in p.iter().zip([1.0, 1.0, 2.0]) {
+        assert!((got - want).abs() < 1e-7, "{p:?}");
+    }
+    assert!((o.value - 452f64.ln()).abs() < 1e-9, "{}", o.value);
+    assert!(o.kkt_residual < 1e-6, "KKT residual {}", o.kkt_residual);
+}
+
+/// The issue's acceptance case: the paper's arm, task 2, l1 + l2 ≥ 0.7, m1 + m2 ≤ 0.5.
+#[test]
+fn paper_arm_design_beats_the_best_of_100k_random_feasible_tools() {
+    let s = spec(MINIMAL, ModelKind::Arm2);
+    let task = TaskSpec::builtin(TaskKind::Velocity);
+    let tasks = ModelTasks::new(&task);
+    let setting = Setting {
+        model: ModelKind::Arm2,
+        task: &task,
+        tasks: &tasks,
+    };
+    let r = design(&s, &setting).unwrap();
+    assert_eq!(r.random.feasible, 100_000);
+    let best_random = r.random.top[0].1;
+    assert!(
+        r.logdet >= best_random,
+        "design {} < random {}",
+        r.logdet,
+        best_random
+    );
+    assert!(
+        r.gradient_check < 1e-6,
+        "gradient vs central differences {}",
+        r.gradient_check
+    );
+    assert!(r.confidence_optimum.kkt_residual < 1e-6);
+    // Feasible: the constraints hold at the design.
+    let p = &r.params;
+    assert!(
+        p[2] + p[3] >= 0.7 - 1e-9 && p[0] + p[1] <= 0.5 + 1e-9,
+        "{p:?}"
+    );
+    // The design and the random tools are simulated, with task error and sensitivity.
+    assert_eq!(r.checks.len(), 6);
+    assert!(r.checks.iter().all(|c| c.simulated.is_ok()));
+}
+
+#[test]
+fn infeasible_constraints_are_refused() {
+    let text = MINIMAL.replace("l1 + l2 >= 0.7", "l1 + l2 >= 1.3");
+    let s = spec(&text, ModelKind::Arm2);
+    let task = TaskSpec::builtin(TaskKind::Velocity);
+    let tasks = ModelTasks::new(&task);
+    let setting = Setting {
+        model: ModelKind::Arm2,
+        task: &task,
+        tasks: &tasks,
+    };
+    match design(&s, &setting) {
+        Err(DesignError::Infeasible(m)) => assert!(
+            m.contains("infeasible") && m.contains("l1 + l2 >= 1.3"),
+            "{m}"
+        ),
+        other => panic!("expected infeasible, got {other:?}"),
+    }
+}
+
+#[test]
+fn same_seed_same_design_whatever_the_thread_count() {
+    let s = spec(
+        &format!("{MINIMAL}\n[search]\nsamples = 2000\n"),
+        ModelKind::Arm2,
+    );
+    let task = TaskSpec::builtin(TaskKind::Position);
+    let tasks = ModelTasks::new(&task);
+    let setting = Setting {
+        model: ModelKind::Arm2,
+        task: &task,
+        tasks: &tasks,
+    };
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(|| design(&s, &setting).unwrap());
+    let two = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap()
+        .install(|| design(&s, &setting).unwrap());
+    assert_eq!(one, two);
+}
+
+#[test]
+fn design_file_mistakes_name_the_key_and_value() {
+    let names = ModelKind::Arm2.parameter_names();
+    let err = |text: &str| {
+        DesignSpec::parse(text, "d.toml", names)
+            .unwrap_err()
+            .to_string()
+    };
+    let e = err(&MINIMAL.replace("m1 + m2 <= 0.5", "m1 + m3 <= 0.5"));
+    assert!(
+        e.starts_with("d.toml, key constraints[1]: 'm1 + m3 <= 0.5': unknown parameter 'm3'"),
+        "{e}"
+    );
+    let e = err(&MINIMAL.replace("l2 = [0.1, 0.6]", "l2 = [-0.1, 0.6]"));
+    assert!(e.contains("key bounds.l2") && e.contains("> 0"), "{e}");
+    let e = err(&MINIMAL.replace("\"confidence\"", "\"speed\""));
+    assert!(e.contains("key objective") && e.contains("'speed'"), "{e}");
+    let e = err(&MINIMAL.replace("l2 = [0.1, 0.6]", ""));
+    assert!(e.contains("'l2' has no bounds"), "{e}");
+    let e = err(&format!("{MINIMAL}\n[fixed]\nl2 = 0.3\n"));
+    assert!(e.contains("also fixed"), "{e}");
+    let e = err(&format!("colour = 1\n{MINIMAL}"));
+    assert!(e.contains("d.toml") && e.contains("colour"), "{e}");
+}
