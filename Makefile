@@ -2,10 +2,11 @@
 SHELL := /bin/bash
 VENV := derive/.venv
 PY := $(VENV)/bin/python
+PY_DEV := $(VENV)/.python-dev-installed
 # Deterministic derivation: the same inputs give byte-identical generated files.
 export PYTHONHASHSEED := 0
 
-.PHONY: run test derive drift-check venv clean-venv bench
+.PHONY: run test derive drift-check venv clean-venv bench python-test
 
 ## make run: build in release mode and reproduce the paper's Results (results/report.md).
 run:
@@ -18,10 +19,21 @@ bench:
 	cargo bench --bench confidence --bench episode --bench stiff --bench reproduce
 
 ## make test: the whole suite: `make derive` reproduces generated/ byte for byte (on this CPU and
-## on an imitated older one), the derivation's own tests, then the crate's.
-test: drift-check
+## on an imitated older one), the derivation's own tests, the crate's, then the Python package's.
+test: drift-check $(PY_DEV)
 	$(PY) -m unittest discover --start-directory derive/tests
 	cargo test --workspace --quiet
+	$(PYTHON_BUILD)
+	$(PYTHON_TESTS)
+
+## make python-test: builds the Python package (python/, `import toolconf`) into derive/.venv
+## with maturin (debug profile, in the workspace's target/, so the crate is not built twice),
+## then runs its pytest suite against the command line's JSON.
+PYTHON_BUILD = VIRTUAL_ENV=$(abspath $(VENV)) $(VENV)/bin/maturin develop --quiet --manifest-path python/Cargo.toml
+PYTHON_TESTS = $(PY) -m pytest -q python/tests
+python-test: $(PY_DEV)
+	$(PYTHON_BUILD)
+	$(PYTHON_TESTS)
 
 venv: $(PY)
 
@@ -29,6 +41,11 @@ $(PY): derive/requirements.txt
 	python3 -m venv $(VENV)
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r derive/requirements.txt
 	touch $(PY)
+
+# maturin and pytest (pinned) for the Python package, added to the same environment.
+$(PY_DEV): python/requirements-dev.txt $(PY)
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r python/requirements-dev.txt
+	touch $(PY_DEV)
 
 ## make derive: model descriptions -> SymPy (checked by CasADi) -> JSON IR + test vectors -> Tera
 ## -> rustfmt, into generated/ (and the renderer's fixture in tests/fixtures/).

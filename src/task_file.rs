@@ -194,6 +194,11 @@ impl TaskSpec {
                 .unwrap_or_default(),
             message: e.message().trim().replace('\n', " "),
         })?;
+        Self::from_raw(raw, file)
+    }
+
+    /// The checks and conversions after TOML has been read into [`RawTask`].
+    fn from_raw(raw: RawTask, file: &str) -> Result<Self, TaskFileError> {
         let err = |key: &str, message: String| TaskFileError {
             file: file.into(),
             place: format!("key {key}"),
@@ -610,6 +615,29 @@ fn check_precision(p: &PrecisionSpec) -> Result<(), String> {
     Ok(())
 }
 
+/// Tasks given as data rather than as a file (the Python binding's task dicts).
+impl TaskSpec {
+    /// A task given as a TOML table with a task file's keys, checked exactly as a task file is;
+    /// `source` names it in errors (`task dict, key precision.theta: …`). A value of the wrong
+    /// type or an unknown key is named by its dotted key, as a file's would be by its line.
+    pub fn from_table(table: toml::Table, source: &str) -> Result<Self, TaskFileError> {
+        let raw: RawTask = table.try_into().map_err(|e| {
+            // toml names the value's place as a last line "in `goal.theta`" (no text, no span).
+            let text = e.to_string();
+            let (message, place) = match text.trim_end().rsplit_once("\nin `") {
+                Some((message, key)) => (message, format!("key {}", key.trim_end_matches('`'))),
+                None => (text.trim_end(), String::new()),
+            };
+            TaskFileError {
+                file: source.into(),
+                place,
+                message: message.trim().replace('\n', " "),
+            }
+        })?;
+        Self::from_raw(raw, source)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -665,6 +693,33 @@ perturbation = 0.0
         .unwrap_err();
         assert_eq!(e.place, "key episode.perturbation");
         assert!(e.message.contains("NaN"), "{e}");
+    }
+
+    #[test]
+    fn a_table_is_checked_as_a_file_is_and_errors_name_the_key() {
+        let table: toml::Table = toml::from_str(ISSUE_EXAMPLE).unwrap();
+        let from_table = TaskSpec::from_table(table, "task dict").unwrap();
+        let from_text = TaskSpec::parse(ISSUE_EXAMPLE, "task dict").unwrap();
+        assert_eq!(from_table, from_text);
+        let table: toml::Table =
+            toml::from_str("kind = \"position\"\n[goal]\ntheta = 0.5\n").unwrap();
+        let e = TaskSpec::from_table(table, "task dict").unwrap_err();
+        assert_eq!(
+            (e.file.as_str(), e.place.as_str()),
+            ("task dict", "key goal.theta")
+        );
+        assert!(e.message.contains("expected a sequence"), "{e}");
+        let table: toml::Table =
+            toml::from_str("kind = \"velocity\"\n[episode]\nt_ned = 3.0\n").unwrap();
+        let e = TaskSpec::from_table(table, "task dict").unwrap_err();
+        assert_eq!(e.place, "key episode");
+        assert!(e.message.contains("unknown field `t_ned`"), "{e}");
+        let table: toml::Table =
+            toml::from_str("kind = \"velocity\"\n[precision]\nu = [[1.0, 2.0], [0.0, 1.0]]\n")
+                .unwrap();
+        let e = TaskSpec::from_table(table, "task dict").unwrap_err();
+        assert_eq!(e.place, "key precision.u");
+        assert!(e.message.contains("is not symmetric"), "{e}");
     }
 
     #[test]

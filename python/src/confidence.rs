@@ -1,0 +1,216 @@
+//! `toolconf.confidence`: the closed-form control confidence of one tool or of many.
+
+use nalgebra::SMatrix;
+use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyFloat};
+use rayon::prelude::*;
+use toolconf::model::{ArmModel, SensitivitiesN, ToolN};
+use toolconf::task_file::TaskSpec;
+use toolconf::Term;
+
+use crate::errors::{detached, Failure};
+use crate::models::{model_kind, ops};
+use crate::task::task_spec;
+
+/// Below this many tools a batch runs on one thread: spreading it costs more than it saves.
+const MIN_TOOLS_PER_THREAD: usize = 256;
+
+/// The results for k tools, each array flat in C order (tool, row, column).
+pub struct Confidences {
+    pub k: usize,
+    pub n: usize,
+    pub nx: usize,
+    /// A = ∂f/∂X at the equilibrium (k × NX × NX).
+    pub a: Vec<f64>,
+    /// B = ∂f/∂U at the equilibrium (k × NX × N).
+    pub b: Vec<f64>,
+    /// The task's sensitivities by name (each k × N × N); a term the task does not use is absent.
+    pub sensitivities: Vec<(&'static str, Vec<f64>)>,
+    /// Π^U (k × N × N).
+    pub pi_u: Vec<f64>,
+    /// ln|Π^U| (k).
+    pub logdet: Vec<f64>,
+}
+
+/// One tool's matrices (on the stack: a batch allocates only its output arrays).
+struct One<const N: usize, const NX: usize> {
+    a: SMatrix<f64, NX, NX>,
+    b: SMatrix<f64, NX, N>,
+    sensitivities: SensitivitiesN<N>,
+    pi_u: SMatrix<f64, N, N>,
+    logdet: f64,
+}
+
+/// Appends `m` to `out` in C order (row by row; nalgebra stores columns).
+fn push_c_order<const R: usize, const C: usize>(out: &mut Vec<f64>, m: &SMatrix<f64, R, C>) {
+    out.extend((0..R).flat_map(|i| (0..C).map(move |j| m[(i, j)])));
+}
+
+/// Π^U = Σ Sᵀ P S + P^U (eq. control_conf) and ln|Π^U| of every tool in `params` (k × NP, row
+/// major) for `spec` bound to model `M`, with A, B and the sensitivities; rayon's threads share
+/// the tools, and the first bad tool in order is the error.
+pub fn confidences<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    spec: &TaskSpec,
+    params: &[f64],
+) -> Result<Confidences, Failure>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let task = spec.task::<M, N, NX, NP, NZ>().map_err(Failure::input)?;
+    let task = task.validated().map_err(Failure::input)?;
+    let kind = task.task().kind;
+    let k = params.len() / NP;
+    let results: Vec<Result<One<N, NX>, toolconf::Error>> = params
+        .par_chunks_exact(NP)
+        .with_min_len(MIN_TOOLS_PER_THREAD)
+        .map(|p| {
+            let tool = ToolN::<M, N, NX, NP, NZ>::new(p.try_into().expect("NP values"))?;
+            let c = task.control_confidence(&tool)?;
+            Ok(One {
+                a: tool.state_matrix(),
+                b: tool.input_matrix(),
+                sensitivities: tool.sensitivities(kind),
+                pi_u: c.pi_u,
+                logdet: c.logdet,
+            })
+        })
+        .collect();
+    let names = ["d_theta_du", "d_theta_dot_du", "d_theta_ddot_du"];
+    let mut sensitivities = vec![Vec::with_capacity(k * N * N); 3];
+    let mut out = Confidences {
+        k,
+        n: N,
+        nx: NX,
+        a: Vec::with_capacity(k * NX * NX),
+        b: Vec::with_capacity(k * NX * N),
+        sensitivities: Vec::new(),
+        pi_u: Vec::with_capacity(k * N * N),
+        logdet: Vec::with_capacity(k),
+    };
+    for (i, r) in results.into_iter().enumerate() {
+        let one = r.map_err(|e| {
+            let row = &params[i * NP..(i + 1) * NP];
+            Failure::Input(if k == 1 {
+                e.to_string()
+            } else {
+                format!("tool {i} ({}): {e}", named(M::PARAMETER_NAMES, row))
+            })
+        })?;
+        push_c_order(&mut out.a, &one.a);
+        push_c_order(&mut out.b, &one.b);
+        push_c_order(&mut out.pi_u, &one.pi_u);
+        out.logdet.push(one.logdet);
+        let s = &one.sensitivities;
+        for (all, m) in
+            sensitivities
+                .iter_mut()
+                .zip([s.d_theta_du, s.d_theta_dot_du, s.d_theta_ddot_du])
+        {
+            if let Some(m) = m {
+                push_c_order(all, &m);
+            }
+        }
+    }
+    // A term the task does not use has no sensitivity (the command line leaves it out too).
+    let used = [Term::Theta, Term::ThetaDot, Term::ThetaDdot].map(|t| kind.uses(t));
+    out.sensitivities = names
+        .into_iter()
+        .zip(sensitivities)
+        .zip(used)
+        .filter_map(|((name, s), used)| used.then_some((name, s)))
+        .collect();
+    Ok(out)
+}
+
+/// `m1=0.3 m2=0.4 …`, as the crate prints a tool.
+fn named<const NP: usize>(names: [&str; NP], values: &[f64]) -> String {
+    let parts: Vec<String> = names
+        .iter()
+        .zip(values)
+        .map(|(n, v)| format!("{n}={v}"))
+        .collect();
+    parts.join(" ")
+}
+
+/// The closed-form control confidence Π^U = ∂²F/∂U² of one tool or of many, for a task.
+///
+/// Computed from the generated closed forms, without simulating (eq. control_conf: Π^U = Σ Sᵀ P S
+/// over the task's terms, plus P^U; ln|Π^U| is the confidence term of the free energy).
+///
+/// Args:
+///     model: a generated model's name (``toolconf.models()``), e.g. ``"arm2"``, the paper's arm.
+///     params: one tool's parameters, a 1-D array in the model's parameter order (arm2:
+///         m1, m2, l1, l2 in kg and m), or a 2-D array with one tool per row. Each must be a
+///         finite number > 0.
+///     task: ``"position"``, ``"velocity"``, ``"acceleration"`` (or ``1``, ``2``, ``3`` as
+///         text), a task file's path, or a dict with a task file's keys, e.g.
+///         ``{"kind": "position", "goal": {"theta": [0.78, 0.0]}, "precision": {"theta": 120.0}}``.
+///
+/// Returns:
+///     dict: ``A`` (∂f/∂X at the equilibrium), ``B`` (∂f/∂U), ``sensitivities`` (a dict of the
+///     task's ∂(task variable)/∂U: ``d_theta_du``, ``d_theta_dot_du``, ``d_theta_ddot_du``),
+///     ``pi_u`` (Π^U) and ``logdet`` (ln|Π^U|). For a 1-D ``params`` the matrices are 2-D arrays
+///     and ``logdet`` a float; for a 2-D ``params`` every entry gains a leading axis of one row
+///     per tool (``logdet`` a 1-D array). The numbers are the command line's
+///     (``toolconf confidence --json``), digit for digit.
+///
+/// Raises:
+///     ValueError: an unknown model, a parameter that is not a finite number > 0 (naming the
+///         tool's row), a wrong number of parameters, or a bad task (naming the key), with the
+///         command line's message.
+///
+/// A batch runs on rayon's threads without holding the GIL.
+#[pyfunction]
+pub fn confidence<'py>(
+    py: Python<'py>,
+    model: &str,
+    params: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
+    task: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let kind = model_kind(model).map_err(|f| f.into_pyerr(py))?;
+    let spec = task_spec(task, None)?;
+    let shape = params.shape().to_vec();
+    let np = kind.parameter_names().len();
+    let batch = match shape.as_slice() {
+        [n] if *n == np => false,
+        [_, n] if *n == np => true,
+        _ => {
+            return Err(Failure::Input(format!(
+                "params of shape {shape:?}: model {kind} takes {np} parameters ({}), as a 1-D \
+                 array (one tool) or a 2-D array with one tool per row",
+                kind.parameter_names().join(",")
+            ))
+            .into_pyerr(py))
+        }
+    };
+    let values: Vec<f64> = params.as_array().iter().copied().collect();
+    let c = detached(py, || ops(kind).confidences(&spec, &values))?;
+    to_dict(py, c, batch)
+}
+
+fn to_dict(py: Python<'_>, c: Confidences, batch: bool) -> PyResult<Bound<'_, PyDict>> {
+    let array = |data: Vec<f64>, rows: usize, cols: usize| {
+        let a = PyArray1::from_vec(py, data);
+        if batch {
+            a.reshape([c.k, rows, cols]).map(|a| a.into_any())
+        } else {
+            a.reshape([rows, cols]).map(|a| a.into_any())
+        }
+    };
+    let out = PyDict::new(py);
+    out.set_item("A", array(c.a, c.nx, c.nx)?)?;
+    out.set_item("B", array(c.b, c.nx, c.n)?)?;
+    let sensitivities = PyDict::new(py);
+    for (name, s) in c.sensitivities {
+        sensitivities.set_item(name, array(s, c.n, c.n)?)?;
+    }
+    out.set_item("sensitivities", sensitivities)?;
+    out.set_item("pi_u", array(c.pi_u, c.n, c.n)?)?;
+    if batch {
+        out.set_item("logdet", PyArray1::from_vec(py, c.logdet))?;
+    } else {
+        out.set_item("logdet", PyFloat::new(py, c.logdet[0]))?;
+    }
+    Ok(out)
+}

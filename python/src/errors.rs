@@ -1,0 +1,93 @@
+//! Rust errors as Python exceptions: bad input is `ValueError` with the command line's message;
+//! a failed episode is `toolconf.SimulationError` with the tool, the time and the reason.
+
+use pyo3::create_exception;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use toolconf::model::ModelSimulationError;
+
+create_exception!(
+    toolconf,
+    SimulationError,
+    PyRuntimeError,
+    "An episode that failed: the integrator gave up or the state diverged.\n\n\
+     Attributes: tool (str, e.g. 'arm2(m1=0.3 m2=0.4 l1=0.5 l2=0.2)'), time (float, s, or None \
+     when the failure has no time) and reason (str)."
+);
+
+/// What a call can fail with, built without the GIL (inside `Python::detach`) and raised after.
+#[derive(Debug)]
+pub enum Failure {
+    /// Bad input: the message the command line prints (after `toolconf: error: `).
+    Input(String),
+    /// A failed episode.
+    Simulation {
+        message: String,
+        tool: String,
+        time: Option<f64>,
+        reason: String,
+    },
+}
+
+impl Failure {
+    pub fn input(e: impl std::fmt::Display) -> Self {
+        Failure::Input(e.to_string())
+    }
+
+    /// An episode's error: bad input stays bad input; the rest names the tool and the time.
+    pub fn episode(e: ModelSimulationError) -> Self {
+        let message = e.to_string();
+        let time = e.time();
+        match e {
+            ModelSimulationError::Input(e) => Failure::input(e),
+            ModelSimulationError::Integration { tool, source } => Failure::Simulation {
+                message,
+                tool,
+                time,
+                reason: source.to_string(),
+            },
+            ModelSimulationError::Diverged {
+                tool, magnitude, ..
+            } => Failure::Simulation {
+                message,
+                tool,
+                time,
+                reason: format!("diverged: |state| = {magnitude:e}"),
+            },
+        }
+    }
+
+    /// The Python exception.
+    pub fn into_pyerr(self, py: Python<'_>) -> PyErr {
+        match self {
+            Failure::Input(message) => PyValueError::new_err(message),
+            Failure::Simulation {
+                message,
+                tool,
+                time,
+                reason,
+            } => {
+                let err = SimulationError::new_err(message);
+                let value = err.value(py);
+                let attributes = [
+                    value.setattr("tool", tool),
+                    value.setattr("time", time),
+                    value.setattr("reason", reason),
+                ];
+                match attributes.into_iter().find_map(Result::err) {
+                    Some(e) => e,
+                    None => err,
+                }
+            }
+        }
+    }
+}
+
+/// Runs `work` without the GIL (so other Python threads go on while rayon's threads compute) and
+/// raises its failure.
+pub fn detached<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce() -> Result<T, Failure> + Send,
+) -> PyResult<T> {
+    py.detach(work).map_err(|f| f.into_pyerr(py))
+}

@@ -1,0 +1,37 @@
+//! `import toolconf`: the toolconf runtime over NumPy arrays (the top layer; nothing in the crate
+//! imports it).
+//!
+//! * [`confidence`]: A, B, the task's sensitivities, Π^U and ln|Π^U| of one tool or of many in
+//!   one call (rayon, without the GIL).
+//! * [`simulate`]: one closed-loop episode's metrics and trajectory, any generated model.
+//! * [`rank`]: `toolconf rank` (screen by confidence, simulate, rank) as columns.
+//! * [`task`]: a task given as a built-in name, a task file or a dict with a task file's keys,
+//!   all checked by the crate's task-file parser so errors name the key.
+//!
+//! Bad input raises `ValueError` with the one-line message the command line prints; a failed
+//! episode raises `toolconf.SimulationError` with `tool`, `time` and `reason`.
+
+mod confidence;
+mod errors;
+mod models;
+mod rank;
+mod simulate;
+mod task;
+
+use pyo3::prelude::*;
+
+/// Confidence-aware decision-making and control for tool selection (Anil Meera & Lanillos):
+/// control confidence Π^U = ∂²F/∂U², closed-loop episodes of the active-inference controller,
+/// and ranking of tools, for every model toolconf generates (see `toolconf.models()`).
+#[pymodule]
+fn _toolconf(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(models::models, m)?)?;
+    m.add_function(wrap_pyfunction!(confidence::confidence, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(rank::rank, m)?)?;
+    m.add(
+        "SimulationError",
+        m.py().get_type::<errors::SimulationError>(),
+    )?;
+    Ok(())
+}

@@ -1,0 +1,87 @@
+//! The generated models, and calling the generic runtime with one model's sizes.
+
+use std::marker::PhantomData;
+
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use toolconf::generated;
+use toolconf::model::mixed::ModelKind;
+use toolconf::model::ArmModel;
+use toolconf::task_file::TaskSpec;
+
+use crate::confidence::Confidences;
+use crate::errors::Failure;
+use crate::simulate::Episode;
+
+/// What the Python functions need of one model, with the model's sizes fixed: each generated
+/// model gets one [`Ops`] (through [`ops`]), so the functions dispatch once, by name.
+pub trait ModelOps: Sync {
+    /// A, B, sensitivities, Π^U and ln|Π^U| of `k` tools (`params`: k × NP, row-major).
+    fn confidences(&self, spec: &TaskSpec, params: &[f64]) -> Result<Confidences, Failure>;
+    /// One episode of the tool `params` (NP values).
+    fn episode(&self, spec: &TaskSpec, params: &[f64]) -> Result<Episode, Failure>;
+}
+
+/// [`ModelOps`] of model `M`.
+pub struct Ops<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    PhantomData<M>,
+);
+
+impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> ModelOps
+    for Ops<M, N, NX, NP, NZ>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    fn confidences(&self, spec: &TaskSpec, params: &[f64]) -> Result<Confidences, Failure> {
+        crate::confidence::confidences::<M, N, NX, NP, NZ>(spec, params)
+    }
+
+    fn episode(&self, spec: &TaskSpec, params: &[f64]) -> Result<Episode, Failure> {
+        crate::simulate::episode_of::<M, N, NX, NP, NZ>(spec, params)
+    }
+}
+
+/// One [`Ops`] per model of the generated registry (`toolconf::for_each_model!`).
+macro_rules! model_ops {
+    ($(($marker:ident, $module:ident, $tool:ident, $name:literal, $title:literal)),* $(,)?) => {
+        /// The operations of `kind`.
+        pub fn ops(kind: ModelKind) -> &'static dyn ModelOps {
+            match kind {
+                $(ModelKind::$marker => &Ops::<
+                    toolconf::model::$marker,
+                    { generated::$module::DOF },
+                    { generated::$module::STATE_DIM },
+                    { generated::$module::PARAMETER_COUNT },
+                    { generated::$module::STATE_DIM + generated::$module::DOF },
+                >(PhantomData),)*
+            }
+        }
+
+        fn title(kind: ModelKind) -> &'static str {
+            match kind { $(ModelKind::$marker => $title,)* }
+        }
+    };
+}
+
+toolconf::for_each_model!(model_ops);
+
+/// A model by name, or the error naming the models there are.
+pub fn model_kind(name: &str) -> Result<ModelKind, Failure> {
+    name.parse().map_err(Failure::Input)
+}
+
+/// The generated models: ``{name: {"title": str, "dof": int, "parameters": [str, ...]}}`` in
+/// registry order. ``parameters`` is the order ``confidence`` and ``simulate`` take a tool's
+/// parameters in (masses in kg, lengths in m, ...); ``dof`` is the number of joints (torques).
+#[pyfunction]
+pub fn models(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    let out = PyDict::new(py);
+    for kind in ModelKind::ALL {
+        let entry = PyDict::new(py);
+        entry.set_item("title", title(kind))?;
+        entry.set_item("dof", kind.dof())?;
+        entry.set_item("parameters", kind.parameter_names().to_vec())?;
+        out.set_item(kind.name(), entry)?;
+    }
+    Ok(out)
+}

@@ -1,0 +1,134 @@
+//! `toolconf.simulate`: one closed-loop episode of any generated model.
+
+use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use toolconf::model::{episode, ArmModel, Metrics, ToolN};
+use toolconf::task_file::TaskSpec;
+
+use crate::errors::{detached, Failure};
+use crate::models::{model_kind, ops};
+use crate::task::task_spec;
+
+/// An episode's metrics and its trajectory on the output grid, each series flat in C order
+/// (time, joint).
+pub struct Episode {
+    pub metrics: Metrics,
+    pub n: usize,
+    pub t: Vec<f64>,
+    pub series: [(&'static str, Vec<f64>); 4],
+}
+
+/// One episode of the tool `params` on `spec` bound to model `M`, with the trajectory: the
+/// generic runtime (`toolconf::model::episode`), which every model shares.
+pub fn episode_of<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    spec: &TaskSpec,
+    params: &[f64],
+) -> Result<Episode, Failure>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let tool = ToolN::<M, N, NX, NP, NZ>::new(params.try_into().expect("NP values"))
+        .map_err(Failure::input)?;
+    let task = spec.task::<M, N, NX, NP, NZ>().map_err(Failure::input)?;
+    let mut options = spec.episode::<M, N, NX, NP, NZ>().map_err(Failure::input)?;
+    options.record_trajectory = true;
+    let e = episode(&tool, &task, &options).map_err(Failure::episode)?;
+    let tr = e.trajectory.expect("a recorded episode has a trajectory");
+    let flat = |s: &[nalgebra::SVector<f64, N>]| -> Vec<f64> {
+        s.iter().flat_map(|v| v.iter().copied()).collect()
+    };
+    Ok(Episode {
+        metrics: e.metrics,
+        n: N,
+        series: [
+            ("theta", flat(&tr.theta)),
+            ("theta_dot", flat(&tr.theta_dot)),
+            ("theta_ddot", flat(&tr.theta_ddot)),
+            ("u", flat(&tr.u)),
+        ],
+        t: tr.t,
+    })
+}
+
+/// One closed-loop episode of the active-inference controller (U̇ = −γ ∂F/∂U) with one tool.
+///
+/// The model's equations are the plant; the episode is the paper's (t ∈ [0, 5] s, output every
+/// 0.05 s, X0 the hanging equilibrium, U0 = 0.1, γ = 1, Dormand–Prince with ode45's tolerances;
+/// on the acceleration task a switch to Rodas5P when the problem turns stiff) unless the task or
+/// the keyword arguments say otherwise.
+///
+/// Args:
+///     model: a generated model's name (``toolconf.models()``).
+///     params: the tool's parameters, a 1-D array in the model's order (all finite, > 0).
+///     task: a built-in task name, a task file's path, or a dict with a task file's keys.
+///     **episode_options: keys of a task file's ``[episode]`` table, over the task's:
+///         ``t_end``, ``dt`` (s), ``perturbation`` (constant torque ΔT, N m: one number or one
+///         per joint), ``learning_rate`` (γ), ``initial_theta``, ``initial_theta_dot``,
+///         ``initial_torque`` (one number or one per joint), ``rtol``, ``atol``.
+///
+/// Returns:
+///     dict: the metrics ``task_error`` (Σ of the task's weighted error over the grid),
+///     ``free_energy`` (∫F dt), ``cost_j`` (∫J dt), ``logdet`` (ln|Π^U|), ``control_effort``
+///     (∫|U|² dt), ``rhs_evals``, ``steps``, ``rejected_steps``, ``jacobian_evals``,
+///     ``factorisations``; and the trajectory on the output grid: ``t`` (shape (T,)) and
+///     ``theta``, ``theta_dot``, ``theta_ddot`` (the plant's, what the controller observes),
+///     ``u`` (each shape (T, joints)). For arm2 the metrics are ``toolconf simulate --json``'s.
+///
+/// Raises:
+///     ValueError: bad input (model, parameters, task or episode option), naming the value.
+///     toolconf.SimulationError: the episode failed; ``tool``, ``time`` and ``reason`` say how.
+#[pyfunction]
+#[pyo3(signature = (model, params, task, **episode_options))]
+pub fn simulate<'py>(
+    py: Python<'py>,
+    model: &str,
+    params: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
+    task: &Bound<'py, PyAny>,
+    episode_options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let kind = model_kind(model).map_err(|f| f.into_pyerr(py))?;
+    let np = kind.parameter_names().len();
+    if params.shape() != [np] {
+        return Err(Failure::Input(format!(
+            "params of shape {:?}: model {kind} takes one tool's {np} parameters ({}) as a 1-D \
+             array (rank many tools with toolconf.rank)",
+            params.shape(),
+            kind.parameter_names().join(",")
+        ))
+        .into_pyerr(py));
+    }
+    let spec = task_spec(task, episode_options)?;
+    let values: Vec<f64> = params.as_array().iter().copied().collect();
+    let e = detached(py, || ops(kind).episode(&spec, &values))?;
+    to_dict(py, e)
+}
+
+fn to_dict(py: Python<'_>, e: Episode) -> PyResult<Bound<'_, PyDict>> {
+    let m = &e.metrics;
+    let out = PyDict::new(py);
+    for (key, value) in [
+        ("task_error", m.task_error),
+        ("free_energy", m.free_energy),
+        ("cost_j", m.cost_j),
+        ("logdet", m.logdet),
+        ("control_effort", m.control_effort),
+    ] {
+        out.set_item(key, value)?;
+    }
+    for (key, value) in [
+        ("rhs_evals", m.rhs_evals),
+        ("steps", m.steps),
+        ("rejected_steps", m.rejected_steps),
+        ("jacobian_evals", m.jacobian_evals),
+        ("factorisations", m.factorisations),
+    ] {
+        out.set_item(key, value)?;
+    }
+    let points = e.t.len();
+    out.set_item("t", PyArray1::from_vec(py, e.t))?;
+    for (key, series) in e.series {
+        out.set_item(key, PyArray1::from_vec(py, series).reshape([points, e.n])?)?;
+    }
+    Ok(out)
+}

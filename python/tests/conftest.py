@@ -1,0 +1,60 @@
+"""Shared fixtures: the repository, and the command line built in the same target directory."""
+
+import json
+import os
+import subprocess
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+DRAWER = REPO / "examples" / "tools" / "drawer.csv"
+REACH_45 = REPO / "examples" / "tasks" / "reach_45.toml"
+
+
+@pytest.fixture(scope="session")
+def cli():
+    """Runs ``toolconf ARGS``; returns (exit status, stdout, stderr). The binary is the one
+    cargo builds in the workspace's target directory (up to date after ``cargo test``)."""
+    subprocess.run(
+        ["cargo", "build", "--quiet", "--bin", "toolconf"], cwd=REPO, check=True
+    )
+    target = Path(os.environ.get("CARGO_TARGET_DIR", REPO / "target"))
+    binary = target / "debug" / "toolconf"
+
+    def run(*args):
+        out = subprocess.run(
+            [str(binary), *map(str, args)], capture_output=True, text=True, cwd=REPO
+        )
+        return out.returncode, out.stdout, out.stderr
+
+    return run
+
+
+@pytest.fixture(scope="session")
+def cli_json(cli):
+    """``toolconf ARGS --json`` parsed; fails the test unless the command succeeded."""
+
+    def run(*args):
+        status, stdout, stderr = cli(*args, "--json")
+        assert status == 0, stderr
+        return json.loads(stdout)
+
+    return run
+
+
+@pytest.fixture(scope="session")
+def cli_error(cli):
+    """The one-line message ``toolconf ARGS`` prints for bad input (status 2), without the
+    ``toolconf: error: `` prefix."""
+
+    def run(*args):
+        status, _, stderr = cli(*args)
+        assert status == 2, stderr
+        lines = stderr.strip().splitlines()
+        assert len(lines) == 1, stderr
+        prefix = "toolconf: error: "
+        assert lines[0].startswith(prefix), stderr
+        return lines[0][len(prefix):]
+
+    return run
