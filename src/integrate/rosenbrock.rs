@@ -88,25 +88,25 @@ pub(super) struct Start<const D: usize> {
 
 /// A stiffly accurate Rosenbrock method with `S` stages in `rodas.f`'s transformed form: the
 /// last stage is the error estimate and `y_new = y + Σ_j a_Sj·k_j + k_S`.
-struct Tableau<const S: usize> {
-    gamma: f64,
+pub(super) struct Tableau<const S: usize> {
+    pub(super) gamma: f64,
     /// Stage times α_i.
-    alpha: [f64; S],
+    pub(super) alpha: [f64; S],
     /// Row i: the coefficients of k_j (j < i) in the argument of stage i.
-    a: [[f64; S]; S],
+    pub(super) a: [[f64; S]; S],
     /// Row i: the coefficients of k_j/h (j < i) added to stage i's right-hand side.
-    c: [[f64; S]; S],
+    pub(super) c: [[f64; S]; S],
     /// The coefficients of h·∂f/∂t.
-    d: [f64; S],
+    pub(super) d: [f64; S],
     /// Rows of the dense output, `q_r = Σ_j h_rj·k_j`.
-    dense: [[f64; S]; 3],
+    pub(super) dense: [[f64; S]; 3],
     /// 1/(order of the embedded method + 1).
-    exponent: f64,
+    pub(super) exponent: f64,
 }
 
 /// Rodas5P (Steinebach 2023). Rows i = 1…8 of `a` and `c` list the coefficients of k_1…k_{i−1}.
 #[rustfmt::skip]
-const RODAS5P: Tableau<8> = Tableau {
+pub(super) const RODAS5P: Tableau<8> = Tableau {
     gamma: 0.21193756319429014,
     alpha: [
         0.0, 0.6358126895828704, 0.4095798393397535, 0.9769306725060716, 0.4288403609558664,
@@ -223,7 +223,7 @@ struct Attempt<const D: usize, const S: usize> {
 
 /// MATLAB's `eps(t)`: the distance from |t| to the next larger double.
 #[inline]
-fn eps_at(t: f64) -> f64 {
+pub(super) fn eps_at(t: f64) -> f64 {
     let a = t.abs();
     f64::from_bits(a.to_bits() + 1) - a
 }
