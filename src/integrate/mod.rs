@@ -80,6 +80,18 @@ pub enum Method {
     Fast,
 }
 
+impl Method {
+    /// The method in words, for reports and command-line output.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Method::Explicit => "explicit: Dormand-Prince 5(4) exactly as MATLAB ode45 (the paper's numerics)",
+            Method::Stiff => "stiff: Rodas5P throughout",
+            Method::Auto => "auto: ode45 on tasks 1-2, ode45 then Rodas5P after Hairer's stiffness test on task 3",
+            Method::Fast => "fast: ode45's steps until a 10-step stiffness test fires, then a lean Rodas5P",
+        }
+    }
+}
+
 /// Error control, step-size limits and method. The tolerances and limits default to `ode45`'s.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Options {
