@@ -121,3 +121,45 @@ fn fast_results_do_not_depend_on_the_number_of_threads() {
     };
     assert_eq!(metrics(1), metrics(3));
 }
+
+fn toolconf(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_toolconf"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn select_json(extra: &[&str]) -> serde_json::Value {
+    let mut args = vec!["select", "--task", "position", "--tools", "8", "--seed", "1", "--json"];
+    args.extend_from_slice(extra);
+    let out = toolconf(&args);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// `select` runs `Method::Fast` unless told otherwise, says so, and `--method explicit` gives
+/// `ode45`'s numbers (the library's task-1 default) exactly.
+#[test]
+fn the_command_line_defaults_to_fast_and_names_the_method() {
+    let tools = draw_tools(8, 1);
+    let task = Task::paper(TaskKind::Position);
+    for (extra, method) in [(&[][..], Method::Fast), (&["--method", "explicit"][..], Method::Explicit)] {
+        let v = select_json(extra);
+        assert_eq!(v["method"], method.describe());
+        for (t, arm) in v["tools"].as_array().unwrap().iter().zip(&tools) {
+            let m = run(arm, TaskKind::Position, method, 1e-3, 1e-6);
+            assert_eq!(t["task_error"].as_f64(), Some(m.task_error), "{method:?} {arm:?}");
+            assert_eq!(t["free_energy"].as_f64(), Some(m.free_energy), "{method:?} {arm:?}");
+        }
+    }
+    let explicit = EpisodeOptions::default();
+    let m = simulate(&tools[0], &task, &explicit).unwrap().metrics;
+    assert_eq!(
+        select_json(&["--method", "explicit"])["tools"][0]["cost_j"].as_f64(),
+        Some(m.cost_j)
+    );
+    let out = toolconf(&["select", "--task", "position", "--tools", "2", "--method", "rk4"]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("rk4"), "{stderr}");
+}

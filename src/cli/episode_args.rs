@@ -61,7 +61,7 @@ pub struct EpisodeArgs {
     pub plant: PlantArg,
 }
 
-/// `--method`, for the commands that rank populations (select, rank, reproduce).
+/// `--method` (select, rank, reproduce, simulate).
 #[derive(clap::Args, Debug, Clone)]
 pub struct MethodArgs {
     /// Integration method. fast (the default): DP5 (ode45's steps) until a quick stiffness test

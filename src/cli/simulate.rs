@@ -22,6 +22,8 @@ pub struct Args {
     task: TaskArgs,
     #[command(flatten)]
     episode: EpisodeArgs,
+    #[command(flatten)]
+    method: super::episode_args::MethodArgs,
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
@@ -117,7 +119,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let (episode, perturb) = match args.task.task_file {
         None => {
             let task = Task::paper(spec.kind);
-            let options = args.episode.options(args.csv.is_some())?;
+            let mut options = args.episode.options(args.csv.is_some())?;
+            options.integrator.method = args.method.method.into();
             let episode = simulate(&args.arm, &task, &options)?;
             (episode, json!(options.perturbation))
         }
@@ -139,6 +142,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             "rhs_evals": m.rhs_evals,
             "steps": m.steps,
             "rejected_steps": m.rejected_steps,
+            "method": toolconf::integrate::Method::from(args.method.method).describe(),
         });
         if let Some(path) = &args.task.task_file {
             out["task_file"] = json!(path);
@@ -152,6 +156,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             "arm: {}    task: {}    perturbation: {perturb} N m",
             args.arm,
             spec.label(),
+        );
+        println!(
+            "integration method: {}",
+            toolconf::integrate::Method::from(args.method.method).describe()
         );
         println!("task error     {:.9e}", m.task_error);
         println!("integral F dt  {:.9e}", m.free_energy);
@@ -172,6 +180,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 /// initial state, initial torque and per-joint perturbation as they are.
 fn from_task_file(args: &Args, mut spec: TaskSpec) -> Result<(Episode, Value), CliError> {
     args.episode.apply(&mut spec.episode)?;
+    spec.episode.method = Some(args.method.method.into());
     let task = spec.task::<Arm2, 2, 4, 4, 6>()?;
     let mut options = spec.episode::<Arm2, 2, 4, 4, 6>()?;
     options.record_trajectory = args.csv.is_some();

@@ -204,6 +204,60 @@ mod tests {
         assert!(tableau_has_successive_solutions(&RODAS5P));
     }
 
+    /// A stiff nonlinear problem (Van der Pol, μ = 50) with its Jacobian.
+    struct VanDerPol;
+
+    impl Problem<2> for VanDerPol {
+        fn rhs(&mut self, _t: f64, y: &SVector<f64, 2>) -> SVector<f64, 2> {
+            nalgebra::vector![y[1], 50.0 * ((1.0 - y[0] * y[0]) * y[1]) - y[0]]
+        }
+
+        fn jacobian(
+            &mut self,
+            _t: f64,
+            y: &SVector<f64, 2>,
+            _f: &SVector<f64, 2>,
+        ) -> (SMatrix<f64, 2, 2>, SVector<f64, 2>, usize) {
+            let j = nalgebra::matrix![0.0, 1.0; -100.0 * y[0] * y[1] - 1.0, 50.0 * (1.0 - y[0] * y[0])];
+            (j, SVector::zeros(), 0)
+        }
+    }
+
+    /// The lean step is Rodas5P: the same steps and output as `rosenbrock.rs` up to rounding.
+    #[test]
+    fn lean_rodas5p_takes_the_steps_of_rosenbrock_rs() {
+        let grid = super::super::uniform_grid(0.0, 20.0, 0.05);
+        let options = super::super::Options::default();
+        let settings = super::super::resolve(&options, &grid).unwrap();
+        let y0 = nalgebra::vector![2.0, 0.0];
+        let run = |lean: bool| {
+            let start = Start {
+                t: 0.0,
+                y: y0,
+                f: VanDerPol.rhs(0.0, &y0),
+                abs_h: None,
+                next: 1,
+                stats: Stats::default(),
+            };
+            let mut out = Vec::new();
+            let output = |_, _, y: &SVector<f64, 2>| out.push(*y);
+            let stats = if lean {
+                integrate(&mut VanDerPol, start, &grid, &settings, output)
+            } else {
+                super::super::rosenbrock::integrate(&mut VanDerPol, start, &grid, &settings, output)
+            }
+            .unwrap();
+            (stats, out)
+        };
+        let ((lean, y_lean), (plain, y_plain)) = (run(true), run(false));
+        assert_eq!(lean, plain);
+        assert!(lean.steps > 50, "{lean:?}");
+        assert_eq!(y_lean.len(), grid.len() - 1);
+        for (a, b) in y_lean.iter().zip(&y_plain) {
+            assert!((a - b).amax() <= 1e-11 * b.amax().max(1.0), "{a} vs {b}");
+        }
+    }
+
     #[test]
     fn lu_solves_a_pivoting_system() {
         let a = nalgebra::matrix![0.0, 2.0, 1.0; 1.0, 1.0, 0.0; 3.0, 0.0, 1.0];

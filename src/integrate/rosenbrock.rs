@@ -543,7 +543,7 @@ mod tests {
             solve_grid(prothero_robinson, &y0, &grid, &explicit, out).unwrap()
         });
         assert!(e_dp5 < 1e-2, "{e_dp5:e}");
-        for method in [Method::Stiff, Method::Auto] {
+        for method in [Method::Stiff, Method::Auto, Method::Fast] {
             let o = options(method, 1e-3, 1e-6);
             let (e, analytic) = max_error(&grid, exact, |out| {
                 let jac = prothero_robinson_jacobian;
@@ -674,7 +674,7 @@ mod tests {
         // A jump from ≈ ±1 to ∓2 every half period (≈ 807): three by t = 3000.
         let jumps = reference.windows(2).filter(|w| w[0] * w[1] < 0.0).count();
         assert_eq!(jumps, 3, "{reference:?}");
-        for method in [Method::Stiff, Method::Auto] {
+        for method in [Method::Stiff, Method::Auto, Method::Fast] {
             let (out, stats) = run(&options(method, 1e-3, 1e-6));
             assert!(stats.steps < 600, "{method:?}: {stats:?}");
             let worst = out
@@ -853,7 +853,7 @@ mod tests {
     fn non_finite_values_are_errors() {
         let grid = uniform_grid(0.0, 2.0, 0.1);
         let y0 = vector![2.0];
-        for method in [Method::Stiff, Method::Auto] {
+        for method in [Method::Stiff, Method::Auto, Method::Fast] {
             let o = options(method, 1e-3, 1e-6);
             // A NaN right-hand side after t = 1.
             let rhs = |t: f64, y: &V1| {
