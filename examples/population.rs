@@ -109,7 +109,11 @@ fn reference(tools: &[Arm], task: &Task) -> Result<Vec<Metrics>, String> {
     o.integrator.atol = 1e-12;
     tools
         .iter()
-        .map(|a| simulate(a, task, &o).map(|e| e.metrics).map_err(|e| e.to_string()))
+        .map(|a| {
+            simulate(a, task, &o)
+                .map(|e| e.metrics)
+                .map_err(|e| e.to_string())
+        })
         .collect()
 }
 
@@ -138,7 +142,8 @@ fn unexplained_swaps(reference: &[f64], candidate: &[f64], tol: f64) -> usize {
     for (x, &a) in order.iter().enumerate() {
         for &b in &order[x + 1..] {
             let gap = reference[b] - reference[a];
-            if gap > tol * reference[a].abs().max(reference[b].abs()) && candidate[a] > candidate[b] {
+            if gap > tol * reference[a].abs().max(reference[b].abs()) && candidate[a] > candidate[b]
+            {
                 swaps += 1;
             }
         }
@@ -226,7 +231,8 @@ fn print_task(kind: TaskKind, rows: &[Row], refs: &[Metrics], markdown: bool) {
         let mut sorted = row.times.clone();
         sorted.sort_by(f64::total_cmp);
         let mean = sorted.iter().sum::<f64>() / n;
-        let avg = |f: &dyn Fn(&Metrics) -> usize| row.metrics.iter().map(f).sum::<usize>() as f64 / n;
+        let avg =
+            |f: &dyn Fn(&Metrics) -> usize| row.metrics.iter().map(f).sum::<usize>() as f64 / n;
         let (rhs, jac, lu) = (
             avg(&|m| m.rhs_evals),
             avg(&|m| m.jacobian_evals),

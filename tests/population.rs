@@ -2,17 +2,18 @@
 //! tools against a tight reference (DP5 at rtol 1e-10, atol 1e-12) and against `ode45`
 //! (`Method::Explicit`) at the same default tolerances: every tool's task error within 1e-4
 //! relative and the same ranking by it; ∫F and ∫J no further from the reference than `ode45`'s
-//! own, beyond 1e-4 relative; identical results whatever the number of threads.
+//! own, beyond 1e-4 of ∫J (`ode45` itself is off by up to ≈ 1e-3 at rtol 1e-3, see
+//! docs/performance.md); identical results whatever the number of threads.
 //!
 //! The full 2000-tool check (`draw_tools(2000, 1)`) is `bench/population.sh`
-//! (`examples/population.rs`); here 120 tools per task keep the debug build to seconds.
+//! (`examples/population.rs`); here 60 tools per task keep the debug build to seconds.
 
 use toolconf::closed_loop::{simulate, EpisodeOptions, Metrics};
 use toolconf::integrate::Method;
 use toolconf::select::{draw_tools, evaluate};
 use toolconf::{Arm, Task, TaskKind};
 
-const TOOLS: usize = 120;
+const TOOLS: usize = 60;
 
 fn run(arm: &Arm, kind: TaskKind, method: Method, rtol: f64, atol: f64) -> Metrics {
     let mut o = EpisodeOptions::default();
@@ -61,12 +62,20 @@ fn check_task(kind: TaskKind, seed: u64) {
         let e = relative(fast.task_error, reference.task_error);
         assert!(e <= 1e-4, "{kind:?} {arm:?}: task error off by {e:e}");
         for (name, f, o, r) in [
-            ("∫F", fast.free_energy, ode45.free_energy, reference.free_energy),
+            (
+                "∫F",
+                fast.free_energy,
+                ode45.free_energy,
+                reference.free_energy,
+            ),
             ("∫J", fast.cost_j, ode45.cost_j, reference.cost_j),
         ] {
+            // ∫F = ∫J − ½ ln|Π^U|·t_end, the last term exact: its error is ∫J's, on ∫J's scale
+            // (∫F itself can be near zero).
+            let scale = r.abs().max(reference.cost_j);
             let (e_fast, e_ode45) = ((f - r).abs(), (o - r).abs());
             assert!(
-                e_fast <= e_ode45 + 1e-4 * r.abs(),
+                e_fast <= e_ode45 + 1e-4 * scale,
                 "{kind:?} {arm:?}: {name} off by {e_fast:e}, ode45's by {e_ode45:e} (reference {r})"
             );
         }
@@ -74,9 +83,15 @@ fn check_task(kind: TaskKind, seed: u64) {
         fast_error.push(fast.task_error);
     }
     let swaps = unexplained_swaps(&ref_error, &fast_error, 1e-4);
-    assert!(swaps.is_empty(), "{kind:?}: ranking by task error swaps {swaps:?}");
+    assert!(
+        swaps.is_empty(),
+        "{kind:?}: ranking by task error swaps {swaps:?}"
+    );
     // The population has stiff tools: the switch to Rodas5P is exercised.
-    assert!(switched > TOOLS / 10, "{kind:?}: only {switched} tools switched");
+    assert!(
+        switched > TOOLS / 10,
+        "{kind:?}: only {switched} tools switched"
+    );
 }
 
 #[test]
@@ -130,10 +145,16 @@ fn toolconf(args: &[&str]) -> std::process::Output {
 }
 
 fn select_json(extra: &[&str]) -> serde_json::Value {
-    let mut args = vec!["select", "--task", "position", "--tools", "8", "--seed", "1", "--json"];
+    let mut args = vec![
+        "select", "--task", "position", "--tools", "8", "--seed", "1", "--json",
+    ];
     args.extend_from_slice(extra);
     let out = toolconf(&args);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
@@ -143,13 +164,24 @@ fn select_json(extra: &[&str]) -> serde_json::Value {
 fn the_command_line_defaults_to_fast_and_names_the_method() {
     let tools = draw_tools(8, 1);
     let task = Task::paper(TaskKind::Position);
-    for (extra, method) in [(&[][..], Method::Fast), (&["--method", "explicit"][..], Method::Explicit)] {
+    for (extra, method) in [
+        (&[][..], Method::Fast),
+        (&["--method", "explicit"][..], Method::Explicit),
+    ] {
         let v = select_json(extra);
         assert_eq!(v["method"], method.describe());
         for (t, arm) in v["tools"].as_array().unwrap().iter().zip(&tools) {
             let m = run(arm, TaskKind::Position, method, 1e-3, 1e-6);
-            assert_eq!(t["task_error"].as_f64(), Some(m.task_error), "{method:?} {arm:?}");
-            assert_eq!(t["free_energy"].as_f64(), Some(m.free_energy), "{method:?} {arm:?}");
+            assert_eq!(
+                t["task_error"].as_f64(),
+                Some(m.task_error),
+                "{method:?} {arm:?}"
+            );
+            assert_eq!(
+                t["free_energy"].as_f64(),
+                Some(m.free_energy),
+                "{method:?} {arm:?}"
+            );
         }
     }
     let explicit = EpisodeOptions::default();
@@ -158,7 +190,9 @@ fn the_command_line_defaults_to_fast_and_names_the_method() {
         select_json(&["--method", "explicit"])["tools"][0]["cost_j"].as_f64(),
         Some(m.cost_j)
     );
-    let out = toolconf(&["select", "--task", "position", "--tools", "2", "--method", "rk4"]);
+    let out = toolconf(&[
+        "select", "--task", "position", "--tools", "2", "--method", "rk4",
+    ]);
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("rk4"), "{stderr}");

@@ -59,7 +59,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     }
     let method = toolconf::integrate::Method::from(args.method.method);
     if method != toolconf::integrate::Method::Fast {
-        command.push_str(&format!(" --method {}", format!("{method:?}").to_lowercase()));
+        command.push_str(&format!(
+            " --method {}",
+            format!("{method:?}").to_lowercase()
+        ));
     }
     let config = Config {
         out_dir: args.out.clone(),

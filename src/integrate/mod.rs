@@ -19,6 +19,9 @@
 //!   fired on to `tf` (no switch back), starting with the step DP5 would have tried next and
 //!   DP5's `f(t, y)`. Until the test fires, the steps, output and [`Stats`] are exactly those
 //!   of [`Method::Explicit`]: a problem never found stiff is integrated by DP5 bit for bit.
+//! * [`Method::Fast`] (the command line's default, for throughput on populations of tools):
+//!   as `Auto` with a test that fires after 10 steps at the boundary instead of 15, then the
+//!   same Rodas5P with less work per step (the `rodas_lean` module).
 //!
 //! # What DP5 follows of `ode45`
 //!

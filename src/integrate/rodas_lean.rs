@@ -218,7 +218,8 @@ mod tests {
             y: &SVector<f64, 2>,
             _f: &SVector<f64, 2>,
         ) -> (SMatrix<f64, 2, 2>, SVector<f64, 2>, usize) {
-            let j = nalgebra::matrix![0.0, 1.0; -100.0 * y[0] * y[1] - 1.0, 50.0 * (1.0 - y[0] * y[0])];
+            let j =
+                nalgebra::matrix![0.0, 1.0; -100.0 * y[0] * y[1] - 1.0, 50.0 * (1.0 - y[0] * y[0])];
             (j, SVector::zeros(), 0)
         }
     }
@@ -226,7 +227,8 @@ mod tests {
     /// The lean step is Rodas5P: the same steps and output as `rosenbrock.rs` up to rounding.
     #[test]
     fn lean_rodas5p_takes_the_steps_of_rosenbrock_rs() {
-        let grid = super::super::uniform_grid(0.0, 20.0, 0.05);
+        // Two relaxation jumps (period ≈ (3 − 2 ln 2)·μ ≈ 81) by t = 100.
+        let grid = super::super::uniform_grid(0.0, 100.0, 0.25);
         let options = super::super::Options::default();
         let settings = super::super::resolve(&options, &grid).unwrap();
         let y0 = nalgebra::vector![2.0, 0.0];
@@ -251,11 +253,16 @@ mod tests {
         };
         let ((lean, y_lean), (plain, y_plain)) = (run(true), run(false));
         assert_eq!(lean, plain);
-        assert!(lean.steps > 50, "{lean:?}");
+        assert!(lean.steps > 100, "{lean:?}");
         assert_eq!(y_lean.len(), grid.len() - 1);
-        for (a, b) in y_lean.iter().zip(&y_plain) {
-            assert!((a - b).amax() <= 1e-11 * b.amax().max(1.0), "{a} vs {b}");
-        }
+        let worst = y_lean
+            .iter()
+            .zip(&y_plain)
+            .map(|(a, b)| (a - b).amax() / b.amax().max(1.0))
+            .fold(0.0, f64::max);
+        // Rounding of differently associated sums, amplified through the two jumps (measured
+        // 2.4e-10): six orders below the tolerance, with exactly the same steps.
+        assert!(worst <= 1e-9, "{worst:e}");
     }
 
     #[test]

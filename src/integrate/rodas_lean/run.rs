@@ -4,7 +4,7 @@
 
 use nalgebra::SVector;
 
-use super::{attempt, dense_rows, error_norm, eps_at, Lu, Problem, Start, RODAS5P};
+use super::{attempt, dense_rows, eps_at, error_norm, Lu, Problem, Start, RODAS5P};
 use super::{IntegrationError, Settings, Stats};
 
 /// Rodas5P from `start` over a validated grid and settings.
