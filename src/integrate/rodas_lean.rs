@@ -111,6 +111,8 @@ fn tableau_has_successive_solutions(tab: &Tableau<S>) -> bool {
 /// The stages of one attempt of size `h = t_new − t` and the new solution.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
+// k[j] and the tableau's a[i][j], c[i][j] are indexed together, as in the formulas.
+#[allow(clippy::needless_range_loop)]
 fn attempt<const D: usize, P: Problem<D>>(
     problem: &mut P,
     lu: &Lu<D>,
