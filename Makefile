@@ -13,10 +13,10 @@ run:
 	cargo build --release --quiet
 	./target/release/toolconf reproduce --out results/
 
-## make bench: criterion benchmarks (Π^U per tool, closed-loop RHS, episodes, a batch of 1000,
+## make bench: criterion benchmarks (Π^U per tool, closed-loop RHS, episodes, a batch of 1000, populations of 2000 tools,
 ## the default reproduce); reports in target/criterion/. Peers: bench/peers/run.sh.
 bench:
-	cargo bench --bench confidence --bench episode --bench stiff --bench reproduce
+	cargo bench --bench confidence --bench episode --bench stiff --bench reproduce --bench population
 
 ## make test: the whole suite: `make derive` reproduces generated/ byte for byte (on this CPU and
 ## on an imitated older one), the derivation's own tests, the crate's, then the Python package's.

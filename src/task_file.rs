@@ -92,6 +92,8 @@ pub struct EpisodeSpec {
     pub initial_torque: Option<PerJoint>,
     pub rtol: Option<f64>,
     pub atol: Option<f64>,
+    /// The integration method (not a task-file key: the command line's `--method`).
+    pub method: Option<crate::integrate::Method>,
 }
 
 /// A task: one of the paper's built-in tasks, or a task file's, not yet bound to a model.
@@ -244,6 +246,7 @@ impl TaskSpec {
                 initial_torque: per_joint("episode.initial_torque", e.initial_torque)?,
                 rtol: e.rtol,
                 atol: e.atol,
+                method: None,
             },
         };
         spec.check().map_err(|(key, m)| err(&key, m))?;
@@ -418,6 +421,7 @@ impl TaskSpec {
         o.learning_rate = e.learning_rate.unwrap_or(o.learning_rate);
         o.integrator.rtol = e.rtol.unwrap_or(o.integrator.rtol);
         o.integrator.atol = e.atol.unwrap_or(o.integrator.atol);
+        o.integrator.method = e.method.unwrap_or(o.integrator.method);
         if let Some(v) = &e.initial_theta {
             let theta = self.vector::<M, N, NX, NP, NZ>("episode.initial_theta", v)?;
             o.x0.fixed_rows_mut::<N>(0).copy_from(&theta);

@@ -126,6 +126,8 @@ fn run(
 ///         ``"confidence"`` (ln|Π^U|).
 ///     skip_bad_rows: warn about a bad row (``UserWarning``) and go on without it, instead of
 ///         raising.
+///     method: the integrator, as the command line's ``--method``: ``"fast"`` (the default),
+///         ``"explicit"`` (exactly MATLAB ode45, the paper's numerics), ``"auto"`` or ``"stiff"``.
 ///
 /// Returns:
 ///     dict of columns, best tool first (``pandas.DataFrame(toolconf.rank(...))``): ``rank``,
@@ -140,7 +142,7 @@ fn run(
 ///         a bad task (naming the key), an unknown objective, or ``screen < 1``; the command
 ///         line's message.
 #[pyfunction]
-#[pyo3(signature = (tools, task, screen=None, objective="free-energy", skip_bad_rows=false))]
+#[pyo3(signature = (tools, task, screen=None, objective="free-energy", skip_bad_rows=false, method="fast"))]
 pub fn rank<'py>(
     py: Python<'py>,
     tools: PathBuf,
@@ -148,6 +150,7 @@ pub fn rank<'py>(
     screen: Option<i64>,
     objective: &str,
     skip_bad_rows: bool,
+    method: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let objective = self::objective(objective).map_err(|f| f.into_pyerr(py))?;
     let screen = match screen {
@@ -156,7 +159,8 @@ pub fn rank<'py>(
         }
         k => k.map(|k| k as usize),
     };
-    let spec = task_spec(task, None)?;
+    let mut spec = task_spec(task, None)?;
+    spec.episode.method = Some(crate::task::method(method).map_err(|f| f.into_pyerr(py))?);
     let ranked = detached(py, || run(&tools, &spec, screen, objective, skip_bad_rows))?;
     for warning in &ranked.skipped {
         let category = py.get_type::<PyUserWarning>();

@@ -62,6 +62,9 @@ where
 ///     model: a generated model's name (``toolconf.models()``).
 ///     params: the tool's parameters, a 1-D array in the model's order (all finite, > 0).
 ///     task: a built-in task name, a task file's path, or a dict with a task file's keys.
+///     method: the integrator, as the command line's ``--method``: ``"fast"`` (the default: ode45's
+///         steps until a quick stiffness test fires, then Rodas5P), ``"explicit"`` (exactly
+///         MATLAB ode45, the paper's numerics), ``"auto"`` or ``"stiff"``.
 ///     **episode_options: keys of a task file's ``[episode]`` table, over the task's:
 ///         ``t_end``, ``dt`` (s), ``perturbation`` (constant torque ΔT, N m: one number or one
 ///         per joint), ``learning_rate`` (γ), ``initial_theta``, ``initial_theta_dot``,
@@ -79,12 +82,13 @@ where
 ///     ValueError: bad input (model, parameters, task or episode option), naming the value.
 ///     toolconf.SimulationError: the episode failed; ``tool``, ``time`` and ``reason`` say how.
 #[pyfunction]
-#[pyo3(signature = (model, params, task, **episode_options))]
+#[pyo3(signature = (model, params, task, method="fast", **episode_options))]
 pub fn simulate<'py>(
     py: Python<'py>,
     model: &str,
     params: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
     task: &Bound<'py, PyAny>,
+    method: &str,
     episode_options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = model_kind(model).map_err(|f| f.into_pyerr(py))?;
@@ -98,7 +102,8 @@ pub fn simulate<'py>(
         ))
         .into_pyerr(py));
     }
-    let spec = task_spec(task, episode_options)?;
+    let mut spec = task_spec(task, episode_options)?;
+    spec.episode.method = Some(crate::task::method(method).map_err(|f| f.into_pyerr(py))?);
     let values: Vec<f64> = params.as_array().iter().copied().collect();
     let e = detached(py, || ops(kind).episode(&spec, &values))?;
     to_dict(py, e)

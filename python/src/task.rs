@@ -171,3 +171,18 @@ fn repr(value: &Bound<'_, PyAny>) -> String {
         .map(|r| r.to_string())
         .unwrap_or_else(|_| "<unprintable>".into())
 }
+
+/// `method="fast"` (the command line's `--method`, and its default), `"explicit"` (MATLAB
+/// ode45 exactly, the paper's numerics), `"auto"` or `"stiff"`.
+pub fn method(name: &str) -> Result<toolconf::integrate::Method, Failure> {
+    use toolconf::integrate::Method;
+    match name {
+        "fast" => Ok(Method::Fast),
+        "explicit" => Ok(Method::Explicit),
+        "auto" => Ok(Method::Auto),
+        "stiff" => Ok(Method::Stiff),
+        other => Err(Failure::Input(format!(
+            "method = '{other}': expected fast, explicit, auto or stiff"
+        ))),
+    }
+}

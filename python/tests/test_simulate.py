@@ -22,6 +22,19 @@ def test_the_paper_arm_equals_the_command_line(task, cli_json):
         assert got[key] == expected[key], key
 
 
+@pytest.mark.parametrize("method", ["explicit", "auto", "stiff"])
+def test_each_method_equals_the_command_line(method, cli_json):
+    expected = cli_json("simulate", "--arm", "0.3,0.4,0.5,0.2", "--task", "velocity", "--method", method)
+    got = toolconf.simulate("arm2", PAPER_ARM, "velocity", method=method)
+    for key in METRICS:
+        assert got[key] == expected[key], key
+
+
+def test_an_unknown_method_is_a_value_error():
+    with pytest.raises(ValueError, match="method = 'rk4'"):
+        toolconf.simulate("arm2", PAPER_ARM, "position", method="rk4")
+
+
 def test_episode_options_equal_the_command_line_flags(cli_json, cli, tmp_path):
     flags = ["--perturb", "-0.8", "--t-end", "3", "--dt", "0.1", "--gamma", "2"]
     expected = cli_json("simulate", "--arm", "0.3,0.4,0.5,0.2", "--task", "position", *flags)

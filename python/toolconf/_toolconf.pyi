@@ -43,6 +43,7 @@ def simulate(
     model: str,
     params: Params,
     task: Task,
+    method: Literal["fast", "explicit", "auto", "stiff"] = "fast",
     *,
     t_end: Optional[float] = ...,
     dt: Optional[float] = ...,
@@ -65,6 +66,7 @@ def rank(
     screen: Optional[int] = None,
     objective: Literal["free-energy", "cost-j", "confidence"] = "free-energy",
     skip_bad_rows: bool = False,
+    method: Literal["fast", "explicit", "auto", "stiff"] = "fast",
 ) -> dict[str, Union[npt.NDArray[np.float64], npt.NDArray[np.int64], list[Optional[str]], list[str]]]:
     """``toolconf rank`` as a dict of columns, best tool first: ``rank``, ``row``, ``name``,
     ``model``, the parameters, ``logdet``, ``task_error``, ``free_energy``, ``cost_j``,

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use toolconf::closed_loop::{EpisodeOptions, Plant};
+use toolconf::integrate::Method;
 use toolconf::model::EpisodeOptionsN;
 use toolconf::task_file::{EpisodeSpec, PerJoint, TaskSpec};
 use toolconf::{Error, TaskKind};
@@ -58,6 +59,38 @@ pub struct EpisodeArgs {
     /// Plant: the paper's generative process, or the exact Lagrangian 2-link dynamics.
     #[arg(long, value_enum, default_value_t = PlantArg::Paper)]
     pub plant: PlantArg,
+}
+
+/// `--method` (select, rank, reproduce, simulate).
+#[derive(clap::Args, Debug, Clone)]
+pub struct MethodArgs {
+    /// Integration method. fast (the default): DP5 (ode45's steps) until a quick stiffness test
+    /// fires, then Rodas5P, for throughput on many tools; explicit: exactly MATLAB ode45, the
+    /// paper's numerics; auto: ode45 on tasks 1-2 and the ode45-to-Rodas5P switch on task 3;
+    /// stiff: Rodas5P throughout.
+    #[arg(long, value_enum, default_value_t = MethodArg::Fast)]
+    pub method: MethodArg,
+}
+
+/// The integration methods by name (see [`Method`]).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum MethodArg {
+    #[default]
+    Fast,
+    Explicit,
+    Auto,
+    Stiff,
+}
+
+impl From<MethodArg> for Method {
+    fn from(m: MethodArg) -> Self {
+        match m {
+            MethodArg::Fast => Method::Fast,
+            MethodArg::Explicit => Method::Explicit,
+            MethodArg::Auto => Method::Auto,
+            MethodArg::Stiff => Method::Stiff,
+        }
+    }
 }
 
 /// The simulated arm's equations of motion (the agent always uses the paper's model).

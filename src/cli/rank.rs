@@ -47,6 +47,8 @@ pub struct Args {
     /// Report a bad row on stderr and go on without it, instead of stopping.
     #[arg(long)]
     skip_bad_rows: bool,
+    #[command(flatten)]
+    method: super::episode_args::MethodArgs,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -254,7 +256,8 @@ struct Counts {
 }
 
 pub fn run(args: &Args) -> Result<(), CliError> {
-    let spec = task_spec(&args.task)?;
+    let mut spec = task_spec(&args.task)?;
+    spec.episode.method = Some(args.method.method.into());
     let tasks = ModelTasks::new(&spec);
     let objective = Objective::from(args.objective);
     let (screen, skipped) = screen_tools(args, &tasks)?;
@@ -353,6 +356,7 @@ fn print_json(
         "task_file": (!spec.file.is_empty()).then_some(&spec.file),
         "tools_file": args.tools,
         "objective": objective.name(),
+        "method": spec.episode.method.unwrap_or_default().describe(),
         "tools_read": counts.read,
         "skipped_rows": counts.skipped,
         "screen": args.screen,
@@ -383,6 +387,10 @@ fn print_text(
         args.tools.display(),
         spec.label(),
         objective.name()
+    );
+    println!(
+        "integration method: {}",
+        spec.episode.method.unwrap_or_default().describe()
     );
     let screened = args.screen.map_or(String::new(), |k| {
         format!(

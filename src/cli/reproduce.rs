@@ -26,6 +26,8 @@ pub struct Args {
     /// (about ten times the run time of the paper's experiments).
     #[arg(long)]
     mpc: bool,
+    #[command(flatten)]
+    method: super::episode_args::MethodArgs,
 }
 
 fn parse_experiment(s: &str) -> Result<String, String> {
@@ -55,6 +57,13 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if args.mpc {
         command.push_str(" --mpc");
     }
+    let method = toolconf::integrate::Method::from(args.method.method);
+    if method != toolconf::integrate::Method::Fast {
+        command.push_str(&format!(
+            " --method {}",
+            format!("{method:?}").to_lowercase()
+        ));
+    }
     let config = Config {
         out_dir: args.out.clone(),
         seed: args.seed,
@@ -69,6 +78,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         only: args.only.clone(),
         progress: std::io::stderr().is_terminal(),
         command,
+        method,
     };
     let summary = reproduce(&config).map_err(|e| match e {
         ReproduceError::Io { path, source } => CliError::Io { path, source },

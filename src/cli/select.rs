@@ -6,6 +6,7 @@
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use toolconf::closed_loop::EpisodeOptions;
+use toolconf::integrate::Method;
 use toolconf::model::mixed::ModelKind;
 use toolconf::model::Arm2;
 use toolconf::rank::ModelTasks;
@@ -16,7 +17,7 @@ use toolconf::select::{
 use toolconf::task_file::TaskSpec;
 use toolconf::Task;
 
-use super::episode_args::{two_link_options, EpisodeArgs, PlantArg, TaskArgs};
+use super::episode_args::{two_link_options, EpisodeArgs, MethodArgs, PlantArg, TaskArgs};
 use super::output::{add_outcome, CliError};
 use super::parse_model;
 use super::simulate::MpcArgs;
@@ -41,6 +42,8 @@ pub struct Args {
     models: Vec<ModelKind>,
     #[command(flatten)]
     episode: EpisodeArgs,
+    #[command(flatten)]
+    method: MethodArgs,
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
@@ -103,6 +106,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         let out = json!({
             "task": kind,
             "seed": args.seed,
+            "method": Method::from(args.method.method).describe(),
             "perturb": options.perturbation,
             "tools": tools_json,
             "choice": choice,
@@ -119,6 +123,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         kind.paper_index(),
         args.tools,
         args.seed
+    );
+    println!(
+        "integration method: {}",
+        Method::from(args.method.method).describe()
     );
     println!(
         "{:>5}  {:>7} {:>7} {:>7} {:>7}  {:>12} {:>14} {:>14} {:>14}",
@@ -178,7 +186,9 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 fn two_link_task(args: &Args) -> Result<(Task, EpisodeOptions), CliError> {
     let spec = args.task.spec()?;
     if args.task.task_file.is_none() {
-        return Ok((Task::paper(spec.kind), args.episode.options(false)?));
+        let mut options = args.episode.options(false)?;
+        options.integrator.method = args.method.method.into();
+        return Ok((Task::paper(spec.kind), options));
     }
     let spec = with_flags(args, spec)?;
     let task = Task::from(&spec.task::<Arm2, 2, 4, 4, 6>()?);
@@ -193,6 +203,7 @@ fn two_link_task(args: &Args) -> Result<(Task, EpisodeOptions), CliError> {
 
 fn with_flags(args: &Args, mut spec: TaskSpec) -> Result<TaskSpec, CliError> {
     args.episode.apply(&mut spec.episode)?;
+    spec.episode.method = Some(args.method.method.into());
     Ok(spec)
 }
 
@@ -243,7 +254,8 @@ fn mixed_tool_json(r: &MixedResult) -> Value {
 fn run_mixed(args: &Args) -> Result<(), CliError> {
     let spec = args.task.spec()?;
     let kind = spec.kind;
-    let options = args.episode.options(false)?;
+    let mut options = args.episode.options(false)?;
+    options.integrator.method = args.method.method.into();
     let tools = draw_mixed_tools(&args.models, args.tools as usize, args.seed)?;
     let results = match args.task.task_file {
         None => evaluate_mixed(&tools, kind, &options),
@@ -262,6 +274,7 @@ fn run_mixed(args: &Args) -> Result<(), CliError> {
         let out = json!({
             "task": kind,
             "seed": args.seed,
+            "method": Method::from(args.method.method).describe(),
             "perturb": options.perturbation,
             "models": models,
             "tools": results.iter().map(mixed_tool_json).collect::<Vec<_>>(),
@@ -280,6 +293,10 @@ fn run_mixed(args: &Args) -> Result<(), CliError> {
         args.tools,
         args.seed,
         models.join(",")
+    );
+    println!(
+        "integration method: {}",
+        Method::from(args.method.method).describe()
     );
     // The model column fits the longest name in this set (at least 10 wide).
     let w = models.iter().map(|m| m.len()).max().unwrap_or(0).max(10);

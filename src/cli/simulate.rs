@@ -34,6 +34,8 @@ pub struct Args {
     task: TaskArgs,
     #[command(flatten)]
     episode: EpisodeArgs,
+    #[command(flatten)]
+    method: super::episode_args::MethodArgs,
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
@@ -134,7 +136,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let (episode, perturb) = match args.task.task_file {
         None => {
             let task = Task::paper(spec.kind);
-            let options = args.episode.options(args.csv.is_some())?;
+            let mut options = args.episode.options(args.csv.is_some())?;
+            options.integrator.method = args.method.method.into();
             let episode = simulate(&arm, &task, &options)?;
             (episode, json!(options.perturbation))
         }
@@ -156,6 +159,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             "rhs_evals": m.rhs_evals,
             "steps": m.steps,
             "rejected_steps": m.rejected_steps,
+            "method": toolconf::integrate::Method::from(args.method.method).describe(),
         });
         if let Some(path) = &args.task.task_file {
             out["task_file"] = json!(path);
@@ -169,6 +173,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             "arm: {}    task: {}    perturbation: {perturb} N m",
             arm,
             spec.label(),
+        );
+        println!(
+            "integration method: {}",
+            toolconf::integrate::Method::from(args.method.method).describe()
         );
         println!("task error     {:.9e}", m.task_error);
         println!("integral F dt  {:.9e}", m.free_energy);
@@ -193,6 +201,7 @@ fn from_task_file(
     mut spec: TaskSpec,
 ) -> Result<(Episode, Value), CliError> {
     args.episode.apply(&mut spec.episode)?;
+    spec.episode.method = Some(args.method.method.into());
     let task = spec.task::<Arm2, 2, 4, 4, 6>()?;
     let mut options = spec.episode::<Arm2, 2, 4, 4, 6>()?;
     options.record_trajectory = args.csv.is_some();
@@ -314,6 +323,7 @@ fn run_model(args: &Args, model: ModelKind, mut spec: TaskSpec) -> Result<(), Cl
         .collect::<Result<Vec<f64>, _>>()?;
     let tool = AnyTool::new(model, &params)?;
     args.episode.apply(&mut spec.episode)?;
+    spec.episode.method = Some(args.method.method.into());
     let tasks = ModelTasks::new(&spec);
     tasks.check(model)?;
     let episode = tasks.episode(&tool, args.csv.is_some())?;
@@ -330,6 +340,7 @@ fn run_model(args: &Args, model: ModelKind, mut spec: TaskSpec) -> Result<(), Cl
         let mut out = json!({
             "model": model.name(),
             "params": named,
+            "method": toolconf::integrate::Method::from(args.method.method).describe(),
             "task": spec.kind,
             "perturb": episode.perturbation,
             "task_error": m.task_error,
@@ -352,6 +363,10 @@ fn run_model(args: &Args, model: ModelKind, mut spec: TaskSpec) -> Result<(), Cl
             "tool: {tool}    task: {}    perturbation: {:?} N m",
             spec.label(),
             episode.perturbation
+        );
+        println!(
+            "integration method: {}",
+            toolconf::integrate::Method::from(args.method.method).describe()
         );
         println!("task error     {:.9e}", m.task_error);
         println!("integral F dt  {:.9e}", m.free_energy);

@@ -258,6 +258,9 @@ pub struct Config {
     pub progress: bool,
     /// The command line, quoted in the report.
     pub command: String,
+    /// The integration method of every episode ([`crate::integrate::Method::Fast`] from the
+    /// command line; [`crate::integrate::Method::Explicit`] is the paper's ode45).
+    pub method: crate::integrate::Method,
 }
 
 /// Timing of one experiment.
@@ -326,7 +329,11 @@ pub fn reproduce(config: &Config) -> Result<Summary, ReproduceError> {
         out_dir: out,
         seed: config.seed,
         plan: &config.plan,
-        options: EpisodeOptions::default(),
+        options: {
+            let mut o = EpisodeOptions::default();
+            o.integrator.method = config.method;
+            o
+        },
         progress: &progress,
         file_prefix: "",
     };

@@ -148,13 +148,15 @@ pub fn document(info: &RunInfo, sections: &[Section]) -> Vec<Block> {
         ),
         Block::p(format!(
             "Episode settings (the paper's \"Implementation details\"): t_end = {} s, output \
-             step dt = {} s, X0 = [{}], U0 = [{}], learning rate γ = {}; integrator `{:?}`.",
+             step dt = {} s, X0 = [{}], U0 = [{}], learning rate γ = {}; integrator `{:?}` \
+             (method {}).",
             info.episode.t_end,
             info.episode.dt,
             join(info.episode.x0.iter()),
             join(info.episode.u0.iter()),
             info.episode.learning_rate,
-            info.episode.integrator
+            info.episode.integrator,
+            info.episode.integrator.method.describe()
         )),
         Block::p(
             "Random streams: each experiment draws from its own sub-seeds, \

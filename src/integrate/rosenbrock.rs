@@ -88,25 +88,25 @@ pub(super) struct Start<const D: usize> {
 
 /// A stiffly accurate Rosenbrock method with `S` stages in `rodas.f`'s transformed form: the
 /// last stage is the error estimate and `y_new = y + Σ_j a_Sj·k_j + k_S`.
-struct Tableau<const S: usize> {
-    gamma: f64,
+pub(super) struct Tableau<const S: usize> {
+    pub(super) gamma: f64,
     /// Stage times α_i.
-    alpha: [f64; S],
+    pub(super) alpha: [f64; S],
     /// Row i: the coefficients of k_j (j < i) in the argument of stage i.
-    a: [[f64; S]; S],
+    pub(super) a: [[f64; S]; S],
     /// Row i: the coefficients of k_j/h (j < i) added to stage i's right-hand side.
-    c: [[f64; S]; S],
+    pub(super) c: [[f64; S]; S],
     /// The coefficients of h·∂f/∂t.
-    d: [f64; S],
+    pub(super) d: [f64; S],
     /// Rows of the dense output, `q_r = Σ_j h_rj·k_j`.
-    dense: [[f64; S]; 3],
+    pub(super) dense: [[f64; S]; 3],
     /// 1/(order of the embedded method + 1).
-    exponent: f64,
+    pub(super) exponent: f64,
 }
 
 /// Rodas5P (Steinebach 2023). Rows i = 1…8 of `a` and `c` list the coefficients of k_1…k_{i−1}.
 #[rustfmt::skip]
-const RODAS5P: Tableau<8> = Tableau {
+pub(super) const RODAS5P: Tableau<8> = Tableau {
     gamma: 0.21193756319429014,
     alpha: [
         0.0, 0.6358126895828704, 0.4095798393397535, 0.9769306725060716, 0.4288403609558664,
@@ -223,7 +223,7 @@ struct Attempt<const D: usize, const S: usize> {
 
 /// MATLAB's `eps(t)`: the distance from |t| to the next larger double.
 #[inline]
-fn eps_at(t: f64) -> f64 {
+pub(super) fn eps_at(t: f64) -> f64 {
     let a = t.abs();
     f64::from_bits(a.to_bits() + 1) - a
 }
@@ -543,7 +543,7 @@ mod tests {
             solve_grid(prothero_robinson, &y0, &grid, &explicit, out).unwrap()
         });
         assert!(e_dp5 < 1e-2, "{e_dp5:e}");
-        for method in [Method::Stiff, Method::Auto] {
+        for method in [Method::Stiff, Method::Auto, Method::Fast] {
             let o = options(method, 1e-3, 1e-6);
             let (e, analytic) = max_error(&grid, exact, |out| {
                 let jac = prothero_robinson_jacobian;
@@ -674,7 +674,7 @@ mod tests {
         // A jump from ≈ ±1 to ∓2 every half period (≈ 807): three by t = 3000.
         let jumps = reference.windows(2).filter(|w| w[0] * w[1] < 0.0).count();
         assert_eq!(jumps, 3, "{reference:?}");
-        for method in [Method::Stiff, Method::Auto] {
+        for method in [Method::Stiff, Method::Auto, Method::Fast] {
             let (out, stats) = run(&options(method, 1e-3, 1e-6));
             assert!(stats.steps < 600, "{method:?}: {stats:?}");
             let worst = out
@@ -853,7 +853,7 @@ mod tests {
     fn non_finite_values_are_errors() {
         let grid = uniform_grid(0.0, 2.0, 0.1);
         let y0 = vector![2.0];
-        for method in [Method::Stiff, Method::Auto] {
+        for method in [Method::Stiff, Method::Auto, Method::Fast] {
             let o = options(method, 1e-3, 1e-6);
             // A NaN right-hand side after t = 1.
             let rhs = |t: f64, y: &V1| {

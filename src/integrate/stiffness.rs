@@ -14,18 +14,40 @@ use nalgebra::SVector;
 const STABILITY_BOUND: f64 = 3.25;
 /// Steps at the boundary before the problem is declared stiff (`DOPRI5`: 15).
 const STIFF_STEPS: u32 = 15;
+/// Steps at the boundary before [`super::Method::Fast`] hands over to Rodas5P: chosen on
+/// `draw_tools(2000, 1)` by the work model of `docs/performance.md` (patience 3, 6, 10, 15:
+/// task 1 favours the shorter, task 2 the longer; 10 is within 5 % of the best of both).
+pub(super) const FAST_STIFF_STEPS: u32 = 10;
 /// Consecutive steps inside the boundary that clear the count (`DOPRI5`: 6).
 const NONSTIFF_STEPS: u32 = 6;
 
 /// The counters of `DOPRI5`'s test (`IASTI`, `NONSTI`, `HLAMB`).
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy)]
 pub(super) struct StiffnessDetector {
+    /// Steps at the boundary before the problem is declared stiff ([`STIFF_STEPS`] by default).
+    patience: u32,
     stiff: u32,
     nonstiff: u32,
     h_lambda: f64,
 }
 
+impl Default for StiffnessDetector {
+    fn default() -> Self {
+        Self::with_patience(STIFF_STEPS)
+    }
+}
+
 impl StiffnessDetector {
+    /// A detector that fires after `patience` steps at the boundary instead of `DOPRI5`'s 15.
+    pub(super) fn with_patience(patience: u32) -> Self {
+        Self {
+            patience,
+            stiff: 0,
+            nonstiff: 0,
+            h_lambda: 0.0,
+        }
+    }
+
     /// Looks at one accepted DP5 step of size `h` (with stage 6 `k6 = f(t + h, y6)` and the FSAL
     /// stage `k7 = f(t + h, y7)`) and says whether the problem is now declared stiff.
     pub(super) fn stiff_after<const D: usize>(
@@ -45,7 +67,7 @@ impl StiffnessDetector {
         if self.h_lambda > STABILITY_BOUND {
             self.nonstiff = 0;
             self.stiff += 1;
-            self.stiff >= STIFF_STEPS
+            self.stiff >= self.patience
         } else {
             self.nonstiff += 1;
             if self.nonstiff == NONSTIFF_STEPS {

@@ -190,6 +190,10 @@ fn task_table(input: &ReportInput) -> Vec<Block> {
         "precision P^U",
         given(spec.precision_u.as_ref().map(precision), paper),
     );
+    add(
+        "integration method",
+        e.method.unwrap_or_default().describe().to_string(),
+    );
     add("episode length t_end [s]", given(number(e.t_end), "5"));
     add("output step dt [s]", given(number(e.dt), "0.05"));
     add(
