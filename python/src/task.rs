@@ -173,16 +173,10 @@ fn repr(value: &Bound<'_, PyAny>) -> String {
 }
 
 /// `method="fast"` (the command line's `--method`, and its default), `"explicit"` (MATLAB
-/// ode45 exactly, the paper's numerics), `"auto"` or `"stiff"`.
+/// ode45 exactly, the paper's numerics), `"auto"` or `"stiff"`: [`Method::name`]s.
+///
+/// [`Method::name`]: toolconf::integrate::Method::name
 pub fn method(name: &str) -> Result<toolconf::integrate::Method, Failure> {
-    use toolconf::integrate::Method;
-    match name {
-        "fast" => Ok(Method::Fast),
-        "explicit" => Ok(Method::Explicit),
-        "auto" => Ok(Method::Auto),
-        "stiff" => Ok(Method::Stiff),
-        other => Err(Failure::Input(format!(
-            "method = '{other}': expected fast, explicit, auto or stiff"
-        ))),
-    }
+    name.parse()
+        .map_err(|e: String| Failure::Input(format!("method = {e}")))
 }

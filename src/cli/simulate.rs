@@ -3,11 +3,12 @@
 use std::path::PathBuf;
 
 use serde_json::{json, Value};
-use toolconf::closed_loop::{simulate, Episode, Plant, Trajectory};
+use toolconf::closed_loop::{simulate, Episode, Metrics, Plant};
+use toolconf::integrate::Method;
 use toolconf::model::mixed::{AnyTool, ModelKind};
 use toolconf::model::{episode_on, Arm2, Arm2Exact, Arm2Tool};
 use toolconf::mpc::{simulate_mpc, MpcModel, MpcOptions};
-use toolconf::rank::ModelTasks;
+use toolconf::rank::{ModelTasks, TrajectoryTable};
 use toolconf::task_file::TaskSpec;
 use toolconf::{Arm, Error, Task};
 
@@ -143,24 +144,36 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         }
         Some(_) => from_task_file(args, &arm, spec.clone())?,
     };
-    let m = episode.metrics;
     if let (Some(path), Some(tr)) = (&args.csv, &episode.trajectory) {
-        write_atomically(path, &trajectory_csv(tr))?;
+        write_atomically(path, &TrajectoryTable::from_trajectory(tr).to_csv())?;
     }
+    let identity = json!({ "arm": arm, "task": spec.kind, "perturb": perturb });
+    let heading = format!(
+        "arm: {arm}    task: {}    perturbation: {perturb} N m",
+        spec.label()
+    );
+    print_episode(args, identity, &heading, &episode.metrics);
+    Ok(())
+}
+
+/// An active-inference episode's result: `identity` (the tool, task and perturbation) and the
+/// metrics as one JSON object, or `heading` and the metrics as text; the same for `--arm` and
+/// `--model`.
+fn print_episode(args: &Args, mut out: Value, heading: &str, m: &Metrics) {
+    let method = Method::from(args.method.method).describe();
     if args.json {
-        let mut out = json!({
-            "arm": arm,
-            "task": spec.kind,
-            "perturb": perturb,
-            "task_error": m.task_error,
-            "free_energy": m.free_energy,
-            "cost_j": m.cost_j,
-            "logdet": m.logdet,
-            "rhs_evals": m.rhs_evals,
-            "steps": m.steps,
-            "rejected_steps": m.rejected_steps,
-            "method": toolconf::integrate::Method::from(args.method.method).describe(),
-        });
+        for (key, value) in [
+            ("task_error", json!(m.task_error)),
+            ("free_energy", json!(m.free_energy)),
+            ("cost_j", json!(m.cost_j)),
+            ("logdet", json!(m.logdet)),
+            ("rhs_evals", json!(m.rhs_evals)),
+            ("steps", json!(m.steps)),
+            ("rejected_steps", json!(m.rejected_steps)),
+            ("method", json!(method)),
+        ] {
+            out[key] = value;
+        }
         if let Some(path) = &args.task.task_file {
             out["task_file"] = json!(path);
         }
@@ -168,29 +181,21 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             "{}",
             serde_json::to_string_pretty(&out).expect("finite numbers")
         );
-    } else {
-        println!(
-            "arm: {}    task: {}    perturbation: {perturb} N m",
-            arm,
-            spec.label(),
-        );
-        println!(
-            "integration method: {}",
-            toolconf::integrate::Method::from(args.method.method).describe()
-        );
-        println!("task error     {:.9e}", m.task_error);
-        println!("integral F dt  {:.9e}", m.free_energy);
-        println!("integral J dt  {:.9e}", m.cost_j);
-        println!("ln|Pi^U|       {:.9e}", m.logdet);
-        println!(
-            "rhs evals      {} ({} steps, {} rejected)",
-            m.rhs_evals, m.steps, m.rejected_steps
-        );
-        if let Some(path) = &args.csv {
-            println!("trajectory     {}", path.display());
-        }
+        return;
     }
-    Ok(())
+    println!("{heading}");
+    println!("integration method: {method}");
+    println!("task error     {:.9e}", m.task_error);
+    println!("integral F dt  {:.9e}", m.free_energy);
+    println!("integral J dt  {:.9e}", m.cost_j);
+    println!("ln|Pi^U|       {:.9e}", m.logdet);
+    println!(
+        "rhs evals      {} ({} steps, {} rejected)",
+        m.rhs_evals, m.steps, m.rejected_steps
+    );
+    if let Some(path) = &args.csv {
+        println!("trajectory     {}", path.display());
+    }
 }
 
 /// One episode of the task file's task: the generic 2-link runtime, which takes the file's
@@ -237,7 +242,7 @@ fn run_mpc(args: &Args, arm: &Arm, mut spec: TaskSpec) -> Result<(), CliError> {
     let episode = simulate_mpc(arm, &task, &options, &args.mpc.options()?)?;
     let m = &episode.metrics;
     if let (Some(path), Some(tr)) = (&args.csv, &episode.trajectory) {
-        write_atomically(path, &trajectory_csv(tr))?;
+        write_atomically(path, &TrajectoryTable::from_trajectory(tr).to_csv())?;
     }
     if args.json {
         let out = json!({
@@ -327,7 +332,6 @@ fn run_model(args: &Args, model: ModelKind, mut spec: TaskSpec) -> Result<(), Cl
     let tasks = ModelTasks::new(&spec);
     tasks.check(model)?;
     let episode = tasks.episode(&tool, args.csv.is_some())?;
-    let m = &episode.metrics;
     if let (Some(path), Some(tr)) = (&args.csv, &episode.trajectory) {
         write_atomically(path, &tr.to_csv())?;
     }
@@ -336,70 +340,17 @@ fn run_model(args: &Args, model: ModelKind, mut spec: TaskSpec) -> Result<(), Cl
         .into_iter()
         .map(|(k, v)| (k.to_string(), json!(v)))
         .collect();
-    if args.json {
-        let mut out = json!({
-            "model": model.name(),
-            "params": named,
-            "method": toolconf::integrate::Method::from(args.method.method).describe(),
-            "task": spec.kind,
-            "perturb": episode.perturbation,
-            "task_error": m.task_error,
-            "free_energy": m.free_energy,
-            "cost_j": m.cost_j,
-            "logdet": m.logdet,
-            "rhs_evals": m.rhs_evals,
-            "steps": m.steps,
-            "rejected_steps": m.rejected_steps,
-        });
-        if let Some(path) = &args.task.task_file {
-            out["task_file"] = json!(path);
-        }
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&out).expect("finite numbers")
-        );
-    } else {
-        println!(
-            "tool: {tool}    task: {}    perturbation: {:?} N m",
-            spec.label(),
-            episode.perturbation
-        );
-        println!(
-            "integration method: {}",
-            toolconf::integrate::Method::from(args.method.method).describe()
-        );
-        println!("task error     {:.9e}", m.task_error);
-        println!("integral F dt  {:.9e}", m.free_energy);
-        println!("integral J dt  {:.9e}", m.cost_j);
-        println!("ln|Pi^U|       {:.9e}", m.logdet);
-        println!(
-            "rhs evals      {} ({} steps, {} rejected)",
-            m.rhs_evals, m.steps, m.rejected_steps
-        );
-        if let Some(path) = &args.csv {
-            println!("trajectory     {}", path.display());
-        }
-    }
+    let identity = json!({
+        "model": model.name(),
+        "params": named,
+        "task": spec.kind,
+        "perturb": episode.perturbation,
+    });
+    let heading = format!(
+        "tool: {tool}    task: {}    perturbation: {:?} N m",
+        spec.label(),
+        episode.perturbation
+    );
+    print_episode(args, identity, &heading, &episode.metrics);
     Ok(())
-}
-
-/// The trajectory as CSV, one row per grid point.
-pub fn trajectory_csv(tr: &Trajectory) -> String {
-    let mut out =
-        String::from("t,theta1,theta2,theta1_dot,theta2_dot,theta1_ddot,theta2_ddot,u1,u2\n");
-    for i in 0..tr.t.len() {
-        out += &format!(
-            "{},{},{},{},{},{},{},{},{}\n",
-            tr.t[i],
-            tr.theta[i][0],
-            tr.theta[i][1],
-            tr.theta_dot[i][0],
-            tr.theta_dot[i][1],
-            tr.theta_ddot[i][0],
-            tr.theta_ddot[i][1],
-            tr.u[i][0],
-            tr.u[i][1]
-        );
-    }
-    out
 }

@@ -84,6 +84,19 @@ pub enum Method {
 }
 
 impl Method {
+    /// Every method, in the order the command line lists them.
+    pub const ALL: [Method; 4] = [Method::Fast, Method::Explicit, Method::Auto, Method::Stiff];
+
+    /// The method's name on the command line (`--method`) and in Python (`method=`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Explicit => "explicit",
+            Method::Stiff => "stiff",
+            Method::Auto => "auto",
+            Method::Fast => "fast",
+        }
+    }
+
     /// The method in words, for reports and command-line output.
     pub fn describe(self) -> &'static str {
         match self {
@@ -92,6 +105,21 @@ impl Method {
             Method::Auto => "auto: ode45 on tasks 1-2, ode45 then Rodas5P after Hairer's stiffness test on task 3",
             Method::Fast => "fast: ode45's steps until a 10-step stiffness test fires, then a lean Rodas5P",
         }
+    }
+}
+
+impl std::str::FromStr for Method {
+    type Err = String;
+
+    /// A method by [`Method::name`].
+    fn from_str(s: &str) -> Result<Self, String> {
+        Method::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| {
+                let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
+                format!("'{s}': expected {}", names.join(", "))
+            })
     }
 }
 

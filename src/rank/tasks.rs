@@ -155,18 +155,14 @@ pub struct TrajectoryTable {
 }
 
 impl TrajectoryTable {
-    fn from_trajectory<const N: usize>(tr: &TrajectoryN<N>) -> Self {
-        let columns = |series: &[SVector<f64, N>]| -> Vec<Vec<f64>> {
-            (0..N)
-                .map(|j| series.iter().map(|v| v[j]).collect())
-                .collect()
-        };
+    /// The table of a trajectory with N joints known at compile time.
+    pub fn from_trajectory<const N: usize>(tr: &TrajectoryN<N>) -> Self {
         TrajectoryTable {
             t: tr.t.clone(),
-            theta: columns(&tr.theta),
-            theta_dot: columns(&tr.theta_dot),
-            theta_ddot: columns(&tr.theta_ddot),
-            u: columns(&tr.u),
+            theta: per_joint(&tr.theta),
+            theta_dot: per_joint(&tr.theta_dot),
+            theta_ddot: per_joint(&tr.theta_ddot),
+            u: per_joint(&tr.u),
         }
     }
 
@@ -193,6 +189,13 @@ impl TrajectoryTable {
         }
         out
     }
+}
+
+/// `series[i][j]` (time i, joint j) as `out[j][i]`.
+fn per_joint<const N: usize>(series: &[SVector<f64, N>]) -> Vec<Vec<f64>> {
+    (0..N)
+        .map(|j| series.iter().map(|v| v[j]).collect())
+        .collect()
 }
 
 fn episode_of<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
@@ -248,9 +251,7 @@ where
     };
     Ok(TaskTrace {
         t: tr.t.clone(),
-        value: (0..N)
-            .map(|j| series.iter().map(|v| v[j]).collect())
-            .collect(),
+        value: per_joint(series),
         goal: goal.iter().copied().collect(),
     })
 }
