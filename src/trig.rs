@@ -84,17 +84,17 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     let head = 1.0 - half_z;
     let cos_r = head + (((1.0 - head) - half_z) + (z * pc - r * tail));
 
-    let (s, c) = if quadrant & 1 == 0 {
-        (sin_r, cos_r)
-    } else {
-        (cos_r, -sin_r)
-    };
-    if quadrant & 2 == 0 {
-        (s, c)
-    } else {
-        (-s, -c)
-    }
+    // The quadrant as bit masks, not branches: a joint hanging near −π/2 sits on a quadrant
+    // boundary, where branches on n mispredict; swapping and negating by masks gives the same bits.
+    let odd = 0u64.wrapping_sub((quadrant & 1) as u64);
+    let flip = ((quadrant & 2) as u64) << 62;
+    let (sin_bits, cos_bits) = (sin_r.to_bits(), cos_r.to_bits());
+    let s = (cos_bits & odd) | (sin_bits & !odd);
+    let c = ((sin_bits ^ SIGN) & odd) | (cos_bits & !odd);
+    (f64::from_bits(s ^ flip), f64::from_bits(c ^ flip))
 }
+
+const SIGN: u64 = 1 << 63;
 
 #[cfg(test)]
 mod tests {
