@@ -60,20 +60,57 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
         return x.sin_cos();
     }
     // x = n·π/2 + (r + tail), |r| ≤ π/4 (musl's medium-size `__rem_pio2`).
-    let n = (x * INV_PIO2 + TO_INT) - TO_INT;
-    let quadrant = n as i64;
-    let mut hi = x - n * PIO2_1;
-    let mut w = n * PIO2_1T;
-    let mut r = hi - w;
+    let (n, mut hi, mut w, mut r) = first_reduction(x);
     if exponent(x) - exponent(r) > 16 {
         (hi, w, r) = next_part(hi, n, PIO2_2, PIO2_2T);
         if exponent(x) - exponent(r) > 49 {
             (hi, w, r) = next_part(hi, n, PIO2_3, PIO2_3T);
         }
     }
-    let tail = (hi - r) - w;
+    let (sin_r, cos_r) = kernels(r, (hi - r) - w);
+    by_quadrant(n as i64, sin_r, cos_r)
+}
 
-    // fdlibm's __kernel_sin(r, tail) and __kernel_cos(r, tail).
+/// [`sin_cos`] of W angles at once, lane by lane the same bits: the usual path is straight-line
+/// code over the lanes, which the compiler vectorises (issue 14's SIMD-across-tools direction,
+/// `examples/lanes.rs`); if any lane needs more of the reduction (an angle next to a multiple of
+/// π/2, or out of range) every lane takes [`sin_cos`].
+#[inline(always)]
+pub fn sin_cos_lanes<const W: usize>(x: [f64; W]) -> ([f64; W], [f64; W]) {
+    let (mut n, mut hi, mut w, mut r) = ([0.0; W], [0.0; W], [0.0; W], [0.0; W]);
+    let mut rare = false;
+    for i in 0..W {
+        (n[i], hi[i], w[i], r[i]) = first_reduction(x[i]);
+        rare |= x[i].is_nan()
+            | (x[i].abs() >= REDUCTION_LIMIT)
+            | (exponent(x[i]) - exponent(r[i]) > 16);
+    }
+    let (mut s, mut c) = ([0.0; W], [0.0; W]);
+    if rare {
+        for i in 0..W {
+            (s[i], c[i]) = sin_cos(x[i]);
+        }
+        return (s, c);
+    }
+    for i in 0..W {
+        let (sin_r, cos_r) = kernels(r[i], (hi[i] - r[i]) - w[i]);
+        (s[i], c[i]) = by_quadrant(n[i] as i64, sin_r, cos_r);
+    }
+    (s, c)
+}
+
+/// n = round(x·2/π) and the first term of x − n·π/2: (n, head, rounding, head − rounding).
+#[inline(always)]
+fn first_reduction(x: f64) -> (f64, f64, f64, f64) {
+    let n = (x * INV_PIO2 + TO_INT) - TO_INT;
+    let hi = x - n * PIO2_1;
+    let w = n * PIO2_1T;
+    (n, hi, w, hi - w)
+}
+
+/// fdlibm's __kernel_sin(r, tail) and __kernel_cos(r, tail), |r| ≤ π/4.
+#[inline(always)]
+fn kernels(r: f64, tail: f64) -> (f64, f64) {
     let z = r * r;
     let w = z * z;
     let v = z * r;
@@ -83,9 +120,15 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     let half_z = 0.5 * z;
     let head = 1.0 - half_z;
     let cos_r = head + (((1.0 - head) - half_z) + (z * pc - r * tail));
+    (sin_r, cos_r)
+}
 
-    // The quadrant as bit masks, not branches: a joint hanging near −π/2 sits on a quadrant
-    // boundary, where branches on n mispredict; swapping and negating by masks gives the same bits.
+/// (sin x, cos x) from those of r, x = n·π/2 + r. The quadrant as bit masks, not branches: a
+/// joint hanging near −π/2 sits on a quadrant boundary, where branches on n mispredicted
+/// (docs/performance.md); swapping and negating by masks gives the same bits.
+#[inline(always)]
+fn by_quadrant(quadrant: i64, sin_r: f64, cos_r: f64) -> (f64, f64) {
+    const SIGN: u64 = 1 << 63;
     let odd = 0u64.wrapping_sub((quadrant & 1) as u64);
     let flip = ((quadrant & 2) as u64) << 62;
     let (sin_bits, cos_bits) = (sin_r.to_bits(), cos_r.to_bits());
@@ -93,8 +136,6 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     let c = ((sin_bits ^ SIGN) & odd) | (cos_bits & !odd);
     (f64::from_bits(s ^ flip), f64::from_bits(c ^ flip))
 }
-
-const SIGN: u64 = 1 << 63;
 
 #[cfg(test)]
 mod tests {
@@ -138,6 +179,26 @@ mod tests {
         assert!(worst_over(near) <= 1.0);
         let far = (0..20_000).map(|i| 1.0e5 + i as f64 * 7.77);
         assert!(worst_over(far) <= 1.0);
+    }
+
+    #[test]
+    fn lanes_give_each_lane_the_scalar_bits() {
+        use super::sin_cos_lanes;
+        let same = |x: [f64; 4]| {
+            let (s, c) = sin_cos_lanes(x);
+            (0..4).all(|i| {
+                let (si, ci) = sin_cos(x[i]);
+                s[i].to_bits() == si.to_bits() && c[i].to_bits() == ci.to_bits()
+            })
+        };
+        for i in -200_000..200_000 {
+            let x = i as f64 * 1.3e-4;
+            assert!(same([x, -x, x + 0.5, x * 7.0]), "x = {x}");
+        }
+        // A lane next to a multiple of π/2, out of range or NaN sends every lane the slow way.
+        let b = 3.0 * std::f64::consts::FRAC_PI_2;
+        assert!(same([b, 0.3, -1.2, 2.0]));
+        assert!(same([f64::from_bits(b.to_bits() + 1), 0.3, 1e12, f64::NAN]));
     }
 
     #[test]

@@ -1,0 +1,438 @@
+//! Issue 14's "SIMD across tools" direction, measured: several tools' DP5 episodes advanced in
+//! f64 lanes, each lane with its own step size, a finished lane refilled with the next tool.
+//!
+//! The same lane code runs at width 1 (the scalar baseline), 4 and 8, compiled for baseline
+//! x86-64 (SSE2) and, through `#[target_feature(enable = "avx2")]`, for AVX2. Every lane does
+//! exactly the scalar arithmetic, so the results are checked bit for bit against width 1, and
+//! width 1's right-hand side against the library's `ClosedLoopN::rhs`.
+//!
+//! The integrator is DP5 with ode45's error norm and a standard step controller, from t = 0 to
+//! 5 s with no dense output: the accuracy-limited and stability-limited work of an episode, which
+//! is what lanes would change. Run: `cargo run --release --example lanes [-- --tools N --task T]`.
+//! Measurements and conclusions: docs/performance.md, "Population throughput".
+
+use std::ops::{Add, Div, Mul, Neg, Sub};
+use std::time::Instant;
+
+use nalgebra::SVector;
+use toolconf::generated::arm2::DynamicsCoefficients;
+use toolconf::model::{Arm2, Arm2Tool, ClosedLoopN, TaskN};
+use toolconf::select::draw_tools;
+use toolconf::{Task, TaskKind};
+
+#[derive(Clone, Copy, Debug)]
+struct L<const W: usize>([f64; W]);
+
+macro_rules! lane_op {
+    ($tr:ident, $f:ident, $op:tt) => {
+        impl<const W: usize> $tr for L<W> {
+            type Output = Self;
+            #[inline(always)]
+            fn $f(self, o: Self) -> Self {
+                let mut r = self.0;
+                for i in 0..W {
+                    r[i] = self.0[i] $op o.0[i];
+                }
+                L(r)
+            }
+        }
+        impl<const W: usize> $tr<f64> for L<W> {
+            type Output = Self;
+            #[inline(always)]
+            fn $f(self, o: f64) -> Self {
+                let mut r = self.0;
+                for i in 0..W {
+                    r[i] = self.0[i] $op o;
+                }
+                L(r)
+            }
+        }
+    };
+}
+lane_op!(Add, add, +);
+lane_op!(Sub, sub, -);
+lane_op!(Mul, mul, *);
+lane_op!(Div, div, /);
+
+impl<const W: usize> Neg for L<W> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        L(self.0.map(|x| -x))
+    }
+}
+
+impl<const W: usize> L<W> {
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        L([x; W])
+    }
+    #[inline(always)]
+    fn map(self, f: impl Fn(f64) -> f64) -> Self {
+        L(self.0.map(f))
+    }
+    #[inline(always)]
+    fn select(mask: [bool; W], a: Self, b: Self) -> Self {
+        let mut r = b.0;
+        for i in 0..W {
+            if mask[i] {
+                r[i] = a.0[i];
+            }
+        }
+        L(r)
+    }
+}
+
+#[inline(always)]
+fn sin_cos<const W: usize>(x: L<W>) -> (L<W>, L<W>) {
+    let (s, c) = toolconf::trig::sin_cos_lanes(x.0);
+    (L(s), L(c))
+}
+
+/// One lane per tool: the plant's coefficients and the controller's gains γK_θ, γK_θ̇, γK_θ̈, γP^U
+/// (row-major 2 × 2) and goals.
+#[derive(Clone, Copy)]
+struct Loop<const W: usize> {
+    k: [L<W>; 8],
+    gains: [[L<W>; 4]; 4],
+    goals: [[L<W>; 2]; 3],
+}
+
+type Z<const W: usize> = [L<W>; 6];
+
+#[inline(always)]
+fn rhs<const W: usize>(p: &Loop<W>, z: &Z<W>) -> Z<W> {
+    let [th1, th2, th1d, th2d, u1, u2] = *z;
+    let [k0, k1, k2, k3, k4, k5, k6, k7] = p.k;
+    let (s1, c1) = sin_cos(th1);
+    let (s2, c2) = sin_cos(th2);
+    let trig0 = -c1 * s2 + c2 * s1;
+    let trig1 = c1 * c2 + s1 * s2;
+    let (t1, t2) = (u1 + 0.0, u2 + 0.0);
+    let a1 = c1 * k2 + c2 * k5 * trig1 + k0 * t1 - k0 * t2
+        + k1 * t2 * trig1
+        + k3 * (th1d * th1d) * trig0
+        + k4 * (th2d * th2d) * trig0;
+    let a2 = c2 * k7 + k6 * t2;
+    let e = [
+        [th1 - p.goals[0][0], th2 - p.goals[0][1]],
+        [th1d - p.goals[1][0], th2d - p.goals[1][1]],
+        [a1 - p.goals[2][0], a2 - p.goals[2][1]],
+        [u1, u2],
+    ];
+    let mv = |m: &[L<W>; 4], v: &[L<W>; 2]| [m[0] * v[0] + m[1] * v[1], m[2] * v[0] + m[3] * v[1]];
+    let [g0, g1, g2, g3] = [
+        mv(&p.gains[0], &e[0]),
+        mv(&p.gains[1], &e[1]),
+        mv(&p.gains[2], &e[2]),
+        mv(&p.gains[3], &e[3]),
+    ];
+    let du = |i: usize| -(((g0[i] + g1[i]) + g2[i]) + g3[i]);
+    [th1d, th2d, a1, a2, du(0), du(1)]
+}
+
+const A: [[f64; 5]; 5] = [
+    [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0],
+    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0],
+    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0],
+    [
+        19372.0 / 6561.0,
+        -25360.0 / 2187.0,
+        64448.0 / 6561.0,
+        -212.0 / 729.0,
+        0.0,
+    ],
+    [
+        9017.0 / 3168.0,
+        -355.0 / 33.0,
+        46732.0 / 5247.0,
+        49.0 / 176.0,
+        -5103.0 / 18656.0,
+    ],
+];
+const B: [f64; 6] = [
+    35.0 / 384.0,
+    0.0,
+    500.0 / 1113.0,
+    125.0 / 192.0,
+    -2187.0 / 6784.0,
+    11.0 / 84.0,
+];
+const E: [f64; 7] = [
+    71.0 / 57600.0,
+    0.0,
+    -71.0 / 16695.0,
+    71.0 / 1920.0,
+    -17253.0 / 339200.0,
+    22.0 / 525.0,
+    -1.0 / 40.0,
+];
+
+#[inline(always)]
+fn combine<const W: usize>(y: &Z<W>, k: &[Z<W>], a: &[f64], h: L<W>) -> Z<W> {
+    let mut out = *y;
+    for c in 0..6 {
+        let mut s = k[0][c] * a[0];
+        for j in 1..k.len() {
+            if a[j] != 0.0 {
+                s = s + k[j][c] * a[j];
+            }
+        }
+        out[c] = y[c] + s * h;
+    }
+    out
+}
+
+const RTOL: f64 = 1e-3;
+const ATOL: f64 = 1e-6;
+const T_END: f64 = 5.0;
+const H_MAX: f64 = 0.5;
+
+/// Per-lane episode bookkeeping.
+struct Lanes<const W: usize> {
+    p: Loop<W>,
+    y: Z<W>,
+    k1: Z<W>,
+    t: L<W>,
+    h: L<W>,
+    tool: [usize; W],
+    rhs: [usize; W],
+}
+
+fn load<const W: usize>(lanes: &mut Lanes<W>, lane: usize, src: &Loop<1>, tool: usize, z0: &Z<1>) {
+    for i in 0..8 {
+        lanes.p.k[i].0[lane] = src.k[i].0[0];
+    }
+    for a in 0..4 {
+        for b in 0..4 {
+            lanes.p.gains[a][b].0[lane] = src.gains[a][b].0[0];
+        }
+    }
+    for a in 0..3 {
+        for b in 0..2 {
+            lanes.p.goals[a][b].0[lane] = src.goals[a][b].0[0];
+        }
+    }
+    for c in 0..6 {
+        lanes.y[c].0[lane] = z0[c].0[0];
+    }
+    lanes.t.0[lane] = 0.0;
+    lanes.h.0[lane] = 0.01;
+    lanes.tool[lane] = tool;
+    lanes.rhs[lane] = 1;
+}
+
+/// Integrates every tool's closed loop to T_END; returns (final state, RHS count) per tool.
+#[inline(always)]
+fn run_lanes<const W: usize>(loops: &[Loop<1>], z0: &Z<1>) -> Vec<([f64; 6], usize)> {
+    let mut out = vec![([0.0; 6], 0); loops.len()];
+    let zero = Loop {
+        k: [L::splat(0.0); 8],
+        gains: [[L::splat(0.0); 4]; 4],
+        goals: [[L::splat(0.0); 2]; 3],
+    };
+    let mut lanes = Lanes {
+        p: zero,
+        y: [L::splat(0.0); 6],
+        k1: [L::splat(0.0); 6],
+        t: L::splat(T_END),
+        h: L::splat(0.01),
+        tool: [usize::MAX; W],
+        rhs: [0; W],
+    };
+    let mut next = 0;
+    let mut active = [false; W];
+    for lane in 0..W.min(loops.len()) {
+        load(&mut lanes, lane, &loops[next], next, z0);
+        active[lane] = true;
+        next += 1;
+    }
+    lanes.k1 = rhs(&lanes.p, &lanes.y);
+    let threshold = ATOL / RTOL;
+    while active.iter().any(|&a| a) {
+        let t_new = L(std::array::from_fn(|i| {
+            (lanes.t.0[i] + lanes.h.0[i]).min(T_END)
+        }));
+        let h = t_new - lanes.t;
+        let y = lanes.y;
+        let k1 = lanes.k1;
+        let k2 = rhs(&lanes.p, &combine(&y, &[k1], &A[0][..1], h));
+        let k3 = rhs(&lanes.p, &combine(&y, &[k1, k2], &A[1][..2], h));
+        let k4 = rhs(&lanes.p, &combine(&y, &[k1, k2, k3], &A[2][..3], h));
+        let k5 = rhs(&lanes.p, &combine(&y, &[k1, k2, k3, k4], &A[3][..4], h));
+        let k6 = rhs(&lanes.p, &combine(&y, &[k1, k2, k3, k4, k5], &A[4], h));
+        let y_new = combine(&y, &[k1, k2, k3, k4, k5, k6], &B, h);
+        let k7 = rhs(&lanes.p, &y_new);
+        let ks = [k1, k2, k3, k4, k5, k6, k7];
+        let mut err = L::<W>::splat(0.0);
+        for c in 0..6 {
+            let mut ek = ks[0][c] * E[0];
+            for j in 2..7 {
+                ek = ek + ks[j][c] * E[j];
+            }
+            let scale = L(std::array::from_fn(|i| {
+                y[c].0[i].abs().max(y_new[c].0[i].abs()).max(threshold)
+            }));
+            let r = (ek * h / scale).map(f64::abs);
+            err = L(std::array::from_fn(|i| err.0[i].max(r.0[i])));
+        }
+        let mut accept = [false; W];
+        let mut fac = [0.0; W];
+        for i in 0..W {
+            let e = err.0[i] / RTOL;
+            accept[i] = active[i] && e <= 1.0;
+            let f = 0.9 * e.powf(-0.2);
+            fac[i] = if f >= 0.2 { f.min(5.0) } else { 0.2 };
+            lanes.rhs[i] += 6;
+        }
+        for c in 0..6 {
+            lanes.y[c] = L::select(accept, y_new[c], y[c]);
+            lanes.k1[c] = L::select(accept, k7[c], k1[c]);
+        }
+        lanes.t = L::select(accept, t_new, lanes.t);
+        lanes.h = L(std::array::from_fn(|i| (h.0[i] * fac[i]).min(H_MAX)));
+        let mut refilled = false;
+        for lane in 0..W {
+            if active[lane] && lanes.t.0[lane] >= T_END {
+                out[lanes.tool[lane]] =
+                    (std::array::from_fn(|c| lanes.y[c].0[lane]), lanes.rhs[lane]);
+                if next < loops.len() {
+                    load(&mut lanes, lane, &loops[next], next, z0);
+                    next += 1;
+                    refilled = true;
+                } else {
+                    active[lane] = false;
+                    lanes.t.0[lane] = T_END;
+                    lanes.h.0[lane] = 0.01;
+                }
+            }
+        }
+        if refilled {
+            // A refilled lane needs its own k1; the others keep theirs (FSAL), bit for bit.
+            let fresh = rhs(&lanes.p, &lanes.y);
+            for lane in 0..W {
+                if lanes.t.0[lane] == 0.0 && active[lane] {
+                    for c in 0..6 {
+                        lanes.k1[c].0[lane] = fresh[c].0[lane];
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+#[target_feature(enable = "avx2")]
+fn run_lanes_avx2<const W: usize>(loops: &[Loop<1>], z0: &Z<1>) -> Vec<([f64; 6], usize)> {
+    run_lanes::<W>(loops, z0)
+}
+
+fn lane_loop(arm: &toolconf::Arm, task: &TaskN<2>) -> (Loop<1>, ClosedLoopN<Arm2, 2, 4, 4, 6>) {
+    let tool = Arm2Tool::from(arm);
+    let cl = ClosedLoopN::<Arm2, 2, 4, 4, 6>::new(&tool, task, 1.0, 0.0).expect("closed loop");
+    let coeff = DynamicsCoefficients::new(&tool.params());
+    let gains = cl.controller.scaled_gains();
+    let m = |g: &nalgebra::Matrix2<f64>| {
+        [
+            L([g[(0, 0)]]),
+            L([g[(0, 1)]]),
+            L([g[(1, 0)]]),
+            L([g[(1, 1)]]),
+        ]
+    };
+    let t = &cl.controller.task;
+    let v = |g: &SVector<f64, 2>| [L([g[0]]), L([g[1]])];
+    let p = Loop {
+        k: coeff.k.map(|k| L([k])),
+        gains: [m(&gains[0]), m(&gains[1]), m(&gains[2]), m(&gains[3])],
+        goals: [
+            v(&t.goal_theta),
+            v(&t.goal_theta_dot),
+            v(&t.goal_theta_ddot),
+        ],
+    };
+    (p, cl)
+}
+
+fn main() {
+    let mut tools_n = 2000;
+    let mut kinds: Vec<TaskKind> = vec!["position".parse().unwrap(), "velocity".parse().unwrap()];
+    let mut rounds = 5;
+    let mut it = std::env::args().skip(1);
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--tools" => tools_n = it.next().unwrap().parse().unwrap(),
+            "--task" => kinds = vec![it.next().unwrap().parse().unwrap()],
+            "--rounds" => rounds = it.next().unwrap().parse().unwrap(),
+            other => panic!("unknown argument {other}"),
+        }
+    }
+    let arms = draw_tools(tools_n, 1);
+    println!(
+        "{tools_n} tools (draw_tools({tools_n}, 1)), one thread, best of {rounds} rounds; avx2 detected: {}",
+        is_x86_feature_detected!("avx2")
+    );
+    println!("| task | lanes | build | µs per tool | × width 1 | mean RHS | bits = width 1 |");
+    println!("|---|---:|---|---:|---:|---:|---|");
+    for kind in kinds {
+        let task = TaskN::<2>::from(&Task::paper(kind));
+        let pairs: Vec<_> = arms.iter().map(|a| lane_loop(a, &task)).collect();
+        let loops: Vec<Loop<1>> = pairs.iter().map(|p| p.0).collect();
+        let x0 = toolconf::Arm::equilibrium_state();
+        let z0: Z<1> = [x0[0], x0[1], x0[2], x0[3], 0.1, 0.1].map(|v| L([v]));
+        // The width-1 right-hand side is the library's, bit for bit.
+        for (p, cl) in pairs.iter().take(50) {
+            let z = SVector::<f64, 6>::from_column_slice(&[-1.3, -1.9, 0.4, -0.7, 0.3, -0.2]);
+            let ours = rhs(p, &std::array::from_fn(|c| L([z[c]])));
+            let lib = cl.rhs(&z);
+            for c in 0..6 {
+                assert_eq!(
+                    ours[c].0[0].to_bits(),
+                    lib[c].to_bits(),
+                    "rhs component {c}"
+                );
+            }
+        }
+        let time = |f: &dyn Fn() -> Vec<([f64; 6], usize)>| {
+            let mut best = f64::INFINITY;
+            let mut out = Vec::new();
+            for _ in 0..rounds {
+                let s = Instant::now();
+                out = std::hint::black_box(f());
+                best = best.min(s.elapsed().as_secs_f64());
+            }
+            (best * 1e6 / loops.len() as f64, out)
+        };
+        let (t1, base) = time(&|| run_lanes::<1>(&loops, &z0));
+        let mean_rhs = base.iter().map(|r| r.1).sum::<usize>() as f64 / base.len() as f64;
+        let same = |o: &Vec<([f64; 6], usize)>| {
+            o.iter().zip(&base).all(|(a, b)| {
+                a.1 == b.1
+                    && a.0
+                        .iter()
+                        .zip(&b.0)
+                        .all(|(x, y)| x.to_bits() == y.to_bits())
+            })
+        };
+        let row = |w: usize, build: &str, t: f64, o: &Vec<([f64; 6], usize)>| {
+            println!(
+                "| {kind} | {w} | {build} | {t:.1} | {:.2} | {mean_rhs:.0} | {} |",
+                t / t1,
+                same(o)
+            );
+        };
+        row(1, "baseline", t1, &base);
+        let (t, o) = time(&|| run_lanes::<2>(&loops, &z0));
+        row(2, "baseline", t, &o);
+        let (t, o) = time(&|| run_lanes::<4>(&loops, &z0));
+        row(4, "baseline", t, &o);
+        if is_x86_feature_detected!("avx2") {
+            let (t, o) = time(&|| unsafe { run_lanes_avx2::<1>(&loops, &z0) });
+            row(1, "avx2", t, &o);
+            let (t, o) = time(&|| unsafe { run_lanes_avx2::<4>(&loops, &z0) });
+            row(4, "avx2", t, &o);
+            let (t, o) = time(&|| unsafe { run_lanes_avx2::<8>(&loops, &z0) });
+            row(8, "avx2", t, &o);
+        }
+    }
+}
