@@ -11,6 +11,8 @@
 //! is what lanes would change. Run: `cargo run --release --example lanes [-- --tools N --task T]`.
 //! Measurements and conclusions: docs/performance.md, "Population throughput".
 
+#![allow(clippy::needless_range_loop)] // lane code indexes its lanes by design
+
 use std::ops::{Add, Div, Mul, Neg, Sub};
 use std::time::Instant;
 

@@ -393,7 +393,7 @@ impl Runs {
             )
             .dashed(),
         );
-        Ok(plot::save(
+        plot::save(
             &ctx.path(SVG),
             &[Panel::Xy(XyPanel {
                 title: format!(
@@ -408,7 +408,7 @@ impl Runs {
                 headroom: 0.0,
             })],
             (860, 480),
-        )?)
+        )
     }
 
     /// Whether the high-confidence tool settles first (`None` if either run failed).

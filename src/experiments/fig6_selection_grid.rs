@@ -219,7 +219,7 @@ fn grid_figure(
         })
         .collect();
     let (f, j) = (&rules[0], &rules[1]);
-    Ok(plot::save(
+    plot::save(
         &ctx.path(SVG),
         &[Panel::Grid(GridPanel {
             title: format!(
@@ -240,7 +240,7 @@ fn grid_figure(
             ],
         })],
         (1000, 380),
-    )?)
+    )
 }
 
 /// For every pair of rules, in how many trials they chose differently (table rows), and that

@@ -396,7 +396,7 @@ impl ChosenValues {
                 })
             })
             .collect();
-        Ok(plot::save(&ctx.path(SVG), &panels, (440, 440))?)
+        plot::save(&ctx.path(SVG), &panels, (440, 440))
     }
 }
 
