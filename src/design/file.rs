@@ -44,7 +44,7 @@ impl DesignObjective {
     }
 }
 
-/// Search settings ([search] table).
+/// Search settings (`[search]` table).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SearchSettings {
     pub seed: u64,

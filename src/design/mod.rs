@@ -1,5 +1,5 @@
 //! Tool design by control confidence (`toolconf design`): which tool to build for a task, under
-//! bounds, linear constraints and fixed parameters from a design file ([`file`]).
+//! bounds, linear constraints and fixed parameters from a design file ([`mod@file`]).
 //!
 //! Flow: the design file → the feasible polytope over the free parameters ([`polytope`]) → a
 //! multi-start SQP on ln|Π^U| with the derived gradient ∂ln|Π^U|/∂p = tr((Π^U)⁻¹ ∂Π^U/∂p)

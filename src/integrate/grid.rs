@@ -6,7 +6,7 @@ use super::{IntegrationError, Options};
 /// last is exactly `tf`, e.g. `(0, 5, 0.05)` gives 101 points. When `dt` does not divide
 /// `tf − t0`, the last interval is shorter than `dt`.
 ///
-/// Returns an empty grid (which [`solve_grid`] rejects) unless all inputs are finite, `dt > 0`
+/// Returns an empty grid (which [`super::solve_grid`] rejects) unless all inputs are finite, `dt > 0`
 /// and `tf > t0`.
 pub fn uniform_grid(t0: f64, tf: f64, dt: f64) -> Vec<f64> {
     if !(t0.is_finite() && tf.is_finite() && dt.is_finite() && dt > 0.0 && tf > t0) {

@@ -142,7 +142,7 @@ impl<const N: usize> ActiveInferenceN<N> {
     }
 
     /// The task's own weighted error at one instant, the summand of the paper's task error:
-    /// (e − e^g)ᵀP(e − e^g) on the task's error term e ([`TaskKind::error_term`]): θ in task 1,
+    /// (e − e^g)ᵀP(e − e^g) on the task's error term e ([`crate::TaskKind::error_term`]): θ in task 1,
     /// θ̇ in task 2, θ̈ in task 3.
     #[inline]
     pub fn task_error(
@@ -278,7 +278,7 @@ where
     }
 }
 
-/// Options of one episode for N joints. The 2-link [`EpisodeOptions`] is these plus the plant
+/// Options of one episode for N joints. The 2-link [`crate::closed_loop::EpisodeOptions`] is these plus the plant
 /// choice, which here is a type parameter of [`simulate_on`]/[`episode_on`] instead.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EpisodeOptionsN<const N: usize, const NX: usize> {
@@ -295,7 +295,7 @@ pub struct EpisodeOptionsN<const N: usize, const NX: usize> {
     pub joint_perturbation: SVector<f64, N>,
     pub learning_rate: f64,
     /// Integrator options; [`Method::Auto`] runs DP5 on tasks 1–2 and the DP5-to-Rodas5P
-    /// switch on task 3, any task whose error term is θ̈ (why: [`EpisodeOptions::integrator`]).
+    /// switch on task 3, any task whose error term is θ̈ (why: [`crate::closed_loop::EpisodeOptions::integrator`]).
     pub integrator: IntegratorOptions,
     /// Keep the trajectory on the output grid ([`episode_on`]; [`simulate_on`] never keeps it).
     pub record_trajectory: bool,
@@ -304,7 +304,7 @@ pub struct EpisodeOptionsN<const N: usize, const NX: usize> {
 impl<const N: usize, const NX: usize> EpisodeOptionsN<N, NX> {
     /// The paper's options ("Implementation details") for model `M`: t_end = 5 s, dt = 0.05 s,
     /// X0 = M's equilibrium, U0 = 0.1 on every joint, ΔT = 0, γ = 1, MATLAB ode45's tolerances.
-    /// [`EpisodeOptions::default`] is this for the 2-link arm.
+    /// [`crate::closed_loop::EpisodeOptions::default`] is this for the 2-link arm.
     pub fn paper<M, const NP: usize, const NZ: usize>() -> Self
     where
         M: ArmModel<N, NX, NP, NZ>,

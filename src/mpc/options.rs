@@ -112,7 +112,7 @@ pub enum MpcError {
     #[error("MPC setup failed: {reason}")]
     Setup { reason: String },
     /// The solver did not return a solution at the `step`-th call (0-based) of
-    /// [`MpcN::control`].
+    /// [`super::MpcN::control`].
     #[error("MPC solve failed at control step {step}: {status}")]
     Solve { status: String, step: usize },
 }

@@ -171,7 +171,7 @@ where
 
 /// Evaluates every tool on its own model's paper-style `kind` task, in parallel; the result
 /// order is the tools' order. `common` gives the horizon, grid, perturbation, learning rate and
-/// integrator ([`options_for`]); `common.plant == Plant::Exact` simulates the
+/// integrator (`options_for`); `common.plant == Plant::Exact` simulates the
 /// arm2 tools on the exact 2-link dynamics (as `--plant exact` does for 2-link selection), other
 /// models always on their own dynamics.
 pub fn evaluate_mixed(

@@ -1,0 +1,221 @@
+//! [`ArmModel`]: what the runtime needs of a generated model, and one marker type implementing it
+//! per model in the generated registry.
+
+use std::fmt::Debug;
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::generated;
+use crate::generated::TaskKind;
+
+use super::{SensitivitiesN, TaskN, ToolN};
+
+/// The equations and closed forms of one generated model, with N joints, state dimension NX,
+/// NP tool parameters and closed-loop dimension NZ = NX + N.
+pub trait ArmModel<const N: usize, const NX: usize, const NP: usize, const NZ: usize>:
+    Copy + Debug + Default + Send + Sync + 'static
+{
+    /// The model's name (`generated::<name>`).
+    const NAME: &'static str;
+    /// The tool parameters in the order every function takes them.
+    const PARAMETER_NAMES: [&'static str; NP];
+    /// The equilibrium state X^e the model is linearised at.
+    const EQUILIBRIUM_STATE: [f64; NX];
+
+    /// The parameter-only factors of [`ArmModel::dynamics`], computed once per tool.
+    type DynamicsCoefficients: Copy + Debug + Send + Sync;
+    /// The parameter-only factors of [`ArmModel::dynamics_jacobian`], computed once per tool.
+    type JacobianCoefficients: Copy + Debug + Send + Sync;
+
+    fn dynamics_coefficients(p: &SVector<f64, NP>) -> Self::DynamicsCoefficients;
+    fn jacobian_coefficients(p: &SVector<f64, NP>) -> Self::JacobianCoefficients;
+    /// Ẋ = f(X, U; p) with the tool's coefficients: what an integrator calls ~10³ times per episode.
+    fn dynamics_with(
+        x: &SVector<f64, NX>,
+        u: &SVector<f64, N>,
+        k: &Self::DynamicsCoefficients,
+    ) -> SVector<f64, NX>;
+    /// (∂f/∂X, ∂f/∂U) with the tool's coefficients.
+    fn dynamics_jacobian_with(
+        x: &SVector<f64, NX>,
+        u: &SVector<f64, N>,
+        k: &Self::JacobianCoefficients,
+    ) -> (SMatrix<f64, NX, NX>, SMatrix<f64, NX, N>);
+    /// Ẋ = f(X, U; p), for a one-off evaluation (an integrator keeps the coefficients).
+    #[inline]
+    fn dynamics(
+        x: &SVector<f64, NX>,
+        u: &SVector<f64, N>,
+        p: &SVector<f64, NP>,
+    ) -> SVector<f64, NX> {
+        Self::dynamics_with(x, u, &Self::dynamics_coefficients(p))
+    }
+    /// (∂f/∂X, ∂f/∂U) at any X, U, for a one-off evaluation.
+    #[inline]
+    fn dynamics_jacobian(
+        x: &SVector<f64, NX>,
+        u: &SVector<f64, N>,
+        p: &SVector<f64, NP>,
+    ) -> (SMatrix<f64, NX, NX>, SMatrix<f64, NX, N>) {
+        Self::dynamics_jacobian_with(x, u, &Self::jacobian_coefficients(p))
+    }
+    /// A = ∂f/∂X at the equilibrium.
+    fn state_matrix(p: &SVector<f64, NP>) -> SMatrix<f64, NX, NX>;
+    /// B = ∂f/∂U at the equilibrium.
+    fn input_matrix(p: &SVector<f64, NP>) -> SMatrix<f64, NX, N>;
+    /// The task's sensitivities ∂(task variable)/∂U.
+    fn sensitivities(kind: TaskKind, p: &SVector<f64, NP>) -> SensitivitiesN<N>;
+    /// Π^U = Σ Sᵀ P S over the task's terms + P^U, unvalidated (the generated closed form).
+    fn pi_u(task: &TaskN<N>, p: &SVector<f64, NP>) -> SMatrix<f64, N, N>;
+    /// ∂ln|Π^U|/∂p = tr((Π^U)⁻¹ ∂Π^U/∂p_i) per tool parameter (Jacobi's formula; the generated
+    /// `<task>_logdet_gradient`): what `toolconf design` climbs. Unvalidated like [`ArmModel::pi_u`].
+    fn logdet_gradient(task: &TaskN<N>, p: &SVector<f64, NP>) -> SVector<f64, NP>;
+    /// The model's paper-style task: its own goals (`derive/models/<name>.toml`) and the
+    /// paper's precisions (`derive/tasks.toml`).
+    fn paper_task(kind: TaskKind) -> TaskN<N>;
+
+    /// X^e as a vector.
+    fn equilibrium_state() -> SVector<f64, NX> {
+        SVector::from(Self::EQUILIBRIUM_STATE)
+    }
+}
+
+/// Implements [`ArmModel`] for a marker type by forwarding to `crate::generated::$module`.
+macro_rules! arm_model {
+    ($(#[$doc:meta])* $marker:ident => $module:ident) => {
+        $(#[$doc])*
+        #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
+        pub struct $marker;
+
+        impl
+            ArmModel<
+                { generated::$module::DOF },
+                { generated::$module::STATE_DIM },
+                { generated::$module::PARAMETER_COUNT },
+                { generated::$module::STATE_DIM + generated::$module::DOF },
+            > for $marker
+        {
+            const NAME: &'static str = generated::$module::NAME;
+            const PARAMETER_NAMES: [&'static str; generated::$module::PARAMETER_COUNT] =
+                generated::$module::PARAMETER_NAMES;
+            const EQUILIBRIUM_STATE: [f64; generated::$module::STATE_DIM] =
+                generated::$module::EQUILIBRIUM_STATE;
+            type DynamicsCoefficients = generated::$module::DynamicsCoefficients;
+            type JacobianCoefficients = generated::$module::DynamicsJacobianCoefficients;
+
+            #[inline]
+            fn dynamics_coefficients(
+                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
+            ) -> Self::DynamicsCoefficients {
+                generated::$module::DynamicsCoefficients::new(p)
+            }
+
+            #[inline]
+            fn jacobian_coefficients(
+                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
+            ) -> Self::JacobianCoefficients {
+                generated::$module::DynamicsJacobianCoefficients::new(p)
+            }
+
+            #[inline]
+            fn dynamics_with(
+                x: &SVector<f64, { generated::$module::STATE_DIM }>,
+                u: &SVector<f64, { generated::$module::DOF }>,
+                k: &Self::DynamicsCoefficients,
+            ) -> SVector<f64, { generated::$module::STATE_DIM }> {
+                generated::$module::dynamics_with(x, u, k)
+            }
+
+            #[inline]
+            fn dynamics_jacobian_with(
+                x: &SVector<f64, { generated::$module::STATE_DIM }>,
+                u: &SVector<f64, { generated::$module::DOF }>,
+                k: &Self::JacobianCoefficients,
+            ) -> (
+                SMatrix<f64, { generated::$module::STATE_DIM }, { generated::$module::STATE_DIM }>,
+                SMatrix<f64, { generated::$module::STATE_DIM }, { generated::$module::DOF }>,
+            ) {
+                generated::$module::dynamics_jacobian_with(x, u, k)
+            }
+
+            #[inline]
+            fn state_matrix(
+                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
+            ) -> SMatrix<f64, { generated::$module::STATE_DIM }, { generated::$module::STATE_DIM }>
+            {
+                generated::$module::state_matrix(p)
+            }
+
+            #[inline]
+            fn input_matrix(
+                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
+            ) -> SMatrix<f64, { generated::$module::STATE_DIM }, { generated::$module::DOF }> {
+                generated::$module::input_matrix(p)
+            }
+
+            #[inline]
+            fn sensitivities(
+                kind: TaskKind,
+                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
+            ) -> SensitivitiesN<{ generated::$module::DOF }> {
+                generated::$module::task_sensitivities(kind, p)
+            }
+
+            #[inline]
+            fn pi_u(
+                task: &TaskN<{ generated::$module::DOF }>,
+                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
+            ) -> SMatrix<f64, { generated::$module::DOF }, { generated::$module::DOF }> {
+                generated::$module::task_control_confidence(
+                    task.kind,
+                    p,
+                    &task.precision_theta,
+                    &task.precision_theta_dot,
+                    &task.precision_theta_ddot,
+                    &task.precision_u,
+                )
+            }
+
+            #[inline]
+            fn logdet_gradient(
+                task: &TaskN<{ generated::$module::DOF }>,
+                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
+            ) -> SVector<f64, { generated::$module::PARAMETER_COUNT }> {
+                generated::$module::task_logdet_gradient(
+                    task.kind,
+                    p,
+                    &task.precision_theta,
+                    &task.precision_theta_dot,
+                    &task.precision_theta_ddot,
+                    &task.precision_u,
+                )
+            }
+
+            fn paper_task(kind: TaskKind) -> TaskN<{ generated::$module::DOF }> {
+                TaskN::from_defaults(kind, &generated::$module::task_defaults(kind))
+            }
+        }
+    };
+}
+
+/// One marker type, its [`ArmModel`] implementation and its tool alias per generated model.
+macro_rules! arm_models {
+    ($(($marker:ident, $module:ident, $tool:ident, $name:literal, $title:literal)),* $(,)?) => {
+        $(
+            arm_model!(
+                #[doc = concat!($title, " (`generated::", $name, "`).")]
+                $marker => $module
+            );
+            #[doc = concat!("A tool of the `", $name, "` model.")]
+            pub type $tool = ToolN<
+                $marker,
+                { generated::$module::DOF },
+                { generated::$module::STATE_DIM },
+                { generated::$module::PARAMETER_COUNT },
+                { generated::$module::STATE_DIM + generated::$module::DOF },
+            >;
+        )*
+    };
+}
+
+crate::for_each_model!(arm_models);

@@ -1,0 +1,140 @@
+//! [`ToolN`]: a tool of one model, its parameters checked once.
+
+use std::fmt;
+use std::fmt::Debug;
+use std::marker::PhantomData;
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::generated;
+use crate::generated::TaskKind;
+use crate::Error;
+
+use super::ArmModel;
+
+/// The sensitivities ∂θ/∂U, ∂θ̇/∂U, ∂θ̈/∂U that a task's controller uses (eq. U_dot_deriv), `None`
+/// for a term the task does not use ([`crate::Sensitivities`] is the 2-link one). Task 1's ∂θ/∂U
+/// is [I O]A⁻¹(∂Ẋ/∂U − B) with ∂Ẋ/∂U = [I; I]; ∂θ̇/∂U is [O I]A⁻¹(∂Ẋ/∂U − B) = I in task 1 and
+/// −[I O]A⁻¹B in task 2, as the paper prints it; ∂θ̈/∂U is I in every task (zero jerk in tasks
+/// 1–2, [I O](A²∂X/∂U + AB) = I in task 3). The formulas are `derive/tasks.toml`'s.
+pub type SensitivitiesN<const N: usize> = generated::TaskSensitivities<N>;
+
+/// One tool of model `M`: its parameters, each finite and > 0.
+///
+/// The parameters are private so that every `ToolN` has passed [`ToolN::new`].
+pub struct ToolN<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> {
+    params: SVector<f64, NP>,
+    model: PhantomData<M>,
+}
+
+// Manual impls: derives would require `M: Clone` etc. through `PhantomData`'s bounds anyway, and
+// `M` is a zero-sized marker.
+impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> Clone
+    for ToolN<M, N, NX, NP, NZ>
+{
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> Copy
+    for ToolN<M, N, NX, NP, NZ>
+{
+}
+impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> PartialEq
+    for ToolN<M, N, NX, NP, NZ>
+{
+    fn eq(&self, other: &Self) -> bool {
+        self.params == other.params
+    }
+}
+
+impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> ToolN<M, N, NX, NP, NZ>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    /// Validates and builds a tool from its parameters in [`ArmModel::PARAMETER_NAMES`] order.
+    /// A non-positive, NaN or infinite value is an [`Error::InvalidParameter`] naming it.
+    pub fn new(params: [f64; NP]) -> Result<Self, Error> {
+        for (name, value) in M::PARAMETER_NAMES.into_iter().zip(params) {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(Error::InvalidParameter { name, value });
+            }
+        }
+        Ok(Self {
+            params: SVector::from(params),
+            model: PhantomData,
+        })
+    }
+
+    /// A tool from parameters a caller has already checked (finite, > 0), such as an
+    /// [`crate::Arm`]'s: no second check on the 2-link façade's hot path.
+    pub(crate) fn from_checked(params: SVector<f64, NP>) -> Self {
+        debug_assert!(params.iter().all(|v| v.is_finite() && *v > 0.0));
+        Self {
+            params,
+            model: PhantomData,
+        }
+    }
+
+    /// The parameter vector p the generated functions take.
+    pub fn params(&self) -> SVector<f64, NP> {
+        self.params
+    }
+
+    /// The model's name.
+    pub fn model_name(&self) -> &'static str {
+        M::NAME
+    }
+
+    /// (name, value) of every parameter, in order.
+    pub fn named_parameters(&self) -> [(&'static str, f64); NP] {
+        std::array::from_fn(|i| (M::PARAMETER_NAMES[i], self.params[i]))
+    }
+
+    /// Ẋ = f(X, U; p).
+    pub fn dynamics(&self, x: &SVector<f64, NX>, u: &SVector<f64, N>) -> SVector<f64, NX> {
+        M::dynamics(x, u, &self.params)
+    }
+
+    /// A at the equilibrium.
+    pub fn state_matrix(&self) -> SMatrix<f64, NX, NX> {
+        M::state_matrix(&self.params)
+    }
+
+    /// B at the equilibrium.
+    pub fn input_matrix(&self) -> SMatrix<f64, NX, N> {
+        M::input_matrix(&self.params)
+    }
+
+    /// The task's sensitivities.
+    pub fn sensitivities(&self, kind: TaskKind) -> SensitivitiesN<N> {
+        M::sensitivities(kind, &self.params)
+    }
+}
+
+impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> Debug
+    for ToolN<M, N, NX, NP, NZ>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}({self})", M::NAME)
+    }
+}
+
+/// `m1=… m2=… …`, as [`crate::Arm`] prints itself.
+impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> fmt::Display
+    for ToolN<M, N, NX, NP, NZ>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, (name, value)) in self.named_parameters().iter().enumerate() {
+            if i > 0 {
+                f.write_str(" ")?;
+            }
+            write!(f, "{name}={value}")?;
+        }
+        Ok(())
+    }
+}
