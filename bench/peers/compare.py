@@ -414,6 +414,10 @@ def population(args, model, tasks, cm, q_ddot, times, z0, arms) -> str:
     return render_population(results, args, len(arms))
 
 
+def ratio(r: float) -> str:
+    return f"{r:,.2f}" if r < 10 else f"{r:,.0f}"
+
+
 def commit() -> str:
     head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=ROOT)
     dirty = subprocess.run(["git", "diff", "--quiet"], cwd=ROOT).returncode != 0
@@ -432,8 +436,8 @@ def render_population(results: dict, args, n_tools: int) -> str:
         "of `bench/population.sh`), every episode as in the tables above (rtol 1e-3, atol 1e-6, "
         "101 output points). On a subsample (stride N > 1: tools 0, N, 2N, … of the population, "
         "the same tools for every row) the means are over the subsample. Time per tool on one "
-        f"thread: SciPy RK45 {args.repeat} run{'s' if args.repeat > 1 else ''} per tool "
-        f"({'median' if args.repeat > 1 else 'one run'}), cvodes the median of 3 runs, toolconf the median of "
+        f"thread: SciPy RK45 {f'the median of {args.repeat} runs' if args.repeat > 1 else 'one run'} per tool, "
+        f"cvodes the median of 3 runs, toolconf the median of "
         f"{args.toolconf_repeat} runs per tool (`examples/peer_timing.rs --method`) in 4 passes, "
         "two before and two after the peers, the methods in turn (median over passes). Columns: mean "
         "over tools of the per-tool time, its percentiles (the element at round((n − 1) q) of the "
@@ -471,7 +475,7 @@ def render_population(results: dict, args, n_tools: int) -> str:
                 d = [rel(r[f"{key}_error"], r["explicit_error"]) for r in rows]
                 agree = f"{statistics.median(d):.1e} / {max(d):.1e}"
             out.append(f"| {label} | {fmt_us(mean)} | {fmt_us(quantile(t, 0.5))} | {fmt_us(quantile(t, 0.9))} | "
-                       f"{fmt_us(quantile(t, 0.99))} | {fmt_us(t[-1])} | {work} | {mean / fast_mean:,.2f}× | {agree} |")
+                       f"{fmt_us(quantile(t, 0.99))} | {fmt_us(t[-1])} | {work} | {ratio(mean / fast_mean)}× | {agree} |")
         out.append("")
     out.append(POP_END)
     return "\n".join(out)
