@@ -232,6 +232,8 @@ def main() -> None:
     ap.add_argument("--tight-tools", type=int, default=10,
                     help="tools for the agreement check at rtol 1e-8, atol 1e-10 (0: skip)")
     ap.add_argument("--no-write", action="store_true", help="print only, leave docs/performance.md alone")
+    ap.add_argument("--method", default="auto",
+                    help="toolconf's integration method in the 100-tool tables (select and peer_timing)")
     ap.add_argument("--population", action="store_true",
                     help="the population table instead (defaults: --tools 2000 --seed 1)")
     ap.add_argument("--tasks", default="position,velocity,acceleration",
@@ -266,7 +268,7 @@ def main() -> None:
     rtol, atol = 1e-3, 1e-6
 
     select = ["--tools", str(args.tools), "--seed", str(args.seed), "--json"]
-    base = toolconf_json("select", "--task", "position", *select)
+    base = toolconf_json("select", "--task", "position", *select, "--method", args.method)
     arms = [t["arm"] for t in base["tools"]]
     if args.population:
         text = population(args, model, tasks, cm, q_ddot, times, z0, arms)
@@ -282,7 +284,8 @@ def main() -> None:
 
     def time_toolconf() -> None:
         passes.append(json.loads(subprocess.run(
-            [str(PEER_TIMING), "--repeat", str(args.toolconf_repeat)], input=json.dumps(base),
+            [str(PEER_TIMING), "--repeat", str(args.toolconf_repeat), "--method", args.method],
+            input=json.dumps(base),
             check=True, capture_output=True, text=True).stdout))
 
     time_toolconf()
@@ -290,7 +293,7 @@ def main() -> None:
     results = {}
     for name in ("position", "velocity", "acceleration"):
         setup = TaskSetup(model, tasks[name])
-        tc = toolconf_json("select", "--task", name, *select)
+        tc = toolconf_json("select", "--task", name, *select, "--method", args.method)
         if [t["arm"] for t in tc["tools"]] != arms:
             raise SystemExit(f"select --task {name} drew different tools")
         if any("error" in t for t in tc["tools"]):
@@ -327,7 +330,7 @@ def main() -> None:
                "--rtol", str(t_rtol), "--atol", str(t_atol)]
         for name in ("position", "velocity", "acceleration"):
             setup = TaskSetup(model, tasks[name])
-            tc = toolconf_json("select", "--task", name, *sel)
+            tc = toolconf_json("select", "--task", name, *sel, "--method", args.method)
             loop = CasadiClosedLoop(cm, setup, times, t_rtol, t_atol)
             rows = []
             for i, t in enumerate(tc["tools"]):
@@ -509,9 +512,11 @@ def render(results: dict, tight: dict, args) -> str:
         f"Command: `{cmd}` (from the repository root). Tools: `toolconf select --task position "
         f"--tools {args.tools} --seed {args.seed} --json`. Every episode: the paper's closed loop at "
         "the defaults (X0 = [-π/2 -π/2 0 0], U0 = [0.1 0.1], γ = 1, ΔT = 0), t ∈ [0, 5] with output "
-        "every 0.05 s (101 points), rtol 1e-3, atol 1e-6; toolconf with `EpisodeOptions::default()`, "
-        "i.e. its default integration method (DP5 with ode45's step control on tasks 1 and 2; see "
-        "`src/integrate` for task 3). Times are per episode on one thread: "
+        "every 0.05 s (101 points), rtol 1e-3, atol 1e-6; toolconf with "
+        + ("`EpisodeOptions::default()`, i.e. the library's default integration method, `--method auto` "
+           "(DP5 with ode45's step control on tasks 1 and 2; see `src/integrate` for task 3)"
+           if args.method == "auto" else f"`--method {args.method}`")
+        + ". Times are per episode on one thread: "
         f"toolconf the median of {args.toolconf_repeat} runs per tool (`examples/peer_timing.rs`), in "
         "4 passes spread over the run (median over passes), the "
         f"peers the median of {args.repeat} runs per tool (1 for SciPy on task 3) around the "
