@@ -6,11 +6,12 @@
 //! calling thread only. Each tool's episode is run once to warm up, then `--repeat` times; the
 //! tool's time is the median of those runs. Prints one JSON object: per task the median over
 //! tools of the per-episode time [µs], and per tool the time, right-hand-side and Jacobian
-//! evaluations and task error.
+//! evaluations and task error. `--method` picks the integration method (`explicit`, `auto`,
+//! `stiff`, `fast`; default: the library's, `EpisodeOptions::default()`), which the output names.
 //!
 //! ```sh
 //! cargo run --release --example peer_timing -- [--tasks position,velocity,acceleration]
-//!     [--repeat 21] [--limit N] < tools.json
+//!     [--repeat 21] [--limit N] [--method NAME] < tools.json
 //! ```
 //!
 //! With `--repeat 1` it is also the small driver for profiling N episodes under callgrind.
@@ -21,6 +22,7 @@ use std::time::Instant;
 
 use serde_json::{json, Value};
 use toolconf::closed_loop::{simulate, EpisodeOptions};
+use toolconf::integrate::Method;
 use toolconf::{Arm, Task, TaskKind};
 
 fn arm_from(v: &Value) -> Result<Arm, String> {
@@ -53,6 +55,7 @@ struct Args {
     tasks: Vec<TaskKind>,
     repeat: usize,
     limit: Option<usize>,
+    method: Method,
 }
 
 fn parse_args() -> Result<Args, String> {
@@ -60,6 +63,7 @@ fn parse_args() -> Result<Args, String> {
         tasks: TaskKind::ALL.to_vec(),
         repeat: 21,
         limit: None,
+        method: EpisodeOptions::default().integrator.method,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -83,6 +87,7 @@ fn parse_args() -> Result<Args, String> {
                         }
                     })?
             }
+            "--method" => args.method = value()?.parse().map_err(|e| format!("--method {e}"))?,
             "--limit" => args.limit = Some(value()?.parse().map_err(|e| format!("--limit: {e}"))?),
             _ => return Err(format!("unknown argument {flag}")),
         }
@@ -107,8 +112,10 @@ fn run() -> Result<Value, String> {
     if let Some(n) = args.limit {
         tools.truncate(n);
     }
-    let options = EpisodeOptions::default();
+    let mut options = EpisodeOptions::default();
+    options.integrator.method = args.method;
     let mut out = serde_json::Map::new();
+    out.insert("method".into(), json!(args.method.name()));
     for kind in &args.tasks {
         let task = Task::paper(*kind);
         let mut times = Vec::with_capacity(tools.len());

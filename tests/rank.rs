@@ -279,8 +279,15 @@ fn results_do_not_depend_on_the_number_of_threads() {
             (out.stdout, std::fs::read(&csv).unwrap())
         })
         .collect();
+    // Everything but the stages' wall times (`timing`), which vary from run to run.
+    let without_timing = |stdout: &[u8]| -> Value {
+        let mut v: Value = serde_json::from_slice(stdout).unwrap();
+        assert!(v.as_object_mut().unwrap().remove("timing").is_some());
+        v
+    };
     assert_eq!(
-        outputs[0].0, outputs[1].0,
+        without_timing(&outputs[0].0),
+        without_timing(&outputs[1].0),
         "JSON differs between 1 and 2 threads"
     );
     assert_eq!(
@@ -349,6 +356,65 @@ fn the_screen_keeps_the_most_confident_tools() {
             "--json",
         ]));
         assert_eq!(f(&c, "logdet"), f(top, "logdet"));
+    }
+}
+
+/// Both stages are timed: the confidence stage over every tool read, the simulation stage over
+/// the K episodes kept, in the JSON, the text and the report.
+#[test]
+fn both_stages_report_their_wall_time_and_throughput() {
+    let dir = scratch("timing");
+    let report = dir.join("report");
+    let args = [
+        "rank",
+        "--tools",
+        DRAWER,
+        "--task",
+        "position",
+        "--screen",
+        "3",
+        "--report",
+        report.to_str().unwrap(),
+    ];
+    let v = json_of(&run(&[&args[..], &["--json"]].concat(), Some("1")));
+    let (c, s) = (
+        &v["timing"]["confidence_stage"],
+        &v["timing"]["simulation_stage"],
+    );
+    assert_eq!(c["tools"], v["tools_read"]);
+    assert!(f(&v, "tools_read") > 3.0, "the screen drops tools");
+    assert_eq!(s["episodes"], 3);
+    assert_eq!(s["episodes"], v["simulated"]);
+    assert_eq!(s["threads"], 1);
+    for (stage, items, rate) in [
+        (c, "tools", "tools_per_second"),
+        (s, "episodes", "episodes_per_second"),
+    ] {
+        let (secs, n, per_s) = (f(stage, "seconds"), f(stage, items), f(stage, rate));
+        assert!(secs > 0.0 && per_s > 0.0, "{stage}");
+        assert!((per_s * secs / n - 1.0).abs() < 1e-9, "{stage}");
+    }
+    assert!((f(c, "ns_per_tool") * 1e-9 * f(c, "tools") / f(c, "seconds") - 1.0).abs() < 1e-9);
+    // On one thread the episodes' own times add up to at most the stage's wall time.
+    let episodes_s = f(s, "us_per_episode") * 1e-6 * f(s, "episodes");
+    assert!(
+        episodes_s > 0.0 && episodes_s <= f(s, "seconds") * (1.0 + 1e-9),
+        "{s}"
+    );
+    let text = toolconf(&args);
+    assert!(text.status.success());
+    let text = String::from_utf8(text.stdout).unwrap();
+    for part in [
+        "confidence stage: ",
+        " tools/s, ",
+        "simulation stage: 3 episodes in ",
+        " episodes/s, ",
+    ] {
+        assert!(text.contains(part), "text lacks {part}: {text}");
+    }
+    let md = std::fs::read_to_string(report.join("report.md")).unwrap();
+    for part in ["## Run time", "tools/s", "3 episodes", "episodes/s"] {
+        assert!(md.contains(part), "report.md lacks {part}");
     }
 }
 

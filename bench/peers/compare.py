@@ -17,6 +17,14 @@ task error are outside the timing).
 
 Writes the tables into docs/performance.md between the `peers` markers (the rest of the file is
 left alone) and prints them. Run through bench/peers/run.sh, which creates the environment.
+
+`--population` (issue 14) instead times the population that `bench/population.sh` ranks,
+`toolconf select --task position --tools 2000 --seed 1 --json` (`draw_tools(2000, 1)`), on one
+thread: per task the mean over tools and p50/p90/p99/max of the per-tool time of SciPy RK45,
+CasADi cvodes, toolconf `--method explicit` (ode45-faithful DP5) and toolconf `--method fast`
+(the command line's default), all on the same tools: every tool, or every `--stride`-th
+(`--stiff-stride` for the stiff task 3, where RK45 needs ~20 000 RHS per tool), starting with
+the first. It writes its tables between the `peers-population` markers.
 """
 
 from __future__ import annotations
@@ -48,6 +56,8 @@ TOOLCONF = ROOT / "target" / "release" / "toolconf"
 PEER_TIMING = ROOT / "target" / "release" / "examples" / "peer_timing"
 DOC = ROOT / "docs" / "performance.md"
 BEGIN, END = "<!-- peers:begin (written by bench/peers/compare.py) -->", "<!-- peers:end -->"
+POP_BEGIN = "<!-- peers-population:begin (written by bench/peers/compare.py --population) -->"
+POP_END = "<!-- peers-population:end -->"
 
 T_END, DT = 5.0, 0.05
 U0 = 0.1
@@ -94,7 +104,7 @@ class TaskSetup:
 
     def gains(self, cm: CasadiModel, p: np.ndarray) -> dict[str, np.ndarray]:
         """K = S^T P for each kinematic term (zero for terms the task does not use)."""
-        s = cm.sensitivity(self.task, p)
+        s = {term: e.to_numpy() for term, e in cm.sensitivity_exact(self.task, p).items()}
         return {term: (s[term].T @ self.precision[term] if term in s else np.zeros((self.n, self.n)))
                 for term in ("theta", "theta_dot", "theta_ddot")}
 
@@ -136,7 +146,7 @@ class CasadiClosedLoop:
         z = ca.SX.sym("z", 3 * n)
         p = ca.SX.sym("p", k + 3 * n * n)
         x, u = z[: 2 * n], z[2 * n:]
-        f = cm.dynamics(x, u, p[:k])
+        f = cm.dynamics.f(x, u, p[:k])  # the CasADi function under the 50-digit evaluator
         value = {"theta": x[:n], "theta_dot": x[n:], "theta_ddot": f[n:]}
         grad = ca.DM(setup.precision["u"]) @ u
         for i, term in enumerate(("theta", "theta_dot", "theta_ddot")):
@@ -222,7 +232,26 @@ def main() -> None:
     ap.add_argument("--tight-tools", type=int, default=10,
                     help="tools for the agreement check at rtol 1e-8, atol 1e-10 (0: skip)")
     ap.add_argument("--no-write", action="store_true", help="print only, leave docs/performance.md alone")
+    ap.add_argument("--method", default="auto",
+                    help="toolconf's integration method in the 100-tool tables (select and peer_timing)")
+    ap.add_argument("--population", action="store_true",
+                    help="the population table instead (defaults: --tools 2000 --seed 1)")
+    ap.add_argument("--tasks", default="position,velocity,acceleration",
+                    help="--population: the tasks, comma-separated")
+    ap.add_argument("--stride", type=int, default=1,
+                    help="--population: time every N-th tool (from the first) on tasks 1 and 2")
+    ap.add_argument("--stiff-stride", type=int, default=10,
+                    help="--population: time every N-th tool (from the first) on task 3")
     args = ap.parse_args()
+    if args.population:
+        if "--tools" not in sys.argv[1:]:
+            args.tools = 2000
+        if "--seed" not in sys.argv[1:]:
+            args.seed = 1
+        if "--repeat" not in sys.argv[1:]:
+            args.repeat = 1
+        if "--toolconf-repeat" not in sys.argv[1:]:
+            args.toolconf_repeat = 5
     for exe in (TOOLCONF, PEER_TIMING):
         if not exe.exists():
             raise SystemExit(f"{exe} is missing: cargo build --release --bin toolconf --example peer_timing")
@@ -239,8 +268,14 @@ def main() -> None:
     rtol, atol = 1e-3, 1e-6
 
     select = ["--tools", str(args.tools), "--seed", str(args.seed), "--json"]
-    base = toolconf_json("select", "--task", "position", *select)
+    base = toolconf_json("select", "--task", "position", *select, "--method", args.method)
     arms = [t["arm"] for t in base["tools"]]
+    if args.population:
+        text = population(args, model, tasks, cm, q_ddot, times, z0, arms)
+        print(text)
+        if not args.no_write:
+            write_block(text, POP_BEGIN, POP_END, after=END)
+        return
 
     # toolconf's episodes are short, so one timing pass is easily skewed by a burst of load from
     # elsewhere: time them in several passes spread over the run (one before and one after each
@@ -249,7 +284,8 @@ def main() -> None:
 
     def time_toolconf() -> None:
         passes.append(json.loads(subprocess.run(
-            [str(PEER_TIMING), "--repeat", str(args.toolconf_repeat)], input=json.dumps(base),
+            [str(PEER_TIMING), "--repeat", str(args.toolconf_repeat), "--method", args.method],
+            input=json.dumps(base),
             check=True, capture_output=True, text=True).stdout))
 
     time_toolconf()
@@ -257,7 +293,7 @@ def main() -> None:
     results = {}
     for name in ("position", "velocity", "acceleration"):
         setup = TaskSetup(model, tasks[name])
-        tc = toolconf_json("select", "--task", name, *select)
+        tc = toolconf_json("select", "--task", name, *select, "--method", args.method)
         if [t["arm"] for t in tc["tools"]] != arms:
             raise SystemExit(f"select --task {name} drew different tools")
         if any("error" in t for t in tc["tools"]):
@@ -294,7 +330,7 @@ def main() -> None:
                "--rtol", str(t_rtol), "--atol", str(t_atol)]
         for name in ("position", "velocity", "acceleration"):
             setup = TaskSetup(model, tasks[name])
-            tc = toolconf_json("select", "--task", name, *sel)
+            tc = toolconf_json("select", "--task", name, *sel, "--method", args.method)
             loop = CasadiClosedLoop(cm, setup, times, t_rtol, t_atol)
             rows = []
             for i, t in enumerate(tc["tools"]):
@@ -312,6 +348,140 @@ def main() -> None:
     print(text)
     if not args.no_write:
         write_doc(text)
+
+
+# --------------------------------------------------------------------------------------------
+# The population (issue 14).
+
+POP_METHODS = ("explicit", "fast")
+
+
+def load_average() -> str:
+    return " ".join(Path("/proc/loadavg").read_text().split()[:3])
+
+
+def quantile(sorted_values: list[float], q: float) -> float:
+    """examples/population.rs's: the element at round((n - 1) q)."""
+    return sorted_values[round((len(sorted_values) - 1) * q)]
+
+
+def time_toolconf_methods(name: str, sub_arms: list, repeat: int, order) -> dict:
+    """One pass of peer_timing per method (in `order`) on `sub_arms`; per method its output."""
+    out = {}
+    for method in order:
+        out[method] = json.loads(subprocess.run(
+            [str(PEER_TIMING), "--tasks", name, "--method", method, "--repeat", str(repeat)],
+            input=json.dumps(sub_arms), check=True, capture_output=True, text=True).stdout)[name]
+    return out
+
+
+def population(args, model, tasks, cm, q_ddot, times, z0, arms) -> str:
+    rtol, atol = 1e-3, 1e-6
+    results = {}
+    for name in args.tasks.split(","):
+        stride = args.stiff_stride if name == "acceleration" else args.stride
+        indices = list(range(0, len(arms), stride))
+        sub_arms = [arms[i] for i in indices]
+        setup = TaskSetup(model, tasks[name])
+        loop = CasadiClosedLoop(cm, setup, times, rtol, atol)
+        load_before = load_average()
+        # toolconf: two passes per method before the peers and two after, the methods in turn,
+        # so that drift of the shared machine hits both alike; per tool the median over passes.
+        passes = [time_toolconf_methods(name, sub_arms, args.toolconf_repeat, POP_METHODS),
+                  time_toolconf_methods(name, sub_arms, args.toolconf_repeat, POP_METHODS[::-1])]
+        rows = []
+        started = time.perf_counter()
+        for k, (i, arm) in enumerate(zip(indices, sub_arms)):
+            p = arm_params(arm)
+            gains = setup.gains(cm, np.array(p))
+            row = {"tool": i}
+            row["cvodes_s"], row["cvodes_rhs"], row["cvodes_jac"], row["cvodes_error"] = run_cvodes(
+                loop, q_ddot, setup, p, gains, z0, 3)
+            row["scipy_s"], row["scipy_rhs"], row["scipy_error"] = run_scipy(
+                q_ddot, setup, p, gains, z0, times, rtol, atol, args.repeat)
+            rows.append(row)
+            if k % 100 == 0 or k == len(sub_arms) - 1:
+                print(f"{name}: {k + 1}/{len(sub_arms)} tools, {time.perf_counter() - started:.0f} s", file=sys.stderr)
+        passes += [time_toolconf_methods(name, sub_arms, args.toolconf_repeat, POP_METHODS),
+                   time_toolconf_methods(name, sub_arms, args.toolconf_repeat, POP_METHODS[::-1])]
+        for method in POP_METHODS:
+            first = passes[0][method]["tools"]
+            for k, row in enumerate(rows):
+                row[f"{method}_s"] = statistics.median(ps[method]["tools"][k]["us"] for ps in passes) * 1e-6
+                row[f"{method}_rhs"] = first[k]["rhs_evals"]
+                row[f"{method}_jac"] = first[k]["jacobian_evals"]
+                row[f"{method}_error"] = first[k]["task_error"]
+                if any(ps[method]["tools"][k]["task_error"] != row[f"{method}_error"] for ps in passes):
+                    raise SystemExit(f"peer_timing --method {method} is not deterministic on {name} tool {row['tool']}")
+        results[name] = {"rows": rows, "stride": stride, "load": (load_before, load_average())}
+    return render_population(results, args, len(arms))
+
+
+def ratio(r: float) -> str:
+    return f"{r:,.2f}" if r < 10 else f"{r:,.0f}"
+
+
+def commit() -> str:
+    head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=ROOT)
+    dirty = subprocess.run(["git", "diff", "--quiet"], cwd=ROOT).returncode != 0
+    return head.stdout.strip() + (" (with local changes)" if dirty else "")
+
+
+def render_population(results: dict, args, n_tools: int) -> str:
+    cmd = "bench/peers/run.sh" + "".join(" " + shlex.quote(a) for a in sys.argv[1:])
+    out = [
+        POP_BEGIN,
+        "",
+        f"Measured {dt.date.today().isoformat()} on {machine()}, commit {commit()}; {versions()}.",
+        "",
+        f"Command: `{cmd}` (from the repository root). Tools: `toolconf select --task position "
+        f"--tools {n_tools} --seed {args.seed} --json` (`draw_tools({n_tools}, {args.seed})`, the population "
+        "of `bench/population.sh`), every episode as in the tables above (rtol 1e-3, atol 1e-6, "
+        "101 output points). On a subsample (stride N > 1: tools 0, N, 2N, … of the population, "
+        "the same tools for every row) the means are over the subsample. Time per tool on one "
+        f"thread: SciPy RK45 {f'the median of {args.repeat} runs' if args.repeat > 1 else 'one run'} per tool, "
+        f"cvodes the median of 3 runs, toolconf the median of "
+        f"{args.toolconf_repeat} runs per tool (`examples/peer_timing.rs --method`) in 4 passes, "
+        "two before and two after the peers, the methods in turn (median over passes). Columns: mean "
+        "over tools of the per-tool time, its percentiles (the element at round((n − 1) q) of the "
+        "sorted times, as `examples/population.rs`), mean RHS (and Jacobian) evaluations per tool "
+        "(counted as in the tables above), the mean time over toolconf `fast`'s mean on the same "
+        "tools, and the task error's relative difference from toolconf `explicit` (median / max).",
+        "",
+    ]
+    labels = (("fast", "toolconf `--method fast` (default)"),
+              ("explicit", "toolconf `--method explicit` (ode45 DP5)"),
+              ("scipy", "SciPy `solve_ivp` RK45"),
+              ("cvodes", "CasADi `cvodes` (BDF)"))
+    for index, name in ((1, "position"), (2, "velocity"), (3, "acceleration")):
+        if name not in results:
+            continue
+        rows, stride = results[name]["rows"], results[name]["stride"]
+        load_before, load_after = results[name]["load"]
+        which = (f"all {len(rows)} tools" if stride == 1
+                 else f"every {stride}th tool: {len(rows)} of {n_tools}")
+        out += [f"### Population, task {index} ({name}), {which}", "",
+                f"Load average {load_before} before this task, {load_after} after.", "",
+                "| | mean per tool | p50 | p90 | p99 | max | mean RHS | mean / toolconf fast | "
+                "task-error rel. difference from toolconf explicit (median / max) |",
+                "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+        fast_mean = statistics.fmean(r["fast_s"] for r in rows)
+        for key, label in labels:
+            t = sorted(r[f"{key}_s"] for r in rows)
+            mean = statistics.fmean(t)
+            rhs = statistics.fmean(r[f"{key}_rhs"] for r in rows)
+            jac = statistics.fmean(r.get(f"{key}_jac", 0) for r in rows)
+            work = f"{rhs:,.0f}" + (f" + {jac:,.1f} Jac." if jac else "")
+            if key == "explicit":
+                agree = "—"
+            else:
+                d = [rel(r[f"{key}_error"], r["explicit_error"]) for r in rows]
+                agree = f"{statistics.median(d):.1e} / {max(d):.1e}"
+            out.append(f"| {label} | {fmt_us(mean)} | {fmt_us(quantile(t, 0.5))} | {fmt_us(quantile(t, 0.9))} | "
+                       f"{fmt_us(quantile(t, 0.99))} | {fmt_us(t[-1])} | {work} | {ratio(mean / fast_mean)}× | {agree} |")
+        out.append("")
+    out.append(POP_END)
+    return "\n".join(out)
 
 
 def machine() -> str:
@@ -342,9 +512,11 @@ def render(results: dict, tight: dict, args) -> str:
         f"Command: `{cmd}` (from the repository root). Tools: `toolconf select --task position "
         f"--tools {args.tools} --seed {args.seed} --json`. Every episode: the paper's closed loop at "
         "the defaults (X0 = [-π/2 -π/2 0 0], U0 = [0.1 0.1], γ = 1, ΔT = 0), t ∈ [0, 5] with output "
-        "every 0.05 s (101 points), rtol 1e-3, atol 1e-6; toolconf with `EpisodeOptions::default()`, "
-        "i.e. its default integration method (DP5 with ode45's step control on tasks 1 and 2; see "
-        "`src/integrate` for task 3). Times are per episode on one thread: "
+        "every 0.05 s (101 points), rtol 1e-3, atol 1e-6; toolconf with "
+        + ("`EpisodeOptions::default()`, i.e. the library's default integration method, `--method auto` "
+           "(DP5 with ode45's step control on tasks 1 and 2; see `src/integrate` for task 3)"
+           if args.method == "auto" else f"`--method {args.method}`")
+        + ". Times are per episode on one thread: "
         f"toolconf the median of {args.toolconf_repeat} runs per tool (`examples/peer_timing.rs`), in "
         "4 passes spread over the run (median over passes), the "
         f"peers the median of {args.repeat} runs per tool (1 for SciPy on task 3) around the "
@@ -397,6 +569,21 @@ def render(results: dict, tight: dict, args) -> str:
         out.append("")
     out.append(END)
     return "\n".join(out)
+
+
+def write_block(text: str, begin: str, end: str, after: str) -> None:
+    """Replaces the block between `begin` and `end` in docs/performance.md, or inserts it after
+    the line holding `after` (with a blank line before it)."""
+    doc = DOC.read_text()
+    if begin in doc and end in doc:
+        head, rest = doc.split(begin, 1)
+        _, tail = rest.split(end, 1)
+        DOC.write_text(head + text + tail)
+    elif after in doc:
+        head, tail = doc.split(after, 1)
+        DOC.write_text(head + after + "\n\n" + text + tail)
+    else:
+        DOC.write_text(doc.rstrip("\n") + "\n\n" + text + "\n")
 
 
 def write_doc(text: str) -> None:

@@ -6,13 +6,17 @@
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::{json, Map, Value};
 use toolconf::experiments::csv::{Cell, CsvWriter};
 use toolconf::model::mixed::ModelKind;
 use toolconf::rank::report::{write_report, ReportInput};
-use toolconf::rank::{ranking, simulate_all, Candidate, ModelTasks, RankedTool, Screen};
+use toolconf::rank::{
+    ranking, simulate_all_timed, Candidate, ConfidenceTiming, ModelTasks, RankedTool, Screen,
+    SimulationTiming, StageTimings,
+};
 use toolconf::select::Objective;
 use toolconf::task_file::TaskSpec;
 use toolconf::tools_file::{read_tools, ToolFileError};
@@ -260,6 +264,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     spec.episode.method = Some(args.method.method.into());
     let tasks = ModelTasks::new(&spec);
     let objective = Objective::from(args.objective);
+    let started = Instant::now();
     let (screen, skipped) = screen_tools(args, &tasks)?;
     let counts = Counts {
         read: screen.read,
@@ -267,18 +272,26 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         without_confidence: screen.without_confidence,
     };
     let candidates = screen.finish();
+    let confidence = ConfidenceTiming {
+        tools: counts.read,
+        wall: started.elapsed(),
+    };
     if let Some(dir) = &args.report {
         std::fs::create_dir_all(dir).map_err(|source| CliError::Io {
             path: dir.clone(),
             source,
         })?;
     }
-    let results = simulate_streaming(args, candidates, &tasks)?;
+    let (results, simulation) = simulate_streaming(args, candidates, &tasks)?;
+    let timing = StageTimings {
+        confidence,
+        simulation,
+    };
     let order = ranking(&results, objective);
     if args.json {
-        print_json(args, &spec, objective, &counts, &results, &order);
+        print_json(args, &spec, objective, &counts, &results, &order, &timing);
     } else {
-        print_text(args, &spec, objective, &counts, &results, &order);
+        print_text(args, &spec, objective, &counts, &results, &order, &timing);
     }
     if let Some(dir) = &args.report {
         let command: Vec<String> = std::env::args().collect();
@@ -293,6 +306,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             screen: args.screen.map(|k| k as usize),
             results: &results,
             order: &order,
+            timing: Some(timing),
         };
         let files = write_report(dir, &input)?;
         if !args.json {
@@ -313,7 +327,7 @@ fn simulate_streaming(
     args: &Args,
     candidates: Vec<Candidate>,
     tasks: &ModelTasks,
-) -> Result<Vec<RankedTool>, CliError> {
+) -> Result<(Vec<RankedTool>, SimulationTiming), CliError> {
     let columns = parameter_columns(&candidates);
     let mut csv = match &args.csv {
         Some(path) => {
@@ -332,7 +346,7 @@ fn simulate_streaming(
         None => None,
     };
     let bar = progress(candidates.len());
-    let results = simulate_all(candidates, tasks, |r| {
+    let (results, timing) = simulate_all_timed(candidates, tasks, |r| {
         bar.inc(1);
         match csv.as_mut() {
             Some(w) => w.row(csv_cells(r, &columns)),
@@ -340,7 +354,46 @@ fn simulate_streaming(
         }
     })?;
     bar.finish_and_clear();
-    Ok(results)
+    Ok((results, timing))
+}
+
+/// Both stages' wall times and throughput, as JSON (they vary from run to run).
+fn timing_json(t: &StageTimings) -> Value {
+    let (c, s) = (&t.confidence, &t.simulation);
+    json!({
+        "confidence_stage": {
+            "tools": c.tools,
+            "seconds": c.wall.as_secs_f64(),
+            "tools_per_second": c.tools_per_second(),
+            "ns_per_tool": c.ns_per_tool(),
+        },
+        "simulation_stage": {
+            "episodes": s.episodes,
+            "seconds": s.wall.as_secs_f64(),
+            "threads": s.threads,
+            "episodes_per_second": s.episodes_per_second(),
+            "us_per_episode": s.us_per_episode(),
+        },
+    })
+}
+
+/// Both stages' wall times and throughput, one line each.
+fn timing_text(t: &StageTimings) -> String {
+    let (c, s) = (&t.confidence, &t.simulation);
+    format!(
+        "confidence stage: {} tools in {:.3} s ({:.0} tools/s, {:.0} ns per tool, reading the file included)\n\
+         simulation stage: {} episodes in {:.3} s on {} thread{} ({:.0} episodes/s, {:.1} µs per episode)",
+        c.tools,
+        c.wall.as_secs_f64(),
+        c.tools_per_second(),
+        c.ns_per_tool(),
+        s.episodes,
+        s.wall.as_secs_f64(),
+        s.threads,
+        if s.threads == 1 { "" } else { "s" },
+        s.episodes_per_second(),
+        s.us_per_episode()
+    )
 }
 
 fn print_json(
@@ -350,6 +403,7 @@ fn print_json(
     counts: &Counts,
     results: &[RankedTool],
     order: &[usize],
+    timing: &StageTimings,
 ) {
     let out = json!({
         "task": spec.kind,
@@ -362,6 +416,7 @@ fn print_json(
         "screen": args.screen,
         "without_confidence": counts.without_confidence,
         "simulated": results.len(),
+        "timing": timing_json(timing),
         "tools": order
             .iter()
             .enumerate()
@@ -381,6 +436,7 @@ fn print_text(
     counts: &Counts,
     results: &[RankedTool],
     order: &[usize],
+    timing: &StageTimings,
 ) {
     println!(
         "tools: {}    task: {}    ranked by: {}",
@@ -405,4 +461,5 @@ fn print_text(
         results.len()
     );
     print_table(results, order);
+    println!("{}", timing_text(timing));
 }

@@ -17,6 +17,7 @@ pub use tasks::{AnyEpisode, Bound, ModelTasks, TaskTrace, TrajectoryTable};
 
 use std::cmp::{Ordering, Reverse};
 use std::collections::BinaryHeap;
+use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
@@ -157,24 +158,122 @@ const CHUNK: usize = 64;
 pub fn simulate_all<E>(
     candidates: Vec<Candidate>,
     tasks: &ModelTasks,
-    mut done: impl FnMut(&RankedTool) -> Result<(), E>,
+    done: impl FnMut(&RankedTool) -> Result<(), E>,
 ) -> Result<Vec<RankedTool>, E> {
+    simulate_all_timed(candidates, tasks, done).map(|(results, _)| results)
+}
+
+/// [`simulate_all`], also timing the stage: its wall time and the sum of the episodes' own
+/// times (each episode timed on its thread; `done` is outside both sums' episodes but inside
+/// the wall time).
+pub fn simulate_all_timed<E>(
+    candidates: Vec<Candidate>,
+    tasks: &ModelTasks,
+    mut done: impl FnMut(&RankedTool) -> Result<(), E>,
+) -> Result<(Vec<RankedTool>, SimulationTiming), E> {
+    let start = Instant::now();
+    let mut episode_time = Duration::ZERO;
     let mut results = Vec::with_capacity(candidates.len());
     for chunk in candidates.chunks(CHUNK) {
-        let finished: Vec<RankedTool> = chunk
+        let finished: Vec<(RankedTool, Duration)> = chunk
             .par_iter()
-            .map(|c| RankedTool {
-                row: c.row.clone(),
-                logdet: c.logdet.clone(),
-                episode: tasks.simulate(&c.row.tool),
+            .map(|c| {
+                let t0 = Instant::now();
+                let episode = tasks.simulate(&c.row.tool);
+                let took = t0.elapsed();
+                let r = RankedTool {
+                    row: c.row.clone(),
+                    logdet: c.logdet.clone(),
+                    episode,
+                };
+                (r, took)
             })
             .collect();
-        for r in finished {
+        for (r, took) in finished {
+            episode_time += took;
             done(&r)?;
             results.push(r);
         }
     }
-    Ok(results)
+    let timing = SimulationTiming {
+        episodes: results.len(),
+        wall: start.elapsed(),
+        episode_time,
+        threads: rayon::current_num_threads(),
+    };
+    Ok((results, timing))
+}
+
+/// The cheap stage's time: every tool read, checked and given its ln|Π^U| (and the screen's
+/// heap), reading and parsing the tools file included.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ConfidenceTiming {
+    /// Tools read (bad rows skipped are not counted).
+    pub tools: usize,
+    pub wall: Duration,
+}
+
+impl ConfidenceTiming {
+    /// Tools per second of wall time.
+    pub fn tools_per_second(&self) -> f64 {
+        per_second(self.tools, self.wall)
+    }
+
+    /// Mean wall time per tool [ns].
+    pub fn ns_per_tool(&self) -> f64 {
+        per_item(self.wall, self.tools) * 1e9
+    }
+}
+
+/// The expensive stage's time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimulationTiming {
+    /// Episodes simulated (failed ones included).
+    pub episodes: usize,
+    /// Wall time of the stage.
+    pub wall: Duration,
+    /// The episodes' own times added up (each measured on its thread): over `episodes`, the mean
+    /// time per episode whatever the number of threads.
+    pub episode_time: Duration,
+    /// Rayon threads the stage ran on.
+    pub threads: usize,
+}
+
+impl SimulationTiming {
+    /// Episodes per second of wall time (on `threads` threads).
+    pub fn episodes_per_second(&self) -> f64 {
+        per_second(self.episodes, self.wall)
+    }
+
+    /// Mean time of one episode [µs] (its own time, not the wall time over the threads).
+    pub fn us_per_episode(&self) -> f64 {
+        per_item(self.episode_time, self.episodes) * 1e6
+    }
+}
+
+/// Both stages' times, for the output and the report. Wall times vary from run to run: they
+/// stay out of everything that is compared byte for byte.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StageTimings {
+    pub confidence: ConfidenceTiming,
+    pub simulation: SimulationTiming,
+}
+
+fn per_second(n: usize, wall: Duration) -> f64 {
+    let s = wall.as_secs_f64();
+    if s > 0.0 {
+        n as f64 / s
+    } else {
+        0.0
+    }
+}
+
+fn per_item(wall: Duration, n: usize) -> f64 {
+    if n > 0 {
+        wall.as_secs_f64() / n as f64
+    } else {
+        0.0
+    }
 }
 
 /// The value an objective minimises for a tool whose episode succeeded (∫F dt, ∫J dt, or

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{score, ModelTasks, RankedTool, TaskTrace};
+use super::{score, ModelTasks, RankedTool, StageTimings, TaskTrace};
 use crate::experiments::common::wants_log;
 use crate::experiments::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use crate::experiments::report::{to_html, to_markdown, Block};
@@ -28,6 +28,9 @@ pub struct ReportInput<'a> {
     /// Simulated tools in file order, and their order from best to worst.
     pub results: &'a [RankedTool],
     pub order: &'a [usize],
+    /// Both stages' wall times (stated under "Run time"; they vary from run to run, so the
+    /// report is not compared byte for byte).
+    pub timing: Option<StageTimings>,
 }
 
 /// How many tools the report lists, and how many of the best and worst it plots over time.
@@ -47,6 +50,7 @@ pub fn write_report(dir: &Path, input: &ReportInput) -> Result<Vec<PathBuf>, Rep
          whatever the number of threads.",
         input.command
     )));
+    doc.extend(run_time(input));
     let md = dir.join("report.md");
     let html = dir.join("report.html");
     write_atomically(&md, &to_markdown(&doc))?;
@@ -57,6 +61,44 @@ pub fn write_report(dir: &Path, input: &ReportInput) -> Result<Vec<PathBuf>, Rep
         dir.join(CONFIDENCE_SVG),
         dir.join(TRAJECTORY_SVG),
     ])
+}
+
+/// Both stages' wall time and throughput (the only part of the report that varies from run
+/// to run).
+fn run_time(input: &ReportInput) -> Vec<Block> {
+    let Some(t) = input.timing else {
+        return Vec::new();
+    };
+    let (c, s) = (&t.confidence, &t.simulation);
+    let threads = if s.threads == 1 { "" } else { "s" };
+    vec![
+        Block::Heading(2, "Run time".into()),
+        Block::table(
+            &[
+                "stage",
+                "work",
+                "wall time [s]",
+                "throughput",
+                "mean per item",
+            ],
+            vec![
+                vec![
+                    "confidence ln|Π^U| (reading the file included)".into(),
+                    format!("{} tools", c.tools),
+                    format!("{:.3}", c.wall.as_secs_f64()),
+                    format!("{:.0} tools/s", c.tools_per_second()),
+                    format!("{:.0} ns per tool", c.ns_per_tool()),
+                ],
+                vec![
+                    format!("simulation ({} thread{threads})", s.threads),
+                    format!("{} episodes", s.episodes),
+                    format!("{:.3}", s.wall.as_secs_f64()),
+                    format!("{:.0} episodes/s", s.episodes_per_second()),
+                    format!("{:.1} µs per episode", s.us_per_episode()),
+                ],
+            ],
+        ),
+    ]
 }
 
 /// The task's error term, as a symbol and an axis label.
