@@ -118,6 +118,7 @@ fn read_csv(
     }
     check_keys(header.iter().map(String::as_str))
         .map_err(|m| error("line 1 (header)".into(), m, false))?;
+    let present = present_keys(|k| header.iter().any(|h| h == k));
     let mut record = csv::StringRecord::new();
     let mut rows = 0;
     loop {
@@ -133,8 +134,8 @@ fn read_csv(
                         Some(text) => Cell::Text(text),
                     },
                 };
-                let row =
-                    build_row(rows, &cell).map_err(|m| error(format!("line {line}"), m, true));
+                let row = build_row(rows, &cell, &present)
+                    .map_err(|m| error(format!("line {line}"), m, true));
                 each(row)?;
             }
             Err(e) => {
@@ -179,6 +180,31 @@ fn known_keys() -> String {
     keys.join(", ")
 }
 
+/// Every model's parameter keys, each once, in [`ModelKind::ALL`] order.
+fn parameter_keys() -> &'static [&'static str] {
+    static KEYS: std::sync::OnceLock<Vec<&'static str>> = std::sync::OnceLock::new();
+    KEYS.get_or_init(|| {
+        let mut keys = Vec::new();
+        for m in ModelKind::ALL {
+            for &p in m.parameter_names() {
+                if !keys.contains(&p) {
+                    keys.push(p);
+                }
+            }
+        }
+        keys
+    })
+}
+
+/// The parameter keys among `has`, in [`parameter_keys`] order.
+fn present_keys(has: impl Fn(&str) -> bool) -> Vec<&'static str> {
+    parameter_keys()
+        .iter()
+        .copied()
+        .filter(|k| has(k))
+        .collect()
+}
+
 fn check_keys<'a>(keys: impl Iterator<Item = &'a str>) -> Result<(), String> {
     let mut seen = Vec::new();
     for key in keys {
@@ -195,49 +221,66 @@ fn check_keys<'a>(keys: impl Iterator<Item = &'a str>) -> Result<(), String> {
 
 /// One row's tool from its cells: the model, then each of its parameters, each a finite
 /// number > 0; a parameter of another model must be empty.
-fn build_row<'a>(row: usize, cell: &dyn Fn(&str) -> Cell<'a>) -> Result<ToolRow, String> {
+///
+/// `present`: the parameter keys the row may give at all (its file's columns, its object's
+/// keys), in [`parameter_keys`] order, so that a file of one model does not look up every other
+/// model's keys on every row.
+fn build_row<'a>(
+    row: usize,
+    cell: &dyn Fn(&str) -> Cell<'a>,
+    present: &[&'static str],
+) -> Result<ToolRow, String> {
     let name = match cell("name") {
         Cell::Absent => None,
         Cell::Text(t) => Some(t.to_string()),
         Cell::Number(x) => Some(x.to_string()),
         Cell::Other(v) => return Err(format!("name = {v} is not text")),
     };
-    let who = name
-        .as_ref()
-        .map_or(String::new(), |n| format!(" (tool '{n}')"));
+    // Built only for an error: most rows have none.
+    let who = || {
+        name.as_ref()
+            .map_or(String::new(), |n| format!(" (tool '{n}')"))
+    };
     let model = match cell("model") {
         Cell::Absent => ModelKind::Arm2,
-        Cell::Text(t) => t.parse().map_err(|e: String| format!("{e}{who}"))?,
-        Cell::Number(x) => return Err(format!("model = {x} is not a model name{who}")),
-        Cell::Other(v) => return Err(format!("model = {v} is not a model name{who}")),
+        Cell::Text(t) => t.parse().map_err(|e: String| format!("{e}{}", who()))?,
+        Cell::Number(x) => return Err(format!("model = {x} is not a model name{}", who())),
+        Cell::Other(v) => return Err(format!("model = {v} is not a model name{}", who())),
     };
     let names = model.parameter_names();
     let mut params = Vec::with_capacity(names.len());
     for &key in names {
         let value = match cell(key) {
-            Cell::Absent => return Err(format!("{key} is missing (model {model} needs it){who}")),
+            Cell::Absent => {
+                return Err(format!(
+                    "{key} is missing (model {model} needs it){}",
+                    who()
+                ))
+            }
             Cell::Number(x) => x,
             Cell::Text(t) => t
                 .parse::<f64>()
-                .map_err(|_| format!("{key} = '{t}' is not a number{who}"))?,
-            Cell::Other(v) => return Err(format!("{key} = {v} is not a number{who}")),
+                .map_err(|_| format!("{key} = '{t}' is not a number{}", who()))?,
+            Cell::Other(v) => return Err(format!("{key} = {v} is not a number{}", who())),
         };
         if !(value.is_finite() && value > 0.0) {
-            return Err(format!("{key} = {value} must be a finite number > 0{who}"));
+            return Err(format!(
+                "{key} = {value} must be a finite number > 0{}",
+                who()
+            ));
         }
         params.push(value);
     }
-    for other in ModelKind::ALL {
-        for &key in other.parameter_names() {
-            if !names.contains(&key) && !matches!(cell(key), Cell::Absent) {
-                return Err(format!(
-                    "{key} is given, but model {model} has no parameter {key} (it takes {}){who}",
-                    names.join(", ")
-                ));
-            }
+    for &key in present {
+        if !names.contains(&key) && !matches!(cell(key), Cell::Absent) {
+            return Err(format!(
+                "{key} is given, but model {model} has no parameter {key} (it takes {}){}",
+                names.join(", "),
+                who()
+            ));
         }
     }
-    let tool = AnyTool::new(model, &params).map_err(|e| format!("{e}{who}"))?;
+    let tool = AnyTool::new(model, &params).map_err(|e| format!("{e}{}", who()))?;
     Ok(ToolRow { row, name, tool })
 }
 
@@ -264,7 +307,10 @@ where
             self.rows += 1;
             let row = self.rows;
             let result = check_keys(object.keys().map(String::as_str))
-                .and_then(|()| build_row(row, &|key| json_cell(&object, key)))
+                .and_then(|()| {
+                    let present = present_keys(|k| object.contains_key(k));
+                    build_row(row, &|key| json_cell(&object, key), &present)
+                })
                 .map_err(|message| ToolFileError {
                     file: self.file.into(),
                     place: format!("tool {row}"),

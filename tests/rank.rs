@@ -670,6 +670,17 @@ fn every_bad_tools_file_is_refused_naming_file_line_and_value() {
             &["row.json", "tool 1", "m2 = 'a' is not a number"],
         ),
         (
+            "extra.json",
+            r#"[{"name": "w", "model": "arm2", "m1": 0.3, "m2": 0.4, "m3": 0.1, "l1": 0.5, "l2": 0.2}]"#,
+            &[
+                "extra.json",
+                "tool 1",
+                "m3 is given",
+                "model arm2",
+                "(tool 'w')",
+            ],
+        ),
+        (
             "key.json",
             r#"[{"m1": 0.3, "m2": 0.4, "l1": 0.5, "l2": 0.2, "colour": 1}]"#,
             &["key.json", "tool 1", "unknown column 'colour'"],
