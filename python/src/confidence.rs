@@ -77,7 +77,7 @@ where
         })
         .collect();
     let names = ["d_theta_du", "d_theta_dot_du", "d_theta_ddot_du"];
-    let mut sensitivities = vec![Vec::with_capacity(k * N * N); 3];
+    let mut sensitivities: [Vec<f64>; 3] = std::array::from_fn(|_| Vec::with_capacity(k * N * N));
     let mut out = Confidences {
         k,
         n: N,

@@ -1,16 +1,15 @@
 //! `toolconf.rank`: `toolconf rank` as a dict of columns.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use numpy::PyArray1;
 use pyo3::exceptions::PyUserWarning;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use toolconf::model::mixed::ModelKind;
-use toolconf::rank::{ranking, simulate_all, Candidate, ModelTasks, RankedTool, Screen};
+use toolconf::rank::{ranking, screen_file, simulate_all, ModelTasks, RankedTool};
 use toolconf::select::Objective;
 use toolconf::task_file::TaskSpec;
-use toolconf::tools_file::{read_tools, ToolFileError};
 
 use crate::errors::{detached, Failure};
 use crate::task::task_spec;
@@ -34,65 +33,8 @@ fn objective(name: &str) -> Result<Objective, Failure> {
     }
 }
 
-/// The cheap stage as `toolconf rank` runs it: every row read and checked, its confidence
-/// computed, the screen keeping what will be simulated.
-fn screen_tools(
-    tools: &PathBuf,
-    tasks: &ModelTasks,
-    screen: Option<usize>,
-    skip_bad_rows: bool,
-    skipped: &mut Vec<String>,
-) -> Result<Screen, Failure> {
-    let mut kept = Screen::new(screen);
-    let mut misfit: Option<Failure> = None;
-    let tools_file = tools.display().to_string();
-    let read = read_tools(tools, |row| match row {
-        Ok(row) => {
-            if let Err(e) = tasks.check(row.tool.model()) {
-                misfit = Some(Failure::Input(format!(
-                    "{e} (tool '{}' of {tools_file} is a {} tool)",
-                    row.label(),
-                    row.tool.model()
-                )));
-                return Err(ToolFileError {
-                    file: tools_file.clone(),
-                    place: String::new(),
-                    message: "stopped".into(),
-                    row_level: false,
-                });
-            }
-            let logdet = tasks.logdet(&row.tool);
-            kept.push(Candidate { row, logdet });
-            Ok(())
-        }
-        Err(bad) if skip_bad_rows && bad.row_level => {
-            skipped.push(format!("toolconf: skipping {bad}"));
-            Ok(())
-        }
-        Err(bad) => Err(bad),
-    });
-    if let Some(e) = misfit {
-        return Err(e);
-    }
-    read.map_err(Failure::input)?;
-    if kept.read == 0 {
-        return Err(Failure::Input(format!(
-            "{tools_file}: no valid tools (all {} rows were bad)",
-            skipped.len()
-        )));
-    }
-    if kept.without_confidence == kept.read {
-        return Err(Failure::Input(format!(
-            "task {}: no tool of {tools_file} has a control confidence: {}",
-            tasks.kind,
-            kept.first_confidence_error.as_deref().unwrap_or("")
-        )));
-    }
-    Ok(kept)
-}
-
 fn run(
-    tools: &PathBuf,
+    tools: &Path,
     spec: &TaskSpec,
     screen: Option<usize>,
     objective: Objective,
@@ -100,7 +42,11 @@ fn run(
 ) -> Result<Ranked, Failure> {
     let tasks = ModelTasks::new(spec);
     let mut skipped = Vec::new();
-    let kept = screen_tools(tools, &tasks, screen, skip_bad_rows, &mut skipped)?;
+    let task = tasks.kind.to_string();
+    let (kept, _) = screen_file(tools, &tasks, &task, screen, skip_bad_rows, |bad| {
+        skipped.push(format!("toolconf: skipping {bad}"))
+    })
+    .map_err(Failure::input)?;
     let results = simulate_all(kept.finish(), &tasks, |_| Ok::<(), Failure>(()))?;
     let order = ranking(&results, objective);
     Ok(Ranked {

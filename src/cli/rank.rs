@@ -14,12 +14,11 @@ use toolconf::experiments::csv::{Cell, CsvWriter};
 use toolconf::model::mixed::ModelKind;
 use toolconf::rank::report::{write_report, ReportInput};
 use toolconf::rank::{
-    ranking, simulate_all_timed, Candidate, ConfidenceTiming, ModelTasks, RankedTool, Screen,
-    SimulationTiming, StageTimings,
+    ranking, screen_file, simulate_all_timed, Candidate, ConfidenceTiming, ModelTasks, RankedTool,
+    Screen, ScreenError, SimulationTiming, StageTimings,
 };
 use toolconf::select::Objective;
 use toolconf::task_file::TaskSpec;
-use toolconf::tools_file::{read_tools, ToolFileError};
 use toolconf::TaskKind;
 
 use super::output::{add_outcome, CliError};
@@ -86,57 +85,22 @@ pub(crate) fn task_spec(task: &str) -> Result<TaskSpec, CliError> {
     Ok(TaskSpec::from_file(Path::new(task))?)
 }
 
-/// The cheap stage: every row read, checked and given its confidence; the screen keeps what
-/// will be simulated. Returns the screen and the number of rows skipped.
+/// The cheap stage ([`screen_file`]), skipped rows reported on stderr. Returns the screen and
+/// the number of rows skipped.
 fn screen_tools(args: &Args, tasks: &ModelTasks) -> Result<(Screen, usize), CliError> {
-    let mut screen = Screen::new(args.screen.map(|k| k as usize));
-    let mut skipped = 0;
-    let mut misfit: Option<CliError> = None;
-    let tools_file = args.tools.display().to_string();
-    let read = read_tools(&args.tools, |row| match row {
-        Ok(row) => {
-            if let Err(e) = tasks.check(row.tool.model()) {
-                misfit = Some(CliError::Usage(format!(
-                    "{e} (tool '{}' of {tools_file} is a {} tool)",
-                    row.label(),
-                    row.tool.model()
-                )));
-                return Err(ToolFileError {
-                    file: tools_file.clone(),
-                    place: String::new(),
-                    message: "stopped".into(),
-                    row_level: false,
-                });
-            }
-            let logdet = tasks.logdet(&row.tool);
-            screen.push(Candidate { row, logdet });
-            Ok(())
-        }
-        Err(bad) if args.skip_bad_rows && bad.row_level => {
-            eprintln!("toolconf: skipping {bad}");
-            skipped += 1;
-            Ok(())
-        }
-        Err(bad) => Err(bad),
-    });
-    if let Some(e) = misfit {
-        return Err(e);
-    }
-    read?;
-    if screen.read == 0 {
-        return Err(CliError::Usage(format!(
-            "{tools_file}: no valid tools (all {skipped} rows were bad)"
-        )));
-    }
-    if screen.without_confidence == screen.read {
-        // The task's precisions, not the tools, are at fault: say so before simulating.
-        return Err(CliError::Usage(format!(
-            "task {}: no tool of {tools_file} has a control confidence: {}",
-            args.task,
-            screen.first_confidence_error.as_deref().unwrap_or("")
-        )));
-    }
-    Ok((screen, skipped))
+    let limit = args.screen.map(|k| k as usize);
+    screen_file(
+        &args.tools,
+        tasks,
+        &args.task,
+        limit,
+        args.skip_bad_rows,
+        |bad| eprintln!("toolconf: skipping {bad}"),
+    )
+    .map_err(|e| match e {
+        ScreenError::File(e) => e.into(),
+        ScreenError::Input(message) => CliError::Usage(message),
+    })
 }
 
 fn progress(total: usize) -> ProgressBar {

@@ -11,12 +11,13 @@
 //! are identical whatever the number of threads.
 
 pub mod report;
+mod screen;
 mod tasks;
 
+pub use screen::{screen_file, Candidate, Screen, ScreenError};
 pub use tasks::{AnyEpisode, Bound, ModelTasks, TaskTrace, TrajectoryTable};
 
-use std::cmp::{Ordering, Reverse};
-use std::collections::BinaryHeap;
+use std::cmp::Ordering;
 use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
@@ -25,108 +26,6 @@ use crate::model::{Metrics, ModelSimulationError};
 use crate::select::Objective;
 use crate::tools_file::ToolRow;
 use crate::Error;
-/// A tool that passed the cheap stage, with its confidence.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Candidate {
-    pub row: ToolRow,
-    pub logdet: Result<f64, Error>,
-}
-
-/// A candidate in the screen's heap, ordered by confidence; on a tie the later row is less.
-struct Screened {
-    logdet: f64,
-    candidate: Candidate,
-}
-
-impl Ord for Screened {
-    fn cmp(&self, other: &Self) -> Ordering {
-        self.logdet
-            .total_cmp(&other.logdet)
-            .then(other.candidate.row.row.cmp(&self.candidate.row.row))
-    }
-}
-
-impl PartialOrd for Screened {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
-impl PartialEq for Screened {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
-}
-
-impl Eq for Screened {}
-
-/// The cheap stage over a stream of tools: keeps every tool, or only the `k` most confident
-/// (largest ln|Π^U|, the earlier row on ties) in O(k) memory.
-pub struct Screen {
-    limit: Option<usize>,
-    heap: BinaryHeap<Reverse<Screened>>,
-    all: Vec<Candidate>,
-    /// Tools seen.
-    pub read: usize,
-    /// Tools whose Π^U is not positive definite (never kept by a screen), and the first reason.
-    pub without_confidence: usize,
-    pub first_confidence_error: Option<String>,
-}
-
-impl Screen {
-    /// `limit`: keep only this many (the `--screen K`), or every tool.
-    pub fn new(limit: Option<usize>) -> Self {
-        Self {
-            limit,
-            heap: BinaryHeap::new(),
-            all: Vec::new(),
-            read: 0,
-            without_confidence: 0,
-            first_confidence_error: None,
-        }
-    }
-
-    pub fn push(&mut self, candidate: Candidate) {
-        self.read += 1;
-        if let Err(e) = &candidate.logdet {
-            self.without_confidence += 1;
-            self.first_confidence_error
-                .get_or_insert_with(|| e.to_string());
-        }
-        let Some(k) = self.limit else {
-            self.all.push(candidate);
-            return;
-        };
-        let Ok(logdet) = candidate.logdet else {
-            return;
-        };
-        let entry = Screened { logdet, candidate };
-        if self.heap.len() < k {
-            self.heap.push(Reverse(entry));
-        } else if self
-            .heap
-            .peek()
-            .is_some_and(|Reverse(worst)| entry > *worst)
-        {
-            self.heap.pop();
-            self.heap.push(Reverse(entry));
-        }
-    }
-
-    /// The kept tools in file order.
-    pub fn finish(self) -> Vec<Candidate> {
-        if self.limit.is_none() {
-            return self.all;
-        }
-        let mut kept: Vec<Candidate> = self
-            .heap
-            .into_iter()
-            .map(|Reverse(s)| s.candidate)
-            .collect();
-        kept.sort_by_key(|c| c.row.row);
-        kept
-    }
-}
 
 /// A simulated tool.
 #[derive(Debug, Clone, PartialEq)]
@@ -358,29 +257,5 @@ mod tests {
         assert_eq!(rows(Objective::CostJ), [3, 5, 2, 1, 4]);
         // Confidence ranks the largest ln|Π^U| (here −F) first.
         assert_eq!(rows(Objective::Confidence), [3, 5, 2, 1, 4]);
-    }
-
-    #[test]
-    fn the_screen_keeps_the_most_confident_and_the_earlier_on_ties() {
-        let mut screen = Screen::new(Some(2));
-        let bad = Err(Error::NotPositiveDefinite { determinant: 0.0 });
-        for (row, l) in [
-            (1, Ok(1.0)),
-            (2, Ok(3.0)),
-            (3, bad),
-            (4, Ok(2.0)),
-            (5, Ok(3.0)),
-            (6, Ok(0.5)),
-        ] {
-            screen.push(candidate(row, l));
-        }
-        assert_eq!((screen.read, screen.without_confidence), (6, 1));
-        let rows: Vec<usize> = screen.finish().iter().map(|c| c.row.row).collect();
-        assert_eq!(rows, [2, 5]);
-        let mut screen = Screen::new(Some(1));
-        for (row, l) in [(1, 2.0), (2, 2.0)] {
-            screen.push(candidate(row, Ok(l)));
-        }
-        assert_eq!(screen.finish()[0].row.row, 1);
     }
 }

@@ -1,0 +1,227 @@
+//! The cheap stage: every tool of a file read, checked against the task and given its control
+//! confidence, the [`Screen`] keeping what will be simulated.
+
+use std::cmp::{Ordering, Reverse};
+use std::collections::BinaryHeap;
+use std::path::Path;
+
+use super::ModelTasks;
+use crate::tools_file::{read_tools, ToolFileError, ToolRow};
+use crate::Error;
+
+/// A tool that passed the cheap stage, with its confidence.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Candidate {
+    pub row: ToolRow,
+    pub logdet: Result<f64, Error>,
+}
+
+/// A candidate in the screen's heap, ordered by confidence; on a tie the later row is less.
+struct Screened {
+    logdet: f64,
+    candidate: Candidate,
+}
+
+impl Ord for Screened {
+    fn cmp(&self, other: &Self) -> Ordering {
+        self.logdet
+            .total_cmp(&other.logdet)
+            .then(other.candidate.row.row.cmp(&self.candidate.row.row))
+    }
+}
+
+impl PartialOrd for Screened {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl PartialEq for Screened {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+
+impl Eq for Screened {}
+
+/// The cheap stage over a stream of tools: keeps every tool, or only the `k` most confident
+/// (largest ln|Π^U|, the earlier row on ties) in O(k) memory.
+pub struct Screen {
+    limit: Option<usize>,
+    heap: BinaryHeap<Reverse<Screened>>,
+    all: Vec<Candidate>,
+    /// Tools seen.
+    pub read: usize,
+    /// Tools whose Π^U is not positive definite (never kept by a screen), and the first reason.
+    pub without_confidence: usize,
+    pub first_confidence_error: Option<String>,
+}
+
+impl Screen {
+    /// `limit`: keep only this many (the `--screen K`), or every tool.
+    pub fn new(limit: Option<usize>) -> Self {
+        Self {
+            limit,
+            heap: BinaryHeap::new(),
+            all: Vec::new(),
+            read: 0,
+            without_confidence: 0,
+            first_confidence_error: None,
+        }
+    }
+
+    pub fn push(&mut self, candidate: Candidate) {
+        self.read += 1;
+        if let Err(e) = &candidate.logdet {
+            self.without_confidence += 1;
+            self.first_confidence_error
+                .get_or_insert_with(|| e.to_string());
+        }
+        let Some(k) = self.limit else {
+            self.all.push(candidate);
+            return;
+        };
+        let Ok(logdet) = candidate.logdet else {
+            return;
+        };
+        let entry = Screened { logdet, candidate };
+        if self.heap.len() < k {
+            self.heap.push(Reverse(entry));
+        } else if self
+            .heap
+            .peek()
+            .is_some_and(|Reverse(worst)| entry > *worst)
+        {
+            self.heap.pop();
+            self.heap.push(Reverse(entry));
+        }
+    }
+
+    /// The kept tools in file order.
+    pub fn finish(self) -> Vec<Candidate> {
+        if self.limit.is_none() {
+            return self.all;
+        }
+        let mut kept: Vec<Candidate> = self
+            .heap
+            .into_iter()
+            .map(|Reverse(s)| s.candidate)
+            .collect();
+        kept.sort_by_key(|c| c.row.row);
+        kept
+    }
+}
+
+/// Why a tools file gives nothing to simulate.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ScreenError {
+    /// The file, or a row that is not skipped.
+    #[error(transparent)]
+    File(#[from] ToolFileError),
+    /// A tool of a model the task does not cover, no valid row, or no tool with a confidence.
+    #[error("{0}")]
+    Input(String),
+}
+
+/// The cheap stage over the tools file `path`, as `toolconf rank` and the Python package run it:
+/// every row checked against `tasks` and pushed with its ln|Π^U| into a [`Screen`] keeping
+/// `limit` tools. A bad row stops the read unless `skip_bad_rows`, in which case `skipping`
+/// hears of it. `task` names the task in the message when no tool has a confidence. Returns the
+/// screen and the number of rows skipped.
+pub fn screen_file(
+    path: &Path,
+    tasks: &ModelTasks,
+    task: &str,
+    limit: Option<usize>,
+    skip_bad_rows: bool,
+    mut skipping: impl FnMut(&ToolFileError),
+) -> Result<(Screen, usize), ScreenError> {
+    let mut screen = Screen::new(limit);
+    let mut skipped = 0;
+    let mut misfit = None;
+    let tools_file = path.display().to_string();
+    let read = read_tools(path, |row| match row {
+        Ok(row) => {
+            if let Err(e) = tasks.check(row.tool.model()) {
+                misfit = Some(format!(
+                    "{e} (tool '{}' of {tools_file} is a {} tool)",
+                    row.label(),
+                    row.tool.model()
+                ));
+                return Err(ToolFileError {
+                    file: tools_file.clone(),
+                    place: String::new(),
+                    message: "stopped".into(),
+                    row_level: false,
+                });
+            }
+            let logdet = tasks.logdet(&row.tool);
+            screen.push(Candidate { row, logdet });
+            Ok(())
+        }
+        Err(bad) if skip_bad_rows && bad.row_level => {
+            skipping(&bad);
+            skipped += 1;
+            Ok(())
+        }
+        Err(bad) => Err(bad),
+    });
+    if let Some(message) = misfit {
+        return Err(ScreenError::Input(message));
+    }
+    read?;
+    if screen.read == 0 {
+        return Err(ScreenError::Input(format!(
+            "{tools_file}: no valid tools (all {skipped} rows were bad)"
+        )));
+    }
+    if screen.without_confidence == screen.read {
+        // The task's precisions, not the tools, are at fault: say so before simulating.
+        return Err(ScreenError::Input(format!(
+            "task {task}: no tool of {tools_file} has a control confidence: {}",
+            screen.first_confidence_error.as_deref().unwrap_or("")
+        )));
+    }
+    Ok((screen, skipped))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::mixed::{AnyTool, ModelKind};
+
+    fn candidate(row: usize, logdet: Result<f64, Error>) -> Candidate {
+        Candidate {
+            row: ToolRow {
+                row,
+                name: None,
+                tool: AnyTool::new(ModelKind::Arm2, &[0.3, 0.3, 0.3, 0.3]).unwrap(),
+            },
+            logdet,
+        }
+    }
+
+    #[test]
+    fn the_screen_keeps_the_most_confident_and_the_earlier_on_ties() {
+        let mut screen = Screen::new(Some(2));
+        let bad = Err(Error::NotPositiveDefinite { determinant: 0.0 });
+        for (row, l) in [
+            (1, Ok(1.0)),
+            (2, Ok(3.0)),
+            (3, bad),
+            (4, Ok(2.0)),
+            (5, Ok(3.0)),
+            (6, Ok(0.5)),
+        ] {
+            screen.push(candidate(row, l));
+        }
+        assert_eq!((screen.read, screen.without_confidence), (6, 1));
+        let rows: Vec<usize> = screen.finish().iter().map(|c| c.row.row).collect();
+        assert_eq!(rows, [2, 5]);
+        let mut screen = Screen::new(Some(1));
+        for (row, l) in [(1, 2.0), (2, 2.0)] {
+            screen.push(candidate(row, Ok(l)));
+        }
+        assert_eq!(screen.finish()[0].row.row, 1);
+    }
+}
