@@ -3,7 +3,7 @@
 use nalgebra::SVector;
 
 use super::stiffness::StiffnessDetector;
-use super::{IntegrationError, Settings, Stats};
+use super::{eps_at, IntegrationError, Settings, Stats};
 
 // Tableau of Dormand & Prince (1980), as matrices A, B, E of ode45.m.
 const C2: f64 = 1.0 / 5.0;
@@ -76,13 +76,6 @@ pub(super) struct Handoff<const D: usize> {
     /// The first grid point not yet output.
     pub next: usize,
     pub stats: Stats,
-}
-
-/// MATLAB's `eps(t)`: the distance from |t| to the next larger double.
-#[inline]
-fn eps_at(t: f64) -> f64 {
-    let a = t.abs();
-    f64::from_bits(a.to_bits() + 1) - a
 }
 
 /// Takes a step of size `h` from `(t, y)` with `k1 = f(t, y)`, landing on `t_new`

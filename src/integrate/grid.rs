@@ -90,3 +90,11 @@ pub(super) fn resolve(options: &Options, grid: &[f64]) -> Result<Settings, Integ
         max_steps: options.max_steps,
     })
 }
+
+/// MATLAB's `eps(t)`: the distance from |t| to the next larger double (the steppers' `hmin` is
+/// `16·eps(t)`).
+#[inline]
+pub(super) fn eps_at(t: f64) -> f64 {
+    let a = t.abs();
+    f64::from_bits(a.to_bits() + 1) - a
+}

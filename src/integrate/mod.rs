@@ -72,7 +72,7 @@ mod tests;
 use nalgebra::{SMatrix, SVector};
 
 pub use grid::uniform_grid;
-use grid::{resolve, Settings};
+use grid::{eps_at, resolve, Settings};
 pub use options::{IntegrationError, Method, Options, Stats};
 use problem::{Analytic, FiniteDifference};
 

@@ -18,7 +18,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use super::rosenbrock::{eps_at, Problem, Start, Tableau, RODAS5P};
+use super::rosenbrock::{run, Problem, Start, Stepper, Tableau, RODAS5P};
 use super::{IntegrationError, Settings, Stats};
 
 /// Stages of Rodas5P.
@@ -119,10 +119,11 @@ fn attempt<const D: usize, P: Problem<D>>(
     t: f64,
     y: &SVector<f64, D>,
     f0: &SVector<f64, D>,
-    dfdt: Option<&SVector<f64, D>>,
+    dfdt: &SVector<f64, D>,
     t_new: f64,
-) -> ([SVector<f64, D>; S], SVector<f64, D>) {
+) -> LeanStep<D> {
     let tab: &Tableau<S> = &RODAS5P;
+    let dfdt = (!dfdt.iter().all(|&v| v == 0.0)).then_some(dfdt);
     let h = t_new - t;
     let r = 1.0 / h;
     let mut k = [SVector::<f64, D>::zeros(); S];
@@ -160,26 +161,11 @@ fn attempt<const D: usize, P: Problem<D>>(
         }
         k[i] = lu.solve(&b);
     }
-    let y_new = u + k[S - 1];
-    (k, y_new)
-}
-
-/// `‖k_S ./ max(|y|, |y_new|, threshold)‖_∞` and whether the estimate and `y_new` are finite.
-#[inline(always)]
-fn error_norm<const D: usize>(
-    y: &SVector<f64, D>,
-    y_new: &SVector<f64, D>,
-    estimate: &SVector<f64, D>,
-    threshold: f64,
-) -> (f64, bool) {
-    let mut finite = true;
-    let mut norm = 0.0f64;
-    for i in 0..D {
-        let (e, y_new) = (estimate[i], y_new[i]);
-        finite &= e.is_finite() & y_new.is_finite();
-        norm = norm.max((e / y[i].abs().max(y_new.abs()).max(threshold)).abs());
+    LeanStep {
+        y_new: u + k[S - 1],
+        k,
+        dense: None,
     }
-    (norm, finite)
 }
 
 /// The dense output's `q_1, q_2, q_3` of a step.
@@ -194,8 +180,75 @@ fn dense_rows<const D: usize>(k: &[SVector<f64, D>; S]) -> [SVector<f64, D>; 3] 
     })
 }
 
-mod run;
-pub(super) use run::integrate;
+/// An attempt: the stages, the new solution and, once the step has output points inside it,
+/// its dense output's rows.
+struct LeanStep<const D: usize> {
+    k: [SVector<f64, D>; S],
+    y_new: SVector<f64, D>,
+    dense: Option<[SVector<f64, D>; 3]>,
+}
+
+/// The lean Rodas5P step inside [`super::rosenbrock::run`].
+struct Lean;
+
+impl<const D: usize> Stepper<D, S> for Lean {
+    type Lu = Lu<D>;
+    type Step = LeanStep<D>;
+
+    fn factor(e: SMatrix<f64, D, D>) -> Option<Lu<D>> {
+        Lu::new(e)
+    }
+
+    #[inline(always)]
+    fn attempt<P: Problem<D>>(
+        &self,
+        problem: &mut P,
+        lu: &Lu<D>,
+        t: f64,
+        y: &SVector<f64, D>,
+        f0: &SVector<f64, D>,
+        dfdt: &SVector<f64, D>,
+        t_new: f64,
+    ) -> LeanStep<D> {
+        attempt(problem, lu, t, y, f0, dfdt, t_new)
+    }
+
+    fn y_new(step: &LeanStep<D>) -> &SVector<f64, D> {
+        &step.y_new
+    }
+
+    fn estimate(step: &LeanStep<D>) -> &SVector<f64, D> {
+        &step.k[S - 1]
+    }
+
+    fn interpolate(
+        &self,
+        step: &mut LeanStep<D>,
+        t: f64,
+        y: &SVector<f64, D>,
+        h: f64,
+        t_out: f64,
+    ) -> SVector<f64, D> {
+        let [q1, q2, q3] = step.dense.get_or_insert_with(|| dense_rows(&step.k));
+        let s = (t_out - t) / h;
+        y * (1.0 - s) + (step.y_new + (*q1 + (*q2 + *q3 * s) * s) * (1.0 - s)) * s
+    }
+}
+
+/// Rodas5P from `start` over a validated grid and settings, with the lean step.
+pub(super) fn integrate<const D: usize, P, O>(
+    problem: &mut P,
+    start: Start<D>,
+    grid: &[f64],
+    s: &Settings,
+    output: O,
+) -> Result<Stats, IntegrationError>
+where
+    P: Problem<D>,
+    O: FnMut(usize, f64, &SVector<f64, D>),
+{
+    run(&RODAS5P, &Lean, problem, start, grid, s, output)
+}
 
 #[cfg(test)]
 mod tests {

@@ -56,7 +56,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use super::{IntegrationError, Settings, Stats};
+use super::{eps_at, IntegrationError, Settings, Stats};
 
 /// What the stiff stepper needs of the problem.
 pub(super) trait Problem<const D: usize> {
@@ -221,13 +221,6 @@ struct Attempt<const D: usize, const S: usize> {
     k: [SVector<f64, D>; S],
 }
 
-/// MATLAB's `eps(t)`: the distance from |t| to the next larger double.
-#[inline]
-pub(super) fn eps_at(t: f64) -> f64 {
-    let a = t.abs();
-    f64::from_bits(a.to_bits() + 1) - a
-}
-
 /// The stages of a step of size `h = t_new − t`, with `E⁻¹` applied by `solve`. `S − 1`
 /// right-hand-side evaluations.
 #[inline(always)]
@@ -283,16 +276,16 @@ where
 
 /// `‖k_S ./ max(|y|, |y_new|, threshold)‖_∞` and whether the estimate and `y_new` are finite.
 #[inline(always)]
-fn error_norm<const D: usize, const S: usize>(
+pub(super) fn error_norm<const D: usize>(
     y: &SVector<f64, D>,
-    step: &Attempt<D, S>,
+    y_new: &SVector<f64, D>,
+    estimate: &SVector<f64, D>,
     threshold: f64,
 ) -> (f64, bool) {
-    let error = &step.k[S - 1];
     let mut finite = true;
     let mut norm = 0.0f64;
     for i in 0..D {
-        let (e, y_new) = (error[i], step.y_new[i]);
+        let (e, y_new) = (estimate[i], y_new[i]);
         finite &= e.is_finite() & y_new.is_finite();
         norm = norm.max((e / y[i].abs().max(y_new.abs()).max(threshold)).abs());
     }
@@ -321,6 +314,86 @@ fn interpolate<const D: usize, const S: usize>(
     y * (1.0 - s) + (step.y_new + (q(h1) + (q(h2) + q(h3) * s) * s) * (1.0 - s)) * s
 }
 
+/// What a Rosenbrock stepper does inside the shared main loop [`run`]: factor the iteration
+/// matrix `E = I/(h·γ) − J`, take an attempt with it, and interpolate inside an accepted step.
+/// [`Standard`] is `rodas.f`'s form for any [`Tableau`]; `rodas_lean` is the other.
+pub(super) trait Stepper<const D: usize, const S: usize> {
+    type Lu;
+    /// An attempt's stages, its new solution and whatever its dense output keeps.
+    type Step;
+    fn factor(e: SMatrix<f64, D, D>) -> Option<Self::Lu>;
+    /// The stages of a step of size `h = t_new − t`; `S − 1` right-hand-side evaluations.
+    #[allow(clippy::too_many_arguments)]
+    fn attempt<P: Problem<D>>(
+        &self,
+        problem: &mut P,
+        lu: &Self::Lu,
+        t: f64,
+        y: &SVector<f64, D>,
+        f0: &SVector<f64, D>,
+        dfdt: &SVector<f64, D>,
+        t_new: f64,
+    ) -> Self::Step;
+    fn y_new(step: &Self::Step) -> &SVector<f64, D>;
+    /// The last stage, the error estimate.
+    fn estimate(step: &Self::Step) -> &SVector<f64, D>;
+    /// The continuous extension at `t_out` inside the step `[t, t + h]`.
+    fn interpolate(
+        &self,
+        step: &mut Self::Step,
+        t: f64,
+        y: &SVector<f64, D>,
+        h: f64,
+        t_out: f64,
+    ) -> SVector<f64, D>;
+}
+
+/// `rodas.f`'s step for any stiffly accurate [`Tableau`].
+struct Standard<'a, const S: usize>(&'a Tableau<S>);
+
+impl<const D: usize, const S: usize> Stepper<D, S> for Standard<'_, S> {
+    type Lu = Lu<D>;
+    type Step = Attempt<D, S>;
+
+    fn factor(e: SMatrix<f64, D, D>) -> Option<Lu<D>> {
+        Lu::new(e)
+    }
+
+    #[inline(always)]
+    fn attempt<P: Problem<D>>(
+        &self,
+        problem: &mut P,
+        lu: &Lu<D>,
+        t: f64,
+        y: &SVector<f64, D>,
+        f0: &SVector<f64, D>,
+        dfdt: &SVector<f64, D>,
+        t_new: f64,
+    ) -> Attempt<D, S> {
+        let solve = |b: SVector<f64, D>| lu.solve(&b);
+        attempt(self.0, problem, solve, t, y, f0, dfdt, t_new)
+    }
+
+    fn y_new(step: &Attempt<D, S>) -> &SVector<f64, D> {
+        &step.y_new
+    }
+
+    fn estimate(step: &Attempt<D, S>) -> &SVector<f64, D> {
+        &step.k[S - 1]
+    }
+
+    fn interpolate(
+        &self,
+        step: &mut Attempt<D, S>,
+        t: f64,
+        y: &SVector<f64, D>,
+        h: f64,
+        t_out: f64,
+    ) -> SVector<f64, D> {
+        interpolate(self.0, t, y, h, step, t_out)
+    }
+}
+
 /// The Rodas5P main loop from `start` over a validated grid and settings.
 pub(super) fn integrate<const D: usize, P, O>(
     problem: &mut P,
@@ -333,12 +406,23 @@ where
     P: Problem<D>,
     O: FnMut(usize, f64, &SVector<f64, D>),
 {
-    run(&RODAS5P, problem, start, grid, s, output)
+    run(
+        &RODAS5P,
+        &Standard(&RODAS5P),
+        problem,
+        start,
+        grid,
+        s,
+        output,
+    )
 }
 
-/// The main loop of any stiffly accurate method in the form of [`Tableau`].
-fn run<const D: usize, const S: usize, P, O>(
+/// The main loop of any stiffly accurate method in the form of [`Tableau`], its steps taken by
+/// `stepper`: `ode45`'s step-size rules, `hmin`, the stretch onto `tf`, singular matrices and
+/// output at the grid points.
+pub(super) fn run<const D: usize, const S: usize, P, O, M>(
     tab: &Tableau<S>,
+    stepper: &M,
     problem: &mut P,
     start: Start<D>,
     grid: &[f64],
@@ -348,6 +432,7 @@ fn run<const D: usize, const S: usize, P, O>(
 where
     P: Problem<D>,
     O: FnMut(usize, f64, &SVector<f64, D>),
+    M: Stepper<D, S>,
 {
     let tf = grid[grid.len() - 1];
     let (rtol, threshold, exponent) = (s.rtol, s.threshold, tab.exponent);
@@ -388,7 +473,7 @@ where
         stats.rhs_evals += evals;
 
         let mut no_failures = true;
-        let (t_new, step, err) = loop {
+        let (t_new, mut step, err) = loop {
             if stats.steps + stats.rejected >= s.max_steps {
                 return Err(IntegrationError::TooManySteps {
                     t,
@@ -403,11 +488,10 @@ where
                 e[(i, i)] += diagonal;
             }
             stats.factorisations += 1;
-            let attempted = if let Some(lu) = Lu::new(e) {
-                let solve = |b: SVector<f64, D>| lu.solve(&b);
-                let step = attempt(tab, problem, solve, t, &y, &f0, &dfdt, t_new);
+            let attempted = if let Some(lu) = M::factor(e) {
+                let step = stepper.attempt(problem, &lu, t, &y, &f0, &dfdt, t_new);
                 stats.rhs_evals += S - 1;
-                let (err, finite) = error_norm(&y, &step, threshold);
+                let (err, finite) = error_norm(&y, M::y_new(&step), M::estimate(&step), threshold);
                 if !finite {
                     return Err(IntegrationError::NonFinite { t: t_new });
                 }
@@ -438,9 +522,13 @@ where
         while next < grid.len() && grid[next] <= t_new {
             let t_out = grid[next];
             if t_out == t_new {
-                output(next, t_out, &step.y_new);
+                output(next, t_out, M::y_new(&step));
             } else {
-                output(next, t_out, &interpolate(tab, t, &y, h, &step, t_out));
+                output(
+                    next,
+                    t_out,
+                    &stepper.interpolate(&mut step, t, &y, h, t_out),
+                );
             }
             next += 1;
         }
@@ -458,7 +546,7 @@ where
             };
         }
         t = t_new;
-        y = step.y_new;
+        y = *M::y_new(&step);
         f0 = problem.rhs(t, &y);
         stats.rhs_evals += 1;
         if !f0.iter().all(|v| v.is_finite()) {

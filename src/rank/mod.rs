@@ -118,7 +118,7 @@ impl ConfidenceTiming {
         per_second(self.tools, self.wall)
     }
 
-    /// Mean wall time per tool [ns].
+    /// Mean wall time per tool, in ns.
     pub fn ns_per_tool(&self) -> f64 {
         per_item(self.wall, self.tools) * 1e9
     }
@@ -144,7 +144,7 @@ impl SimulationTiming {
         per_second(self.episodes, self.wall)
     }
 
-    /// Mean time of one episode [µs] (its own time, not the wall time over the threads).
+    /// Mean time of one episode, in µs (its own time, not the wall time over the threads).
     pub fn us_per_episode(&self) -> f64 {
         per_item(self.episode_time, self.episodes) * 1e6
     }
