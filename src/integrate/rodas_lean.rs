@@ -108,66 +108,6 @@ fn tableau_has_successive_solutions(tab: &Tableau<S>) -> bool {
     })
 }
 
-/// The stages of one attempt of size `h = t_new − t` and the new solution.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-// k[j] and the tableau's a[i][j], c[i][j] are indexed together, as in the formulas.
-#[allow(clippy::needless_range_loop)]
-fn attempt<const D: usize, P: Problem<D>>(
-    problem: &mut P,
-    lu: &Lu<D>,
-    t: f64,
-    y: &SVector<f64, D>,
-    f0: &SVector<f64, D>,
-    dfdt: &SVector<f64, D>,
-    t_new: f64,
-) -> LeanStep<D> {
-    let tab: &Tableau<S> = &RODAS5P;
-    let dfdt = (!dfdt.iter().all(|&v| v == 0.0)).then_some(dfdt);
-    let h = t_new - t;
-    let r = 1.0 / h;
-    let mut k = [SVector::<f64, D>::zeros(); S];
-    let time_term = |b: &mut SVector<f64, D>, i: usize| {
-        if let Some(dfdt) = dfdt {
-            *b += dfdt * (h * tab.d[i]);
-        }
-    };
-    let mut b = *f0;
-    time_term(&mut b, 0);
-    k[0] = lu.solve(&b);
-    for i in 1..LAST_ROW {
-        let mut u = *y;
-        for j in 0..i {
-            u += k[j] * tab.a[i][j];
-        }
-        let mut b = problem.rhs(t + tab.alpha[i] * h, &u);
-        time_term(&mut b, i);
-        for j in 0..i {
-            b += k[j] * (tab.c[i][j] * r);
-        }
-        k[i] = lu.solve(&b);
-    }
-    let mut u = *y;
-    for j in 0..LAST_ROW {
-        u += k[j] * tab.a[LAST_ROW][j];
-    }
-    for i in LAST_ROW..S {
-        if i > LAST_ROW {
-            u += k[i - 1];
-        }
-        let mut b = problem.rhs(t_new, &u);
-        for j in 0..i {
-            b += k[j] * (tab.c[i][j] * r);
-        }
-        k[i] = lu.solve(&b);
-    }
-    LeanStep {
-        y_new: u + k[S - 1],
-        k,
-        dense: None,
-    }
-}
-
 /// The dense output's `q_1, q_2, q_3` of a step.
 #[inline]
 fn dense_rows<const D: usize>(k: &[SVector<f64, D>; S]) -> [SVector<f64, D>; 3] {
@@ -200,6 +140,8 @@ impl<const D: usize> Stepper<D, S> for Lean {
     }
 
     #[inline(always)]
+    // k[j] and the tableau's a[i][j], c[i][j] are indexed together, as in the formulas.
+    #[allow(clippy::needless_range_loop)]
     fn attempt<P: Problem<D>>(
         &self,
         problem: &mut P,
@@ -210,7 +152,50 @@ impl<const D: usize> Stepper<D, S> for Lean {
         dfdt: &SVector<f64, D>,
         t_new: f64,
     ) -> LeanStep<D> {
-        attempt(problem, lu, t, y, f0, dfdt, t_new)
+        let tab: &Tableau<S> = &RODAS5P;
+        let dfdt = (!dfdt.iter().all(|&v| v == 0.0)).then_some(dfdt);
+        let h = t_new - t;
+        let r = 1.0 / h;
+        let mut k = [SVector::<f64, D>::zeros(); S];
+        let time_term = |b: &mut SVector<f64, D>, i: usize| {
+            if let Some(dfdt) = dfdt {
+                *b += dfdt * (h * tab.d[i]);
+            }
+        };
+        let mut b = *f0;
+        time_term(&mut b, 0);
+        k[0] = lu.solve(&b);
+        for i in 1..LAST_ROW {
+            let mut u = *y;
+            for j in 0..i {
+                u += k[j] * tab.a[i][j];
+            }
+            let mut b = problem.rhs(t + tab.alpha[i] * h, &u);
+            time_term(&mut b, i);
+            for j in 0..i {
+                b += k[j] * (tab.c[i][j] * r);
+            }
+            k[i] = lu.solve(&b);
+        }
+        let mut u = *y;
+        for j in 0..LAST_ROW {
+            u += k[j] * tab.a[LAST_ROW][j];
+        }
+        for i in LAST_ROW..S {
+            if i > LAST_ROW {
+                u += k[i - 1];
+            }
+            let mut b = problem.rhs(t_new, &u);
+            for j in 0..i {
+                b += k[j] * (tab.c[i][j] * r);
+            }
+            k[i] = lu.solve(&b);
+        }
+        LeanStep {
+            y_new: u + k[S - 1],
+            k,
+            dense: None,
+        }
     }
 
     fn y_new(step: &LeanStep<D>) -> &SVector<f64, D> {

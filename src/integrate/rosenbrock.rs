@@ -221,59 +221,6 @@ struct Attempt<const D: usize, const S: usize> {
     k: [SVector<f64, D>; S],
 }
 
-/// The stages of a step of size `h = t_new − t`, with `E⁻¹` applied by `solve`. `S − 1`
-/// right-hand-side evaluations.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn attempt<const D: usize, const S: usize, P, L>(
-    tab: &Tableau<S>,
-    problem: &mut P,
-    solve: L,
-    t: f64,
-    y: &SVector<f64, D>,
-    f0: &SVector<f64, D>,
-    dfdt: &SVector<f64, D>,
-    t_new: f64,
-) -> Attempt<D, S>
-where
-    P: Problem<D>,
-    L: Fn(SVector<f64, D>) -> SVector<f64, D>,
-{
-    let h = t_new - t;
-    let r = 1.0 / h;
-    let mut k = [SVector::<f64, D>::zeros(); S];
-    let mut u = *y;
-    for i in 0..S {
-        let f = if i == 0 {
-            *f0
-        } else {
-            u = *y;
-            for (k, &a) in k[..i].iter().zip(&tab.a[i][..i]) {
-                u += k * a;
-            }
-            // Stages at α = 1 are evaluated at t_new itself.
-            let t_i = if tab.alpha[i] == 1.0 {
-                t_new
-            } else {
-                t + tab.alpha[i] * h
-            };
-            problem.rhs(t_i, &u)
-        };
-        let mut b = f;
-        if tab.d[i] != 0.0 {
-            b += dfdt * (h * tab.d[i]);
-        }
-        for (k, &c) in k[..i].iter().zip(&tab.c[i][..i]) {
-            b += k * (c * r);
-        }
-        k[i] = solve(b);
-    }
-    Attempt {
-        y_new: u + k[S - 1],
-        k,
-    }
-}
-
 /// `‖k_S ./ max(|y|, |y_new|, threshold)‖_∞` and whether the estimate and `y_new` are finite.
 #[inline(always)]
 pub(super) fn error_norm<const D: usize>(
@@ -370,8 +317,40 @@ impl<const D: usize, const S: usize> Stepper<D, S> for Standard<'_, S> {
         dfdt: &SVector<f64, D>,
         t_new: f64,
     ) -> Attempt<D, S> {
-        let solve = |b: SVector<f64, D>| lu.solve(&b);
-        attempt(self.0, problem, solve, t, y, f0, dfdt, t_new)
+        let tab = self.0;
+        let h = t_new - t;
+        let r = 1.0 / h;
+        let mut k = [SVector::<f64, D>::zeros(); S];
+        let mut u = *y;
+        for i in 0..S {
+            let f = if i == 0 {
+                *f0
+            } else {
+                u = *y;
+                for (k, &a) in k[..i].iter().zip(&tab.a[i][..i]) {
+                    u += k * a;
+                }
+                // Stages at α = 1 are evaluated at t_new itself.
+                let t_i = if tab.alpha[i] == 1.0 {
+                    t_new
+                } else {
+                    t + tab.alpha[i] * h
+                };
+                problem.rhs(t_i, &u)
+            };
+            let mut b = f;
+            if tab.d[i] != 0.0 {
+                b += dfdt * (h * tab.d[i]);
+            }
+            for (k, &c) in k[..i].iter().zip(&tab.c[i][..i]) {
+                b += k * (c * r);
+            }
+            k[i] = lu.solve(&b);
+        }
+        Attempt {
+            y_new: u + k[S - 1],
+            k,
+        }
     }
 
     fn y_new(step: &Attempt<D, S>) -> &SVector<f64, D> {

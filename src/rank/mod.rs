@@ -204,19 +204,8 @@ pub fn ranking(results: &[RankedTool], objective: Objective) -> Vec<usize> {
 
 #[cfg(test)]
 mod tests {
+    use super::screen::tests::candidate;
     use super::*;
-    use crate::model::mixed::{AnyTool, ModelKind};
-
-    fn candidate(row: usize, logdet: Result<f64, Error>) -> Candidate {
-        Candidate {
-            row: ToolRow {
-                row,
-                name: None,
-                tool: AnyTool::new(ModelKind::Arm2, &[0.3, 0.3, 0.3, 0.3]).unwrap(),
-            },
-            logdet,
-        }
-    }
 
     #[test]
     fn failed_episodes_rank_last_in_file_order_and_ties_keep_file_order() {

@@ -186,11 +186,11 @@ pub fn screen_file(
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::model::mixed::{AnyTool, ModelKind};
 
-    fn candidate(row: usize, logdet: Result<f64, Error>) -> Candidate {
+    pub(in crate::rank) fn candidate(row: usize, logdet: Result<f64, Error>) -> Candidate {
         Candidate {
             row: ToolRow {
                 row,
