@@ -43,33 +43,42 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("model", type=Path, help="model description (TOML)")
     ap.add_argument("--tasks", type=Path, default=HERE / "tasks.toml", help="task definitions (TOML)")
-    ap.add_argument("--out", type=Path, required=True,
-                    help="where to write the JSON IR (any path ending in .json; the vectors go beside it)")
+    where = ap.add_mutually_exclusive_group(required=True)
+    where.add_argument("--out", type=Path,
+                       help="where to write the JSON IR (any path ending in .json; the vectors go beside it)")
+    where.add_argument("--out-dir", type=Path,
+                       help="the folder to write <model name>.json and its vectors into (the name is the "
+                            "description's model.name, whatever the file is called)")
     ap.add_argument("--vectors", type=int, default=100, help="test vectors per function (default 100)")
+    ap.add_argument("--command", default="make derive",
+                    help="the command the generated files name as their maker (default: make derive)")
     args = ap.parse_args()
     root = HERE.parent
-    if args.out.suffix != ".json":
+    if args.out is not None and args.out.suffix != ".json":
         print(f"derive: --out {args.out}: the IR's file name must end in .json", file=sys.stderr)
         return 2
-    if not args.out.parent.is_dir():
-        print(f"derive: --out {args.out}: the folder {args.out.parent} does not exist", file=sys.stderr)
+    folder = args.out_dir if args.out is None else args.out.parent
+    if not folder.is_dir():
+        flag = f"--out {args.out}" if args.out is not None else f"--out-dir {args.out_dir}"
+        print(f"derive: {flag}: the folder {folder} does not exist", file=sys.stderr)
         return 2
     if args.vectors < 1:
         print(f"derive: --vectors {args.vectors}: need at least one test vector per function", file=sys.stderr)
         return 2
-    vectors_out = args.out.with_suffix(".vectors.json")
     try:
         model = load_model(args.model)
+        out = args.out if args.out is not None else args.out_dir / f"{model.name}.json"
+        vectors_out = out.with_suffix(".vectors.json")
         tasks = load_tasks(args.tasks)
         d = derive(model, tasks)
         functions = build_functions(d, CasadiModel(model))
         # Names, not the paths written to: the same bytes wherever --out points (the drift check
         # derives into a temporary folder and compares).
         generator = {
-            "command": "make derive",
+            "command": args.command,
             "model": shown(args.model, root),
             "tasks": shown(args.tasks, root),
-            "ir": args.out.name,
+            "ir": out.name,
             "vectors": vectors_out.name,
             "derive": "derive/derive.py (SymPy derives, CasADi checks)",
             "render": "derive/render (Tera) + rustfmt",
@@ -84,14 +93,14 @@ def main() -> int:
         print(f"derive: {err}", file=sys.stderr)
         return 1
     try:
-        write(args.out, ir)
+        write(out, ir)
         write(vectors_out, vectors)
     except OSError as err:
         print(f"derive: cannot write {err.filename}: {err.strerror}", file=sys.stderr)
         return 1
     checked = sum(len(f["vectors"]) for f in vectors["functions"])
     print(f"derive: {model.name}: {len(ir['functions'])} functions, {checked} points checked SymPy = CasADi "
-          f"-> {args.out}, {vectors_out}")
+          f"-> {out}, {vectors_out}")
     return 0
 
 

@@ -117,24 +117,28 @@ def first_difference(a: bytes, b: bytes) -> str:
     return f"line {min(len(la), len(lb)) + 1}: one file ends there ({len(la)} vs {len(lb)} lines)"
 
 
+def files_under(folder: Path) -> set[Path]:
+    """Every file under `folder`, sub-folders included, relative to it."""
+    return {p.relative_to(folder) for p in folder.rglob("*") if p.is_file()}
+
+
 def compare(derived: Path, committed: Path, whole_folder: bool) -> list[str]:
-    """Problems found comparing `derived` with `committed` (relative to the repository). With
-    `whole_folder`, a committed file that the derivation no longer produces is stale too."""
+    """Problems found comparing the tree `derived` with `committed` (relative to the repository).
+    With `whole_folder`, a committed file that the derivation no longer produces is stale too."""
     problems = []
-    made = {p.name for p in derived.iterdir()}
+    made = files_under(derived)
     for name in sorted(made):
         target = committed / name
         where = target.relative_to(ROOT)
-        if not target.exists():
+        if not target.is_file():
             problems.append(f"{where}: make derive produces it, but it is not there")
             continue
         a, b = target.read_bytes(), (derived / name).read_bytes()
         if a != b:
             problems.append(f"{where} differs from what make derive produces, first at {first_difference(a, b)}")
     if whole_folder:
-        for p in sorted(committed.iterdir()):
-            if p.is_file() and p.name not in made:
-                problems.append(f"{p.relative_to(ROOT)}: make derive no longer produces it (stale)")
+        for name in sorted(files_under(committed) - made):
+            problems.append(f"{(committed / name).relative_to(ROOT)}: make derive no longer produces it (stale)")
     return problems
 
 

@@ -25,7 +25,7 @@ fn rendered_rust_is_rustfmt_stable() {
     // `make derive` would not be byte-identical run to run.
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let generated =
-        std::fs::read_to_string(root.join("generated/arm2.rs")).expect("generated/arm2.rs");
+        std::fs::read_to_string(root.join("generated/src/arm2.rs")).expect("generated/src/arm2.rs");
     assert_eq!(
         toolconf_render::rustfmt(&generated).expect("rustfmt"),
         generated

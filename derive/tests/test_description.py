@@ -165,8 +165,9 @@ class BrokenDescription(unittest.TestCase):
 
     def test_model_name_taken_by_the_registry(self):
         name = PENDULUM.split('name = "', 1)[1].split('"', 1)[0]
-        self.model_stops(edit(PENDULUM, f'name = "{name}"', 'name = "tasks"'), "model.name",
-                         "taken by the generated registry")
+        for taken in ("tasks", "lib", "trig", "powi"):
+            self.model_stops(edit(PENDULUM, f'name = "{name}"', f'name = "{taken}"'), "model.name",
+                             "taken by the generated registry")
 
 
 if __name__ == "__main__":

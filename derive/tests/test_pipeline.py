@@ -52,6 +52,23 @@ class Compare(unittest.TestCase):
         # For tests/fixtures only the produced files count: old.rs is not stale there.
         self.assertEqual(len(pipeline.compare(self.derived, self.committed, False)), 1)
 
+    def test_the_whole_tree_counts(self):
+        # The generated crate has sub-folders (src/, tests/): a difference, a missing and a stale
+        # file there are found as at the top.
+        for d in (self.derived, self.committed):
+            (d / "src").mkdir()
+            (d / "Cargo.toml").write_text("[package]\n")
+        (self.derived / "src" / "lib.rs").write_text("one\n")
+        (self.committed / "src" / "lib.rs").write_text("two\n")
+        (self.derived / "src" / "new.rs").write_text("x\n")
+        (self.committed / "tests").mkdir()
+        (self.committed / "tests" / "old.rs").write_text("y\n")
+        problems = pipeline.compare(self.derived, self.committed, True)
+        self.assertEqual(len(problems), 3, problems)
+        self.assertIn("committed/src/lib.rs differs", problems[0])
+        self.assertIn("committed/src/new.rs: make derive produces it", problems[1])
+        self.assertIn("committed/tests/old.rs: make derive no longer produces it (stale)", problems[2])
+
     def test_a_shorter_file(self):
         (self.derived / "a.rs").write_text("one\ntwo\n")
         (self.committed / "a.rs").write_text("one\n")

@@ -119,8 +119,9 @@ class Task:
 
 
 KNOWN_TERMS = ("theta", "theta_dot", "theta_ddot", "u")
-# generated/<model>.rs must not clash with the registry's own files (templates/registry/).
-RESERVED_MODEL_NAMES = ("mod", "tasks")
+# A model's module, src/<model>.rs of the generated crate, must not clash with the crate's own
+# (templates/registry/src/: lib.rs, tasks.rs, trig.rs, powi.rs; `mod` is a Rust keyword).
+RESERVED_MODEL_NAMES = ("lib", "mod", "powi", "tasks", "trig")
 KINEMATIC_TERMS = ("theta", "theta_dot", "theta_ddot")
 
 # The keys each table may have, as serde's deny_unknown_fields: a misspelt key is an error, not a

@@ -138,10 +138,12 @@ def build_functions(d: Derivation, cm: CasadiModel) -> list[Function]:
     m = d.model
     n, nx, k = m.dof, m.state_dim, len(m.parameters)
     state_names = " ".join(s.name for s in m.state)
-    x = Arg("x", f"state X = [{state_names}]", (nx, 1), _vector_reads(d.x), False, _sample_state(n))
-    u = Arg("u", f"control U = [{' '.join(s.name for s in m.u)}]", (n, 1), _vector_reads(d.u), False,
+    # The entries as code (`[force]`): in the generated docs, a bracketed lone name would be an
+    # intra-doc link.
+    x = Arg("x", f"state X = `[{state_names}]`", (nx, 1), _vector_reads(d.x), False, _sample_state(n))
+    u = Arg("u", f"control U = `[{' '.join(s.name for s in m.u)}]`", (n, 1), _vector_reads(d.u), False,
             _sample_control(n))
-    p = Arg("params", f"tool parameters [{' '.join(s.name for s in m.parameters)}]", (k, 1),
+    p = Arg("params", f"tool parameters `[{' '.join(s.name for s in m.parameters)}]`", (k, 1),
             _vector_reads(d.params), False, _sample_parameters(k))
     eqs = ", ".join(m.equations)
 

@@ -38,7 +38,7 @@ def _trig_symbols(angle: sp.Symbol) -> tuple[sp.Symbol, sp.Symbol]:
 def joint_trigonometry(entries: list[sp.Expr], angles: list[sp.Symbol]):
     """Replaces every sine and cosine in `entries` by a symbol: sin_q, cos_q for a joint angle q,
     and for an angle sum or difference (sin(q1 - q2), ...) a `trig<i>` defined from those by the
-    addition theorems. One `sin_cos` per joint then covers all trigonometry (src/trig.rs), and
+    addition theorems. One `sin_cos` per joint then covers all trigonometry (generated/src/trig.rs), and
     the entries keep their shape (each compound is one atom for hoisting and CSE).
     Returns the rewritten entries and the compound definitions [(symbol, expression)]."""
     single = {}
@@ -220,7 +220,7 @@ def vectors_document(d: Derivation, functions: list[Function], generator: dict, 
         "schema": IR_SCHEMA,
         "generator": generator,
         "model": d.model.name,
-        "tolerance": "max|rust - casadi| <= 1e-12 max|casadi| per output (tests/generated_vectors.rs)",
+        "tolerance": "max|rust - casadi| <= 1e-12 max|casadi| per output (the generated crate's tests/vectors.rs)",
         "functions": [{"name": fn.name, "vectors": test_vectors(fn, d, count)} for fn in functions],
     }
 

@@ -10,9 +10,11 @@
 
 #![allow(clippy::all)]
 
-use nalgebra::{SMatrix, SVector};
 #[allow(unused_imports)]
-use std::f64::consts::PI;
+use crate::powi::Powi;
+#[allow(unused_imports)]
+use core::f64::consts::PI;
+use nalgebra::{SMatrix, SVector};
 
 /// Name of the model description.
 pub const NAME: &str = "arm2";
@@ -220,7 +222,7 @@ pub struct DynamicsCoefficients {
 }
 
 impl DynamicsCoefficients {
-    /// - `params`: tool parameters [m1 m2 l1 l2]
+    /// - `params`: tool parameters `[m1 m2 l1 l2]`
     ///
     /// Cost, once per tool: 34 operations, weighted 99 (2 ADD, 9 DIV, 16 MUL, 5 NEG, 2 POW) (derive/toolconf_derive/cost.py).
     #[inline]
@@ -256,9 +258,9 @@ impl DynamicsCoefficients {
 ///
 /// From eq. (theta_1_ddot), eq. (theta_2_ddot).
 ///
-/// - `x`: state X = [theta1 theta2 theta1_dot theta2_dot]
-/// - `u`: control U = [torque1 torque2]
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `x`: state X = `[theta1 theta2 theta1_dot theta2_dot]`
+/// - `u`: control U = `[torque1 torque2]`
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 ///
 /// Cost per call: 62 operations, weighted 129, plus 2 `sin_cos`: [`DynamicsCoefficients::new`] (34, weighted 99), then [`dynamics_with`] (28, weighted 30). Build the coefficients once per tool and call [`dynamics_with`] where it is called often.
 /// The same closed form with the parameters inline (not hoisted) would take 44 operations, weighted 90 (7 ADD, 6 DIV, 23 MUL, 1 NEG, 4 POW, 3 SUB), plus 2 `sin_cos`.
@@ -321,7 +323,7 @@ pub struct DynamicsJacobianCoefficients {
 }
 
 impl DynamicsJacobianCoefficients {
-    /// - `params`: tool parameters [m1 m2 l1 l2]
+    /// - `params`: tool parameters `[m1 m2 l1 l2]`
     ///
     /// Cost, once per tool: 39 operations, weighted 104 (2 ADD, 9 DIV, 21 MUL, 5 NEG, 2 POW) (derive/toolconf_derive/cost.py).
     #[inline]
@@ -362,9 +364,9 @@ impl DynamicsJacobianCoefficients {
 ///
 /// From eq. (theta_1_ddot), eq. (theta_2_ddot).
 ///
-/// - `x`: state X = [theta1 theta2 theta1_dot theta2_dot]
-/// - `u`: control U = [torque1 torque2]
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `x`: state X = `[theta1 theta2 theta1_dot theta2_dot]`
+/// - `u`: control U = `[torque1 torque2]`
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 ///
 /// Cost per call: 71 operations, weighted 138, plus 2 `sin_cos`: [`DynamicsJacobianCoefficients::new`] (39, weighted 104), then [`dynamics_jacobian_with`] (32, weighted 34). Build the coefficients once per tool and call [`dynamics_jacobian_with`] where it is called often.
 /// The same closed form with the parameters inline (not hoisted) would take 65 operations, weighted 132 (5 ADD, 9 DIV, 36 MUL, 6 NEG, 4 POW, 5 SUB), plus 2 `sin_cos`.
@@ -433,7 +435,7 @@ pub fn dynamics_jacobian_with(
 ///
 /// From eq. (LTI).
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 ///
 /// Cost per call: 17 operations, weighted 45 (2 ADD, 4 DIV, 9 MUL, 2 NEG).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -461,7 +463,7 @@ pub fn state_matrix(params: &SVector<f64, 4>) -> SMatrix<f64, 4, 4> {
 ///
 /// From eq. (LTI).
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 ///
 /// Cost per call: 17 operations, weighted 40 (2 ADD, 3 DIV, 9 MUL, 1 NEG, 2 POW).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -485,7 +487,7 @@ pub fn input_matrix(params: &SVector<f64, 4>) -> SMatrix<f64, 4, 2> {
 ///
 /// From appendix "Task specific controllers".
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 ///
 /// Cost per call: 29 operations, weighted 59 (3 ADD, 4 DIV, 15 MUL, 3 NEG, 2 POW, 2 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -522,7 +524,7 @@ pub fn position_sensitivity(
 ///
 /// From eq. (control_conf) and the closed forms after it.
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 /// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
@@ -593,7 +595,7 @@ pub fn position_control_confidence(
 ///
 /// From eq. (control_conf) differentiated in the tool parameters.
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 /// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
@@ -768,7 +770,7 @@ pub fn position_logdet_gradient(
 ///
 /// From appendix "Task specific controllers".
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 ///
 /// Cost per call: 8 operations, weighted 29 (1 ADD, 3 DIV, 3 MUL, 1 NEG).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -798,7 +800,7 @@ pub fn velocity_sensitivity(params: &SVector<f64, 4>) -> (SMatrix<f64, 2, 2>, SM
 ///
 /// From eq. (control_conf) and the closed forms after it.
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
@@ -850,7 +852,7 @@ pub fn velocity_control_confidence(
 ///
 /// From eq. (control_conf) differentiated in the tool parameters.
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
@@ -966,7 +968,7 @@ pub fn velocity_logdet_gradient(
 ///
 /// From appendix "Task specific controllers".
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 ///
 /// Cost per call: 0 operations, weighted 0.
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -984,7 +986,7 @@ pub fn acceleration_sensitivity(_params: &SVector<f64, 4>) -> SMatrix<f64, 2, 2>
 ///
 /// From eq. (control_conf) and the closed forms after it.
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
 ///
@@ -1016,7 +1018,7 @@ pub fn acceleration_control_confidence(
 ///
 /// From eq. (control_conf) differentiated in the tool parameters.
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
 ///

@@ -10,9 +10,11 @@
 
 #![allow(clippy::all)]
 
-use nalgebra::{SMatrix, SVector};
 #[allow(unused_imports)]
-use std::f64::consts::PI;
+use crate::powi::Powi;
+#[allow(unused_imports)]
+use core::f64::consts::PI;
+use nalgebra::{SMatrix, SVector};
 
 /// Name of the model description.
 pub const NAME: &str = "arm2_exact";
@@ -220,7 +222,7 @@ pub struct DynamicsCoefficients {
 }
 
 impl DynamicsCoefficients {
-    /// - `params`: tool parameters [m1 m2 l1 l2]
+    /// - `params`: tool parameters `[m1 m2 l1 l2]`
     ///
     /// Cost, once per tool: 26 operations, weighted 63 (2 ADD, 5 DIV, 12 MUL, 5 NEG, 2 POW) (derive/toolconf_derive/cost.py).
     #[inline]
@@ -258,9 +260,9 @@ impl DynamicsCoefficients {
 ///
 /// From Lagrangian mechanics of uniform rods.
 ///
-/// - `x`: state X = [theta1 theta2 theta1_dot theta2_dot]
-/// - `u`: control U = [torque1 torque2]
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `x`: state X = `[theta1 theta2 theta1_dot theta2_dot]`
+/// - `u`: control U = `[torque1 torque2]`
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 ///
 /// Cost per call: 62 operations, weighted 109, plus 2 `sin_cos`: [`DynamicsCoefficients::new`] (26, weighted 63), then [`dynamics_with`] (36, weighted 46). Build the coefficients once per tool and call [`dynamics_with`] where it is called often.
 /// The same closed form with the parameters inline (not hoisted) would take 56 operations, weighted 96 (5 ADD, 5 DIV, 33 MUL, 5 POW, 8 SUB), plus 2 `sin_cos`.
@@ -330,7 +332,7 @@ pub struct DynamicsJacobianCoefficients {
 }
 
 impl DynamicsJacobianCoefficients {
-    /// - `params`: tool parameters [m1 m2 l1 l2]
+    /// - `params`: tool parameters `[m1 m2 l1 l2]`
     ///
     /// Cost, once per tool: 64 operations, weighted 153 (2 ADD, 12 DIV, 31 MUL, 14 NEG, 5 POW) (derive/toolconf_derive/cost.py).
     #[inline]
@@ -395,9 +397,9 @@ impl DynamicsJacobianCoefficients {
 ///
 /// From Lagrangian mechanics of uniform rods.
 ///
-/// - `x`: state X = [theta1 theta2 theta1_dot theta2_dot]
-/// - `u`: control U = [torque1 torque2]
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `x`: state X = `[theta1 theta2 theta1_dot theta2_dot]`
+/// - `u`: control U = `[torque1 torque2]`
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 ///
 /// Cost per call: 164 operations, weighted 271, plus 2 `sin_cos`: [`DynamicsJacobianCoefficients::new`] (64, weighted 153), then [`dynamics_jacobian_with`] (100, weighted 118). Build the coefficients once per tool and call [`dynamics_jacobian_with`] where it is called often.
 /// The same closed form with the parameters inline (not hoisted) would take 166 operations, weighted 280 (12 ADD, 15 DIV, 105 MUL, 7 NEG, 9 POW, 18 SUB), plus 2 `sin_cos`.
@@ -506,7 +508,7 @@ pub fn dynamics_jacobian_with(
 ///
 /// From eq. (LTI).
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 ///
 /// Cost per call: 21 operations, weighted 42 (3 ADD, 3 DIV, 13 MUL, 2 NEG).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -538,7 +540,7 @@ pub fn state_matrix(params: &SVector<f64, 4>) -> SMatrix<f64, 4, 4> {
 ///
 /// From eq. (LTI).
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 ///
 /// Cost per call: 31 operations, weighted 68 (4 ADD, 5 DIV, 18 MUL, 2 NEG, 2 POW).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -567,7 +569,7 @@ pub fn input_matrix(params: &SVector<f64, 4>) -> SMatrix<f64, 4, 2> {
 ///
 /// From appendix "Task specific controllers".
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 ///
 /// Cost per call: 31 operations, weighted 61 (3 ADD, 4 DIV, 16 MUL, 4 NEG, 2 POW, 2 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -605,7 +607,7 @@ pub fn position_sensitivity(
 ///
 /// From eq. (control_conf) and the closed forms after it.
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 /// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
@@ -666,7 +668,7 @@ pub fn position_control_confidence(
 ///
 /// From eq. (control_conf) differentiated in the tool parameters.
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 /// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
@@ -838,7 +840,7 @@ pub fn position_logdet_gradient(
 ///
 /// From appendix "Task specific controllers".
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 ///
 /// Cost per call: 8 operations, weighted 29 (1 ADD, 3 DIV, 3 MUL, 1 NEG).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -868,7 +870,7 @@ pub fn velocity_sensitivity(params: &SVector<f64, 4>) -> (SMatrix<f64, 2, 2>, SM
 ///
 /// From eq. (control_conf) and the closed forms after it.
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
@@ -920,7 +922,7 @@ pub fn velocity_control_confidence(
 ///
 /// From eq. (control_conf) differentiated in the tool parameters.
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
@@ -1036,7 +1038,7 @@ pub fn velocity_logdet_gradient(
 ///
 /// From appendix "Task specific controllers".
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 ///
 /// Cost per call: 0 operations, weighted 0.
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -1054,7 +1056,7 @@ pub fn acceleration_sensitivity(_params: &SVector<f64, 4>) -> SMatrix<f64, 2, 2>
 ///
 /// From eq. (control_conf) and the closed forms after it.
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
 ///
@@ -1086,7 +1088,7 @@ pub fn acceleration_control_confidence(
 ///
 /// From eq. (control_conf) differentiated in the tool parameters.
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2]
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
 ///

@@ -10,9 +10,11 @@
 
 #![allow(clippy::all)]
 
-use nalgebra::{SMatrix, SVector};
 #[allow(unused_imports)]
-use std::f64::consts::PI;
+use crate::powi::Powi;
+#[allow(unused_imports)]
+use core::f64::consts::PI;
+use nalgebra::{SMatrix, SVector};
 
 /// Name of the model description.
 pub const NAME: &str = "arm2_payload";
@@ -220,7 +222,7 @@ pub struct DynamicsCoefficients {
 }
 
 impl DynamicsCoefficients {
-    /// - `params`: tool parameters [m1 m2 l1 l2 mp]
+    /// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
     ///
     /// Cost, once per tool: 49 operations, weighted 88 (8 ADD, 5 DIV, 24 MUL, 8 NEG, 4 POW) (derive/toolconf_derive/cost.py).
     #[inline]
@@ -269,9 +271,9 @@ impl DynamicsCoefficients {
 ///
 /// From Lagrangian mechanics of uniform rods.
 ///
-/// - `x`: state X = [theta1 theta2 theta1_dot theta2_dot]
-/// - `u`: control U = [torque1 torque2]
-/// - `params`: tool parameters [m1 m2 l1 l2 mp]
+/// - `x`: state X = `[theta1 theta2 theta1_dot theta2_dot]`
+/// - `u`: control U = `[torque1 torque2]`
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
 ///
 /// Cost per call: 97 operations, weighted 146, plus 2 `sin_cos`: [`DynamicsCoefficients::new`] (49, weighted 88), then [`dynamics_with`] (48, weighted 58). Build the coefficients once per tool and call [`dynamics_with`] where it is called often.
 /// The same closed form with the parameters inline (not hoisted) would take 86 operations, weighted 128 (14 ADD, 5 DIV, 49 MUL, 7 POW, 11 SUB), plus 2 `sin_cos`.
@@ -350,7 +352,7 @@ pub struct DynamicsJacobianCoefficients {
 }
 
 impl DynamicsJacobianCoefficients {
-    /// - `params`: tool parameters [m1 m2 l1 l2 mp]
+    /// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
     ///
     /// Cost, once per tool: 89 operations, weighted 163 (8 ADD, 10 DIV, 46 MUL, 21 NEG, 4 POW) (derive/toolconf_derive/cost.py).
     #[inline]
@@ -433,9 +435,9 @@ impl DynamicsJacobianCoefficients {
 ///
 /// From Lagrangian mechanics of uniform rods.
 ///
-/// - `x`: state X = [theta1 theta2 theta1_dot theta2_dot]
-/// - `u`: control U = [torque1 torque2]
-/// - `params`: tool parameters [m1 m2 l1 l2 mp]
+/// - `x`: state X = `[theta1 theta2 theta1_dot theta2_dot]`
+/// - `u`: control U = `[torque1 torque2]`
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
 ///
 /// Cost per call: 223 operations, weighted 315, plus 2 `sin_cos`: [`DynamicsJacobianCoefficients::new`] (89, weighted 163), then [`dynamics_jacobian_with`] (134, weighted 152). Build the coefficients once per tool and call [`dynamics_jacobian_with`] where it is called often.
 /// The same closed form with the parameters inline (not hoisted) would take 208 operations, weighted 307 (26 ADD, 13 DIV, 127 MUL, 8 NEG, 8 POW, 26 SUB), plus 2 `sin_cos`.
@@ -568,7 +570,7 @@ pub fn dynamics_jacobian_with(
 ///
 /// From eq. (LTI).
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2 mp]
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
 ///
 /// Cost per call: 36 operations, weighted 59 (9 ADD, 3 DIV, 20 MUL, 2 NEG, 2 POW).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -604,7 +606,7 @@ pub fn state_matrix(params: &SVector<f64, 5>) -> SMatrix<f64, 4, 4> {
 ///
 /// From eq. (LTI).
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2 mp]
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
 ///
 /// Cost per call: 50 operations, weighted 88 (11 ADD, 5 DIV, 29 MUL, 2 NEG, 3 POW).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -638,7 +640,7 @@ pub fn input_matrix(params: &SVector<f64, 5>) -> SMatrix<f64, 4, 2> {
 ///
 /// From appendix "Task specific controllers".
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2 mp]
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
 ///
 /// Cost per call: 41 operations, weighted 71 (8 ADD, 4 DIV, 21 MUL, 4 NEG, 2 POW, 2 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -681,7 +683,7 @@ pub fn position_sensitivity(
 ///
 /// From eq. (control_conf) and the closed forms after it.
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2 mp]
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
 /// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
@@ -747,7 +749,7 @@ pub fn position_control_confidence(
 ///
 /// From eq. (control_conf) differentiated in the tool parameters.
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2 mp]
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
 /// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
@@ -942,7 +944,7 @@ pub fn position_logdet_gradient(
 ///
 /// From appendix "Task specific controllers".
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2 mp]
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
 ///
 /// Cost per call: 11 operations, weighted 32 (3 ADD, 3 DIV, 4 MUL, 1 NEG).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -974,7 +976,7 @@ pub fn velocity_sensitivity(params: &SVector<f64, 5>) -> (SMatrix<f64, 2, 2>, SM
 ///
 /// From eq. (control_conf) and the closed forms after it.
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2 mp]
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
@@ -1028,7 +1030,7 @@ pub fn velocity_control_confidence(
 ///
 /// From eq. (control_conf) differentiated in the tool parameters.
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2 mp]
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
@@ -1157,7 +1159,7 @@ pub fn velocity_logdet_gradient(
 ///
 /// From appendix "Task specific controllers".
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2 mp]
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
 ///
 /// Cost per call: 0 operations, weighted 0.
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -1175,7 +1177,7 @@ pub fn acceleration_sensitivity(_params: &SVector<f64, 5>) -> SMatrix<f64, 2, 2>
 ///
 /// From eq. (control_conf) and the closed forms after it.
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2 mp]
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
 ///
@@ -1207,7 +1209,7 @@ pub fn acceleration_control_confidence(
 ///
 /// From eq. (control_conf) differentiated in the tool parameters.
 ///
-/// - `params`: tool parameters [m1 m2 l1 l2 mp]
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
 ///

@@ -10,9 +10,11 @@
 
 #![allow(clippy::all)]
 
-use nalgebra::{SMatrix, SVector};
 #[allow(unused_imports)]
-use std::f64::consts::PI;
+use crate::powi::Powi;
+#[allow(unused_imports)]
+use core::f64::consts::PI;
+use nalgebra::{SMatrix, SVector};
 
 /// Name of the model description.
 pub const NAME: &str = "arm3";
@@ -227,7 +229,7 @@ pub struct DynamicsCoefficients {
 }
 
 impl DynamicsCoefficients {
-    /// - `params`: tool parameters [m1 m2 m3 l1 l2 l3]
+    /// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
     ///
     /// Cost, once per tool: 127 operations, weighted 244 (11 ADD, 16 DIV, 69 MUL, 26 NEG, 5 POW) (derive/toolconf_derive/cost.py).
     #[inline]
@@ -323,9 +325,9 @@ impl DynamicsCoefficients {
 ///
 /// From Lagrangian mechanics of uniform rods.
 ///
-/// - `x`: state X = [theta1 theta2 theta3 theta1_dot theta2_dot theta3_dot]
-/// - `u`: control U = [torque1 torque2 torque3]
-/// - `params`: tool parameters [m1 m2 m3 l1 l2 l3]
+/// - `x`: state X = `[theta1 theta2 theta3 theta1_dot theta2_dot theta3_dot]`
+/// - `u`: control U = `[torque1 torque2 torque3]`
+/// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
 ///
 /// Cost per call: 263 operations, weighted 393, plus 3 `sin_cos`: [`DynamicsCoefficients::new`] (127, weighted 244), then [`dynamics_with`] (136, weighted 149). Build the coefficients once per tool and call [`dynamics_with`] where it is called often.
 /// The same closed form with the parameters inline (not hoisted) would take 244 operations, weighted 381 (31 ADD, 18 DIV, 152 MUL, 11 POW, 32 SUB), plus 3 `sin_cos`.
@@ -464,7 +466,7 @@ pub struct DynamicsJacobianCoefficients {
 }
 
 impl DynamicsJacobianCoefficients {
-    /// - `params`: tool parameters [m1 m2 m3 l1 l2 l3]
+    /// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
     ///
     /// Cost, once per tool: 160 operations, weighted 312 (11 ADD, 21 DIV, 85 MUL, 38 NEG, 5 POW) (derive/toolconf_derive/cost.py).
     #[inline]
@@ -588,9 +590,9 @@ impl DynamicsJacobianCoefficients {
 ///
 /// From Lagrangian mechanics of uniform rods.
 ///
-/// - `x`: state X = [theta1 theta2 theta3 theta1_dot theta2_dot theta3_dot]
-/// - `u`: control U = [torque1 torque2 torque3]
-/// - `params`: tool parameters [m1 m2 m3 l1 l2 l3]
+/// - `x`: state X = `[theta1 theta2 theta3 theta1_dot theta2_dot theta3_dot]`
+/// - `u`: control U = `[torque1 torque2 torque3]`
+/// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
 ///
 /// Cost per call: 626 operations, weighted 799, plus 3 `sin_cos`: [`DynamicsJacobianCoefficients::new`] (160, weighted 312), then [`dynamics_jacobian_with`] (466, weighted 487). Build the coefficients once per tool and call [`dynamics_jacobian_with`] where it is called often.
 /// The same closed form with the parameters inline (not hoisted) would take 601 operations, weighted 753 (94 ADD, 20 DIV, 372 MUL, 15 NEG, 12 POW, 88 SUB), plus 3 `sin_cos`.
@@ -873,7 +875,7 @@ pub fn dynamics_jacobian_with(
 ///
 /// From eq. (LTI).
 ///
-/// - `params`: tool parameters [m1 m2 m3 l1 l2 l3]
+/// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
 ///
 /// Cost per call: 65 operations, weighted 108 (13 ADD, 6 DIV, 40 MUL, 5 NEG, 1 POW).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -927,7 +929,7 @@ pub fn state_matrix(params: &SVector<f64, 6>) -> SMatrix<f64, 6, 6> {
 ///
 /// From eq. (LTI).
 ///
-/// - `params`: tool parameters [m1 m2 m3 l1 l2 l3]
+/// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
 ///
 /// Cost per call: 97 operations, weighted 150 (24 ADD, 7 DIV, 58 MUL, 4 NEG, 4 POW).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -982,7 +984,7 @@ pub fn input_matrix(params: &SVector<f64, 6>) -> SMatrix<f64, 6, 3> {
 ///
 /// From appendix "Task specific controllers".
 ///
-/// - `params`: tool parameters [m1 m2 m3 l1 l2 l3]
+/// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
 ///
 /// Cost per call: 59 operations, weighted 111 (9 ADD, 7 DIV, 29 MUL, 8 NEG, 3 POW, 3 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -1037,7 +1039,7 @@ pub fn position_sensitivity(
 ///
 /// From eq. (control_conf) and the closed forms after it.
 ///
-/// - `params`: tool parameters [m1 m2 m3 l1 l2 l3]
+/// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
 /// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
@@ -1137,7 +1139,7 @@ pub fn position_control_confidence(
 ///
 /// From eq. (control_conf) differentiated in the tool parameters.
 ///
-/// - `params`: tool parameters [m1 m2 m3 l1 l2 l3]
+/// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
 /// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
@@ -1612,7 +1614,7 @@ pub fn position_logdet_gradient(
 ///
 /// From appendix "Task specific controllers".
 ///
-/// - `params`: tool parameters [m1 m2 m3 l1 l2 l3]
+/// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
 ///
 /// Cost per call: 14 operations, weighted 42 (3 ADD, 4 DIV, 5 MUL, 2 NEG).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -1649,7 +1651,7 @@ pub fn velocity_sensitivity(params: &SVector<f64, 6>) -> (SMatrix<f64, 3, 3>, SM
 ///
 /// From eq. (control_conf) and the closed forms after it.
 ///
-/// - `params`: tool parameters [m1 m2 m3 l1 l2 l3]
+/// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
@@ -1726,7 +1728,7 @@ pub fn velocity_control_confidence(
 ///
 /// From eq. (control_conf) differentiated in the tool parameters.
 ///
-/// - `params`: tool parameters [m1 m2 m3 l1 l2 l3]
+/// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
@@ -1953,7 +1955,7 @@ pub fn velocity_logdet_gradient(
 ///
 /// From appendix "Task specific controllers".
 ///
-/// - `params`: tool parameters [m1 m2 m3 l1 l2 l3]
+/// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
 ///
 /// Cost per call: 0 operations, weighted 0.
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -1972,7 +1974,7 @@ pub fn acceleration_sensitivity(_params: &SVector<f64, 6>) -> SMatrix<f64, 3, 3>
 ///
 /// From eq. (control_conf) and the closed forms after it.
 ///
-/// - `params`: tool parameters [m1 m2 m3 l1 l2 l3]
+/// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
 ///
@@ -2015,7 +2017,7 @@ pub fn acceleration_control_confidence(
 ///
 /// From eq. (control_conf) differentiated in the tool parameters.
 ///
-/// - `params`: tool parameters [m1 m2 m3 l1 l2 l3]
+/// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
 ///

@@ -10,9 +10,11 @@
 
 #![allow(clippy::all)]
 
-use nalgebra::{SMatrix, SVector};
 #[allow(unused_imports)]
-use std::f64::consts::PI;
+use crate::powi::Powi;
+#[allow(unused_imports)]
+use core::f64::consts::PI;
+use nalgebra::{SMatrix, SVector};
 
 /// Name of the model description.
 pub const NAME: &str = "msd";
@@ -217,7 +219,7 @@ pub struct DynamicsCoefficients {
 }
 
 impl DynamicsCoefficients {
-    /// - `params`: tool parameters [m k c]
+    /// - `params`: tool parameters `[m k c]`
     ///
     /// Cost, once per tool: 5 operations, weighted 12 (1 DIV, 2 MUL, 2 NEG) (derive/toolconf_derive/cost.py).
     #[inline]
@@ -237,9 +239,9 @@ impl DynamicsCoefficients {
 ///
 /// From Newton's second law for the mass.
 ///
-/// - `x`: state X = [z z_dot]
-/// - `u`: control U = [force]
-/// - `params`: tool parameters [m k c]
+/// - `x`: state X = `[z z_dot]`
+/// - `u`: control U = `[force]`
+/// - `params`: tool parameters `[m k c]`
 ///
 /// Cost per call: 10 operations, weighted 17: [`DynamicsCoefficients::new`] (5, weighted 12), then [`dynamics_with`] (5, weighted 5). Build the coefficients once per tool and call [`dynamics_with`] where it is called often.
 /// The same closed form with the parameters inline (not hoisted) would take 5 operations, weighted 12 (1 DIV, 2 MUL, 2 SUB).
@@ -285,7 +287,7 @@ pub struct DynamicsJacobianCoefficients {
 }
 
 impl DynamicsJacobianCoefficients {
-    /// - `params`: tool parameters [m k c]
+    /// - `params`: tool parameters `[m k c]`
     ///
     /// Cost, once per tool: 5 operations, weighted 12 (1 DIV, 2 MUL, 2 NEG) (derive/toolconf_derive/cost.py).
     #[inline]
@@ -305,9 +307,9 @@ impl DynamicsJacobianCoefficients {
 ///
 /// From Newton's second law for the mass.
 ///
-/// - `x`: state X = [z z_dot]
-/// - `u`: control U = [force]
-/// - `params`: tool parameters [m k c]
+/// - `x`: state X = `[z z_dot]`
+/// - `u`: control U = `[force]`
+/// - `params`: tool parameters `[m k c]`
 ///
 /// Cost per call: 5 operations, weighted 12: [`DynamicsJacobianCoefficients::new`] (5, weighted 12), then [`dynamics_jacobian_with`] (0, weighted 0). Build the coefficients once per tool and call [`dynamics_jacobian_with`] where it is called often.
 /// The same closed form with the parameters inline (not hoisted) would take 5 operations, weighted 12 (1 DIV, 2 MUL, 2 NEG).
@@ -350,7 +352,7 @@ pub fn dynamics_jacobian_with(
 ///
 /// From eq. (LTI).
 ///
-/// - `params`: tool parameters [m k c]
+/// - `params`: tool parameters `[m k c]`
 ///
 /// Cost per call: 5 operations, weighted 12 (1 DIV, 2 MUL, 2 NEG).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -373,7 +375,7 @@ pub fn state_matrix(params: &SVector<f64, 3>) -> SMatrix<f64, 2, 2> {
 ///
 /// From eq. (LTI).
 ///
-/// - `params`: tool parameters [m k c]
+/// - `params`: tool parameters `[m k c]`
 ///
 /// Cost per call: 1 operation, weighted 8 (1 DIV).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -391,7 +393,7 @@ pub fn input_matrix(params: &SVector<f64, 3>) -> SVector<f64, 2> {
 ///
 /// From appendix "Task specific controllers".
 ///
-/// - `params`: tool parameters [m k c]
+/// - `params`: tool parameters `[m k c]`
 ///
 /// Cost per call: 4 operations, weighted 11 (1 ADD, 1 DIV, 1 NEG, 1 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -419,7 +421,7 @@ pub fn position_sensitivity(
 ///
 /// From eq. (control_conf) and the closed forms after it.
 ///
-/// - `params`: tool parameters [m k c]
+/// - `params`: tool parameters `[m k c]`
 /// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
@@ -454,7 +456,7 @@ pub fn position_control_confidence(
 ///
 /// From eq. (control_conf) differentiated in the tool parameters.
 ///
-/// - `params`: tool parameters [m k c]
+/// - `params`: tool parameters `[m k c]`
 /// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
@@ -494,7 +496,7 @@ pub fn position_logdet_gradient(
 ///
 /// From appendix "Task specific controllers".
 ///
-/// - `params`: tool parameters [m k c]
+/// - `params`: tool parameters `[m k c]`
 ///
 /// Cost per call: 1 operation, weighted 8 (1 DIV).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -515,7 +517,7 @@ pub fn velocity_sensitivity(params: &SVector<f64, 3>) -> (SVector<f64, 1>, SVect
 ///
 /// From eq. (control_conf) and the closed forms after it.
 ///
-/// - `params`: tool parameters [m k c]
+/// - `params`: tool parameters `[m k c]`
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
@@ -544,7 +546,7 @@ pub fn velocity_control_confidence(
 ///
 /// From eq. (control_conf) differentiated in the tool parameters.
 ///
-/// - `params`: tool parameters [m k c]
+/// - `params`: tool parameters `[m k c]`
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
@@ -574,7 +576,7 @@ pub fn velocity_logdet_gradient(
 ///
 /// From appendix "Task specific controllers".
 ///
-/// - `params`: tool parameters [m k c]
+/// - `params`: tool parameters `[m k c]`
 ///
 /// Cost per call: 0 operations, weighted 0.
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -591,7 +593,7 @@ pub fn acceleration_sensitivity(_params: &SVector<f64, 3>) -> SVector<f64, 1> {
 ///
 /// From eq. (control_conf) and the closed forms after it.
 ///
-/// - `params`: tool parameters [m k c]
+/// - `params`: tool parameters `[m k c]`
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
 ///
@@ -616,7 +618,7 @@ pub fn acceleration_control_confidence(
 ///
 /// From eq. (control_conf) differentiated in the tool parameters.
 ///
-/// - `params`: tool parameters [m k c]
+/// - `params`: tool parameters `[m k c]`
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
 ///

@@ -1,16 +1,19 @@
 //! Renders a toolconf derivation IR (the JSON that `derive/derive.py` writes) through the Tera
-//! templates in `templates/` into the files under `generated/`.
+//! templates in `templates/` into the generated crate (`generated/`, the package
+//! toolconf-generated; or a crate of a user's own with `make crate`).
 //!
-//! A template named `<kind>.<ext>.tera` renders to `<model>.<ext>`, once per model; a template in
-//! `templates/registry/` named `<file>.tera` renders once over all models to `<file>` (the
-//! generated model registry, `generated/mod.rs`). Rust output goes through rustfmt so that the
+//! A template named `<kind>.<ext>.tera` renders to `<model>.<ext>`, once per model, which
+//! [`crate_path`] places in the crate (Rust sources under `src/`); a template under
+//! `templates/registry/`, at `<path>.tera`, renders once over all models to `<path>` in the crate:
+//! that folder is laid out as the crate (`Cargo.toml`, `src/lib.rs` with the model registry,
+//! `src/tasks.rs`, `tests/vectors.rs`, ...). Rust output goes through rustfmt so that the
 //! checked-in code is exactly what `make derive` produces.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-use serde_json::Value;
+use serde_json::{json, Value};
 use tera::{Context, Tera};
 
 mod tasks;
@@ -99,6 +102,68 @@ pub fn load_templates(dir: &Path) -> Result<Vec<(String, String)>, RenderError> 
         .collect()
 }
 
+/// Loads every `*.tera` file under `dir` and its sub-folders, in path order, each named by its
+/// path relative to `dir` with `/` between folders (`src/lib.rs.tera`): the registry templates,
+/// laid out as the crate they render to.
+pub fn load_template_tree(dir: &Path) -> Result<Vec<(String, String)>, RenderError> {
+    let mut out = Vec::new();
+    let mut pending = vec![PathBuf::new()];
+    while let Some(relative) = pending.pop() {
+        let folder = dir.join(&relative);
+        let io = |source| RenderError::Io {
+            path: folder.clone(),
+            source,
+        };
+        for entry in std::fs::read_dir(&folder).map_err(io)? {
+            let entry = entry.map_err(io)?;
+            let name = relative.join(entry.file_name());
+            if entry.file_type().map_err(io)?.is_dir() {
+                pending.push(name);
+            } else if name.extension().is_some_and(|x| x == "tera") {
+                let path = dir.join(&name);
+                let text = std::fs::read_to_string(&path)
+                    .map_err(|source| RenderError::Io { path, source })?;
+                let parts: Vec<String> = name
+                    .components()
+                    .map(|c| c.as_os_str().to_string_lossy().into_owned())
+                    .collect();
+                out.push((parts.join("/"), text));
+            }
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
+/// Where a per-model file goes in the crate: Rust sources (`arm2.rs`) are modules under `src/`,
+/// the rest (`arm2.md`, and the IR and vectors that derive.py writes) stays at the crate root.
+pub fn crate_path(file_name: &str) -> PathBuf {
+    if file_name.ends_with(".rs") {
+        Path::new("src").join(file_name)
+    } else {
+        PathBuf::from(file_name)
+    }
+}
+
+/// The crate the registry renders: its package name, and whether it is a crate of its own
+/// (`make crate`: an empty `[workspace]` table, so that no enclosing workspace claims it) or a
+/// member of toolconf's workspace (`generated/`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Package {
+    pub name: String,
+    pub standalone: bool,
+}
+
+impl Package {
+    /// toolconf's own generated crate, `generated/`.
+    pub fn in_repository() -> Self {
+        Self {
+            name: "toolconf-generated".into(),
+            standalone: false,
+        }
+    }
+}
+
 /// A Tera engine over the templates, with no HTML escaping (the outputs are Rust and Markdown).
 fn engine(templates: &[(String, String)]) -> Result<Tera, RenderError> {
     let mut tera = Tera::default();
@@ -172,22 +237,108 @@ fn registry_entry(ir: &Value) -> Result<Value, RenderError> {
     // A Rust string literal (quotes escaped) for the macro's arguments.
     let title = model.get("title").and_then(Value::as_str).unwrap_or(name);
     entry["title_literal"] = Value::from(format!("{title:?}"));
+    entry["functions"] = Value::from(
+        ir.get("functions")
+            .and_then(Value::as_array)
+            .map(|fs| fs.iter().map(vector_test_entry).collect::<Vec<_>>())
+            .unwrap_or_default(),
+    );
     Ok(entry)
 }
 
-/// Renders the registry templates once over all models (in the order given).
+/// What the vector test needs of one generated function: its argument and output names, and
+/// the pattern binding its outputs (a one-output function returns the matrix, not a 1-tuple).
+fn vector_test_entry(function: &Value) -> Value {
+    let names = |key: &str| -> Vec<String> {
+        function
+            .get(key)
+            .and_then(Value::as_array)
+            .map(|a| {
+                a.iter()
+                    .filter_map(|x| x.get("name").and_then(Value::as_str).map(String::from))
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    let outputs = names("outputs");
+    let pattern = match outputs.as_slice() {
+        [one] => one.clone(),
+        many => format!("({})", many.join(", ")),
+    };
+    json!({
+        "name": function.get("name").cloned().unwrap_or(Value::Null),
+        "args": names("args"),
+        "outputs": outputs,
+        "pattern": pattern,
+    })
+}
+
+/// The same `generator` entry of every IR (the command, the task definitions), or an error
+/// naming the first model that differs.
+fn shared_generator(irs: &[Value], key: &str) -> Result<String, RenderError> {
+    let of = |ir: &Value| {
+        ir.pointer(&format!("/generator/{key}"))
+            .and_then(Value::as_str)
+            .unwrap_or("")
+            .to_string()
+    };
+    let first = irs.first().map(of).unwrap_or_default();
+    match irs.iter().find(|ir| of(ir) != first) {
+        Some(ir) => Err(RenderError::Template(format!(
+            "model {} has generator.{key} {:?}, the first model {first:?}: the models of one crate come from one run",
+            ir.pointer("/model/name").cloned().unwrap_or(Value::Null),
+            of(ir)
+        ))),
+        None => Ok(first),
+    }
+}
+
+/// "position, velocity or acceleration (or 1, 2, 3)": how messages list the tasks, as a Rust
+/// string literal.
+fn task_choices(tasks: &[Value]) -> String {
+    let names: Vec<&str> = tasks
+        .iter()
+        .filter_map(|t| t.get("name").and_then(Value::as_str))
+        .collect();
+    let numbers: Vec<String> = tasks
+        .iter()
+        .filter_map(|t| t.get("index").and_then(Value::as_u64))
+        .map(|n| n.to_string())
+        .collect();
+    let names = match names.split_last() {
+        Some((last, [])) => last.to_string(),
+        Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+        None => String::new(),
+    };
+    format!("{:?}", format!("{names} (or {})", numbers.join(", ")))
+}
+
+/// Renders the registry templates once over all models (in the order given), for `package`.
 pub fn render_registry(
     irs: &[Value],
     templates: &[(String, String)],
+    package: &Package,
 ) -> Result<Vec<Rendered>, RenderError> {
     let models = irs
         .iter()
         .map(registry_entry)
         .collect::<Result<Vec<_>, _>>()?;
     let tera = engine(templates)?;
+    let tasks = tasks::task_list(irs)?;
     let mut context = Context::new();
     context.insert("models", &models);
-    context.insert("tasks", &tasks::task_list(irs)?);
+    context.insert("task_choices", &task_choices(&tasks));
+    context.insert("tasks", &tasks);
+    context.insert(
+        "package",
+        &json!({
+            "name": package.name,
+            "lib": package.name.replace('-', "_"),
+            "standalone": package.standalone,
+            "command": shared_generator(irs, "command")?,
+            "tasks": shared_generator(irs, "tasks")?,
+        }),
+    );
     templates
         .iter()
         .map(|(name, _)| {
