@@ -1,7 +1,8 @@
 //! Control confidence per tool, Π^U and ln|Π^U|, for each of the paper's tasks:
 //!
 //! * `checked`: [`control_confidence`], the public API (validates the task, checks Π^U ≻ 0);
-//! * `unchecked`: [`pi_u`] and the log-determinant, the per-tool work once the task is validated;
+//! * `unchecked`: Π^U ([`ArmModel::pi_u`]) and the log-determinant, the per-tool work once the
+//!   task is validated;
 //! * `checked_1000_tools`: the API over 1000 random tools (per tool: the time / 1000, printed as
 //!   throughput);
 //! * `validated`, `validated_1000_tools`: the ranking path, the task checked once
@@ -15,16 +16,13 @@
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use toolconf::confidence::pi_u;
-use toolconf::model::{Arm2Tool, TaskN, ValidatedTaskN};
+use toolconf::model::{Arm2, ArmModel, ValidatedTaskN};
 use toolconf::select::draw_tools;
 use toolconf::{control_confidence, Arm, Task, TaskKind};
 
 fn confidence(c: &mut Criterion) {
-    let arm = Arm::new(0.3, 0.4, 0.5, 0.2).unwrap();
+    let arm = Arm::new([0.3, 0.4, 0.5, 0.2]).unwrap();
     let tools = draw_tools(1000, 42);
-    let tool = Arm2Tool::from(&arm);
-    let generic_tools: Vec<Arm2Tool> = tools.iter().map(Arm2Tool::from).collect();
     let mut group = c.benchmark_group("confidence");
     for kind in TaskKind::ALL {
         let task = Task::paper(kind);
@@ -34,16 +32,16 @@ fn confidence(c: &mut Criterion) {
         });
         group.bench_function(format!("{kind}/unchecked"), |b| {
             b.iter(|| {
-                let p = pi_u(black_box(&arm), black_box(&task));
+                let p = Arm2::pi_u(black_box(&task), &black_box(&arm).params());
                 let logdet = (p[(0, 0)] * p[(1, 1)] - p[(0, 1)] * p[(1, 0)]).ln();
                 (p, logdet)
             })
         });
-        let validated: ValidatedTaskN<2> = TaskN::from(&task).validated().unwrap();
+        let validated: ValidatedTaskN<2> = task.validated().unwrap();
         group.bench_function(format!("{kind}/validated"), |b| {
             b.iter(|| {
                 black_box(&validated)
-                    .control_confidence(black_box(&tool))
+                    .control_confidence(black_box(&arm))
                     .unwrap()
             })
         });
@@ -51,7 +49,7 @@ fn confidence(c: &mut Criterion) {
         group.bench_function(format!("{kind}/validated_1000_tools"), |b| {
             b.iter(|| {
                 let v = black_box(&validated);
-                black_box(&generic_tools)
+                black_box(&tools)
                     .iter()
                     .map(|t| v.control_confidence(t).unwrap().logdet)
                     .sum::<f64>()
@@ -60,7 +58,7 @@ fn confidence(c: &mut Criterion) {
         group.bench_function(format!("{kind}/pi_u_1000_tools"), |b| {
             b.iter(|| {
                 let v = black_box(&validated);
-                black_box(&generic_tools)
+                black_box(&tools)
                     .iter()
                     .map(|t| {
                         let p = v.pi_u(t);

@@ -7,13 +7,13 @@
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use toolconf::closed_loop::{simulate, ClosedLoop, EpisodeOptions, JointState};
+use toolconf::closed_loop::{simulate, ClosedLoop, EpisodeOptions, JointState, Plant};
 use toolconf::select::{draw_tools, evaluate};
 use toolconf::{Arm, Task, TaskKind};
 
 /// The fixed arm of the README (m1, m2, l1, l2).
 fn arm() -> Arm {
-    Arm::new(0.3, 0.4, 0.5, 0.2).unwrap()
+    Arm::new([0.3, 0.4, 0.5, 0.2]).unwrap()
 }
 
 fn rhs(c: &mut Criterion) {
@@ -73,7 +73,7 @@ fn batch(c: &mut Criterion) {
             "position_1000_tools_{}_threads",
             rayon::current_num_threads()
         ),
-        |b| b.iter(|| evaluate(black_box(&tools), &task, &options)),
+        |b| b.iter(|| evaluate(black_box(&tools), &task, &options, Plant::Paper)),
     );
     group.finish();
 }

@@ -6,7 +6,7 @@
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use toolconf::experiments::{reproduce, Config, Plan};
+use toolconf_report::experiments::{reproduce, Config, Plan};
 
 fn default_reproduce(c: &mut Criterion) {
     let out_dir =

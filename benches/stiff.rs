@@ -21,7 +21,7 @@ const ARMS: [[f64; 4]; 3] = [
 fn task3_episode(c: &mut Criterion) {
     let task = Task::paper(TaskKind::Acceleration);
     for p in ARMS {
-        let arm = Arm::new(p[0], p[1], p[2], p[3]).unwrap();
+        let arm = Arm::new([p[0], p[1], p[2], p[3]]).unwrap();
         let mut group = c.benchmark_group(format!("task3/{}_{}_{}_{}", p[0], p[1], p[2], p[3]));
         // DP5 needs 289k right-hand sides on the smallest arm.
         group.sample_size(if p[0] < 0.2 { 10 } else { 30 });
@@ -41,7 +41,7 @@ fn task3_episode(c: &mut Criterion) {
 }
 
 fn jacobian(c: &mut Criterion) {
-    let arm = Arm::new(0.3, 0.4, 0.5, 0.2).unwrap();
+    let arm = Arm::new([0.3, 0.4, 0.5, 0.2]).unwrap();
     let system = ClosedLoop::new(&arm, &Task::paper(TaskKind::Acceleration), 1.0, 0.0).unwrap();
     let z = JointState::from([-1.2, -1.9, 0.7, -0.4, 0.3, -0.2]);
     let mut group = c.benchmark_group("closed_loop");

@@ -18,7 +18,7 @@ use std::time::Instant;
 
 use nalgebra::SVector;
 use toolconf::generated::arm2::DynamicsCoefficients;
-use toolconf::model::{Arm2, Arm2Tool, ClosedLoopN, TaskN};
+use toolconf::model::{Arm2, ArmModel, ClosedLoopN, TaskN};
 use toolconf::select::draw_tools;
 use toolconf::{Task, TaskKind};
 
@@ -87,7 +87,7 @@ impl<const W: usize> L<W> {
 
 #[inline(always)]
 fn sin_cos<const W: usize>(x: L<W>) -> (L<W>, L<W>) {
-    let (s, c) = toolconf::trig::sin_cos_lanes(x.0);
+    let (s, c) = toolconf::generated::trig::sin_cos_lanes(x.0);
     (L(s), L(c))
 }
 
@@ -330,7 +330,7 @@ fn run_lanes_avx2<const W: usize>(loops: &[Loop<1>], z0: &Z<1>) -> Vec<([f64; 6]
 }
 
 fn lane_loop(arm: &toolconf::Arm, task: &TaskN<2>) -> (Loop<1>, ClosedLoopN<Arm2, 2, 4, 4, 6>) {
-    let tool = Arm2Tool::from(arm);
+    let tool = *arm;
     let cl = ClosedLoopN::<Arm2, 2, 4, 4, 6>::new(&tool, task, 1.0, 0.0).expect("closed loop");
     let coeff = DynamicsCoefficients::new(&tool.params());
     let gains = cl.controller.scaled_gains();
@@ -377,10 +377,10 @@ fn main() {
     println!("| task | lanes | build | µs per tool | × width 1 | mean RHS | bits = width 1 |");
     println!("|---|---:|---|---:|---:|---:|---|");
     for kind in kinds {
-        let task = TaskN::<2>::from(&Task::paper(kind));
+        let task = Task::paper(kind);
         let pairs: Vec<_> = arms.iter().map(|a| lane_loop(a, &task)).collect();
         let loops: Vec<Loop<1>> = pairs.iter().map(|p| p.0).collect();
-        let x0 = toolconf::Arm::equilibrium_state();
+        let x0 = Arm2::equilibrium_state();
         let z0: Z<1> = [x0[0], x0[1], x0[2], x0[3], 0.1, 0.1].map(|v| L([v]));
         // The width-1 right-hand side is the library's, bit for bit.
         for (p, cl) in pairs.iter().take(50) {

@@ -36,7 +36,7 @@ fn arm_from(v: &Value) -> Result<Arm, String> {
         _ => Vec::new(),
     };
     match numbers[..] {
-        [m1, m2, l1, l2] => Arm::new(m1, m2, l1, l2).map_err(|e| e.to_string()),
+        [m1, m2, l1, l2] => Arm::new([m1, m2, l1, l2]).map_err(|e| e.to_string()),
         _ => Err(format!("not a tool: {v}")),
     }
 }

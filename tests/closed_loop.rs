@@ -3,7 +3,8 @@
 //! determinism of selection across thread counts.
 
 use proptest::prelude::*;
-use toolconf::closed_loop::{simulate, EpisodeOptions, Metrics};
+use toolconf::closed_loop::{simulate, EpisodeOptions, Metrics, Plant};
+use toolconf::model::{Arm2, ArmModel};
 use toolconf::select::{draw_tools, evaluate, Objective};
 use toolconf::{Arm, Task, TaskKind, Vector2};
 
@@ -14,7 +15,7 @@ const ARMS: [[f64; 4]; 3] = [
 ];
 
 fn arm(p: [f64; 4]) -> Arm {
-    Arm::new(p[0], p[1], p[2], p[3]).unwrap()
+    Arm::new([p[0], p[1], p[2], p[3]]).unwrap()
 }
 
 fn run(arm: &Arm, kind: TaskKind, options: &EpisodeOptions) -> Metrics {
@@ -81,7 +82,7 @@ fn trajectory_is_on_the_paper_grid_and_starts_at_the_initial_conditions() {
     assert!((tr.t[1] - 0.05).abs() < 1e-15);
     assert_eq!(
         tr.theta[0],
-        Arm::equilibrium_state().fixed_rows::<2>(0).into_owned()
+        Arm2::equilibrium_state().fixed_rows::<2>(0).into_owned()
     );
     assert_eq!(tr.u[0], Vector2::new(0.1, 0.1));
     // The recorded task error is the sum of the per-sample errors on this trajectory.
@@ -158,7 +159,7 @@ fn selection_is_identical_for_any_thread_count() {
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| evaluate(&tools, &task, &options))
+            .install(|| evaluate(&tools, &task, &options, Plant::Paper))
     };
     let one = with(1);
     let two = with(2);
@@ -181,7 +182,7 @@ fn tools_are_drawn_from_the_documented_stream() {
     assert_eq!(a, draw_tools(50, 3));
     assert_ne!(a, draw_tools(50, 4));
     for t in &a {
-        for v in [t.m1(), t.m2(), t.l1(), t.l2()] {
+        for &v in t.params().iter() {
             assert!((0.1..0.6).contains(&v));
         }
     }
@@ -196,6 +197,7 @@ fn choices_follow_their_objectives() {
         &tools,
         &Task::paper(TaskKind::Velocity),
         &EpisodeOptions::default(),
+        Plant::Paper,
     );
     let f = Objective::FreeEnergy.choose(&results).unwrap();
     let j = Objective::CostJ.choose(&results).unwrap();
@@ -212,7 +214,7 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(24))]
     #[test]
     fn valid_arms_never_panic(m1 in 0.05..1.0f64, m2 in 0.05..1.0f64, l1 in 0.05..1.0f64, l2 in 0.05..1.0f64, k in 0usize..2, dt in -1.0..1.0f64) {
-        let arm = Arm::new(m1, m2, l1, l2).unwrap();
+        let arm = Arm::new([m1, m2, l1, l2]).unwrap();
         let options = EpisodeOptions { perturbation: dt, ..EpisodeOptions::default() };
         // Either a finite result or a typed error: never a panic, never a NaN.
         if let Ok(e) = simulate(&arm, &Task::paper(TaskKind::ALL[k]), &options) {
@@ -223,17 +225,16 @@ proptest! {
 
 #[test]
 fn the_exact_plant_changes_the_world_not_the_agent() {
-    use toolconf::closed_loop::Plant;
     for p in ARMS {
         let paper = run(&arm(p), TaskKind::Position, &EpisodeOptions::default());
-        let exact = run(
-            &arm(p),
-            TaskKind::Position,
-            &EpisodeOptions {
-                plant: Plant::Exact,
-                ..EpisodeOptions::default()
-            },
-        );
+        let exact = Plant::Exact
+            .simulate(
+                &arm(p),
+                &Task::paper(TaskKind::Position),
+                &EpisodeOptions::default(),
+            )
+            .unwrap()
+            .metrics;
         assert_eq!(paper.logdet, exact.logdet);
         assert_ne!(paper.task_error, exact.task_error);
         let identity = exact.free_energy - exact.cost_j + 2.5 * exact.logdet;

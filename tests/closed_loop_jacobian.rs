@@ -23,7 +23,7 @@ fn central_differences(system: &ClosedLoop, z: &JointState) -> JointJacobian {
 
 fn arm_strategy() -> impl Strategy<Value = Arm> {
     (0.1..0.6f64, 0.1..0.6f64, 0.1..0.6f64, 0.1..0.6f64)
-        .prop_map(|(a, b, c, d)| Arm::new(a, b, c, d).unwrap())
+        .prop_map(|(a, b, c, d)| Arm::new([a, b, c, d]).unwrap())
 }
 
 fn state_strategy() -> impl Strategy<Value = JointState> {
@@ -95,7 +95,7 @@ fn jacobian_at_the_paper_initial_state_for_the_paper_arms() {
         [0.1, 0.1, 0.1, 0.1],
         [0.6, 0.6, 0.6, 0.6],
     ] {
-        let arm = Arm::new(p[0], p[1], p[2], p[3]).unwrap();
+        let arm = Arm::new([p[0], p[1], p[2], p[3]]).unwrap();
         for kind in TaskKind::ALL {
             let system = ClosedLoop::new(&arm, &Task::paper(kind), 1.0, 0.0).unwrap();
             let analytic = system.jacobian(&z0);

@@ -7,7 +7,7 @@ use toolconf::mpc::{simulate_mpc, Mpc, MpcEpisodeError, MpcModel, MpcOptions};
 use toolconf::{Arm, Task, TaskKind, Vector2};
 
 fn arm() -> Arm {
-    Arm::new(0.3, 0.4, 0.5, 0.2).unwrap()
+    Arm::new([0.3, 0.4, 0.5, 0.2]).unwrap()
 }
 
 /// A position task whose goal is near the hanging equilibrium, where the linearised model the

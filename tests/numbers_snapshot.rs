@@ -3,7 +3,7 @@
 
 use std::fmt::Write;
 
-use toolconf::{control_confidence, sensitivities, Arm, Task, TaskKind};
+use toolconf::{control_confidence, Arm, Task, TaskKind};
 
 /// Tools spanning the paper's parameter domain [0.1, 0.6], corners and the CLI example.
 const TOOLS: [[f64; 4]; 5] = [
@@ -23,7 +23,7 @@ fn row(name: &str, values: impl IntoIterator<Item = f64>) -> String {
 fn linearisation_sensitivities_and_confidence_table() {
     let mut out = String::new();
     for [m1, m2, l1, l2] in TOOLS {
-        let arm = Arm::new(m1, m2, l1, l2).unwrap();
+        let arm = Arm::new([m1, m2, l1, l2]).unwrap();
         writeln!(out, "arm {arm}").unwrap();
         let a = arm.state_matrix();
         let b = arm.input_matrix();
@@ -32,7 +32,7 @@ fn linearisation_sensitivities_and_confidence_table() {
         out += &row("B[3,:]", b.row(2).iter().copied());
         out += &row("B[4,:]", b.row(3).iter().copied());
         for kind in TaskKind::ALL {
-            let s = sensitivities(&arm, kind);
+            let s = arm.sensitivities(kind);
             let c = control_confidence(&arm, &Task::paper(kind)).unwrap();
             writeln!(out, " task {kind}").unwrap();
             for (name, m) in [

@@ -8,7 +8,7 @@
 //! The full 2000-tool check (`draw_tools(2000, 1)`) is `bench/population.sh`
 //! (`examples/population.rs`); here 60 tools per task keep the debug build to seconds.
 
-use toolconf::closed_loop::{simulate, EpisodeOptions, Metrics};
+use toolconf::closed_loop::{simulate, EpisodeOptions, Metrics, Plant};
 use toolconf::integrate::Method;
 use toolconf::select::{draw_tools, evaluate};
 use toolconf::{Arm, Task, TaskKind};
@@ -129,7 +129,7 @@ fn fast_results_do_not_depend_on_the_number_of_threads() {
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| evaluate(&tools, &task, &options))
+            .install(|| evaluate(&tools, &task, &options, Plant::Paper))
             .into_iter()
             .map(|r| r.episode.unwrap())
             .collect()

@@ -22,7 +22,7 @@ fn arms() -> Vec<Arm> {
         [0.6, 0.6, 0.6, 0.6],
     ]
     .iter()
-    .map(|p| Arm::new(p[0], p[1], p[2], p[3]).unwrap())
+    .map(|p| Arm::new([p[0], p[1], p[2], p[3]]).unwrap())
     .collect();
     arms.extend(draw_tools(20, 7));
     arms
@@ -73,7 +73,7 @@ fn stiff_and_auto_match_the_reference_better_than_dp5_for_a_tenth_of_the_work() 
         );
         println!(
             "{:<44} {:>8} {:>7} {:>7} | DP5 {:.1e} {:.1e} {:.1e} | Rodas5P {:.1e} {:.1e} {:.1e} | Auto {:.1e} {:.1e} {:.1e}",
-            format!("{:.4} {:.4} {:.4} {:.4}", arm.m1(), arm.m2(), arm.l1(), arm.l2()),
+            format!("{:.4} {:.4} {:.4} {:.4}", arm.params()[0], arm.params()[1], arm.params()[2], arm.params()[3]),
             work(&dp5),
             work(&stiff),
             work(&auto),

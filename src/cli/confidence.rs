@@ -2,7 +2,7 @@
 
 use serde_json::json;
 use toolconf::model::Arm2;
-use toolconf::{control_confidence, sensitivities, Arm, Task};
+use toolconf::{control_confidence, Arm};
 
 use super::episode_args::TaskArgs;
 use super::output::{matrix_rows, print_matrix, CliError};
@@ -23,9 +23,9 @@ pub struct Args {
 pub fn run(args: &Args) -> Result<(), CliError> {
     let spec = args.task.spec()?;
     let kind = spec.kind;
-    let task = Task::from(&spec.task::<Arm2, 2, 4, 4, 6>()?);
-    let confidence = control_confidence(&args.arm, &task)?;
-    let s = sensitivities(&args.arm, kind);
+    let task = spec.task::<Arm2, 2, 4, 4, 6>()?;
+    let confidence = control_confidence(&args.arm, &task).map_err(toolconf::Error::from)?;
+    let s = args.arm.sensitivities(kind);
     let a = args.arm.state_matrix();
     let b = args.arm.input_matrix();
     if args.json {

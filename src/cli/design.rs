@@ -6,11 +6,11 @@ use std::time::Instant;
 
 use serde_json::{json, Map, Value};
 use toolconf::design::file::DesignSpec;
-use toolconf::design::report::{parameters_text, write_report, ReportInput};
 use toolconf::design::sweep::{parse_sweep, run_sweep};
 use toolconf::design::{design, DesignError, DesignResult, Setting};
 use toolconf::model::mixed::ModelKind;
 use toolconf::rank::ModelTasks;
+use toolconf_report::design::{parameters_text, write_report, ReportInput};
 
 use super::output::CliError;
 use super::rank::task_spec;

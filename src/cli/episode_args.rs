@@ -5,7 +5,6 @@ use std::path::PathBuf;
 
 use toolconf::closed_loop::{EpisodeOptions, Plant};
 use toolconf::integrate::Method;
-use toolconf::model::EpisodeOptionsN;
 use toolconf::task_file::{EpisodeSpec, PerJoint, TaskSpec};
 use toolconf::{Error, TaskKind};
 
@@ -131,7 +130,6 @@ impl EpisodeArgs {
             perturbation: self.perturbation.unwrap_or(d.perturbation),
             learning_rate: self.learning_rate.unwrap_or(d.learning_rate),
             record_trajectory,
-            plant: self.plant.into(),
             ..d
         };
         o.integrator.rtol = self.rtol.unwrap_or(d.integrator.rtol);
@@ -159,13 +157,9 @@ impl EpisodeArgs {
     }
 }
 
-/// A task file's 2-link options as the paper's-arm [`EpisodeOptions`], which carries one ΔT
-/// for both joints: a perturbation that differs between the joints is refused with `why`.
-pub fn two_link_options(
-    o: &EpisodeOptionsN<2, 4>,
-    plant: Plant,
-    why: &str,
-) -> Result<EpisodeOptions, Error> {
+/// A task file's options for the paper's arm with one ΔT for both joints, as the 2-link
+/// commands take them: a perturbation that differs between the joints is refused with `why`.
+pub fn two_link_options(o: &EpisodeOptions, why: &str) -> Result<EpisodeOptions, Error> {
     let dt = o.total_perturbation();
     if dt[0] != dt[1] {
         return Err(Error::Unsupported(format!(
@@ -174,14 +168,8 @@ pub fn two_link_options(
         )));
     }
     Ok(EpisodeOptions {
-        t_end: o.t_end,
-        dt: o.dt,
-        x0: o.x0,
-        u0: o.u0,
         perturbation: dt[0],
-        learning_rate: o.learning_rate,
-        integrator: o.integrator,
-        record_trajectory: o.record_trajectory,
-        plant,
+        joint_perturbation: nalgebra::SVector::zeros(),
+        ..*o
     })
 }

@@ -13,7 +13,7 @@ mod simulate;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use toolconf::{Arm, Error, TaskKind};
+use toolconf::{Arm, TaskKind};
 
 /// Confidence-aware decision-making and control for tool selection.
 #[derive(Parser)]
@@ -40,7 +40,7 @@ enum Command {
 }
 
 pub(crate) fn parse_arm(s: &str) -> Result<Arm, String> {
-    s.parse().map_err(|e: Error| e.to_string())
+    toolconf::arm::parse(s).map_err(|e| e.to_string())
 }
 
 pub(crate) fn parse_model(s: &str) -> Result<toolconf::model::mixed::ModelKind, String> {
@@ -48,7 +48,7 @@ pub(crate) fn parse_model(s: &str) -> Result<toolconf::model::mixed::ModelKind, 
 }
 
 pub(crate) fn parse_task(s: &str) -> Result<TaskKind, String> {
-    s.parse().map_err(|e: Error| e.to_string())
+    toolconf::task::parse_task(s).map_err(|e| e.to_string())
 }
 
 pub fn run() -> ExitCode {

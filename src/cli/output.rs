@@ -50,8 +50,6 @@ pub enum CliError {
     #[error(transparent)]
     Input(#[from] toolconf::Error),
     #[error(transparent)]
-    Simulation(#[from] toolconf::closed_loop::SimulationError),
-    #[error(transparent)]
     Mpc(#[from] toolconf::mpc::MpcEpisodeError),
     #[error("cannot write {path}: {source}")]
     Io {
@@ -65,7 +63,9 @@ pub enum CliError {
     #[error(transparent)]
     Model(#[from] toolconf::model::ModelSimulationError),
     #[error(transparent)]
-    Output(#[from] toolconf::experiments::ReproduceError),
+    Output(#[from] toolconf_report::experiments::ReproduceError),
+    #[error(transparent)]
+    Write(#[from] toolconf::output::WriteError),
     /// Bad input that is none of the above, in words.
     #[error("{0}")]
     Usage(String),
@@ -76,35 +76,25 @@ pub enum CliError {
 
 impl CliError {
     pub fn exit_code(&self) -> u8 {
-        use toolconf::closed_loop::SimulationError;
         match self {
             CliError::Input(_)
-            | CliError::Simulation(SimulationError::Input(_))
             | CliError::Mpc(toolconf::mpc::MpcEpisodeError::Input(_))
             | CliError::Model(toolconf::model::ModelSimulationError::Input(_))
             | CliError::TaskFile(_)
             | CliError::ToolsFile(_)
             | CliError::Usage(_) => 2,
-            CliError::Simulation(_)
-            | CliError::Mpc(_)
+            CliError::Mpc(_)
             | CliError::Model(_)
             | CliError::Io { .. }
             | CliError::Output(_)
+            | CliError::Write(_)
             | CliError::Failed(_) => 1,
         }
     }
 }
 
 /// Writes a whole file or nothing: a temporary file beside the target, renamed into place, so an
-/// interrupted run never leaves a half-written file.
+/// interrupted run never leaves a half-written file ([`toolconf::output::write_atomically`]).
 pub fn write_atomically(path: &std::path::Path, contents: &str) -> Result<(), CliError> {
-    let io = |source| CliError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".partial");
-    let tmp = std::path::PathBuf::from(tmp);
-    std::fs::write(&tmp, contents).map_err(io)?;
-    std::fs::rename(&tmp, path).map_err(io)
+    Ok(toolconf::output::write_atomically(path, contents)?)
 }

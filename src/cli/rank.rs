@@ -8,11 +8,9 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::{json, Map, Value};
-use toolconf::experiments::csv::{Cell, CsvWriter};
 use toolconf::model::mixed::ModelKind;
-use toolconf::rank::report::{write_report, ReportInput};
+use toolconf::output::csv::{Cell, CsvWriter};
 use toolconf::rank::{
     ranking, screen_file, simulate_all_timed, Candidate, ConfidenceTiming, ModelTasks, RankedTool,
     Screen, ScreenError, SimulationTiming, StageTimings,
@@ -20,6 +18,8 @@ use toolconf::rank::{
 use toolconf::select::Objective;
 use toolconf::task_file::TaskSpec;
 use toolconf::TaskKind;
+use toolconf_report::progress::{self, ProgressBar};
+use toolconf_report::rank::{write_report, ReportInput};
 
 use super::output::{add_outcome, CliError};
 
@@ -104,16 +104,7 @@ fn screen_tools(args: &Args, tasks: &ModelTasks) -> Result<(Screen, usize), CliE
 }
 
 fn progress(total: usize) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(total as u64);
-    if let Ok(style) = ProgressStyle::with_template(
-        "{elapsed_precise} [{bar:40}] {pos}/{len} episodes ({per_sec}, eta {eta})",
-    ) {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar
+    progress::episodes(std::io::stderr().is_terminal(), total as u64)
 }
 
 /// The parameter columns of the models present, in the models' order.

@@ -4,7 +4,7 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-use toolconf::experiments::{experiment_ids, reproduce, Config, Plan, ReproduceError};
+use toolconf_report::experiments::{experiment_ids, reproduce, Config, Plan, ReproduceError};
 
 use super::output::CliError;
 

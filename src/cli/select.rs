@@ -5,7 +5,7 @@
 
 use rayon::prelude::*;
 use serde_json::{json, Value};
-use toolconf::closed_loop::EpisodeOptions;
+use toolconf::closed_loop::{EpisodeOptions, Plant};
 use toolconf::integrate::Method;
 use toolconf::model::mixed::ModelKind;
 use toolconf::model::Arm2;
@@ -73,7 +73,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let (task, options) = two_link_task(args)?;
     let kind = task.kind;
     let tools = draw_tools(args.tools as usize, args.seed);
-    let results = evaluate(&tools, &task, &options);
+    let plant = Plant::from(args.episode.plant);
+    let results = evaluate(&tools, &task, &options, plant);
     let choices: Vec<(Objective, Option<usize>)> = Objective::ALL
         .iter()
         .map(|o| (*o, o.choose(&results)))
@@ -84,6 +85,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             &task,
             &options,
             &args.mpc_options.options()?,
+            plant,
         ))
     } else {
         None
@@ -144,15 +146,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             ),
             Err(e) => format!("failed: {e}"),
         };
+        let p = r.arm.params();
         println!(
             "{:>5}  {:>7.4} {:>7.4} {:>7.4} {:>7.4}  {:>12} {}",
-            r.index,
-            r.arm.m1(),
-            r.arm.m2(),
-            r.arm.l1(),
-            r.arm.l2(),
-            logdet,
-            metrics
+            r.index, p[0], p[1], p[2], p[3], logdet, metrics
         );
     }
     if let Some(mpc) = &mpc {
@@ -191,13 +188,9 @@ fn two_link_task(args: &Args) -> Result<(Task, EpisodeOptions), CliError> {
         return Ok((Task::paper(spec.kind), options));
     }
     let spec = with_flags(args, spec)?;
-    let task = Task::from(&spec.task::<Arm2, 2, 4, 4, 6>()?);
+    let task = spec.task::<Arm2, 2, 4, 4, 6>()?;
     let why = "is not supported by select's 2-link tools; use rank with a tools file";
-    let options = two_link_options(
-        &spec.episode::<Arm2, 2, 4, 4, 6>()?,
-        args.episode.plant.into(),
-        why,
-    )?;
+    let options = two_link_options(&spec.episode::<Arm2, 2, 4, 4, 6>()?, why)?;
     Ok((task, options))
 }
 
@@ -258,7 +251,7 @@ fn run_mixed(args: &Args) -> Result<(), CliError> {
     options.integrator.method = args.method.method.into();
     let tools = draw_mixed_tools(&args.models, args.tools as usize, args.seed)?;
     let results = match args.task.task_file {
-        None => evaluate_mixed(&tools, kind, &options),
+        None => evaluate_mixed(&tools, kind, &options, args.episode.plant.into()),
         Some(_) => evaluate_on_file(args, spec, &tools)?,
     };
     let choices: Vec<(MixedObjective, Option<usize>)> = MixedObjective::ALL

@@ -3,11 +3,11 @@
 use std::path::PathBuf;
 
 use serde_json::{json, Value};
-use toolconf::closed_loop::{simulate, Episode, Metrics, Plant};
+use toolconf::closed_loop::{Episode, Metrics, Plant};
 use toolconf::integrate::Method;
 use toolconf::model::mixed::{AnyTool, ModelKind};
-use toolconf::model::{episode_on, Arm2, Arm2Exact, Arm2Tool};
-use toolconf::mpc::{simulate_mpc, MpcModel, MpcOptions};
+use toolconf::model::{episode_on, Arm2, Arm2Exact};
+use toolconf::mpc::{MpcModel, MpcOptions};
 use toolconf::rank::{ModelTasks, TrajectoryTable};
 use toolconf::task_file::TaskSpec;
 use toolconf::{Arm, Error, Task};
@@ -139,7 +139,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             let task = Task::paper(spec.kind);
             let mut options = args.episode.options(args.csv.is_some())?;
             options.integrator.method = args.method.method.into();
-            let episode = simulate(&arm, &task, &options)?;
+            let episode = Plant::from(args.episode.plant).simulate(&arm, &task, &options)?;
             (episode, json!(options.perturbation))
         }
         Some(_) => from_task_file(args, &arm, spec.clone())?,
@@ -210,10 +210,9 @@ fn from_task_file(
     let task = spec.task::<Arm2, 2, 4, 4, 6>()?;
     let mut options = spec.episode::<Arm2, 2, 4, 4, 6>()?;
     options.record_trajectory = args.csv.is_some();
-    let tool = Arm2Tool::from(arm);
     let episode = match Plant::from(args.episode.plant) {
-        Plant::Paper => episode_on::<Arm2, Arm2, 2, 4, 4, 6>(&tool, &task, &options)?,
-        Plant::Exact => episode_on::<Arm2, Arm2Exact, 2, 4, 4, 6>(&tool, &task, &options)?,
+        Plant::Paper => episode_on::<Arm2, Arm2, 2, 4, 4, 6>(arm, &task, &options)?,
+        Plant::Exact => episode_on::<Arm2, Arm2Exact, 2, 4, 4, 6>(arm, &task, &options)?,
     };
     let dt = options.total_perturbation();
     let perturb = if dt[0] == dt[1] {
@@ -232,14 +231,15 @@ fn run_mpc(args: &Args, arm: &Arm, mut spec: TaskSpec) -> Result<(), CliError> {
         ),
         Some(_) => {
             args.episode.apply(&mut spec.episode)?;
-            let task = Task::from(&spec.task::<Arm2, 2, 4, 4, 6>()?);
+            let task = spec.task::<Arm2, 2, 4, 4, 6>()?;
             let mut o = spec.episode::<Arm2, 2, 4, 4, 6>()?;
             o.record_trajectory = args.csv.is_some();
             let why = "is not supported by the MPC baseline";
-            (task, two_link_options(&o, args.episode.plant.into(), why)?)
+            (task, two_link_options(&o, why)?)
         }
     };
-    let episode = simulate_mpc(arm, &task, &options, &args.mpc.options()?)?;
+    let plant = Plant::from(args.episode.plant);
+    let episode = plant.simulate_mpc(arm, &task, &options, &args.mpc.options()?)?;
     let m = &episode.metrics;
     if let (Some(path), Some(tr)) = (&args.csv, &episode.trajectory) {
         write_atomically(path, &TrajectoryTable::from_trajectory(tr).to_csv())?;

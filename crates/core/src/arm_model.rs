@@ -1,7 +1,7 @@
-//! [`ArmModel`]: what the runtime needs of a generated model, and one marker type implementing it
-//! per model in the generated registry.
+//! [`ArmModel`]: what the controller and the runtime need of a generated model, and one marker
+//! type implementing it per model in the generated registry.
 
-use std::fmt::Debug;
+use core::fmt::Debug;
 
 use nalgebra::{SMatrix, SVector};
 
@@ -80,7 +80,7 @@ pub trait ArmModel<const N: usize, const NX: usize, const NP: usize, const NZ: u
     }
 }
 
-/// Implements [`ArmModel`] for a marker type by forwarding to `crate::generated::$module`.
+/// Implements [`ArmModel`] for a marker type by forwarding to `toolconf_generated::$module`.
 macro_rules! arm_model {
     ($(#[$doc:meta])* $marker:ident => $module:ident) => {
         $(#[$doc])*
@@ -203,7 +203,7 @@ macro_rules! arm_models {
     ($(($marker:ident, $module:ident, $tool:ident, $name:literal, $title:literal)),* $(,)?) => {
         $(
             arm_model!(
-                #[doc = concat!($title, " (`generated::", $name, "`).")]
+                #[doc = concat!($title, " (`toolconf_generated::", $name, "`).")]
                 $marker => $module
             );
             #[doc = concat!("A tool of the `", $name, "` model.")]
@@ -218,4 +218,4 @@ macro_rules! arm_models {
     };
 }
 
-crate::for_each_model!(arm_models);
+generated::for_each_model!(arm_models);

@@ -1,7 +1,5 @@
 //! Control confidence Π^U and ln|Π^U| (eq. control_conf) of a tool on a validated task.
 
-use std::fmt::Debug;
-
 use nalgebra::{SMatrix, SVector};
 
 use crate::Error;
@@ -9,7 +7,7 @@ use crate::Error;
 use super::{ArmModel, TaskN, ToolN};
 
 /// Π^U with its log-determinant ln|Π^U|, the confidence term of the free energy
-/// (eq. FE_components); [`crate::ControlConfidence`] is the 2-link one.
+/// (eq. FE_components).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ControlConfidenceN<const N: usize> {
     /// Π^U, symmetric positive definite.
@@ -112,10 +110,10 @@ pub fn logdet_of<const N: usize>(pi: &SMatrix<f64, N, N>) -> Result<f64, Error> 
         if !(pi[(0, 0)] > 0.0 && determinant > 0.0 && determinant.is_finite()) {
             return Err(Error::NotPositiveDefinite { determinant });
         }
-        return Ok(determinant.ln());
+        return Ok(crate::ln(determinant));
     }
     let not_pd = || Error::NotPositiveDefinite {
-        determinant: nalgebra::DMatrix::from_fn(N, N, |i, j| pi[(i, j)]).determinant(),
+        determinant: crate::linalg::determinant(pi),
     };
     if pi.iter().any(|v| !v.is_finite()) {
         return Err(not_pd());
@@ -128,7 +126,7 @@ pub fn logdet_of<const N: usize>(pi: &SMatrix<f64, N, N>) -> Result<f64, Error> 
         if !(d > 0.0 && d.is_finite()) {
             return Err(not_pd());
         }
-        logdet += 2.0 * d.ln();
+        logdet += 2.0 * crate::ln(d);
     }
     if logdet.is_finite() {
         Ok(logdet)

@@ -1,17 +1,16 @@
 //! [`TaskN`]: a task's goals and precisions for N joints, and their checks.
 
-use std::fmt::Debug;
-
 use nalgebra::{SMatrix, SVector};
 
 use crate::generated;
 use crate::generated::TaskKind;
-use crate::Error;
+use crate::{Error, PrecisionProblem};
 
 use super::{ArmModel, ValidatedTaskN};
 
-/// A task for N joints: goals and prior precisions (the N-joint [`crate::Task`]). A term the task's
-/// controller does not use has precision zero.
+/// A task for N joints: goals θ^g, θ̇^g, θ̈^g and prior precisions P^θ, P^θ̇, P^θ̈, P^U
+/// (eq. free_energy). A term the task's controller does not use has precision zero: task 2
+/// ignores θ, task 3 ignores θ and θ̇.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TaskN<const N: usize> {
     pub kind: TaskKind,
@@ -46,16 +45,7 @@ impl<const N: usize> TaskN<N> {
         }
     }
 
-    /// Model `M`'s paper-style task ([`ArmModel::paper_task`]).
-    pub fn paper<M, const NX: usize, const NP: usize, const NZ: usize>(kind: TaskKind) -> Self
-    where
-        M: ArmModel<N, NX, NP, NZ>,
-    {
-        M::paper_task(kind)
-    }
-
-    /// Checks goals are finite and precisions finite, symmetric and positive semi-definite,
-    /// with the errors [`crate::Task::validate`] gives.
+    /// Checks goals are finite and precisions finite, symmetric and positive semi-definite.
     pub fn validate(&self) -> Result<(), Error> {
         for (name, goal) in [
             ("theta_g", &self.goal_theta),
@@ -63,10 +53,7 @@ impl<const N: usize> TaskN<N> {
             ("theta_ddot_g", &self.goal_theta_ddot),
         ] {
             if let Some(&value) = goal.iter().find(|v| !v.is_finite()) {
-                return Err(Error::InvalidGoal {
-                    name: name.into(),
-                    value,
-                });
+                return Err(Error::InvalidGoal { name, value });
             }
         }
         for (name, p) in [
@@ -81,45 +68,46 @@ impl<const N: usize> TaskN<N> {
     }
 }
 
+impl TaskN<2> {
+    /// The paper's task `kind` for its arm, with the published goals and precisions
+    /// ("Implementation details"; [`ArmModel::paper_task`] of [`crate::Arm2`]; another model's is
+    /// its own `paper_task`).
+    pub fn paper(kind: TaskKind) -> Self {
+        crate::Arm2::paper_task(kind)
+    }
+}
+
 /// Finite, symmetric (to 1e-12 relative) and positive semi-definite: the smallest eigenvalue
 /// of the symmetric part is ≥ −1e-12·max|P| (for N = 2 the closed-form determinant test).
-fn check_precision<const N: usize>(name: &str, p: &SMatrix<f64, N, N>) -> Result<(), Error> {
-    let invalid = |reason: String| Error::InvalidPrecision {
-        name: name.into(),
-        reason,
-    };
-    if p.iter().any(|v| !v.is_finite()) {
-        return Err(invalid(format!(
-            "has a non-finite entry: {:?}",
-            p.as_slice()
-        )));
+fn check_precision<const N: usize>(
+    name: &'static str,
+    p: &SMatrix<f64, N, N>,
+) -> Result<(), Error> {
+    let invalid = |problem| Error::InvalidPrecision { name, problem };
+    if let Some((k, &value)) = p.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        // Column-major storage: entry k is (k mod N, k div N).
+        let (row, col) = (k % N, k / N);
+        return Err(invalid(PrecisionProblem::NonFinite { row, col, value }));
     }
     let scale = p.amax();
     for i in 0..N {
         for j in (i + 1)..N {
             if (p[(i, j)] - p[(j, i)]).abs() > 1e-12 * scale.max(1.0) {
-                return Err(invalid(format!(
-                    "is not symmetric ({} vs {})",
-                    p[(i, j)],
-                    p[(j, i)]
-                )));
+                return Err(invalid(PrecisionProblem::NotSymmetric {
+                    upper: p[(i, j)],
+                    lower: p[(j, i)],
+                }));
             }
         }
     }
-    let not_psd = || invalid("is not positive semi-definite".into());
+    let not_psd = || invalid(PrecisionProblem::NotPositiveSemiDefinite);
     if N == 2 {
         let det = p[(0, 0)] * p[(1, 1)] - p[(0, 1)] * p[(1, 0)];
-        if p[(0, 0)] < 0.0 || p[(1, 1)] < 0.0 || det < -1e-12 * scale.powi(2) {
+        if p[(0, 0)] < 0.0 || p[(1, 1)] < 0.0 || det < -1e-12 * (scale * scale) {
             return Err(not_psd());
         }
-    } else if N > 0 {
-        // Dynamic storage: nalgebra's eigen-decomposition needs dimension bounds a const
-        // generic N cannot state on stable Rust. Once per task, so the allocation is moot.
-        let symmetric = nalgebra::DMatrix::from_fn(N, N, |i, j| 0.5 * (p[(i, j)] + p[(j, i)]));
-        let smallest = symmetric.symmetric_eigenvalues().min();
-        if smallest < -1e-12 * scale {
-            return Err(not_psd());
-        }
+    } else if N > 0 && !crate::linalg::is_positive_semi_definite(p, 1e-12 * scale) {
+        return Err(not_psd());
     }
     Ok(())
 }

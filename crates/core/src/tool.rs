@@ -1,8 +1,8 @@
 //! [`ToolN`]: a tool of one model, its parameters checked once.
 
-use std::fmt;
-use std::fmt::Debug;
-use std::marker::PhantomData;
+use core::fmt;
+use core::fmt::Debug;
+use core::marker::PhantomData;
 
 use nalgebra::{SMatrix, SVector};
 
@@ -13,7 +13,7 @@ use crate::Error;
 use super::ArmModel;
 
 /// The sensitivities ∂θ/∂U, ∂θ̇/∂U, ∂θ̈/∂U that a task's controller uses (eq. U_dot_deriv), `None`
-/// for a term the task does not use ([`crate::Sensitivities`] is the 2-link one). Task 1's ∂θ/∂U
+/// for a term the task does not use. Task 1's ∂θ/∂U
 /// is [I O]A⁻¹(∂Ẋ/∂U − B) with ∂Ẋ/∂U = [I; I]; ∂θ̇/∂U is [O I]A⁻¹(∂Ẋ/∂U − B) = I in task 1 and
 /// −[I O]A⁻¹B in task 2, as the paper prints it; ∂θ̈/∂U is I in every task (zero jerk in tasks
 /// 1–2, [I O](A²∂X/∂U + AB) = I in task 3). The formulas are `derive/tasks.toml`'s.
@@ -66,16 +66,6 @@ where
         })
     }
 
-    /// A tool from parameters a caller has already checked (finite, > 0), such as an
-    /// [`crate::Arm`]'s: no second check on the 2-link façade's hot path.
-    pub(crate) fn from_checked(params: SVector<f64, NP>) -> Self {
-        debug_assert!(params.iter().all(|v| v.is_finite() && *v > 0.0));
-        Self {
-            params,
-            model: PhantomData,
-        }
-    }
-
     /// The parameter vector p the generated functions take.
     pub fn params(&self) -> SVector<f64, NP> {
         self.params
@@ -88,7 +78,7 @@ where
 
     /// (name, value) of every parameter, in order.
     pub fn named_parameters(&self) -> [(&'static str, f64); NP] {
-        std::array::from_fn(|i| (M::PARAMETER_NAMES[i], self.params[i]))
+        core::array::from_fn(|i| (M::PARAMETER_NAMES[i], self.params[i]))
     }
 
     /// Ẋ = f(X, U; p).
@@ -122,7 +112,7 @@ where
     }
 }
 
-/// `m1=… m2=… …`, as [`crate::Arm`] prints itself.
+/// `m1=… m2=… …`: the parameters by name, as error messages name a tool.
 impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> fmt::Display
     for ToolN<M, N, NX, NP, NZ>
 where
@@ -136,5 +126,22 @@ where
             write!(f, "{name}={value}")?;
         }
         Ok(())
+    }
+}
+
+/// The parameters by name, `{"m1": 0.3, "m2": 0.4, ...}`, as the command line's JSON gives a tool.
+#[cfg(feature = "serde")]
+impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> serde::Serialize
+    for ToolN<M, N, NX, NP, NZ>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = serializer.serialize_map(Some(NP))?;
+        for (name, value) in self.named_parameters() {
+            map.serialize_entry(name, &value)?;
+        }
+        map.end()
     }
 }

@@ -8,9 +8,9 @@ use crate::experiments::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use crate::experiments::report::{to_html, to_markdown, Block};
 use crate::experiments::{write_atomically, ReproduceError};
 
-use super::file::DesignSpec;
-use super::sweep::{Sweep, SweepPoint};
-use super::DesignResult;
+use toolconf::design::file::DesignSpec;
+use toolconf::design::sweep::{Sweep, SweepPoint};
+use toolconf::design::DesignResult;
 
 pub const SWEEP_CSV: &str = "sweep.csv";
 pub const SWEEP_SVG: &str = "sweep.svg";

@@ -4,7 +4,6 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{score, ModelTasks, RankedTool, StageTimings, TaskTrace};
 use crate::experiments::common::wants_log;
 use crate::experiments::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use crate::experiments::report::{to_html, to_markdown, Block};
@@ -13,6 +12,7 @@ use crate::select::Objective;
 use crate::stats::spearman;
 use crate::task_file::{PerJoint, PrecisionSpec, TaskSpec};
 use crate::{TaskKind, Term};
+use toolconf::rank::{score, ModelTasks, RankedTool, StageTimings, TaskTrace};
 
 /// What the report describes.
 pub struct ReportInput<'a> {

@@ -3,22 +3,17 @@
 /// Everything that can go wrong in toolconf, each naming the offending value.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum Error {
-    /// A tool parameter that is not a finite number > 0.
-    #[error("invalid arm parameter {name} = {value}: must be a finite number > 0")]
-    InvalidParameter { name: &'static str, value: f64 },
+    /// A tool, task or controller the no_std core refuses (a parameter, goal, precision or
+    /// learning rate out of its domain, Π^U not positive definite), with the core's message.
+    #[error(transparent)]
+    Core(#[from] toolconf_core::Error),
     /// An arm given in text that is not four comma-separated numbers.
     #[error("invalid arm '{text}': expected M1,M2,L1,L2 (four comma-separated numbers), {reason}")]
     ArmSyntax { text: String, reason: String },
     /// A task name that is not one of `derive/tasks.toml`'s.
     #[error("unknown task '{0}': expected {names}", names = crate::task::task_choices())]
     UnknownTask(String),
-    /// A goal that is not finite.
-    #[error("invalid goal {name} = {value}: must be finite")]
-    InvalidGoal { name: String, value: f64 },
-    /// A precision matrix that is not finite, symmetric and positive semi-definite.
-    #[error("invalid precision {name}: {reason}")]
-    InvalidPrecision { name: String, reason: String },
-    /// A numeric option outside its domain.
+    /// A numeric option of the runtime outside its domain (episode, integrator, MPC).
     #[error("invalid {name} = {value}")]
     InvalidOption { name: &'static str, value: f64 },
     /// An episode whose output grid would have more points than can be kept in memory.
@@ -40,7 +35,4 @@ pub enum Error {
     /// A combination of options that is not supported, with the reason.
     #[error("unsupported: {0}")]
     Unsupported(String),
-    /// Π^U that is not positive definite, so it is no precision and ln|Π^U| is undefined.
-    #[error("control confidence Π^U is not positive definite for this arm and task (determinant {determinant:e}); check the task's precisions")]
-    NotPositiveDefinite { determinant: f64 },
 }

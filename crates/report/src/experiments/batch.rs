@@ -5,7 +5,7 @@
 use indicatif::ProgressBar;
 use rayon::prelude::*;
 
-use crate::closed_loop::{simulate, EpisodeOptions, Metrics};
+use crate::closed_loop::{EpisodeOptions, Metrics, Plant};
 use crate::confidence::control_confidence;
 use crate::{Arm, Task};
 
@@ -98,9 +98,9 @@ impl ToolRuns {
     }
 }
 
-/// Runs `arm` on `task` once per entry of `options` (sequentially: the parallelism is across
-/// tools).
-pub fn run_tool(arm: &Arm, task: &Task, options: &[EpisodeOptions]) -> ToolRuns {
+/// Runs `arm` on `task` on `plant` once per entry of `options` (sequentially: the parallelism
+/// is across tools).
+pub fn run_tool(arm: &Arm, task: &Task, options: &[EpisodeOptions], plant: Plant) -> ToolRuns {
     ToolRuns {
         arm: *arm,
         logdet: control_confidence(arm, task)
@@ -111,9 +111,10 @@ pub fn run_tool(arm: &Arm, task: &Task, options: &[EpisodeOptions]) -> ToolRuns 
             .map(|o| {
                 let o = EpisodeOptions {
                     record_trajectory: false,
-                    ..o.clone()
+                    ..*o
                 };
-                simulate(arm, task, &o)
+                plant
+                    .simulate(arm, task, &o)
                     .map(|e| e.metrics)
                     .map_err(|e| e.to_string())
             })
@@ -156,13 +157,13 @@ mod tests {
 
     #[test]
     fn a_failed_episode_is_data_not_an_abort() {
-        let arm = Arm::new(0.3, 0.4, 0.5, 0.2).unwrap();
+        let arm = Arm::new([0.3, 0.4, 0.5, 0.2]).unwrap();
         let task = Task::paper(crate::TaskKind::Position);
         let bad = EpisodeOptions {
             t_end: -1.0,
             ..EpisodeOptions::default()
         };
-        let r = run_tool(&arm, &task, &[EpisodeOptions::default(), bad]);
+        let r = run_tool(&arm, &task, &[EpisodeOptions::default(), bad], Plant::Paper);
         assert!(r.logdet().is_some() && r.task_error(0).is_some());
         assert_eq!(r.task_error(1), None);
         assert_eq!(r.abs_change(1), None);

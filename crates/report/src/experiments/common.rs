@@ -20,7 +20,8 @@ pub fn task_label(kind: TaskKind) -> String {
 
 /// The four parameter cells m1, m2, l1, l2 of a tool.
 pub fn arm_cells(arm: &Arm) -> [Cell; 4] {
-    [arm.m1(), arm.m2(), arm.l1(), arm.l2()].map(Cell::from)
+    let p = arm.params();
+    [p[0], p[1], p[2], p[3]].map(Cell::from)
 }
 
 pub const ARM_COLUMNS: [&str; 4] = ["m1", "m2", "l1", "l2"];

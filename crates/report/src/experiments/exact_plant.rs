@@ -9,7 +9,7 @@
 
 use super::report::{Block, Section};
 use super::{Context, Experiment, Plan, ReproduceError};
-use crate::closed_loop::{EpisodeOptions, Plant};
+use crate::closed_loop::Plant;
 
 /// The prefix of the wrapped experiments' files.
 pub const FILE_PREFIX: &str = "exact_plant_";
@@ -46,10 +46,8 @@ impl Experiment for OnExactPlant {
             out_dir: ctx.out_dir,
             seed: ctx.seed,
             plan: ctx.plan,
-            options: EpisodeOptions {
-                plant: Plant::Exact,
-                ..ctx.options.clone()
-            },
+            options: ctx.options,
+            plant: Plant::Exact,
             progress: ctx.progress,
             file_prefix: FILE_PREFIX,
         };

@@ -146,12 +146,15 @@ fn simulate_every_task(
         .flat_map(|&k| (0..tools.len()).map(move |i| (k, i)))
         .collect();
     let mut csv = CsvWriter::create(&ctx.path(CSV), &HEADER)?;
-    let options = [ctx.options.clone()];
+    let options = [ctx.options];
     map_ordered(
         &items,
         ctx.progress,
         1,
-        |&(kind, i)| (kind, i, run_tool(&tools[i], &Task::paper(kind), &options)),
+        |&(kind, i)| {
+            let runs = run_tool(&tools[i], &Task::paper(kind), &options, ctx.plant);
+            (kind, i, runs)
+        },
         |(kind, i, r)| {
             let m = r.metrics(0);
             let mut row = vec![Cell::from(kind.name()), Cell::from(*i)];
@@ -164,7 +167,7 @@ fn simulate_every_task(
                 m.map_or(Cell::Empty, |m| Cell::from(m.rhs_evals)),
                 Cell::from(r.error()),
             ]);
-            csv.row(row)
+            csv.row(row).map_err(ReproduceError::from)
         },
     )
 }

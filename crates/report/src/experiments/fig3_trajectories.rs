@@ -4,7 +4,7 @@
 //! Seed: the sample from `"fig3/tools"`. Confidence needs no simulation, so only the two chosen
 //! tools are simulated (four episodes, trajectories recorded).
 
-use crate::closed_loop::{simulate, Metrics, Trajectory};
+use crate::closed_loop::{Metrics, Trajectory};
 use crate::confidence::control_confidence;
 use crate::select::draw_tools;
 use crate::{Arm, Task, TaskKind};
@@ -224,7 +224,8 @@ fn simulate_pair(
         |&(role, (tool, logdet), dt)| {
             let mut options = ctx.perturbed(dt);
             options.record_trajectory = true;
-            let result = simulate(&tools[tool], task, &options)
+            let result = (ctx.plant)
+                .simulate(&tools[tool], task, &options)
                 .map(|e| (e.metrics, e.trajectory.expect("trajectory was requested")))
                 .map_err(|e| e.to_string());
             Run {
@@ -272,7 +273,7 @@ fn write_run(csv: &mut CsvWriter, run: &Run) -> Result<(), ReproduceError> {
             let mut row = lead.to_vec();
             row.extend(std::iter::repeat(Cell::Empty).take(7));
             row.push(Cell::from(e.as_str()));
-            csv.row(row)
+            Ok(csv.row(row)?)
         }
     }
 }
@@ -498,7 +499,7 @@ mod tests {
 
     #[test]
     fn settling_time_is_when_the_band_is_entered_for_good() {
-        let theta = |v: f64| crate::Vector2::new(0.0, v);
+        let theta = |v: f64| toolconf::Vector2::new(0.0, v);
         let tr = Trajectory {
             t: vec![0.0, 1.0, 2.0, 3.0],
             theta: vec![theta(-1.0), theta(0.01), theta(0.2), theta(0.02)],

@@ -58,13 +58,16 @@ impl Experiment for Fig4 {
             .iter()
             .flat_map(|&k| (0..tools.len()).map(move |i| (k, i)))
             .collect();
-        let options = [ctx.options.clone(), ctx.perturbed(plan.perturbation)];
+        let options = [ctx.options, ctx.perturbed(plan.perturbation)];
         let mut csv = CsvWriter::create(&ctx.path(CSV), &HEADER)?;
         let results = map_ordered(
             &items,
             ctx.progress,
             2,
-            |&(kind, i)| (kind, i, run_tool(&tools[i], &Task::paper(kind), &options)),
+            |&(kind, i)| {
+                let runs = run_tool(&tools[i], &Task::paper(kind), &options, ctx.plant);
+                (kind, i, runs)
+            },
             |(kind, i, r)| {
                 let mut row = vec![Cell::from(kind.name()), Cell::from(*i)];
                 row.extend(arm_cells(&r.arm));

@@ -170,7 +170,7 @@ fn simulate_sweep(
         &indices,
         ctx.progress,
         options.len() as u64,
-        |&i| run_tool(&tools[i], &task, &options),
+        |&i| run_tool(&tools[i], &task, &options, ctx.plant),
         |r| {
             let i = next;
             next += 1;
@@ -188,7 +188,7 @@ fn simulate_sweep(
                 ]);
                 csv.row(row)?;
             }
-            Ok(())
+            Ok::<(), ReproduceError>(())
         },
     )?;
     Ok((results, listed.len()))

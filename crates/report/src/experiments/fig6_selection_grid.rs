@@ -155,12 +155,13 @@ impl Fig6 {
             plan.fig6_tools as u64,
             |&k| {
                 let tools = draw_tools(plan.fig6_tools, ctx.seed_for(self, &format!("trial/{k}")));
-                let results = evaluate(&tools, &task, &ctx.options);
+                let results = evaluate(&tools, &task, &ctx.options, ctx.plant);
                 let trial = Trial {
                     task: &task,
                     tools: &tools,
                     results: &results,
                     options: &ctx.options,
+                    plant: ctx.plant,
                 };
                 let chosen = choices(rules, &trial);
                 TrialResult {

@@ -236,13 +236,14 @@ impl Fig7 {
             2 * plan.fig7_tools as u64,
             |&k| {
                 let tools = draw_tools(plan.fig7_tools, ctx.seed_for(self, &format!("trial/{k}")));
-                let results = evaluate(&tools, &task, &ctx.options);
-                let perturbed = evaluate(&tools, &task, &perturbed);
+                let results = evaluate(&tools, &task, &ctx.options, ctx.plant);
+                let perturbed = evaluate(&tools, &task, &perturbed, ctx.plant);
                 let trial = Trial {
                     task: &task,
                     tools: &tools,
                     results: &results,
                     options: &ctx.options,
+                    plant: ctx.plant,
                 };
                 let chosen = choices(rules, &trial);
                 TrialResult {

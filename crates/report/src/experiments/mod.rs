@@ -27,7 +27,8 @@
 
 pub mod batch;
 pub(crate) mod common;
-pub mod csv;
+/// The CSV writer, the runtime's ([`toolconf::output::csv`]).
+pub use toolconf::output::csv;
 mod exact_plant;
 mod fig2_confidence_vs_error;
 mod fig3_trajectories;
@@ -46,7 +47,7 @@ use std::time::{Duration, Instant};
 
 use indicatif::ProgressBar;
 
-use crate::closed_loop::EpisodeOptions;
+use crate::closed_loop::{EpisodeOptions, Plant};
 pub use report::{Block, Outcome, Section, Verdict};
 
 /// How many tools, trials and resamples each experiment uses.
@@ -156,6 +157,15 @@ pub enum ReproduceError {
     UnknownExperiment(String),
 }
 
+impl From<toolconf::output::WriteError> for ReproduceError {
+    fn from(e: toolconf::output::WriteError) -> Self {
+        ReproduceError::Io {
+            path: e.path,
+            source: e.source,
+        }
+    }
+}
+
 impl ReproduceError {
     pub(crate) fn io(path: &Path) -> impl FnOnce(std::io::Error) -> ReproduceError + '_ {
         move |source| ReproduceError::Io {
@@ -172,6 +182,8 @@ pub struct Context<'a> {
     pub plan: &'a Plan,
     /// The paper's episode settings (ode45 tolerances, 5 s, dt 0.05, ΔT = 0).
     pub options: EpisodeOptions,
+    /// The equations of motion the tools are simulated on (the paper's, or the exact ones).
+    pub plant: Plant,
     pub progress: &'a ProgressBar,
     /// Prefix of every file the experiment writes (empty, or e.g. `exact_plant_`).
     pub file_prefix: &'a str,
@@ -191,7 +203,7 @@ impl Context<'_> {
     pub fn perturbed(&self, perturbation: f64) -> EpisodeOptions {
         EpisodeOptions {
             perturbation,
-            ..self.options.clone()
+            ..self.options
         }
     }
 }
@@ -324,7 +336,7 @@ pub fn reproduce(config: &Config) -> Result<Summary, ReproduceError> {
         .iter()
         .map(|e| e.planned_episodes(&config.plan))
         .sum();
-    let progress = progress_bar(config.progress, total);
+    let progress = crate::progress::episodes(config.progress, total);
     let ctx = Context {
         out_dir: out,
         seed: config.seed,
@@ -334,6 +346,7 @@ pub fn reproduce(config: &Config) -> Result<Summary, ReproduceError> {
             o.integrator.method = config.method;
             o
         },
+        plant: Plant::Paper,
         progress: &progress,
         file_prefix: "",
     };
@@ -386,26 +399,9 @@ fn remove_if_present(path: &Path) -> Result<(), ReproduceError> {
     }
 }
 
-fn progress_bar(visible: bool, total: u64) -> ProgressBar {
-    if !visible {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(total);
-    if let Ok(style) = indicatif::ProgressStyle::with_template(
-        "{elapsed_precise} [{bar:40}] {pos}/{len} episodes ({per_sec}, eta {eta}) {msg}",
-    ) {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar
-}
-
-/// Writes a whole file or nothing: `X.partial` beside it, renamed into place.
+/// Writes a whole file or nothing (the runtime's [`toolconf::output::write_atomically`]).
 pub fn write_atomically(path: &Path, contents: &str) -> Result<(), ReproduceError> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".partial");
-    let tmp = PathBuf::from(tmp);
-    std::fs::write(&tmp, contents).map_err(ReproduceError::io(&tmp))?;
-    std::fs::rename(&tmp, path).map_err(ReproduceError::io(path))
+    Ok(toolconf::output::write_atomically(path, contents)?)
 }
 
 #[cfg(test)]

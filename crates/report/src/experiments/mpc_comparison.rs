@@ -8,8 +8,7 @@
 
 use std::time::{Duration, Instant};
 
-use crate::closed_loop::simulate;
-use crate::mpc::{simulate_mpc, MpcOptions};
+use crate::mpc::MpcOptions;
 use crate::select::draw_tools;
 use crate::stats::summary;
 use crate::{Arm, Task, TaskKind};
@@ -195,7 +194,8 @@ fn run_one(ctx: &Context, arm: &Arm, task: &Task, controller: usize, dt: f64) ->
     let options = ctx.perturbed(dt);
     let (values, time) = if controller == 0 {
         timed(|| {
-            simulate(arm, task, &options)
+            ctx.plant
+                .simulate(arm, task, &options)
                 .map(|e| {
                     let m = e.metrics;
                     [m.task_error, m.cost_j, m.control_effort, m.free_energy]
@@ -204,7 +204,8 @@ fn run_one(ctx: &Context, arm: &Arm, task: &Task, controller: usize, dt: f64) ->
         })
     } else {
         timed(|| {
-            simulate_mpc(arm, task, &options, &MpcOptions::default())
+            ctx.plant
+                .simulate_mpc(arm, task, &options, &MpcOptions::default())
                 .map(|e| {
                     let m = e.metrics;
                     [m.task_error, m.cost_j, m.control_effort, m.free_energy]

@@ -9,8 +9,8 @@
 
 use plotters::style::RGBColor;
 
-use crate::closed_loop::EpisodeOptions;
-use crate::mpc::{simulate_mpc, MpcOptions};
+use crate::closed_loop::{EpisodeOptions, Plant};
+use crate::mpc::MpcOptions;
 use crate::select::{Objective, ToolResult};
 use crate::{Arm, Task};
 
@@ -22,6 +22,8 @@ pub struct Trial<'a> {
     pub results: &'a [ToolResult],
     /// The episode settings the results were computed with.
     pub options: &'a EpisodeOptions,
+    /// The plant they were simulated on.
+    pub plant: Plant,
 }
 
 /// A way of choosing one tool of a trial.
@@ -85,7 +87,8 @@ impl DecisionRule for MpcCost {
 
     fn choose(&self, trial: &Trial) -> Option<usize> {
         crate::select::first_argmin(trial.tools.iter().enumerate().filter_map(|(i, arm)| {
-            simulate_mpc(arm, trial.task, trial.options, &self.0)
+            (trial.plant)
+                .simulate_mpc(arm, trial.task, trial.options, &self.0)
                 .ok()
                 .map(|e| (i, e.metrics.cost_j))
         }))

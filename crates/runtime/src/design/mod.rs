@@ -17,7 +17,6 @@ pub mod file;
 pub mod free_energy;
 pub mod polytope;
 pub mod qp;
-pub mod report;
 pub mod solver;
 pub mod sweep;
 pub mod verify;

@@ -1,10 +1,10 @@
-//! The active-inference controller, closed loop and episode for any [`ArmModel`]: the one
-//! implementation. The 2-link `crate::closed_loop` (and `crate::confidence`) are façades over it
-//! that keep the paper's `Arm`/`Task`/`Matrix2` API and its error messages.
+//! The closed loop and episode for any [`ArmModel`], around the core's controller
+//! ([`ActiveInferenceN`]): the one implementation, which `crate::closed_loop` names for the
+//! paper's arm.
 
 use nalgebra::{SMatrix, SVector};
 
-use super::{control_confidence, ArmModel, TaskN, ToolN};
+use super::{ActiveInferenceN, ArmModel, TaskN, ToolN};
 use crate::generated::Term;
 use crate::integrate::{
     solve_grid_with_jacobian, uniform_grid, IntegrationError, Method, Options as IntegratorOptions,
@@ -22,145 +22,6 @@ impl<const N: usize, const NX: usize, const NZ: usize> Dims<N, NX, NZ> {
         NX == 2 * N && NZ == NX + N,
         "model sizes must satisfy NX == 2N and NZ == NX + N"
     );
-}
-
-/// The task-based active-inference controller of one tool for one task, U̇ = −γ ∂F/∂U
-/// (eq. U_dot_deriv), with every matrix that does not change during an episode precomputed
-/// ([`crate::closed_loop::ActiveInference`] is its 2-link façade).
-#[derive(Debug, Clone, Copy)]
-pub struct ActiveInferenceN<const N: usize> {
-    pub task: TaskN<N>,
-    /// Learning rate γ of the gradient descent (eq. AIC_gradient_des).
-    pub learning_rate: f64,
-    /// Sᵀ P for each term (zero for terms the task does not use), so that
-    /// ∂F/∂U = K_θ(θ − θ^g) + K_θ̇(θ̇ − θ̇^g) + K_θ̈(θ̈ − θ̈^g) + P^U U.
-    gain_theta: SMatrix<f64, N, N>,
-    gain_theta_dot: SMatrix<f64, N, N>,
-    gain_theta_ddot: SMatrix<f64, N, N>,
-    /// ln|Π^U|, constant for the tool and task (eq. control_conf).
-    pub logdet: f64,
-}
-
-impl<const N: usize> ActiveInferenceN<N> {
-    pub fn new<M, const NX: usize, const NP: usize, const NZ: usize>(
-        tool: &ToolN<M, N, NX, NP, NZ>,
-        task: &TaskN<N>,
-        learning_rate: f64,
-    ) -> Result<Self, Error>
-    where
-        M: ArmModel<N, NX, NP, NZ>,
-    {
-        if !(learning_rate.is_finite() && learning_rate > 0.0) {
-            return Err(Error::InvalidOption {
-                name: "learning rate",
-                value: learning_rate,
-            });
-        }
-        let confidence = control_confidence(tool, task)?;
-        let s = tool.sensitivities(task.kind);
-        let zero = SMatrix::<f64, N, N>::zeros();
-        let gain = |s: Option<SMatrix<f64, N, N>>, p: &SMatrix<f64, N, N>| {
-            s.map_or(zero, |s| s.transpose() * p)
-        };
-        Ok(Self {
-            task: *task,
-            learning_rate,
-            gain_theta: gain(s.d_theta_du, &task.precision_theta),
-            gain_theta_dot: gain(s.d_theta_dot_du, &task.precision_theta_dot),
-            gain_theta_ddot: gain(s.d_theta_ddot_du, &task.precision_theta_ddot),
-            logdet: confidence.logdet,
-        })
-    }
-
-    /// U̇ = −γ ∂F/∂U (eq. U_dot_deriv) from the observed θ, θ̇, θ̈ and the current U (η^U = 0).
-    #[inline]
-    pub fn control_rate(
-        &self,
-        theta: &SVector<f64, N>,
-        theta_dot: &SVector<f64, N>,
-        theta_ddot: &SVector<f64, N>,
-        u: &SVector<f64, N>,
-    ) -> SVector<f64, N> {
-        let t = &self.task;
-        let gradient = self.gain_theta * (theta - t.goal_theta)
-            + self.gain_theta_dot * (theta_dot - t.goal_theta_dot)
-            + self.gain_theta_ddot * (theta_ddot - t.goal_theta_ddot)
-            + t.precision_u * u;
-        -self.learning_rate * gradient
-    }
-
-    /// The gains γ·(K_θ, K_θ̇, K_θ̈) and γ·P^U of U̇ = −γ ∂F/∂U, for the closed-loop Jacobian.
-    pub fn scaled_gains(&self) -> [SMatrix<f64, N, N>; 4] {
-        let g = self.learning_rate;
-        [
-            g * self.gain_theta,
-            g * self.gain_theta_dot,
-            g * self.gain_theta_ddot,
-            g * self.task.precision_u,
-        ]
-    }
-
-    /// The performance and control-cost part of F, ½[Σ eᵀPe + UᵀP^U U] over the task's terms:
-    /// the optimal-control cost J of the paper (F without the confidence term).
-    #[inline]
-    pub fn cost_j(
-        &self,
-        theta: &SVector<f64, N>,
-        theta_dot: &SVector<f64, N>,
-        theta_ddot: &SVector<f64, N>,
-        u: &SVector<f64, N>,
-    ) -> f64 {
-        let t = &self.task;
-        let q = |e: SVector<f64, N>, p: &SMatrix<f64, N, N>| e.dot(&(p * e));
-        // The terms in a fixed order (θ̈, U, θ̇, θ), each only if the task uses it.
-        let mut sum = 0.0;
-        if t.kind.uses(Term::ThetaDdot) {
-            sum += q(*theta_ddot - t.goal_theta_ddot, &t.precision_theta_ddot);
-        }
-        if t.kind.uses(Term::U) {
-            sum += u.dot(&(t.precision_u * u));
-        }
-        if t.kind.uses(Term::ThetaDot) {
-            sum += q(*theta_dot - t.goal_theta_dot, &t.precision_theta_dot);
-        }
-        if t.kind.uses(Term::Theta) {
-            sum += q(*theta - t.goal_theta, &t.precision_theta);
-        }
-        0.5 * sum
-    }
-
-    /// F = J − ½ ln|Π^U| (eq. free_energy).
-    #[inline]
-    pub fn free_energy(
-        &self,
-        theta: &SVector<f64, N>,
-        theta_dot: &SVector<f64, N>,
-        theta_ddot: &SVector<f64, N>,
-        u: &SVector<f64, N>,
-    ) -> f64 {
-        self.cost_j(theta, theta_dot, theta_ddot, u) - 0.5 * self.logdet
-    }
-
-    /// The task's own weighted error at one instant, the summand of the paper's task error:
-    /// (e − e^g)ᵀP(e − e^g) on the task's error term e ([`crate::TaskKind::error_term`]): θ in task 1,
-    /// θ̇ in task 2, θ̈ in task 3.
-    #[inline]
-    pub fn task_error(
-        &self,
-        theta: &SVector<f64, N>,
-        theta_dot: &SVector<f64, N>,
-        theta_ddot: &SVector<f64, N>,
-        u: &SVector<f64, N>,
-    ) -> f64 {
-        let t = &self.task;
-        let (e, p) = match t.kind.error_term() {
-            Term::Theta => (theta - t.goal_theta, &t.precision_theta),
-            Term::ThetaDot => (theta_dot - t.goal_theta_dot, &t.precision_theta_dot),
-            Term::ThetaDdot => (theta_ddot - t.goal_theta_ddot, &t.precision_theta_ddot),
-            Term::U => (*u, &t.precision_u),
-        };
-        e.dot(&(p * e))
-    }
 }
 
 /// Ż = [f_P(X, U + ΔT); −γ ∂F/∂U], the object the integrators see: the controller uses model
@@ -278,8 +139,8 @@ where
     }
 }
 
-/// Options of one episode for N joints. The 2-link [`crate::closed_loop::EpisodeOptions`] is these plus the plant
-/// choice, which here is a type parameter of [`simulate_on`]/[`episode_on`] instead.
+/// Options of one episode for N joints ([`crate::closed_loop::EpisodeOptions`] for the paper's
+/// arm). The plant is not among them: it is a type parameter of [`simulate_on`]/[`episode_on`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EpisodeOptionsN<const N: usize, const NX: usize> {
     pub t_end: f64,
@@ -295,7 +156,8 @@ pub struct EpisodeOptionsN<const N: usize, const NX: usize> {
     pub joint_perturbation: SVector<f64, N>,
     pub learning_rate: f64,
     /// Integrator options; [`Method::Auto`] runs DP5 on tasks 1–2 and the DP5-to-Rodas5P
-    /// switch on task 3, any task whose error term is θ̈ (why: [`crate::closed_loop::EpisodeOptions::integrator`]).
+    /// switch on task 3, any task whose error term is θ̈ (why: the paper's options,
+    /// `EpisodeOptions::default()` in [`crate::closed_loop`]).
     pub integrator: IntegratorOptions,
     /// Keep the trajectory on the output grid ([`episode_on`]; [`simulate_on`] never keeps it).
     pub record_trajectory: bool,
@@ -304,7 +166,8 @@ pub struct EpisodeOptionsN<const N: usize, const NX: usize> {
 impl<const N: usize, const NX: usize> EpisodeOptionsN<N, NX> {
     /// The paper's options ("Implementation details") for model `M`: t_end = 5 s, dt = 0.05 s,
     /// X0 = M's equilibrium, U0 = 0.1 on every joint, ΔT = 0, γ = 1, MATLAB ode45's tolerances.
-    /// [`crate::closed_loop::EpisodeOptions::default`] is this for the 2-link arm.
+    /// `EpisodeOptions::default()` ([`crate::closed_loop::EpisodeOptions`]) is this for the
+    /// paper's arm.
     pub fn paper<M, const NP: usize, const NZ: usize>() -> Self
     where
         M: ArmModel<N, NX, NP, NZ>,
@@ -371,9 +234,9 @@ pub struct EpisodeN<const N: usize> {
     pub trajectory: Option<TrajectoryN<N>>,
 }
 
-/// Why an episode failed, before the tool is named: each runtime's public error names the tool
-/// its own way ([`ModelSimulationError`] as `model(m1=… …)`, the 2-link
-/// [`crate::closed_loop::SimulationError`] as `arm m1=… …`), with the same time and reason.
+/// Why an episode failed, before the tool is named: the generic entry points name it
+/// `model(m1=… …)`, the paper's arm's ([`crate::closed_loop`]) `arm m1=… …`, with the same time
+/// and reason.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) enum EpisodeFailure {
     Input(Error),
@@ -387,8 +250,7 @@ impl From<Error> for EpisodeFailure {
     }
 }
 
-/// Why an episode of the generic runtime failed (the generic
-/// [`crate::closed_loop::SimulationError`]; the tool is named as `model(m1=… …)`).
+/// Why an episode failed: bad input, or the simulation of the named tool failed at a time.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ModelSimulationError {
     #[error(transparent)]
@@ -416,7 +278,7 @@ impl ModelSimulationError {
         }
     }
 
-    fn named(failure: EpisodeFailure, tool: impl FnOnce() -> String) -> Self {
+    pub(crate) fn named(failure: EpisodeFailure, tool: impl FnOnce() -> String) -> Self {
         match failure {
             EpisodeFailure::Input(e) => ModelSimulationError::Input(e),
             EpisodeFailure::Integration(source) => ModelSimulationError::Integration {

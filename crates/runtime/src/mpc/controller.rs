@@ -1,8 +1,7 @@
-//! The receding-horizon controller ([`MpcN`], generic over the arm model) and its 2-link
-//! façade ([`Mpc`]); the formulation is in the module docs of [`crate::mpc`].
+//! The receding-horizon controller ([`MpcN`], generic over the arm model; [`Mpc`] for the
+//! paper's arm); the formulation is in the module docs of [`crate::mpc`].
 
 use std::marker::PhantomData;
-use std::ops::{Deref, DerefMut};
 use std::time::{Duration, Instant};
 
 use clarabel::solver::SolverStatus;
@@ -11,8 +10,7 @@ use nalgebra::{SMatrix, SVector};
 use super::discretise::{discretise, Discretised};
 use super::options::{MpcError, MpcModel, MpcOptions, SolveInfo};
 use super::qp::{QpSolver, StageCost};
-use crate::model::{Arm2, Arm2Tool, ArmModel, TaskN, ToolN};
-use crate::{Arm, Task};
+use crate::model::{Arm2, ArmModel, TaskN, ToolN};
 
 /// A continuous affine model ẋ = a x + b u + c.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -226,30 +224,5 @@ where
     }
 }
 
-/// The MPC of the paper's 2-DOF arm: [`MpcN`] with [`Arm2`], built from an [`Arm`] and a
-/// [`Task`]. A newtype only so that [`Mpc::new`] keeps its 2-link signature; `control`,
-/// `reset`, `disturbance_estimate`, `last_solve`, `horizon_steps` and `last_plan` are
-/// [`MpcN`]'s, through `Deref`/`DerefMut`.
-pub struct Mpc(MpcN<Arm2, 2, 4, 4, 6>);
-
-impl Mpc {
-    /// Discretises the arm's model at the equilibrium, builds the QP and sets up Clarabel once.
-    /// (With [`MpcModel::Local`], the first call re-linearises at its state.)
-    pub fn new(arm: &Arm, task: &Task, options: &MpcOptions) -> Result<Self, MpcError> {
-        MpcN::new(&Arm2Tool::from(arm), &TaskN::from(task), options).map(Self)
-    }
-}
-
-impl Deref for Mpc {
-    type Target = MpcN<Arm2, 2, 4, 4, 6>;
-
-    fn deref(&self) -> &Self::Target {
-        &self.0
-    }
-}
-
-impl DerefMut for Mpc {
-    fn deref_mut(&mut self) -> &mut Self::Target {
-        &mut self.0
-    }
-}
+/// The MPC of the paper's 2-DOF arm: [`MpcN`] with [`Arm2`] (`Mpc::new(&arm, &task, &options)`).
+pub type Mpc = MpcN<Arm2, 2, 4, 4, 6>;

@@ -40,6 +40,7 @@ pub fn discretise<const N: usize, const M: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::{Arm2, ArmModel};
     use crate::Arm;
 
     #[test]
@@ -73,13 +74,13 @@ mod tests {
     fn arm_matches_taylor_series() {
         let t = 0.05;
         for arm in [
-            Arm::new(0.3, 0.3, 0.3, 0.3),
-            Arm::new(0.6, 0.1, 0.1, 0.6),
-            Arm::new(0.1, 0.6, 0.5, 0.1),
+            Arm::new([0.3, 0.3, 0.3, 0.3]),
+            Arm::new([0.6, 0.1, 0.1, 0.6]),
+            Arm::new([0.1, 0.6, 0.5, 0.1]),
         ] {
             let arm = arm.unwrap();
             let (a, b) = (arm.state_matrix(), arm.input_matrix());
-            let xe = Arm::equilibrium_state();
+            let xe = Arm2::equilibrium_state();
             let d = discretise(&a, &b, &(-a * xe), t);
             // Ad = Σ (AT)^k/k!, Bd = Σ A^k B T^{k+1}/(k+1)!; 40 terms is far past convergence
             // for ‖AT‖ ≲ 12 on these arms.

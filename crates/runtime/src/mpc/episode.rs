@@ -2,9 +2,9 @@
 //! sees the state every control period and holds its torque (zero-order hold) while the plant
 //! Ẋ = f(X, U + ΔT) is integrated; metrics are those of the active-inference episode.
 //!
-//! [`simulate_mpc_on`] is the implementation for any [`ArmModel`]; [`simulate_mpc`] is the
-//! 2-link façade (the paper's `Arm`/`Task`, the run-time [`crate::closed_loop::Plant`], errors
-//! naming `arm m1=…`).
+//! [`simulate_mpc_on`] is the implementation for any [`ArmModel`]; [`simulate_mpc`] and
+//! [`Plant::simulate_mpc`] run it for the paper's arm on the plant chosen at run time, the errors
+//! naming `arm m1=…`.
 
 use std::time::Duration;
 
@@ -14,8 +14,7 @@ use super::{MpcError, MpcN, MpcOptions};
 use crate::closed_loop::{EpisodeOptions, Plant};
 use crate::integrate::{solve_grid, IntegrationError};
 use crate::model::{
-    ActiveInferenceN, Arm2, Arm2Exact, Arm2Tool, ArmModel, EpisodeOptionsN, TaskN, ToolN,
-    TrajectoryN,
+    ActiveInferenceN, Arm2, Arm2Exact, ArmModel, EpisodeOptionsN, TaskN, ToolN, TrajectoryN,
 };
 use crate::{Arm, Error, Task};
 
@@ -73,32 +72,11 @@ impl From<Error> for MpcFailure {
     }
 }
 
-/// Why an MPC episode failed, naming the tool and time.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum MpcEpisodeError {
-    #[error(transparent)]
-    Input(#[from] Error),
-    #[error("MPC for arm {arm}: {source}")]
-    Setup { arm: Arm, source: MpcError },
-    #[error("MPC for arm {arm} failed at t = {t} s: {source}")]
-    Controller { arm: Arm, t: f64, source: MpcError },
-    #[error("simulation of arm {arm} under MPC failed: {source}")]
-    Integration { arm: Arm, source: IntegrationError },
-}
+/// Why an MPC episode of the paper's arm failed ([`MpcSimulationError`], the tool named
+/// `arm m1=…`).
+pub type MpcEpisodeError = MpcSimulationError;
 
-impl MpcEpisodeError {
-    fn named(failure: MpcFailure, arm: Arm) -> Self {
-        match failure {
-            MpcFailure::Input(e) => MpcEpisodeError::Input(e),
-            MpcFailure::Setup(source) => MpcEpisodeError::Setup { arm, source },
-            MpcFailure::Controller { t, source } => MpcEpisodeError::Controller { arm, t, source },
-            MpcFailure::Integration(source) => MpcEpisodeError::Integration { arm, source },
-        }
-    }
-}
-
-/// Why an MPC episode of the generic runtime failed ([`MpcEpisodeError`] with the tool named as
-/// `model(m1=… …)`).
+/// Why an MPC episode failed: bad input, or the MPC or the simulation of the named tool failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MpcSimulationError {
     #[error(transparent)]
@@ -139,25 +117,35 @@ impl MpcSimulationError {
     }
 }
 
-/// Runs the MPC baseline for one episode of the paper's 2-DOF arm, on the plant
-/// `options.plant` chooses (matched once here), with the same options (horizon, grid, initial
-/// state, perturbation, integrator) as the active-inference episode. The output grid spacing
-/// must be a whole number of control periods. The paper's U0 is not used: the MPC chooses U at
-/// t = 0.
+/// Runs the MPC baseline for one episode of the paper's 2-DOF arm on the paper's plant
+/// ([`Plant::simulate_mpc`]).
 pub fn simulate_mpc(
     arm: &Arm,
     task: &Task,
     options: &EpisodeOptions,
     mpc_options: &MpcOptions,
 ) -> Result<MpcEpisode, MpcEpisodeError> {
-    let tool = Arm2Tool::from(arm);
-    let task = TaskN::from(task);
-    let generic = EpisodeOptionsN::from(options);
-    match options.plant {
-        Plant::Paper => run::<Arm2, Arm2, 2, 4, 4, 6>(&tool, &task, &generic, mpc_options),
-        Plant::Exact => run::<Arm2, Arm2Exact, 2, 4, 4, 6>(&tool, &task, &generic, mpc_options),
+    Plant::Paper.simulate_mpc(arm, task, options, mpc_options)
+}
+
+impl Plant {
+    /// The MPC baseline for one episode of the paper's 2-DOF arm on this plant (matched once
+    /// here), with the same options (horizon, grid, initial state, perturbation, integrator) as
+    /// the active-inference episode. The output grid spacing must be a whole number of control
+    /// periods. The paper's U0 is not used: the MPC chooses U at t = 0.
+    pub fn simulate_mpc(
+        self,
+        arm: &Arm,
+        task: &Task,
+        options: &EpisodeOptions,
+        mpc_options: &MpcOptions,
+    ) -> Result<MpcEpisode, MpcEpisodeError> {
+        match self {
+            Plant::Paper => run::<Arm2, Arm2, 2, 4, 4, 6>(arm, task, options, mpc_options),
+            Plant::Exact => run::<Arm2, Arm2Exact, 2, 4, 4, 6>(arm, task, options, mpc_options),
+        }
+        .map_err(|failure| MpcSimulationError::named(failure, || format!("arm {arm}")))
     }
-    .map_err(|failure| MpcEpisodeError::named(failure, *arm))
 }
 
 /// The MPC episode of `tool` (prediction model `M`) on `task`, simulated on plant model `P`
@@ -187,7 +175,7 @@ where
     M: ArmModel<N, NX, NP, NZ>,
     P: ArmModel<N, NX, NP, NZ>,
 {
-    let metrics_of = ActiveInferenceN::new(tool, task, 1.0)?;
+    let metrics_of = ActiveInferenceN::new(tool, task, 1.0).map_err(Error::from)?;
     // The QP log holds one entry per control period: refuse horizons too long to keep.
     for step in [options.dt, mpc_options.period] {
         if step > 0.0 {

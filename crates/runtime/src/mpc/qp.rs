@@ -94,7 +94,7 @@ impl StageCost {
         task: &Task,
         period: f64,
     ) -> Self {
-        Self::of(a, b, c, &TaskN::from(task), period)
+        Self::of(a, b, c, task, period)
     }
 }
 
@@ -415,11 +415,12 @@ fn write_q<const N: usize, const NX: usize, const NZ: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::{Arm2, ArmModel};
     use crate::{Arm, TaskKind};
 
     /// The paper's J times the period, evaluated directly.
     fn direct_cost(arm: &Arm, task: &Task, x: &State, u: &Vector2, period: f64) -> f64 {
-        let accel = (arm.state_matrix() * (x - Arm::equilibrium_state()) + arm.input_matrix() * u)
+        let accel = (arm.state_matrix() * (x - Arm2::equilibrium_state()) + arm.input_matrix() * u)
             .fixed_rows::<2>(2)
             .into_owned();
         let quad = |e: Vector2, p: &crate::Matrix2| (e.transpose() * p * e)[0];
@@ -445,7 +446,7 @@ mod tests {
     ) {
         let t = 0.05;
         let (a, b) = (arm.state_matrix(), arm.input_matrix());
-        let c = -a * Arm::equilibrium_state();
+        let c = -a * Arm2::equilibrium_state();
         let equilibrium = (
             crate::mpc::discretise(&a, &b, &c, t),
             StageCost::new(&a, &b, &c, task, t),
@@ -472,7 +473,10 @@ mod tests {
     #[test]
     fn in_place_update_solves_the_same_qp_as_a_fresh_solver() {
         let x0 = State::new(0.9, 0.6, 0.0, 1.5);
-        for arm in [Arm::new(0.3, 0.4, 0.5, 0.2), Arm::new(0.6, 0.1, 0.1, 0.6)] {
+        for arm in [
+            Arm::new([0.3, 0.4, 0.5, 0.2]),
+            Arm::new([0.6, 0.1, 0.1, 0.6]),
+        ] {
             let arm = arm.unwrap();
             for kind in TaskKind::ALL {
                 let task = Task::paper(kind);
@@ -545,12 +549,12 @@ mod tests {
 
     #[test]
     fn stage_cost_is_the_papers_cost_up_to_a_constant() {
-        let arm = Arm::new(0.2, 0.5, 0.4, 0.3).unwrap();
+        let arm = Arm::new([0.2, 0.5, 0.4, 0.3]).unwrap();
         let period = 0.05;
         let points = [
             (State::new(-1.0, -2.0, 0.3, -0.4), Vector2::new(0.5, -1.5)),
             (State::new(0.7, 0.1, -2.0, 1.0), Vector2::new(-3.0, 2.0)),
-            (Arm::equilibrium_state(), Vector2::zeros()),
+            (Arm2::equilibrium_state(), Vector2::zeros()),
         ];
         for kind in TaskKind::ALL {
             let task = Task::paper(kind);
@@ -558,7 +562,7 @@ mod tests {
             let cost = StageCost::new(
                 &a,
                 &arm.input_matrix(),
-                &(-a * Arm::equilibrium_state()),
+                &(-a * Arm2::equilibrium_state()),
                 &task,
                 period,
             );

@@ -4,18 +4,19 @@
 use super::qp::StageCost;
 use super::*;
 use crate::generated::arm2;
+use crate::model::{Arm2, ArmModel};
 use crate::{Arm, State, Task, TaskKind, Vector2};
 
 fn arms() -> [Arm; 3] {
     [
-        Arm::new(0.3, 0.3, 0.3, 0.3).unwrap(),
-        Arm::new(0.1, 0.6, 0.5, 0.2).unwrap(),
-        Arm::new(0.6, 0.1, 0.1, 0.6).unwrap(),
+        Arm::new([0.3, 0.3, 0.3, 0.3]).unwrap(),
+        Arm::new([0.1, 0.6, 0.5, 0.2]).unwrap(),
+        Arm::new([0.6, 0.1, 0.1, 0.6]).unwrap(),
     ]
 }
 
 fn states() -> [State; 3] {
-    let xe = Arm::equilibrium_state();
+    let xe = Arm2::equilibrium_state();
     [
         xe,
         xe + State::new(0.3, -0.2, 0.5, -1.0),
@@ -39,7 +40,7 @@ fn unconstrained_mpc_equals_finite_horizon_lqr() {
         let (a, b, xe) = (
             arm.state_matrix(),
             arm.input_matrix(),
-            Arm::equilibrium_state(),
+            Arm2::equilibrium_state(),
         );
         let model = discretise(&a, &b, &(-a * xe), options.period);
         for kind in TaskKind::ALL {
@@ -84,7 +85,7 @@ fn torque_bound_holds_and_is_active_far_from_goal() {
     // more than 5 Nm on these arms, so the bounded one must saturate.
     let task = Task::paper(TaskKind::Position);
     let x = State::new(3.0, 2.0, 0.0, 0.0);
-    for arm in [Arm::new(0.6, 0.6, 0.6, 0.6).unwrap(), arms()[1]] {
+    for arm in [Arm::new([0.6, 0.6, 0.6, 0.6]).unwrap(), arms()[1]] {
         let free = Mpc::new(&arm, &task, &unconstrained())
             .unwrap()
             .control(&x)
@@ -224,7 +225,7 @@ fn non_finite_state_is_a_solve_error_with_its_step() {
         &MpcOptions::default(),
     )
     .unwrap();
-    mpc.control(&Arm::equilibrium_state()).unwrap();
+    mpc.control(&Arm2::equilibrium_state()).unwrap();
     let err = mpc
         .control(&State::new(f64::NAN, 0.0, 0.0, 0.0))
         .unwrap_err();
@@ -234,7 +235,7 @@ fn non_finite_state_is_a_solve_error_with_its_step() {
 
 #[test]
 fn local_model_at_the_equilibrium_is_the_equilibrium_model() {
-    let xe = Arm::equilibrium_state();
+    let xe = Arm2::equilibrium_state();
     for arm in arms() {
         // The generated Jacobian at (X^e, 0) is the paper's A, B, and f(X^e, 0) = 0.
         let (a, b) = arm2::dynamics_jacobian(&xe, &Vector2::zeros(), &arm.params());
@@ -277,7 +278,7 @@ fn observer_recovers_a_constant_disturbance_on_the_linear_model() {
     let (a, b, xe) = (
         arm.state_matrix(),
         arm.input_matrix(),
-        Arm::equilibrium_state(),
+        Arm2::equilibrium_state(),
     );
     let plant = discretise(&a, &b, &(-a * xe), 0.05);
     let disturbance = Vector2::new(-0.3, 0.7);

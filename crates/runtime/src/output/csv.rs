@@ -10,7 +10,7 @@ use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use super::ReproduceError;
+use super::WriteError;
 
 /// One cell of a row.
 #[derive(Debug, Clone, PartialEq)]
@@ -106,8 +106,8 @@ pub struct CsvWriter {
 
 impl CsvWriter {
     /// Creates (truncates) `path` and writes the header.
-    pub fn create(path: &Path, header: &[&str]) -> Result<Self, ReproduceError> {
-        let file = File::create(path).map_err(ReproduceError::io(path))?;
+    pub fn create(path: &Path, header: &[&str]) -> Result<Self, WriteError> {
+        let file = File::create(path).map_err(WriteError::at(path))?;
         let mut writer = Self {
             file,
             path: path.to_path_buf(),
@@ -119,7 +119,7 @@ impl CsvWriter {
     }
 
     /// Appends one row; it must have as many cells as the header.
-    pub fn row(&mut self, cells: Vec<Cell>) -> Result<(), ReproduceError> {
+    pub fn row(&mut self, cells: Vec<Cell>) -> Result<(), WriteError> {
         assert_eq!(
             cells.len(),
             self.columns,
@@ -130,7 +130,7 @@ impl CsvWriter {
         );
         self.file
             .write_all(format_row(&cells).as_bytes())
-            .map_err(ReproduceError::io(&self.path))
+            .map_err(WriteError::at(&self.path))
     }
 }
 

@@ -10,7 +10,6 @@
 //! are handed on in file order, and every episode is deterministic, so results and streamed rows
 //! are identical whatever the number of threads.
 
-pub mod report;
 mod screen;
 mod tasks;
 
@@ -43,7 +42,7 @@ impl RankedTool {
             .tool
             .named_parameters()
             .iter()
-            .map(|(n, v)| format!("{n}={}", crate::experiments::csv::format_number(*v)))
+            .map(|(n, v)| format!("{n}={}", crate::output::csv::format_number(*v)))
             .collect();
         params.join(" ")
     }

@@ -204,7 +204,9 @@ pub(super) mod tests {
     #[test]
     fn the_screen_keeps_the_most_confident_and_the_earlier_on_ties() {
         let mut screen = Screen::new(Some(2));
-        let bad = Err(Error::NotPositiveDefinite { determinant: 0.0 });
+        let bad = Err(Error::from(toolconf_core::Error::NotPositiveDefinite {
+            determinant: 0.0,
+        }));
         for (row, l) in [
             (1, Ok(1.0)),
             (2, Ok(3.0)),

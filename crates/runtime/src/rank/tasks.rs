@@ -76,7 +76,7 @@ macro_rules! model_tasks {
             pub fn logdet(&self, tool: &AnyTool) -> Result<f64, Error> {
                 match tool {
                     $(AnyTool::$marker(t) => match &self.$module {
-                        Ok(b) => b.task.control_confidence(t).map(|c| c.logdet),
+                        Ok(b) => Ok(b.task.control_confidence(t)?.logdet),
                         Err(e) => Err(Error::Unsupported(e.to_string())),
                     },)*
                 }
@@ -87,9 +87,10 @@ macro_rules! model_tasks {
             pub fn logdet_and_gradient(&self, tool: &AnyTool) -> Result<(f64, Vec<f64>), Error> {
                 match tool {
                     $(AnyTool::$marker(t) => match &self.$module {
-                        Ok(b) => b.task.control_confidence(t).map(|c| {
-                            (c.logdet, b.task.logdet_gradient(t).as_slice().to_vec())
-                        }),
+                        Ok(b) => {
+                            let logdet = b.task.control_confidence(t)?.logdet;
+                            Ok((logdet, b.task.logdet_gradient(t).as_slice().to_vec()))
+                        }
                         Err(e) => Err(Error::Unsupported(e.to_string())),
                     },)*
                 }

@@ -161,34 +161,39 @@ fn evaluate_one<M, const N: usize, const NX: usize, const NP: usize, const NZ: u
 where
     M: ArmModel<N, NX, NP, NZ>,
 {
-    let task = TaskN::paper::<M, NX, NP, NZ>(kind);
+    let task = M::paper_task(kind);
     let options = options_for::<M, N, NX, NP, NZ>(common);
     (
-        control_confidence(tool, &task).map(|c| c.logdet),
+        control_confidence(tool, &task)
+            .map(|c| c.logdet)
+            .map_err(Error::from),
         simulate(tool, &task, &options),
     )
 }
 
 /// Evaluates every tool on its own model's paper-style `kind` task, in parallel; the result
 /// order is the tools' order. `common` gives the horizon, grid, perturbation, learning rate and
-/// integrator (`options_for`); `common.plant == Plant::Exact` simulates the
-/// arm2 tools on the exact 2-link dynamics (as `--plant exact` does for 2-link selection), other
-/// models always on their own dynamics.
+/// integrator (`options_for`); `plant` [`Plant::Exact`] simulates the arm2 tools on the exact
+/// 2-link dynamics (as `--plant exact` does for 2-link selection), other models always on their
+/// own dynamics.
 pub fn evaluate_mixed(
     tools: &[AnyTool],
     kind: TaskKind,
     common: &EpisodeOptions,
+    plant: Plant,
 ) -> Vec<MixedResult> {
     tools
         .par_iter()
         .enumerate()
         .map(|(index, tool)| {
             let (logdet, episode) = match tool {
-                AnyTool::Arm2(t) if common.plant == Plant::Exact => {
-                    let task = TaskN::paper::<Arm2, 4, 4, 6>(kind);
+                AnyTool::Arm2(t) if plant == Plant::Exact => {
+                    let task = TaskN::paper(kind);
                     let options = options_for::<Arm2, 2, 4, 4, 6>(common);
                     (
-                        control_confidence(t, &task).map(|c| c.logdet),
+                        control_confidence(t, &task)
+                            .map(|c| c.logdet)
+                            .map_err(Error::from),
                         simulate_on::<Arm2, Arm2Exact, 2, 4, 4, 6>(t, &task, &options),
                     )
                 }

@@ -14,9 +14,9 @@ use rand::{RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use crate::closed_loop::{simulate, EpisodeOptions, Metrics, SimulationError};
+use crate::closed_loop::{EpisodeOptions, Metrics, Plant, SimulationError};
 use crate::confidence::control_confidence;
-use crate::mpc::{simulate_mpc, MpcEpisodeError, MpcMetrics, MpcOptions};
+use crate::mpc::{MpcEpisodeError, MpcMetrics, MpcOptions};
 use crate::{Arm, Error, Task};
 
 /// The paper's parameter domain for m1, m2, l1, l2 ("Implementation details").
@@ -45,7 +45,7 @@ impl ToolSampler {
         for v in &mut p {
             *v = lo + (hi - lo) * self.uniform();
         }
-        Arm::new(p[0], p[1], p[2], p[3]).expect("parameters drawn from [0.1, 0.6) are valid")
+        Arm::new(p).expect("parameters drawn from [0.1, 0.6) are valid")
     }
 
     pub fn tools(&mut self, n: usize) -> Vec<Arm> {
@@ -67,11 +67,16 @@ pub struct ToolResult {
     pub episode: Result<Metrics, SimulationError>,
 }
 
-/// Runs every tool's episode in parallel; the result order is the tools' order.
-pub fn evaluate(tools: &[Arm], task: &Task, options: &EpisodeOptions) -> Vec<ToolResult> {
+/// Runs every tool's episode on `plant` in parallel; the result order is the tools' order.
+pub fn evaluate(
+    tools: &[Arm],
+    task: &Task,
+    options: &EpisodeOptions,
+    plant: Plant,
+) -> Vec<ToolResult> {
     let options = EpisodeOptions {
         record_trajectory: false,
-        ..options.clone()
+        ..*options
     };
     tools
         .par_iter()
@@ -79,27 +84,35 @@ pub fn evaluate(tools: &[Arm], task: &Task, options: &EpisodeOptions) -> Vec<Too
         .map(|(index, arm)| ToolResult {
             index,
             arm: *arm,
-            logdet: control_confidence(arm, task).map(|c| c.logdet),
-            episode: simulate(arm, task, &options).map(|e| e.metrics),
+            logdet: control_confidence(arm, task)
+                .map(|c| c.logdet)
+                .map_err(Error::from),
+            episode: plant.simulate(arm, task, &options).map(|e| e.metrics),
         })
         .collect()
 }
 
-/// The MPC baseline's episode for every tool, in parallel, in the tools' order: the cost it
-/// achieves, ∫J dt, is the objective J* (issue 5), the conventional optimal-control ranking.
+/// The MPC baseline's episode on `plant` for every tool, in parallel, in the tools' order: the
+/// cost it achieves, ∫J dt, is the objective J* (issue 5), the conventional optimal-control
+/// ranking.
 pub fn evaluate_mpc(
     tools: &[Arm],
     task: &Task,
     options: &EpisodeOptions,
     mpc: &MpcOptions,
+    plant: Plant,
 ) -> Vec<Result<MpcMetrics, MpcEpisodeError>> {
     let options = EpisodeOptions {
         record_trajectory: false,
-        ..options.clone()
+        ..*options
     };
     tools
         .par_iter()
-        .map(|arm| simulate_mpc(arm, task, &options, mpc).map(|e| e.metrics))
+        .map(|arm| {
+            plant
+                .simulate_mpc(arm, task, &options, mpc)
+                .map(|e| e.metrics)
+        })
         .collect()
 }
 

@@ -1,0 +1,120 @@
+//! The layers as crates (README, "Crates"): each depends only on the ones below it, and the low
+//! ones carry little. Checked with `cargo tree` on the manifests, as a user would look.
+
+use std::collections::BTreeSet;
+use std::path::Path;
+use std::process::Command;
+
+/// What a robot, a microcontroller or the Python package must not pull in.
+const HEAVY: [&str; 10] = [
+    "clap",
+    "rayon",
+    "plotters",
+    "clarabel",
+    "indicatif",
+    "csv",
+    "toml",
+    "serde_json",
+    "tera",
+    "toolconf-report",
+];
+
+/// The package names of `cargo tree` on `manifest` with `args`.
+fn tree(manifest: &str, args: &[&str]) -> BTreeSet<String> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+        .current_dir(root)
+        .args([
+            "tree",
+            "--manifest-path",
+            manifest,
+            "--prefix",
+            "none",
+            "--format",
+            "{p}",
+        ])
+        .args(args)
+        .output()
+        .expect("run cargo tree");
+    assert!(
+        out.status.success(),
+        "cargo tree {manifest}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .filter_map(|l| l.split_whitespace().next().map(String::from))
+        .collect()
+}
+
+fn no_std_root(file: &str) -> bool {
+    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(file)).unwrap();
+    text.lines().any(|l| l.trim() == "#![no_std]")
+}
+
+#[test]
+fn the_generated_crate_is_no_std_on_nalgebra_alone() {
+    assert!(no_std_root("generated/src/lib.rs"));
+    let direct = tree("generated/Cargo.toml", &["-e", "normal", "--depth", "1"]);
+    let expected: BTreeSet<String> = ["toolconf-generated", "nalgebra", "libm"]
+        .map(String::from)
+        .into();
+    assert_eq!(direct, expected);
+    // nalgebra without default features: none of its std-only or optional dependencies.
+    let all = tree("generated/Cargo.toml", &["-e", "normal"]);
+    for std_only in ["matrixmultiply", "serde", "rand", "wide", "rayon"] {
+        assert!(!all.contains(std_only), "{std_only} in {all:?}");
+    }
+}
+
+#[test]
+fn the_core_is_no_std_on_the_generated_crate() {
+    assert!(no_std_root("crates/core/src/lib.rs"));
+    let direct = tree("crates/core/Cargo.toml", &["-e", "normal", "--depth", "1"]);
+    let expected: BTreeSet<String> = [
+        "toolconf-core",
+        "toolconf-generated",
+        "nalgebra",
+        "libm",
+        "thiserror",
+    ]
+    .map(String::from)
+    .into();
+    assert_eq!(direct, expected);
+}
+
+#[test]
+fn what_a_robot_links_has_nothing_heavy() {
+    assert!(no_std_root("examples/on_robot/src/lib.rs"));
+    // All edges, dev and build included: the crate's whole tree.
+    let all = tree("examples/on_robot/Cargo.toml", &[]);
+    assert!(all.contains("toolconf-core") && all.contains("toolconf-generated"));
+    for heavy in HEAVY.iter().chain(&["toolconf"]) {
+        assert!(
+            !all.contains(*heavy),
+            "{heavy} in the on-robot tree {all:?}"
+        );
+    }
+}
+
+#[test]
+fn the_runtime_and_the_python_package_have_no_command_line_plots_or_progress_bars() {
+    for manifest in ["crates/runtime/Cargo.toml", "python/Cargo.toml"] {
+        let normal = tree(manifest, &["-e", "normal"]);
+        for top in [
+            "clap",
+            "plotters",
+            "indicatif",
+            "toolconf-report",
+            "toolconf-cli",
+        ] {
+            assert!(!normal.contains(top), "{top} in {manifest}'s tree");
+        }
+    }
+    let runtime = tree(
+        "crates/runtime/Cargo.toml",
+        &["-e", "normal", "--depth", "1"],
+    );
+    assert!(runtime.contains("toolconf-core") && runtime.contains("toolconf-generated"));
+}
