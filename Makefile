@@ -6,7 +6,7 @@ PY_DEV := $(VENV)/.python-dev-installed
 # Deterministic derivation: the same inputs give byte-identical generated files.
 export PYTHONHASHSEED := 0
 
-.PHONY: run test derive drift-check venv clean-venv bench python-test
+.PHONY: run test derive drift-check venv clean-venv bench python-test crate on-robot-test
 
 ## make run: build in release mode and reproduce the paper's Results (results/report.md).
 run:
@@ -14,17 +14,25 @@ run:
 	./target/release/toolconf reproduce --out results/
 
 ## make bench: criterion benchmarks (Π^U per tool, closed-loop RHS, episodes, a batch of 1000, populations of 2000 tools,
-## the default reproduce); reports in target/criterion/. Peers: bench/peers/run.sh.
+## the default reproduce, the on-robot controller's tick); reports in target/criterion/ and
+## examples/on_robot/bench/target/criterion/. Peers: bench/peers/run.sh.
 bench:
 	cargo bench --bench confidence --bench episode --bench stiff --bench reproduce --bench population
+	cargo bench --manifest-path examples/on_robot/bench/Cargo.toml
 
 ## make test: the whole suite: `make derive` reproduces generated/ byte for byte (on this CPU and
 ## on an imitated older one), the derivation's own tests, the crate's, then the Python package's.
 test: drift-check $(PY_DEV)
 	$(PY) -m unittest discover --start-directory derive/tests
 	cargo test --workspace --quiet
+	$(MAKE) --no-print-directory on-robot-test
 	$(PYTHON_BUILD)
 	$(PYTHON_TESTS)
+
+## make on-robot-test: the on-robot controller's own tests (examples/on_robot, a crate outside the
+## workspace, as a robot's firmware would build it).
+on-robot-test:
+	cargo test --quiet --manifest-path examples/on_robot/Cargo.toml
 
 ## make python-test: builds the Python package (python/, `import toolconf`) into derive/.venv
 ## with maturin (debug profile, in the workspace's target/, so the crate is not built twice),
@@ -51,6 +59,14 @@ $(PY_DEV): python/requirements-dev.txt $(PY)
 ## -> rustfmt, into generated/ (and the renderer's fixture in tests/fixtures/).
 derive: $(PY)
 	$(PY) derive/pipeline.py
+
+## make crate MODELS=<folder> OUT=<folder> [TASKS=<file>] [NAME=<crate>]: derive the model descriptions in
+## MODELS (with derive/tasks.toml, or TASKS) into a standalone no_std crate at OUT, with its own
+## test against the CasADi vectors (cargo test --manifest-path OUT/Cargo.toml); nothing in the
+## repository changes (derive/make_crate.py).
+crate: $(PY)
+	@if [ -z "$(MODELS)" ] || [ -z "$(OUT)" ]; then echo "usage: make crate MODELS=<folder of model descriptions> OUT=<folder> [TASKS=<file>] [NAME=<crate>]" >&2; exit 2; fi
+	$(PY) derive/make_crate.py --models "$(MODELS)" --out "$(OUT)" $(if $(TASKS),--tasks "$(TASKS)") $(if $(NAME),--name "$(NAME)")
 
 ## make drift-check: derive into a temporary folder, twice: as this CPU does, and with numpy's
 ## optional kernels (AVX-512, AVX2, ...) and glibc's AVX/FMA variants switched off; fail, naming
