@@ -2,8 +2,9 @@
 //! a linear(ised) arm model, solved as a sparse QP with Clarabel.
 //!
 //! The controller ([`MpcN`]) and its episode ([`simulate_mpc_on`]) are generic over the arm
-//! model ([`crate::model::ArmModel`]), like the active-inference runtime; [`Mpc`] and
-//! [`simulate_mpc`] are the 2-link façade (the paper's `Arm`, `Task` and run-time `Plant`).
+//! model ([`crate::model::ArmModel`]), like the active-inference runtime; [`Mpc`] is the
+//! controller of the paper's arm, and [`simulate_mpc`] (the paper's plant) and
+//! [`crate::closed_loop::Plant::simulate_mpc`] run its episode, the tool named `arm m1=…`.
 //! The sizes quoted below (6×6 stage blocks, four x_0 rows, the 7×7 exponential) are the 2-link
 //! arm's; for an arm with n joints (state 2n) they are 3n×3n, 2n and 3n + 1.
 //!
