@@ -118,3 +118,41 @@ fn the_runtime_and_the_python_package_have_no_command_line_plots_or_progress_bar
     );
     assert!(runtime.contains("toolconf-core") && runtime.contains("toolconf-generated"));
 }
+
+/// What a robot links builds for a microcontroller without std or an allocator (a Cortex-M4F),
+/// where the rustup target is installed (`rustup target add thumbv7em-none-eabihf`).
+#[test]
+fn the_on_robot_controller_builds_for_a_bare_metal_target() {
+    let target = "thumbv7em-none-eabihf";
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let sysroot = Command::new("rustc").args(["--print", "sysroot"]).output();
+    let installed = sysroot.is_ok_and(|o| {
+        let lib = Path::new(String::from_utf8_lossy(&o.stdout).trim())
+            .join("lib/rustlib")
+            .join(target);
+        lib.is_dir()
+    });
+    if !installed {
+        eprintln!("skipped: the {target} target is not installed");
+        return;
+    }
+    let out = Command::new(cargo)
+        .current_dir(root)
+        .args([
+            "build",
+            "--quiet",
+            "--lib",
+            "--target",
+            target,
+            "--manifest-path",
+            "examples/on_robot/Cargo.toml",
+        ])
+        .output()
+        .expect("run cargo build");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

@@ -5,7 +5,11 @@
 //! torque U to apply until the next tick and the tool's control confidence ln|Π^U|. `no_std`,
 //! no allocation, no integrator and no threads: this crate depends on toolconf's core
 //! (`toolconf-core`) and the generated code beneath it (`toolconf-generated`) only, with
-//! nalgebra's fixed-size types; `cargo tree` here is what a robot's firmware gets.
+//! nalgebra's fixed-size types; `cargo tree` here is what a robot's firmware gets. It builds
+//! for a microcontroller without std or an allocator, e.g. a Cortex-M4F: `rustup target add
+//! thumbv7em-none-eabihf`, then `cargo build --manifest-path examples/on_robot/Cargo.toml
+//! --target thumbv7em-none-eabihf` (the workspace's tests/layers.rs does, where the target is
+//! installed).
 //!
 //! ```
 //! use toolconf_on_robot::{Arm2Controller, Arm2Tool, TaskKind};

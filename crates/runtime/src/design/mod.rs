@@ -6,7 +6,7 @@
 //! (generated `<task>_logdet_gradient`; [`solver`], QPs by Clarabel) → optionally ∫F dt by
 //! simulation from there ([`free_energy`]) → the design beside the best of N random feasible
 //! tools, simulated with and without a torque perturbation ΔT ([`verify`]). [`sweep`] traces
-//! the confidence–budget trade-off; [`report`] writes it down.
+//! the confidence–budget trade-off; the report (`toolconf_report::design`) writes it down.
 //!
 //! Determinism: starts and random tools come from seeded ChaCha8 streams drawn sequentially;
 //! the multi-start runs in start order; simulations run in parallel but are collected in input
