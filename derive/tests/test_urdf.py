@@ -373,6 +373,11 @@ class SpatialLagrangian(unittest.TestCase):
         self.assertLess(worst, TOLERANCE, f"worst normwise relative difference {worst:.2e}")
 
 
+def _quarter_turn(angle: float) -> float:
+    k = round(angle / (math.pi / 2))
+    return k * (math.pi / 2) if abs(angle - k * (math.pi / 2)) < 1e-9 else angle
+
+
 class Pinocchio(unittest.TestCase):
     """(c) Pinocchio (pin, derive/requirements.txt) on the same URDF cut at the flange, the tool
     added as a fixed link."""
@@ -386,6 +391,12 @@ class Pinocchio(unittest.TestCase):
                 name = e.get("name") if tag == "link" else e.find("child").get("link")
                 if name not in keep:
                     root.remove(e)
+        # The reader takes rotation entries within 1e-9 of 0 or +-1 as exact (urdf.py): give
+        # Pinocchio the same angles, each within 1e-9 of a multiple of pi/2 written as the double
+        # nearest it (UR5's 1.57079632679 otherwise makes a robot 5e-12 rad away, 8e-11 apart).
+        for origin in root.iter("origin"):
+            if origin.get("rpy"):
+                origin.set("rpy", " ".join(repr(_quarter_turn(float(v))) for v in origin.get("rpy").split()))
         m, cx, cy, cz, ixx, iyy, izz = (float(v) for v in tool)
         root.append(ET.fromstring(_link("tool", _inertial(m, (cx, cy, cz), (ixx, iyy, izz)))))
         root.append(ET.fromstring(_joint("tool_joint", "fixed", model.chain.flange, "tool")))
