@@ -313,7 +313,7 @@ def _sympy_lagrangian(tool):
         return sp.eye(3) + sp.sin(angle) * k + (1 - sp.cos(angle)) * k * k
 
     n = len(SPATIAL)
-    q, qd = sp.symbols(f"q0:{n}"), sp.symbols(f"qd0:{n}")
+    q = sp.symbols(f"q0:{n}")
     rot, pos = sp.eye(3), sp.zeros(3, 1)
     bodies = []
     for i, (xyz, angles, axis, m, com, irpy, inertia) in enumerate(SPATIAL):
@@ -371,6 +371,9 @@ class SpatialLagrangian(unittest.TestCase):
             worst = max(worst, np.max(np.abs(got - want)) / np.max(np.abs(want)),
                         np.max(np.abs(np.array(crba(q, tool)) - mass)) / np.max(np.abs(mass)))
         self.assertLess(worst, TOLERANCE, f"worst normwise relative difference {worst:.2e}")
+
+
+LIMIT = '<limit effort="10" velocity="1" lower="-4" upper="4"/>'
 
 
 def _quarter_turn(angle: float) -> float:
@@ -449,6 +452,41 @@ class Pinocchio(unittest.TestCase):
             worst["plant"] = max(worst["plant"], rel(np.array(plant(np.concatenate([q, qd]), u, tool)).ravel(), want))
         for what, err in worst.items():
             self.assertLess(err, TOLERANCE, f"{path.stem} {what}: worst normwise relative difference {err:.2e}")
+
+    # urdfdom (Pinocchio's parser) wants limits on revolute and prismatic joints; toolconf ignores them.
+    def test_a_prismatic_joint_and_a_continuous_one(self):
+        """A chain the arms do not have: a prismatic joint along a tilted axis between a
+        continuous and a revolute joint, with a tool, against crba, rnea and aba."""
+        import pinocchio as pin
+        links = [_link("base"), _link("a", _inertial(1.5, (0.02, 0.0, 0.1), (0.02, 0.018, 0.01), "0.1 0 0.2",
+                                                      (0.001, 0.0, 0.0))),
+                 _link("b", _inertial(0.7, (0.0, 0.05, 0.0), (0.005, 0.004, 0.006))),
+                 _link("c", _inertial(0.4, (0.1, 0.0, 0.02), (0.001, 0.003, 0.0035))), _link("flange")]
+        joints = [_joint("j1", "continuous", "base", "a", "0 0 0.1"),
+                  _joint("j2", "prismatic", "a", "b", "0.05 0 0.2", "0.3 0 0", "0 0.6 0.8", LIMIT),
+                  _joint("j3", "revolute", "b", "c", "0 0.1 0", "0 1.2 0", "1 0 0", LIMIT),
+                  _joint("f", "fixed", "c", "flange", "0.2 0 0", "0 0 0.4")]
+        tool = [0.5, 0.01, 0.02, 0.07, 0.002, 0.003, 0.001]
+        tool_link = [_link("tool", _inertial(tool[0], tuple(tool[1:4]), tuple(tool[4:7]))),
+                     _joint("tj", "fixed", "flange", "tool")]
+        tmp = Path(self.enterContext(tempfile.TemporaryDirectory()))
+        (tmp / "slide.urdf").write_text(_robot(*links, *joints))
+        dyn = ChainDynamics(read_chain(tmp / "slide.urdf", "base", "flange"), [0.0, 0.0, -9.81])
+        fd, crba, bias = _raw_dynamics(dyn, tool=True)
+        pm = pin.buildModelFromXML(_robot(*links, *joints, *tool_link))
+        data = pm.createData()
+        rng = np.random.default_rng(11)
+        worst = 0.0
+        for _ in range(100):
+            q, qd, tau = rng.uniform(-math.pi, math.pi, 3), rng.uniform(-3, 3, 3), rng.uniform(-5, 5, 3)
+            q_pin = np.array([math.cos(q[0]), math.sin(q[0]), q[1], q[2]])   # continuous: (cos, sin)
+            m_pin = pin.crba(pm, data, q_pin)
+            m_pin = np.triu(m_pin) + np.triu(m_pin, 1).T
+            for got, want in ((crba(q, tool), m_pin), (bias(q, qd, tool), pin.rnea(pm, data, q_pin, qd, np.zeros(3))),
+                              (fd(q, qd, tau, tool), pin.aba(pm, data, q_pin, qd, tau))):
+                got = np.array(got, dtype=float).reshape(np.shape(want))
+                worst = max(worst, float(np.max(np.abs(got - want)) / np.max(np.abs(want))))
+        self.assertLess(worst, TOLERANCE, f"worst normwise relative difference {worst:.2e}")
 
     def test_panda(self):
         self.check_robot(PANDA)

@@ -14,7 +14,7 @@ import casadi as ca
 import numpy as np
 
 from .description import Model
-from .exact import Exact, ExactFunction
+from .exact import ExactFunction
 from .functions import _sample_control, _sample_precision, _sample_state, TERM_DOC
 from .ir import _rust_type, _struct_name
 from .rigid_body import ldl_logdet

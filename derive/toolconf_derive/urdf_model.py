@@ -28,7 +28,6 @@ constant torque K q^e + g(q^e; p).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Callable
@@ -38,11 +37,10 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from .description import DescriptionError, Model, Named, Task
+from .description import Model, Named, Task
 from .exact import DIGITS, Exact, ExactFunction
-from .functions import GRID, _grid_uniform, _sample_control, _sample_precision, _sample_state
-from .rigid_body import ChainDynamics, aba, ldl_factor, ldl_logdet, ldl_apply
-from .sequence import instruction_count, instructions
+from .functions import _grid_uniform
+from .rigid_body import ChainDynamics, aba, ldl_apply, ldl_factor
 from .urdf import Chain
 
 TOOL_PARAMETERS = [
