@@ -171,6 +171,15 @@ class Refusals(unittest.TestCase):
         self.stops(_robot(*GOOD).replace('<child link="flange"/>', '<child link="nowhere"/>'),
                    "joint 'fix'", "its child link 'nowhere' is not defined")
 
+    def test_too_many_joints_and_too_large_a_file(self):
+        parts = [_link("base")]
+        for i in range(13):
+            parts += [_link(f"l{i}", _inertial(0.5, (0.0, 0.0, 0.1))),
+                      _joint(f"j{i}", "revolute", "base" if i == 0 else f"l{i - 1}", f"l{i}", "0 0 0.1")]
+        parts += [_link("flange"), _joint("fix", "fixed", "l12", "flange")]
+        self.stops(_robot(*parts), "link 'flange'", "13 moving joints")
+        self.stops(_robot(*GOOD) + " " * (4 * 1024 * 1024), "", "a URDF the derivation reads is at most")
+
     def test_not_xml(self):
         self.stops("<robot><link name='a'></robot>", "", "not valid XML")
 

@@ -31,6 +31,10 @@ from .description import DescriptionError
 DIGITS = 50
 SNAP = mpmath.mpf("1e-9")
 SUPPORTED = ("revolute", "continuous", "prismatic", "fixed")
+# Bounds on what is read: the Panda's URDF is 15 KB; the derivation's graphs grow as n^2 (M) to
+# n^3 (the Jacobian's solves) and a 7-joint arm already emits 2 MB of Rust.
+MAX_BYTES = 4 * 1024 * 1024
+MAX_JOINTS = 12
 MOVING = ("revolute", "continuous", "prismatic")
 
 
@@ -286,9 +290,14 @@ def _fixed_subtree(tree: _Tree, link: str, on_path: set[str], flange: str) -> _I
 
 def read_chain(path: Path, base: str, flange: str) -> Chain:
     try:
+        size = path.stat().st_size
+        if size > MAX_BYTES:
+            raise DescriptionError(path, "", f"is {size} bytes; a URDF the derivation reads is at most {MAX_BYTES}")
         text = path.read_text()
     except OSError as err:
         raise DescriptionError(path, "", f"cannot read: {err.strerror}") from err
+    except UnicodeDecodeError as err:
+        raise DescriptionError(path, "", f"not text (UTF-8): {err.reason} at byte {err.start}") from err
     with mpmath.workdps(DIGITS):
         return _chain(_Tree(path, text), base, flange)
 
@@ -312,6 +321,9 @@ def _chain(tree: _Tree, base: str, flange: str) -> Chain:
     moving = [j for j in joints if j.get("type") in MOVING]
     if not moving:
         raise DescriptionError(path, f"link '{flange}'", f"no moving joint between the base '{base}' and the flange")
+    if len(moving) > MAX_JOINTS:
+        raise DescriptionError(path, f"link '{flange}'", f"{len(moving)} moving joints between the base '{base}' and "
+                                                         f"the flange; at most {MAX_JOINTS} are derived")
     # Accumulate: the pose of the current link's frame in the last body's frame (or the base's),
     # and the current body's inertia (in its joint frame).
     bodies, pending_r, pending_t = [], mpmath.eye(3), mpmath.matrix(3, 1)
