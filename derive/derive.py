@@ -22,10 +22,16 @@ from toolconf_derive.crosscheck import DerivationMismatch  # noqa: E402
 from toolconf_derive.description import DescriptionError, load_model, load_tasks  # noqa: E402
 from toolconf_derive.functions import build_functions  # noqa: E402
 from toolconf_derive.exact import ExactEvaluationError  # noqa: E402
-from toolconf_derive.ir import model_ir, vectors_document  # noqa: E402
+from toolconf_derive.ir import IR_SCHEMA, model_ir, vectors_document  # noqa: E402
 from toolconf_derive.numeric import CasadiModel  # noqa: E402
 from toolconf_derive.report import report_data  # noqa: E402
+from toolconf_derive.sequence import SequenceError  # noqa: E402
 from toolconf_derive.symbolic import derive  # noqa: E402
+from toolconf_derive.urdf_functions import urdf_documents  # noqa: E402
+from toolconf_derive.urdf_model import UrdfMismatch  # noqa: E402
+
+# Test vectors per function for a URDF model (make derive asks 100 of every model).
+URDF_VECTORS = 12
 
 
 def shown(path: Path, root: Path) -> str:
@@ -70,8 +76,6 @@ def main() -> int:
         out = args.out if args.out is not None else args.out_dir / f"{model.name}.json"
         vectors_out = out.with_suffix(".vectors.json")
         tasks = load_tasks(args.tasks)
-        d = derive(model, tasks)
-        functions = build_functions(d, CasadiModel(model))
         # Names, not the paths written to: the same bytes wherever --out points (the drift check
         # derives into a temporary folder and compares).
         generator = {
@@ -83,13 +87,21 @@ def main() -> int:
             "derive": "derive/derive.py (SymPy derives, CasADi checks)",
             "render": "derive/render (Tera) + rustfmt",
         }
-        ir = model_ir(d, functions, generator, report_data(d), args.vectors)
-        vectors = vectors_document(d, functions, generator, args.vectors)
+        if model.dynamics_kind == "urdf":
+            # CasADi SX, not SymPy (derive/toolconf_derive/urdf_model.py); each test vector is
+            # checked in 50-digit arithmetic on two graphs of thousands of instructions, so fewer.
+            generator["derive"] = "derive/derive.py (CasADi SX: RNEA/CRBA/LDL^T, checked against ABA)"
+            ir, vectors = urdf_documents(model, tasks, generator, min(args.vectors, URDF_VECTORS), IR_SCHEMA)
+        else:
+            d = derive(model, tasks)
+            functions = build_functions(d, CasadiModel(model))
+            ir = model_ir(d, functions, generator, report_data(d), args.vectors)
+            vectors = vectors_document(d, functions, generator, args.vectors)
     except DescriptionError as err:
         # Bad input: one line naming the file, the key and the problem.
         print(f"derive: {err}", file=sys.stderr)
         return 2
-    except (DerivationMismatch, ExactEvaluationError) as err:
+    except (DerivationMismatch, ExactEvaluationError, UrdfMismatch, SequenceError) as err:
         print(f"derive: {err}", file=sys.stderr)
         return 1
     try:

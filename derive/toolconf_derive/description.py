@@ -6,6 +6,8 @@ CasADi (numeric.py) each parse them on their own, which keeps the cross-check in
 
 from __future__ import annotations
 
+import math
+import os
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -64,6 +66,13 @@ class Model:
     printed_where: str = ""
     printed_a: list[list[str]] | None = None
     printed_b: list[list[str]] | None = None
+    # urdf: the chain read from the URDF file (urdf.Chain), its gravity vector, the joint
+    # impedance (stiffness K, damping D per joint) and where the impedance values come from.
+    chain: object = None
+    urdf_gravity: list[float] = field(default_factory=list)
+    impedance_stiffness: list[float] = field(default_factory=list)
+    impedance_damping: list[float] = field(default_factory=list)
+    impedance_source: str = ""
 
     @property
     def state(self) -> list[Named]:
@@ -138,10 +147,16 @@ MODEL_KEYS = {
     "link": (("mass", "string", True), ("length", "string", True)),
     "equilibrium": (("q", "values", True), ("q_dot", "values", True), ("u", "values", True)),
     "printed": (("where", "string", False), ("A", "matrix", False), ("B", "matrix", False)),
+    "urdf": (("file", "string", True), ("base", "string", True), ("flange", "string", True),
+             ("gravity", "numbers", True), ("source", "string", False)),
+    "impedance": (("stiffness", "numbers", True), ("damping", "numbers", True), ("source", "string", False)),
 }
-TOP_KEYS = (("model", "table", True), ("parameters", "tables", True), ("constants", "table", False),
-            ("coordinates", "table", True), ("dynamics", "table", True), ("equilibrium", "table", True),
-            ("goals", "table", False), ("printed", "table", False))
+# parameters and coordinates are required except for kind "urdf", where the URDF and the tool
+# define them (_urdf_names).
+TOP_KEYS = (("model", "table", True), ("parameters", "tables", False), ("constants", "table", False),
+            ("coordinates", "table", False), ("dynamics", "table", True), ("equilibrium", "table", True),
+            ("goals", "table", False), ("printed", "table", False), ("urdf", "table", False),
+            ("impedance", "table", False))
 TASK_KEYS = (("name", "string", True), ("index", "integer", True), ("title", "string", False),
              ("doc", "string", False), ("terms", "strings", True), ("error", "string", True),
              ("sensitivity", "table", True),
@@ -165,6 +180,9 @@ _TYPES = {
                lambda v: isinstance(v, list) and all(isinstance(x, (str, int, float)) and not isinstance(x, bool)
                                                      for x in v)),
     "matrix": ("an array of rows of expression strings", _is_matrix),
+    "numbers": ("an array of finite numbers",
+                lambda v: isinstance(v, list) and all(isinstance(x, (int, float)) and not isinstance(x, bool)
+                                                      and math.isfinite(x) for x in v)),
 }
 
 
@@ -239,21 +257,30 @@ def _goals(top: _Table) -> dict[str, dict[str, list[str]]]:
 def load_model(path: Path) -> Model:
     top = _Table(path, "", read_toml(path), TOP_KEYS)
     m = top.table("model", MODEL_KEYS["model"])
-    coords = top.table("coordinates", MODEL_KEYS["coordinates"])
     dyn = top.table("dynamics", MODEL_KEYS["dynamics"])
     eq = top.table("equilibrium", MODEL_KEYS["equilibrium"])
     printed = top.table("printed", MODEL_KEYS["printed"])
+    if dyn.get("kind") == "urdf":
+        parameters, q, q_dot, u, urdf = _urdf_names(path, top)
+    else:
+        for key in ("parameters", "coordinates"):
+            if key not in top.raw:
+                raise DescriptionError(path, key, "missing (required)")
+        coords = top.table("coordinates", MODEL_KEYS["coordinates"])
+        parameters = [_named(p) for p in top.tables("parameters", NAMED)]
+        q, q_dot, u = ([_named(c) for c in coords.tables(k, NAMED)] for k in ("q", "q_dot", "u"))
+        urdf = {}
     model = Model(
         path=path,
         name=m.get("name"),
         title=m.get("title", ""),
         source=m.get("source", ""),
         dof=m.get("dof"),
-        parameters=[_named(p) for p in top.tables("parameters", NAMED)],
+        parameters=parameters,
         constants=_constants(top),
-        q=[_named(c) for c in coords.tables("q", NAMED)],
-        q_dot=[_named(c) for c in coords.tables("q_dot", NAMED)],
-        u=[_named(c) for c in coords.tables("u", NAMED)],
+        q=q,
+        q_dot=q_dot,
+        u=u,
         dynamics_kind=dyn.get("kind"),
         equations=dyn.get("equations", []),
         q_ddot=list(dyn.get("q_ddot", [])),
@@ -267,9 +294,50 @@ def load_model(path: Path) -> Model:
         printed_where=printed.get("where", ""),
         printed_a=printed.get("A"),
         printed_b=printed.get("B"),
+        **urdf,
     )
     _validate_model(model)
     return model
+
+
+def _urdf_names(path: Path, top: _Table):
+    """Kind "urdf": the chain from the URDF file, the tool's parameters (urdf_model.TOOL_PARAMETERS)
+    and the coordinates named after the URDF's joints: q = the joint positions, U = their torques."""
+    from .urdf import read_chain
+    from .urdf_model import TOOL_PARAMETERS
+    for key in ("parameters", "coordinates"):
+        if key in top.raw:
+            raise DescriptionError(path, key, "not allowed for dynamics.kind = 'urdf': the tool's parameters and the "
+                                              "URDF's joints define them")
+    for key in ("urdf", "impedance"):
+        if key not in top.raw:
+            raise DescriptionError(path, key, "missing (required for dynamics.kind = 'urdf')")
+    urdf = top.table("urdf", MODEL_KEYS["urdf"])
+    imp = top.table("impedance", MODEL_KEYS["impedance"])
+    if len(urdf.get("gravity")) != 3:
+        raise DescriptionError(path, "urdf.gravity", f"must be 3 numbers (m/s^2, in the base frame), got {urdf.get('gravity')!r}")
+    chain = read_chain(Path(os.path.normpath(path.parent / urdf.get("file"))), urdf.get("base"), urdf.get("flange"))
+    dof = top.raw["model"]["dof"]
+    if dof != chain.dof:
+        raise DescriptionError(path, "model.dof", f"is {dof}, the chain from '{chain.base}' to '{chain.flange}' "
+                                                  f"has {chain.dof} moving joints")
+    for key in ("stiffness", "damping"):
+        values = imp.get(key)
+        if len(values) != chain.dof:
+            raise DescriptionError(path, f"impedance.{key}", f"has {len(values)} entries, the chain from "
+                                                             f"'{chain.base}' to '{chain.flange}' has {chain.dof} joints")
+        for i, v in enumerate(values):
+            if v < 0:
+                raise DescriptionError(path, f"impedance.{key}[{i}]", f"{v} is negative ({chain.joint_names[i]})")
+    q = [Named(j, rf"q_{{{i + 1}}}", "rad" if b.kind == "revolute" else "m", f"position of joint {j}")
+         for i, (j, b) in enumerate(zip(chain.joint_names, chain.bodies))]
+    q_dot = [Named(f"{j}_dot", rf"\dot{{q}}_{{{i + 1}}}") for i, j in enumerate(chain.joint_names)]
+    u = [Named(f"{j}_torque", rf"U_{{{i + 1}}}") for i, j in enumerate(chain.joint_names)]
+    extra = {"chain": chain, "urdf_gravity": [float(g) for g in urdf.get("gravity")],
+             "impedance_stiffness": [float(v) for v in imp.get("stiffness")],
+             "impedance_damping": [float(v) for v in imp.get("damping")],
+             "impedance_source": imp.get("source", "")}
+    return list(TOOL_PARAMETERS), q, q_dot, u, extra
 
 
 def _check_identifier(name: str, path: Path, key: str) -> None:
@@ -333,8 +401,11 @@ def _validate_dynamics(m: Model) -> None:
             raise DescriptionError(path, "dynamics.payload", f"must name a parameter, got {m.payload!r}")
         if m.gravity not in {c.name for c in m.constants}:
             raise DescriptionError(path, "dynamics.gravity", f"must name a constant, got {m.gravity!r}")
+    elif m.dynamics_kind == "urdf":
+        pass  # checked against the URDF when it was read (_urdf_names)
     else:
-        raise DescriptionError(path, "dynamics.kind", f"'{m.dynamics_kind}' is not known (known: explicit, planar_chain)")
+        raise DescriptionError(path, "dynamics.kind",
+                               f"'{m.dynamics_kind}' is not known (known: explicit, planar_chain, urdf)")
 
 
 def _validate_model(m: Model) -> None:

@@ -76,7 +76,11 @@ class ExactFunction:
     def __call__(self, *args) -> list["Exact"]:
         """Evaluates at `args`, arrays of doubles (each taken exactly)."""
         with mpmath.workdps(DIGITS):
-            inputs = [self._input_nonzeros(i, a) for i, a in enumerate(args)]
+            return self.exact_at([self._input_nonzeros(i, a) for i, a in enumerate(args)])
+
+    def exact_at(self, inputs: list[list]) -> list["Exact"]:
+        """Evaluates at inputs given exactly: each input's non-zeros as mpmath numbers."""
+        with mpmath.workdps(DIGITS):
             outputs = [mpmath.zeros(r, c) for r, c in self.out_shapes]
             w: list = [None] * max(self.work_size, 1)
             largest = mpmath.mpf(0)

@@ -227,7 +227,16 @@ def vectors_document(d: Derivation, functions: list[Function], generator: dict, 
 
 def model_ir(d: Derivation, functions: list[Function], generator: dict, report: dict, vectors: int) -> dict:
     """The IR; `vectors` is the number of test vectors per function, which live in their own file."""
-    m = d.model
+    printer = RustPrinter()
+    return model_document(d.model, [printer(v) for v in d.x_e], [printer(v) for v in d.u_e],
+                          [t.task for t in d.tasks], [function_ir(fn, d) for fn in functions], generator, report,
+                          vectors)
+
+
+def model_document(m, x_e: list[str], u_e: list[str], tasks: list, functions: list[dict], generator: dict,
+                   report: dict, vectors: int) -> dict:
+    """The IR of model `m` around its functions' IR (each `function_ir`'s shape), with the
+    equilibrium as Rust literals and the tasks of tasks.toml."""
     printer = RustPrinter()
     return {
         "schema": IR_SCHEMA,
@@ -243,27 +252,24 @@ def model_ir(d: Derivation, functions: list[Function], generator: dict, report: 
                            "doc": c.doc} for c in m.constants],
             "state": [{"name": s.name, "latex": s.latex} for s in m.state],
             "control": [{"name": s.name, "latex": s.latex} for s in m.u],
-            "equilibrium": {
-                "x": [printer(v) for v in d.x_e],
-                "u": [printer(v) for v in d.u_e],
-            },
+            "equilibrium": {"x": x_e, "u": u_e},
         },
         "tasks": [
             {
-                "name": t.task.name, "index": t.task.index, "title": t.task.title, "doc": t.task.doc,
-                "terms": t.task.terms, "sensitivity_terms": t.task.sensitivity_terms, "error": t.task.error,
-                "sensitivity_function": t.task.sensitivity_function,
-                "confidence_function": t.task.confidence_function,
-                "gradient_function": t.task.gradient_function,
+                "name": t.name, "index": t.index, "title": t.title, "doc": t.doc,
+                "terms": t.terms, "sensitivity_terms": t.sensitivity_terms, "error": t.error,
+                "sensitivity_function": t.sensitivity_function,
+                "confidence_function": t.confidence_function,
+                "gradient_function": t.gradient_function,
                 "goals": [{"term": term, "rust": [printer(sp.sympify(v)) for v in
-                                                  m.goals.get(t.task.name, {}).get(term, ["0"] * m.dof)]}
-                          for term in t.task.sensitivity_terms],
-                "precisions": [{"term": term, "rust": float_literal(t.task.default_precision[term]),
-                                "value": t.task.default_precision[term]} for term in t.task.terms],
+                                                  m.goals.get(t.name, {}).get(term, ["0"] * m.dof)]}
+                          for term in t.sensitivity_terms],
+                "precisions": [{"term": term, "rust": float_literal(t.default_precision[term]),
+                                "value": t.default_precision[term]} for term in t.terms],
             }
-            for t in d.tasks
+            for t in tasks
         ],
-        "functions": [function_ir(fn, d) for fn in functions],
+        "functions": functions,
         "test_vectors": {"file": generator["vectors"], "per_function": vectors},
         "report": report,
     }

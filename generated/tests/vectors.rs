@@ -49,11 +49,20 @@ fn check(model: &str, functions: usize, evaluate: Evaluator) {
         "{model}: the vectors cover {} functions, the crate has {functions}",
         listed.len()
     );
+    // As many per function as the IR says make derive drew (100; fewer for a URDF arm, whose
+    // every vector is checked in 50-digit arithmetic on graphs of thousands of instructions).
+    let per_function = load(&format!("{model}.json"))["test_vectors"]["per_function"]
+        .as_u64()
+        .expect("the IR gives its vectors per function") as usize;
+    assert!(
+        per_function >= 12,
+        "{model}: only {per_function} test vectors per function"
+    );
     let mut checked = 0;
     for f in listed {
         let name = f["name"].as_str().expect("name");
         let vectors = f["vectors"].as_array().expect("vectors");
-        assert!(!vectors.is_empty(), "{model}: no test vectors for {name}");
+        assert_eq!(vectors.len(), per_function, "{model}: {name}: test vectors");
         for (k, v) in vectors.iter().enumerate() {
             let got = evaluate(name, &v["inputs"]).unwrap_or_else(|| {
                 panic!("{model}: the vectors name {name}, which the crate lacks")
@@ -85,7 +94,7 @@ fn check(model: &str, functions: usize, evaluate: Evaluator) {
         }
     }
     assert!(
-        checked >= functions,
+        checked >= per_function * functions,
         "{model}: only {checked} outputs checked"
     );
 }
@@ -627,5 +636,221 @@ mod msd {
     #[test]
     fn functions_match_casadi_vectors() {
         check("msd", 13, evaluate);
+    }
+}
+
+mod panda {
+    use super::*;
+    use toolconf_generated::panda as m;
+
+    fn evaluate(name: &str, i: &Value) -> Option<Vec<(&'static str, Vec<f64>)>> {
+        Some(match name {
+            "dynamics" => {
+                let x_dot = m::dynamics(&input(i, "x"), &input(i, "u"), &input(i, "params"));
+                vec![("x_dot", rows(&x_dot))]
+            }
+            "dynamics_jacobian" => {
+                let (f_x, f_u) =
+                    m::dynamics_jacobian(&input(i, "x"), &input(i, "u"), &input(i, "params"));
+                vec![("f_x", rows(&f_x)), ("f_u", rows(&f_u))]
+            }
+            "state_matrix" => {
+                let a = m::state_matrix(&input(i, "params"));
+                vec![("a", rows(&a))]
+            }
+            "input_matrix" => {
+                let b = m::input_matrix(&input(i, "params"));
+                vec![("b", rows(&b))]
+            }
+            "position_sensitivity" => {
+                let (d_theta_du, d_theta_dot_du, d_theta_ddot_du) =
+                    m::position_sensitivity(&input(i, "params"));
+                vec![
+                    ("d_theta_du", rows(&d_theta_du)),
+                    ("d_theta_dot_du", rows(&d_theta_dot_du)),
+                    ("d_theta_ddot_du", rows(&d_theta_ddot_du)),
+                ]
+            }
+            "position_control_confidence" => {
+                let pi_u = m::position_control_confidence(
+                    &input(i, "params"),
+                    &input(i, "p_theta"),
+                    &input(i, "p_theta_dot"),
+                    &input(i, "p_theta_ddot"),
+                    &input(i, "p_u"),
+                );
+                vec![("pi_u", rows(&pi_u))]
+            }
+            "position_logdet_gradient" => {
+                let gradient = m::position_logdet_gradient(
+                    &input(i, "params"),
+                    &input(i, "p_theta"),
+                    &input(i, "p_theta_dot"),
+                    &input(i, "p_theta_ddot"),
+                    &input(i, "p_u"),
+                );
+                vec![("gradient", rows(&gradient))]
+            }
+            "velocity_sensitivity" => {
+                let (d_theta_dot_du, d_theta_ddot_du) =
+                    m::velocity_sensitivity(&input(i, "params"));
+                vec![
+                    ("d_theta_dot_du", rows(&d_theta_dot_du)),
+                    ("d_theta_ddot_du", rows(&d_theta_ddot_du)),
+                ]
+            }
+            "velocity_control_confidence" => {
+                let pi_u = m::velocity_control_confidence(
+                    &input(i, "params"),
+                    &input(i, "p_theta_dot"),
+                    &input(i, "p_theta_ddot"),
+                    &input(i, "p_u"),
+                );
+                vec![("pi_u", rows(&pi_u))]
+            }
+            "velocity_logdet_gradient" => {
+                let gradient = m::velocity_logdet_gradient(
+                    &input(i, "params"),
+                    &input(i, "p_theta_dot"),
+                    &input(i, "p_theta_ddot"),
+                    &input(i, "p_u"),
+                );
+                vec![("gradient", rows(&gradient))]
+            }
+            "acceleration_sensitivity" => {
+                let d_theta_ddot_du = m::acceleration_sensitivity(&input(i, "params"));
+                vec![("d_theta_ddot_du", rows(&d_theta_ddot_du))]
+            }
+            "acceleration_control_confidence" => {
+                let pi_u = m::acceleration_control_confidence(
+                    &input(i, "params"),
+                    &input(i, "p_theta_ddot"),
+                    &input(i, "p_u"),
+                );
+                vec![("pi_u", rows(&pi_u))]
+            }
+            "acceleration_logdet_gradient" => {
+                let gradient = m::acceleration_logdet_gradient(
+                    &input(i, "params"),
+                    &input(i, "p_theta_ddot"),
+                    &input(i, "p_u"),
+                );
+                vec![("gradient", rows(&gradient))]
+            }
+            _ => return None,
+        })
+    }
+
+    #[test]
+    fn functions_match_casadi_vectors() {
+        check("panda", 13, evaluate);
+    }
+}
+
+mod ur5 {
+    use super::*;
+    use toolconf_generated::ur5 as m;
+
+    fn evaluate(name: &str, i: &Value) -> Option<Vec<(&'static str, Vec<f64>)>> {
+        Some(match name {
+            "dynamics" => {
+                let x_dot = m::dynamics(&input(i, "x"), &input(i, "u"), &input(i, "params"));
+                vec![("x_dot", rows(&x_dot))]
+            }
+            "dynamics_jacobian" => {
+                let (f_x, f_u) =
+                    m::dynamics_jacobian(&input(i, "x"), &input(i, "u"), &input(i, "params"));
+                vec![("f_x", rows(&f_x)), ("f_u", rows(&f_u))]
+            }
+            "state_matrix" => {
+                let a = m::state_matrix(&input(i, "params"));
+                vec![("a", rows(&a))]
+            }
+            "input_matrix" => {
+                let b = m::input_matrix(&input(i, "params"));
+                vec![("b", rows(&b))]
+            }
+            "position_sensitivity" => {
+                let (d_theta_du, d_theta_dot_du, d_theta_ddot_du) =
+                    m::position_sensitivity(&input(i, "params"));
+                vec![
+                    ("d_theta_du", rows(&d_theta_du)),
+                    ("d_theta_dot_du", rows(&d_theta_dot_du)),
+                    ("d_theta_ddot_du", rows(&d_theta_ddot_du)),
+                ]
+            }
+            "position_control_confidence" => {
+                let pi_u = m::position_control_confidence(
+                    &input(i, "params"),
+                    &input(i, "p_theta"),
+                    &input(i, "p_theta_dot"),
+                    &input(i, "p_theta_ddot"),
+                    &input(i, "p_u"),
+                );
+                vec![("pi_u", rows(&pi_u))]
+            }
+            "position_logdet_gradient" => {
+                let gradient = m::position_logdet_gradient(
+                    &input(i, "params"),
+                    &input(i, "p_theta"),
+                    &input(i, "p_theta_dot"),
+                    &input(i, "p_theta_ddot"),
+                    &input(i, "p_u"),
+                );
+                vec![("gradient", rows(&gradient))]
+            }
+            "velocity_sensitivity" => {
+                let (d_theta_dot_du, d_theta_ddot_du) =
+                    m::velocity_sensitivity(&input(i, "params"));
+                vec![
+                    ("d_theta_dot_du", rows(&d_theta_dot_du)),
+                    ("d_theta_ddot_du", rows(&d_theta_ddot_du)),
+                ]
+            }
+            "velocity_control_confidence" => {
+                let pi_u = m::velocity_control_confidence(
+                    &input(i, "params"),
+                    &input(i, "p_theta_dot"),
+                    &input(i, "p_theta_ddot"),
+                    &input(i, "p_u"),
+                );
+                vec![("pi_u", rows(&pi_u))]
+            }
+            "velocity_logdet_gradient" => {
+                let gradient = m::velocity_logdet_gradient(
+                    &input(i, "params"),
+                    &input(i, "p_theta_dot"),
+                    &input(i, "p_theta_ddot"),
+                    &input(i, "p_u"),
+                );
+                vec![("gradient", rows(&gradient))]
+            }
+            "acceleration_sensitivity" => {
+                let d_theta_ddot_du = m::acceleration_sensitivity(&input(i, "params"));
+                vec![("d_theta_ddot_du", rows(&d_theta_ddot_du))]
+            }
+            "acceleration_control_confidence" => {
+                let pi_u = m::acceleration_control_confidence(
+                    &input(i, "params"),
+                    &input(i, "p_theta_ddot"),
+                    &input(i, "p_u"),
+                );
+                vec![("pi_u", rows(&pi_u))]
+            }
+            "acceleration_logdet_gradient" => {
+                let gradient = m::acceleration_logdet_gradient(
+                    &input(i, "params"),
+                    &input(i, "p_theta_ddot"),
+                    &input(i, "p_u"),
+                );
+                vec![("gradient", rows(&gradient))]
+            }
+            _ => return None,
+        })
+    }
+
+    #[test]
+    fn functions_match_casadi_vectors() {
+        check("ur5", 13, evaluate);
     }
 }

@@ -73,8 +73,17 @@ pub fn read_ir(path: &Path) -> Result<Value, RenderError> {
     }
 }
 
-/// Loads every `*.tera` file of a folder, in name order.
+/// Loads every `*.tera` file of a folder, in name order, then those of its sub-folders but
+/// `registry/` as `<folder>/<file>` ([`load_variants`]): macros a template imports
+/// (`include/`) and per-model variants of the top-level templates (`urdf/`).
 pub fn load_templates(dir: &Path) -> Result<Vec<(String, String)>, RenderError> {
+    let mut all = load_folder(dir)?;
+    all.extend(load_variants(dir)?);
+    Ok(all)
+}
+
+/// Every `*.tera` file directly in `dir`, in name order.
+fn load_folder(dir: &Path) -> Result<Vec<(String, String)>, RenderError> {
     let io = |source| RenderError::Io {
         path: dir.into(),
         source,
@@ -195,17 +204,18 @@ fn render_one(
 }
 
 /// Renders the IR through each template; Rust outputs are formatted with rustfmt.
-pub fn render(ir: &Value, templates: &[(String, String)]) -> Result<Vec<Rendered>, RenderError> {
-    let model = ir
+pub fn render(source: &Value, templates: &[(String, String)]) -> Result<Vec<Rendered>, RenderError> {
+    let model = source
         .pointer("/model/name")
         .and_then(Value::as_str)
         .ok_or(RenderError::NoModelName)?;
     let tera = engine(templates)?;
-    let mut ir = ir.clone();
+    let mut ir = source.clone();
     ir["tasks"] = Value::from(tasks::tasks_with_rust(&ir)?);
     let context = Context::from_value(ir).map_err(|e| RenderError::Template(chain(&e)))?;
     let mut out: Vec<Rendered> = Vec::new();
-    for (name, _) in templates {
+    for (name, _) in templates.iter().filter(|(n, _)| !n.contains('/')) {
+        let chosen = variant(source, name, templates);
         let ext = name
             .trim_end_matches(".tera")
             .rsplit('.')
@@ -215,7 +225,50 @@ pub fn render(ir: &Value, templates: &[(String, String)]) -> Result<Vec<Rendered
         if out.iter().any(|r| r.file_name == file_name) {
             return Err(RenderError::Clash(file_name));
         }
-        out.push(render_one(&tera, name, &context, file_name)?);
+        out.push(render_one(&tera, chosen, &context, file_name)?);
+    }
+    Ok(out)
+}
+
+/// The template that renders `name` for this model: a variant `<folder>/<name>` (loaded by
+/// [`load_variants`]) when the IR's `templates` list names one, else `name` itself. A URDF
+/// model's report is not the closed forms' (templates/urdf/report.md.tera).
+fn variant<'a>(ir: &Value, name: &'a str, templates: &'a [(String, String)]) -> &'a str {
+    let wanted: Vec<&str> = ir
+        .get("templates")
+        .and_then(Value::as_array)
+        .map(|a| a.iter().filter_map(Value::as_str).collect())
+        .unwrap_or_default();
+    templates
+        .iter()
+        .map(|(n, _)| n.as_str())
+        .find(|n| wanted.contains(n) && n.rsplit('/').next() == Some(name))
+        .unwrap_or(name)
+}
+
+/// Every `*.tera` file in the sub-folders of `dir` other than `registry/`, named
+/// `<folder>/<file>`.
+fn load_variants(dir: &Path) -> Result<Vec<(String, String)>, RenderError> {
+    let io = |source| RenderError::Io {
+        path: dir.into(),
+        source,
+    };
+    let mut folders: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(io)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_dir() && p.file_name().is_some_and(|n| n != "registry"))
+        .collect();
+    folders.sort();
+    let mut out = Vec::new();
+    for folder in folders {
+        let prefix = folder
+            .file_name()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .into_owned();
+        for (name, text) in load_folder(&folder)? {
+            out.push((format!("{prefix}/{name}"), text));
+        }
     }
     Ok(out)
 }

@@ -1,0 +1,508 @@
+"""URDF robots (description kind `urdf`): every refusal, and the rigid-body derivation against
+three independent sources.
+
+- A bad URDF or description stops derive.py with one line naming the file, the joint or link and
+  the reason, status 2 (each case below).
+- (a) A planar two-link URDF of uniform rods moves as `arm2_exact` (its Lagrangian, CasADi side)
+  after the change from relative to absolute angles, to 1e-10.
+- (b) SymPy's Lagrangian of a 3-DOF spatial chain (tilted axes, rotated origins, full inertia
+  tensors, a tool) built from the raw URDF numbers, not from urdf.py, agrees to 1e-10.
+- (c) Pinocchio's crba, rnea and aba agree on the Panda and the UR5 with random tools at 100
+  random states each, and so does the generated plant `dynamics` (aba with the impedance torque).
+
+    derive/.venv/bin/python -m unittest discover -s derive/tests      (part of make test)
+"""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+import tempfile
+import unittest
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "derive"))
+
+from toolconf_derive.description import DescriptionError, load_model, load_tasks  # noqa: E402
+from toolconf_derive.numeric import CasadiModel  # noqa: E402
+from toolconf_derive.rigid_body import ChainDynamics, ldl_apply, ldl_factor  # noqa: E402
+from toolconf_derive.urdf import read_chain  # noqa: E402
+from toolconf_derive.urdf_model import UrdfDerivation, _sample_tool  # noqa: E402
+
+DERIVE = ROOT / "derive" / "derive.py"
+PANDA = ROOT / "derive" / "models" / "panda.toml"
+UR5 = ROOT / "derive" / "models" / "ur5.toml"
+TOLERANCE = 1e-10
+
+
+def _inertial(mass, com=(0.0, 0.0, 0.0), moments=(0.01, 0.01, 0.01), rpy="0 0 0", products=(0.0, 0.0, 0.0)):
+    ixx, iyy, izz = moments
+    ixy, ixz, iyz = products
+    return (f'<inertial><origin xyz="{" ".join(map(repr, com))}" rpy="{rpy}"/><mass value="{mass!r}"/>'
+            f'<inertia ixx="{ixx!r}" ixy="{ixy!r}" ixz="{ixz!r}" iyy="{iyy!r}" iyz="{iyz!r}" izz="{izz!r}"/></inertial>')
+
+
+def _joint(name, kind, parent, child, xyz="0 0 0", rpy="0 0 0", axis="0 0 1", extra=""):
+    return (f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+            f'<origin xyz="{xyz}" rpy="{rpy}"/><axis xyz="{axis}"/>{extra}</joint>')
+
+
+def _robot(*parts):
+    return '<?xml version="1.0"?><robot name="test">' + "".join(parts) + "</robot>"
+
+
+def _link(name, inertial=""):
+    return f'<link name="{name}">{inertial}</link>'
+
+
+GOOD = [_link("base"), _link("a", _inertial(1.0, (0.0, 0.0, 0.1))), _link("b", _inertial(0.5, (0.0, 0.0, 0.1))),
+        _link("flange"), _joint("j1", "revolute", "base", "a"), _joint("j2", "revolute", "a", "b", "0 0 0.2", axis="0 1 0"),
+        _joint("fix", "fixed", "b", "flange", "0 0 0.2")]
+
+MODEL = """
+[model]
+name = "two"
+dof = 2
+[dynamics]
+kind = "urdf"
+[urdf]
+file = "{file}"
+base = "base"
+flange = "flange"
+gravity = [0.0, 0.0, -9.81]
+[impedance]
+stiffness = [{k1}, 50.0]
+damping = [5.0, 5.0]
+[equilibrium]
+q = ["0", "0.3"]
+q_dot = ["0", "0"]
+u = ["0", "0"]
+"""
+
+
+class Refusals(unittest.TestCase):
+    """Each bad URDF: derive.py exits 2 with one line naming the URDF file, the joint or link, and
+    what is wrong."""
+
+    def derive(self, urdf: str, k1: str = "50.0", model: str = MODEL):
+        tmp = Path(self.enterContext(tempfile.TemporaryDirectory()))
+        (tmp / "robot.urdf").write_text(urdf)
+        (tmp / "two.toml").write_text(model.format(file="robot.urdf", k1=k1))
+        r = subprocess.run([sys.executable, str(DERIVE), str(tmp / "two.toml"), "--out", str(tmp / "two.json"),
+                            "--vectors", "1"], capture_output=True, text=True)
+        return r, tmp
+
+    def stops(self, urdf: str, where: str, problem: str, k1: str = "50.0", in_model: bool = False):
+        r, tmp = self.derive(urdf, k1)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertNotIn("Traceback", r.stderr)
+        lines = r.stderr.splitlines()
+        self.assertEqual(len(lines), 1, r.stderr)
+        file = tmp / ("two.toml" if in_model else "robot.urdf")
+        self.assertTrue(lines[0].startswith(f"derive: {file}: {where}"), lines[0])
+        self.assertIn(problem, lines[0])
+        self.assertEqual(sorted(p.name for p in tmp.iterdir()), ["robot.urdf", "two.toml"], "nothing written")
+
+    def test_the_good_chain_derives(self):
+        r, tmp = self.derive(_robot(*GOOD))
+        self.assertEqual(r.returncode, 0, r.stderr)
+
+    def test_floating_planar_and_unknown_joints(self):
+        for kind in ("floating", "planar", "ball"):
+            urdf = _robot(*GOOD).replace('name="j2" type="revolute"', f'name="j2" type="{kind}"')
+            self.stops(urdf, "joint 'j2'", f"type '{kind}' is not supported")
+
+    def test_mimic_joint(self):
+        urdf = _robot(*GOOD).replace('<axis xyz="0 1 0"/>', '<axis xyz="0 1 0"/><mimic joint="j1"/>')
+        self.stops(urdf, "joint 'j2'", "mimic joint")
+
+    def test_branch(self):
+        urdf = _robot(*GOOD, _link("side", _inertial(0.2)), _joint("jside", "revolute", "a", "side"))
+        self.stops(urdf, "joint 'jside'", "branches off the chain at link 'a'")
+
+    def test_fixed_side_links_merge_but_a_fixed_side_link_with_a_moving_child_is_a_branch(self):
+        merged = _robot(*GOOD, _link("cam", _inertial(0.2, (0.05, 0.0, 0.0))), _joint("jcam", "fixed", "a", "cam"))
+        chain = self.chain(merged)
+        self.assertAlmostEqual(chain.bodies[0].mass, 1.2)
+        deeper = _robot(*GOOD, _link("cam"), _joint("jcam", "fixed", "a", "cam"), _link("lens", _inertial(0.1)),
+                        _joint("jlens", "prismatic", "cam", "lens"))
+        self.stops(deeper, "joint 'jlens'", "branches off the chain at link 'cam'")
+
+    def chain(self, urdf: str):
+        tmp = Path(self.enterContext(tempfile.TemporaryDirectory()))
+        (tmp / "r.urdf").write_text(urdf)
+        return read_chain(tmp / "r.urdf", "base", "flange")
+
+    def test_loop(self):
+        urdf = _robot(*GOOD, _joint("back", "fixed", "base", "b"))
+        self.stops(urdf, "link 'b'", "has two parents")
+
+    def test_missing_inertial_on_a_moving_body(self):
+        urdf = _robot(*GOOD).replace(_link("b", _inertial(0.5, (0.0, 0.0, 0.1))), _link("b"))
+        self.stops(urdf, "link 'b'", "has no <inertial>, but a moving joint carries it")
+
+    def test_mass_zero_or_negative(self):
+        for mass in (0.0, -1.0):
+            urdf = _robot(*GOOD).replace(_inertial(0.5, (0.0, 0.0, 0.1)), _inertial(mass, (0.0, 0.0, 0.1)))
+            self.stops(urdf, "link 'b'", "must be > 0")
+
+    def test_inertia_not_positive_definite(self):
+        urdf = _robot(*GOOD).replace(_inertial(0.5, (0.0, 0.0, 0.1)), _inertial(0.5, moments=(0.01, 0.01, -0.01)))
+        self.stops(urdf, "link 'b'", "not positive definite")
+        urdf = _robot(*GOOD).replace(_inertial(0.5, (0.0, 0.0, 0.1)),
+                                     _inertial(0.5, moments=(0.01, 0.01, 0.01), products=(0.02, 0.0, 0.0)))
+        self.stops(urdf, "link 'b'", "not positive definite")
+
+    def test_triangle_inequality(self):
+        urdf = _robot(*GOOD).replace(_inertial(0.5, (0.0, 0.0, 0.1)), _inertial(0.5, moments=(0.01, 0.01, 0.03)))
+        self.stops(urdf, "link 'b'", "violate the triangle inequality")
+
+    def test_flange_not_below_the_base_and_undefined_links(self):
+        urdf = _robot(*GOOD, _link("elsewhere"))
+        self.stops(urdf.replace('name="flange"/>', 'name="flange"/>', 1).replace(
+            _joint("fix", "fixed", "b", "flange", "0 0 0.2"), _joint("fix", "fixed", "elsewhere", "flange")),
+            "link 'flange'", "is not below the base")
+        self.stops(_robot(*GOOD).replace('<child link="flange"/>', '<child link="nowhere"/>'),
+                   "joint 'fix'", "its child link 'nowhere' is not defined")
+
+    def test_too_many_joints_and_too_large_a_file(self):
+        parts = [_link("base")]
+        for i in range(13):
+            parts += [_link(f"l{i}", _inertial(0.5, (0.0, 0.0, 0.1))),
+                      _joint(f"j{i}", "revolute", "base" if i == 0 else f"l{i - 1}", f"l{i}", "0 0 0.1")]
+        parts += [_link("flange"), _joint("fix", "fixed", "l12", "flange")]
+        self.stops(_robot(*parts), "link 'flange'", "13 moving joints")
+        self.stops(_robot(*GOOD) + " " * (4 * 1024 * 1024), "", "a URDF the derivation reads is at most")
+
+    def test_not_xml(self):
+        self.stops("<robot><link name='a'></robot>", "", "not valid XML")
+
+    def test_singular_a_names_the_joint(self):
+        # j1 turns about the vertical: gravity gives it no stiffness, so without K it has none.
+        self.stops(_robot(*GOOD), "impedance.stiffness", "along joints j1", k1="0.0", in_model=True)
+
+    def test_description_keys(self):
+        tmp = Path(self.enterContext(tempfile.TemporaryDirectory()))
+        (tmp / "robot.urdf").write_text(_robot(*GOOD))
+        for text, key in ((MODEL.replace("dof = 2", "dof = 3"), "model.dof"),
+                          (MODEL.replace("damping = [5.0, 5.0]", "damping = [5.0]"), "impedance.damping"),
+                          (MODEL + '[[parameters]]\nname = "m"\n', "parameters"),
+                          (MODEL.replace("gravity = [0.0, 0.0, -9.81]", "gravity = [0.0, -9.81]"), "urdf.gravity")):
+            (tmp / "two.toml").write_text(text.format(file="robot.urdf", k1="50.0"))
+            with self.assertRaises(DescriptionError) as caught:
+                load_model(tmp / "two.toml")
+            self.assertIn(f": {key}: ", str(caught.exception))
+
+
+def _rod_urdf(m1, l1, m2, l2) -> str:
+    """Two uniform rods in the x-y plane (joint axes z), gravity along -y."""
+    def rod(m, l):
+        return _inertial(m, (l / 2, 0.0, 0.0), (m * 1e-6, m * l * l / 12, m * l * l / 12))
+    return _robot(_link("base"), _link("rod1", rod(m1, l1)), _link("rod2", rod(m2, l2)), _link("tip"),
+                  _joint("j1", "revolute", "base", "rod1"), _joint("j2", "revolute", "rod1", "rod2", f"{l1!r} 0 0"),
+                  _joint("tip", "fixed", "rod2", "tip", f"{l2!r} 0 0"))
+
+
+def _raw_dynamics(dyn: ChainDynamics, tool=None):
+    """(q, q_dot, tau[, tool]) -> q_ddot of the rigid-body dynamics alone (no impedance):
+    CRBA + RNEA + LDL^T, the code's route."""
+    n = dyn.n
+    q, qd, tau = ca.SX.sym("q", n), ca.SX.sym("qd", n), ca.SX.sym("tau", n)
+    p = ca.SX.sym("p", 7)
+    last = dyn.tool_parameters([p[i] for i in range(7)]) if tool else dyn.link_parameters(n - 1)
+    qs, qds = [q[i] for i in range(n)], [qd[i] for i in range(n)]
+    trig = [(ca.sin(q[i]), ca.cos(q[i])) for i in range(n)]
+    mass = dyn.mass_matrix(qs, trig, last)
+    bias = dyn.rnea(qs, trig, qds, [0.0] * n, last)
+    acc = ldl_apply(ldl_factor(mass), [tau[i] - bias[i] for i in range(n)])
+    mass_sx = ca.vertcat(*[ca.horzcat(*row) for row in mass])
+    inverse = dyn.rnea(qs, trig, qds, [0.0] * n, last)
+    return (ca.Function("fd", [q, qd, tau, p], [ca.vertcat(*acc)]),
+            ca.Function("crba", [q, p], [mass_sx]),
+            ca.Function("bias", [q, qd, p], [ca.vertcat(*inverse)]))
+
+
+class PlanarRods(unittest.TestCase):
+    """(a) The URDF route on two uniform rods is arm2_exact after q1 = theta1, q2 = theta2 - theta1."""
+
+    def test_moves_as_arm2_exact(self):
+        exact = CasadiModel(load_model(ROOT / "derive" / "models" / "arm2_exact.toml")).dynamics.f
+        rng = np.random.default_rng(23)
+        worst = 0.0
+        tmp = Path(self.enterContext(tempfile.TemporaryDirectory()))
+        for tool in range(20):
+            m1, m2, l1, l2 = (float(v) for v in rng.uniform(0.1, 0.6, 4))
+            (tmp / "rods.urdf").write_text(_rod_urdf(m1, l1, m2, l2))
+            dyn = ChainDynamics(read_chain(tmp / "rods.urdf", "base", "tip"), [0.0, -9.81, 0.0])
+            fd, _, _ = _raw_dynamics(dyn)
+
+            def urdf_rhs(x, u):
+                q = np.array([x[0], x[1] - x[0]])
+                qd = np.array([x[2], x[3] - x[2]])
+                a = np.array(fd(q, qd, u, np.zeros(7))).ravel()
+                return np.array([x[2], x[3], a[0], a[0] + a[1]])
+
+            def exact_rhs(x, u):
+                return np.array(exact(x, u, [m1, m2, l1, l2])).ravel()
+
+            for _ in range(10):
+                x = np.concatenate([rng.uniform(-math.pi, math.pi, 2), rng.uniform(-3, 3, 2)])
+                u = rng.uniform(-2, 2, 2)
+                want = exact_rhs(x, u)
+                worst = max(worst, np.max(np.abs(urdf_rhs(x, u) - want)) / np.max(np.abs(want)))
+            if tool >= 3:
+                continue
+            # The motion: 2 s of RK4 from rest off the hanging pose under a constant torque.
+            xa = xb = np.array([-1.2, -1.9, 0.0, 0.0])
+            u = np.array([0.3, -0.1])
+            h = 1e-3
+            for _ in range(2000):
+                xa, xb = _rk4(urdf_rhs, xa, u, h), _rk4(exact_rhs, xb, u, h)
+            worst = max(worst, np.max(np.abs(xa - xb)) / np.max(np.abs(xb)))
+        self.assertLess(worst, TOLERANCE, f"worst normwise relative difference {worst:.2e}")
+
+
+def _rk4(f, x, u, h):
+    k1 = f(x, u)
+    k2 = f(x + h / 2 * k1, u)
+    k3 = f(x + h / 2 * k2, u)
+    k4 = f(x + h * k3, u)
+    return x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+
+
+# A 3-DOF spatial chain with tilted axes, rotated joint origins and inertial frames, full inertia
+# tensors and offset centres of mass: (joint origin xyz, rpy, axis, mass, com, inertial rpy,
+# (ixx, iyy, izz, ixy, ixz, iyz)).
+SPATIAL = [
+    ((0.0, 0.0, 0.3), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0), 2.0, (0.01, -0.02, 0.1), (0.0, 0.0, 0.0),
+     (0.03, 0.025, 0.01, 0.001, -0.002, 0.0015)),
+    ((0.05, 0.0, 0.1), (-math.pi / 2, 0.0, 0.3), (0.0, 0.6, 0.8), 1.2, (0.2, 0.01, 0.0), (0.1, 0.2, 0.0),
+     (0.004, 0.02, 0.021, -0.0005, 0.0002, 0.0001)),
+    ((0.4, 0.0, 0.0), (0.2, -0.1, 0.5), (1.0, 0.0, 0.0), 0.7, (0.1, 0.0, 0.03), (0.0, 0.0, 0.4),
+     (0.002, 0.006, 0.007, 0.0, 0.0004, -0.0003)),
+]
+FLANGE = ((0.15, 0.0, 0.02), (0.0, 0.3, 0.0))
+
+
+def _spatial_urdf() -> str:
+    parts = [_link("base")]
+    parent = "base"
+    for i, (xyz, rpy, axis, m, com, irpy, inertia) in enumerate(SPATIAL):
+        ixx, iyy, izz, ixy, ixz, iyz = inertia
+        parts.append(_link(f"l{i}", _inertial(m, com, (ixx, iyy, izz), " ".join(map(repr, irpy)), (ixy, ixz, iyz))))
+        parts.append(_joint(f"j{i}", "revolute", parent, f"l{i}", " ".join(map(repr, xyz)), " ".join(map(repr, rpy)),
+                            " ".join(map(repr, axis))))
+        parent = f"l{i}"
+    parts += [_link("flange"), _joint("f", "fixed", parent, "flange", " ".join(map(repr, FLANGE[0])),
+                                      " ".join(map(repr, FLANGE[1])))]
+    return _robot(*parts)
+
+
+def _sympy_lagrangian(tool):
+    """q_ddot(q, q_dot, tau) of SPATIAL with `tool` at the flange by Lagrange's equations, from the
+    raw numbers above: forward kinematics, T = sum m |v_c|^2/2 + w^T I w/2 with w from R_dot R^T,
+    V = sum m g z_c."""
+    import sympy as sp
+
+    def rpy(r, p, y):
+        rx = sp.Matrix([[1, 0, 0], [0, sp.cos(r), -sp.sin(r)], [0, sp.sin(r), sp.cos(r)]])
+        ry = sp.Matrix([[sp.cos(p), 0, sp.sin(p)], [0, 1, 0], [-sp.sin(p), 0, sp.cos(p)]])
+        rz = sp.Matrix([[sp.cos(y), -sp.sin(y), 0], [sp.sin(y), sp.cos(y), 0], [0, 0, 1]])
+        return rz * ry * rx
+
+    def about(axis, angle):
+        a = sp.Matrix(axis) / sp.sqrt(sum(x * x for x in axis))
+        k = sp.Matrix([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+        return sp.eye(3) + sp.sin(angle) * k + (1 - sp.cos(angle)) * k * k
+
+    n = len(SPATIAL)
+    q = sp.symbols(f"q0:{n}")
+    rot, pos = sp.eye(3), sp.zeros(3, 1)
+    bodies = []
+    for i, (xyz, angles, axis, m, com, irpy, inertia) in enumerate(SPATIAL):
+        pos = pos + rot * sp.Matrix(xyz)
+        rot = rot * rpy(*angles) * about(axis, q[i])
+        ixx, iyy, izz, ixy, ixz, iyz = inertia
+        r_in = rpy(*irpy)
+        local = r_in * sp.Matrix([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]) * r_in.T
+        bodies.append((m, pos + rot * sp.Matrix(com), rot, local))
+    m_t, c_t, moments = tool[0], tool[1:4], tool[4:7]
+    r_f = rot * rpy(0, FLANGE[1][1], 0)
+    bodies.append((m_t, pos + rot * sp.Matrix(FLANGE[0]) + r_f * sp.Matrix(c_t), r_f, sp.diag(*moments)))
+    # T = q_dot^T M q_dot / 2 with M = sum m J_v^T J_v + J_w^T I J_w (v = J_v q_dot, and
+    # w_body = J_w q_dot from [w_body]x = R^T R_dot); Lagrange's equations then give
+    # M q_ddot + sum_k (dM/dq_k q_dot) q_dot_k - [q_dot^T dM/dq_k q_dot / 2]_k + dV/dq = tau.
+    qv = sp.Matrix(q)
+    mass, potential = sp.zeros(n, n), 0
+    for m, c, r, inertia in bodies:
+        j_v = c.jacobian(qv)
+        j_w = sp.zeros(3, n)
+        for j in range(n):
+            w = r.T * r.diff(q[j])
+            j_w[:, j] = sp.Matrix([w[2, 1], w[0, 2], w[1, 0]])
+        mass += m * j_v.T * j_v + j_w.T * inertia * j_w
+        potential += m * 9.81 * c[2]
+    d_mass = [mass.diff(q[k]) for k in range(n)]
+    gravity = sp.Matrix([potential]).jacobian(qv).T
+    evaluate = sp.lambdify([q], [mass, gravity, *d_mass], modules="numpy", cse=True)
+
+    def terms(q_value, qd_value):
+        m_num, g_num, *dm = (np.array(a, dtype=float) for a in evaluate(q_value))
+        bias = sum(dm[k] @ qd_value * qd_value[k] for k in range(n))
+        bias = bias - 0.5 * np.array([qd_value @ dm[k] @ qd_value for k in range(n)]) + g_num.ravel()
+        return m_num, bias
+    return terms
+
+
+class SpatialLagrangian(unittest.TestCase):
+    """(b) SymPy's Lagrangian of a 3-DOF spatial chain with a tool agrees with the URDF route."""
+
+    def test_agrees_with_sympy(self):
+        tmp = Path(self.enterContext(tempfile.TemporaryDirectory()))
+        (tmp / "spatial.urdf").write_text(_spatial_urdf())
+        dyn = ChainDynamics(read_chain(tmp / "spatial.urdf", "base", "flange"), [0.0, 0.0, -9.81])
+        fd, crba, _ = _raw_dynamics(dyn, tool=True)
+        tool = [0.6, 0.02, -0.01, 0.09, 0.003, 0.004, 0.002]
+        lagrange = _sympy_lagrangian(tool)
+        rng = np.random.default_rng(5)
+        worst = 0.0
+        for _ in range(100):
+            q, qd, tau = rng.uniform(-math.pi, math.pi, 3), rng.uniform(-3, 3, 3), rng.uniform(-5, 5, 3)
+            mass, bias = lagrange(q, qd)
+            want = np.linalg.solve(mass, tau - bias)
+            got = np.array(fd(q, qd, tau, tool)).ravel()
+            worst = max(worst, np.max(np.abs(got - want)) / np.max(np.abs(want)),
+                        np.max(np.abs(np.array(crba(q, tool)) - mass)) / np.max(np.abs(mass)))
+        self.assertLess(worst, TOLERANCE, f"worst normwise relative difference {worst:.2e}")
+
+
+LIMIT = '<limit effort="10" velocity="1" lower="-4" upper="4"/>'
+
+
+def _quarter_turn(angle: float) -> float:
+    k = round(angle / (math.pi / 2))
+    return k * (math.pi / 2) if abs(angle - k * (math.pi / 2)) < 1e-9 else angle
+
+
+class Pinocchio(unittest.TestCase):
+    """(c) Pinocchio (pin, derive/requirements.txt) on the same URDF cut at the flange, the tool
+    added as a fixed link."""
+
+    def pinocchio_model(self, model, tool):
+        import pinocchio as pin
+        root = ET.parse(model.chain.path).getroot()
+        keep = self.chain_links(root, model.chain.flange)
+        for tag in ("link", "joint"):
+            for e in list(root.findall(tag)):
+                name = e.get("name") if tag == "link" else e.find("child").get("link")
+                if name not in keep:
+                    root.remove(e)
+        # The reader takes rotation entries within 1e-9 of 0 or +-1 as exact (urdf.py): give
+        # Pinocchio the same angles, each within 1e-9 of a multiple of pi/2 written as the double
+        # nearest it (UR5's 1.57079632679 otherwise makes a robot 5e-12 rad away, 8e-11 apart).
+        for origin in root.iter("origin"):
+            if origin.get("rpy"):
+                origin.set("rpy", " ".join(repr(_quarter_turn(float(v))) for v in origin.get("rpy").split()))
+        m, cx, cy, cz, ixx, iyy, izz = (float(v) for v in tool)
+        root.append(ET.fromstring(_link("tool", _inertial(m, (cx, cy, cz), (ixx, iyy, izz)))))
+        root.append(ET.fromstring(_joint("tool_joint", "fixed", model.chain.flange, "tool")))
+        built = pin.buildModelFromXML(ET.tostring(root, encoding="unicode"))
+        return built, built.createData()
+
+    @staticmethod
+    def chain_links(root, flange):
+        """Every link but those below the flange."""
+        children = {}
+        for j in root.findall("joint"):
+            children.setdefault(j.find("parent").get("link"), []).append(j.find("child").get("link"))
+        below, stack = set(), list(children.get(flange, []))
+        while stack:
+            link = stack.pop()
+            below.add(link)
+            stack += children.get(link, [])
+        return {l.get("name") for l in root.findall("link")} - below
+
+    def check_robot(self, path: Path):
+        import pinocchio as pin
+        model = load_model(path)
+        dv = UrdfDerivation(model, model.chain, load_tasks(ROOT / "derive" / "tasks.toml"))
+        n = dv.n
+        fd, crba, bias = _raw_dynamics(dv.dyn, tool=True)
+        plant = ca.Function("f", [dv.x, dv.u, dv.p], [dv.dynamics_with(dv.x, dv.u, dv.coefficients(dv.p))])
+        rng = np.random.default_rng(7)
+        worst = dict.fromkeys(("crba", "rnea", "aba", "plant"), 0.0)
+        for k in range(100):
+            tool = _sample_tool(rng).ravel()
+            pm, data = self.pinocchio_model(model, tool)
+            self.assertEqual(pm.nq, n)
+            q, qd = rng.uniform(-math.pi, math.pi, n), rng.uniform(-3, 3, n)
+            tau, u = rng.uniform(-20, 20, n), rng.uniform(-2, 2, n)
+
+            def rel(a, b):
+                return float(np.max(np.abs(np.asarray(a, dtype=float) - b)) / np.max(np.abs(b)))
+
+            m_pin = pin.crba(pm, data, q)
+            m_pin = np.triu(m_pin) + np.triu(m_pin, 1).T
+            worst["crba"] = max(worst["crba"], rel(crba(q, tool), m_pin))
+            worst["rnea"] = max(worst["rnea"], rel(np.array(bias(q, qd, tool)).ravel(),
+                                                   pin.rnea(pm, data, q, qd, np.zeros(n))))
+            worst["aba"] = max(worst["aba"], rel(np.array(fd(q, qd, tau, tool)).ravel(), pin.aba(pm, data, q, qd, tau)))
+            # The generated plant: aba with tau = U + K (q^e - q) - D q_dot + g(q^e).
+            q_e = np.array(dv.q_e)
+            g_e = pin.computeGeneralizedGravity(pm, data, q_e)
+            torque = u + np.array(dv.stiffness) * (q_e - q) - np.array(dv.damping) * qd + g_e
+            want = np.concatenate([qd, pin.aba(pm, data, q, qd, torque)])
+            worst["plant"] = max(worst["plant"], rel(np.array(plant(np.concatenate([q, qd]), u, tool)).ravel(), want))
+        for what, err in worst.items():
+            self.assertLess(err, TOLERANCE, f"{path.stem} {what}: worst normwise relative difference {err:.2e}")
+
+    # urdfdom (Pinocchio's parser) wants limits on revolute and prismatic joints; toolconf ignores them.
+    def test_a_prismatic_joint_and_a_continuous_one(self):
+        """A chain the arms do not have: a prismatic joint along a tilted axis between a
+        continuous and a revolute joint, with a tool, against crba, rnea and aba."""
+        import pinocchio as pin
+        links = [_link("base"), _link("a", _inertial(1.5, (0.02, 0.0, 0.1), (0.02, 0.018, 0.01), "0.1 0 0.2",
+                                                      (0.001, 0.0, 0.0))),
+                 _link("b", _inertial(0.7, (0.0, 0.05, 0.0), (0.005, 0.004, 0.006))),
+                 _link("c", _inertial(0.4, (0.1, 0.0, 0.02), (0.001, 0.003, 0.0035))), _link("flange")]
+        joints = [_joint("j1", "continuous", "base", "a", "0 0 0.1"),
+                  _joint("j2", "prismatic", "a", "b", "0.05 0 0.2", "0.3 0 0", "0 0.6 0.8", LIMIT),
+                  _joint("j3", "revolute", "b", "c", "0 0.1 0", "0 1.2 0", "1 0 0", LIMIT),
+                  _joint("f", "fixed", "c", "flange", "0.2 0 0", "0 0 0.4")]
+        tool = [0.5, 0.01, 0.02, 0.07, 0.002, 0.003, 0.001]
+        tool_link = [_link("tool", _inertial(tool[0], tuple(tool[1:4]), tuple(tool[4:7]))),
+                     _joint("tj", "fixed", "flange", "tool")]
+        tmp = Path(self.enterContext(tempfile.TemporaryDirectory()))
+        (tmp / "slide.urdf").write_text(_robot(*links, *joints))
+        dyn = ChainDynamics(read_chain(tmp / "slide.urdf", "base", "flange"), [0.0, 0.0, -9.81])
+        fd, crba, bias = _raw_dynamics(dyn, tool=True)
+        pm = pin.buildModelFromXML(_robot(*links, *joints, *tool_link))
+        data = pm.createData()
+        rng = np.random.default_rng(11)
+        worst = 0.0
+        for _ in range(100):
+            q, qd, tau = rng.uniform(-math.pi, math.pi, 3), rng.uniform(-3, 3, 3), rng.uniform(-5, 5, 3)
+            q_pin = np.array([math.cos(q[0]), math.sin(q[0]), q[1], q[2]])   # continuous: (cos, sin)
+            m_pin = pin.crba(pm, data, q_pin)
+            m_pin = np.triu(m_pin) + np.triu(m_pin, 1).T
+            for got, want in ((crba(q, tool), m_pin), (bias(q, qd, tool), pin.rnea(pm, data, q_pin, qd, np.zeros(3))),
+                              (fd(q, qd, tau, tool), pin.aba(pm, data, q_pin, qd, tau))):
+                got = np.array(got, dtype=float).reshape(np.shape(want))
+                worst = max(worst, float(np.max(np.abs(got - want)) / np.max(np.abs(want))))
+        self.assertLess(worst, TOLERANCE, f"worst normwise relative difference {worst:.2e}")
+
+    def test_panda(self):
+        self.check_robot(PANDA)
+
+    def test_ur5(self):
+        self.check_robot(UR5)
+
+
+if __name__ == "__main__":
+    unittest.main()

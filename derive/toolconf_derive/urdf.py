@@ -1,0 +1,360 @@
+"""A URDF robot read into the serial chain the derivation needs: the moving joints from the base
+link to the flange link, each with the rigid body it carries (its link and every link fixed to it
+merged in), and the flange's pose in the last body's frame.
+
+Only the kinematic and inertial data are read (Python's xml.etree: URDF is small and plain XML).
+Everything beyond the flange is dropped (the tool replaces the hand). Refused, each with one line
+naming the file, the joint or link and the reason (a DescriptionError, status 2 from derive.py):
+floating, planar and mimic joints (and any unknown type) between the base and the flange; a
+moving joint that leaves the chain (a branch); a link with two parents (a loop); a body carried
+by a moving joint without an <inertial>, or with mass <= 0; an inertia that is not positive
+definite or whose principal moments violate the triangle inequality.
+
+Numbers: the file's decimals are read as doubles (correctly rounded, the same on every machine);
+rotations (URDF rpy) and the merging of fixed links are done in 50-digit mpmath and rounded once,
+never in libm. Rotation entries within SNAP of 0 or +-1 are taken as exactly 0 or +-1: URDFs
+write pi/2 rounded (UR5: 1.57079632679, whose cosine is 4.9e-12), and the exact zero keeps the
+generated code from multiplying by 1e-12 residues. That moves a link by less than 1e-9 of its
+offset; the check against Pinocchio, which uses the literal angles, passes at 1e-10 relative.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+import mpmath
+
+from .description import DescriptionError
+
+DIGITS = 50
+SNAP = mpmath.mpf("1e-9")
+SUPPORTED = ("revolute", "continuous", "prismatic", "fixed")
+# Bounds on what is read: the Panda's URDF is 15 KB; the derivation's graphs grow as n^2 (M) to
+# n^3 (the Jacobian's solves) and a 7-joint arm already emits 2 MB of Rust.
+MAX_BYTES = 4 * 1024 * 1024
+MAX_JOINTS = 12
+MOVING = ("revolute", "continuous", "prismatic")
+
+
+@dataclass(frozen=True)
+class Body:
+    """One moving joint and the rigid body it carries, in the joint's frame.
+
+    `rotation`, `translation`: the joint frame (at q = 0) in the parent body's frame (the base
+    link's for the first joint), fixed links in between composed in. `axis`: unit vector in the
+    joint frame. Inertia in barycentric form about the joint frame's origin: mass m, first
+    moment h = m c, and the rotational inertia about the origin (3x3, symmetric)."""
+    joint: str
+    kind: str          # "revolute" (continuous too) or "prismatic"
+    rotation: tuple
+    translation: tuple
+    axis: tuple
+    mass: float
+    first_moment: tuple
+    inertia: tuple
+
+
+@dataclass(frozen=True)
+class Chain:
+    path: Path
+    robot: str
+    base: str
+    flange: str
+    bodies: list[Body]
+    # The flange frame in the last body's frame.
+    flange_rotation: tuple
+    flange_translation: tuple
+
+    @property
+    def dof(self) -> int:
+        return len(self.bodies)
+
+    @property
+    def joint_names(self) -> list[str]:
+        return [b.joint for b in self.bodies]
+
+
+@dataclass
+class _Inertial:
+    """Mass, centre of mass and inertia about it, in some frame (mpmath)."""
+    mass: mpmath.mpf
+    com: mpmath.matrix
+    inertia: mpmath.matrix
+
+
+def _floats(path: Path, where: str, text: str | None, n: int, default: str) -> list[mpmath.mpf]:
+    words = (text if text is not None else default).split()
+    try:
+        values = [float(w) for w in words]
+    except ValueError:
+        values = []
+    if len(values) != n or not all(mpmath.isfinite(v) for v in values):
+        raise DescriptionError(path, where, f"'{text}' is not {n} finite numbers")
+    return [mpmath.mpf(v) for v in values]
+
+
+def _number(path: Path, where: str, element, attribute: str) -> mpmath.mpf:
+    text = element.get(attribute) if element is not None else None
+    if text is None:
+        raise DescriptionError(path, where, f"missing {attribute}")
+    return _floats(path, f"{where} {attribute}", text, 1, "")[0]
+
+
+def _snap(x: mpmath.mpf) -> mpmath.mpf:
+    for target in (0, 1, -1):
+        if abs(x - target) < SNAP:
+            return mpmath.mpf(target)
+    return x
+
+
+def rpy_rotation(rpy: list[mpmath.mpf]) -> mpmath.matrix:
+    """URDF's fixed-axis roll, pitch, yaw: R = Rz(yaw) Ry(pitch) Rx(roll), snapped."""
+    r, p, y = rpy
+    cr, sr, cp, sp, cy, sy = (mpmath.cos(r), mpmath.sin(r), mpmath.cos(p), mpmath.sin(p),
+                              mpmath.cos(y), mpmath.sin(y))
+    m = mpmath.matrix([
+        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+        [-sp, cp * sr, cp * cr],
+    ])
+    return mpmath.matrix([[_snap(m[i, j]) for j in range(3)] for i in range(3)])
+
+
+def _origin(path: Path, where: str, element) -> tuple[mpmath.matrix, mpmath.matrix]:
+    origin = element.find("origin") if element is not None else None
+    xyz = _floats(path, f"{where} origin xyz", origin.get("xyz") if origin is not None else None, 3, "0 0 0")
+    rpy = _floats(path, f"{where} origin rpy", origin.get("rpy") if origin is not None else None, 3, "0 0 0")
+    return rpy_rotation(rpy), mpmath.matrix(xyz)
+
+
+def _check_inertia(path: Path, where: str, inertia: mpmath.matrix, massless: bool) -> None:
+    """Positive definite, principal moments obeying the triangle inequality (zero for a frame)."""
+    if massless:
+        if any(inertia[i, j] != 0 for i in range(3) for j in range(3)):
+            raise DescriptionError(path, where, "has mass 0 but a non-zero inertia")
+        return
+    moments = sorted(mpmath.eigsy(inertia)[0])
+    shown = ", ".join(mpmath.nstr(m, 6) for m in moments)
+    if moments[0] <= 0:
+        raise DescriptionError(path, where, f"inertia is not positive definite (principal moments {shown})")
+    # Relative slack for the decimals URDFs print (a thin rod's Izz = Ixx + Iyy to 9 digits).
+    if moments[2] > (moments[0] + moments[1]) * (1 + mpmath.mpf("1e-9")):
+        raise DescriptionError(path, where, f"principal moments {shown} violate the triangle inequality "
+                                            "(the largest exceeds the sum of the other two)")
+
+
+def _inertial(path: Path, link, carried: bool) -> _Inertial:
+    """The link's <inertial> in its own frame. `carried`: the link is the child of a moving joint,
+    so it is a body and must have mass; a fixed link may be a massless frame."""
+    name = link.get("name")
+    where = f"link '{name}'"
+    element = link.find("inertial")
+    zero = _Inertial(mpmath.mpf(0), mpmath.matrix(3, 1), mpmath.matrix(3, 3))
+    if element is None:
+        if carried:
+            raise DescriptionError(path, where, "has no <inertial>, but a moving joint carries it")
+        return zero
+    mass = _number(path, f"{where} mass", element.find("mass"), "value")
+    if mass < 0 or (carried and mass == 0):
+        raise DescriptionError(path, where, f"mass {mpmath.nstr(mass, 17)} must be > 0")
+    tensor = element.find("inertia")
+    if tensor is None:
+        raise DescriptionError(path, where, "<inertial> has no <inertia>")
+    i = {k: _number(path, f"{where} inertia", tensor, k) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
+    local = mpmath.matrix([[i["ixx"], i["ixy"], i["ixz"]], [i["ixy"], i["iyy"], i["iyz"]],
+                           [i["ixz"], i["iyz"], i["izz"]]])
+    _check_inertia(path, where, local, mass == 0)
+    rotation, com = _origin(path, f"{where} inertial", element)
+    return _Inertial(mass, com, rotation * local * rotation.T)
+
+
+def _moved(inertial: _Inertial, rotation: mpmath.matrix, translation: mpmath.matrix) -> _Inertial:
+    return _Inertial(inertial.mass, rotation * inertial.com + translation,
+                     rotation * inertial.inertia * rotation.T)
+
+
+def _merged(a: _Inertial, b: _Inertial) -> _Inertial:
+    """Two rigidly joined bodies in one frame (parallel-axis theorem)."""
+    mass = a.mass + b.mass
+    if mass == 0:
+        return a
+    com = (a.com * a.mass + b.com * b.mass) / mass
+    total = mpmath.matrix(3, 3)
+    for part in (a, b):
+        d = part.com - com
+        shift = (d.T * d)[0] * mpmath.eye(3) - d * d.T
+        total += part.inertia + part.mass * shift
+    return _Inertial(mass, com, total)
+
+
+def _barycentric(x: _Inertial) -> tuple[float, tuple, tuple]:
+    """(m, h = m c, inertia about the frame's origin) rounded once to doubles."""
+    c = x.com
+    about_origin = x.inertia + x.mass * ((c.T * c)[0] * mpmath.eye(3) - c * c.T)
+    return (float(x.mass), tuple(float(x.mass * c[i]) for i in range(3)),
+            tuple(tuple(float(about_origin[i, j]) for j in range(3)) for i in range(3)))
+
+
+class _Tree:
+    """The URDF's links and joints, with parent and child maps."""
+
+    def __init__(self, path: Path, text: str):
+        self.path = path
+        try:
+            root = ET.fromstring(text)
+        except ET.ParseError as err:
+            raise DescriptionError(path, "", f"not valid XML: {err}") from err
+        if root.tag != "robot":
+            raise DescriptionError(path, "", f"the root element is <{root.tag}>, not <robot>")
+        self.robot = root.get("name", "")
+        self.links = {}
+        for link in root.findall("link"):
+            name = link.get("name")
+            if not name:
+                raise DescriptionError(path, "link", "a <link> has no name")
+            if name in self.links:
+                raise DescriptionError(path, f"link '{name}'", "is defined twice")
+            self.links[name] = link
+        self.joints = {}
+        self.parent_joint = {}
+        self.child_joints: dict[str, list] = {name: [] for name in self.links}
+        for joint in root.findall("joint"):
+            name = joint.get("name")
+            if not name:
+                raise DescriptionError(path, "joint", "a <joint> has no name")
+            if name in self.joints:
+                raise DescriptionError(path, f"joint '{name}'", "is defined twice")
+            parent, child = joint.find("parent"), joint.find("child")
+            parent = parent.get("link") if parent is not None else None
+            child = child.get("link") if child is not None else None
+            for role, link in (("parent", parent), ("child", child)):
+                if link not in self.links:
+                    raise DescriptionError(path, f"joint '{name}'", f"its {role} link '{link}' is not defined")
+            if child in self.parent_joint:
+                raise DescriptionError(path, f"link '{child}'",
+                                       f"has two parents (joints '{self.parent_joint[child].get('name')}' and "
+                                       f"'{name}'): a loop, which a serial chain cannot have")
+            self.joints[name] = joint
+            self.parent_joint[child] = joint
+            self.child_joints[parent].append(joint)
+
+    def path_to(self, base: str, flange: str) -> list:
+        """The joints from `base` down to `flange`, in order."""
+        for role, link in (("base", base), ("flange", flange)):
+            if link not in self.links:
+                raise DescriptionError(self.path, f"link '{link}'", f"(the {role}) is not defined in the file")
+        joints, link, seen = [], flange, set()
+        while link != base:
+            if link in seen or link not in self.parent_joint:
+                raise DescriptionError(self.path, f"link '{flange}'", f"(the flange) is not below the base '{base}'")
+            seen.add(link)
+            joint = self.parent_joint[link]
+            joints.append(joint)
+            link = joint.find("parent").get("link")
+        return joints[::-1]
+
+
+def _joint_kind(path: Path, joint) -> str:
+    name, kind = joint.get("name"), joint.get("type")
+    if joint.find("mimic") is not None:
+        raise DescriptionError(path, f"joint '{name}'", "is a mimic joint, which is not supported "
+                                                       "(each joint of the chain must be driven on its own)")
+    if kind not in SUPPORTED:
+        raise DescriptionError(path, f"joint '{name}'", f"type '{kind}' is not supported "
+                                                       f"(supported: {', '.join(SUPPORTED)})")
+    return kind
+
+
+def _fixed_subtree(tree: _Tree, link: str, on_path: set[str], flange: str) -> _Inertial:
+    """The inertia of `link` and of every link fixed below it off the chain, in `link`'s frame;
+    a moving joint off the chain is a branch, refused. Nothing below the flange is read."""
+    total = _inertial(tree.path, tree.links[link], link in on_path and tree.parent_joint.get(link) is not None
+                      and tree.parent_joint[link].get("type") in MOVING)
+    if link == flange:
+        return total
+    for joint in tree.child_joints[link]:
+        child = joint.find("child").get("link")
+        if child in on_path:
+            continue
+        kind = _joint_kind(tree.path, joint)
+        if kind != "fixed":
+            raise DescriptionError(tree.path, f"joint '{joint.get('name')}'",
+                                   f"({kind}) branches off the chain at link '{link}': only a serial chain from "
+                                   "the base to the flange is supported")
+        rotation, translation = _origin(tree.path, f"joint '{joint.get('name')}'", joint)
+        total = _merged(total, _moved(_fixed_subtree(tree, child, on_path, flange), rotation, translation))
+    return total
+
+
+def read_chain(path: Path, base: str, flange: str) -> Chain:
+    try:
+        size = path.stat().st_size
+        if size > MAX_BYTES:
+            raise DescriptionError(path, "", f"is {size} bytes; a URDF the derivation reads is at most {MAX_BYTES}")
+        text = path.read_text()
+    except OSError as err:
+        raise DescriptionError(path, "", f"cannot read: {err.strerror}") from err
+    except UnicodeDecodeError as err:
+        raise DescriptionError(path, "", f"not text (UTF-8): {err.reason} at byte {err.start}") from err
+    with mpmath.workdps(DIGITS):
+        return _chain(_Tree(path, text), base, flange)
+
+
+def _axis(path: Path, joint) -> mpmath.matrix:
+    element = joint.find("axis")
+    a = mpmath.matrix(_floats(path, f"joint '{joint.get('name')}' axis", element.get("xyz") if element is not None
+                              else None, 3, "1 0 0"))
+    norm = mpmath.sqrt((a.T * a)[0])
+    if norm == 0:
+        raise DescriptionError(path, f"joint '{joint.get('name')}'", "axis is zero")
+    return a / norm
+
+
+def _chain(tree: _Tree, base: str, flange: str) -> Chain:
+    path = tree.path
+    joints = tree.path_to(base, flange)
+    on_path = {j.find("child").get("link") for j in joints} | {base}
+    for j in joints:
+        _joint_kind(path, j)
+    moving = [j for j in joints if j.get("type") in MOVING]
+    if not moving:
+        raise DescriptionError(path, f"link '{flange}'", f"no moving joint between the base '{base}' and the flange")
+    if len(moving) > MAX_JOINTS:
+        raise DescriptionError(path, f"link '{flange}'", f"{len(moving)} moving joints between the base '{base}' and "
+                                                         f"the flange; at most {MAX_JOINTS} are derived")
+    # Accumulate: the pose of the current link's frame in the last body's frame (or the base's),
+    # and the current body's inertia (in its joint frame).
+    bodies, pending_r, pending_t = [], mpmath.eye(3), mpmath.matrix(3, 1)
+    current: _Inertial | None = None
+    joint_of_body = None
+    for j in joints:
+        rotation, translation = _origin(path, f"joint '{j.get('name')}'", j)
+        rotation, translation = pending_r * rotation, pending_r * translation + pending_t
+        child = j.find("child").get("link")
+        subtree = _fixed_subtree(tree, child, on_path, flange)
+        if j.get("type") in MOVING:
+            if current is not None:
+                bodies.append(_body(joint_of_body, current))
+            joint_of_body = (j, rotation, translation, _axis(path, j))
+            current = subtree
+            pending_r, pending_t = mpmath.eye(3), mpmath.matrix(3, 1)
+        else:
+            if current is not None:
+                current = _merged(current, _moved(subtree, rotation, translation))
+            pending_r, pending_t = rotation, translation
+    bodies.append(_body(joint_of_body, current))
+    return Chain(path, tree.robot, base, flange, bodies,
+                 tuple(tuple(float(pending_r[i, k]) for k in range(3)) for i in range(3)),
+                 tuple(float(pending_t[i]) for i in range(3)))
+
+
+def _body(joint_data, inertial: _Inertial) -> Body:
+    joint, rotation, translation, axis = joint_data
+    mass, h, about_origin = _barycentric(inertial)
+    kind = "prismatic" if joint.get("type") == "prismatic" else "revolute"
+    return Body(joint.get("name"), kind,
+                tuple(tuple(float(rotation[i, k]) for k in range(3)) for i in range(3)),
+                tuple(float(translation[i]) for i in range(3)),
+                tuple(float(axis[i]) for i in range(3)), mass, h, about_origin)
