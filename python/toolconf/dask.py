@@ -27,7 +27,6 @@ with one thread per worker), or the processes of one machine compete for its cor
 """
 
 import math
-import operator
 import warnings
 from typing import TYPE_CHECKING, Any, Literal, Optional
 
@@ -76,6 +75,10 @@ def _counts(block):
 
 def _episodes(block, task, objective, method):
     return _toolconf._episodes(block, task, objective, method)
+
+
+def _kept_episodes(screened, task, objective, method):
+    return _toolconf._episodes(screened["kept"], task, objective, method)
 
 
 def _batch(model, params, task, perturbations, method, first_tool, episode_options):
@@ -129,6 +132,10 @@ def rank(
     import pandas
     from dask import delayed
 
+    if not hasattr(ddf, "to_delayed"):
+        raise ValueError(f"ddf = {type(ddf).__name__}: toolconf.dask.rank takes a dask DataFrame "
+                         "(dask.dataframe.from_pandas(frame, npartitions=...)); toolconf.rank "
+                         "takes a pandas DataFrame")
     client = _client(client)
     given = task
     task = _toolconf._portable_task(task, screen, objective, method)
@@ -144,18 +151,19 @@ def rank(
         delayed(_screen_partition)(p, task, first, screen, skip_bad_rows)
         for p, first in zip(parts, first_rows)
     ])
-    # In row order, so that the first bad row raises and the warnings keep their order.
-    counts = [client.submit(_counts, s).result() for s in screened]
+    if screen is None:
+        # Only the counts come to the client; each partition's tools stay where they are.
+        counts = _in_order(client, [client.submit(_counts, s) for s in screened])
+    else:
+        counts = _in_order(client, screened)
     for block in counts:
         for warning in block["skipped"]:
             warnings.warn(warning, UserWarning, stacklevel=2)
     if screen is None:
         _toolconf._merge_screens(counts, task, None, DATAFRAME_SOURCE)
-        kept = [client.submit(operator.getitem, s, "kept") for s in screened]
-        simulated = [client.submit(_episodes, k, task, objective, method) for k in kept]
+        simulated = [client.submit(_kept_episodes, s, task, objective, method) for s in screened]
     else:
-        full = client.gather(screened)
-        kept = _toolconf._merge_screens(full, task, screen, DATAFRAME_SOURCE)
+        kept = _toolconf._merge_screens(counts, task, screen, DATAFRAME_SOURCE)
         n = len(kept["row"])
         per_block = episodes_per_task or max(1, math.ceil(n / (4 * _threads(client))))
         simulated = [
@@ -163,6 +171,18 @@ def rank(
             for a, b in _blocks(n, per_block)
         ]
     return pandas.DataFrame(_toolconf._rank_table(client.gather(simulated)))
+
+
+def _in_order(client, futures):
+    """The futures' results; if any failed, the first one's error in their order (a bad row
+    of an earlier partition before a later one's, as a file is read)."""
+    import distributed
+
+    distributed.wait(futures)
+    for future in futures:
+        if future.status == "error":
+            future.result()
+    return client.gather(futures)
 
 
 def simulate_batch(
@@ -216,7 +236,7 @@ def simulate_batch(
         futures.append(client.submit(_batch, model, block, task, perturbations, method, first,
                                      episode_options))
         first += rows
-    parts = [f.result() for f in futures]
+    parts = _in_order(client, futures)
     return {key: (sum((p[key] for p in parts), []) if key == "error"
                   else np.concatenate([p[key] for p in parts]))
             for key in parts[0]}
