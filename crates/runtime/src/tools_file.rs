@@ -12,9 +12,6 @@
 //! Rows are handed to a callback one at a time, so a file of 10⁷ tools is never held in memory.
 //! A bad row is an error naming the file, the line (CSV) or tool number (JSON), the key and the
 //! value; the callback decides whether it stops the read or is skipped.
-//!
-//! Tools already in memory (columns: a DataFrame's, a dict's) go through the same row checks
-//! with [`read_columns`], their errors naming `row N` where a file's name the line.
 
 use std::fs::File;
 use std::io::BufReader;
