@@ -124,7 +124,7 @@ where
 }
 
 /// `m1=0.3 m2=0.4 …`, as the crate prints a tool.
-fn named<const NP: usize>(names: [&str; NP], values: &[f64]) -> String {
+pub fn named<const NP: usize>(names: [&str; NP], values: &[f64]) -> String {
     let parts: Vec<String> = names
         .iter()
         .zip(values)

@@ -4,19 +4,29 @@
 //! * [`confidence`]: A, B, the task's sensitivities, Π^U and ln|Π^U| of one tool or of many in
 //!   one call (rayon, without the GIL).
 //! * [`simulate`]: one closed-loop episode's metrics and trajectory, any generated model.
-//! * [`rank`]: `toolconf rank` (screen by confidence, simulate, rank) as columns.
+//! * [`rank`]: `toolconf rank` (screen by confidence, simulate, rank) as columns, of a tools
+//!   file or of columns in memory ([`tools`]).
+//! * [`batch`]: `simulate_batch`, the episodes of many tools under many perturbations.
+//! * [`design`]: `toolconf design --json` as a dict.
+//! * [`blocks`]: the steps of `rank` that `toolconf.dask` spreads over a cluster.
 //! * [`task`]: a task given as a built-in name, a task file or a dict with a task file's keys,
 //!   all checked by the crate's task-file parser so errors name the key.
 //!
 //! Bad input raises `ValueError` with the one-line message the command line prints; a failed
 //! episode raises `toolconf.SimulationError` with `tool`, `time` and `reason`.
 
+mod arrays;
+mod batch;
+mod blocks;
 mod confidence;
+mod design;
 mod errors;
 mod models;
 mod rank;
 mod simulate;
+mod table;
 mod task;
+mod tools;
 
 use pyo3::prelude::*;
 
@@ -29,6 +39,13 @@ fn _toolconf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(confidence::confidence, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(rank::rank, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::simulate_batch, m)?)?;
+    m.add_function(wrap_pyfunction!(design::design, m)?)?;
+    m.add_function(wrap_pyfunction!(blocks::portable_task, m)?)?;
+    m.add_function(wrap_pyfunction!(blocks::screen_block, m)?)?;
+    m.add_function(wrap_pyfunction!(blocks::merge_screens, m)?)?;
+    m.add_function(wrap_pyfunction!(blocks::episodes, m)?)?;
+    m.add_function(wrap_pyfunction!(blocks::rank_table, m)?)?;
     m.add(
         "SimulationError",
         m.py().get_type::<errors::SimulationError>(),

@@ -6,7 +6,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use toolconf::generated;
 use toolconf::model::mixed::ModelKind;
-use toolconf::model::ArmModel;
+use toolconf::model::{ArmModel, Metrics};
 use toolconf::task_file::TaskSpec;
 
 use crate::confidence::Confidences;
@@ -20,6 +20,14 @@ pub trait ModelOps: Sync {
     fn confidences(&self, spec: &TaskSpec, params: &[f64]) -> Result<Confidences, Failure>;
     /// One episode of the tool `params` (NP values).
     fn episode(&self, spec: &TaskSpec, params: &[f64]) -> Result<Episode, Failure>;
+    /// The metrics of every tool of `params` (k × NP) under every task of `specs`, tool-major
+    /// (bad tools named from `first_tool`, or unnumbered for a single 1-D tool).
+    fn batch(
+        &self,
+        specs: &[TaskSpec],
+        params: &[f64],
+        first_tool: Option<usize>,
+    ) -> Result<Vec<Result<Metrics, String>>, Failure>;
 }
 
 /// [`ModelOps`] of model `M`.
@@ -38,6 +46,15 @@ where
 
     fn episode(&self, spec: &TaskSpec, params: &[f64]) -> Result<Episode, Failure> {
         crate::simulate::episode_of::<M, N, NX, NP, NZ>(spec, params)
+    }
+
+    fn batch(
+        &self,
+        specs: &[TaskSpec],
+        params: &[f64],
+        first_tool: Option<usize>,
+    ) -> Result<Vec<Result<Metrics, String>>, Failure> {
+        crate::batch::batch::<M, N, NX, NP, NZ>(specs, params, first_tool)
     }
 }
 

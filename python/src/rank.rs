@@ -1,27 +1,18 @@
 //! `toolconf.rank`: `toolconf rank` as a dict of columns.
 
-use std::path::{Path, PathBuf};
-
-use numpy::PyArray1;
 use pyo3::exceptions::PyUserWarning;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use toolconf::model::mixed::ModelKind;
-use toolconf::rank::{ranking, screen_file, simulate_all, ModelTasks, RankedTool};
+use toolconf::rank::{simulate_all, ModelTasks};
 use toolconf::select::Objective;
 use toolconf::task_file::TaskSpec;
 
 use crate::errors::{detached, Failure};
+use crate::table::{ranked_to_py, Outcome};
 use crate::task::task_spec;
+use crate::tools::Tools;
 
-/// The ranked tools (best first) and the bad rows skipped.
-struct Ranked {
-    results: Vec<RankedTool>,
-    order: Vec<usize>,
-    skipped: Vec<String>,
-}
-
-fn objective(name: &str) -> Result<Objective, Failure> {
+pub fn objective(name: &str) -> Result<Objective, Failure> {
     match name.replace('_', "-").as_str() {
         "free-energy" => Ok(Objective::FreeEnergy),
         "cost-j" => Ok(Objective::CostJ),
@@ -33,27 +24,23 @@ fn objective(name: &str) -> Result<Objective, Failure> {
     }
 }
 
+/// The cheap stage, then every kept tool's episode (the library's [`simulate_all`]); returns
+/// the outcomes in row order and the bad rows skipped.
 fn run(
-    tools: &Path,
+    tools: &Tools,
     spec: &TaskSpec,
     screen: Option<usize>,
     objective: Objective,
     skip_bad_rows: bool,
-) -> Result<Ranked, Failure> {
+) -> Result<(Vec<Outcome>, Vec<String>), Failure> {
     let tasks = ModelTasks::new(spec);
-    let mut skipped = Vec::new();
-    let task = tasks.kind.to_string();
-    let (kept, _) = screen_file(tools, &tasks, &task, screen, skip_bad_rows, |bad| {
-        skipped.push(format!("toolconf: skipping {bad}"))
-    })
-    .map_err(Failure::input)?;
-    let results = simulate_all(kept.finish(), &tasks, |_| Ok::<(), Failure>(()))?;
-    let order = ranking(&results, objective);
-    Ok(Ranked {
-        results,
-        order,
-        skipped,
-    })
+    let screened = tools.screen(&tasks, screen, skip_bad_rows, 1, true)?;
+    let results = simulate_all(screened.screen.finish(), &tasks, |_| Ok::<(), Failure>(()))?;
+    let outcomes = results
+        .into_iter()
+        .map(|r| Outcome::new(r, objective))
+        .collect();
+    Ok((outcomes, screened.skipped))
 }
 
 /// Ranks your tools on a task, as ``toolconf rank`` does, with the same numbers.
@@ -65,7 +52,11 @@ fn run(
 ///
 /// Args:
 ///     tools: a tools file's path: CSV (columns ``name``, ``model``, and the models' parameters
-///         such as ``m1,m2,l1,l2``) or JSON (``.json``: an array of objects with those keys).
+///         such as ``m1,m2,l1,l2``) or JSON (``.json``: an array of objects with those keys);
+///         or the same columns in memory, a mapping of column name to a 1-D array or list
+///         (``toolconf.rank`` also takes a pandas DataFrame or a NumPy structured array and
+///         makes this mapping of it). In memory, NaN and None are empty cells; rows are named
+///         ``row N`` (1-based) in errors.
 ///     task: a built-in task name, a task file's path, or a dict with a task file's keys.
 ///     screen: simulate only the K most confident tools (K ≥ 1); ``None`` simulates all.
 ///     objective: ``"free-energy"`` (the paper's ∫F dt, the default), ``"cost-j"`` (∫J dt) or
@@ -74,10 +65,12 @@ fn run(
 ///         raising.
 ///     method: the integrator, as the command line's ``--method``: ``"fast"`` (the default),
 ///         ``"explicit"`` (exactly MATLAB ode45, the paper's numerics), ``"auto"`` or ``"stiff"``.
+///     source: what errors call columns in memory (default ``"tools dict"``; ``toolconf.rank``
+///         passes ``"tools DataFrame"`` or ``"tools array"``).
 ///
 /// Returns:
-///     dict of columns, best tool first (``pandas.DataFrame(toolconf.rank(...))``): ``rank``,
-///     ``row`` (1-based in the file), ``name`` (str or None), ``model``, one column per
+///     dict of columns, best tool first (``toolconf.rank`` makes a pandas DataFrame of it when
+///     it was given one): ``rank``, ``row`` (1-based in the file or table), ``name`` (str or None), ``model``, one column per
 ///     parameter of the models present (NaN for a tool whose model has no such parameter),
 ///     ``logdet``, ``task_error``, ``free_energy``, ``cost_j`` (NaN for a tool whose episode
 ///     failed), ``rhs_evals`` (-1 for those) and ``error`` (None, or why the episode failed:
@@ -88,92 +81,42 @@ fn run(
 ///         a bad task (naming the key), an unknown objective, or ``screen < 1``; the command
 ///         line's message.
 #[pyfunction]
-#[pyo3(signature = (tools, task, screen=None, objective="free-energy", skip_bad_rows=false, method="fast"))]
+#[pyo3(signature = (tools, task, screen=None, objective="free-energy", skip_bad_rows=false, method="fast", source=None))]
+#[allow(clippy::too_many_arguments)]
 pub fn rank<'py>(
     py: Python<'py>,
-    tools: PathBuf,
+    tools: &Bound<'py, PyAny>,
     task: &Bound<'py, PyAny>,
     screen: Option<i64>,
     objective: &str,
     skip_bad_rows: bool,
     method: &str,
+    source: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let objective = self::objective(objective).map_err(|f| f.into_pyerr(py))?;
-    let screen = match screen {
-        Some(k) if k < 1 => {
-            return Err(Failure::Input(format!("screen = {k}: must be at least 1")).into_pyerr(py))
-        }
-        k => k.map(|k| k as usize),
-    };
+    let screen = screen_limit(screen).map_err(|f| f.into_pyerr(py))?;
     let mut spec = task_spec(task, None)?;
     spec.episode.method = Some(crate::task::method(method).map_err(|f| f.into_pyerr(py))?);
-    let ranked = detached(py, || run(&tools, &spec, screen, objective, skip_bad_rows))?;
-    for warning in &ranked.skipped {
+    let tools = Tools::from_py(tools, source).map_err(|f| f.into_pyerr(py))?;
+    let (outcomes, skipped) =
+        detached(py, || run(&tools, &spec, screen, objective, skip_bad_rows))?;
+    warn_skipped(py, &skipped)?;
+    ranked_to_py(py, &outcomes)
+}
+
+/// `screen=K` as a limit: K ≥ 1, or every tool.
+pub fn screen_limit(screen: Option<i64>) -> Result<Option<usize>, Failure> {
+    match screen {
+        Some(k) if k < 1 => Err(Failure::Input(format!("screen = {k}: must be at least 1"))),
+        k => Ok(k.map(|k| k as usize)),
+    }
+}
+
+/// One `UserWarning` per bad row skipped, in row order.
+pub fn warn_skipped(py: Python<'_>, skipped: &[String]) -> PyResult<()> {
+    for warning in skipped {
         let category = py.get_type::<PyUserWarning>();
         PyErr::warn(py, &category, &std::ffi::CString::new(warning.as_str())?, 1)?;
     }
-    columns(py, &ranked)
-}
-
-/// The parameter columns of the models present, in the models' order (as the CLI's CSV).
-fn parameter_columns(results: &[RankedTool]) -> Vec<&'static str> {
-    let mut columns = Vec::new();
-    for model in ModelKind::ALL {
-        if results.iter().any(|r| r.row.tool.model() == model) {
-            for p in model.parameter_names() {
-                if !columns.contains(p) {
-                    columns.push(*p);
-                }
-            }
-        }
-    }
-    columns
-}
-
-fn columns<'py>(py: Python<'py>, ranked: &Ranked) -> PyResult<Bound<'py, PyDict>> {
-    let tools: Vec<&RankedTool> = ranked.order.iter().map(|&i| &ranked.results[i]).collect();
-    let out = PyDict::new(py);
-    let ints = |f: &dyn Fn(usize, &RankedTool) -> i64| {
-        PyArray1::from_vec(py, tools.iter().enumerate().map(|(k, r)| f(k, r)).collect())
-    };
-    let floats = |f: &dyn Fn(&RankedTool) -> Option<f64>| {
-        PyArray1::from_vec(py, tools.iter().map(|r| f(r).unwrap_or(f64::NAN)).collect())
-    };
-    out.set_item("rank", ints(&|k, _| k as i64 + 1))?;
-    out.set_item("row", ints(&|_, r| r.row.row as i64))?;
-    out.set_item(
-        "name",
-        tools.iter().map(|r| r.row.name.clone()).collect::<Vec<_>>(),
-    )?;
-    out.set_item(
-        "model",
-        tools
-            .iter()
-            .map(|r| r.row.tool.model().name())
-            .collect::<Vec<_>>(),
-    )?;
-    for p in parameter_columns(&ranked.results) {
-        let value = |r: &RankedTool| {
-            let params = r.row.tool.named_parameters();
-            params.iter().find(|(n, _)| *n == p).map(|(_, v)| *v)
-        };
-        out.set_item(p, floats(&value))?;
-    }
-    out.set_item("logdet", floats(&|r| r.logdet.as_ref().ok().copied()))?;
-    let metric = |f: fn(&toolconf::model::Metrics) -> f64| {
-        floats(&move |r: &RankedTool| r.episode.as_ref().ok().map(f))
-    };
-    out.set_item("task_error", metric(|m| m.task_error))?;
-    out.set_item("free_energy", metric(|m| m.free_energy))?;
-    out.set_item("cost_j", metric(|m| m.cost_j))?;
-    out.set_item(
-        "rhs_evals",
-        ints(&|_, r| r.episode.as_ref().map_or(-1, |m| m.rhs_evals as i64)),
-    )?;
-    let errors: Vec<Option<String>> = tools
-        .iter()
-        .map(|r| r.episode.as_ref().err().map(|e| e.to_string()))
-        .collect();
-    out.set_item("error", errors)?;
-    Ok(out)
+    Ok(())
 }

@@ -25,12 +25,12 @@ pub fn task_spec(
     let py = task.py();
     let episode = match episode {
         Some(kwargs) if !kwargs.is_empty() => {
-            Some(table(kwargs, "episode").map_err(|f| f.into_pyerr(py))?)
+            Some(table(kwargs, "episode", DICT_SOURCE).map_err(|f| f.into_pyerr(py))?)
         }
         _ => None,
     };
     let spec = if let Ok(dict) = task.cast::<PyDict>() {
-        let mut t = table(dict, "").map_err(|f| f.into_pyerr(py))?;
+        let mut t = table(dict, "", DICT_SOURCE).map_err(|f| f.into_pyerr(py))?;
         if let Some(e) = episode {
             merge_episode(&mut t, e);
         }
@@ -92,13 +92,13 @@ fn merge_episode(task: &mut toml::Table, episode: toml::Table) {
 }
 
 /// A dict as a TOML table; `None` values are left out (the default). `at` is the dotted key of
-/// the dict itself, for errors.
-pub fn table(dict: &Bound<'_, PyDict>, at: &str) -> Result<toml::Table, Failure> {
+/// the dict itself and `source` names the dict (`task dict`, `design dict`), for errors.
+pub fn table(dict: &Bound<'_, PyDict>, at: &str, source: &str) -> Result<toml::Table, Failure> {
     let mut out = toml::Table::new();
     for (key, value) in dict.iter() {
         let Ok(key) = key.extract::<String>() else {
             return Err(Failure::Input(format!(
-                "{DICT_SOURCE}, key {}: {} is not a string key",
+                "{source}, key {}: {} is not a string key",
                 if at.is_empty() { "(top level)" } else { at },
                 repr(&key)
             )));
@@ -111,14 +111,14 @@ pub fn table(dict: &Bound<'_, PyDict>, at: &str) -> Result<toml::Table, Failure>
         } else {
             format!("{at}.{key}")
         };
-        out.insert(key, to_toml(&value, &path)?);
+        out.insert(key, to_toml(&value, &path, source)?);
     }
     Ok(out)
 }
 
 /// A Python value as TOML: bool, int, float (NumPy scalars included), str, list, tuple, NumPy
 /// array (by `tolist()`) or dict.
-fn to_toml(value: &Bound<'_, PyAny>, path: &str) -> Result<toml::Value, Failure> {
+fn to_toml(value: &Bound<'_, PyAny>, path: &str, source: &str) -> Result<toml::Value, Failure> {
     if value.is_instance_of::<PyBool>() {
         return Ok(toml::Value::Boolean(value.is_truthy().unwrap_or(false)));
     }
@@ -136,15 +136,15 @@ fn to_toml(value: &Bound<'_, PyAny>, path: &str) -> Result<toml::Value, Failure>
         return Ok(toml::Value::String(s.to_string()));
     }
     if let Ok(d) = value.cast::<PyDict>() {
-        return table(d, path).map(toml::Value::Table);
+        return table(d, path, source).map(toml::Value::Table);
     }
     if value.is_instance_of::<PyList>() || value.is_instance_of::<PyTuple>() {
         let items: Result<Vec<_>, _> = value
             .try_iter()
-            .map_err(|_| unsupported(value, path))?
+            .map_err(|_| unsupported(value, path, source))?
             .map(|item| {
-                item.map_err(|_| unsupported(value, path))
-                    .and_then(|item| to_toml(&item, path))
+                item.map_err(|_| unsupported(value, path, source))
+                    .and_then(|item| to_toml(&item, path, source))
             })
             .collect();
         return items.map(toml::Value::Array);
@@ -152,15 +152,15 @@ fn to_toml(value: &Bound<'_, PyAny>, path: &str) -> Result<toml::Value, Failure>
     // NumPy arrays and scalars: their Python equivalents.
     if let Ok(plain) = value.call_method0("tolist") {
         if !plain.is(value) {
-            return to_toml(&plain, path);
+            return to_toml(&plain, path, source);
         }
     }
-    Err(unsupported(value, path))
+    Err(unsupported(value, path, source))
 }
 
-fn unsupported(value: &Bound<'_, PyAny>, path: &str) -> Failure {
+fn unsupported(value: &Bound<'_, PyAny>, path: &str, source: &str) -> Failure {
     Failure::Input(format!(
-        "{DICT_SOURCE}, key {path}: {} is not a number, string, list or dict",
+        "{source}, key {path}: {} is not a number, string, list or dict",
         repr(value)
     ))
 }

@@ -58,3 +58,22 @@ def cli_error(cli):
         return lines[0][len(prefix):]
 
     return run
+
+
+@pytest.fixture(scope="session")
+def dask_client():
+    """A ``distributed`` cluster of 2 worker processes (one thread and one rayon thread each) on
+    the loopback interface, and a client of it. The workers are started with this Python, so
+    they import the same ``toolconf`` (checked in test_dask.py)."""
+    import logging
+
+    import distributed
+
+    cluster = distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+        dashboard_address=None, silence_logs=logging.ERROR, env={"RAYON_NUM_THREADS": "1"},
+    )
+    client = distributed.Client(cluster)
+    yield client
+    client.close()
+    cluster.close()

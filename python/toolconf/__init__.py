@@ -7,9 +7,15 @@ The runtime is Rust (the ``toolconf`` crate); this package exposes it over NumPy
   ln|Π^U| of one tool (1-D ``params``) or of many (2-D, one tool per row), in one call.
 * ``simulate(model, params, task, **episode_options)``: one closed-loop episode's metrics and
   trajectory.
-* ``rank(tools, task, screen=None, objective="free-energy")``: ``toolconf rank`` as a dict of
-  columns (``pandas.DataFrame(toolconf.rank(...))``).
+* ``simulate_batch(model, params_2d, task, perturbations=..., **episode_options)``: the
+  episodes of many tools under many perturbations, one row of metrics each.
+* ``rank(tools, task, screen=None, objective="free-energy")``: ``toolconf rank`` on a tools
+  file, a pandas DataFrame, a dict of 1-D arrays or a NumPy structured array; a DataFrame for a
+  DataFrame, else a dict of columns.
+* ``design(model, task, design)``: ``toolconf design --json``, which tool to build.
 * ``models()``: the generated models and their parameter names.
+* ``toolconf.dask`` (``pip install "./python[dask]"``): ``rank`` and ``simulate_batch`` on a
+  Dask cluster, with the same results.
 
 A task is ``"position"``, ``"velocity"`` or ``"acceleration"`` (the paper's tasks 1-3), a task
 file's path, or a dict with a task file's keys. Bad input raises ``ValueError`` with the
@@ -17,6 +23,87 @@ command line's message; a failed episode raises ``SimulationError`` (``tool``, `
 ``reason``).
 """
 
-from ._toolconf import SimulationError, confidence, models, rank, simulate
+import os
+from typing import TYPE_CHECKING, Any, Literal, Mapping, Optional, Union
 
-__all__ = ["SimulationError", "confidence", "models", "rank", "simulate"]
+import numpy as np
+
+from . import _toolconf
+from ._tables import native_tools
+from ._toolconf import SimulationError, confidence, design, models, simulate, simulate_batch
+
+__all__ = [
+    "SimulationError",
+    "confidence",
+    "design",
+    "models",
+    "rank",
+    "simulate",
+    "simulate_batch",
+]
+
+
+if TYPE_CHECKING:
+    import pandas
+
+    from ._toolconf import Columns, Task
+
+
+def rank(
+    tools: Union[str, "os.PathLike[str]", "pandas.DataFrame", Mapping[str, Any], np.ndarray],
+    task: "Task",
+    screen: Optional[int] = None,
+    objective: Literal["free-energy", "cost-j", "confidence"] = "free-energy",
+    skip_bad_rows: bool = False,
+    method: Literal["fast", "explicit", "auto", "stiff"] = "fast",
+) -> Union["pandas.DataFrame", "Columns"]:
+    """Ranks your tools on a task, as ``toolconf rank`` does, with the same numbers.
+
+    First every tool's control confidence ln|Π^U| in closed form (no simulation); then an
+    episode for every tool, or with ``screen=K`` only for the K most confident (ties: the
+    earlier row); then the ranking by ``objective``. Episodes run on rayon's threads without the
+    GIL; results do not depend on the number of threads.
+
+    Args:
+        tools: the tools, one per row, with a tools file's columns (``name``, ``model``, and the
+            models' parameters such as ``m1, m2, l1, l2``), as any of
+            a tools file's path (CSV, or JSON by the ``.json`` extension);
+            a pandas DataFrame;
+            a dict of 1-D arrays or lists, one per column;
+            a NumPy structured array, one field per column.
+            In memory, NaN and None are empty cells (a model's missing parameter, or ``arm2``
+            for an empty ``model``); the checks are the file's, and a bad row's message names
+            ``row N`` (1-based, the result's ``row``) where a file's names the line, e.g.
+            ``tools DataFrame, row 7: m2 = 'heavy' is not a number (tool 'mallet')``.
+        task: a built-in task name, a task file's path, or a dict with a task file's keys.
+        screen: simulate only the K most confident tools (K ≥ 1); ``None`` simulates all.
+        objective: ``"free-energy"`` (the paper's ∫F dt, the default), ``"cost-j"`` (∫J dt) or
+            ``"confidence"`` (ln|Π^U|).
+        skip_bad_rows: warn about a bad row (``UserWarning``) and go on without it, instead of
+            raising.
+        method: the integrator, as the command line's ``--method``: ``"fast"`` (the default),
+            ``"explicit"`` (exactly MATLAB ode45, the paper's numerics), ``"auto"`` or
+            ``"stiff"``.
+
+    Returns:
+        The ranked tools, best first, with the columns ``rank``, ``row`` (1-based in the file
+        or table), ``name``, ``model``, one per parameter of the models present (NaN where a
+        tool's model has none), ``logdet``, ``task_error``, ``free_energy``, ``cost_j`` (NaN
+        for a failed episode), ``rhs_evals`` (-1 for one) and ``error`` (None, or why the
+        episode failed: such tools rank last, in row order). A pandas DataFrame when ``tools``
+        was one; otherwise a dict of columns (NumPy arrays and lists), so that pandas stays
+        optional (``pandas.DataFrame(result)`` makes the same frame). The numbers are
+        ``toolconf rank --json``'s for the same rows.
+
+    Raises:
+        ValueError: a bad tools file, table or row (naming the file or table, the line or row
+            and the value), a bad task (naming the key), an unknown objective, or
+            ``screen < 1``; the command line's message.
+    """
+    native, source, frame = native_tools(tools)
+    table = _toolconf.rank(native, task, screen, objective, skip_bad_rows, method, source)
+    if frame:
+        import pandas
+
+        return pandas.DataFrame(table)
+    return table

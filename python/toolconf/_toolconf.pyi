@@ -60,14 +60,104 @@ def simulate(
     ``theta_dot``, ``theta_ddot``, ``u`` as arrays). Raises ``ValueError`` for bad input and
     ``SimulationError`` for a failed episode."""
 
+Columns = dict[str, Union[npt.NDArray[np.float64], npt.NDArray[np.int64], list[Optional[str]], list[str]]]
+"""A table as a dict of columns: NumPy arrays for numbers, lists for text (None when empty)."""
+
+ToolColumns = Union[Mapping[str, Any], Sequence[tuple[str, Any]]]
+"""Tools in memory: a mapping of column name to a 1-D array or list, or (name, values) pairs."""
+
 def rank(
-    tools: Union[str, "os.PathLike[str]"],
+    tools: Union[str, "os.PathLike[str]", ToolColumns],
     task: Task,
     screen: Optional[int] = None,
     objective: Literal["free-energy", "cost-j", "confidence"] = "free-energy",
     skip_bad_rows: bool = False,
     method: Literal["fast", "explicit", "auto", "stiff"] = "fast",
-) -> dict[str, Union[npt.NDArray[np.float64], npt.NDArray[np.int64], list[Optional[str]], list[str]]]:
+    source: Optional[str] = None,
+) -> Columns:
     """``toolconf rank`` as a dict of columns, best tool first: ``rank``, ``row``, ``name``,
     ``model``, the parameters, ``logdet``, ``task_error``, ``free_energy``, ``cost_j``,
-    ``rhs_evals``, ``error``. Raises ``ValueError`` for bad input."""
+    ``rhs_evals``, ``error``. ``tools`` is a tools file or columns in memory (``source`` names
+    them in errors). ``toolconf.rank`` wraps this for DataFrames and structured arrays. Raises
+    ``ValueError`` for bad input."""
+
+def simulate_batch(
+    model: str,
+    params: Params,
+    task: Task,
+    perturbations: Optional[Union[Sequence[Union[float, Sequence[float]]], npt.ArrayLike]] = None,
+    method: Literal["fast", "explicit", "auto", "stiff"] = "fast",
+    first_tool: int = 0,
+    *,
+    t_end: Optional[float] = ...,
+    dt: Optional[float] = ...,
+    perturbation: Optional[Union[float, Sequence[float]]] = ...,
+    learning_rate: Optional[float] = ...,
+    initial_theta: Optional[Sequence[float]] = ...,
+    initial_theta_dot: Optional[Sequence[float]] = ...,
+    initial_torque: Optional[Union[float, Sequence[float]]] = ...,
+    rtol: Optional[float] = ...,
+    atol: Optional[float] = ...,
+) -> Columns:
+    """The episodes of every tool (a row of ``params``) under every perturbation: one row of
+    metrics per (tool, perturbation), tool-major, equal to a loop of ``simulate``: ``tool``,
+    ``perturbation`` (indices), ``task_error``, ``free_energy``, ``cost_j``, ``logdet``,
+    ``control_effort`` (NaN for a failed episode), ``rhs_evals``, ``steps``,
+    ``rejected_steps``, ``jacobian_evals``, ``factorisations`` (-1 for one) and ``error``.
+    A failed episode never stops the batch; bad input raises ``ValueError``."""
+
+def design(
+    model: str,
+    task: Task,
+    design: Union[str, "os.PathLike[str]", Mapping[str, Any]],
+    sweep: Optional[str] = None,
+) -> dict[str, Any]:
+    """``toolconf design --json`` as a dict: the tool to build (``params``, ``logdet``), the
+    confidence optimum's checks (``gradient_check``, ``kkt_residual``), the random comparison
+    and the ``verification`` episodes; with ``sweep``, the front. Raises ``ValueError`` for
+    bad input or infeasible constraints, ``RuntimeError`` for a design that failed."""
+
+# The steps toolconf.dask spreads over a cluster (python/src/blocks.rs); blocks are dicts of
+# columns (Columns) that pickle exactly.
+
+PortableTask = Union[str, Mapping[str, Any], tuple[str, str, str]]
+
+def _portable_task(
+    task: Task,
+    screen: Optional[int] = None,
+    objective: str = "free-energy",
+    method: str = "fast",
+) -> PortableTask:
+    """The task as workers read it (a task file as its text); checks the options as ``rank``."""
+
+def _screen_block(
+    tools: ToolColumns,
+    task: PortableTask,
+    first_row: int,
+    screen: Optional[int] = None,
+    skip_bad_rows: bool = False,
+    source: str = "tools DataFrame",
+) -> dict[str, Any]:
+    """The confidence stage over one block of rows numbered from ``first_row``: ``kept``
+    (candidates), ``read``, ``without_confidence``, ``first_confidence_error``, ``skipped``,
+    ``rows``."""
+
+def _merge_screens(
+    blocks: list[dict[str, Any]],
+    task: PortableTask,
+    screen: Optional[int] = None,
+    source: str = "tools DataFrame",
+) -> Columns:
+    """The blocks' screens (in row order) absorbed into the global top ``screen``, with the
+    whole table's checks; the kept candidates."""
+
+def _episodes(
+    block: Columns,
+    task: PortableTask,
+    objective: str = "free-energy",
+    method: str = "fast",
+) -> Columns:
+    """The episodes of a block of candidates: a block of simulated tools."""
+
+def _rank_table(blocks: list[Columns]) -> Columns:
+    """Simulated blocks ranked into ``rank``'s table."""

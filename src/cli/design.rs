@@ -4,8 +4,8 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use serde_json::{json, Map, Value};
 use toolconf::design::file::DesignSpec;
+use toolconf::design::json::design_json;
 use toolconf::design::sweep::{parse_sweep, run_sweep};
 use toolconf::design::{design, DesignError, DesignResult, Setting};
 use toolconf::model::mixed::ModelKind;
@@ -96,18 +96,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         write_report(dir, &input)?;
     }
     if args.json {
-        let mut v = to_json(&spec, &result);
-        v["model"] = Value::from(model.name());
-        v["task"] = Value::from(args.task.as_str());
-        if let Some(points) = &front {
-            v["sweep"] = points
-                .iter()
-                .map(|p| match &p.outcome {
-                    Ok((params, logdet, _)) => json!({"budget": p.value, "logdet": logdet, "params": named(&names, params)}),
-                    Err(e) => json!({"budget": p.value, "error": e}),
-                })
-                .collect();
-        }
+        let v = design_json(&spec, &result, model, &args.task, front.as_deref());
         println!("{}", serde_json::to_string_pretty(&v).expect("JSON"));
     } else {
         print_text(&spec, &result, elapsed.as_secs_f64());
@@ -126,65 +115,6 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         }
     }
     Ok(())
-}
-
-fn named(names: &[&str], values: &[f64]) -> Value {
-    Value::Object(
-        names
-            .iter()
-            .zip(values)
-            .map(|(n, v)| (n.to_string(), Value::from(*v)))
-            .collect::<Map<_, _>>(),
-    )
-}
-
-fn to_json(spec: &DesignSpec, r: &DesignResult) -> Value {
-    let free: Vec<&str> = spec
-        .names
-        .iter()
-        .zip(&spec.fixed)
-        .filter(|(_, f)| f.is_none())
-        .map(|(n, _)| *n)
-        .collect();
-    let o = &r.confidence_optimum;
-    let verification: Vec<Value> = r
-        .checks
-        .iter()
-        .map(|c| {
-            let mut v = json!({"tool": c.label, "params": named(&spec.names, &c.params), "logdet": c.logdet});
-            match &c.simulated {
-                Ok(m) => {
-                    v["task_error"] = Value::from(m.task_error);
-                    v["free_energy"] = Value::from(m.free_energy);
-                    v["task_error_perturbed"] = Value::from(m.task_error_perturbed);
-                    v["sensitivity"] = Value::from(m.sensitivity);
-                }
-                Err(e) => v["error"] = Value::from(e.as_str()),
-            }
-            v
-        })
-        .collect();
-    let best = r.random.top.first();
-    json!({
-        "objective": r.objective.name(),
-        "params": named(&spec.names, &r.params),
-        "logdet": r.logdet,
-        "confidence_optimum": {"params": named(&spec.names, &spec_params(spec, o)), "logdet": o.value},
-        "gradient": named(&free, &o.gradient),
-        "gradient_check": r.gradient_check,
-        "kkt_residual": o.kkt_residual,
-        "iterations": o.iterations,
-        "start": o.start,
-        "free_energy_simulations": r.free_energy_evaluations,
-        "perturbation": spec.search.perturbation,
-        "random": {
-            "requested": r.random.requested,
-            "feasible": r.random.feasible,
-            "drawn": r.random.drawn,
-            "best_logdet": best.map(|b| b.1),
-        },
-        "verification": verification,
-    })
 }
 
 /// The confidence optimum's full parameters (fixed ones in place).

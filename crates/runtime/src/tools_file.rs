@@ -361,3 +361,8 @@ fn read_json<R: std::io::Read>(
     })?;
     Ok(elements.rows)
 }
+
+// Tools held in memory (the Python package's DataFrames, dicts and structured arrays): the
+// same row checks over columns instead of a file's lines.
+mod columns;
+pub use columns::{read_columns, Column, MemoryCell};

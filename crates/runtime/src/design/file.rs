@@ -121,6 +121,10 @@ impl DesignSpec {
             let place = line.map(|l| format!("line {l}")).unwrap_or_default();
             DesignError::input(file, &place, e.message().trim().replace('\n', " "))
         })?;
+        Self::from_raw(raw, file, names)
+    }
+
+    fn from_raw(raw: RawDesign, file: &str, names: &[&'static str]) -> Result<Self, DesignError> {
         let err =
             |key: &str, message: String| DesignError::input(file, &format!("key {key}"), message);
         let objective = match raw.objective.as_deref() {
@@ -242,4 +246,27 @@ fn search_settings(raw: &RawSearch) -> Result<SearchSettings, (&'static str, Str
         return Err(("perturbation", format!("{} is not finite", s.perturbation)));
     }
     Ok(s)
+}
+
+/// Designs given as data rather than as a file (the Python package's design dicts).
+impl DesignSpec {
+    /// A design given as a TOML table with a design file's keys, checked exactly as a design
+    /// file is; `source` names it in errors (`design dict, key bounds.m1: …`). A value of the
+    /// wrong type or an unknown key is named by its dotted key, as a file's would be by its line.
+    pub fn from_table(
+        table: toml::Table,
+        source: &str,
+        names: &[&'static str],
+    ) -> Result<Self, DesignError> {
+        let raw: RawDesign = table.try_into().map_err(|e| {
+            // As TaskSpec::from_table: toml names the place as a last line "in `bounds.m1`".
+            let text = e.to_string();
+            let (message, place) = match text.trim_end().rsplit_once("\nin `") {
+                Some((message, key)) => (message, format!("key {}", key.trim_end_matches('`'))),
+                None => (text.trim_end(), String::new()),
+            };
+            DesignError::input(source, &place, message.trim().replace('\n', " "))
+        })?;
+        Self::from_raw(raw, source, names)
+    }
 }

@@ -15,6 +15,7 @@
 pub mod constraint;
 pub mod file;
 pub mod free_energy;
+pub mod json;
 pub mod polytope;
 pub mod qp;
 pub mod solver;

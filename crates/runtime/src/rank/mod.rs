@@ -13,7 +13,10 @@
 mod screen;
 mod tasks;
 
-pub use screen::{screen_file, Candidate, Screen, ScreenError};
+pub use screen::{
+    check_screened, screen_file, screen_rows, Candidate, EachRow, Screen, ScreenError,
+    ScreenedBlock,
+};
 pub use tasks::{AnyEpisode, Bound, ModelTasks, TaskTrace, TrajectoryTable};
 
 use std::cmp::Ordering;
@@ -177,26 +180,45 @@ fn per_item(wall: Duration, n: usize) -> f64 {
 /// The value an objective minimises for a tool whose episode succeeded (∫F dt, ∫J dt, or
 /// −ln|Π^U|); `None` for a failed episode.
 pub fn score(objective: Objective, r: &RankedTool) -> Option<f64> {
-    let m = r.episode.as_ref().ok()?;
-    Some(match objective {
+    r.episode
+        .as_ref()
+        .ok()
+        .map(|m| objective_value(objective, m))
+}
+
+/// What `objective` minimises in an episode's metrics: ∫F dt, ∫J dt, or −ln|Π^U|.
+pub fn objective_value(objective: Objective, m: &Metrics) -> f64 {
+    match objective {
         Objective::FreeEnergy => m.free_energy,
         Objective::CostJ => m.cost_j,
         Objective::Confidence => -m.logdet,
-    })
+    }
 }
 
 /// Indices into `results` from best to worst by `objective`: ties keep file order, and tools
 /// whose episode failed come last, in file order.
 pub fn ranking(results: &[RankedTool], objective: Objective) -> Vec<usize> {
-    let mut order: Vec<usize> = (0..results.len()).collect();
+    let scored: Vec<(Option<f64>, usize)> = results
+        .iter()
+        .map(|r| (score(objective, r), r.row.row))
+        .collect();
+    order_by_score(&scored)
+}
+
+/// [`ranking`]'s order over `(score, row)` pairs, for tools held in another form (the Python
+/// package's, gathered from Dask workers): the smaller score first, ties by row, tools without a
+/// score (failed) last in row order.
+pub fn order_by_score(scored: &[(Option<f64>, usize)]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..scored.len()).collect();
     order.sort_by(|&a, &b| {
-        match (score(objective, &results[a]), score(objective, &results[b])) {
+        let ((sa, ra), (sb, rb)) = (scored[a], scored[b]);
+        match (sa, sb) {
             (Some(x), Some(y)) => x.total_cmp(&y),
             (Some(_), None) => Ordering::Less,
             (None, Some(_)) => Ordering::Greater,
             (None, None) => Ordering::Equal,
         }
-        .then(results[a].row.row.cmp(&results[b].row.row))
+        .then(ra.cmp(&rb))
     });
     order
 }

@@ -77,6 +77,37 @@ impl Screen {
             self.first_confidence_error
                 .get_or_insert_with(|| e.to_string());
         }
+        self.keep(candidate);
+    }
+
+    /// Takes in what screening another block of the same rows found, as if its rows had been
+    /// pushed here: the kept tools are the most confident of both (ties: the earlier row) and
+    /// the counts add up. Blocks screened apart (toolconf.dask's partitions) are absorbed in
+    /// row order, so that the first reason a tool has no confidence stays the first row's.
+    pub fn absorb(&mut self, block: ScreenedBlock) {
+        self.read += block.read;
+        self.without_confidence += block.without_confidence;
+        if self.first_confidence_error.is_none() {
+            self.first_confidence_error = block.first_confidence_error;
+        }
+        for candidate in block.kept {
+            self.keep(candidate);
+        }
+    }
+
+    /// The kept tools and the counts, for a block screened apart.
+    pub fn into_block(mut self) -> ScreenedBlock {
+        let (read, without_confidence) = (self.read, self.without_confidence);
+        let first_confidence_error = self.first_confidence_error.take();
+        ScreenedBlock {
+            kept: self.finish(),
+            read,
+            without_confidence,
+            first_confidence_error,
+        }
+    }
+
+    fn keep(&mut self, candidate: Candidate) {
         let Some(k) = self.limit else {
             self.all.push(candidate);
             return;
@@ -112,6 +143,16 @@ impl Screen {
     }
 }
 
+/// What screening one block of rows found: the tools kept (in row order) and the counts
+/// [`Screen::absorb`] adds up.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScreenedBlock {
+    pub kept: Vec<Candidate>,
+    pub read: usize,
+    pub without_confidence: usize,
+    pub first_confidence_error: Option<String>,
+}
+
 /// Why a tools file gives nothing to simulate.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ScreenError {
@@ -134,13 +175,34 @@ pub fn screen_file(
     task: &str,
     limit: Option<usize>,
     skip_bad_rows: bool,
+    skipping: impl FnMut(&ToolFileError),
+) -> Result<(Screen, usize), ScreenError> {
+    let source = path.display().to_string();
+    let read = |each: &mut EachRow| read_tools(path, each);
+    let (screen, skipped) = screen_rows(&source, read, tasks, limit, skip_bad_rows, skipping)?;
+    check_screened(&screen, skipped, &source, task)?;
+    Ok((screen, skipped))
+}
+
+/// Where a reader of tools hands each row ([`read_tools`]'s and
+/// [`read_columns`](crate::tools_file::read_columns)'s callback); an `Err` it returns stops the
+/// read.
+pub type EachRow<'a> = dyn FnMut(Result<ToolRow, ToolFileError>) -> Result<(), ToolFileError> + 'a;
+
+/// [`screen_file`] over the rows `read` gives (`tools_file` names them in errors), without the
+/// checks of the whole input ([`check_screened`]): what one block of a larger table runs.
+pub fn screen_rows(
+    tools_file: &str,
+    read: impl FnOnce(&mut EachRow) -> Result<usize, ToolFileError>,
+    tasks: &ModelTasks,
+    limit: Option<usize>,
+    skip_bad_rows: bool,
     mut skipping: impl FnMut(&ToolFileError),
 ) -> Result<(Screen, usize), ScreenError> {
     let mut screen = Screen::new(limit);
     let mut skipped = 0;
     let mut misfit = None;
-    let tools_file = path.display().to_string();
-    let read = read_tools(path, |row| match row {
+    let read = read(&mut |row| match row {
         Ok(row) => {
             if let Err(e) = tasks.check(row.tool.model()) {
                 misfit = Some(format!(
@@ -149,7 +211,7 @@ pub fn screen_file(
                     row.tool.model()
                 ));
                 return Err(ToolFileError {
-                    file: tools_file.clone(),
+                    file: tools_file.into(),
                     place: String::new(),
                     message: "stopped".into(),
                     row_level: false,
@@ -170,19 +232,30 @@ pub fn screen_file(
         return Err(ScreenError::Input(message));
     }
     read?;
+    Ok((screen, skipped))
+}
+
+/// The whole input's checks after the cheap stage: some row was valid (`skipped` rows were
+/// not), and some tool has a control confidence (else the task's precisions are at fault).
+pub fn check_screened(
+    screen: &Screen,
+    skipped: usize,
+    source: &str,
+    task: &str,
+) -> Result<(), ScreenError> {
     if screen.read == 0 {
         return Err(ScreenError::Input(format!(
-            "{tools_file}: no valid tools (all {skipped} rows were bad)"
+            "{source}: no valid tools (all {skipped} rows were bad)"
         )));
     }
     if screen.without_confidence == screen.read {
         // The task's precisions, not the tools, are at fault: say so before simulating.
         return Err(ScreenError::Input(format!(
-            "task {task}: no tool of {tools_file} has a control confidence: {}",
+            "task {task}: no tool of {source} has a control confidence: {}",
             screen.first_confidence_error.as_deref().unwrap_or("")
         )));
     }
-    Ok((screen, skipped))
+    Ok(())
 }
 
 #[cfg(test)]
@@ -225,5 +298,35 @@ pub(super) mod tests {
             screen.push(candidate(row, Ok(l)));
         }
         assert_eq!(screen.finish()[0].row.row, 1);
+    }
+
+    #[test]
+    fn blocks_screened_apart_and_absorbed_in_order_keep_what_one_screen_keeps() {
+        let bad = || Err(Error::Unsupported("no confidence".into()));
+        let logdets = [
+            Ok(2.0),
+            bad(),
+            Ok(3.0),
+            Ok(3.0),
+            Ok(1.0),
+            Ok(3.0),
+            bad(),
+            Ok(2.0),
+        ];
+        for limit in [Some(1), Some(3), Some(20), None] {
+            let mut whole = Screen::new(limit);
+            for (i, l) in logdets.iter().enumerate() {
+                whole.push(candidate(i + 1, l.clone()));
+            }
+            let mut merged = Screen::new(limit);
+            for block in [0..3, 3..3, 3..7, 7..8] {
+                let mut part = Screen::new(limit);
+                for i in block {
+                    part.push(candidate(i + 1, logdets[i].clone()));
+                }
+                merged.absorb(part.into_block());
+            }
+            assert_eq!(merged.into_block(), whole.into_block(), "{limit:?}");
+        }
     }
 }

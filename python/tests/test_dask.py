@@ -1,0 +1,196 @@
+"""toolconf.dask on a 2-worker LocalCluster against toolconf on the concatenated rows: the same
+table row for row and digit for digit (global row numbers, ties across partitions broken by
+global row order), the same first error in row order, the same warnings; simulate_batch the
+same entry for entry."""
+
+import warnings
+
+import numpy as np
+import pandas as pd
+import pytest
+from dask import delayed
+
+import dask.array as da
+import dask.dataframe as dd
+
+import toolconf
+import toolconf.dask as tdask
+
+GIANT = [1e5, 1e5, 1e5, 1e5]
+
+
+def tools(n=90, seed=3):
+    """Random arm2 tools with three copies of one tool spread over the frame (a tie in
+    confidence across partitions), a few arm3 and unnamed tools, and a giant whose episode
+    diverges on the position task."""
+    rng = np.random.default_rng(seed)
+    frame = pd.DataFrame({
+        "name": [f"tool {i}" for i in range(n)],
+        "model": ["arm2"] * n,
+        "m1": 0.1 + 0.5 * rng.random(n), "m2": 0.1 + 0.5 * rng.random(n),
+        "m3": np.nan, "l1": 0.1 + 0.5 * rng.random(n), "l2": 0.1 + 0.5 * rng.random(n),
+        "l3": np.nan,
+    })
+    best = frame.loc[[0]].assign(m1=0.1, m2=0.1, l1=0.12, l2=0.1)
+    for row in (20, 50, 75):
+        frame.loc[row, ["m1", "m2", "l1", "l2"]] = best[["m1", "m2", "l1", "l2"]].values[0]
+    for row in (33, 60):
+        frame.loc[row, ["model", "m3", "l3"]] = ["arm3", 0.2, 0.2]
+    frame.loc[[5, 40], "name"] = None
+    frame.loc[44, ["m1", "m2", "l1", "l2"]] = GIANT
+    return frame
+
+
+def partitioned(frame, cuts):
+    """A dask DataFrame whose partitions are frame[cuts[i]:cuts[i+1]] (an empty one included
+    when two cuts are equal)."""
+    bounds = [0, *cuts, len(frame)]
+    parts = [delayed(frame.iloc[a:b]) for a, b in zip(bounds, bounds[1:])]
+    return dd.from_delayed(parts, meta=frame.iloc[:0], verify_meta=False)
+
+
+CUTS = [15, 30, 30, 52, 70]
+
+
+def test_the_workers_import_the_clients_extension_on_the_loopback(dask_client):
+    here = toolconf._toolconf.__file__
+    there = dask_client.run(lambda: __import__("toolconf")._toolconf.__file__)
+    assert len(there) == 2 and set(there.values()) == {here}
+    assert all(address.startswith("tcp://127.0.0.1:") for address in there)
+
+
+@pytest.mark.parametrize("task, screen, objective", [
+    ("position", None, "free-energy"),
+    ("position", 3, "free-energy"),
+    ("velocity", 7, "cost-j"),
+    ("task file", 25, "confidence"),
+])
+def test_rank_equals_toolconf_rank_on_the_concatenated_rows(task, screen, objective,
+                                                            dask_client, tmp_path):
+    if task == "task file":
+        # Read on the client and sent as text: the workers need not see the file.
+        task = tmp_path / "task.toml"
+        task.write_text('kind = "velocity"\n[precision]\ntheta_dot = 40.0\n[episode]\n'
+                        't_end = 3.0\nperturbation = -0.3\n')
+    frame = tools()
+    ddf = partitioned(frame, CUTS)
+    got = tdask.rank(ddf, task, screen=screen, objective=objective, client=dask_client)
+    expected = toolconf.rank(ddf.compute(), task, screen=screen, objective=objective)
+    pd.testing.assert_frame_equal(got, expected, check_exact=True)
+    if screen == 3:
+        # The giant (row 45) is the most confident, then a tie of three equal tools (rows 21,
+        # 51, 76 in three partitions): the two earlier rows are kept.
+        assert sorted(got["row"]) == [21, 45, 51]
+    if screen is None and task == "position":
+        assert got["name"].iloc[-1] == "tool 44" and "diverged" in got["error"].iloc[-1]
+        assert len(got) == len(frame)
+
+
+def test_episodes_spread_in_small_blocks_give_the_same_table(dask_client):
+    ddf = partitioned(tools(), CUTS)
+    got = tdask.rank(ddf, "velocity", screen=30, client=dask_client, episodes_per_task=4)
+    expected = toolconf.rank(ddf.compute(), "velocity", screen=30)
+    pd.testing.assert_frame_equal(got, expected, check_exact=True)
+
+
+def bad(frame, rows):
+    frame = frame.astype({"m2": object})
+    for row in rows:
+        frame.loc[row, "m2"] = "heavy"
+    return frame
+
+
+def test_the_first_bad_row_in_row_order_raises_toolconfs_error(dask_client):
+    frame = bad(tools(), [58, 35])
+    ddf = partitioned(frame, CUTS)
+    with pytest.raises(ValueError) as expected:
+        toolconf.rank(ddf.compute(), "position", screen=5)
+    assert str(expected.value).startswith("tools DataFrame, row 36: m2 = 'heavy'")
+    with pytest.raises(ValueError) as got:
+        tdask.rank(ddf, "position", screen=5, client=dask_client)
+    assert str(got.value) == str(expected.value)
+
+
+def test_skipped_rows_warn_in_row_order(dask_client):
+    frame = bad(tools(), [58, 3, 35])
+    ddf = partitioned(frame, CUTS)
+    with pytest.warns(UserWarning) as expected_warnings:
+        expected = toolconf.rank(ddf.compute(), "velocity", screen=6, skip_bad_rows=True)
+    with pytest.warns(UserWarning) as got_warnings:
+        got = tdask.rank(ddf, "velocity", screen=6, skip_bad_rows=True, client=dask_client)
+    pd.testing.assert_frame_equal(got, expected, check_exact=True)
+    messages = [str(w.message) for w in got_warnings]
+    assert messages == [str(w.message) for w in expected_warnings]
+    assert [m.split(", ")[1].split(":")[0] for m in messages] == ["row 4", "row 36", "row 59"]
+
+
+@pytest.mark.parametrize("frame, task", [
+    (tools(), {"kind": "position", "goal": {"theta": [0.1, 0.2]}}),
+    (tools().assign(m2="heavy"), "position"),
+    (tools(), {"kind": "position", "precision": {"theta": 0.0, "theta_dot": 0.0,
+                                                  "theta_ddot": 0.0, "u": 0.0}}),
+    (tools().iloc[:0], "position"),
+    (tools().assign(weight=1.0), "position"),
+])
+def test_whole_table_errors_equal_toolconfs(frame, task, dask_client):
+    ddf = partitioned(frame, [0] if len(frame) == 0 else CUTS)
+    with pytest.raises(ValueError) as expected, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        toolconf.rank(ddf.compute(), task, skip_bad_rows=True)
+    with pytest.raises(ValueError) as got, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        tdask.rank(ddf, task, skip_bad_rows=True, client=dask_client)
+    assert str(got.value) == str(expected.value)
+
+
+def test_bad_options_raise_before_the_cluster_works(dask_client):
+    ddf = partitioned(tools(), CUTS)
+    for kwargs in ({"screen": 0}, {"objective": "speed"}, {"method": "rk4"}):
+        with pytest.raises(ValueError) as expected:
+            toolconf.rank(ddf.compute(), "position", **kwargs)
+        with pytest.raises(ValueError) as got:
+            tdask.rank(ddf, "position", client=dask_client, **kwargs)
+        assert str(got.value) == str(expected.value)
+
+
+def arrays_equal(got, expected):
+    assert list(got) == list(expected)
+    for key in expected:
+        if key == "error":
+            assert got[key] == expected[key]
+        else:
+            assert got[key].dtype == expected[key].dtype, key
+            assert np.array_equal(got[key], expected[key], equal_nan=True), key
+
+
+def test_simulate_batch_equals_toolconf_simulate_batch(dask_client):
+    rng = np.random.default_rng(8)
+    params = np.vstack([0.1 + 0.5 * rng.random((10, 4)), GIANT, 0.1 + 0.5 * rng.random((6, 4))])
+    perturbations = [-0.8, 0.0, [0.5, -0.5]]
+    expected = toolconf.simulate_batch("arm2", params, "position", perturbations, t_end=3.0)
+    assert expected["error"][30] is not None
+    got = tdask.simulate_batch("arm2", params, "position", perturbations, client=dask_client,
+                               tools_per_task=3, t_end=3.0)
+    arrays_equal(got, expected)
+    chunked = da.from_array(params, chunks=(5, 2))
+    arrays_equal(tdask.simulate_batch("arm2", chunked, "position", perturbations,
+                                      client=dask_client, t_end=3.0), expected)
+    task = {"kind": "velocity", "goal": {"theta_dot": [0.2, -0.1]}}
+    arrays_equal(tdask.simulate_batch("arm2", params, task, client=dask_client),
+                 toolconf.simulate_batch("arm2", params, task))
+
+
+def test_simulate_batch_errors_equal_toolconfs(dask_client):
+    params = np.full((9, 4), 0.3)
+    params[7, 2] = -1.0
+    for args, kwargs in [((params, "position"), {}),
+                         ((np.ones((9, 5)), "position"), {}),
+                         ((params[:6], "position"), {"t_end": -1.0}),
+                         ((params[:6], "reach"), {})]:
+        with pytest.raises(ValueError) as expected:
+            toolconf.simulate_batch("arm2", *args, **kwargs)
+        with pytest.raises(ValueError) as got:
+            tdask.simulate_batch("arm2", *args, client=dask_client, tools_per_task=2, **kwargs)
+        assert str(got.value) == str(expected.value)
+    empty = tdask.simulate_batch("arm2", np.empty((0, 4)), "position", client=dask_client)
+    arrays_equal(empty, toolconf.simulate_batch("arm2", np.empty((0, 4)), "position"))
