@@ -9,7 +9,8 @@ use serde::Serialize;
 use crate::generated::arm2;
 use crate::{Error, InputMatrix, State, StateMatrix, Vector2};
 
-/// One tool: link masses m1, m2 (kg) and lengths l1, l2 (m), all finite and > 0.
+/// One tool: link masses m1, m2 (kg) and lengths l1, l2 (m), each in
+/// [`crate::validate::TOOL_PARAMETER`].
 ///
 /// The fields are private so that every `Arm` in existence has passed [`Arm::new`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -21,11 +22,11 @@ pub struct Arm {
 }
 
 impl Arm {
-    /// Validates and builds an arm. Non-positive, NaN or infinite values are an
+    /// Validates and builds an arm. A value outside [`crate::validate::TOOL_PARAMETER`] is an
     /// [`Error::InvalidParameter`] naming the parameter.
     pub fn new(m1: f64, m2: f64, l1: f64, l2: f64) -> Result<Self, Error> {
         for (name, value) in arm2::PARAMETER_NAMES.into_iter().zip([m1, m2, l1, l2]) {
-            if !(value.is_finite() && value > 0.0) {
+            if !crate::validate::TOOL_PARAMETER.contains(value) {
                 return Err(Error::InvalidParameter { name, value });
             }
         }
@@ -73,10 +74,14 @@ impl Arm {
 
 impl fmt::Display for Arm {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        use crate::display::Short;
         write!(
             f,
             "m1={} m2={} l1={} l2={}",
-            self.m1, self.m2, self.l1, self.l2
+            Short(self.m1),
+            Short(self.m2),
+            Short(self.l1),
+            Short(self.l2)
         )
     }
 }
@@ -87,15 +92,16 @@ impl FromStr for Arm {
 
     fn from_str(text: &str) -> Result<Self, Error> {
         let syntax = |reason: String| Error::ArmSyntax {
-            text: text.to_string(),
+            text: crate::display::Clip(text).to_string(),
             reason,
         };
         let values: Vec<f64> = text
             .split(',')
             .map(|v| {
-                v.trim()
-                    .parse::<f64>()
-                    .map_err(|e| syntax(format!("'{}' is not a number ({e})", v.trim())))
+                v.trim().parse::<f64>().map_err(|e| {
+                    let v = crate::display::Clip(v.trim());
+                    syntax(format!("'{v}' is not a number ({e})"))
+                })
             })
             .collect::<Result<_, _>>()?;
         match values[..] {

@@ -11,9 +11,11 @@
 //! Flow: model description → derivation → JSON IR → templates → generated code → this runtime.
 
 pub mod arm;
+pub mod bounded_read;
 pub mod closed_loop;
 pub mod confidence;
 pub mod design;
+pub mod display;
 pub mod error;
 pub mod experiments;
 /// The code `make derive` writes into `generated/`, included unchanged: one module per model
@@ -25,13 +27,16 @@ pub mod generated;
 pub mod integrate;
 pub mod model;
 pub mod mpc;
+pub mod output_file;
 pub mod rank;
 pub mod select;
 pub mod stats;
 pub mod task;
 pub mod task_file;
+pub mod threads;
 pub mod tools_file;
 pub mod trig;
+pub mod validate;
 
 pub use arm::Arm;
 pub use confidence::{control_confidence, sensitivities, ControlConfidence, Sensitivities};

@@ -17,9 +17,12 @@ use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
 
-use serde::de::{Error as _, SeqAccess, Visitor};
-use serde_json::{Map, Value};
+use serde::de::{Error as _, MapAccess, SeqAccess, Visitor};
+use serde::{Deserialize, Deserializer};
+use serde_json::Value;
 
+use crate::bounded_read::{record_error, CsvRows, JsonElements, RecordLimit};
+use crate::display::{Clip, Short};
 use crate::model::mixed::{AnyTool, ModelKind};
 
 /// One tool read from a file.
@@ -35,8 +38,8 @@ impl ToolRow {
     /// The name, or `row N` when the file gives none.
     pub fn label(&self) -> String {
         self.name
-            .clone()
-            .unwrap_or_else(|| format!("row {}", self.row))
+            .as_deref()
+            .map_or_else(|| format!("row {}", self.row), |n| Clip(n).to_string())
     }
 }
 
@@ -75,11 +78,15 @@ pub fn read_tools(
         row_level: false,
     };
     let file = File::open(path).map_err(|e| fatal(format!("cannot open the tools file: {e}")))?;
+    if file.metadata().is_ok_and(|m| m.is_dir()) {
+        return Err(fatal("is a folder, not a tools file".into()));
+    }
     let is_json = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"));
     let rows = if is_json {
-        read_json(BufReader::new(file), &file_name, &mut each)?
+        let bounded = RecordLimit::new(BufReader::new(file), JsonElements::default());
+        read_json(bounded, &file_name, &mut each)?
     } else {
         read_csv(file, &file_name, &mut each)?
     };
@@ -100,12 +107,16 @@ fn read_csv(
         message,
         row_level,
     };
+    let bounded = RecordLimit::new(BufReader::new(file), CsvRows::default());
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
-        .from_reader(BufReader::new(file));
+        .from_reader(bounded);
     let header: Vec<String> = reader
         .headers()
-        .map_err(|e| error("line 1".into(), e.to_string(), false))?
+        .map_err(|e| {
+            let (line, message) = csv_error(&e);
+            error(format!("line {}", line.unwrap_or(1)), message, false)
+        })?
         .iter()
         .map(str::to_string)
         .collect();
@@ -116,7 +127,7 @@ fn read_csv(
             false,
         ));
     }
-    check_keys(header.iter().map(String::as_str))
+    check_keys(header.iter().map(String::as_str), "column")
         .map_err(|m| error("line 1 (header)".into(), m, false))?;
     let present = present_keys(|k| header.iter().any(|h| h == k));
     let mut record = csv::StringRecord::new();
@@ -140,15 +151,9 @@ fn read_csv(
             }
             Err(e) => {
                 rows += 1;
-                let line = e.position().map_or(0, |p| p.line());
-                let message = match e.kind() {
-                    csv::ErrorKind::UnequalLengths {
-                        expected_len, len, ..
-                    } => format!("the row has {len} cells, the header {expected_len}"),
-                    _ => e.to_string(),
-                };
+                let (line, message) = csv_error(&e);
                 let row_level = matches!(e.kind(), csv::ErrorKind::UnequalLengths { .. });
-                let e = error(format!("line {line}"), message, row_level);
+                let e = error(format!("line {}", line.unwrap_or(0)), message, row_level);
                 if !row_level {
                     return Err(e);
                 }
@@ -157,6 +162,25 @@ fn read_csv(
         }
     }
     Ok(rows)
+}
+
+/// A CSV error's line and message: a row too long or a quote never closed as the bounded
+/// reader says ([`crate::bounded_read`]), a row of the wrong length in cells, else the `csv`
+/// crate's words.
+fn csv_error(e: &csv::Error) -> (Option<u64>, String) {
+    match e.kind() {
+        csv::ErrorKind::Io(io) => match record_error(io) {
+            Some((line, message)) => (Some(line), message),
+            None => (None, format!("cannot read the tools file: {io}")),
+        },
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => (
+            e.position().map(|p| p.line()),
+            format!("the row has {len} cells, the header {expected_len}"),
+        ),
+        _ => (e.position().map(|p| p.line()), e.to_string()),
+    }
 }
 
 /// Keys a row may have: `name`, `model`, and every model's parameter names.
@@ -205,14 +229,19 @@ fn present_keys(has: impl Fn(&str) -> bool) -> Vec<&'static str> {
         .collect()
 }
 
-fn check_keys<'a>(keys: impl Iterator<Item = &'a str>) -> Result<(), String> {
+/// Every key known and none twice; `noun` is "column" (CSV) or "key" (JSON).
+fn check_keys<'a>(keys: impl Iterator<Item = &'a str>, noun: &str) -> Result<(), String> {
     let mut seen = Vec::new();
     for key in keys {
         if !known_key(key) {
-            return Err(format!("unknown column '{key}' (known: {})", known_keys()));
+            return Err(format!(
+                "unknown {noun} '{}' (known: {})",
+                Clip(key),
+                known_keys()
+            ));
         }
         if seen.contains(&key) {
-            return Err(format!("column '{key}' appears twice"));
+            return Err(format!("{noun} '{key}' appears twice"));
         }
         seen.push(key);
     }
@@ -234,18 +263,24 @@ fn build_row<'a>(
         Cell::Absent => None,
         Cell::Text(t) => Some(t.to_string()),
         Cell::Number(x) => Some(x.to_string()),
-        Cell::Other(v) => return Err(format!("name = {v} is not text")),
+        Cell::Other(v) => return Err(format!("name = {} is not text", Clip(&v))),
     };
     // Built only for an error: most rows have none.
     let who = || {
         name.as_ref()
-            .map_or(String::new(), |n| format!(" (tool '{n}')"))
+            .map_or(String::new(), |n| format!(" (tool '{}')", Clip(n)))
     };
     let model = match cell("model") {
         Cell::Absent => ModelKind::Arm2,
         Cell::Text(t) => t.parse().map_err(|e: String| format!("{e}{}", who()))?,
-        Cell::Number(x) => return Err(format!("model = {x} is not a model name{}", who())),
-        Cell::Other(v) => return Err(format!("model = {v} is not a model name{}", who())),
+        Cell::Number(x) => {
+            let x = Short(x);
+            return Err(format!("model = {x} is not a model name{}", who()));
+        }
+        Cell::Other(v) => {
+            let v = Clip(&v);
+            return Err(format!("model = {v} is not a model name{}", who()));
+        }
     };
     let names = model.parameter_names();
     let mut params = Vec::with_capacity(names.len());
@@ -260,14 +295,11 @@ fn build_row<'a>(
             Cell::Number(x) => x,
             Cell::Text(t) => t
                 .parse::<f64>()
-                .map_err(|_| format!("{key} = '{t}' is not a number{}", who()))?,
-            Cell::Other(v) => return Err(format!("{key} = {v} is not a number{}", who())),
+                .map_err(|_| format!("{key} = '{}' is not a number{}", Clip(t), who()))?,
+            Cell::Other(v) => return Err(format!("{key} = {} is not a number{}", Clip(&v), who())),
         };
-        if !(value.is_finite() && value > 0.0) {
-            return Err(format!(
-                "{key} = {value} must be a finite number > 0{}",
-                who()
-            ));
+        if let Err(why) = crate::validate::TOOL_PARAMETER.check(value) {
+            return Err(format!("{key} = {why}{}", who()));
         }
         params.push(value);
     }
@@ -303,12 +335,12 @@ where
     }
 
     fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<(), A::Error> {
-        while let Some(object) = seq.next_element::<Map<String, Value>>()? {
+        while let Some(Entries(object)) = seq.next_element::<Entries>()? {
             self.rows += 1;
             let row = self.rows;
-            let result = check_keys(object.keys().map(String::as_str))
+            let result = check_keys(object.iter().map(|(k, _)| k.as_str()), "key")
                 .and_then(|()| {
-                    let present = present_keys(|k| object.contains_key(k));
+                    let present = present_keys(|k| object.iter().any(|(key, _)| key == k));
                     build_row(row, &|key| json_cell(&object, key), &present)
                 })
                 .map_err(|message| ToolFileError {
@@ -326,8 +358,33 @@ where
     }
 }
 
-fn json_cell<'a>(object: &'a Map<String, Value>, key: &str) -> Cell<'a> {
-    match object.get(key) {
+/// One tool's object with its keys as written, a key given twice twice (a `Map` would keep the
+/// last silently, where the CSV reader refuses a column given twice).
+struct Entries(Vec<(String, Value)>);
+
+impl<'de> Deserialize<'de> for Entries {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Object;
+        impl<'de> Visitor<'de> for Object {
+            type Value = Entries;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a tool (an object)")
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Entries, A::Error> {
+                let mut entries = Vec::new();
+                while let Some(entry) = map.next_entry::<String, Value>()? {
+                    entries.push(entry);
+                }
+                Ok(Entries(entries))
+            }
+        }
+        d.deserialize_map(Object)
+    }
+}
+
+fn json_cell<'a>(object: &'a [(String, Value)], key: &str) -> Cell<'a> {
+    let value = object.iter().find(|(k, _)| k == key).map(|(_, v)| v);
+    match value {
         None | Some(Value::Null) => Cell::Absent,
         Some(Value::String(s)) if s.is_empty() => Cell::Absent,
         Some(Value::String(s)) => Cell::Text(s),
@@ -353,11 +410,23 @@ fn read_json<R: std::io::Read>(
     if let Some(e) = elements.stopped {
         return Err(e);
     }
-    parsed.map_err(|e| ToolFileError {
-        file: file_name.into(),
-        place: format!("line {}", e.line()),
-        message: format!("not a JSON array of tools: {e}"),
-        row_level: false,
+    parsed.map_err(|e| {
+        let (line, message) = if e.is_io() {
+            let io = std::io::Error::from(e);
+            match record_error(&io) {
+                Some((line, message)) => (line as usize, message),
+                None => (0, format!("cannot read the tools file: {io}")),
+            }
+        } else {
+            let message = format!("not a JSON array of tools: {}", Clip(&e.to_string()));
+            (e.line(), message)
+        };
+        ToolFileError {
+            file: file_name.into(),
+            place: format!("line {line}"),
+            message,
+            row_level: false,
+        }
     })?;
     Ok(elements.rows)
 }

@@ -223,7 +223,7 @@ fn simulate_and_select_reject_bad_input() {
                 "--perturb",
                 "nan",
             ],
-            "perturbation",
+            "--perturb: NaN must be a number in [-1e6, 1e6] N m",
         ),
         (
             vec![

@@ -7,6 +7,8 @@ use std::path::{Path, PathBuf};
 
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use toolconf::bounded_read::read_text_file;
+use toolconf::display::Clip;
 use toolconf::task_file::TaskSpec;
 use toolconf::TaskKind;
 
@@ -62,10 +64,10 @@ fn named(name: &Path, episode: Option<toml::Table>) -> Result<TaskSpec, Failure>
         }
         return Ok(spec);
     }
-    if !name.is_file() {
+    if std::fs::metadata(name).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound) {
         return Err(Failure::Input(format!(
             "task '{}': neither a built-in task ({}) nor an existing task file",
-            name.display(),
+            Clip(&name.display().to_string()),
             toolconf::task::task_choices()
         )));
     }
@@ -74,7 +76,8 @@ fn named(name: &Path, episode: Option<toml::Table>) -> Result<TaskSpec, Failure>
         return Ok(spec);
     };
     // The file parsed, so it is a table; read it again as one to put the options over it.
-    let text = std::fs::read_to_string(name).map_err(Failure::input)?;
+    let text = read_text_file(name, "task file")
+        .map_err(|m| Failure::Input(format!("{}: {m}", spec.file)))?;
     let mut t: toml::Table = toml::from_str(&text).map_err(Failure::input)?;
     merge_episode(&mut t, e);
     TaskSpec::from_table(t, &spec.file).map_err(Failure::input)

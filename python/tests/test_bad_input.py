@@ -103,7 +103,7 @@ def test_a_dict_of_the_wrong_shape_names_the_key(task, message):
 def test_unknown_or_bad_episode_options_name_the_key():
     with pytest.raises(ValueError, match="key episode: unknown field `t_ned`"):
         toolconf.simulate("arm2", PAPER_ARM, "position", t_ned=3.0)
-    with pytest.raises(ValueError, match=r"key episode.dt: 10 is larger than t_end = 5"):
+    with pytest.raises(ValueError, match=r"key episode.dt: the output step dt = 10 s is larger than t_end = 5 s"):
         toolconf.simulate("arm2", PAPER_ARM, "position", dt=10.0)
     with pytest.raises(ValueError, match=r"key episode.t_end: episode too long"):
         toolconf.simulate("arm2", PAPER_ARM, "position", t_end=1e9)

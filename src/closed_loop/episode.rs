@@ -69,7 +69,7 @@ pub enum SimulationError {
     Input(#[from] Error),
     #[error("simulation of arm {arm} failed: {source}")]
     Integration { arm: Arm, source: IntegrationError },
-    #[error("simulation of arm {arm} diverged at t = {t} s: |state| = {magnitude:e} exceeds {DIVERGENCE_BOUND:e}")]
+    #[error("simulation of arm {arm} diverged at t = {} s: |state| = {magnitude:e} exceeds {DIVERGENCE_BOUND:e}", crate::display::Short(*t))]
     Diverged { arm: Arm, t: f64, magnitude: f64 },
 }
 

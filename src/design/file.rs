@@ -25,6 +25,7 @@ use serde::Deserialize;
 
 use super::constraint::{parse_constraint, LinearConstraint};
 use super::DesignError;
+use crate::display::{Clip, ShortList};
 
 /// What the design optimises.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -108,9 +109,8 @@ impl DesignSpec {
     /// Reads and checks a design file for a model with parameters `names`.
     pub fn from_file(path: &Path, names: &[&'static str]) -> Result<Self, DesignError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| {
-            DesignError::input(&file, "", format!("cannot read the design file: {e}"))
-        })?;
+        let text = crate::bounded_read::read_text_file(path, "design file")
+            .map_err(|message| DesignError::input(&file, "", message))?;
         Self::parse(&text, &file, names)
     }
 
@@ -129,16 +129,20 @@ impl DesignSpec {
             Some(other) => {
                 return Err(err(
                     "objective",
-                    format!("'{other}' is not an objective (confidence or free_energy)"),
+                    format!(
+                        "'{}' is not an objective (confidence or free_energy)",
+                        Clip(other)
+                    ),
                 ))
             }
         };
         let known = |key: String, name: &str| -> Result<usize, DesignError> {
             names.iter().position(|n| *n == name).ok_or_else(|| {
                 err(
-                    &key,
+                    &Clip(&key).to_string(),
                     format!(
-                        "unknown parameter '{name}' (parameters: {})",
+                        "unknown parameter '{}' (parameters: {})",
+                        Clip(name),
                         names.join(", ")
                     ),
                 )
@@ -147,11 +151,8 @@ impl DesignSpec {
         let mut fixed = vec![None; names.len()];
         for (name, &value) in &raw.fixed {
             let k = known(format!("fixed.{name}"), name)?;
-            if !(value.is_finite() && value > 0.0) {
-                return Err(err(
-                    &format!("fixed.{name}"),
-                    format!("{value} is not a positive number"),
-                ));
+            if let Err(why) = crate::validate::TOOL_PARAMETER.check(value) {
+                return Err(err(&format!("fixed.{name}"), why));
             }
             fixed[k] = Some(value);
         }
@@ -186,7 +187,7 @@ impl DesignSpec {
             .enumerate()
             .map(|(i, c)| {
                 parse_constraint(c, names)
-                    .map_err(|m| err(&format!("constraints[{i}]"), format!("'{c}': {m}")))
+                    .map_err(|m| err(&format!("constraints[{i}]"), format!("'{}': {m}", Clip(c))))
             })
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
@@ -202,20 +203,25 @@ impl DesignSpec {
     }
 }
 
+/// `[lo, hi]` within [`crate::validate::TOOL_PARAMETER`], lo ≤ hi.
 fn check_bounds(range: &[f64]) -> Result<(f64, f64), String> {
     let &[lo, hi] = range else {
-        return Err(format!("{range:?} is not [lo, hi]"));
+        return Err(format!("{} is not [lo, hi]", ShortList(range)));
     };
-    if !(lo.is_finite() && hi.is_finite()) {
-        return Err(format!("[{lo}, {hi}] is not finite"));
-    }
+    let valid = crate::validate::TOOL_PARAMETER;
+    let shown = ShortList(range);
     if lo <= 0.0 {
         return Err(format!(
-            "[{lo}, {hi}] admits values <= 0; masses and lengths must be > 0 (give lo > 0)"
+            "{shown} admits values <= 0; masses and lengths must be > 0 (give lo > 0)"
+        ));
+    }
+    if !(valid.contains(lo) && valid.contains(hi)) {
+        return Err(format!(
+            "{shown} goes outside {valid}, where every tool parameter must lie"
         ));
     }
     if lo > hi {
-        return Err(format!("[{lo}, {hi}] is empty (lo > hi)"));
+        return Err(format!("{shown} is empty (lo > hi)"));
     }
     Ok((lo, hi))
 }
@@ -238,8 +244,8 @@ fn search_settings(raw: &RawSearch) -> Result<SearchSettings, (&'static str, Str
     if s.simulate > 1000 {
         return Err(("simulate", format!("{} is more than 1000", s.simulate)));
     }
-    if !s.perturbation.is_finite() {
-        return Err(("perturbation", format!("{} is not finite", s.perturbation)));
-    }
+    crate::validate::TORQUE
+        .check(s.perturbation)
+        .map_err(|m| ("perturbation", m))?;
     Ok(s)
 }

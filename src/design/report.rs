@@ -37,7 +37,7 @@ pub fn parameters_text(names: &[&str], params: &[f64]) -> String {
 
 /// Writes the report into `dir` (created if needed); returns the files written.
 pub fn write_report(dir: &Path, input: &ReportInput) -> Result<Vec<PathBuf>, ReproduceError> {
-    std::fs::create_dir_all(dir).map_err(ReproduceError::io(dir))?;
+    crate::output_file::create_folder(dir).map_err(ReproduceError::io(dir))?;
     let r = input.result;
     let mut doc = vec![
         Block::Heading(1, format!("Tool design for the {} task ({})", input.task, input.model)),

@@ -39,8 +39,22 @@ pub struct RandomTools {
     pub top: Vec<(Vec<f64>, f64)>,
 }
 
-/// Draws up to `n` feasible tools (rejection from the box, at most 1000·n draws) and keeps the
-/// `keep` most confident. Sequential and seeded: the same tools on every machine.
+/// The most draws from the box the random comparison makes (about 2 s): a thin feasible set
+/// with `samples = 10⁷` stops there, with the tools found, instead of drawing for minutes.
+pub const MAX_DRAWS: u64 = 100_000_000;
+
+/// How far the random comparison has got, as [`random_tools`] reports it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sampling {
+    pub feasible: usize,
+    pub requested: usize,
+    pub drawn: u64,
+    pub max_draws: u64,
+}
+
+/// Draws up to `n` feasible tools (rejection from the box, at most 1000·n and [`MAX_DRAWS`]
+/// draws) and keeps the `keep` most confident, telling `progress` every 2¹⁶ draws. Sequential
+/// and seeded: the same tools on every machine.
 pub fn random_tools(
     polytope: &Polytope,
     model: ModelKind,
@@ -48,14 +62,27 @@ pub fn random_tools(
     n: usize,
     keep: usize,
     seed: u64,
+    progress: &mut dyn FnMut(&Sampling),
 ) -> RandomTools {
     let mut sampler = FeasibleSampler::new(polytope, seed);
-    let max_draws = 1000 * n.max(1) as u64;
+    let max_draws = (1000 * n.max(1) as u64).min(MAX_DRAWS);
     let mut top: Vec<(Vec<f64>, f64)> = Vec::with_capacity(keep + 1);
     let mut feasible = 0;
+    let mut next_report = 0;
     while feasible < n {
-        let Some(x) = sampler.next_point(max_draws) else {
-            break;
+        let batch_end = (next_report + (1 << 16)).min(max_draws);
+        let Some(x) = sampler.next_point(batch_end) else {
+            if sampler.drawn >= max_draws {
+                break;
+            }
+            next_report = sampler.drawn;
+            progress(&Sampling {
+                feasible,
+                requested: n,
+                drawn: sampler.drawn,
+                max_draws,
+            });
+            continue;
         };
         feasible += 1;
         let Ok(tool) = AnyTool::new(model, &polytope.full(&x)) else {

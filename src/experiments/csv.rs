@@ -107,7 +107,7 @@ pub struct CsvWriter {
 impl CsvWriter {
     /// Creates (truncates) `path` and writes the header.
     pub fn create(path: &Path, header: &[&str]) -> Result<Self, ReproduceError> {
-        let file = File::create(path).map_err(ReproduceError::io(path))?;
+        let file = crate::output_file::create_streaming(path).map_err(ReproduceError::io(path))?;
         let mut writer = Self {
             file,
             path: path.to_path_buf(),

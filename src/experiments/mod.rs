@@ -17,7 +17,7 @@
 //! ([`batch::map_ordered`]) and each chunk's rows are appended in input order, one `write_all`
 //! per row ([`csv::CsvWriter`]). The files are therefore byte-identical whatever the thread count,
 //! and an interrupted run leaves complete rows. Figures and the report are written whole
-//! (`X.partial`, then renamed).
+//! (`.X.*.partial`, then renamed: [`crate::output_file`]).
 //!
 //! # Extending
 //!
@@ -312,7 +312,7 @@ pub fn reproduce(config: &Config) -> Result<Summary, ReproduceError> {
         }
     };
     let out = config.out_dir.as_path();
-    std::fs::create_dir_all(out).map_err(ReproduceError::io(out))?;
+    crate::output_file::create_folder(out).map_err(ReproduceError::io(out))?;
     let report_md = out.join("report.md");
     let report_html = out.join("report.html");
     // A report left from an older run would describe other data than an interrupted run leaves.
@@ -399,13 +399,10 @@ fn progress_bar(visible: bool, total: u64) -> ProgressBar {
     bar
 }
 
-/// Writes a whole file or nothing: `X.partial` beside it, renamed into place.
+/// Writes a whole file or nothing, without replacing what is not a regular file
+/// ([`crate::output_file::write_whole`]).
 pub fn write_atomically(path: &Path, contents: &str) -> Result<(), ReproduceError> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".partial");
-    let tmp = PathBuf::from(tmp);
-    std::fs::write(&tmp, contents).map_err(ReproduceError::io(&tmp))?;
-    std::fs::rename(&tmp, path).map_err(ReproduceError::io(path))
+    crate::output_file::write_whole(path, contents.as_bytes()).map_err(ReproduceError::io(path))
 }
 
 #[cfg(test)]

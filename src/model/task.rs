@@ -5,7 +5,7 @@ use std::fmt::Debug;
 use nalgebra::{SMatrix, SVector};
 
 use crate::generated;
-use crate::generated::TaskKind;
+use crate::generated::{TaskKind, Term};
 use crate::Error;
 
 use super::{ArmModel, ValidatedTaskN};
@@ -54,15 +54,18 @@ impl<const N: usize> TaskN<N> {
         M::paper_task(kind)
     }
 
-    /// Checks goals are finite and precisions finite, symmetric and positive semi-definite,
-    /// with the errors [`crate::Task::validate`] gives.
+    /// Checks goals are in [`crate::validate::JOINT_VALUE`] and precisions in
+    /// [`crate::validate::PRECISION_ENTRY`], symmetric and positive semi-definite, and that they
+    /// can make Π^U positive definite at all ([`Error::ConfidenceRank`]), with the errors
+    /// [`crate::Task::validate`] gives.
     pub fn validate(&self) -> Result<(), Error> {
         for (name, goal) in [
             ("theta_g", &self.goal_theta),
             ("theta_dot_g", &self.goal_theta_dot),
             ("theta_ddot_g", &self.goal_theta_ddot),
         ] {
-            if let Some(&value) = goal.iter().find(|v| !v.is_finite()) {
+            let valid = |v: &f64| crate::validate::JOINT_VALUE.contains(*v);
+            if let Some(&value) = goal.iter().find(|v| !valid(v)) {
                 return Err(Error::InvalidGoal {
                     name: name.into(),
                     value,
@@ -77,8 +80,65 @@ impl<const N: usize> TaskN<N> {
         ] {
             check_precision(name, p)?;
         }
+        self.check_confidence_rank()
+    }
+
+    /// Π^U = Σ SᵀPS + P^U over the terms the task uses, and rank(SᵀPS) ≤ rank(P) whatever the
+    /// tool's sensitivities S: if the ranks of those precisions add up to fewer than N, Π^U is
+    /// singular for every tool, and no tool has a control confidence ([`Error::ConfidenceRank`]).
+    fn check_confidence_rank(&self) -> Result<(), Error> {
+        let used = [
+            (Term::Theta, &self.precision_theta),
+            (Term::ThetaDot, &self.precision_theta_dot),
+            (Term::ThetaDdot, &self.precision_theta_ddot),
+            (Term::U, &self.precision_u),
+        ];
+        let rank: usize = used
+            .iter()
+            .filter(|(term, _)| self.kind.uses(*term))
+            .map(|(_, p)| psd_rank(p))
+            .sum();
+        if rank < N {
+            return Err(Error::ConfidenceRank {
+                kind: self.kind,
+                rank,
+                joints: N,
+            });
+        }
         Ok(())
     }
+}
+
+/// The rank of a symmetric positive semi-definite matrix: the pivots of a Cholesky
+/// factorisation with diagonal pivoting above 1e-12 of the largest entry (on the stack: no
+/// allocation).
+fn psd_rank<const N: usize>(p: &SMatrix<f64, N, N>) -> usize {
+    let mut a = *p;
+    let tolerance = 1e-12 * a.amax();
+    let mut rank = 0;
+    let mut remaining: [bool; N] = [true; N];
+    for _ in 0..N {
+        let Some(k) = (0..N)
+            .filter(|&i| remaining[i])
+            .max_by(|&i, &j| a[(i, i)].total_cmp(&a[(j, j)]))
+        else {
+            break;
+        };
+        let pivot = a[(k, k)];
+        if !(pivot > tolerance) {
+            break;
+        }
+        remaining[k] = false;
+        rank += 1;
+        for i in 0..N {
+            for j in 0..N {
+                if remaining[i] && remaining[j] {
+                    a[(i, j)] -= a[(i, k)] * a[(k, j)] / pivot;
+                }
+            }
+        }
+    }
+    rank
 }
 
 /// Finite, symmetric (to 1e-12 relative) and positive semi-definite: the smallest eigenvalue
@@ -88,10 +148,14 @@ fn check_precision<const N: usize>(name: &str, p: &SMatrix<f64, N, N>) -> Result
         name: name.into(),
         reason,
     };
-    if p.iter().any(|v| !v.is_finite()) {
+    if let Some(&v) = p
+        .iter()
+        .find(|v| !crate::validate::PRECISION_ENTRY.contains(**v))
+    {
         return Err(invalid(format!(
-            "has a non-finite entry: {:?}",
-            p.as_slice()
+            "entry {} must be a number in {}",
+            crate::display::Short(v),
+            crate::validate::PRECISION_ENTRY
         )));
     }
     let scale = p.amax();

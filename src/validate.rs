@@ -1,0 +1,182 @@
+//! The valid range of every number a user gives toolconf, in one place: tool parameters, task
+//! precisions and goals, episode and integrator options, MPC options. The command line, the
+//! files it reads and the Python package all check against these constants before any work
+//! starts, so a value refused in one is refused, with the same words, in the others.
+//!
+//! # Why these ranges
+//!
+//! The generated closed forms are rational functions of the tool parameters. With every
+//! parameter in [10⁻ᵏ, 10ᵏ], a term of total degree d (a product like m·l², counted with its
+//! exponents' absolute values: m·l² has degree 3, 1/(m·l²)² degree 6) lies within 10^(±k·d).
+//! `python/tests/test_parameter_range.py` bounds every temporary of every generated function of
+//! every model that way, from the IR (`generated/*.json`), interval arithmetic on log10|value|:
+//! with k = 6 and precisions |P| ≤ 10⁶ the largest magnitude anywhere in A, B, the sensitivities,
+//! Π^U and the dynamics is below 10⁷¹ and the smallest nonzero above 10⁻⁵⁴ (ln|Π^U|'s 2×2
+//! determinant doubles the exponent: 10¹⁴²), and the gradients of ln|Π^U| reach 10²¹⁰ before
+//! their division by |Π^U| (where a tool makes Π^U nearly singular, design's finiteness check
+//! takes over). k = 9 would leave the gradients of arm3 past 10³⁰⁸. Hence [1e-6, 1e6] for every
+//! tool parameter (a micro-gram to a thousand tonnes, a micrometre to a thousand kilometres) and
+//! 1e6 for |P|. States, goals and torques are bounded by the episode's divergence bound (10⁶:
+//! a state beyond it is a diverged simulation, so no start or goal may lie there).
+//! `tests/parameter_range.rs` evaluates every generated function at the corners of that box and
+//! checks that every output is finite.
+
+use core::fmt;
+
+use crate::display::Short;
+
+/// An interval of valid values, `[lo, hi]` or `(lo, hi]`, with the unit named in messages.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Range {
+    pub lo: f64,
+    pub hi: f64,
+    /// `(lo, hi]`: lo itself is not valid (a step or a rate of 0).
+    pub lo_open: bool,
+    pub unit: &'static str,
+}
+
+impl Range {
+    pub const fn closed(lo: f64, hi: f64, unit: &'static str) -> Self {
+        Self {
+            lo,
+            hi,
+            lo_open: false,
+            unit,
+        }
+    }
+
+    pub const fn above(lo: f64, hi: f64, unit: &'static str) -> Self {
+        Self {
+            lo,
+            hi,
+            lo_open: true,
+            unit,
+        }
+    }
+
+    /// Whether `x` is in the range (never NaN).
+    pub fn contains(&self, x: f64) -> bool {
+        let above_lo = if self.lo_open {
+            x > self.lo
+        } else {
+            x >= self.lo
+        };
+        above_lo && x <= self.hi
+    }
+
+    /// `x` if it is in the range, else the reason in words: `0 must be a number in [1e-6, 1e6] s`.
+    pub fn check(&self, x: f64) -> Result<f64, String> {
+        if self.contains(x) {
+            Ok(x)
+        } else {
+            Err(format!("{} must be a number in {self}", Short(x)))
+        }
+    }
+}
+
+/// A range's end: `1e6` rather than `1000000`.
+struct End(f64);
+
+impl fmt::Display for End {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.0.is_finite() && self.0.abs() >= 1e4 {
+            write!(f, "{:e}", self.0)
+        } else {
+            write!(f, "{}", Short(self.0))
+        }
+    }
+}
+
+impl fmt::Display for Range {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let open = if self.lo_open { "(" } else { "[" };
+        write!(f, "{open}{}, {}]", End(self.lo), End(self.hi))?;
+        if !self.unit.is_empty() {
+            write!(f, " {}", self.unit)?;
+        }
+        Ok(())
+    }
+}
+
+/// Every tool parameter, in its SI unit (kg, m, N/m, N s/m): see the module docs.
+pub const TOOL_PARAMETER: Range = Range::closed(1e-6, 1e6, "");
+/// Each entry of a precision matrix (a precision is also symmetric positive semi-definite).
+pub const PRECISION_ENTRY: Range = Range::closed(-1e6, 1e6, "");
+/// The episode's divergence bound: a state past it is a diverged simulation
+/// (`crate::model::runtime::DIVERGENCE_BOUND`).
+pub const STATE_BOUND: f64 = 1e6;
+/// Goals, initial angles and rates (rad, rad/s, rad/s²).
+pub const JOINT_VALUE: Range = Range::closed(-STATE_BOUND, STATE_BOUND, "");
+/// Torques: the initial torque U0 and the perturbation ΔT.
+pub const TORQUE: Range = Range::closed(-STATE_BOUND, STATE_BOUND, "N m");
+/// The controller's learning rate γ.
+pub const LEARNING_RATE: Range = Range::above(0.0, 1e6, "");
+/// The episode's end time.
+pub const T_END: Range = Range::above(0.0, 1e6, "s");
+/// The output step; also at most t_end, and the grid at most
+/// [`crate::model::MAX_GRID_POINTS`] points.
+pub const DT: Range = Range::closed(1e-6, 1e6, "s");
+/// The integrator's relative tolerance: below 1e-12 the error estimate is rounding noise
+/// (ode45 raises anything below 100·ε itself); above 0.1 it no longer controls the error, and
+/// the run ends in "state became non-finite" rather than a result.
+pub const RTOL: Range = Range::closed(1e-12, 0.1, "");
+/// The integrator's absolute tolerance (same reasons; angles are of order 1 rad).
+pub const ATOL: Range = Range::closed(1e-15, 1.0, "");
+/// The MPC's control period.
+pub const MPC_PERIOD: Range = Range::closed(1e-4, 1e3, "s");
+/// The MPC's prediction horizon (also at most `MAX_HORIZON_STEPS` periods).
+pub const MPC_HORIZON: Range = Range::above(0.0, 1e6, "s");
+/// The MPC's torque bound per joint (`inf`: none).
+pub const TORQUE_LIMIT: Range = Range::above(0.0, f64::INFINITY, "N m");
+/// The MPC's disturbance-observer gain.
+pub const OBSERVER_GAIN: Range = Range::above(0.0, 1.0, "");
+/// A coefficient of a design constraint: with parameters in [`TOOL_PARAMETER`], a term stays
+/// within 10¹², which the QP solver handles (rows are also scaled to a largest coefficient of 1).
+pub const CONSTRAINT_COEFFICIENT: Range = Range::closed(-1e6, 1e6, "");
+/// The constant side of a design constraint.
+pub const CONSTRAINT_BOUND: Range = Range::closed(-1e12, 1e12, "");
+
+/// The last line of defence at the output: every value of `quantity` finite, else
+/// [`crate::Error::NonFiniteResult`] naming the tool and the quantity, so that a front end never
+/// prints NaN, inf or (in JSON) null for a number.
+pub fn finite_output(
+    tool: &dyn fmt::Display,
+    quantity: &'static str,
+    values: impl IntoIterator<Item = f64>,
+) -> Result<(), crate::Error> {
+    match values.into_iter().find(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(value) => Err(crate::Error::NonFiniteResult {
+            quantity,
+            tool: tool.to_string(),
+            value,
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges_say_what_is_valid() {
+        assert!(DT.contains(0.05) && !DT.contains(0.0) && !DT.contains(f64::NAN));
+        assert!(!LEARNING_RATE.contains(0.0) && LEARNING_RATE.contains(1e6));
+        assert!(TORQUE_LIMIT.contains(f64::INFINITY) && !TORQUE_LIMIT.contains(0.0));
+        assert_eq!(
+            DT.check(5e-324).unwrap_err(),
+            "5e-324 must be a number in [1e-6, 1e6] s"
+        );
+        assert_eq!(LEARNING_RATE.to_string(), "(0, 1e6]");
+        assert_eq!(
+            RTOL.check(1e10).unwrap_err(),
+            "1e10 must be a number in [1e-12, 0.1]"
+        );
+        let e = finite_output(&"arm2(m1=1)", "ln|Π^U|", [1.0, f64::NAN]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "ln|Π^U| of arm2(m1=1) is NaN, not a finite number: the run cannot report it"
+        );
+        assert!(finite_output(&"t", "A", [1.0, -2.0]).is_ok());
+    }
+}
