@@ -63,6 +63,10 @@ pub enum Error {
         tool: String,
         value: f64,
     },
+    /// Π^U so ill-conditioned for one tool that its determinant has no correct digit in double
+    /// precision ([`crate::model::logdet_of`]).
+    #[error("control confidence Π^U of this tool is too ill-conditioned for ln|Π^U| to be computed (its determinant is {} of the product of its diagonal, below 1e-10): the tool's parameters span too many decades", Short(*ratio))]
+    IllConditioned { ratio: f64 },
     /// A task whose precisions cannot make Π^U = Σ SᵀPS + P^U positive definite for any tool:
     /// rank(SᵀPS) ≤ rank(P), so the ranks of the precisions it uses must add up to the joints.
     #[error("control confidence Π^U = Σ SᵀPS + P^U cannot be positive definite for any tool: the precisions the {kind} task uses ({}) have ranks adding up to {rank}, fewer than the {joints} joints; give them more weight (e.g. precision.u = 1.0)", precision_keys(*kind))]

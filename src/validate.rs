@@ -9,17 +9,21 @@
 //! parameter in [10⁻ᵏ, 10ᵏ], a term of total degree d (a product like m·l², counted with its
 //! exponents' absolute values: m·l² has degree 3, 1/(m·l²)² degree 6) lies within 10^(±k·d).
 //! `python/tests/test_parameter_range.py` bounds every temporary of every generated function of
-//! every model that way, from the IR (`generated/*.json`), interval arithmetic on log10|value|:
-//! with k = 6 and precisions |P| ≤ 10⁶ the largest magnitude anywhere in A, B, the sensitivities,
-//! Π^U and the dynamics is below 10⁷¹ and the smallest nonzero above 10⁻⁵⁴ (ln|Π^U|'s 2×2
-//! determinant doubles the exponent: 10¹⁴²), and the gradients of ln|Π^U| reach 10²¹⁰ before
-//! their division by |Π^U| (where a tool makes Π^U nearly singular, design's finiteness check
-//! takes over). k = 9 would leave the gradients of arm3 past 10³⁰⁸. Hence [1e-6, 1e6] for every
-//! tool parameter (a micro-gram to a thousand tonnes, a micrometre to a thousand kilometres) and
-//! 1e6 for |P|. States, goals and torques are bounded by the episode's divergence bound (10⁶:
-//! a state beyond it is a diverged simulation, so no start or goal may lie there).
-//! `tests/parameter_range.rs` evaluates every generated function at the corners of that box and
-//! checks that every output is finite.
+//! every model that way, from the IR (`generated/*.json`), by interval arithmetic on
+//! log10|value|: with k = 6 and precisions |P| ≤ 10⁶, no value anywhere exceeds 10²¹⁰ (the
+//! gradients of ln|Π^U| of arm3, before their division by det Π^U; A, B, the sensitivities, Π^U
+//! and the dynamics stay below 10⁷⁰) or falls below 10⁻⁵⁴ unless it is 0, and Π^U's entries stay
+//! below 10⁶⁷, so that ln|Π^U|'s determinant cannot overflow either. At k = 9 the bound reaches
+//! 10³⁰³: no margin. Hence [1e-6, 1e6] for every tool parameter (a microgram to a thousand
+//! tonnes, a micrometre to a thousand kilometres) and 1e6 for |P|. States, goals and torques
+//! are bounded by the episode's divergence bound (10⁶: a state beyond it is a diverged
+//! simulation, so no start or goal may lie there). `tests/parameter_range.rs` evaluates every
+//! generated function at the corners of that box and checks that every output is finite.
+//!
+//! Finite is not the same as accurate: a tool whose parameters span many decades (1e-4 and 1e4
+//! in one tool) can make Π^U so ill-conditioned that its determinant has no correct digit.
+//! [`crate::model::logdet_of`] refuses those ([`crate::Error::IllConditioned`]) rather than
+//! report a ln|Π^U| of noise; over [1e-2, 1e2] it never does.
 
 use core::fmt;
 
@@ -135,6 +139,29 @@ pub const OBSERVER_GAIN: Range = Range::above(0.0, 1.0, "");
 pub const CONSTRAINT_COEFFICIENT: Range = Range::closed(-1e6, 1e6, "");
 /// The constant side of a design constraint.
 pub const CONSTRAINT_BOUND: Range = Range::closed(-1e12, 1e12, "");
+
+/// Every documented range by its name (as `toolconf.ranges()` and the README give them).
+pub const RANGES: [(&str, Range); 16] = [
+    ("tool_parameter", TOOL_PARAMETER),
+    ("precision_entry", PRECISION_ENTRY),
+    ("joint_value", JOINT_VALUE),
+    ("torque", TORQUE),
+    ("learning_rate", LEARNING_RATE),
+    ("t_end", T_END),
+    ("dt", DT),
+    ("rtol", RTOL),
+    ("atol", ATOL),
+    ("mpc_period", MPC_PERIOD),
+    ("mpc_horizon", MPC_HORIZON),
+    ("torque_limit", TORQUE_LIMIT),
+    ("observer_gain", OBSERVER_GAIN),
+    ("constraint_coefficient", CONSTRAINT_COEFFICIENT),
+    ("constraint_bound", CONSTRAINT_BOUND),
+    (
+        "grid_points",
+        Range::closed(1.0, crate::model::MAX_GRID_POINTS as f64, ""),
+    ),
+];
 
 /// The last line of defence at the output: every value of `quantity` finite, else
 /// [`crate::Error::NonFiniteResult`] naming the tool and the quantity, so that a front end never

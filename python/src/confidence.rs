@@ -7,6 +7,7 @@ use pyo3::types::{PyDict, PyFloat};
 use rayon::prelude::*;
 use toolconf::model::{ArmModel, SensitivitiesN, ToolN};
 use toolconf::task_file::TaskSpec;
+use toolconf::validate::finite_output;
 use toolconf::Term;
 
 use crate::errors::{detached, Failure};
@@ -42,6 +43,31 @@ struct One<const N: usize, const NX: usize> {
     logdet: f64,
 }
 
+impl<const N: usize, const NX: usize> One<N, NX> {
+    /// The last line of defence before the arrays reach Python: every number finite
+    /// ([`toolconf::validate::finite_output`]).
+    fn check_finite<M, const NP: usize, const NZ: usize>(
+        &self,
+        tool: &ToolN<M, N, NX, NP, NZ>,
+    ) -> Result<(), toolconf::Error>
+    where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
+        let tool = format!("{}({tool})", M::NAME);
+        finite_output(&tool, "A", self.a.iter().copied())?;
+        finite_output(&tool, "B", self.b.iter().copied())?;
+        let s = &self.sensitivities;
+        for m in [s.d_theta_du, s.d_theta_dot_du, s.d_theta_ddot_du]
+            .iter()
+            .flatten()
+        {
+            finite_output(&tool, "a sensitivity", m.iter().copied())?;
+        }
+        finite_output(&tool, "Π^U", self.pi_u.iter().copied())?;
+        finite_output(&tool, "ln|Π^U|", [self.logdet])
+    }
+}
+
 /// Appends `m` to `out` in C order (row by row; nalgebra stores columns).
 fn push_c_order<const R: usize, const C: usize>(out: &mut Vec<f64>, m: &SMatrix<f64, R, C>) {
     out.extend((0..R).flat_map(|i| (0..C).map(move |j| m[(i, j)])));
@@ -67,13 +93,15 @@ where
         .map(|p| {
             let tool = ToolN::<M, N, NX, NP, NZ>::new(p.try_into().expect("NP values"))?;
             let c = task.control_confidence(&tool)?;
-            Ok(One {
+            let one = One {
                 a: tool.state_matrix(),
                 b: tool.input_matrix(),
                 sensitivities: tool.sensitivities(kind),
                 pi_u: c.pi_u,
                 logdet: c.logdet,
-            })
+            };
+            one.check_finite(&tool)?;
+            Ok(one)
         })
         .collect();
     let names = ["d_theta_du", "d_theta_dot_du", "d_theta_ddot_du"];
@@ -91,11 +119,15 @@ where
     for (i, r) in results.into_iter().enumerate() {
         let one = r.map_err(|e| {
             let row = &params[i * NP..(i + 1) * NP];
-            Failure::Input(if k == 1 {
+            let message = if k == 1 {
                 e.to_string()
             } else {
                 format!("tool {i} ({}): {e}", named(M::PARAMETER_NAMES, row))
-            })
+            };
+            match Failure::from_error(e) {
+                Failure::Run(_) => Failure::Run(message),
+                _ => Failure::Input(message),
+            }
         })?;
         push_c_order(&mut out.a, &one.a);
         push_c_order(&mut out.b, &one.b);

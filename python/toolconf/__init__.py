@@ -10,13 +10,14 @@ The runtime is Rust (the ``toolconf`` crate); this package exposes it over NumPy
 * ``rank(tools, task, screen=None, objective="free-energy")``: ``toolconf rank`` as a dict of
   columns (``pandas.DataFrame(toolconf.rank(...))``).
 * ``models()``: the generated models and their parameter names.
+* ``ranges()``: the valid range of every number the package and the command line take.
 
 A task is ``"position"``, ``"velocity"`` or ``"acceleration"`` (the paper's tasks 1-3), a task
-file's path, or a dict with a task file's keys. Bad input raises ``ValueError`` with the
-command line's message; a failed episode raises ``SimulationError`` (``tool``, ``time``,
-``reason``).
+file's path, or a dict with a task file's keys. Bad input (a value outside ``ranges()``
+included) raises ``ValueError`` with the command line's message; a failed episode raises
+``SimulationError`` (``tool``, ``time``, ``reason``).
 """
 
-from ._toolconf import SimulationError, confidence, models, rank, simulate
+from ._toolconf import SimulationError, confidence, models, rank, ranges, simulate
 
-__all__ = ["SimulationError", "confidence", "models", "rank", "simulate"]
+__all__ = ["SimulationError", "confidence", "models", "rank", "ranges", "simulate"]
