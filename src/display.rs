@@ -74,28 +74,46 @@ impl fmt::Display for ShortRows<'_> {
 /// The most characters of a user's text a message repeats.
 pub const CLIP_CHARS: usize = 60;
 
+/// The most characters of another crate's message (toml's, serde_json's) a message repeats:
+/// such a message may itself repeat a user's key or value.
+pub const CLIP_MESSAGE_CHARS: usize = 300;
+
 /// A user's text as a message repeats it: whole if short, else its first [`CLIP_CHARS`]
 /// characters and how long it was (a 10 MB header cell is not echoed), with line breaks and
 /// other control characters shown as `\n`, `\u{0}`, … so that the message stays one line.
 pub struct Clip<'a>(pub &'a str);
 
+/// Another crate's message, clipped as [`Clip`] is but at [`CLIP_MESSAGE_CHARS`].
+pub struct ClipMessage<'a>(pub &'a str);
+
 impl fmt::Display for Clip<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let text = self.0;
-        let mut shown = 0;
-        for c in text.chars() {
-            if shown == CLIP_CHARS {
-                return write!(f, "… ({} characters)", text.chars().count());
-            }
-            if c.is_control() {
-                write!(f, "{}", c.escape_default())?;
-            } else {
-                write!(f, "{c}")?;
-            }
-            shown += 1;
-        }
-        Ok(())
+        clip(f, self.0, CLIP_CHARS)
     }
+}
+
+impl fmt::Display for ClipMessage<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        clip(f, self.0, CLIP_MESSAGE_CHARS)
+    }
+}
+
+/// `text` up to `most` characters as shown (an escape counts as its length).
+fn clip(f: &mut fmt::Formatter<'_>, text: &str, most: usize) -> fmt::Result {
+    let mut shown = 0;
+    for c in text.chars() {
+        let escaped = c.is_control().then(|| c.escape_default().to_string());
+        let width = escaped.as_ref().map_or(1, |e| e.chars().count());
+        if shown + width > most {
+            return write!(f, "… ({} characters)", text.chars().count());
+        }
+        match escaped {
+            Some(e) => f.write_str(&e)?,
+            None => write!(f, "{c}")?,
+        }
+        shown += width;
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -137,5 +155,8 @@ mod tests {
             format!("{}… (10000000 characters)", "x".repeat(CLIP_CHARS))
         );
         assert_eq!(Clip("a\nb\0").to_string(), "a\\nb\\u{0}");
+        // Escapes count as what they show: never more than CLIP_CHARS of message.
+        let zeros = Clip(&"\0".repeat(100)).to_string();
+        assert!(zeros.chars().count() <= CLIP_CHARS + 20, "{zeros}");
     }
 }

@@ -33,7 +33,7 @@ use nalgebra::{DMatrix, SMatrix, SVector};
 use serde::Deserialize;
 
 use crate::bounded_read::read_text_file;
-use crate::display::{Clip, Short, ShortList, ShortRows as Rows};
+use crate::display::{Clip, ClipMessage, Short, ShortList, ShortRows as Rows};
 use crate::model::runtime::check_grid;
 use crate::model::{ArmModel, EpisodeOptionsN, TaskN};
 use crate::{TaskKind, Term};
@@ -196,7 +196,7 @@ impl TaskSpec {
                 .span()
                 .map(|s| syntax_place(text, s.start))
                 .unwrap_or_default(),
-            message: e.message().trim().replace('\n', " "),
+            message: ClipMessage(&e.message().trim().replace('\n', " ")).to_string(),
         })?;
         Self::from_raw(raw, file)
     }
@@ -540,7 +540,7 @@ fn syntax_place(text: &str, offset: usize) -> String {
     if line.is_empty() {
         format!("line {number}")
     } else {
-        format!("line {number} ({line})")
+        format!("line {number} ({})", Clip(line))
     }
 }
 
@@ -672,8 +672,8 @@ impl TaskSpec {
             };
             TaskFileError {
                 file: source.into(),
-                place,
-                message: message.trim().replace('\n', " "),
+                place: Clip(&place).to_string(),
+                message: ClipMessage(&message.trim().replace('\n', " ")).to_string(),
             }
         })?;
         Self::from_raw(raw, source)

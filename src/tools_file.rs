@@ -14,7 +14,7 @@
 //! value; the callback decides whether it stops the read or is skipped.
 
 use std::fs::File;
-use std::io::BufReader;
+use std::io::{BufReader, Read};
 use std::path::Path;
 
 use serde::de::{Error as _, MapAccess, SeqAccess, Visitor};
@@ -22,7 +22,7 @@ use serde::{Deserialize, Deserializer};
 use serde_json::Value;
 
 use crate::bounded_read::{record_error, CsvRows, JsonElements, RecordLimit};
-use crate::display::{Clip, Short};
+use crate::display::{Clip, ClipMessage, Short};
 use crate::model::mixed::{AnyTool, ModelKind};
 
 /// One tool read from a file.
@@ -68,7 +68,7 @@ enum Cell<'a> {
 /// A file without any row is an error.
 pub fn read_tools(
     path: &Path,
-    mut each: impl FnMut(Result<ToolRow, ToolFileError>) -> Result<(), ToolFileError>,
+    each: impl FnMut(Result<ToolRow, ToolFileError>) -> Result<(), ToolFileError>,
 ) -> Result<usize, ToolFileError> {
     let file_name = path.display().to_string();
     let fatal = |message: String| ToolFileError {
@@ -84,20 +84,36 @@ pub fn read_tools(
     let is_json = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    read_tools_from(BufReader::new(file), &file_name, is_json, each)
+}
+
+/// [`read_tools`] of a tools file's bytes from `reader`, named `file_name` in errors: JSON if
+/// `is_json`, else CSV.
+pub fn read_tools_from<R: Read>(
+    reader: R,
+    file_name: &str,
+    is_json: bool,
+    mut each: impl FnMut(Result<ToolRow, ToolFileError>) -> Result<(), ToolFileError>,
+) -> Result<usize, ToolFileError> {
     let rows = if is_json {
-        let bounded = RecordLimit::new(BufReader::new(file), JsonElements::default());
-        read_json(bounded, &file_name, &mut each)?
+        let bounded = RecordLimit::new(reader, JsonElements::default());
+        read_json(bounded, file_name, &mut each)?
     } else {
-        read_csv(file, &file_name, &mut each)?
+        read_csv(reader, file_name, &mut each)?
     };
     if rows == 0 {
-        return Err(fatal("no tools: the file has no rows".into()));
+        return Err(ToolFileError {
+            file: file_name.into(),
+            place: String::new(),
+            message: "no tools: the file has no rows".into(),
+            row_level: false,
+        });
     }
     Ok(rows)
 }
 
-fn read_csv(
-    file: File,
+fn read_csv<R: Read>(
+    reader: R,
     file_name: &str,
     each: &mut impl FnMut(Result<ToolRow, ToolFileError>) -> Result<(), ToolFileError>,
 ) -> Result<usize, ToolFileError> {
@@ -107,7 +123,7 @@ fn read_csv(
         message,
         row_level,
     };
-    let bounded = RecordLimit::new(BufReader::new(file), CsvRows::default());
+    let bounded = RecordLimit::new(reader, CsvRows::default());
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .from_reader(bounded);
@@ -179,7 +195,10 @@ fn csv_error(e: &csv::Error) -> (Option<u64>, String) {
             e.position().map(|p| p.line()),
             format!("the row has {len} cells, the header {expected_len}"),
         ),
-        _ => (e.position().map(|p| p.line()), e.to_string()),
+        _ => (
+            e.position().map(|p| p.line()),
+            ClipMessage(&e.to_string()).to_string(),
+        ),
     }
 }
 
@@ -418,7 +437,7 @@ fn read_json<R: std::io::Read>(
                 None => (0, format!("cannot read the tools file: {io}")),
             }
         } else {
-            let message = format!("not a JSON array of tools: {}", Clip(&e.to_string()));
+            let message = format!("not a JSON array of tools: {}", ClipMessage(&e.to_string()));
             (e.line(), message)
         };
         ToolFileError {

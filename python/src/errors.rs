@@ -40,7 +40,9 @@ impl Failure {
     /// A crate error: bad input, or a result that is not finite (a failed run).
     pub fn from_error(e: toolconf::Error) -> Self {
         match e {
-            toolconf::Error::NonFiniteResult { .. } => Failure::Run(e.to_string()),
+            toolconf::Error::NonFiniteResult { .. } | toolconf::Error::IllConditioned { .. } => {
+                Failure::Run(e.to_string())
+            }
             e => Failure::input(e),
         }
     }

@@ -81,7 +81,9 @@ impl CliError {
     pub fn exit_code(&self) -> u8 {
         use toolconf::closed_loop::SimulationError;
         match self {
-            CliError::Input(toolconf::Error::NonFiniteResult { .. }) => 1,
+            // Valid input the arithmetic cannot answer: a failed run, not bad input.
+            CliError::Input(toolconf::Error::NonFiniteResult { .. })
+            | CliError::Input(toolconf::Error::IllConditioned { .. }) => 1,
             CliError::Input(_)
             | CliError::Simulation(SimulationError::Input(_))
             | CliError::Mpc(toolconf::mpc::MpcEpisodeError::Input(_))

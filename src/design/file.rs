@@ -25,7 +25,7 @@ use serde::Deserialize;
 
 use super::constraint::{parse_constraint, LinearConstraint};
 use super::DesignError;
-use crate::display::{Clip, ShortList};
+use crate::display::{Clip, ClipMessage, ShortList};
 
 /// What the design optimises.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -119,7 +119,8 @@ impl DesignSpec {
         let raw: RawDesign = toml::from_str(text).map_err(|e| {
             let line = e.span().map(|s| 1 + text[..s.start].matches('\n').count());
             let place = line.map(|l| format!("line {l}")).unwrap_or_default();
-            DesignError::input(file, &place, e.message().trim().replace('\n', " "))
+            let message = e.message().trim().replace('\n', " ");
+            DesignError::input(file, &place, ClipMessage(&message).to_string())
         })?;
         let err =
             |key: &str, message: String| DesignError::input(file, &format!("key {key}"), message);
