@@ -160,7 +160,7 @@ fn named<const NP: usize>(names: [&str; NP], values: &[f64]) -> String {
     let parts: Vec<String> = names
         .iter()
         .zip(values)
-        .map(|(n, v)| format!("{n}={v}"))
+        .map(|(n, v)| format!("{n}={}", toolconf::display::Short(*v)))
         .collect();
     parts.join(" ")
 }

@@ -102,7 +102,11 @@ pub fn table(dict: &Bound<'_, PyDict>, at: &str) -> Result<toml::Table, Failure>
         let Ok(key) = key.extract::<String>() else {
             return Err(Failure::Input(format!(
                 "{DICT_SOURCE}, key {}: {} is not a string key",
-                if at.is_empty() { "(top level)" } else { at },
+                if at.is_empty() {
+                    "(top level)".into()
+                } else {
+                    Clip(at).to_string()
+                },
                 repr(&key)
             )));
         };
@@ -128,6 +132,10 @@ fn to_toml(value: &Bound<'_, PyAny>, path: &str) -> Result<toml::Value, Failure>
     if value.is_instance_of::<PyInt>() {
         if let Ok(i) = value.extract::<i64>() {
             return Ok(toml::Value::Integer(i));
+        }
+        // Past i64 (TOML's integers): as a float, which the range checks then judge.
+        if let Ok(x) = value.extract::<f64>() {
+            return Ok(toml::Value::Float(x));
         }
     }
     if value.is_instance_of::<PyFloat>() {
@@ -163,16 +171,19 @@ fn to_toml(value: &Bound<'_, PyAny>, path: &str) -> Result<toml::Value, Failure>
 
 fn unsupported(value: &Bound<'_, PyAny>, path: &str) -> Failure {
     Failure::Input(format!(
-        "{DICT_SOURCE}, key {path}: {} is not a number, string, list or dict",
+        "{DICT_SOURCE}, key {}: {} is not a number, string, list or dict",
+        Clip(path),
         repr(value)
     ))
 }
 
+/// `repr(value)` as a message repeats it ([`Clip`]: one line, not long).
 fn repr(value: &Bound<'_, PyAny>) -> String {
-    value
+    let text = value
         .repr()
         .map(|r| r.to_string())
-        .unwrap_or_else(|_| "<unprintable>".into())
+        .unwrap_or_else(|_| "<unprintable>".into());
+    Clip(&text).to_string()
 }
 
 /// `method="fast"` (the command line's `--method`, and its default), `"explicit"` (MATLAB
