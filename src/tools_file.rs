@@ -9,9 +9,12 @@
 //! JSON (`.json`): an array of objects with the same keys, e.g.
 //! `[{"name": "hammer", "model": "arm2", "m1": 0.3, "m2": 0.4, "l1": 0.5, "l2": 0.2}]`.
 //!
-//! Rows are handed to a callback one at a time, so a file of 10⁷ tools is never held in memory.
-//! A bad row is an error naming the file, the line (CSV) or tool number (JSON), the key and the
-//! value; the callback decides whether it stops the read or is skipped.
+//! Rows are handed to a callback one at a time, so a file of 10⁷ tools is never held in memory,
+//! and each row (a JSON tool) may be at most 1 MiB ([`crate::bounded_read`]), so that no file,
+//! `/dev/zero` included, is read without bound. A bad row is an error naming the file, the line
+//! (CSV) or tool number (JSON), the key and the value (clipped if long); the callback decides
+//! whether it stops the read or is skipped. A column given twice in a CSV header, or a key twice
+//! in a JSON tool, is refused.
 
 use std::fs::File;
 use std::io::{BufReader, Read};
