@@ -170,6 +170,43 @@ fn a_box_of_twelve_decades_reaches_its_light_short_corner() {
     }
 }
 
+/// An optimum the SQP does not converge to (found by a search over random design files): ln|Π^U|
+/// still rises as l1 falls along the second constraint, but a step that way leaves the tools
+/// whose Π^U is well enough conditioned to have a ln|Π^U|. It is reported as not converged,
+/// with its KKT residual; `toolconf design` then warns.
+#[test]
+fn an_unconverged_optimum_is_reported_as_such() {
+    let text = "constraints = [\"2*m1 + 10*l2 >= 1\", \"1*m2 + 3*l2 + 2*l1 >= 50\"]\n[bounds]\n\
+                m1 = [2.157e-05, 1.116e+03]\nm2 = [2.157e-05, 1.116e+03]\n\
+                l1 = [2.157e-05, 1.116e+03]\nl2 = [2.157e-05, 1.116e+03]\n";
+    let s = spec(text, ModelKind::Arm2);
+    let task = TaskSpec::builtin(TaskKind::Velocity);
+    let tasks = ModelTasks::new(&task);
+    let setting = Setting {
+        model: ModelKind::Arm2,
+        task: &task,
+        tasks: &tasks,
+    };
+    let (polytope, o) = confidence_optimum(&s, &setting).unwrap();
+    assert!(!o.converged() && o.kkt_residual > 0.1, "{}", o.kkt_residual);
+    // Independently: ∂ln|Π^U|/∂l1 is far from balanced by the constraints' multipliers, and
+    // moving l1 down by 1 % (l2 up to keep the constraint) is feasible but ill-conditioned.
+    assert!(o.gradient[2] * o.x[2] < -1.0, "{:?}", o.gradient);
+    let p = polytope.full(&o.x);
+    let mut q = p.clone();
+    q[2] *= 0.99;
+    q[3] += 2.0 * 0.01 * p[2] / 3.0;
+    let tool = AnyTool::new(ModelKind::Arm2, &q).unwrap();
+    assert!(polytope.contains(&q[..]));
+    assert!(
+        matches!(
+            tasks.logdet(&tool),
+            Err(toolconf::Error::IllConditioned { .. })
+        ),
+        "{q:?}"
+    );
+}
+
 /// The issue's acceptance case: the paper's arm, task 2, l1 + l2 ≥ 0.7, m1 + m2 ≤ 0.5.
 #[test]
 fn paper_arm_design_beats_the_best_of_100k_random_feasible_tools() {
