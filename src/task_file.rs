@@ -264,7 +264,8 @@ impl TaskSpec {
         }
     }
 
-    fn error(&self, key: &str, message: String) -> TaskFileError {
+    /// An error at `key` of this task: the file, or `task <kind>` for a built-in task.
+    pub fn error(&self, key: &str, message: String) -> TaskFileError {
         TaskFileError {
             file: if self.file.is_empty() {
                 format!("task {}", self.kind)

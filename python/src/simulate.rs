@@ -5,7 +5,6 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use toolconf::model::{episode, ArmModel, Metrics, ToolN};
 use toolconf::task_file::TaskSpec;
-use toolconf::validate::finite_output;
 
 use crate::errors::{detached, Failure};
 use crate::models::{model_kind, ops};
@@ -35,20 +34,9 @@ where
     let mut options = spec.episode::<M, N, NX, NP, NZ>().map_err(Failure::input)?;
     options.record_trajectory = true;
     let e = episode(&tool, &task, &options).map_err(Failure::episode)?;
-    let m = &e.metrics;
-    let metrics = [
-        m.task_error,
-        m.free_energy,
-        m.cost_j,
-        m.logdet,
-        m.control_effort,
-    ];
-    finite_output(
-        &format!("{}({tool})", M::NAME),
-        "the episode's metrics",
-        metrics,
-    )
-    .map_err(Failure::from_error)?;
+    e.metrics
+        .check_finite(&format!("{}({tool})", M::NAME))
+        .map_err(Failure::from_error)?;
     let tr = e.trajectory.expect("a recorded episode has a trajectory");
     let flat = |s: &[nalgebra::SVector<f64, N>]| -> Vec<f64> {
         s.iter().flat_map(|v| v.iter().copied()).collect()

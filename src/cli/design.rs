@@ -1,11 +1,9 @@
 //! `toolconf design --model M --task NAME|FILE --design FILE [--json] [--report DIR]
 //! [--sweep 'LEFT <= A..B:K']`: which tool to build (src/design).
 
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::{json, Map, Value};
 use toolconf::design::file::DesignSpec;
 use toolconf::design::report::{parameters_text, write_report, ReportInput};
@@ -16,7 +14,7 @@ use toolconf::model::mixed::ModelKind;
 use toolconf::rank::ModelTasks;
 use toolconf::validate::finite_output;
 
-use super::output::{check_output_folder, CliError};
+use super::output::{check_output_folder, progress_bar, CliError};
 use super::rank::task_spec;
 
 #[derive(clap::Args)]
@@ -75,7 +73,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         tasks: &tasks,
     };
     let started = Instant::now();
-    let bar = sampling_bar(spec.search.samples);
+    let counts = "draws of random tools, {msg} (eta {eta})";
+    let bar = progress_bar(spec.search.samples as u64, counts);
     let result = design_with_progress(&spec, &setting, &mut |s| {
         bar.set_length(s.max_draws);
         bar.set_position(s.drawn);
@@ -151,20 +150,6 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         }
     }
     Ok(())
-}
-
-/// A progress bar for the random comparison's draws, on a terminal only.
-fn sampling_bar(samples: usize) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(samples as u64);
-    if let Ok(style) = ProgressStyle::with_template(
-        "{elapsed_precise} [{bar:40}] {pos}/{len} draws of random tools, {msg} (eta {eta})",
-    ) {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar
 }
 
 /// What the result itself cannot say loudly enough, on stderr: an optimum that did not converge,

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use toolconf::closed_loop::{EpisodeOptions, Plant};
 use toolconf::integrate::Method;
 use toolconf::model::EpisodeOptionsN;
-use toolconf::task_file::{PerJoint, TaskFileError, TaskSpec};
+use toolconf::task_file::{PerJoint, TaskSpec};
 use toolconf::{Error, TaskKind};
 
 use super::output::CliError;
@@ -166,16 +166,7 @@ impl EpisodeArgs {
         };
         match self.flag_for(key) {
             Some(flag) => Err(CliError::Usage(format!("{flag}: {message}"))),
-            None => Err(TaskFileError {
-                file: if spec.file.is_empty() {
-                    format!("task {}", spec.kind)
-                } else {
-                    spec.file.clone()
-                },
-                place: format!("key {key}"),
-                message,
-            }
-            .into()),
+            None => Err(spec.error(key, message).into()),
         }
     }
 

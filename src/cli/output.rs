@@ -124,3 +124,18 @@ pub fn check_output_folder(flag: &str, path: &std::path::Path) -> Result<(), Cli
     toolconf::output_file::check_folder(path)
         .map_err(|m| CliError::Usage(format!("{flag} {}: {m}", path.display())))
 }
+
+/// A progress bar on stderr, when stderr is a terminal (hidden otherwise): `counts` follows
+/// `{pos}/{len}` in the template, e.g. `episodes ({per_sec}, eta {eta})`.
+pub fn progress_bar(total: u64, counts: &str) -> indicatif::ProgressBar {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(total);
+    let template = format!("{{elapsed_precise}} [{{bar:40}}] {{pos}}/{{len}} {counts}");
+    if let Ok(style) = indicatif::ProgressStyle::with_template(&template) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar
+}

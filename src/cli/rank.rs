@@ -4,11 +4,9 @@
 //! The whole tools file is read and checked (and every tool's confidence computed) before any
 //! output is created, so bad input leaves nothing half-written.
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::{json, Map, Value};
 use toolconf::display::Clip;
 use toolconf::experiments::csv::{Cell, CsvWriter};
@@ -22,7 +20,7 @@ use toolconf::select::Objective;
 use toolconf::task_file::TaskSpec;
 use toolconf::TaskKind;
 
-use super::output::{add_outcome, check_output_file, check_output_folder, CliError};
+use super::output::{add_outcome, check_output_file, check_output_folder, progress_bar, CliError};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -103,19 +101,6 @@ fn screen_tools(args: &Args, tasks: &ModelTasks) -> Result<(Screen, usize), CliE
         ScreenError::File(e) => e.into(),
         ScreenError::Input(message) => CliError::Usage(message),
     })
-}
-
-fn progress(total: usize) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(total as u64);
-    if let Ok(style) = ProgressStyle::with_template(
-        "{elapsed_precise} [{bar:40}] {pos}/{len} episodes ({per_sec}, eta {eta})",
-    ) {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar
 }
 
 /// The parameter columns of the models present, in the models' order.
@@ -327,7 +312,7 @@ fn simulate_streaming(
         }
         None => None,
     };
-    let bar = progress(candidates.len());
+    let bar = progress_bar(candidates.len() as u64, "episodes ({per_sec}, eta {eta})");
     let (results, timing) = simulate_all_timed(candidates, tasks, |r| {
         bar.inc(1);
         match csv.as_mut() {

@@ -163,8 +163,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 /// metrics as one JSON object, or `heading` and the metrics as text; the same for `--arm` and
 /// `--model`.
 fn print_episode(args: &Args, mut out: Value, heading: &str, m: &Metrics) -> Result<(), CliError> {
-    let values = [m.task_error, m.free_energy, m.cost_j, m.logdet];
-    finite_output(&heading, "the episode's metrics", values)?;
+    m.check_finite(&heading)?;
     let method = Method::from(args.method.method).describe();
     if args.json {
         for (key, value) in [

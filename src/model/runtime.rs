@@ -353,6 +353,21 @@ pub struct Metrics {
     pub control_effort: f64,
 }
 
+impl Metrics {
+    /// The last line of defence before the metrics are printed ([`crate::validate::finite_output`]):
+    /// the task error, ∫F dt, ∫J dt, ln|Π^U| and ∫|U|² dt of `tool` all finite.
+    pub fn check_finite(&self, tool: &dyn std::fmt::Display) -> Result<(), Error> {
+        let values = [
+            self.task_error,
+            self.free_energy,
+            self.cost_j,
+            self.logdet,
+            self.control_effort,
+        ];
+        crate::validate::finite_output(tool, "the episode's metrics", values)
+    }
+}
+
 /// The trajectory on the output grid.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TrajectoryN<const N: usize> {
