@@ -5,9 +5,10 @@
 //!   renamed over it once whole, so that a reader sees the old file or the whole new one;
 //! * a symbolic link: written through to its target by the same rules, and the link stays a
 //!   link (a link to nothing is refused, as a link to a folder is);
-//! * a device, a FIFO, a socket, or anything under `/dev/` or `/proc/` (`/dev/stdout`): written
-//!   in place, never replaced: `--csv /dev/null` discards, `--csv /dev/full` fails with "No space
-//!   left on device" and the device stays a device, even for root;
+//! * a device, a FIFO, a socket, or a name of an open descriptor (`/dev/stdout`, `/dev/fd/N`,
+//!   anything under `/proc`): written in place, never replaced: `--csv /dev/null` discards,
+//!   `--csv /dev/full` fails with "No space left on device" and the device stays a device, even
+//!   for root;
 //! * a folder: refused, as "is a folder, not a file".
 //!
 //! The temporary file is removed on every failure path (the `tempfile` crate removes it when it
@@ -37,9 +38,17 @@ fn refused(message: &str) -> io::Error {
     io::Error::new(io::ErrorKind::InvalidInput, message.to_string())
 }
 
+/// Whether `path` names an open descriptor (`/dev/stdout` is a link to `/proc/self/fd/1`):
+/// what it leads to is the descriptor's file, which a rename would not reach.
+fn names_a_descriptor(path: &Path) -> bool {
+    ["/proc", "/dev/fd", "/dev/stdout", "/dev/stderr"]
+        .iter()
+        .any(|p| path.starts_with(p))
+}
+
 /// How `path` is written, or why it cannot be.
 fn target(path: &Path) -> io::Result<Target> {
-    if path.starts_with("/dev") || path.starts_with("/proc") {
+    if names_a_descriptor(path) {
         return Ok(Target::InPlace);
     }
     let meta = match fs::symlink_metadata(path) {
@@ -230,6 +239,18 @@ mod tests {
         );
         assert_eq!(entries(&dir), ["file", "sub"]);
         fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_file_under_dev_that_is_a_folder_of_files_follows_the_usual_rules() {
+        // /dev/shm is a tmpfs of regular files: a new one there is created, by rename.
+        let dir = Path::new("/dev/shm");
+        if dir.is_dir() {
+            let path = dir.join(format!("toolconf-out-{}.csv", std::process::id()));
+            write_whole(&path, b"x\n").unwrap();
+            assert_eq!(fs::read(&path).unwrap(), b"x\n");
+            fs::remove_file(&path).unwrap();
+        }
     }
 
     #[cfg(target_os = "linux")]
