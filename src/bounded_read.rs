@@ -93,12 +93,15 @@ pub fn record_error(e: &io::Error) -> Option<(u64, String)> {
         .map(|q| (q.line, q.to_string()))
 }
 
-/// Where a format's records begin and end, fed one byte at a time.
+/// Where a format's records begin and end.
 pub trait Records {
     /// "row" or "tool", for the error.
     const RECORD: &'static str;
-    /// Takes the next byte; true if it ends a record.
-    fn ends_record(&mut self, byte: u8) -> bool;
+    /// Takes `bytes` in order up to and including the first that ends a record, and returns its
+    /// index; None if none of them does (all taken).
+    fn next_end(&mut self, bytes: &[u8]) -> Option<usize>;
+    /// Line breaks taken so far.
+    fn lines(&self) -> u64;
     /// At the end of the input: the line of a quote left open, if any.
     fn open_quote(&self) -> Option<u64> {
         None
@@ -111,10 +114,11 @@ pub trait Records {
 #[derive(Debug, Default)]
 pub struct CsvRows {
     state: CsvState,
+    /// Line breaks taken, and the one the open quote was on.
     line: u64,
     quote_line: u64,
-    /// Bytes seen, for the UTF-8 byte-order mark the `csv` crate skips at the start.
-    seen: u64,
+    /// Bytes of the UTF-8 byte-order mark (which the `csv` crate skips) still possible.
+    started: bool,
 }
 
 #[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
@@ -130,31 +134,86 @@ enum CsvState {
 impl Records for CsvRows {
     const RECORD: &'static str = "row";
 
-    fn ends_record(&mut self, byte: u8) -> bool {
+    fn next_end(&mut self, bytes: &[u8]) -> Option<usize> {
         use CsvState::*;
-        let bom = self.seen < 3 && byte == [0xEF, 0xBB, 0xBF][self.seen as usize];
-        self.seen += 1;
-        if byte == b'\n' {
-            self.line += 1;
-        }
-        if bom {
-            return false;
-        }
-        let terminator = byte == b'\n' || byte == b'\r';
-        let (next, ends) = match (self.state, byte) {
-            (Quoted, b'"') => (QuoteInQuoted, false),
-            (Quoted, _) => (Quoted, false),
-            (QuoteInQuoted, b'"') => (Quoted, false),
-            (FieldStart, b'"') => {
-                self.quote_line = self.line;
-                (Quoted, false)
+        let mut i = 0;
+        if !self.started && !bytes.is_empty() {
+            self.started = true;
+            if bytes.starts_with(b"\xEF\xBB\xBF") {
+                i = 3;
             }
-            (_, b',') => (FieldStart, false),
-            (_, _) if terminator => (FieldStart, true),
-            (_, _) => (Unquoted, false),
-        };
-        self.state = next;
-        ends
+        }
+        // The common row, without a quote: its end is the next line break, found at memchr's
+        // speed (SIMD), cell boundaries need not be followed.
+        if matches!(self.state, FieldStart | Unquoted) {
+            if let Some(k) = memchr::memchr3(b'\n', b'\r', b'"', &bytes[i..]) {
+                let at = i + k;
+                if bytes[at] != b'"' {
+                    self.line += u64::from(bytes[at] == b'\n');
+                    self.state = FieldStart;
+                    return Some(at);
+                }
+            } else {
+                // No line break and no quote: whether the last byte ends a cell or not, the
+                // state is one of these two, and FieldStart matters only before a quote.
+                self.state = if bytes.last() == Some(&b',') {
+                    FieldStart
+                } else {
+                    Unquoted
+                };
+                return None;
+            }
+        }
+        while i < bytes.len() {
+            match self.state {
+                // To the next byte that can change the state (cells are short: a plain loop
+                // beats a memchr call per cell).
+                Unquoted => {
+                    while i < bytes.len() && !matches!(bytes[i], b',' | b'\n' | b'\r') {
+                        i += 1;
+                    }
+                    if i == bytes.len() {
+                        return None;
+                    }
+                }
+                Quoted => {
+                    while i < bytes.len() && bytes[i] != b'"' {
+                        self.line += u64::from(bytes[i] == b'\n');
+                        i += 1;
+                    }
+                    if i == bytes.len() {
+                        return None;
+                    }
+                }
+                FieldStart | QuoteInQuoted => {}
+            }
+            let byte = bytes[i];
+            let terminator = byte == b'\n' || byte == b'\r';
+            let (next, ends) = match (self.state, byte) {
+                (Quoted, _) => (QuoteInQuoted, false),
+                (QuoteInQuoted, b'"') => (Quoted, false),
+                (FieldStart, b'"') => {
+                    self.quote_line = self.line;
+                    (Quoted, false)
+                }
+                (_, b',') => (FieldStart, false),
+                (_, _) if terminator => (FieldStart, true),
+                (_, _) => (Unquoted, false),
+            };
+            if byte == b'\n' {
+                self.line += 1;
+            }
+            self.state = next;
+            if ends {
+                return Some(i);
+            }
+            i += 1;
+        }
+        None
+    }
+
+    fn lines(&self) -> u64 {
+        self.line
     }
 
     fn open_quote(&self) -> Option<u64> {
@@ -169,35 +228,65 @@ pub struct JsonElements {
     depth: u32,
     in_string: bool,
     escaped: bool,
+    line: u64,
 }
 
 impl Records for JsonElements {
     const RECORD: &'static str = "tool";
 
-    fn ends_record(&mut self, byte: u8) -> bool {
-        if self.in_string {
-            match (self.escaped, byte) {
-                (true, _) => self.escaped = false,
-                (false, b'\\') => self.escaped = true,
-                (false, b'"') => self.in_string = false,
-                _ => {}
+    fn next_end(&mut self, bytes: &[u8]) -> Option<usize> {
+        let mut i = 0;
+        while i < bytes.len() {
+            if self.in_string {
+                if self.escaped {
+                    self.escaped = false;
+                    i += 1;
+                    continue;
+                }
+                // Keys and values are short: a plain loop beats a memchr call per string.
+                while i < bytes.len() && !matches!(bytes[i], b'"' | b'\\') {
+                    i += 1;
+                }
+                if i == bytes.len() {
+                    return None;
+                }
+                match bytes[i] {
+                    b'\\' => self.escaped = true,
+                    _ => self.in_string = false,
+                }
+                i += 1;
+                continue;
             }
-            return false;
+            let ends = match bytes[i] {
+                b'"' => {
+                    self.in_string = true;
+                    false
+                }
+                b'[' | b'{' => {
+                    self.depth += 1;
+                    self.depth == 1
+                }
+                b']' | b'}' => {
+                    self.depth = self.depth.saturating_sub(1);
+                    self.depth == 0
+                }
+                b',' => self.depth == 1,
+                b'\n' => {
+                    self.line += 1;
+                    false
+                }
+                _ => false,
+            };
+            if ends {
+                return Some(i);
+            }
+            i += 1;
         }
-        match byte {
-            b'"' => self.in_string = true,
-            b'[' | b'{' => {
-                self.depth += 1;
-                return self.depth == 1;
-            }
-            b']' | b'}' => {
-                self.depth = self.depth.saturating_sub(1);
-                return self.depth == 0;
-            }
-            b',' => return self.depth == 1,
-            _ => {}
-        }
-        false
+        None
+    }
+
+    fn lines(&self) -> u64 {
+        self.line
     }
 }
 
@@ -209,7 +298,6 @@ pub struct RecordLimit<R, T> {
     /// Bytes of the current record so far, and the line it started on (0-based).
     length: usize,
     start_line: u64,
-    line: u64,
     limit: usize,
 }
 
@@ -224,9 +312,19 @@ impl<R: Read, T: Records> RecordLimit<R, T> {
             records,
             length: 0,
             start_line: 0,
-            line: 0,
             limit,
         }
+    }
+
+    fn too_long(&self) -> io::Error {
+        io::Error::new(
+            io::ErrorKind::InvalidData,
+            RecordTooLong {
+                line: self.start_line + 1,
+                limit: self.limit,
+                record: T::RECORD,
+            },
+        )
     }
 }
 
@@ -242,25 +340,21 @@ impl<R: Read, T: Records> Read for RecordLimit<R, T> {
             }
             return Ok(0);
         }
-        for &byte in &buf[..n] {
-            self.length += 1;
+        // Segment by segment, each up to a record's end: the limit is checked per segment, so
+        // a record is refused within a read buffer (8 KiB) of the limit.
+        let mut rest = &buf[..n];
+        while !rest.is_empty() {
+            let end = self.records.next_end(rest);
+            let (segment, after) = rest.split_at(end.map_or(rest.len(), |i| i + 1));
+            self.length += segment.len();
             if self.length > self.limit {
-                return Err(io::Error::new(
-                    io::ErrorKind::InvalidData,
-                    RecordTooLong {
-                        line: self.start_line + 1,
-                        limit: self.limit,
-                        record: T::RECORD,
-                    },
-                ));
+                return Err(self.too_long());
             }
-            if byte == b'\n' {
-                self.line += 1;
-            }
-            if self.records.ends_record(byte) {
+            if end.is_some() {
                 self.length = 0;
-                self.start_line = self.line;
+                self.start_line = self.records.lines();
             }
+            rest = after;
         }
         Ok(n)
     }

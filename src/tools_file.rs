@@ -22,7 +22,7 @@ use std::path::Path;
 
 use serde::de::{Error as _, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer};
-use serde_json::Value;
+use serde_json::{Map, Value};
 
 use crate::bounded_read::{record_error, CsvRows, JsonElements, RecordLimit};
 use crate::display::{Clip, ClipMessage, Short};
@@ -99,7 +99,8 @@ pub fn read_tools_from<R: Read>(
     mut each: impl FnMut(Result<ToolRow, ToolFileError>) -> Result<(), ToolFileError>,
 ) -> Result<usize, ToolFileError> {
     let rows = if is_json {
-        let bounded = RecordLimit::new(reader, JsonElements::default());
+        // serde_json reads a byte at a time: the buffer goes between it and the limit.
+        let bounded = BufReader::new(RecordLimit::new(reader, JsonElements::default()));
         read_json(bounded, file_name, &mut each)?
     } else {
         read_csv(reader, file_name, &mut each)?
@@ -357,13 +358,14 @@ where
     }
 
     fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<(), A::Error> {
-        while let Some(Entries(object)) = seq.next_element::<Entries>()? {
+        while let Some(Object { map, twice }) = seq.next_element::<Object>()? {
             self.rows += 1;
             let row = self.rows;
-            let result = check_keys(object.iter().map(|(k, _)| k.as_str()), "key")
+            let keys = map.keys().map(String::as_str).chain(twice.as_deref());
+            let result = check_keys(keys, "key")
                 .and_then(|()| {
-                    let present = present_keys(|k| object.iter().any(|(key, _)| key == k));
-                    build_row(row, &|key| json_cell(&object, key), &present)
+                    let present = present_keys(|k| map.contains_key(k));
+                    build_row(row, &|key| json_cell(&map, key), &present)
                 })
                 .map_err(|message| ToolFileError {
                     file: self.file.into(),
@@ -380,33 +382,42 @@ where
     }
 }
 
-/// One tool's object with its keys as written, a key given twice twice (a `Map` would keep the
-/// last silently, where the CSV reader refuses a column given twice).
-struct Entries(Vec<(String, Value)>);
+/// One tool's object, and the first key it gives twice if any (a `Map` alone would keep the
+/// last value silently, where the CSV reader refuses a column given twice).
+struct Object {
+    map: Map<String, Value>,
+    twice: Option<String>,
+}
 
-impl<'de> Deserialize<'de> for Entries {
+impl<'de> Deserialize<'de> for Object {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct Object;
-        impl<'de> Visitor<'de> for Object {
-            type Value = Entries;
+        struct Entries;
+        impl<'de> Visitor<'de> for Entries {
+            type Value = Object;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
                 f.write_str("a tool (an object)")
             }
-            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Entries, A::Error> {
-                let mut entries = Vec::new();
-                while let Some(entry) = map.next_entry::<String, Value>()? {
-                    entries.push(entry);
+            fn visit_map<A: MapAccess<'de>>(self, mut entries: A) -> Result<Object, A::Error> {
+                let mut object = Object {
+                    map: Map::new(),
+                    twice: None,
+                };
+                while let Some((key, value)) = entries.next_entry::<String, Value>()? {
+                    if object.map.contains_key(&key) {
+                        object.twice.get_or_insert(key);
+                    } else {
+                        object.map.insert(key, value);
+                    }
                 }
-                Ok(Entries(entries))
+                Ok(object)
             }
         }
-        d.deserialize_map(Object)
+        d.deserialize_map(Entries)
     }
 }
 
-fn json_cell<'a>(object: &'a [(String, Value)], key: &str) -> Cell<'a> {
-    let value = object.iter().find(|(k, _)| k == key).map(|(_, v)| v);
-    match value {
+fn json_cell<'a>(object: &'a Map<String, Value>, key: &str) -> Cell<'a> {
+    match object.get(key) {
         None | Some(Value::Null) => Cell::Absent,
         Some(Value::String(s)) if s.is_empty() => Cell::Absent,
         Some(Value::String(s)) => Cell::Text(s),

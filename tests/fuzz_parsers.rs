@@ -314,6 +314,43 @@ fn check_constraint(text: &str) -> Result<(), TestCaseError> {
 
 const ARMS: &[&str] = &["0.3,0.4,0.5,0.2", "1e-6,1e6,0.1,0.1"];
 
+/// The bounded reader's CSV rows against the csv crate's: cells of any text (quotes, commas,
+/// line breaks) written by `csv::Writer` are read back whole through the limit, every row ends
+/// where the writer ended it, and no quote is left open; the same file cut inside a quoted cell
+/// is "never closed".
+fn check_csv_rows(cells: &[Vec<String>]) -> Result<(), TestCaseError> {
+    use std::io::Read;
+    use toolconf::bounded_read::{record_error, CsvRows, RecordLimit};
+    let mut writer = csv::WriterBuilder::new()
+        .flexible(true)
+        .from_writer(Vec::new());
+    for row in cells {
+        writer.write_record(row).unwrap();
+    }
+    let bytes = writer.into_inner().unwrap();
+    let mut read = Vec::new();
+    let mut limited = RecordLimit::new(&bytes[..], CsvRows::default());
+    prop_assert!(limited.read_to_end(&mut read).is_ok());
+    prop_assert_eq!(&read, &bytes);
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .from_reader(RecordLimit::new(&bytes[..], CsvRows::default()));
+    let back: Vec<Vec<String>> = reader
+        .records()
+        .map(|r| r.unwrap().iter().map(str::to_string).collect())
+        .collect();
+    prop_assert_eq!(&back[..], cells);
+    // The writer's first quote opens a cell: cut just after it, the file ends inside that cell.
+    if let Some(at) = bytes.iter().position(|&b| b == b'"') {
+        let e = RecordLimit::new(&bytes[..=at], CsvRows::default())
+            .read_to_end(&mut Vec::new())
+            .unwrap_err();
+        prop_assert!(record_error(&e).is_some_and(|(_, m)| m.contains("never closed")));
+    }
+    Ok(())
+}
+
 proptest! {
     #![proptest_config(config())]
 
@@ -340,6 +377,16 @@ proptest! {
     #[test]
     fn constraints_and_sweeps(text in mutated(CONSTRAINTS)) {
         check_constraint(&text)?;
+    }
+
+    #[test]
+    fn csv_rows_end_where_the_csv_crate_ends_them(
+        cells in prop::collection::vec(
+            prop::collection::vec("[a-c\",\n\r ]{0,6}", 1..4),
+            1..6,
+        )
+    ) {
+        check_csv_rows(&cells)?;
     }
 
     #[test]
