@@ -182,7 +182,7 @@ fn named<const NP: usize>(names: [&str; NP], values: &[f64]) -> String {
 ///     model: a generated model's name (``toolconf.models()``), e.g. ``"arm2"``, the paper's arm.
 ///     params: one tool's parameters, a 1-D array in the model's parameter order (arm2:
 ///         m1, m2, l1, l2 in kg and m), or a 2-D array with one tool per row. Each must be a
-///         finite number > 0.
+///         number in ``toolconf.ranges()["tool_parameter"]``, [1e-6, 1e6].
 ///     task: ``"position"``, ``"velocity"``, ``"acceleration"`` (or ``1``, ``2``, ``3`` as
 ///         text), a task file's path, or a dict with a task file's keys, e.g.
 ///         ``{"kind": "position", "goal": {"theta": [0.78, 0.0]}, "precision": {"theta": 120.0}}``.
@@ -196,9 +196,11 @@ fn named<const NP: usize>(names: [&str; NP], values: &[f64]) -> String {
 ///     (``toolconf confidence --json``), digit for digit.
 ///
 /// Raises:
-///     ValueError: an unknown model, a parameter that is not a finite number > 0 (naming the
+///     ValueError: an unknown model, a parameter outside [1e-6, 1e6] (naming the
 ///         tool's row), a wrong number of parameters, or a bad task (naming the key), with the
 ///         command line's message.
+///     RuntimeError: a tool whose Π^U is too ill-conditioned for its ln|Π^U| to be computed
+///         (its parameters span too many decades), the command line's status 1.
 ///
 /// A batch runs on rayon's threads without holding the GIL.
 #[pyfunction]
