@@ -22,6 +22,8 @@ bench:
 
 ## make test: the whole suite: `make derive` reproduces generated/ byte for byte (on this CPU and
 ## on an imitated older one), the derivation's own tests, the crate's, then the Python package's.
+## The fuzzers of every parser run in it with bounded case counts (TOOLCONF_FUZZ_CASES raises
+## them: README "Bad input"), and so does the sweep of hostile inputs (tests/hostile.rs).
 test: drift-check $(PY_DEV)
 	$(PY) -m unittest discover --start-directory derive/tests
 	cargo test --workspace --quiet

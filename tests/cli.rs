@@ -160,7 +160,12 @@ fn simulate_json_and_csv() {
     assert!(lines[1..]
         .iter()
         .all(|l| l.split(',').count() == 9 && !l.contains("NaN")));
-    assert!(!dir.join("trajectory.csv.partial").exists());
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|name| name.contains(".partial"))
+        .collect();
+    assert!(left.is_empty(), "temporary files left: {left:?}");
     // The trajectory and the metrics agree: task error is the sum over the CSV's θ rows.
     let g = [std::f64::consts::FRAC_PI_3, std::f64::consts::FRAC_PI_6];
     let sum: f64 = lines[1..]
@@ -223,7 +228,7 @@ fn simulate_and_select_reject_bad_input() {
                 "--perturb",
                 "nan",
             ],
-            "perturbation",
+            "--perturb: NaN must be a number in [-1e6, 1e6] N m",
         ),
         (
             vec![

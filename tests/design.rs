@@ -123,6 +123,90 @@ k = [0.5, 4.0]
     assert!(o.kkt_residual < 1e-6, "KKT residual {}", o.kkt_residual);
 }
 
+/// Bounds of twelve decades: from the box's centre (5·10⁵, where ln|Π^U| of tasks 1 and 2 is
+/// flat to 10⁻³⁰) the search must still reach the light, short corner. The optimum is checked
+/// against every corner of the box and 2000 tools drawn uniformly in ln p, none better.
+#[test]
+fn a_box_of_twelve_decades_reaches_its_light_short_corner() {
+    let text = "[bounds]\nm1 = [1e-6, 1e6]\nm2 = [1e-6, 1e6]\nl1 = [1e-6, 1e6]\nl2 = [1e-6, 1e6]\n";
+    let s = spec(text, ModelKind::Arm2);
+    for kind in [TaskKind::Position, TaskKind::Velocity] {
+        let task = TaskSpec::builtin(kind);
+        let tasks = ModelTasks::new(&task);
+        let setting = Setting {
+            model: ModelKind::Arm2,
+            task: &task,
+            tasks: &tasks,
+        };
+        let (polytope, o) = confidence_optimum(&s, &setting).unwrap();
+        assert_eq!(polytope.full(&o.x), [1e-6; 4], "{kind}");
+        assert!(o.converged(), "{kind}: KKT residual {}", o.kkt_residual);
+        let logdet = |p: &[f64]| {
+            tasks
+                .logdet(&AnyTool::new(ModelKind::Arm2, p).unwrap())
+                .ok()
+        };
+        assert_eq!(logdet(&[1e-6; 4]), Some(o.value));
+        assert!(o.value > 100.0, "{kind}: {}", o.value);
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut uniform = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for bits in 0..16usize {
+            let corner: Vec<f64> = (0..4)
+                .map(|j| if bits >> j & 1 == 0 { 1e-6 } else { 1e6 })
+                .collect();
+            assert!(logdet(&corner).map_or(true, |l| l <= o.value), "{corner:?}");
+        }
+        for _ in 0..2000 {
+            let p: Vec<f64> = (0..4)
+                .map(|_| 10f64.powf(-6.0 + 12.0 * uniform()))
+                .collect();
+            assert!(logdet(&p).map_or(true, |l| l <= o.value), "{p:?}");
+        }
+    }
+}
+
+/// An optimum the SQP does not converge to (found by a search over random design files): ln|Π^U|
+/// still rises as l1 falls along the second constraint, but a step that way leaves the tools
+/// whose Π^U is well enough conditioned to have a ln|Π^U|. It is reported as not converged,
+/// with its KKT residual; `toolconf design` then warns.
+#[test]
+fn an_unconverged_optimum_is_reported_as_such() {
+    let text = "constraints = [\"2*m1 + 10*l2 >= 1\", \"1*m2 + 3*l2 + 2*l1 >= 50\"]\n[bounds]\n\
+                m1 = [2.157e-05, 1.116e+03]\nm2 = [2.157e-05, 1.116e+03]\n\
+                l1 = [2.157e-05, 1.116e+03]\nl2 = [2.157e-05, 1.116e+03]\n";
+    let s = spec(text, ModelKind::Arm2);
+    let task = TaskSpec::builtin(TaskKind::Velocity);
+    let tasks = ModelTasks::new(&task);
+    let setting = Setting {
+        model: ModelKind::Arm2,
+        task: &task,
+        tasks: &tasks,
+    };
+    let (polytope, o) = confidence_optimum(&s, &setting).unwrap();
+    assert!(!o.converged() && o.kkt_residual > 0.1, "{}", o.kkt_residual);
+    // Independently: ∂ln|Π^U|/∂l1 is far from balanced by the constraints' multipliers, and
+    // moving l1 down by 1 % (l2 up to keep the constraint) is feasible but ill-conditioned.
+    assert!(o.gradient[2] * o.x[2] < -1.0, "{:?}", o.gradient);
+    let p = polytope.full(&o.x);
+    let mut q = p.clone();
+    q[2] *= 0.99;
+    q[3] += 2.0 * 0.01 * p[2] / 3.0;
+    let tool = AnyTool::new(ModelKind::Arm2, &q).unwrap();
+    assert!(polytope.contains(&q[..]));
+    assert!(
+        matches!(
+            tasks.logdet(&tool),
+            Err(toolconf::Error::Core(toolconf::model::Error::IllConditioned { .. }))
+        ),
+        "{q:?}"
+    );
+}
+
 /// The issue's acceptance case: the paper's arm, task 2, l1 + l2 ≥ 0.7, m1 + m2 ≤ 0.5.
 #[test]
 fn paper_arm_design_beats_the_best_of_100k_random_feasible_tools() {

@@ -145,3 +145,36 @@ fn bad_input_is_one_line_and_status_2() {
     let e = refused(&good, &["--model", "arm9"]);
     assert!(e.contains("unknown model 'arm9'"), "{e}");
 }
+
+/// A thin feasible set that gives fewer random tools than asked for says so on stderr (an
+/// optimum that did not converge does too: tests/design.rs finds one).
+#[test]
+fn a_thin_set_is_warned_about() {
+    let dir = std::env::temp_dir().join(format!("toolconf-design-warn-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let thin = dir.join("thin.toml");
+    std::fs::write(
+        &thin,
+        "constraints = [\"m1 + m2 <= 0.2000001\", \"m1 + m2 >= 0.2\"]\n[bounds]\n\
+         m1 = [0.1, 0.6]\nm2 = [0.1, 0.6]\nl1 = [0.1, 0.6]\nl2 = [0.1, 0.6]\n[search]\nsamples = 50\n",
+    )
+    .unwrap();
+    let out = toolconf(
+        &[
+            "design",
+            "--task",
+            "velocity",
+            "--design",
+            thin.to_str().unwrap(),
+        ],
+        "2",
+    );
+    assert!(out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("toolconf: warning: only 0 of the 50 random feasible tools asked for")
+            && stderr.contains("in 50000 draws"),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

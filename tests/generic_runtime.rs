@@ -221,12 +221,22 @@ fn invalid_input_gives_typed_errors() {
     ));
 
     let tool = Arm3Tool::new([0.3, 0.25, 0.2, 0.4, 0.35, 0.3]).unwrap();
-    // All-zero precisions: Π^U = 0 is no precision.
+    // All-zero precisions: Π^U = 0 for every tool, refused as such.
     let mut task = Arm3::paper_task(TaskKind::Acceleration);
     task.precision_theta_ddot = SMatrix::zeros();
     assert!(matches!(
         control_confidence(&tool, &task),
-        Err(model::Error::NotPositiveDefinite { .. })
+        Err(model::Error::ConfidenceRank {
+            rank: 0,
+            joints: 3,
+            ..
+        })
+    ));
+    // Rank 2 of 3 in all is still singular for every tool.
+    task.precision_theta_ddot = SMatrix::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, 0.0));
+    assert!(matches!(
+        control_confidence(&tool, &task),
+        Err(model::Error::ConfidenceRank { rank: 2, .. })
     ));
     // Not positive semi-definite.
     let mut task = Arm3::paper_task(TaskKind::Velocity);
@@ -263,9 +273,7 @@ fn invalid_input_gives_typed_errors() {
     };
     assert!(matches!(
         simulate(&tool, &task, &bad),
-        Err(model::ModelSimulationError::Input(
-            Error::InvalidOption { .. }
-        ))
+        Err(model::ModelSimulationError::Input(Error::OutOfRange { .. }))
     ));
     let bad = EpisodeOptionsN {
         learning_rate: 0.0,
@@ -273,9 +281,7 @@ fn invalid_input_gives_typed_errors() {
     };
     assert!(matches!(
         simulate(&tool, &task, &bad),
-        Err(model::ModelSimulationError::Input(Error::Core(
-            model::Error::InvalidOption { .. }
-        )))
+        Err(model::ModelSimulationError::Input(Error::OutOfRange { .. }))
     ));
 }
 

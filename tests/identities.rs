@@ -194,10 +194,30 @@ fn invalid_tasks_are_errors() {
         control_confidence(&arm, &task),
         Err(model::Error::InvalidGoal { .. })
     ));
+    // Precisions that leave Π^U singular for every tool are refused as such...
     let mut task = Task::paper(TaskKind::Acceleration);
     task.precision_theta_ddot = Matrix2::zeros();
     assert!(matches!(
         control_confidence(&arm, &task),
+        Err(model::Error::ConfidenceRank {
+            rank: 0,
+            joints: 2,
+            ..
+        })
+    ));
+    // ...and a tool whose sensitivities leave a direction of U without precision gets
+    // NotPositiveDefinite: with P^θ = e₁e₁ᵀ and P^U = e₂e₂ᵀ, Π^U = r rᵀ + e₂e₂ᵀ for r the first
+    // row of ∂θ/∂U, whose first entry −(2/3)(l1²(m1 + 3m2) − 3)/(g l1 (m1 + 2m2)) vanishes at
+    // l1 = 1, m1 + 3m2 = 3: r ∥ e₂ and Π^U is singular.
+    let mut task = Task::paper(TaskKind::Position);
+    task.precision_theta = Matrix2::new(1.0, 0.0, 0.0, 0.0);
+    task.precision_theta_dot = Matrix2::zeros();
+    task.precision_theta_ddot = Matrix2::zeros();
+    task.precision_u = Matrix2::new(0.0, 0.0, 0.0, 1.0);
+    assert!(control_confidence(&arm, &task).is_ok());
+    let singular = Arm::new([1.5, 0.5, 1.0, 0.3]).unwrap();
+    assert!(matches!(
+        control_confidence(&singular, &task),
         Err(model::Error::NotPositiveDefinite { .. })
     ));
     assert!(matches!(

@@ -488,18 +488,26 @@ fn the_report_has_markdown_html_and_inline_figures() {
 #[test]
 fn a_failed_tool_keeps_its_error_and_goes_last() {
     let dir = scratch("failed");
-    // Links of 1e200 m overflow the model's coefficients: that tool fails, the batch goes on.
+    // With P^θ = e₁e₁ᵀ and P^U = e₂e₂ᵀ, Π^U = r rᵀ + e₂e₂ᵀ for r the first row of ∂θ/∂U, whose
+    // first entry vanishes at l1 = 1, m1 + 3 m2 = 3 (tests/identities.rs): that tool fails, the
+    // batch goes on.
     let tools = write(
         &dir,
         "t.csv",
-        "name,m1,m2,l1,l2\nok,0.3,0.3,0.3,0.3\ngiant,0.3,0.3,1e200,1e200\nok2,0.2,0.4,0.3,0.3\n",
+        "name,m1,m2,l1,l2\nok,0.3,0.3,0.3,0.3\nsingular,1.5,0.5,1.0,0.3\nok2,0.2,0.4,0.3,0.3\n",
+    );
+    let singular = write(
+        &dir,
+        "singular.toml",
+        "kind = \"position\"\n[precision]\ntheta = [[1.0, 0.0], [0.0, 0.0]]\ntheta_dot = 0.0\n\
+         theta_ddot = 0.0\nu = [[0.0, 0.0], [0.0, 1.0]]\n[episode]\nt_end = 0.5\n",
     );
     let v = json_of(&toolconf(&[
-        "rank", "--tools", &tools, "--task", "position", "--json",
+        "rank", "--tools", &tools, "--task", &singular, "--json",
     ]));
     let tools_json = v["tools"].as_array().unwrap();
     assert_eq!(tools_json.len(), 3);
-    assert_eq!(tools_json[2]["name"], "giant");
+    assert_eq!(tools_json[2]["name"], "singular");
     assert_eq!(tools_json[2]["rank"], 3);
     assert!(tools_json[2]["error"]
         .as_str()
@@ -507,18 +515,26 @@ fn a_failed_tool_keeps_its_error_and_goes_last() {
         .contains("not positive definite"));
     assert!(tools_json[..2].iter().all(|t| t.get("error").is_none()));
 
-    // When every episode fails (here each starts with a non-finite right-hand side), each row
-    // still gets its error, and the run as a whole exits with 1.
+    // When every episode fails (here a torque of 2·10⁶ N m, at the edge of the valid range,
+    // throws each arm past the divergence bound within 0.01 s), each row still gets its error,
+    // and the run as a whole exits with 1.
     let task = write(
         &dir,
         "wild.toml",
-        "kind = \"position\"\n[episode]\ninitial_theta_dot = [1e200, 1e200]\n",
+        "kind = \"position\"\n[episode]\nperturbation = 1e6\ninitial_torque = 1e6\n\
+         t_end = 0.01\ndt = 0.01\n",
+    );
+    let three = write(
+        &dir,
+        "three.csv",
+        "name,m1,m2,l1,l2\nshort hammer,0.30,0.40,0.25,0.20\nlong hammer,0.30,0.40,0.55,0.45\n\
+         mallet,0.25,0.60,0.40,0.15\n",
     );
     let csv = dir.join("out.csv");
     let out = toolconf(&[
         "rank",
         "--tools",
-        DRAWER,
+        &three,
         "--task",
         &task,
         "--json",
@@ -528,19 +544,21 @@ fn a_failed_tool_keeps_its_error_and_goes_last() {
     assert_eq!(out.status.code(), Some(1));
     let v: Value = serde_json::from_slice(&out.stdout).unwrap();
     let all = v["tools"].as_array().unwrap();
-    assert_eq!(all.len(), 12);
-    assert!(all
-        .iter()
-        .all(|t| t["error"].as_str().unwrap().contains("non-finite")));
+    assert_eq!(all.len(), 3);
+    assert!(all.iter().all(|t| t["error"]
+        .as_str()
+        .unwrap()
+        .contains("diverged at t = 0.01 s")));
     let rows: Vec<u64> = all.iter().map(|t| t["row"].as_u64().unwrap()).collect();
-    assert_eq!(
-        rows,
-        (1..=12).collect::<Vec<_>>(),
-        "failed tools keep file order"
-    );
+    assert_eq!(rows, [1, 2, 3], "failed tools keep file order");
     let text = std::fs::read_to_string(csv).unwrap();
-    assert_eq!(text.lines().count(), 13);
-    assert!(text.lines().skip(1).all(|l| l.contains("non-finite")));
+    assert_eq!(text.lines().count(), 4);
+    assert!(text.lines().skip(1).all(|l| l.contains("diverged")));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        stderr.trim_end(),
+        "toolconf: error: every one of the 3 simulated tools failed"
+    );
 }
 
 #[test]
@@ -624,7 +642,11 @@ fn every_bad_tools_file_is_refused_naming_file_line_and_value() {
         (
             "nan.csv",
             "name,model,m1,m2,l1,l2\nw,arm2,NaN,0.4,0.5,0.2\n",
-            &["nan.csv", "line 2", "m1 = NaN", "finite number > 0"],
+            &[
+                "nan.csv",
+                "line 2",
+                "m1 = NaN must be a number in [1e-6, 1e6]",
+            ],
         ),
         (
             "zero.csv",
@@ -683,7 +705,7 @@ fn every_bad_tools_file_is_refused_naming_file_line_and_value() {
         (
             "key.json",
             r#"[{"m1": 0.3, "m2": 0.4, "l1": 0.5, "l2": 0.2, "colour": 1}]"#,
-            &["key.json", "tool 1", "unknown column 'colour'"],
+            &["key.json", "tool 1", "unknown key 'colour'"],
         ),
         (
             "object.json",
@@ -802,12 +824,21 @@ fn every_bad_task_file_is_refused_naming_file_key_and_value() {
         ),
         (
             "long.toml",
-            "kind = \"position\"\n[episode]\nt_end = 1e9\n",
+            "kind = \"position\"\n[episode]\nt_end = 1e5\n",
             &[
                 "long.toml",
                 "key episode.t_end",
                 "episode too long",
-                "1000000000",
+                "t_end = 100000 s",
+            ],
+        ),
+        (
+            "far.toml",
+            "kind = \"position\"\n[episode]\nt_end = 1e9\n",
+            &[
+                "far.toml",
+                "key episode.t_end",
+                "1e9 must be a number in (0, 1e6] s",
             ],
         ),
         (
@@ -840,9 +871,9 @@ fn every_bad_task_file_is_refused_naming_file_key_and_value() {
         &["rank", "--tools", DRAWER, "--task", &task],
         &[
             "singular.toml",
-            "no tool",
-            "has a control confidence",
-            "not positive definite",
+            "key precision",
+            "cannot be positive definite for any tool",
+            "(precision.theta_ddot, precision.u) have ranks adding up to 0",
         ],
     );
     // A two-joint goal for a three-joint tool.
@@ -1004,14 +1035,14 @@ fn an_episode_too_long_to_hold_is_refused_up_front() {
             "--task",
             "position",
             "--t-end",
-            "1e9",
+            "1e5",
         ];
         args.extend(extra);
         let out = toolconf(&args);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
         assert!(
-            stderr.contains("episode too long") && stderr.contains("t_end = 1000000000"),
+            stderr.contains("episode too long") && stderr.contains("t_end = 100000 s"),
             "{stderr}"
         );
         assert_eq!(stderr.trim_end().lines().count(), 1);

@@ -19,12 +19,18 @@ class DescriptionError(ValueError):
 
     def __init__(self, path: Path | str, key: str, problem: str):
         self.path, self.key, self.problem = str(path), key, problem
-        # One line whatever the problem quotes (equations may span lines in the TOML).
-        super().__init__(one_line(f"{path}: {key}: {problem}" if key else f"{path}: {problem}"))
+        # One line whatever the problem quotes (equations may span lines in the TOML), and short
+        # whatever it repeats (a key or value of 100 kB is shown by its start and length).
+        key, problem = clip(one_line(key), 80), clip(one_line(problem), 300)
+        super().__init__(f"{path}: {key}: {problem}" if key else f"{path}: {problem}")
 
 
 def one_line(text: str) -> str:
     return " ".join(text.split())
+
+
+def clip(text: str, most: int) -> str:
+    return text if len(text) <= most else f"{text[:most]}… ({len(text)} characters)"
 
 
 @dataclass(frozen=True)
@@ -221,14 +227,29 @@ class _Table:
         return [_Table(self.path, f"{self.sub(k)}[{i}]", t, spec) for i, t in enumerate(self.raw.get(k, []))]
 
 
+# The largest description file read (a model is a few kB): `/dev/zero` or a stray large file is
+# one line and status 2, not an exhausted memory.
+MAX_DESCRIPTION_BYTES = 1 << 20
+
+
 def read_toml(path: Path) -> dict:
-    """The parsed file; a missing file or a TOML syntax error is a DescriptionError."""
+    """The parsed file; a missing, unreadable or too large file or a TOML syntax error is a
+    DescriptionError."""
     try:
-        return tomllib.loads(path.read_text())
+        with open(path, "rb") as f:
+            data = f.read(MAX_DESCRIPTION_BYTES + 1)
     except OSError as err:
         raise DescriptionError(path, "", f"cannot read: {err.strerror}") from err
+    if len(data) > MAX_DESCRIPTION_BYTES:
+        raise DescriptionError(path, "", f"larger than {MAX_DESCRIPTION_BYTES} bytes (1 MiB), "
+                                         "more than any description needs")
+    try:
+        return tomllib.loads(data.decode())
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
         raise DescriptionError(path, "", f"not valid TOML: {err}") from err
+    except RecursionError as err:
+        # tomllib recurses once per nested array or table: `q = [[[[…` thousands deep.
+        raise DescriptionError(path, "", "nested too deeply to be a description") from err
 
 
 def _named(t: _Table) -> Named:

@@ -7,6 +7,7 @@ use pyo3::types::{PyDict, PyFloat};
 use rayon::prelude::*;
 use toolconf::model::{ArmModel, SensitivitiesN, ToolN};
 use toolconf::task_file::TaskSpec;
+use toolconf::validate::finite_output;
 use toolconf::Term;
 
 use crate::errors::{detached, Failure};
@@ -42,6 +43,39 @@ struct One<const N: usize, const NX: usize> {
     logdet: f64,
 }
 
+impl<const N: usize, const NX: usize> One<N, NX> {
+    /// The last line of defence before the arrays reach Python: every number finite
+    /// ([`toolconf::validate::finite_output`]).
+    fn check_finite<M, const NP: usize, const NZ: usize>(
+        &self,
+        tool: &ToolN<M, N, NX, NP, NZ>,
+    ) -> Result<(), toolconf::Error>
+    where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
+        let s = &self.sensitivities;
+        let sensitivities = [s.d_theta_du, s.d_theta_dot_du, s.d_theta_ddot_du];
+        let finite = |m: &[f64]| m.iter().all(|v| v.is_finite());
+        if finite(self.a.as_slice())
+            && finite(self.b.as_slice())
+            && finite(self.pi_u.as_slice())
+            && self.logdet.is_finite()
+            && sensitivities.iter().flatten().all(|m| finite(m.as_slice()))
+        {
+            // The common case, without naming the tool: a batch checks millions.
+            return Ok(());
+        }
+        let tool = format!("{}({tool})", M::NAME);
+        finite_output(&tool, "A", self.a.iter().copied())?;
+        finite_output(&tool, "B", self.b.iter().copied())?;
+        for m in sensitivities.iter().flatten() {
+            finite_output(&tool, "a sensitivity", m.iter().copied())?;
+        }
+        finite_output(&tool, "Π^U", self.pi_u.iter().copied())?;
+        finite_output(&tool, "ln|Π^U|", [self.logdet])
+    }
+}
+
 /// Appends `m` to `out` in C order (row by row; nalgebra stores columns).
 fn push_c_order<const R: usize, const C: usize>(out: &mut Vec<f64>, m: &SMatrix<f64, R, C>) {
     out.extend((0..R).flat_map(|i| (0..C).map(move |j| m[(i, j)])));
@@ -67,13 +101,15 @@ where
         .map(|p| {
             let tool = ToolN::<M, N, NX, NP, NZ>::new(p.try_into().expect("NP values"))?;
             let c = task.control_confidence(&tool)?;
-            Ok(One {
+            let one = One {
                 a: tool.state_matrix(),
                 b: tool.input_matrix(),
                 sensitivities: tool.sensitivities(kind),
                 pi_u: c.pi_u,
                 logdet: c.logdet,
-            })
+            };
+            one.check_finite(&tool)?;
+            Ok(one)
         })
         .collect();
     let names = ["d_theta_du", "d_theta_dot_du", "d_theta_ddot_du"];
@@ -91,11 +127,15 @@ where
     for (i, r) in results.into_iter().enumerate() {
         let one = r.map_err(|e| {
             let row = &params[i * NP..(i + 1) * NP];
-            Failure::Input(if k == 1 {
+            let message = if k == 1 {
                 e.to_string()
             } else {
                 format!("tool {i} ({}): {e}", named(M::PARAMETER_NAMES, row))
-            })
+            };
+            match Failure::from_error(e) {
+                Failure::Run(_) => Failure::Run(message),
+                _ => Failure::Input(message),
+            }
         })?;
         push_c_order(&mut out.a, &one.a);
         push_c_order(&mut out.b, &one.b);
@@ -128,7 +168,7 @@ pub fn named<const NP: usize>(names: [&str; NP], values: &[f64]) -> String {
     let parts: Vec<String> = names
         .iter()
         .zip(values)
-        .map(|(n, v)| format!("{n}={v}"))
+        .map(|(n, v)| format!("{n}={}", toolconf::display::Short(*v)))
         .collect();
     parts.join(" ")
 }
@@ -142,7 +182,7 @@ pub fn named<const NP: usize>(names: [&str; NP], values: &[f64]) -> String {
 ///     model: a generated model's name (``toolconf.models()``), e.g. ``"arm2"``, the paper's arm.
 ///     params: one tool's parameters, a 1-D array in the model's parameter order (arm2:
 ///         m1, m2, l1, l2 in kg and m), or a 2-D array with one tool per row. Each must be a
-///         finite number > 0.
+///         number in ``toolconf.ranges()["tool_parameter"]``, [1e-6, 1e6].
 ///     task: ``"position"``, ``"velocity"``, ``"acceleration"`` (or ``1``, ``2``, ``3`` as
 ///         text), a task file's path, or a dict with a task file's keys, e.g.
 ///         ``{"kind": "position", "goal": {"theta": [0.78, 0.0]}, "precision": {"theta": 120.0}}``.
@@ -156,9 +196,11 @@ pub fn named<const NP: usize>(names: [&str; NP], values: &[f64]) -> String {
 ///     (``toolconf confidence --json``), digit for digit.
 ///
 /// Raises:
-///     ValueError: an unknown model, a parameter that is not a finite number > 0 (naming the
+///     ValueError: an unknown model, a parameter outside [1e-6, 1e6] (naming the
 ///         tool's row), a wrong number of parameters, or a bad task (naming the key), with the
 ///         command line's message.
+///     RuntimeError: a tool whose Π^U is too ill-conditioned for its ln|Π^U| to be computed
+///         (its parameters span too many decades), the command line's status 1.
 ///
 /// A batch runs on rayon's threads without holding the GIL.
 #[pyfunction]

@@ -92,6 +92,9 @@ pub fn design<'py>(
                 tasks: &tasks,
             };
             let result = run_design(&design_spec, &setting)?;
+            result
+                .check_finite(&names)
+                .map_err(|e| DesignError::Failed(e.to_string()))?;
             let front = match &sweep {
                 Some(s) => Some(run_sweep(&design_spec, &setting, s)?),
                 None => None,

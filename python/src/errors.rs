@@ -20,6 +20,9 @@ create_exception!(
 pub enum Failure {
     /// Bad input: the message the command line prints (after `toolconf: error: `).
     Input(String),
+    /// A run that failed other than by an episode (a result that is not finite: the command
+    /// line's status 1), raised as `RuntimeError`.
+    Run(String),
     /// A failed episode.
     Simulation {
         message: String,
@@ -32,6 +35,15 @@ pub enum Failure {
 impl Failure {
     pub fn input(e: impl std::fmt::Display) -> Self {
         Failure::Input(e.to_string())
+    }
+
+    /// A crate error: bad input, or a result that is not finite (a failed run).
+    pub fn from_error(e: toolconf::Error) -> Self {
+        if e.is_failed_run() {
+            Failure::Run(e.to_string())
+        } else {
+            Failure::input(e)
+        }
     }
 
     /// An episode's error: bad input stays bad input; the rest names the tool and the time.
@@ -61,6 +73,7 @@ impl Failure {
     pub fn into_pyerr(self, py: Python<'_>) -> PyErr {
         match self {
             Failure::Input(message) => PyValueError::new_err(message),
+            Failure::Run(message) => PyRuntimeError::new_err(message),
             Failure::Simulation {
                 message,
                 tool,

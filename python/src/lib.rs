@@ -35,7 +35,14 @@ use pyo3::prelude::*;
 /// and ranking of tools, for every model toolconf generates (see `toolconf.models()`).
 #[pymodule]
 fn _toolconf(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // RAYON_NUM_THREADS=5000 would start 5000 threads; the pool is capped as the command
+    // line's is (toolconf::threads), with a warning.
+    if let Some(note) = toolconf::threads::cap_pool() {
+        let category = m.py().get_type::<pyo3::exceptions::PyRuntimeWarning>();
+        PyErr::warn(m.py(), &category, &std::ffi::CString::new(note)?, 1)?;
+    }
     m.add_function(wrap_pyfunction!(models::models, m)?)?;
+    m.add_function(wrap_pyfunction!(models::ranges, m)?)?;
     m.add_function(wrap_pyfunction!(confidence::confidence, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(rank::rank, m)?)?;

@@ -102,3 +102,21 @@ pub fn models(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     }
     Ok(out)
 }
+
+/// Every documented valid range (``README.md``, "Bad input"): ``{name: {"low", "high",
+/// "low_open", "unit"}}``, e.g. ``ranges()["tool_parameter"]`` is ``[1e-6, 1e6]``, the range of
+/// every tool parameter, where the generated arithmetic is known to stay finite. A value outside
+/// its range raises ``ValueError`` before any work starts.
+#[pyfunction]
+pub fn ranges(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    let out = PyDict::new(py);
+    for (name, range) in toolconf::validate::RANGES {
+        let entry = PyDict::new(py);
+        entry.set_item("low", range.lo)?;
+        entry.set_item("high", range.hi)?;
+        entry.set_item("low_open", range.lo_open)?;
+        entry.set_item("unit", range.unit)?;
+        out.set_item(name, entry)?;
+    }
+    Ok(out)
+}

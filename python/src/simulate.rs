@@ -34,6 +34,9 @@ where
     let mut options = spec.episode::<M, N, NX, NP, NZ>().map_err(Failure::input)?;
     options.record_trajectory = true;
     let e = episode(&tool, &task, &options).map_err(Failure::episode)?;
+    e.metrics
+        .check_finite(&format!("{}({tool})", M::NAME))
+        .map_err(Failure::from_error)?;
     let tr = e.trajectory.expect("a recorded episode has a trajectory");
     let flat = |s: &[nalgebra::SVector<f64, N>]| -> Vec<f64> {
         s.iter().flat_map(|v| v.iter().copied()).collect()
@@ -60,7 +63,7 @@ where
 ///
 /// Args:
 ///     model: a generated model's name (``toolconf.models()``).
-///     params: the tool's parameters, a 1-D array in the model's order (all finite, > 0).
+///     params: the tool's parameters, a 1-D array in the model's order (each in [1e-6, 1e6]).
 ///     task: a built-in task name, a task file's path, or a dict with a task file's keys.
 ///     method: the integrator, as the command line's ``--method``: ``"fast"`` (the default: ode45's
 ///         steps until a quick stiffness test fires, then Rodas5P), ``"explicit"`` (exactly

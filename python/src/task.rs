@@ -7,6 +7,8 @@ use std::path::{Path, PathBuf};
 
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use toolconf::bounded_read::read_text_file;
+use toolconf::display::Clip;
 use toolconf::task_file::TaskSpec;
 use toolconf::TaskKind;
 
@@ -62,10 +64,10 @@ fn named(name: &Path, episode: Option<toml::Table>) -> Result<TaskSpec, Failure>
         }
         return Ok(spec);
     }
-    if !name.is_file() {
+    if std::fs::metadata(name).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound) {
         return Err(Failure::Input(format!(
             "task '{}': neither a built-in task ({}) nor an existing task file",
-            name.display(),
+            Clip(&name.display().to_string()),
             toolconf::task::task_choices()
         )));
     }
@@ -74,7 +76,8 @@ fn named(name: &Path, episode: Option<toml::Table>) -> Result<TaskSpec, Failure>
         return Ok(spec);
     };
     // The file parsed, so it is a table; read it again as one to put the options over it.
-    let text = std::fs::read_to_string(name).map_err(Failure::input)?;
+    let text = read_text_file(name, "task file")
+        .map_err(|m| Failure::Input(format!("{}: {m}", spec.file)))?;
     let mut t: toml::Table = toml::from_str(&text).map_err(Failure::input)?;
     merge_episode(&mut t, e);
     TaskSpec::from_table(t, &spec.file).map_err(Failure::input)
@@ -99,7 +102,11 @@ pub fn table(dict: &Bound<'_, PyDict>, at: &str, source: &str) -> Result<toml::T
         let Ok(key) = key.extract::<String>() else {
             return Err(Failure::Input(format!(
                 "{source}, key {}: {} is not a string key",
-                if at.is_empty() { "(top level)" } else { at },
+                if at.is_empty() {
+                    "(top level)".into()
+                } else {
+                    Clip(at).to_string()
+                },
                 repr(&key)
             )));
         };
@@ -125,6 +132,10 @@ fn to_toml(value: &Bound<'_, PyAny>, path: &str, source: &str) -> Result<toml::V
     if value.is_instance_of::<PyInt>() {
         if let Ok(i) = value.extract::<i64>() {
             return Ok(toml::Value::Integer(i));
+        }
+        // Past i64 (TOML's integers): as a float, which the range checks then judge.
+        if let Ok(x) = value.extract::<f64>() {
+            return Ok(toml::Value::Float(x));
         }
     }
     if value.is_instance_of::<PyFloat>() {
@@ -160,16 +171,19 @@ fn to_toml(value: &Bound<'_, PyAny>, path: &str, source: &str) -> Result<toml::V
 
 fn unsupported(value: &Bound<'_, PyAny>, path: &str, source: &str) -> Failure {
     Failure::Input(format!(
-        "{source}, key {path}: {} is not a number, string, list or dict",
+        "{source}, key {}: {} is not a number, string, list or dict",
+        Clip(path),
         repr(value)
     ))
 }
 
+/// `repr(value)` as a message repeats it ([`Clip`]: one line, not long).
 fn repr(value: &Bound<'_, PyAny>) -> String {
-    value
+    let text = value
         .repr()
         .map(|r| r.to_string())
-        .unwrap_or_else(|_| "<unprintable>".into())
+        .unwrap_or_else(|_| "<unprintable>".into());
+    Clip(&text).to_string()
 }
 
 /// `method="fast"` (the command line's `--method`, and its default), `"explicit"` (MATLAB

@@ -32,7 +32,7 @@ def test_a_bad_tool_in_a_batch_is_named_by_its_row():
     params = np.full((5, 4), 0.3)
     params[3, 1] = -1.0
     with pytest.raises(ValueError, match=r"^tool 3 \(m1=0.3 m2=-1 l1=0.3 l2=0.3\): invalid arm "
-                                         r"parameter m2 = -1: must be a finite number > 0$"):
+                                         r"parameter m2 = -1: must be a number in \[1e-6, 1e6\]$"):
         toolconf.confidence("arm2", params, "position")
 
 
@@ -75,6 +75,15 @@ def test_an_unknown_task(cli_error):
     ('kind = "position"\n[episode]\nt_end = -1.0\n', {"kind": "position", "episode": {"t_end": -1.0}}),
     ('kind = "position"\n[goal]\ntheta = [nan, 0.0]\n',
      {"kind": "position", "goal": {"theta": [float("nan"), 0.0]}}),
+    # The valid ranges (toolconf.ranges()), checked by the same code on both sides.
+    ('kind = "position"\n[episode]\nrtol = 1e10\n', {"kind": "position", "episode": {"rtol": 1e10}}),
+    ('kind = "position"\n[episode]\ndt = 5e-324\n', {"kind": "position", "episode": {"dt": 5e-324}}),
+    ('kind = "position"\n[precision]\ntheta = 1e300\n',
+     {"kind": "position", "precision": {"theta": 1e300}}),
+    ('kind = "position"\n[goal]\ntheta = [1e300, 0.0]\n',
+     {"kind": "position", "goal": {"theta": [1e300, 0.0]}}),
+    ('kind = "acceleration"\n[precision]\ntheta_ddot = 0.0\nu = 0.0\n',
+     {"kind": "acceleration", "precision": {"theta_ddot": 0.0, "u": 0.0}}),
 ])
 def test_a_bad_task_dict_gives_the_task_files_message_for_the_same_key(toml, task, cli_error,
                                                                        tmp_path):
@@ -103,9 +112,12 @@ def test_a_dict_of_the_wrong_shape_names_the_key(task, message):
 def test_unknown_or_bad_episode_options_name_the_key():
     with pytest.raises(ValueError, match="key episode: unknown field `t_ned`"):
         toolconf.simulate("arm2", PAPER_ARM, "position", t_ned=3.0)
-    with pytest.raises(ValueError, match=r"key episode.dt: 10 is larger than t_end = 5"):
+    with pytest.raises(ValueError,
+                       match=r"key episode.dt: the output step dt = 10 s is larger than t_end = 5 s"):
         toolconf.simulate("arm2", PAPER_ARM, "position", dt=10.0)
     with pytest.raises(ValueError, match=r"key episode.t_end: episode too long"):
+        toolconf.simulate("arm2", PAPER_ARM, "position", t_end=1e5)
+    with pytest.raises(ValueError, match=r"key episode.t_end: 1e9 must be a number in \(0, 1e6\] s"):
         toolconf.simulate("arm2", PAPER_ARM, "position", t_end=1e9)
     with pytest.raises(ValueError, match=r"key episode.perturbation: 3 values \[.*\], but model "
                                          r"arm2 has 2 joints"):
@@ -148,3 +160,15 @@ def test_a_task_that_does_not_fit_a_tool_of_the_file(cli_error, tmp_path):
     with pytest.raises(ValueError) as caught:
         toolconf.rank(DRAWER, task)
     assert str(caught.value) == expected
+
+
+def test_a_parameter_outside_its_range_is_refused_with_the_range(cli):
+    status, _, stderr = cli("confidence", "--arm", "1e308,1e308,1e308,1e308", "--task", "velocity")
+    assert status == 2
+    expected = stderr.splitlines()[0].split("for '--arm <ARM>': ", 1)[1]
+    assert expected == "invalid arm parameter m1 = 1e308: must be a number in [1e-6, 1e6]"
+    with pytest.raises(ValueError) as caught:
+        toolconf.confidence("arm2", [1e308] * 4, "velocity")
+    assert str(caught.value) == expected
+    assert toolconf.ranges()["tool_parameter"] == {"low": 1e-6, "high": 1e6, "low_open": False,
+                                                   "unit": ""}

@@ -43,13 +43,19 @@ def test_rank_equals_the_command_line(task, screen, objective, cli_json):
 
 
 def test_failed_tools_rank_last_with_their_error(cli_json, tmp_path):
+    # P^θ = e₁e₁ᵀ and P^U = e₂e₂ᵀ leave Π^U singular for a tool whose ∂θ₁/∂U₁ vanishes
+    # (l1 = 1, m1 + 3 m2 = 3; tests/identities.rs).
     path = tmp_path / "t.csv"
-    path.write_text("name,m1,m2,l1,l2\nok,0.3,0.3,0.3,0.3\ngiant,0.3,0.3,1e200,1e200\n"
+    path.write_text("name,m1,m2,l1,l2\nok,0.3,0.3,0.3,0.3\nsingular,1.5,0.5,1.0,0.3\n"
                     "ok2,0.2,0.4,0.3,0.3\n")
-    expected = cli_json("rank", "--tools", path, "--task", "position")["tools"]
-    got = toolconf.rank(path, "position")
+    task = tmp_path / "singular.toml"
+    task.write_text('kind = "position"\n[precision]\ntheta = [[1.0, 0.0], [0.0, 0.0]]\n'
+                    "theta_dot = 0.0\ntheta_ddot = 0.0\nu = [[0.0, 0.0], [0.0, 1.0]]\n"
+                    "[episode]\nt_end = 0.5\n")
+    expected = cli_json("rank", "--tools", path, "--task", task)["tools"]
+    got = toolconf.rank(path, task)
     assert_same_as_cli(got, expected)
-    assert got["name"][-1] == "giant" and "not positive definite" in got["error"][-1]
+    assert got["name"][-1] == "singular" and "not positive definite" in got["error"][-1]
 
 
 def test_mixed_models_and_a_json_tools_file(cli_json, tmp_path):

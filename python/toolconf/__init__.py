@@ -16,11 +16,12 @@ The runtime is Rust (the ``toolconf`` crate); this package exposes it over NumPy
 * ``models()``: the generated models and their parameter names.
 * ``toolconf.dask`` (``pip install "./python[dask]"``): ``rank`` and ``simulate_batch`` on a
   Dask cluster, with the same results.
+* ``ranges()``: the valid range of every number the package and the command line take.
 
 A task is ``"position"``, ``"velocity"`` or ``"acceleration"`` (the paper's tasks 1-3), a task
-file's path, or a dict with a task file's keys. Bad input raises ``ValueError`` with the
-command line's message; a failed episode raises ``SimulationError`` (``tool``, ``time``,
-``reason``).
+file's path, or a dict with a task file's keys. Bad input (a value outside ``ranges()``
+included) raises ``ValueError`` with the command line's message; a failed episode raises
+``SimulationError`` (``tool``, ``time``, ``reason``).
 """
 
 import os
@@ -30,13 +31,22 @@ import numpy as np
 
 from . import _toolconf
 from ._tables import native_tools
-from ._toolconf import SimulationError, confidence, design, models, simulate, simulate_batch
+from ._toolconf import (
+    SimulationError,
+    confidence,
+    design,
+    models,
+    ranges,
+    simulate,
+    simulate_batch,
+)
 
 __all__ = [
     "SimulationError",
     "confidence",
     "design",
     "models",
+    "ranges",
     "rank",
     "simulate",
     "simulate_batch",

@@ -31,6 +31,18 @@ class SimulationError(RuntimeError):
 def models() -> dict[str, ModelInfo]:
     """The generated models: ``{name: {"title", "dof", "parameters"}}`` in registry order."""
 
+class RangeInfo(TypedDict):
+    low: float
+    high: float
+    low_open: bool
+    unit: str
+
+def ranges() -> dict[str, RangeInfo]:
+    """Every documented valid range, e.g. ``ranges()["tool_parameter"]`` (``[1e-6, 1e6]``).
+
+    A value outside its range raises ``ValueError`` before any work starts.
+    """
+
 def confidence(model: str, params: Params, task: Task) -> dict[str, Any]:
     """The closed-form control confidence Π^U = ∂²F/∂U² of one tool or of many.
 

@@ -2,6 +2,7 @@
 
 use serde_json::json;
 use toolconf::model::Arm2;
+use toolconf::validate::finite_output;
 use toolconf::{control_confidence, Arm};
 
 use super::episode_args::TaskArgs;
@@ -28,6 +29,17 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let s = args.arm.sensitivities(kind);
     let a = args.arm.state_matrix();
     let b = args.arm.input_matrix();
+    let arm = format!("arm {}", args.arm);
+    finite_output(&arm, "A", a.iter().copied())?;
+    finite_output(&arm, "B", b.iter().copied())?;
+    for m in [s.d_theta_du, s.d_theta_dot_du, s.d_theta_ddot_du]
+        .iter()
+        .flatten()
+    {
+        finite_output(&arm, "a sensitivity", m.iter().copied())?;
+    }
+    finite_output(&arm, "Π^U", confidence.pi_u.iter().copied())?;
+    finite_output(&arm, "ln|Π^U|", [confidence.logdet])?;
     if args.json {
         let mut sens = serde_json::Map::new();
         for (name, m) in [
@@ -51,13 +63,13 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         if let Some(path) = &args.task.task_file {
             out["task_file"] = json!(path);
         }
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&out).expect("JSON of finite numbers")
         );
         return Ok(());
     }
-    println!("arm: {}    task: {}", args.arm, spec.label());
+    outln!("arm: {}    task: {}", args.arm, spec.label());
     print_matrix("A = df/dX at the equilibrium", &a);
     print_matrix("B = df/dU at the equilibrium", &b);
     for (name, m) in [
@@ -70,6 +82,6 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         }
     }
     print_matrix("Pi^U (control confidence)", &confidence.pi_u);
-    println!("ln|Pi^U| = {:.12}", confidence.logdet);
+    outln!("ln|Pi^U| = {:.12}", confidence.logdet);
     Ok(())
 }

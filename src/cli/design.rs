@@ -1,18 +1,20 @@
 //! `toolconf design --model M --task NAME|FILE --design FILE [--json] [--report DIR]
 //! [--sweep 'LEFT <= A..B:K']`: which tool to build (src/design).
 
+use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Instant;
 
 use toolconf::design::file::DesignSpec;
 use toolconf::design::json::design_json;
+use toolconf::design::solver::KKT_TOLERANCE;
 use toolconf::design::sweep::{parse_sweep, run_sweep};
-use toolconf::design::{design, DesignError, DesignResult, Setting};
+use toolconf::design::{design_with_progress, DesignError, DesignResult, Setting};
 use toolconf::model::mixed::ModelKind;
 use toolconf::rank::ModelTasks;
 use toolconf_report::design::{parameters_text, write_report, ReportInput};
 
-use super::output::CliError;
+use super::output::{check_output_folder, CliError};
 use super::rank::task_spec;
 
 #[derive(clap::Args)]
@@ -52,6 +54,9 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         .parse()
         .map_err(|e| CliError::Usage(format!("--model: {e}")))?;
     let task = task_spec(&args.task)?;
+    if let Some(dir) = &args.report {
+        check_output_folder("--report", dir)?;
+    }
     let tasks = ModelTasks::new(&task);
     tasks.check(model)?;
     let names: Vec<&'static str> = model.parameter_names().to_vec();
@@ -68,8 +73,21 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         tasks: &tasks,
     };
     let started = Instant::now();
-    let result = design(&spec, &setting)?;
+    let counts = "draws of random tools, {msg} (eta {eta})";
+    let bar = toolconf_report::progress::counting(
+        std::io::stderr().is_terminal(),
+        spec.search.samples as u64,
+        counts,
+    );
+    let result = design_with_progress(&spec, &setting, &mut |s| {
+        bar.set_length(s.max_draws);
+        bar.set_position(s.drawn);
+        bar.set_message(format!("{} of {} feasible", s.feasible, s.requested));
+    })?;
+    bar.finish_and_clear();
     let elapsed = started.elapsed();
+    result.check_finite(&names)?;
+    warn_about(&result);
     let front = match &sweep {
         Some(s) => Some(run_sweep(&spec, &setting, s)?),
         None => None,
@@ -97,24 +115,50 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     }
     if args.json {
         let v = design_json(&spec, &result, model, &args.task, front.as_deref());
-        println!("{}", serde_json::to_string_pretty(&v).expect("JSON"));
+        outln!("{}", serde_json::to_string_pretty(&v).expect("JSON"));
     } else {
         print_text(&spec, &result, elapsed.as_secs_f64());
         if let (Some(s), Some(points)) = (&sweep, &front) {
-            println!("\ntrade-off, {} b:", s.label);
+            outln!("\ntrade-off, {} b:", s.label);
             for p in points {
                 match &p.outcome {
-                    Ok((params, logdet, _)) => println!(
+                    Ok((params, logdet, _)) => outln!(
                         "  b = {:<8} ln|Pi^U| = {logdet:.6}  {}",
                         p.value,
                         parameters_text(&names, params)
                     ),
-                    Err(e) => println!("  b = {:<8} {e}", p.value),
+                    Err(e) => outln!("  b = {:<8} {e}", p.value),
                 }
             }
         }
     }
     Ok(())
+}
+
+/// What the result itself cannot say loudly enough, on stderr: an optimum that did not converge,
+/// a random comparison that stopped short.
+fn warn_about(r: &DesignResult) {
+    let o = &r.confidence_optimum;
+    if !o.converged() {
+        errln!(
+            "toolconf: warning: the confidence optimum did not converge (KKT residual {:.2e} > {:.0e} \
+             after {} SQP iterations): the design is the best point found, not a proven maximum",
+            o.kkt_residual,
+            KKT_TOLERANCE,
+            o.iterations
+        );
+    }
+    let random = &r.random;
+    if random.feasible < random.requested {
+        errln!(
+            "toolconf: warning: only {} of the {} random feasible tools asked for ([search] samples) \
+             were found in {} draws from the box: the feasible set is a small part of it, and the \
+             comparison uses those found",
+            random.feasible,
+            random.requested,
+            random.drawn
+        );
+    }
 }
 
 /// The confidence optimum's full parameters (fixed ones in place).
@@ -124,23 +168,23 @@ fn spec_params(spec: &DesignSpec, o: &toolconf::design::solver::Optimum) -> Vec<
 
 fn print_text(spec: &DesignSpec, r: &DesignResult, seconds: f64) {
     let o = &r.confidence_optimum;
-    println!(
+    outln!(
         "design ({}): {}",
         r.objective.name(),
         parameters_text(&spec.names, &r.params)
     );
-    println!("  ln|Pi^U| = {:.6}", r.logdet);
+    outln!("  ln|Pi^U| = {:.6}", r.logdet);
     if r.free_energy_evaluations > 0 {
-        println!(
+        outln!(
             "  free-energy search: {} episodes from the confidence optimum, {} (ln|Pi^U| = {:.6})",
             r.free_energy_evaluations,
             parameters_text(&spec.names, &spec_params(spec, o)),
             o.value
         );
     }
-    println!("  confidence optimum: KKT residual {:.2e}, {} SQP iterations from start {}, gradient vs central differences {:.1e}", o.kkt_residual, o.iterations, o.start, r.gradient_check);
-    println!("  time (design, random comparison and episodes): {seconds:.3} s");
-    println!(
+    outln!("  confidence optimum: KKT residual {:.2e}, {} SQP iterations from start {}, gradient vs central differences {:.1e}", o.kkt_residual, o.iterations, o.start, r.gradient_check);
+    outln!("  time (design, random comparison and episodes): {seconds:.3} s");
+    outln!(
         "best of {} random feasible tools ({} draws): ln|Pi^U| = {}",
         r.random.feasible,
         r.random.drawn,
@@ -149,7 +193,7 @@ fn print_text(spec: &DesignSpec, r: &DesignResult, seconds: f64) {
             .first()
             .map_or("-".into(), |b| format!("{:.6}", b.1))
     );
-    println!(
+    outln!(
         "\n{:<10} {:>11} {:>14} {:>14} {:>14}  parameters",
         "tool",
         "ln|Pi^U|",
@@ -165,7 +209,7 @@ fn print_text(spec: &DesignSpec, r: &DesignResult, seconds: f64) {
             ),
             Err(e) => format!("episode failed: {e}"),
         };
-        println!(
+        outln!(
             "{:<10} {:>11.6} {cells}  {}",
             c.label,
             c.logdet,

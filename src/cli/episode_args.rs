@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use toolconf::closed_loop::{EpisodeOptions, Plant};
 use toolconf::integrate::Method;
-use toolconf::task_file::{EpisodeSpec, PerJoint, TaskSpec};
+use toolconf::task_file::{PerJoint, TaskSpec};
 use toolconf::{Error, TaskKind};
 
 use super::output::CliError;
@@ -111,18 +111,21 @@ impl From<PlantArg> for Plant {
     }
 }
 
-fn check_tolerances(rtol: f64, atol: f64) -> Result<(), Error> {
-    for (name, value) in [("rtol", rtol), ("atol", atol)] {
-        if !(value.is_finite() && value > 0.0) {
-            return Err(Error::InvalidOption { name, value });
-        }
-    }
-    Ok(())
-}
+/// The episode flags by the task-file key they override, to name a refused value by its flag.
+const FLAGS: [(&str, &str); 6] = [
+    ("episode.t_end", "--t-end"),
+    ("episode.dt", "--dt"),
+    ("episode.perturbation", "--perturb"),
+    ("episode.learning_rate", "--gamma"),
+    ("episode.rtol", "--rtol"),
+    ("episode.atol", "--atol"),
+];
 
 impl EpisodeArgs {
-    /// The 2-link options of a built-in task: the flags over the paper's defaults.
-    pub fn options(&self, record_trajectory: bool) -> Result<EpisodeOptions, Error> {
+    /// The 2-link options of a built-in task: the flags over the paper's defaults, checked as a
+    /// task file's `[episode]` is.
+    pub fn options(&self, record_trajectory: bool) -> Result<EpisodeOptions, CliError> {
+        self.apply(&mut TaskSpec::builtin(TaskKind::Position))?;
         let d = EpisodeOptions::default();
         let mut o = EpisodeOptions {
             t_end: self.t_end.unwrap_or(d.t_end),
@@ -134,17 +137,20 @@ impl EpisodeArgs {
         };
         o.integrator.rtol = self.rtol.unwrap_or(d.integrator.rtol);
         o.integrator.atol = self.atol.unwrap_or(d.integrator.atol);
-        check_tolerances(o.integrator.rtol, o.integrator.atol)?;
         Ok(o)
     }
 
-    /// Puts the flags that were given over a task file's `[episode]`.
-    pub fn apply(&self, e: &mut EpisodeSpec) -> Result<(), Error> {
+    /// Puts the flags that were given over the task's `[episode]`, then checks every option
+    /// against its range ([`toolconf::task_file::EpisodeSpec::check`]): a refused value is named
+    /// by the flag that gave it (`--dt: 0 must be a number in [1e-6, 1e6] s`), else by the task
+    /// file and key.
+    pub fn apply(&self, spec: &mut TaskSpec) -> Result<(), CliError> {
         let set = |slot: &mut Option<f64>, v: Option<f64>| {
             if v.is_some() {
                 *slot = v;
             }
         };
+        let e = &mut spec.episode;
         set(&mut e.t_end, self.t_end);
         set(&mut e.dt, self.dt);
         set(&mut e.learning_rate, self.learning_rate);
@@ -153,7 +159,41 @@ impl EpisodeArgs {
         if let Some(p) = self.perturbation {
             e.perturbation = Some(PerJoint::All(p));
         }
-        check_tolerances(e.rtol.unwrap_or(1e-3), e.atol.unwrap_or(1e-6))
+        let Err((key, message)) = spec.episode.check() else {
+            return Ok(());
+        };
+        match self.flag_for(key) {
+            Some(flag) => Err(CliError::Usage(format!("{flag}: {message}"))),
+            None => Err(spec.error(key, message).into()),
+        }
+    }
+
+    /// The flag that gave the value of `key`, if one did; for dt and t_end, which are checked
+    /// against each other, the other one's flag if only it was given.
+    fn flag_for(&self, key: &str) -> Option<&'static str> {
+        let given = |k: &str| match k {
+            "episode.t_end" => self.t_end.is_some(),
+            "episode.dt" => self.dt.is_some(),
+            "episode.perturbation" => self.perturbation.is_some(),
+            "episode.learning_rate" => self.learning_rate.is_some(),
+            "episode.rtol" => self.rtol.is_some(),
+            "episode.atol" => self.atol.is_some(),
+            _ => false,
+        };
+        let flag = |k: &str| FLAGS.iter().find(|(key, _)| *key == k).map(|(_, f)| *f);
+        if given(key) {
+            return flag(key);
+        }
+        let other = match key {
+            "episode.dt" => "episode.t_end",
+            "episode.t_end" => "episode.dt",
+            _ => return None,
+        };
+        if given(other) {
+            flag(other)
+        } else {
+            None
+        }
     }
 }
 

@@ -1,5 +1,27 @@
 //! Command-line front end: parses arguments, runs one subcommand, prints text or JSON.
-//! Bad input is a message on stderr and exit status 2; a failed simulation exits with 1.
+//!
+//! The exit-code rule, the same for every subcommand: bad input (an argument, a file, an option
+//! out of its range, a task whose Π^U cannot be positive definite) is refused before any work
+//! starts, with one line on stderr and status 2; a run that fails (a simulation, every tool of a
+//! batch, a write) ends with one line and status 1; a batch in which only some tools failed
+//! succeeds (0) and reports them with the results.
+
+/// `println!` that never panics: standard output through [`stdout::write`].
+macro_rules! outln {
+    () => {
+        $crate::toolconf_cli::stdout::write(format_args!("\n"))
+    };
+    ($($arg:tt)*) => {
+        $crate::toolconf_cli::stdout::write(format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
+
+/// `eprintln!` that never panics: standard error through [`stdout::write_error`].
+macro_rules! errln {
+    ($($arg:tt)*) => {
+        $crate::toolconf_cli::stdout::write_error(format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
 
 mod confidence;
 mod design;
@@ -9,10 +31,11 @@ mod rank;
 mod reproduce;
 mod select;
 mod simulate;
+mod stdout;
 
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use toolconf::{Arm, TaskKind};
 
 /// Confidence-aware decision-making and control for tool selection.
@@ -52,7 +75,13 @@ pub(crate) fn parse_task(s: &str) -> Result<TaskKind, String> {
 }
 
 pub fn run() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match parse() {
+        Ok(cli) => cli,
+        Err(code) => return code,
+    };
+    if let Some(note) = toolconf::threads::cap_pool() {
+        errln!("toolconf: note: {note}");
+    }
     let result = match cli.command {
         Command::Confidence(args) => confidence::run(&args),
         Command::Simulate(args) => simulate::run(&args),
@@ -61,11 +90,77 @@ pub fn run() -> ExitCode {
         Command::Reproduce(args) => reproduce::run(&args),
         Command::Design(args) => design::run(&args),
     };
-    match result {
+    let flushed = stdout::finish().map_err(output::CliError::Stdout);
+    match result.and(flushed) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
-            eprintln!("toolconf: error: {err}");
+            errln!("toolconf: error: {err}");
             ExitCode::from(err.exit_code())
         }
     }
+}
+
+/// The arguments, or the exit code of a run that ends here: `--help` and `--version` (0, or 1
+/// when they cannot be printed), a bad argument (2, one line on stderr). A negative number is
+/// a value, not a flag (`--tools -1` is the value -1 of `--tools`, refused by its own check).
+fn parse() -> Result<Cli, ExitCode> {
+    let command = Cli::command().mut_subcommands(|sub| {
+        sub.mut_args(|arg| {
+            if arg.get_action().takes_values() {
+                arg.allow_negative_numbers(true)
+            } else {
+                arg
+            }
+        })
+    });
+    let error = match command
+        .try_get_matches()
+        .and_then(|m| Cli::from_arg_matches(&m))
+    {
+        Ok(cli) => return Ok(cli),
+        Err(e) => e,
+    };
+    use clap::error::ErrorKind;
+    match error.kind() {
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+            outln!("{}", error.to_string().trim_end());
+            match stdout::finish() {
+                Ok(()) => Err(ExitCode::SUCCESS),
+                Err(e) => {
+                    errln!("toolconf: error: {}", output::CliError::Stdout(e));
+                    Err(ExitCode::from(1))
+                }
+            }
+        }
+        // `toolconf` alone: the list of subcommands is the answer.
+        ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            errln!("{}", error.to_string().trim_end());
+            Err(ExitCode::from(2))
+        }
+        _ => {
+            errln!("toolconf: error: {}", one_line(&error.to_string()));
+            Err(ExitCode::from(2))
+        }
+    }
+}
+
+/// The most characters of clap's message the one line keeps (it may repeat a long value).
+const MAX_MESSAGE_CHARS: usize = 400;
+
+/// clap's message as one line: its first paragraph and tips, without the usage and the pointer
+/// to `--help`, at most [`MAX_MESSAGE_CHARS`] characters.
+fn one_line(rendered: &str) -> String {
+    let parts: Vec<&str> = rendered
+        .lines()
+        .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect();
+    let line = parts.join("; ");
+    let line = line.strip_prefix("error: ").unwrap_or(&line);
+    let mut out: String = line.chars().take(MAX_MESSAGE_CHARS).collect();
+    if line.chars().count() > MAX_MESSAGE_CHARS {
+        out.push('…');
+    }
+    out.replace(['\n', '\r'], " ")
 }

@@ -14,10 +14,10 @@ pub fn matrix_rows<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> Va
 
 /// A titled matrix, one row a line, in a width that keeps columns aligned.
 pub fn print_matrix<const R: usize, const C: usize>(title: &str, m: &SMatrix<f64, R, C>) {
-    println!("{title}:");
+    outln!("{title}:");
     for i in 0..R {
         let row: Vec<String> = (0..C).map(|j| format!("{:>16.9e}", m[(i, j)])).collect();
-        println!("  [{}]", row.join(" "));
+        outln!("  [{}]", row.join(" "));
     }
 }
 
@@ -72,11 +72,22 @@ pub enum CliError {
     /// A run that failed as a whole, in words.
     #[error("{0}")]
     Failed(String),
+    /// Standard output could not be written (other than a closed pipe, which ends the process).
+    #[error("cannot write to standard output: {0}")]
+    Stdout(std::io::Error),
 }
 
 impl CliError {
     pub fn exit_code(&self) -> u8 {
         match self {
+            // Valid input the arithmetic cannot answer: a failed run, not bad input.
+            CliError::Input(e)
+            | CliError::Mpc(toolconf::mpc::MpcEpisodeError::Input(e))
+            | CliError::Model(toolconf::model::ModelSimulationError::Input(e))
+                if e.is_failed_run() =>
+            {
+                1
+            }
             CliError::Input(_)
             | CliError::Mpc(toolconf::mpc::MpcEpisodeError::Input(_))
             | CliError::Model(toolconf::model::ModelSimulationError::Input(_))
@@ -88,13 +99,31 @@ impl CliError {
             | CliError::Io { .. }
             | CliError::Output(_)
             | CliError::Write(_)
-            | CliError::Failed(_) => 1,
+            | CliError::Failed(_)
+            | CliError::Stdout(_) => 1,
         }
     }
 }
 
 /// Writes a whole file or nothing: a temporary file beside the target, renamed into place, so an
-/// interrupted run never leaves a half-written file ([`toolconf::output::write_atomically`]).
+/// interrupted run never leaves a half-written file; a device or other non-regular file is
+/// written in place, never replaced ([`toolconf::output::file`]).
 pub fn write_atomically(path: &std::path::Path, contents: &str) -> Result<(), CliError> {
-    Ok(toolconf::output::write_atomically(path, contents)?)
+    toolconf::output::file::write_whole(path, contents.as_bytes()).map_err(|source| CliError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// `--csv FILE` (or another output file flag) checked before any work: a folder, a link to
+/// nothing or a missing folder is bad input (status 2), not a failed run.
+pub fn check_output_file(flag: &str, path: &std::path::Path) -> Result<(), CliError> {
+    toolconf::output::file::check_file(path)
+        .map_err(|m| CliError::Usage(format!("{flag} {}: {m}", path.display())))
+}
+
+/// `--report DIR` (or `--out DIR`) checked before any work: an existing file is bad input.
+pub fn check_output_folder(flag: &str, path: &std::path::Path) -> Result<(), CliError> {
+    toolconf::output::file::check_folder(path)
+        .map_err(|m| CliError::Usage(format!("{flag} {}: {m}", path.display())))
 }

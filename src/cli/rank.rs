@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use serde_json::{json, Map, Value};
+use toolconf::display::Clip;
 use toolconf::model::mixed::ModelKind;
 use toolconf::output::csv::{Cell, CsvWriter};
 use toolconf::rank::{
@@ -21,7 +22,7 @@ use toolconf::TaskKind;
 use toolconf_report::progress::{self, ProgressBar};
 use toolconf_report::rank::{write_report, ReportInput};
 
-use super::output::{add_outcome, CliError};
+use super::output::{add_outcome, check_output_file, check_output_folder, CliError};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -71,14 +72,15 @@ impl From<ObjectiveArg> for Objective {
     }
 }
 
-/// A built-in task name, else a task file.
+/// A built-in task name, else a task file (one that exists but cannot be read says why).
 pub(crate) fn task_spec(task: &str) -> Result<TaskSpec, CliError> {
     if let Ok(kind) = task.parse::<TaskKind>() {
         return Ok(TaskSpec::builtin(kind));
     }
-    if !Path::new(task).exists() {
+    if std::fs::metadata(task).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound) {
         return Err(CliError::Usage(format!(
-            "--task {task}: neither a built-in task ({}) nor an existing task file",
+            "--task {}: neither a built-in task ({}) nor an existing task file",
+            Clip(task),
             toolconf::task::task_choices()
         )));
     }
@@ -95,7 +97,7 @@ fn screen_tools(args: &Args, tasks: &ModelTasks) -> Result<(Screen, usize), CliE
         &args.task,
         limit,
         args.skip_bad_rows,
-        |bad| eprintln!("toolconf: skipping {bad}"),
+        |bad| errln!("toolconf: skipping {bad}"),
     )
     .map_err(|e| match e {
         ScreenError::File(e) => e.into(),
@@ -170,6 +172,9 @@ fn tool_json(rank: usize, r: &RankedTool) -> Value {
     v
 }
 
+/// The widest the name column grows; a longer name runs past it.
+const NAME_COLUMN: usize = 40;
+
 fn print_table(results: &[RankedTool], order: &[usize]) {
     let name = |r: &RankedTool| r.row.name.clone().unwrap_or_else(|| "-".into());
     let w = results
@@ -177,10 +182,17 @@ fn print_table(results: &[RankedTool], order: &[usize]) {
         .map(|r| name(r).chars().count())
         .max()
         .unwrap_or(4)
-        .max(4);
-    println!(
+        .clamp(4, NAME_COLUMN);
+    outln!(
         "{:>5} {:>6}  {:<w$} {:<10} {:>12}  {:>14} {:>14} {:>14}  parameters",
-        "rank", "row", "name", "model", "ln|Pi^U|", "task error", "int F dt", "int J dt"
+        "rank",
+        "row",
+        "name",
+        "model",
+        "ln|Pi^U|",
+        "task error",
+        "int F dt",
+        "int J dt"
     );
     for (k, &i) in order.iter().enumerate() {
         let r = &results[i];
@@ -195,7 +207,7 @@ fn print_table(results: &[RankedTool], order: &[usize]) {
             ),
             Err(e) => format!("failed: {e}"),
         };
-        println!(
+        outln!(
             "{:>5} {:>6}  {:<w$} {:<10} {:>12}  {metrics}  {}",
             k + 1,
             r.row.row,
@@ -216,6 +228,12 @@ struct Counts {
 
 pub fn run(args: &Args) -> Result<(), CliError> {
     let mut spec = task_spec(&args.task)?;
+    if let Some(path) = &args.csv {
+        check_output_file("--csv", path)?;
+    }
+    if let Some(dir) = &args.report {
+        check_output_folder("--report", dir)?;
+    }
     spec.episode.method = Some(args.method.method.into());
     let tasks = ModelTasks::new(&spec);
     let objective = Objective::from(args.objective);
@@ -232,7 +250,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         wall: started.elapsed(),
     };
     if let Some(dir) = &args.report {
-        std::fs::create_dir_all(dir).map_err(|source| CliError::Io {
+        toolconf::output::file::create_folder(dir).map_err(|source| CliError::Io {
             path: dir.clone(),
             source,
         })?;
@@ -265,7 +283,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         };
         let files = write_report(dir, &input)?;
         if !args.json {
-            println!("report: {}", files[1].display());
+            outln!("report: {}", files[1].display());
         }
     }
     if results.iter().all(|r| r.episode.is_err()) {
@@ -378,7 +396,7 @@ fn print_json(
             .map(|(k, &i)| tool_json(k + 1, &results[i]))
             .collect::<Vec<_>>(),
     });
-    println!(
+    outln!(
         "{}",
         serde_json::to_string_pretty(&out).expect("finite numbers")
     );
@@ -393,13 +411,13 @@ fn print_text(
     order: &[usize],
     timing: &StageTimings,
 ) {
-    println!(
+    outln!(
         "tools: {}    task: {}    ranked by: {}",
         args.tools.display(),
         spec.label(),
         objective.name()
     );
-    println!(
+    outln!(
         "integration method: {}",
         spec.episode.method.unwrap_or_default().describe()
     );
@@ -409,12 +427,12 @@ fn print_text(
             counts.without_confidence
         )
     });
-    println!(
+    outln!(
         "read {} tools    skipped {} bad rows    simulated {}{screened}",
         counts.read,
         counts.skipped,
         results.len()
     );
     print_table(results, order);
-    println!("{}", timing_text(timing));
+    outln!("{}", timing_text(timing));
 }

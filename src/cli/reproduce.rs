@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use toolconf_report::experiments::{experiment_ids, reproduce, Config, Plan, ReproduceError};
 
-use super::output::CliError;
+use super::output::{check_output_folder, CliError};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -43,6 +43,7 @@ fn parse_experiment(s: &str) -> Result<String, String> {
 }
 
 pub fn run(args: &Args) -> Result<(), CliError> {
+    check_output_folder("--out", &args.out)?;
     let mut command = format!(
         "toolconf reproduce --out {} --seed {}",
         args.out.display(),
@@ -89,11 +90,11 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     })?;
     for section in &summary.sections {
         for v in section.verdicts() {
-            println!("{:<34} {}", v.claim, v.outcome.words());
+            outln!("{:<34} {}", v.claim, v.outcome.words());
         }
     }
     let secs = summary.wall.as_secs_f64();
-    println!(
+    outln!(
         "{} episodes in {:.2} s on {} thread(s) ({:.0} episodes/s)",
         summary.episodes(),
         secs,
@@ -104,8 +105,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             0.0
         }
     );
-    println!("report: {}", summary.report_md.display());
-    println!(
+    outln!("report: {}", summary.report_md.display());
+    outln!(
         "report (HTML, figures inline): {}",
         summary.report_html.display()
     );

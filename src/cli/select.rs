@@ -71,6 +71,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         return run_mixed(args);
     }
     let (task, options) = two_link_task(args)?;
+    let mpc_options = match args.mpc {
+        true => Some(args.mpc_options.options(options.t_end, options.dt)?),
+        false => None,
+    };
     let kind = task.kind;
     let tools = draw_tools(args.tools as usize, args.seed);
     let plant = Plant::from(args.episode.plant);
@@ -79,17 +83,9 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         .iter()
         .map(|o| (*o, o.choose(&results)))
         .collect();
-    let mpc = if args.mpc {
-        Some(evaluate_mpc(
-            &tools,
-            &task,
-            &options,
-            &args.mpc_options.options()?,
-            plant,
-        ))
-    } else {
-        None
-    };
+    let mpc = mpc_options.map(|o| evaluate_mpc(&tools, &task, &options, &o, plant));
+    let errors = results.iter().filter_map(|r| r.episode.as_ref().err());
+    let outcome = every_tool_failed(results.len(), errors);
     if args.json {
         let mut choice = serde_json::Map::new();
         for (o, c) in &choices {
@@ -113,26 +109,34 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             "tools": tools_json,
             "choice": choice,
         });
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&out).expect("finite numbers")
         );
-        return Ok(());
+        return outcome;
     }
-    println!(
+    outln!(
         "task: {} (task {})    tools: {}    seed: {}",
         kind,
         kind.paper_index(),
         args.tools,
         args.seed
     );
-    println!(
+    outln!(
         "integration method: {}",
         Method::from(args.method.method).describe()
     );
-    println!(
+    outln!(
         "{:>5}  {:>7} {:>7} {:>7} {:>7}  {:>12} {:>14} {:>14} {:>14}",
-        "tool", "m1", "m2", "l1", "l2", "ln|Pi^U|", "task error", "int F dt", "int J dt"
+        "tool",
+        "m1",
+        "m2",
+        "l1",
+        "l2",
+        "ln|Pi^U|",
+        "task error",
+        "int F dt",
+        "int J dt"
     );
     for r in &results {
         let logdet = r
@@ -147,7 +151,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             Err(e) => format!("failed: {e}"),
         };
         let p = r.arm.params();
-        println!(
+        outln!(
             "{:>5}  {:>7.4} {:>7.4} {:>7.4} {:>7.4}  {:>12} {}",
             r.index, p[0], p[1], p[2], p[3], logdet, metrics
         );
@@ -155,27 +159,43 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if let Some(mpc) = &mpc {
         for (i, r) in mpc.iter().enumerate() {
             match r {
-                Ok(m) => println!("tool {i:>3}  J* (MPC int J dt) {:>14.6e}", m.cost_j),
-                Err(e) => println!("tool {i:>3}  MPC failed: {e}"),
+                Ok(m) => outln!("tool {i:>3}  J* (MPC int J dt) {:>14.6e}", m.cost_j),
+                Err(e) => outln!("tool {i:>3}  MPC failed: {e}"),
             }
         }
     }
     for (o, c) in &choices {
         match c {
-            Some(i) => println!("chosen by {:<12} tool {i}", o.name()),
-            None => println!("chosen by {:<12} none (every tool failed)", o.name()),
+            Some(i) => outln!("chosen by {:<12} tool {i}", o.name()),
+            None => outln!("chosen by {:<12} none (every tool failed)", o.name()),
         }
     }
     if let Some(mpc) = &mpc {
         match choose_by_mpc_cost(mpc) {
-            Some(i) => println!("chosen by {:<12} tool {i}", "mpc_cost"),
-            None => println!(
+            Some(i) => outln!("chosen by {:<12} tool {i}", "mpc_cost"),
+            None => outln!(
                 "chosen by {:<12} none (every MPC episode failed)",
                 "mpc_cost"
             ),
         }
     }
-    Ok(())
+    outcome
+}
+
+/// A batch succeeds if one tool's episode did (the others' failures are in its output); if
+/// every one failed, the run failed (status 1), as `rank` says too.
+fn every_tool_failed<'a, E: std::fmt::Display + 'a>(
+    tools: usize,
+    mut errors: impl Iterator<Item = &'a E>,
+) -> Result<(), CliError> {
+    let first = errors.next();
+    let failed = usize::from(first.is_some()) + errors.count();
+    match first {
+        Some(e) if failed == tools => Err(CliError::Failed(format!(
+            "every one of the {tools} tools failed; the first: {e}"
+        ))),
+        _ => Ok(()),
+    }
 }
 
 /// The 2-link task and options: the paper's task with the flags, or the task file's with the
@@ -195,7 +215,7 @@ fn two_link_task(args: &Args) -> Result<(Task, EpisodeOptions), CliError> {
 }
 
 fn with_flags(args: &Args, mut spec: TaskSpec) -> Result<TaskSpec, CliError> {
-    args.episode.apply(&mut spec.episode)?;
+    args.episode.apply(&mut spec)?;
     spec.episode.method = Some(args.method.method.into());
     Ok(spec)
 }
@@ -258,6 +278,8 @@ fn run_mixed(args: &Args) -> Result<(), CliError> {
         .iter()
         .map(|o| (*o, o.choose(&results)))
         .collect();
+    let errors = results.iter().filter_map(|r| r.episode.as_ref().err());
+    let outcome = every_tool_failed(results.len(), errors);
     let models: Vec<&str> = args.models.iter().map(|m| m.name()).collect();
     if args.json {
         let mut choice = serde_json::Map::new();
@@ -273,13 +295,13 @@ fn run_mixed(args: &Args) -> Result<(), CliError> {
             "tools": results.iter().map(mixed_tool_json).collect::<Vec<_>>(),
             "choice": choice,
         });
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&out).expect("finite numbers")
         );
-        return Ok(());
+        return outcome;
     }
-    println!(
+    outln!(
         "task: {} (task {})    tools: {}    seed: {}    models: {}",
         kind,
         kind.paper_index(),
@@ -287,15 +309,21 @@ fn run_mixed(args: &Args) -> Result<(), CliError> {
         args.seed,
         models.join(",")
     );
-    println!(
+    outln!(
         "integration method: {}",
         Method::from(args.method.method).describe()
     );
     // The model column fits the longest name in this set (at least 10 wide).
     let w = models.iter().map(|m| m.len()).max().unwrap_or(0).max(10);
-    println!(
+    outln!(
         "{:>5}  {:<w$} {:>12} {:>12}  {:>14} {:>14} {:>14}  parameters",
-        "tool", "model", "ln|Pi^U|", "ln|Pi^U|/n", "task error", "int F dt", "int J dt"
+        "tool",
+        "model",
+        "ln|Pi^U|",
+        "ln|Pi^U|/n",
+        "task error",
+        "int F dt",
+        "int J dt"
     );
     for r in &results {
         let (logdet, per_joint) = match (&r.logdet, r.logdet_per_joint()) {
@@ -315,7 +343,7 @@ fn run_mixed(args: &Args) -> Result<(), CliError> {
             .into_iter()
             .map(|(name, value)| format!("{name}={value:.4}"))
             .collect();
-        println!(
+        outln!(
             "{:>5}  {:<w$} {:>12} {:>12}  {}  {}",
             r.index,
             r.model().name(),
@@ -327,13 +355,13 @@ fn run_mixed(args: &Args) -> Result<(), CliError> {
     }
     for (o, c) in &choices {
         match c {
-            Some(i) => println!(
+            Some(i) => outln!(
                 "chosen by {:<21} tool {i} ({})",
                 o.name(),
                 results[*i].model().name()
             ),
-            None => println!("chosen by {:<21} none (every tool failed)", o.name()),
+            None => outln!("chosen by {:<21} none (every tool failed)", o.name()),
         }
     }
-    Ok(())
+    outcome
 }

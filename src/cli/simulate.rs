@@ -10,10 +10,11 @@ use toolconf::model::{episode_on, Arm2, Arm2Exact};
 use toolconf::mpc::{MpcModel, MpcOptions};
 use toolconf::rank::{ModelTasks, TrajectoryTable};
 use toolconf::task_file::TaskSpec;
-use toolconf::{Arm, Error, Task};
+use toolconf::validate::finite_output;
+use toolconf::{Arm, Task};
 
 use super::episode_args::{two_link_options, EpisodeArgs, PlantArg, TaskArgs};
-use super::output::{write_atomically, CliError};
+use super::output::{check_output_file, write_atomically, CliError};
 use super::{parse_arm, parse_model};
 
 #[derive(clap::Args)]
@@ -89,28 +90,22 @@ pub enum MpcModelArg {
 }
 
 impl MpcArgs {
-    pub fn options(&self) -> Result<MpcOptions, Error> {
-        for (name, value) in [
-            ("MPC period", self.mpc_period),
-            ("MPC horizon", self.horizon),
+    /// The options, each flag against its range ([`toolconf::validate`]) and all of them
+    /// against an episode of `t_end` s output every `dt` s ([`MpcOptions::check_grid`]), before
+    /// any episode runs.
+    pub fn options(&self, t_end: f64, dt: f64) -> Result<MpcOptions, CliError> {
+        use toolconf::validate::{MPC_HORIZON, MPC_PERIOD, OBSERVER_GAIN, TORQUE_LIMIT};
+        for (flag, value, range) in [
+            ("--mpc-period", self.mpc_period, MPC_PERIOD),
+            ("--horizon", self.horizon, MPC_HORIZON),
+            ("--torque-limit", self.torque_limit, TORQUE_LIMIT),
+            ("--observer-gain", self.observer_gain, OBSERVER_GAIN),
         ] {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(Error::InvalidOption { name, value });
-            }
+            range
+                .check(value)
+                .map_err(|m| CliError::Usage(format!("{flag}: {m}")))?;
         }
-        if self.torque_limit.is_nan() || self.torque_limit <= 0.0 {
-            return Err(Error::InvalidOption {
-                name: "torque limit",
-                value: self.torque_limit,
-            });
-        }
-        if !(self.observer_gain > 0.0 && self.observer_gain <= 1.0) {
-            return Err(Error::InvalidOption {
-                name: "observer gain (must be in (0, 1])",
-                value: self.observer_gain,
-            });
-        }
-        Ok(MpcOptions {
+        let options = MpcOptions {
             period: self.mpc_period,
             horizon: self.horizon,
             torque_limit: self.torque_limit,
@@ -120,12 +115,21 @@ impl MpcArgs {
             },
             disturbance_observer: self.disturbance_observer,
             observer_gain: self.observer_gain,
-        })
+        };
+        options.check_grid(t_end, dt).map_err(|m| {
+            CliError::Usage(format!(
+                "--mpc-period, --horizon (and the episode's grid): {m}"
+            ))
+        })?;
+        Ok(options)
     }
 }
 
 pub fn run(args: &Args) -> Result<(), CliError> {
     let spec = args.task.spec()?;
+    if let Some(path) = &args.csv {
+        check_output_file("--csv", path)?;
+    }
     let arm = match (args.arm, args.model) {
         (Some(arm), _) => arm,
         (None, Some(model)) => return run_model(args, model, spec),
@@ -152,14 +156,14 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         "arm: {arm}    task: {}    perturbation: {perturb} N m",
         spec.label()
     );
-    print_episode(args, identity, &heading, &episode.metrics);
-    Ok(())
+    print_episode(args, identity, &heading, &episode.metrics)
 }
 
 /// An active-inference episode's result: `identity` (the tool, task and perturbation) and the
 /// metrics as one JSON object, or `heading` and the metrics as text; the same for `--arm` and
 /// `--model`.
-fn print_episode(args: &Args, mut out: Value, heading: &str, m: &Metrics) {
+fn print_episode(args: &Args, mut out: Value, heading: &str, m: &Metrics) -> Result<(), CliError> {
+    m.check_finite(&heading)?;
     let method = Method::from(args.method.method).describe();
     if args.json {
         for (key, value) in [
@@ -177,25 +181,28 @@ fn print_episode(args: &Args, mut out: Value, heading: &str, m: &Metrics) {
         if let Some(path) = &args.task.task_file {
             out["task_file"] = json!(path);
         }
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&out).expect("finite numbers")
         );
-        return;
+        return Ok(());
     }
-    println!("{heading}");
-    println!("integration method: {method}");
-    println!("task error     {:.9e}", m.task_error);
-    println!("integral F dt  {:.9e}", m.free_energy);
-    println!("integral J dt  {:.9e}", m.cost_j);
-    println!("ln|Pi^U|       {:.9e}", m.logdet);
-    println!(
+    outln!("{heading}");
+    outln!("integration method: {method}");
+    outln!("task error     {:.9e}", m.task_error);
+    outln!("integral F dt  {:.9e}", m.free_energy);
+    outln!("integral J dt  {:.9e}", m.cost_j);
+    outln!("ln|Pi^U|       {:.9e}", m.logdet);
+    outln!(
         "rhs evals      {} ({} steps, {} rejected)",
-        m.rhs_evals, m.steps, m.rejected_steps
+        m.rhs_evals,
+        m.steps,
+        m.rejected_steps
     );
     if let Some(path) = &args.csv {
-        println!("trajectory     {}", path.display());
+        outln!("trajectory     {}", path.display());
     }
+    Ok(())
 }
 
 /// One episode of the task file's task: the generic 2-link runtime, which takes the file's
@@ -205,7 +212,7 @@ fn from_task_file(
     arm: &Arm,
     mut spec: TaskSpec,
 ) -> Result<(Episode, Value), CliError> {
-    args.episode.apply(&mut spec.episode)?;
+    args.episode.apply(&mut spec)?;
     spec.episode.method = Some(args.method.method.into());
     let task = spec.task::<Arm2, 2, 4, 4, 6>()?;
     let mut options = spec.episode::<Arm2, 2, 4, 4, 6>()?;
@@ -230,7 +237,7 @@ fn run_mpc(args: &Args, arm: &Arm, mut spec: TaskSpec) -> Result<(), CliError> {
             args.episode.options(args.csv.is_some())?,
         ),
         Some(_) => {
-            args.episode.apply(&mut spec.episode)?;
+            args.episode.apply(&mut spec)?;
             let task = spec.task::<Arm2, 2, 4, 4, 6>()?;
             let mut o = spec.episode::<Arm2, 2, 4, 4, 6>()?;
             o.record_trajectory = args.csv.is_some();
@@ -239,8 +246,17 @@ fn run_mpc(args: &Args, arm: &Arm, mut spec: TaskSpec) -> Result<(), CliError> {
         }
     };
     let plant = Plant::from(args.episode.plant);
-    let episode = plant.simulate_mpc(arm, &task, &options, &args.mpc.options()?)?;
+    let mpc = args.mpc.options(options.t_end, options.dt)?;
+    let episode = plant.simulate_mpc(arm, &task, &options, &mpc)?;
     let m = &episode.metrics;
+    let values = [
+        m.task_error,
+        m.free_energy,
+        m.cost_j,
+        m.control_effort,
+        m.logdet,
+    ];
+    finite_output(&format!("arm {arm}"), "the MPC episode's metrics", values)?;
     if let (Some(path), Some(tr)) = (&args.csv, &episode.trajectory) {
         write_atomically(path, &TrajectoryTable::from_trajectory(tr).to_csv())?;
     }
@@ -262,33 +278,33 @@ fn run_mpc(args: &Args, arm: &Arm, mut spec: TaskSpec) -> Result<(), CliError> {
             "max_solve_time_us": m.max_solve_time.as_secs_f64() * 1e6,
             "solver_status": m.worst_status,
         });
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&out).expect("finite numbers")
         );
     } else {
-        println!(
+        outln!(
             "arm: {}    task: {}    controller: MPC    perturbation: {} N m",
             arm,
             spec.label(),
             options.perturbation
         );
-        println!("task error       {:.9e}", m.task_error);
-        println!(
+        outln!("task error       {:.9e}", m.task_error);
+        outln!(
             "integral J dt    {:.9e}  (J*: the cost the MPC achieves)",
             m.cost_j
         );
-        println!(
+        outln!(
             "integral F dt    {:.9e}  (J* - T/2 ln|Pi^U|)",
             m.free_energy
         );
-        println!(
+        outln!(
             "control effort   {:.9e}  (integral |U|^2 dt)",
             m.control_effort
         );
-        println!("ln|Pi^U|         {:.9e}", m.logdet);
-        println!("rhs evals        {}", m.rhs_evals);
-        println!(
+        outln!("ln|Pi^U|         {:.9e}", m.logdet);
+        outln!("rhs evals        {}", m.rhs_evals);
+        outln!(
             "QP solves        {} ({} iterations, median {:.1} us, max {:.1} us, status {})",
             m.qp_solves,
             m.qp_iterations,
@@ -297,7 +313,7 @@ fn run_mpc(args: &Args, arm: &Arm, mut spec: TaskSpec) -> Result<(), CliError> {
             m.worst_status
         );
         if let Some(path) = &args.csv {
-            println!("trajectory       {}", path.display());
+            outln!("trajectory       {}", path.display());
         }
     }
     Ok(())
@@ -327,7 +343,7 @@ fn run_model(args: &Args, model: ModelKind, mut spec: TaskSpec) -> Result<(), Cl
         })
         .collect::<Result<Vec<f64>, _>>()?;
     let tool = AnyTool::new(model, &params)?;
-    args.episode.apply(&mut spec.episode)?;
+    args.episode.apply(&mut spec)?;
     spec.episode.method = Some(args.method.method.into());
     let tasks = ModelTasks::new(&spec);
     tasks.check(model)?;
@@ -351,6 +367,5 @@ fn run_model(args: &Args, model: ModelKind, mut spec: TaskSpec) -> Result<(), Cl
         spec.label(),
         episode.perturbation
     );
-    print_episode(args, identity, &heading, &episode.metrics);
-    Ok(())
+    print_episode(args, identity, &heading, &episode.metrics)
 }

@@ -95,7 +95,13 @@ impl<const N: usize> ValidatedTaskN<N> {
     }
 }
 
-/// ln|Π| of a symmetric positive definite Π, or [`Error::NotPositiveDefinite`].
+/// The smallest a determinant (2×2: of Π₀₀Π₁₁) or a squared Cholesky pivot (of max Π_ii) may be
+/// for ln|Π^U| to be computed ([`logdet_of`]): with rounding ε ≈ 2.2e-16 in the entries, the
+/// determinant is then good to about 4e-6 relative.
+pub const MIN_PIVOT_RATIO: f64 = 1e-10;
+
+/// ln|Π| of a symmetric positive definite Π, or [`Error::NotPositiveDefinite`] (or
+/// [`Error::IllConditioned`]).
 ///
 /// In general 2 Σ ln L_ii of the Cholesky factor. For N = 2 it is ln(Π₀₀Π₁₁ − Π₀₁Π₁₀) instead:
 /// a symmetric 2×2 is positive definite iff Π₀₀ > 0 and its determinant > 0, so one product and
@@ -103,10 +109,24 @@ impl<const N: usize> ValidatedTaskN<N> {
 /// bits, and the paper's numbers (tests/numbers_snapshot.rs and the figure snapshots) are pinned
 /// to every digit of this closed form. `N` is a constant, so the branch is resolved at compile
 /// time.
+///
+/// Conditioning: Π^U's entries carry the generated arithmetic's rounding, about ε·|Π_ij|, so its
+/// determinant is known only to about ε·Π₀₀Π₁₁ (ε·max Π_ii per pivot for N > 2). A determinant
+/// below [`MIN_PIVOT_RATIO`] of that (a tool whose parameters span many decades: with every
+/// parameter at 1e-4 or 1e4, Π^U of the velocity task has a condition number of 10¹⁶) is
+/// [`Error::IllConditioned`] rather than a ln|Π^U| with no correct digit; above it, ln|Π^U| is
+/// good to about 1e-5.
 #[inline]
 pub fn logdet_of<const N: usize>(pi: &SMatrix<f64, N, N>) -> Result<f64, Error> {
     if N == 2 {
-        let determinant = pi[(0, 0)] * pi[(1, 1)] - pi[(0, 1)] * pi[(1, 0)];
+        let product = pi[(0, 0)] * pi[(1, 1)];
+        let determinant = product - pi[(0, 1)] * pi[(1, 0)];
+        let positive = pi[(0, 0)] > 0.0 && pi[(1, 1)] > 0.0;
+        if positive && determinant.abs() < MIN_PIVOT_RATIO * product {
+            return Err(Error::IllConditioned {
+                ratio: determinant / product,
+            });
+        }
         if !(pi[(0, 0)] > 0.0 && determinant > 0.0 && determinant.is_finite()) {
             return Err(Error::NotPositiveDefinite { determinant });
         }
@@ -118,13 +138,21 @@ pub fn logdet_of<const N: usize>(pi: &SMatrix<f64, N, N>) -> Result<f64, Error> 
     if pi.iter().any(|v| !v.is_finite()) {
         return Err(not_pd());
     }
-    let cholesky = nalgebra::Cholesky::new(*pi).ok_or_else(not_pd)?;
+    let largest = (0..N).map(|i| pi[(i, i)]).fold(0.0_f64, f64::max);
+    let Some(cholesky) = nalgebra::Cholesky::new(*pi) else {
+        return Err(why_not_positive_definite(pi, largest).unwrap_or_else(not_pd));
+    };
     let l = cholesky.l_dirty();
     let mut logdet = 0.0;
     for i in 0..N {
         let d = l[(i, i)];
         if !(d > 0.0 && d.is_finite()) {
             return Err(not_pd());
+        }
+        if d * d < MIN_PIVOT_RATIO * largest {
+            return Err(Error::IllConditioned {
+                ratio: d * d / largest,
+            });
         }
         logdet += 2.0 * crate::ln(d);
     }
@@ -133,4 +161,29 @@ pub fn logdet_of<const N: usize>(pi: &SMatrix<f64, N, N>) -> Result<f64, Error> 
     } else {
         Err(not_pd())
     }
+}
+
+/// Why a Cholesky factorisation of Π failed: a pivot within [`MIN_PIVOT_RATIO`] of Π's largest
+/// diagonal entry, of either sign, is rounding in an ill-conditioned matrix
+/// ([`Error::IllConditioned`]); `None` if a pivot is clearly negative (not positive definite).
+fn why_not_positive_definite<const N: usize>(
+    pi: &SMatrix<f64, N, N>,
+    largest: f64,
+) -> Option<Error> {
+    let mut a = *pi;
+    for k in 0..N {
+        let d = a[(k, k)];
+        if d.abs() < MIN_PIVOT_RATIO * largest {
+            return Some(Error::IllConditioned { ratio: d / largest });
+        }
+        if !(d > 0.0) {
+            return None;
+        }
+        for i in k + 1..N {
+            for j in k + 1..N {
+                a[(i, j)] -= a[(i, k)] * a[(k, j)] / d;
+            }
+        }
+    }
+    None
 }

@@ -1,40 +1,76 @@
 //! The core's error type: every bad input names the value that is wrong, without allocating
-//! (names are `&'static str`, values `f64`). The runtime's `toolconf::Error` wraps it
-//! transparently, so the command line prints these messages as they are.
+//! (names are `&'static str`, values `f64`, numbers shown by [`Short`]). The runtime's
+//! `toolconf::Error` wraps it transparently, so the command line and the Python package print
+//! these messages as they are.
+
+use core::fmt;
+
+use crate::display::Short;
+use crate::validate::{JOINT_VALUE, PRECISION_ENTRY, TOOL_PARAMETER};
+use crate::TaskKind;
 
 /// What can go wrong building a tool, a task or a controller, or computing ln|Π^U|.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum Error {
-    /// A tool parameter that is not a finite number > 0.
-    #[error("invalid arm parameter {name} = {value}: must be a finite number > 0")]
+    /// A tool parameter outside [`TOOL_PARAMETER`].
+    #[error("invalid arm parameter {name} = {}: must be a number in {}", Short(*value), TOOL_PARAMETER)]
     InvalidParameter { name: &'static str, value: f64 },
-    /// A goal that is not finite.
-    #[error("invalid goal {name} = {value}: must be finite")]
+    /// A goal outside [`JOINT_VALUE`].
+    #[error("invalid goal {name} = {}: must be a number in {}", Short(*value), JOINT_VALUE)]
     InvalidGoal { name: &'static str, value: f64 },
-    /// A precision matrix that is not finite, symmetric and positive semi-definite.
+    /// A precision matrix that is not in range, symmetric and positive semi-definite.
     #[error("invalid precision {name}: {problem}")]
     InvalidPrecision {
         name: &'static str,
         problem: PrecisionProblem,
     },
     /// A numeric option outside its domain (the learning rate γ, the control period).
-    #[error("invalid {name} = {value}")]
+    #[error("invalid {name} = {}", Short(*value))]
     InvalidOption { name: &'static str, value: f64 },
-    /// Π^U that is not positive definite, so it is no precision and ln|Π^U| is undefined.
-    #[error("control confidence Π^U is not positive definite for this arm and task (determinant {determinant:e}); check the task's precisions")]
+    /// Π^U that is not positive definite for one tool, so it is no precision and ln|Π^U| is
+    /// undefined. (A task whose precisions leave Π^U singular for every tool is refused up
+    /// front: [`Error::ConfidenceRank`].)
+    #[error("control confidence Π^U is not positive definite for this tool on this task (determinant {}): through this tool's sensitivities the task's precisions leave a direction of U without precision", Short(*determinant))]
     NotPositiveDefinite { determinant: f64 },
+    /// Π^U so ill-conditioned for one tool that its determinant has no correct digit in double
+    /// precision ([`crate::logdet_of`]).
+    #[error("control confidence Π^U of this tool is too ill-conditioned for ln|Π^U| to be computed (its determinant is {} of the product of its diagonal, below 1e-10): the tool's parameters span too many decades", Short(*ratio))]
+    IllConditioned { ratio: f64 },
+    /// A task whose precisions cannot make Π^U = Σ SᵀPS + P^U positive definite for any tool:
+    /// rank(SᵀPS) ≤ rank(P), so the ranks of the precisions it uses must add up to the joints.
+    #[error("control confidence Π^U = Σ SᵀPS + P^U cannot be positive definite for any tool: the precisions the {kind} task uses ({}) have ranks adding up to {rank}, fewer than the {joints} joints; give them more weight (e.g. precision.u = 1.0)", PrecisionKeys(*kind))]
+    ConfidenceRank {
+        kind: TaskKind,
+        rank: usize,
+        joints: usize,
+    },
 }
 
 /// Why a precision matrix is refused.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum PrecisionProblem {
-    /// An entry that is NaN or infinite, with its (row, column), counted from 0.
-    #[error("has a non-finite entry: {value} at ({row}, {col})")]
-    NonFinite { row: usize, col: usize, value: f64 },
+    /// An entry outside [`PRECISION_ENTRY`] (so also NaN or infinite).
+    #[error("entry {} must be a number in {}", Short(*value), PRECISION_ENTRY)]
+    OutOfRange { value: f64 },
     /// Two mirrored entries that differ by more than 1e-12 relative.
-    #[error("is not symmetric ({upper} vs {lower})")]
+    #[error("is not symmetric ({} vs {})", Short(*upper), Short(*lower))]
     NotSymmetric { upper: f64, lower: f64 },
     /// A negative eigenvalue beyond rounding.
     #[error("is not positive semi-definite")]
     NotPositiveSemiDefinite,
+}
+
+/// `precision.theta_ddot, precision.u`: the task-file keys of the precisions `kind` uses.
+pub struct PrecisionKeys(pub TaskKind);
+
+impl fmt::Display for PrecisionKeys {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, term) in self.0.terms().iter().enumerate() {
+            if i > 0 {
+                f.write_str(", ")?;
+            }
+            write!(f, "precision.{}", term.name())?;
+        }
+        Ok(())
+    }
 }

@@ -36,10 +36,12 @@ extern crate std;
 mod arm_model;
 mod confidence;
 mod controller;
+pub mod display;
 mod error;
 mod linalg;
 mod task;
 mod tool;
+pub mod validate;
 
 /// The generated crate this one is built on (`generated/`).
 pub use toolconf_generated as generated;
@@ -47,7 +49,7 @@ pub use toolconf_generated as generated;
 pub use arm_model::*;
 pub use confidence::{control_confidence, logdet_of, ControlConfidenceN, ValidatedTaskN};
 pub use controller::ActiveInferenceN;
-pub use error::{Error, PrecisionProblem};
+pub use error::{Error, PrecisionKeys, PrecisionProblem};
 pub use generated::{TaskKind, Term};
 pub use task::TaskN;
 pub use tool::{SensitivitiesN, ToolN};

@@ -3,7 +3,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use crate::generated;
-use crate::generated::TaskKind;
+use crate::generated::{TaskKind, Term};
 use crate::{Error, PrecisionProblem};
 
 use super::{ArmModel, ValidatedTaskN};
@@ -45,14 +45,17 @@ impl<const N: usize> TaskN<N> {
         }
     }
 
-    /// Checks goals are finite and precisions finite, symmetric and positive semi-definite.
+    /// Checks goals are in [`crate::validate::JOINT_VALUE`] and precisions in
+    /// [`crate::validate::PRECISION_ENTRY`], symmetric and positive semi-definite, and that they
+    /// can make Π^U positive definite at all ([`Error::ConfidenceRank`]).
     pub fn validate(&self) -> Result<(), Error> {
         for (name, goal) in [
             ("theta_g", &self.goal_theta),
             ("theta_dot_g", &self.goal_theta_dot),
             ("theta_ddot_g", &self.goal_theta_ddot),
         ] {
-            if let Some(&value) = goal.iter().find(|v| !v.is_finite()) {
+            let valid = |v: &f64| crate::validate::JOINT_VALUE.contains(*v);
+            if let Some(&value) = goal.iter().find(|v| !valid(v)) {
                 return Err(Error::InvalidGoal { name, value });
             }
         }
@@ -63,6 +66,31 @@ impl<const N: usize> TaskN<N> {
             ("P_u", &self.precision_u),
         ] {
             check_precision(name, p)?;
+        }
+        self.check_confidence_rank()
+    }
+
+    /// Π^U = Σ SᵀPS + P^U over the terms the task uses, and rank(SᵀPS) ≤ rank(P) whatever the
+    /// tool's sensitivities S: if the ranks of those precisions add up to fewer than N, Π^U is
+    /// singular for every tool, and no tool has a control confidence ([`Error::ConfidenceRank`]).
+    fn check_confidence_rank(&self) -> Result<(), Error> {
+        let used = [
+            (Term::Theta, &self.precision_theta),
+            (Term::ThetaDot, &self.precision_theta_dot),
+            (Term::ThetaDdot, &self.precision_theta_ddot),
+            (Term::U, &self.precision_u),
+        ];
+        let rank: usize = used
+            .iter()
+            .filter(|(term, _)| self.kind.uses(*term))
+            .map(|(_, p)| psd_rank(p))
+            .sum();
+        if rank < N {
+            return Err(Error::ConfidenceRank {
+                kind: self.kind,
+                rank,
+                joints: N,
+            });
         }
         Ok(())
     }
@@ -77,6 +105,38 @@ impl TaskN<2> {
     }
 }
 
+/// The rank of a symmetric positive semi-definite matrix: the pivots of a Cholesky
+/// factorisation with diagonal pivoting above 1e-12 of the largest entry (on the stack: no
+/// allocation).
+fn psd_rank<const N: usize>(p: &SMatrix<f64, N, N>) -> usize {
+    let mut a = *p;
+    let tolerance = 1e-12 * a.amax();
+    let mut rank = 0;
+    let mut remaining: [bool; N] = [true; N];
+    for _ in 0..N {
+        let Some(k) = (0..N)
+            .filter(|&i| remaining[i])
+            .max_by(|&i, &j| a[(i, i)].total_cmp(&a[(j, j)]))
+        else {
+            break;
+        };
+        let pivot = a[(k, k)];
+        if !(pivot > tolerance) {
+            break;
+        }
+        remaining[k] = false;
+        rank += 1;
+        for i in 0..N {
+            for j in 0..N {
+                if remaining[i] && remaining[j] {
+                    a[(i, j)] -= a[(i, k)] * a[(k, j)] / pivot;
+                }
+            }
+        }
+    }
+    rank
+}
+
 /// Finite, symmetric (to 1e-12 relative) and positive semi-definite: the smallest eigenvalue
 /// of the symmetric part is ≥ −1e-12·max|P| (for N = 2 the closed-form determinant test).
 fn check_precision<const N: usize>(
@@ -84,10 +144,9 @@ fn check_precision<const N: usize>(
     p: &SMatrix<f64, N, N>,
 ) -> Result<(), Error> {
     let invalid = |problem| Error::InvalidPrecision { name, problem };
-    if let Some((k, &value)) = p.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-        // Column-major storage: entry k is (k mod N, k div N).
-        let (row, col) = (k % N, k / N);
-        return Err(invalid(PrecisionProblem::NonFinite { row, col, value }));
+    let in_range = |v: &&f64| crate::validate::PRECISION_ENTRY.contains(**v);
+    if let Some(&value) = p.iter().find(|v| !in_range(v)) {
+        return Err(invalid(PrecisionProblem::OutOfRange { value }));
     }
     let scale = p.amax();
     for i in 0..N {

@@ -19,7 +19,7 @@ use super::ArmModel;
 /// 1–2, [I O](A²∂X/∂U + AB) = I in task 3). The formulas are `derive/tasks.toml`'s.
 pub type SensitivitiesN<const N: usize> = generated::TaskSensitivities<N>;
 
-/// One tool of model `M`: its parameters, each finite and > 0.
+/// One tool of model `M`: its parameters, each in [`crate::validate::TOOL_PARAMETER`].
 ///
 /// The parameters are private so that every `ToolN` has passed [`ToolN::new`].
 pub struct ToolN<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> {
@@ -53,10 +53,12 @@ where
     M: ArmModel<N, NX, NP, NZ>,
 {
     /// Validates and builds a tool from its parameters in [`ArmModel::PARAMETER_NAMES`] order.
-    /// A non-positive, NaN or infinite value is an [`Error::InvalidParameter`] naming it.
+    /// A value outside [`crate::validate::TOOL_PARAMETER`] (so also a non-positive, NaN or
+    /// infinite one), where the generated arithmetic is not known to stay finite, is an
+    /// [`Error::InvalidParameter`] naming it. No allocation: tools are checked in bulk.
     pub fn new(params: [f64; NP]) -> Result<Self, Error> {
         for (name, value) in M::PARAMETER_NAMES.into_iter().zip(params) {
-            if !(value.is_finite() && value > 0.0) {
+            if !crate::validate::TOOL_PARAMETER.contains(value) {
                 return Err(Error::InvalidParameter { name, value });
             }
         }
@@ -123,7 +125,7 @@ where
             if i > 0 {
                 f.write_str(" ")?;
             }
-            write!(f, "{name}={value}")?;
+            write!(f, "{name}={}", crate::display::Short(*value))?;
         }
         Ok(())
     }

@@ -25,19 +25,11 @@ pub struct ReportInput<'a> {
     pub sweep: Option<(&'a Sweep, &'a [SweepPoint])>,
 }
 
-/// `m1=0.1 m2=0.4 …`.
-pub fn parameters_text(names: &[&str], params: &[f64]) -> String {
-    names
-        .iter()
-        .zip(params)
-        .map(|(n, v)| format!("{n}={v:.6}"))
-        .collect::<Vec<_>>()
-        .join(" ")
-}
+pub use toolconf::design::parameters_text;
 
 /// Writes the report into `dir` (created if needed); returns the files written.
 pub fn write_report(dir: &Path, input: &ReportInput) -> Result<Vec<PathBuf>, ReproduceError> {
-    std::fs::create_dir_all(dir).map_err(ReproduceError::io(dir))?;
+    toolconf::output::file::create_folder(dir).map_err(ReproduceError::io(dir))?;
     let r = input.result;
     let mut doc = vec![
         Block::Heading(1, format!("Tool design for the {} task ({})", input.task, input.model)),

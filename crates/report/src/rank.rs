@@ -39,7 +39,7 @@ const TRACED: usize = 3;
 
 /// Writes the report into `dir` (created if needed); returns the files written.
 pub fn write_report(dir: &Path, input: &ReportInput) -> Result<Vec<PathBuf>, ReproduceError> {
-    std::fs::create_dir_all(dir).map_err(ReproduceError::io(dir))?;
+    toolconf::output::file::create_folder(dir).map_err(ReproduceError::io(dir))?;
     let mut doc = introduction(input);
     doc.extend(ranking_table(input));
     doc.extend(confidence_figure(dir, input)?);

@@ -4,23 +4,24 @@
 use crate::model::Arm2Tool;
 use crate::Error;
 
-/// One tool of the paper's arm: link masses m1, m2 (kg) and lengths l1, l2 (m), all finite
-/// and > 0. The generic [`Arm2Tool`] (`Arm::new([m1, m2, l1, l2])`); its dynamics, A, B and
+/// One tool of the paper's arm: link masses m1, m2 (kg) and lengths l1, l2 (m), each in
+/// [`crate::validate::TOOL_PARAMETER`]. The generic [`Arm2Tool`] (`Arm::new([m1, m2, l1, l2])`); its dynamics, A, B and
 /// sensitivities are its methods, Π^U is [`crate::control_confidence`].
 pub type Arm = Arm2Tool;
 
 /// Parses `M1,M2,L1,L2`, as the command line takes an arm.
 pub fn parse(text: &str) -> Result<Arm, Error> {
     let syntax = |reason: String| Error::ArmSyntax {
-        text: text.to_string(),
+        text: crate::display::Clip(text).to_string(),
         reason,
     };
     let values: Vec<f64> = text
         .split(',')
         .map(|v| {
-            v.trim()
-                .parse::<f64>()
-                .map_err(|e| syntax(format!("'{}' is not a number ({e})", v.trim())))
+            v.trim().parse::<f64>().map_err(|e| {
+                let v = crate::display::Clip(v.trim());
+                syntax(format!("'{v}' is not a number ({e})"))
+            })
         })
         .collect::<Result<_, _>>()?;
     match values[..] {

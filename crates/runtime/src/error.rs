@@ -1,5 +1,7 @@
 //! The crate's error type: every bad input names the value that is wrong.
 
+use crate::display::Short;
+
 /// Everything that can go wrong in toolconf, each naming the offending value.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum Error {
@@ -14,10 +16,17 @@ pub enum Error {
     #[error("unknown task '{0}': expected {names}", names = crate::task::task_choices())]
     UnknownTask(String),
     /// A numeric option of the runtime outside its domain (episode, integrator, MPC).
-    #[error("invalid {name} = {value}")]
+    #[error("invalid {name} = {}", Short(*value))]
     InvalidOption { name: &'static str, value: f64 },
+    /// A numeric option outside its documented range ([`crate::validate`]).
+    #[error("invalid {name} = {}: must be a number in {range}", Short(*value))]
+    OutOfRange {
+        name: &'static str,
+        value: f64,
+        range: crate::validate::Range,
+    },
     /// An episode whose output grid would have more points than can be kept in memory.
-    #[error("episode too long: t_end = {t_end} s at dt = {dt} s is {points:e} output points, more than the {max} an episode may have; shorten t_end or enlarge dt")]
+    #[error("episode too long: t_end = {} s at dt = {} s is {} output points, more than the {max} an episode may have; shorten t_end or enlarge dt", Short(*t_end), Short(*dt), Short(*points))]
     GridTooLarge {
         t_end: f64,
         dt: f64,
@@ -35,4 +44,25 @@ pub enum Error {
     /// A combination of options that is not supported, with the reason.
     #[error("unsupported: {0}")]
     Unsupported(String),
+    /// A result that is not a finite number: the last line of defence at the output
+    /// ([`crate::validate::finite_output`]), so that no NaN, inf or null is ever printed. The
+    /// input ranges ([`crate::validate`]) are chosen so that it does not happen.
+    #[error("{quantity} of {tool} is {}, not a finite number: the run cannot report it", Short(*value))]
+    NonFiniteResult {
+        quantity: &'static str,
+        tool: String,
+        value: f64,
+    },
+}
+
+impl Error {
+    /// Valid input the arithmetic cannot answer (a result that is not finite, Π^U too
+    /// ill-conditioned): a failed run (status 1), not bad input.
+    pub fn is_failed_run(&self) -> bool {
+        matches!(
+            self,
+            Error::NonFiniteResult { .. }
+                | Error::Core(toolconf_core::Error::IllConditioned { .. })
+        )
+    }
 }

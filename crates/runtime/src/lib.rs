@@ -23,9 +23,11 @@
 //! runtime → report → command line and Python package.
 
 pub mod arm;
+pub mod bounded_read;
 pub mod closed_loop;
 pub mod confidence;
 pub mod design;
+pub mod display;
 pub mod error;
 /// The code `make derive` writes into `generated/` (the crate toolconf-generated): one module
 /// per model (see `generated/<model>.md` for each derivation report), the tasks and the
@@ -42,7 +44,9 @@ pub mod select;
 pub mod stats;
 pub mod task;
 pub mod task_file;
+pub mod threads;
 pub mod tools_file;
+pub mod validate;
 
 pub use arm::Arm;
 pub use confidence::{control_confidence, ControlConfidence, Sensitivities};

@@ -32,6 +32,8 @@ use std::path::Path;
 use nalgebra::{DMatrix, SMatrix, SVector};
 use serde::Deserialize;
 
+use crate::bounded_read::read_text_file;
+use crate::display::{Clip, ClipMessage, Short, ShortList, ShortRows as Rows};
 use crate::model::runtime::check_grid;
 use crate::model::{ArmModel, EpisodeOptionsN, TaskN};
 use crate::{TaskKind, Term};
@@ -178,10 +180,10 @@ impl TaskSpec {
     /// Reads and checks a task file.
     pub fn from_file(path: &Path) -> Result<Self, TaskFileError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| TaskFileError {
+        let text = read_text_file(path, "task file").map_err(|message| TaskFileError {
             file: file.clone(),
             place: String::new(),
-            message: format!("cannot read the task file: {e}"),
+            message,
         })?;
         Self::parse(&text, &file)
     }
@@ -194,7 +196,7 @@ impl TaskSpec {
                 .span()
                 .map(|s| syntax_place(text, s.start))
                 .unwrap_or_default(),
-            message: e.message().trim().replace('\n', " "),
+            message: ClipMessage(&e.message().trim().replace('\n', " ")).to_string(),
         })?;
         Self::from_raw(raw, file)
     }
@@ -211,7 +213,7 @@ impl TaskSpec {
                 "kind",
                 format!(
                     "'{}' is not a task kind: expected {}",
-                    raw.kind,
+                    Clip(&raw.kind),
                     crate::task::task_choices()
                 ),
             )
@@ -262,7 +264,8 @@ impl TaskSpec {
         }
     }
 
-    fn error(&self, key: &str, message: String) -> TaskFileError {
+    /// An error at `key` of this task: the file, or `task <kind>` for a built-in task.
+    pub fn error(&self, key: &str, message: String) -> TaskFileError {
         TaskFileError {
             file: if self.file.is_empty() {
                 format!("task {}", self.kind)
@@ -319,11 +322,9 @@ impl TaskSpec {
             ("goal.theta", &self.goal_theta),
             ("goal.theta_dot", &self.goal_theta_dot),
             ("goal.theta_ddot", &self.goal_theta_ddot),
-            ("episode.initial_theta", &self.episode.initial_theta),
-            ("episode.initial_theta_dot", &self.episode.initial_theta_dot),
         ] {
             if let Some(v) = v {
-                finite_list(v).map_err(|m| (key.to_string(), m))?;
+                in_range(v, crate::validate::JOINT_VALUE).map_err(|m| (key.to_string(), m))?;
             }
         }
         for (key, p) in [
@@ -456,8 +457,9 @@ impl TaskSpec {
             return Err(self.error(
                 key,
                 format!(
-                    "{} values {v:?}, but model {} has {N} joints",
+                    "{} values {}, but model {} has {N} joints",
                     v.len(),
+                    ShortList(v),
                     M::NAME
                 ),
             ));
@@ -481,33 +483,47 @@ impl TaskSpec {
 }
 
 impl EpisodeSpec {
-    fn check(&self) -> Result<(), (&'static str, String)> {
-        let positive = |key: &'static str, v: Option<f64>| match v {
-            Some(x) if !(x.is_finite() && x > 0.0) => {
-                Err((key, format!("{x} must be a finite number > 0")))
-            }
-            _ => Ok(()),
+    /// Every option against its documented range ([`crate::validate`]), dt against t_end and
+    /// the grid's size, the defaults standing in for what is not given. Returns (key, message).
+    pub fn check(&self) -> Result<(), (&'static str, String)> {
+        use crate::validate::{ATOL, DT, JOINT_VALUE, LEARNING_RATE, RTOL, TORQUE, T_END};
+        let within = |key: &'static str, v: Option<f64>, range: crate::validate::Range| match v {
+            Some(x) => range.check(x).map(|_| ()).map_err(|m| (key, m)),
+            None => Ok(()),
         };
-        positive("episode.t_end", self.t_end)?;
-        positive("episode.dt", self.dt)?;
-        positive("episode.learning_rate", self.learning_rate)?;
-        positive("episode.rtol", self.rtol)?;
-        positive("episode.atol", self.atol)?;
+        within("episode.t_end", self.t_end, T_END)?;
+        within("episode.dt", self.dt, DT)?;
+        within("episode.learning_rate", self.learning_rate, LEARNING_RATE)?;
+        within("episode.rtol", self.rtol, RTOL)?;
+        within("episode.atol", self.atol, ATOL)?;
         let (t_end, dt) = (self.t_end.unwrap_or(5.0), self.dt.unwrap_or(0.05));
         if dt > t_end {
-            return Err(("episode.dt", format!("{dt} is larger than t_end = {t_end}")));
+            return Err((
+                "episode.dt",
+                format!(
+                    "the output step dt = {} s is larger than t_end = {} s",
+                    Short(dt),
+                    Short(t_end)
+                ),
+            ));
         }
         check_grid(t_end, dt).map_err(|e| ("episode.t_end", e.to_string()))?;
-        for (key, v) in [
-            ("episode.perturbation", &self.perturbation),
-            ("episode.initial_torque", &self.initial_torque),
+        for (key, v, range) in [
+            ("episode.perturbation", &self.perturbation, TORQUE),
+            ("episode.initial_torque", &self.initial_torque, TORQUE),
         ] {
             match v {
-                Some(PerJoint::All(x)) if !x.is_finite() => {
-                    return Err((key, format!("{x} is not a finite number")))
-                }
-                Some(PerJoint::Each(v)) => finite_list(v).map_err(|m| (key, m))?,
-                _ => {}
+                Some(PerJoint::All(x)) => within(key, Some(*x), range)?,
+                Some(PerJoint::Each(v)) => in_range(v, range).map_err(|m| (key, m))?,
+                None => {}
+            }
+        }
+        for (key, v) in [
+            ("episode.initial_theta", &self.initial_theta),
+            ("episode.initial_theta_dot", &self.initial_theta_dot),
+        ] {
+            if let Some(v) = v {
+                in_range(v, JOINT_VALUE).map_err(|m| (key, m))?;
             }
         }
         Ok(())
@@ -525,16 +541,21 @@ fn syntax_place(text: &str, offset: usize) -> String {
     if line.is_empty() {
         format!("line {number}")
     } else {
-        format!("line {number} ({line})")
+        format!("line {number} ({})", Clip(line))
     }
 }
 
-fn finite_list(v: &[f64]) -> Result<(), String> {
+/// A non-empty list whose every value is in `range`.
+fn in_range(v: &[f64], range: crate::validate::Range) -> Result<(), String> {
     if v.is_empty() {
         return Err("is an empty list".into());
     }
-    match v.iter().find(|x| !x.is_finite()) {
-        Some(x) => Err(format!("{x} in {v:?} is not a finite number")),
+    match v.iter().find(|x| !range.contains(**x)) {
+        Some(&x) => Err(format!(
+            "{} in {}",
+            range.check(x).unwrap_err(),
+            ShortList(v)
+        )),
         None => Ok(()),
     }
 }
@@ -561,7 +582,7 @@ fn precision_spec(v: &toml::Value) -> Result<PrecisionSpec, String> {
         .as_array()
         .and_then(|rows| rows.iter().map(numbers).collect());
     rows.map(PrecisionSpec::Matrix)
-        .ok_or_else(|| format!("{shape}; got {v}"))
+        .ok_or_else(|| format!("{shape}; got {}", Clip(&v.to_string())))
 }
 
 fn per_joint_spec(v: &toml::Value) -> Result<PerJoint, String> {
@@ -569,16 +590,20 @@ fn per_joint_spec(v: &toml::Value) -> Result<PerJoint, String> {
         return Ok(PerJoint::All(x));
     }
     numbers(v).map(PerJoint::Each).ok_or_else(|| {
-        format!("expected a number (every joint) or a list (one per joint); got {v}")
+        format!(
+            "expected a number (every joint) or a list (one per joint); got {}",
+            Clip(&v.to_string())
+        )
     })
 }
 
 /// Finite; a matrix square, symmetric (to 1e-12 relative) and positive semi-definite, with the
 /// tolerances [`TaskN::validate`] applies once the model is known.
 fn check_precision(p: &PrecisionSpec) -> Result<(), String> {
+    let entry = crate::validate::PRECISION_ENTRY;
     let rows = match p {
-        PrecisionSpec::Scalar(s) if !(s.is_finite() && *s >= 0.0) => {
-            return Err(format!("{s} must be a finite number ≥ 0"))
+        PrecisionSpec::Scalar(s) if !(entry.contains(*s) && *s >= 0.0) => {
+            return Err(format!("{} must be a number ≥ 0 in {entry}", Short(*s)))
         }
         PrecisionSpec::Scalar(_) => return Ok(()),
         PrecisionSpec::Matrix(rows) => rows,
@@ -587,25 +612,37 @@ fn check_precision(p: &PrecisionSpec) -> Result<(), String> {
     if n == 0 || rows.iter().any(|r| r.len() != n) {
         let lengths: Vec<usize> = rows.iter().map(Vec::len).collect();
         return Err(format!(
-            "a matrix must be square, given row by row; got rows of lengths {lengths:?}"
+            "a matrix must be square, given row by row; got rows of lengths {}",
+            Clip(&format!("{lengths:?}"))
+        ));
+    }
+    let most = crate::model::mixed::ModelKind::ALL
+        .iter()
+        .map(|m| m.dof())
+        .max()
+        .unwrap_or(0);
+    if n > most {
+        return Err(format!(
+            "a {n}×{n} matrix, but no model has more than {most} joints"
         ));
     }
     let m = DMatrix::from_fn(n, n, |i, j| rows[i][j]);
-    if let Some(x) = m.iter().find(|x| !x.is_finite()) {
-        return Err(format!("{x} in {rows:?} is not a finite number"));
+    if let Some(&x) = m.iter().find(|x| !entry.contains(**x)) {
+        return Err(format!("{} in {}", entry.check(x).unwrap_err(), Rows(rows)));
     }
     let scale = m.amax().max(1.0);
     for i in 0..n {
         for j in (i + 1)..n {
             if (m[(i, j)] - m[(j, i)]).abs() > 1e-12 * scale {
                 return Err(format!(
-                    "{rows:?} is not symmetric: entry ({}, {}) = {} but ({}, {}) = {}",
+                    "{} is not symmetric: entry ({}, {}) = {} but ({}, {}) = {}",
+                    Rows(rows),
                     i + 1,
                     j + 1,
-                    m[(i, j)],
+                    Short(m[(i, j)]),
                     j + 1,
                     i + 1,
-                    m[(j, i)]
+                    Short(m[(j, i)])
                 ));
             }
         }
@@ -613,7 +650,9 @@ fn check_precision(p: &PrecisionSpec) -> Result<(), String> {
     let smallest = m.symmetric_eigenvalues().min();
     if smallest < -1e-12 * scale {
         return Err(format!(
-            "{rows:?} is not positive semi-definite (smallest eigenvalue {smallest:e})"
+            "{} is not positive semi-definite (smallest eigenvalue {})",
+            Rows(rows),
+            Short(smallest)
         ));
     }
     Ok(())
@@ -634,8 +673,8 @@ impl TaskSpec {
             };
             TaskFileError {
                 file: source.into(),
-                place,
-                message: message.trim().replace('\n', " "),
+                place: Clip(&place).to_string(),
+                message: ClipMessage(&message.trim().replace('\n', " ")).to_string(),
             }
         })?;
         Self::from_raw(raw, source)

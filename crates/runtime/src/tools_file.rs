@@ -9,17 +9,23 @@
 //! JSON (`.json`): an array of objects with the same keys, e.g.
 //! `[{"name": "hammer", "model": "arm2", "m1": 0.3, "m2": 0.4, "l1": 0.5, "l2": 0.2}]`.
 //!
-//! Rows are handed to a callback one at a time, so a file of 10⁷ tools is never held in memory.
-//! A bad row is an error naming the file, the line (CSV) or tool number (JSON), the key and the
-//! value; the callback decides whether it stops the read or is skipped.
+//! Rows are handed to a callback one at a time, so a file of 10⁷ tools is never held in memory,
+//! and each row (a JSON tool) may be at most 1 MiB ([`crate::bounded_read`]), so that no file,
+//! `/dev/zero` included, is read without bound. A bad row is an error naming the file, the line
+//! (CSV) or tool number (JSON), the key and the value (clipped if long); the callback decides
+//! whether it stops the read or is skipped. A column given twice in a CSV header, or a key twice
+//! in a JSON tool, is refused.
 
 use std::fs::File;
-use std::io::BufReader;
+use std::io::{BufReader, Read};
 use std::path::Path;
 
-use serde::de::{Error as _, SeqAccess, Visitor};
+use serde::de::{Error as _, MapAccess, SeqAccess, Visitor};
+use serde::{Deserialize, Deserializer};
 use serde_json::{Map, Value};
 
+use crate::bounded_read::{record_error, CsvRows, JsonElements, RecordLimit};
+use crate::display::{Clip, ClipMessage, Short};
 use crate::model::mixed::{AnyTool, ModelKind};
 
 /// One tool read from a file.
@@ -35,8 +41,8 @@ impl ToolRow {
     /// The name, or `row N` when the file gives none.
     pub fn label(&self) -> String {
         self.name
-            .clone()
-            .unwrap_or_else(|| format!("row {}", self.row))
+            .as_deref()
+            .map_or_else(|| format!("row {}", self.row), |n| Clip(n).to_string())
     }
 }
 
@@ -65,7 +71,7 @@ enum Cell<'a> {
 /// A file without any row is an error.
 pub fn read_tools(
     path: &Path,
-    mut each: impl FnMut(Result<ToolRow, ToolFileError>) -> Result<(), ToolFileError>,
+    each: impl FnMut(Result<ToolRow, ToolFileError>) -> Result<(), ToolFileError>,
 ) -> Result<usize, ToolFileError> {
     let file_name = path.display().to_string();
     let fatal = |message: String| ToolFileError {
@@ -75,22 +81,43 @@ pub fn read_tools(
         row_level: false,
     };
     let file = File::open(path).map_err(|e| fatal(format!("cannot open the tools file: {e}")))?;
+    if file.metadata().is_ok_and(|m| m.is_dir()) {
+        return Err(fatal("is a folder, not a tools file".into()));
+    }
     let is_json = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"));
+    read_tools_from(BufReader::new(file), &file_name, is_json, each)
+}
+
+/// [`read_tools`] of a tools file's bytes from `reader`, named `file_name` in errors: JSON if
+/// `is_json`, else CSV.
+pub fn read_tools_from<R: Read>(
+    reader: R,
+    file_name: &str,
+    is_json: bool,
+    mut each: impl FnMut(Result<ToolRow, ToolFileError>) -> Result<(), ToolFileError>,
+) -> Result<usize, ToolFileError> {
     let rows = if is_json {
-        read_json(BufReader::new(file), &file_name, &mut each)?
+        // serde_json reads a byte at a time: the buffer goes between it and the limit.
+        let bounded = BufReader::new(RecordLimit::new(reader, JsonElements::default()));
+        read_json(bounded, file_name, &mut each)?
     } else {
-        read_csv(file, &file_name, &mut each)?
+        read_csv(reader, file_name, &mut each)?
     };
     if rows == 0 {
-        return Err(fatal("no tools: the file has no rows".into()));
+        return Err(ToolFileError {
+            file: file_name.into(),
+            place: String::new(),
+            message: "no tools: the file has no rows".into(),
+            row_level: false,
+        });
     }
     Ok(rows)
 }
 
-fn read_csv(
-    file: File,
+fn read_csv<R: Read>(
+    reader: R,
     file_name: &str,
     each: &mut impl FnMut(Result<ToolRow, ToolFileError>) -> Result<(), ToolFileError>,
 ) -> Result<usize, ToolFileError> {
@@ -100,12 +127,16 @@ fn read_csv(
         message,
         row_level,
     };
+    let bounded = RecordLimit::new(reader, CsvRows::default());
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
-        .from_reader(BufReader::new(file));
+        .from_reader(bounded);
     let header: Vec<String> = reader
         .headers()
-        .map_err(|e| error("line 1".into(), e.to_string(), false))?
+        .map_err(|e| {
+            let (line, message) = csv_error(&e);
+            error(format!("line {}", line.unwrap_or(1)), message, false)
+        })?
         .iter()
         .map(str::to_string)
         .collect();
@@ -116,7 +147,7 @@ fn read_csv(
             false,
         ));
     }
-    check_keys(header.iter().map(String::as_str))
+    check_keys(header.iter().map(String::as_str), "column")
         .map_err(|m| error("line 1 (header)".into(), m, false))?;
     let present = present_keys(|k| header.iter().any(|h| h == k));
     let mut record = csv::StringRecord::new();
@@ -140,15 +171,9 @@ fn read_csv(
             }
             Err(e) => {
                 rows += 1;
-                let line = e.position().map_or(0, |p| p.line());
-                let message = match e.kind() {
-                    csv::ErrorKind::UnequalLengths {
-                        expected_len, len, ..
-                    } => format!("the row has {len} cells, the header {expected_len}"),
-                    _ => e.to_string(),
-                };
+                let (line, message) = csv_error(&e);
                 let row_level = matches!(e.kind(), csv::ErrorKind::UnequalLengths { .. });
-                let e = error(format!("line {line}"), message, row_level);
+                let e = error(format!("line {}", line.unwrap_or(0)), message, row_level);
                 if !row_level {
                     return Err(e);
                 }
@@ -157,6 +182,28 @@ fn read_csv(
         }
     }
     Ok(rows)
+}
+
+/// A CSV error's line and message: a row too long or a quote never closed as the bounded
+/// reader says ([`crate::bounded_read`]), a row of the wrong length in cells, else the `csv`
+/// crate's words.
+fn csv_error(e: &csv::Error) -> (Option<u64>, String) {
+    match e.kind() {
+        csv::ErrorKind::Io(io) => match record_error(io) {
+            Some((line, message)) => (Some(line), message),
+            None => (None, format!("cannot read the tools file: {io}")),
+        },
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => (
+            e.position().map(|p| p.line()),
+            format!("the row has {len} cells, the header {expected_len}"),
+        ),
+        _ => (
+            e.position().map(|p| p.line()),
+            ClipMessage(&e.to_string()).to_string(),
+        ),
+    }
 }
 
 /// Keys a row may have: `name`, `model`, and every model's parameter names.
@@ -205,14 +252,19 @@ fn present_keys(has: impl Fn(&str) -> bool) -> Vec<&'static str> {
         .collect()
 }
 
-fn check_keys<'a>(keys: impl Iterator<Item = &'a str>) -> Result<(), String> {
+/// Every key known and none twice; `noun` is "column" (CSV) or "key" (JSON).
+fn check_keys<'a>(keys: impl Iterator<Item = &'a str>, noun: &str) -> Result<(), String> {
     let mut seen = Vec::new();
     for key in keys {
         if !known_key(key) {
-            return Err(format!("unknown column '{key}' (known: {})", known_keys()));
+            return Err(format!(
+                "unknown {noun} '{}' (known: {})",
+                Clip(key),
+                known_keys()
+            ));
         }
         if seen.contains(&key) {
-            return Err(format!("column '{key}' appears twice"));
+            return Err(format!("{noun} '{key}' appears twice"));
         }
         seen.push(key);
     }
@@ -234,18 +286,24 @@ fn build_row<'a>(
         Cell::Absent => None,
         Cell::Text(t) => Some(t.to_string()),
         Cell::Number(x) => Some(x.to_string()),
-        Cell::Other(v) => return Err(format!("name = {v} is not text")),
+        Cell::Other(v) => return Err(format!("name = {} is not text", Clip(&v))),
     };
     // Built only for an error: most rows have none.
     let who = || {
         name.as_ref()
-            .map_or(String::new(), |n| format!(" (tool '{n}')"))
+            .map_or(String::new(), |n| format!(" (tool '{}')", Clip(n)))
     };
     let model = match cell("model") {
         Cell::Absent => ModelKind::Arm2,
         Cell::Text(t) => t.parse().map_err(|e: String| format!("{e}{}", who()))?,
-        Cell::Number(x) => return Err(format!("model = {x} is not a model name{}", who())),
-        Cell::Other(v) => return Err(format!("model = {v} is not a model name{}", who())),
+        Cell::Number(x) => {
+            let x = Short(x);
+            return Err(format!("model = {x} is not a model name{}", who()));
+        }
+        Cell::Other(v) => {
+            let v = Clip(&v);
+            return Err(format!("model = {v} is not a model name{}", who()));
+        }
     };
     let names = model.parameter_names();
     let mut params = Vec::with_capacity(names.len());
@@ -260,14 +318,11 @@ fn build_row<'a>(
             Cell::Number(x) => x,
             Cell::Text(t) => t
                 .parse::<f64>()
-                .map_err(|_| format!("{key} = '{t}' is not a number{}", who()))?,
-            Cell::Other(v) => return Err(format!("{key} = {v} is not a number{}", who())),
+                .map_err(|_| format!("{key} = '{}' is not a number{}", Clip(t), who()))?,
+            Cell::Other(v) => return Err(format!("{key} = {} is not a number{}", Clip(&v), who())),
         };
-        if !(value.is_finite() && value > 0.0) {
-            return Err(format!(
-                "{key} = {value} must be a finite number > 0{}",
-                who()
-            ));
+        if let Err(why) = crate::validate::TOOL_PARAMETER.check(value) {
+            return Err(format!("{key} = {why}{}", who()));
         }
         params.push(value);
     }
@@ -303,13 +358,14 @@ where
     }
 
     fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<(), A::Error> {
-        while let Some(object) = seq.next_element::<Map<String, Value>>()? {
+        while let Some(Object { map, twice }) = seq.next_element::<Object>()? {
             self.rows += 1;
             let row = self.rows;
-            let result = check_keys(object.keys().map(String::as_str))
+            let keys = map.keys().map(String::as_str).chain(twice.as_deref());
+            let result = check_keys(keys, "key")
                 .and_then(|()| {
-                    let present = present_keys(|k| object.contains_key(k));
-                    build_row(row, &|key| json_cell(&object, key), &present)
+                    let present = present_keys(|k| map.contains_key(k));
+                    build_row(row, &|key| json_cell(&map, key), &present)
                 })
                 .map_err(|message| ToolFileError {
                     file: self.file.into(),
@@ -323,6 +379,40 @@ where
             }
         }
         Ok(())
+    }
+}
+
+/// One tool's object, and the first key it gives twice if any (a `Map` alone would keep the
+/// last value silently, where the CSV reader refuses a column given twice).
+struct Object {
+    map: Map<String, Value>,
+    twice: Option<String>,
+}
+
+impl<'de> Deserialize<'de> for Object {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Entries;
+        impl<'de> Visitor<'de> for Entries {
+            type Value = Object;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a tool (an object)")
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut entries: A) -> Result<Object, A::Error> {
+                let mut object = Object {
+                    map: Map::new(),
+                    twice: None,
+                };
+                while let Some((key, value)) = entries.next_entry::<String, Value>()? {
+                    if object.map.contains_key(&key) {
+                        object.twice.get_or_insert(key);
+                    } else {
+                        object.map.insert(key, value);
+                    }
+                }
+                Ok(object)
+            }
+        }
+        d.deserialize_map(Entries)
     }
 }
 
@@ -353,11 +443,23 @@ fn read_json<R: std::io::Read>(
     if let Some(e) = elements.stopped {
         return Err(e);
     }
-    parsed.map_err(|e| ToolFileError {
-        file: file_name.into(),
-        place: format!("line {}", e.line()),
-        message: format!("not a JSON array of tools: {e}"),
-        row_level: false,
+    parsed.map_err(|e| {
+        let (line, message) = if e.is_io() {
+            let io = std::io::Error::from(e);
+            match record_error(&io) {
+                Some((line, message)) => (line as usize, message),
+                None => (0, format!("cannot read the tools file: {io}")),
+            }
+        } else {
+            let message = format!("not a JSON array of tools: {}", ClipMessage(&e.to_string()));
+            (e.line(), message)
+        };
+        ToolFileError {
+            file: file_name.into(),
+            place: format!("line {line}"),
+            message,
+            row_level: false,
+        }
     })?;
     Ok(elements.rows)
 }

@@ -17,7 +17,7 @@
 //! ([`batch::map_ordered`]) and each chunk's rows are appended in input order, one `write_all`
 //! per row ([`csv::CsvWriter`]). The files are therefore byte-identical whatever the thread count,
 //! and an interrupted run leaves complete rows. Figures and the report are written whole
-//! (`X.partial`, then renamed).
+//! (`.X.*.partial`, then renamed: [`toolconf::output::file`]).
 //!
 //! # Extending
 //!
@@ -324,7 +324,7 @@ pub fn reproduce(config: &Config) -> Result<Summary, ReproduceError> {
         }
     };
     let out = config.out_dir.as_path();
-    std::fs::create_dir_all(out).map_err(ReproduceError::io(out))?;
+    toolconf::output::file::create_folder(out).map_err(ReproduceError::io(out))?;
     let report_md = out.join("report.md");
     let report_html = out.join("report.html");
     // A report left from an older run would describe other data than an interrupted run leaves.

@@ -7,6 +7,9 @@
 
 use std::fmt;
 
+use crate::display::Clip;
+use crate::validate::{CONSTRAINT_BOUND, CONSTRAINT_COEFFICIENT};
+
 /// a·p ≤ b over a model's parameters (in the model's order), with the text it came from.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinearConstraint {
@@ -71,9 +74,18 @@ pub fn parse_constraint(text: &str, names: &[&str]) -> Result<LinearConstraint, 
     if coefficients.iter().all(|&c| c == 0.0) {
         return Err("names no parameter (or its terms cancel)".into());
     }
+    for (name, &c) in names.iter().zip(&coefficients) {
+        CONSTRAINT_COEFFICIENT
+            .check(c)
+            .map_err(|why| format!("the coefficient of {name}: {why}"))?;
+    }
+    let bound = sign * (c_right - c_left);
+    CONSTRAINT_BOUND
+        .check(bound)
+        .map_err(|why| format!("the constant side: {why}"))?;
     Ok(LinearConstraint {
         coefficients,
-        bound: sign * (c_right - c_left),
+        bound,
         text: text.trim().to_string(),
     })
 }
@@ -119,7 +131,8 @@ fn parse_side(side: &str, names: &[&str]) -> Result<(Vec<f64>, f64), String> {
             Some(name) => {
                 let k = names.iter().position(|n| *n == name).ok_or_else(|| {
                     format!(
-                        "unknown parameter '{name}' (parameters: {})",
+                        "unknown parameter '{}' (parameters: {})",
+                        Clip(&name),
                         names.join(", ")
                     )
                 })?;
@@ -167,8 +180,8 @@ enum Token {
 impl Token {
     fn text(&self) -> String {
         match self {
-            Token::Number(v) => v.to_string(),
-            Token::Name(n) => n.clone(),
+            Token::Number(v) => crate::display::Short(*v).to_string(),
+            Token::Name(n) => Clip(n).to_string(),
             Token::Sign(s) => (if *s > 0.0 { "+" } else { "-" }).into(),
             Token::Times => "*".into(),
             Token::Divide => "/".into(),
@@ -209,9 +222,9 @@ fn tokenize(s: &str) -> Result<Vec<Token>, String> {
             let text: String = chars[start..i].iter().collect();
             let v: f64 = text
                 .parse()
-                .map_err(|_| format!("'{text}' is not a number"))?;
+                .map_err(|_| format!("'{}' is not a number", Clip(&text)))?;
             if !v.is_finite() {
-                return Err(format!("'{text}' is not a finite number"));
+                return Err(format!("'{}' is not a finite number", Clip(&text)));
             }
             tokens.push(Token::Number(v));
         } else if c.is_alphabetic() || c == '_' {

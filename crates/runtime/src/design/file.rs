@@ -25,6 +25,7 @@ use serde::Deserialize;
 
 use super::constraint::{parse_constraint, LinearConstraint};
 use super::DesignError;
+use crate::display::{Clip, ClipMessage, ShortList};
 
 /// What the design optimises.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -108,9 +109,8 @@ impl DesignSpec {
     /// Reads and checks a design file for a model with parameters `names`.
     pub fn from_file(path: &Path, names: &[&'static str]) -> Result<Self, DesignError> {
         let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| {
-            DesignError::input(&file, "", format!("cannot read the design file: {e}"))
-        })?;
+        let text = crate::bounded_read::read_text_file(path, "design file")
+            .map_err(|message| DesignError::input(&file, "", message))?;
         Self::parse(&text, &file, names)
     }
 
@@ -119,7 +119,8 @@ impl DesignSpec {
         let raw: RawDesign = toml::from_str(text).map_err(|e| {
             let line = e.span().map(|s| 1 + text[..s.start].matches('\n').count());
             let place = line.map(|l| format!("line {l}")).unwrap_or_default();
-            DesignError::input(file, &place, e.message().trim().replace('\n', " "))
+            let message = e.message().trim().replace('\n', " ");
+            DesignError::input(file, &place, ClipMessage(&message).to_string())
         })?;
         Self::from_raw(raw, file, names)
     }
@@ -133,16 +134,20 @@ impl DesignSpec {
             Some(other) => {
                 return Err(err(
                     "objective",
-                    format!("'{other}' is not an objective (confidence or free_energy)"),
+                    format!(
+                        "'{}' is not an objective (confidence or free_energy)",
+                        Clip(other)
+                    ),
                 ))
             }
         };
         let known = |key: String, name: &str| -> Result<usize, DesignError> {
             names.iter().position(|n| *n == name).ok_or_else(|| {
                 err(
-                    &key,
+                    &Clip(&key).to_string(),
                     format!(
-                        "unknown parameter '{name}' (parameters: {})",
+                        "unknown parameter '{}' (parameters: {})",
+                        Clip(name),
                         names.join(", ")
                     ),
                 )
@@ -151,11 +156,8 @@ impl DesignSpec {
         let mut fixed = vec![None; names.len()];
         for (name, &value) in &raw.fixed {
             let k = known(format!("fixed.{name}"), name)?;
-            if !(value.is_finite() && value > 0.0) {
-                return Err(err(
-                    &format!("fixed.{name}"),
-                    format!("{value} is not a positive number"),
-                ));
+            if let Err(why) = crate::validate::TOOL_PARAMETER.check(value) {
+                return Err(err(&format!("fixed.{name}"), why));
             }
             fixed[k] = Some(value);
         }
@@ -190,7 +192,7 @@ impl DesignSpec {
             .enumerate()
             .map(|(i, c)| {
                 parse_constraint(c, names)
-                    .map_err(|m| err(&format!("constraints[{i}]"), format!("'{c}': {m}")))
+                    .map_err(|m| err(&format!("constraints[{i}]"), format!("'{}': {m}", Clip(c))))
             })
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
@@ -206,20 +208,25 @@ impl DesignSpec {
     }
 }
 
+/// `[lo, hi]` within [`crate::validate::TOOL_PARAMETER`], lo ≤ hi.
 fn check_bounds(range: &[f64]) -> Result<(f64, f64), String> {
     let &[lo, hi] = range else {
-        return Err(format!("{range:?} is not [lo, hi]"));
+        return Err(format!("{} is not [lo, hi]", ShortList(range)));
     };
-    if !(lo.is_finite() && hi.is_finite()) {
-        return Err(format!("[{lo}, {hi}] is not finite"));
-    }
+    let valid = crate::validate::TOOL_PARAMETER;
+    let shown = ShortList(range);
     if lo <= 0.0 {
         return Err(format!(
-            "[{lo}, {hi}] admits values <= 0; masses and lengths must be > 0 (give lo > 0)"
+            "{shown} admits values <= 0; masses and lengths must be > 0 (give lo > 0)"
+        ));
+    }
+    if !(valid.contains(lo) && valid.contains(hi)) {
+        return Err(format!(
+            "{shown} goes outside {valid}, where every tool parameter must lie"
         ));
     }
     if lo > hi {
-        return Err(format!("[{lo}, {hi}] is empty (lo > hi)"));
+        return Err(format!("{shown} is empty (lo > hi)"));
     }
     Ok((lo, hi))
 }
@@ -242,9 +249,9 @@ fn search_settings(raw: &RawSearch) -> Result<SearchSettings, (&'static str, Str
     if s.simulate > 1000 {
         return Err(("simulate", format!("{} is more than 1000", s.simulate)));
     }
-    if !s.perturbation.is_finite() {
-        return Err(("perturbation", format!("{} is not finite", s.perturbation)));
-    }
+    crate::validate::TORQUE
+        .check(s.perturbation)
+        .map_err(|m| ("perturbation", m))?;
     Ok(s)
 }
 

@@ -12,7 +12,7 @@ use crate::model::mixed::ModelKind;
 /// The design `r` of `model` on the task named `task` (as the user gave it), with the sweep's
 /// front if there was one. Keys: `objective`, `params` (by name), `logdet`,
 /// `confidence_optimum`, `gradient` (over the free parameters), `gradient_check`,
-/// `kkt_residual`, `iterations`, `start`, `free_energy_simulations`, `perturbation`, `random`,
+/// `kkt_residual`, `converged`, `iterations`, `start`, `free_energy_simulations`, `perturbation`, `random`,
 /// `verification` (one object per simulated tool), `model`, `task` and, after a sweep, `sweep`.
 pub fn design_json(
     spec: &DesignSpec,
@@ -72,7 +72,15 @@ fn result_json(spec: &DesignSpec, r: &DesignResult) -> Value {
             v
         })
         .collect();
-    let best = r.random.top.first();
+    let mut random = json!({
+        "requested": r.random.requested,
+        "feasible": r.random.feasible,
+        "drawn": r.random.drawn,
+    });
+    // No best at all is a missing key, not a null.
+    if let Some(best) = r.random.top.first() {
+        random["best_logdet"] = Value::from(best.1);
+    }
     let optimum = Polytope::new(spec).full(&o.x);
     json!({
         "objective": r.objective.name(),
@@ -82,16 +90,12 @@ fn result_json(spec: &DesignSpec, r: &DesignResult) -> Value {
         "gradient": named(&free, &o.gradient),
         "gradient_check": r.gradient_check,
         "kkt_residual": o.kkt_residual,
+        "converged": o.converged(),
         "iterations": o.iterations,
         "start": o.start,
         "free_energy_simulations": r.free_energy_evaluations,
         "perturbation": spec.search.perturbation,
-        "random": {
-            "requested": r.random.requested,
-            "feasible": r.random.feasible,
-            "drawn": r.random.drawn,
-            "best_logdet": best.map(|b| b.1),
-        },
+        "random": random,
         "verification": verification,
     })
 }

@@ -27,7 +27,7 @@ use crate::rank::ModelTasks;
 use crate::task_file::TaskSpec;
 
 use file::{DesignObjective, DesignSpec};
-use polytope::{FeasibleSampler, Polytope};
+use polytope::{FeasibleSampler, Polytope, Spread};
 use solver::Optimum;
 use verify::{RandomTools, ToolCheck};
 
@@ -62,35 +62,45 @@ pub struct Setting<'a> {
 
 impl<'a> Setting<'a> {
     /// ln|Π^U| and its gradient over the free parameters at free parameters `x`.
+    /// None where ln|Π^U| is undefined, or where its gradient is not finite (Π^U so nearly
+    /// singular that the generated tr((Π^U)⁻¹ ∂Π^U/∂p) overflows): the search treats both alike.
     pub fn confidence(&self, polytope: &Polytope, x: &[f64]) -> Option<(f64, Vec<f64>)> {
         let tool = AnyTool::new(self.model, &polytope.full(x)).ok()?;
         let (value, gradient) = self.tasks.logdet_and_gradient(&tool).ok()?;
-        Some((value, polytope.free.iter().map(|&k| gradient[k]).collect()))
+        let gradient: Vec<f64> = polytope.free.iter().map(|&k| gradient[k]).collect();
+        (value.is_finite() && gradient.iter().all(|g| g.is_finite())).then_some((value, gradient))
     }
 }
 
-/// The confidence optimum over the feasible set, from the centre and `search.starts` seeded
-/// random feasible starts.
+/// The confidence optimum over the feasible set, from the centre, `search.starts` seeded
+/// random feasible starts, drawn uniformly in ln p ([`Spread::LogUniform`]) so that every
+/// decade of a wide box is started from, and the box's feasible corners (ln|Π^U| grows as a tool
+/// gets lighter and shorter, so its maxima are often there; where it is flat over decades, a
+/// start inside never reaches them).
 pub fn confidence_optimum(
     spec: &DesignSpec,
     setting: &Setting,
 ) -> Result<(Polytope, Optimum), DesignError> {
     let polytope = Polytope::new(spec);
     let mut starts = vec![polytope.centre(&spec.file)?];
-    let mut sampler = FeasibleSampler::new(&polytope, spec.search.seed);
+    let mut sampler = FeasibleSampler::with_spread(&polytope, spec.search.seed, Spread::LogUniform);
     while starts.len() <= spec.search.starts {
         match sampler.next_point(100_000) {
             Some(x) => starts.push(x),
             None => break,
         }
     }
+    starts.extend(polytope.feasible_corners());
     let mut objective = |x: &[f64]| setting.confidence(&polytope, x);
-    let optimum = solver::maximise(&polytope, &starts, &mut objective).ok_or_else(|| {
-        DesignError::Input(format!(
-            "{}: ln|Π^U| is undefined at every start (Π^U not positive definite); check the task's precisions",
-            spec.file
-        ))
-    })?;
+    let optimum = solver::maximise(&polytope, &starts, &mut objective)
+        .map_err(|reason| polytope.solver_failed(&spec.file, "climbing ln|Π^U|", &reason))?
+        .ok_or_else(|| {
+            DesignError::Input(format!(
+                "{}: ln|Π^U| is undefined at every start: for the tools there, the task's \
+                 precisions leave Π^U not positive definite",
+                spec.file
+            ))
+        })?;
     Ok((polytope, optimum))
 }
 
@@ -133,15 +143,29 @@ pub struct DesignResult {
 
 /// Designs a tool: the optimum, then the verification against random feasible tools.
 pub fn design(spec: &DesignSpec, setting: &Setting) -> Result<DesignResult, DesignError> {
+    design_with_progress(spec, setting, &mut |_| {})
+}
+
+/// [`design`], telling `sampling` how the random comparison goes as it draws
+/// ([`verify::random_tools`]).
+pub fn design_with_progress(
+    spec: &DesignSpec,
+    setting: &Setting,
+    sampling: &mut dyn FnMut(&verify::Sampling),
+) -> Result<DesignResult, DesignError> {
     let (polytope, optimum) = confidence_optimum(spec, setting)?;
     let check = gradient_check(setting, &polytope, &optimum);
     let (x, logdet, evaluations) = match spec.objective {
         DesignObjective::Confidence => (optimum.x.clone(), optimum.value, 0),
         DesignObjective::FreeEnergy => {
             let found = free_energy::minimise(&polytope, setting, &optimum.x)?;
-            let logdet = setting
-                .confidence(&polytope, &found.x)
-                .map_or(f64::NAN, |v| v.0);
+            let Some((logdet, _)) = setting.confidence(&polytope, &found.x) else {
+                return Err(DesignError::Failed(format!(
+                    "{}: ln|Π^U| is undefined at the ∫F dt optimum {}",
+                    spec.file,
+                    parameters_text(&spec.names, &polytope.full(&found.x))
+                )));
+            };
             (found.x, logdet, found.simulations)
         }
     };
@@ -153,6 +177,7 @@ pub fn design(spec: &DesignSpec, setting: &Setting) -> Result<DesignResult, Desi
         s.samples,
         s.simulate,
         s.seed ^ 0x9e37_79b9_7f4a_7c15,
+        sampling,
     );
     let mut tools = vec![("design".to_string(), polytope.full(&x), logdet)];
     for (k, (xr, l)) in random.top.iter().enumerate().take(s.simulate) {
@@ -170,4 +195,27 @@ pub fn design(spec: &DesignSpec, setting: &Setting) -> Result<DesignResult, Desi
         random,
         checks,
     })
+}
+
+/// `m1=0.1 m2=0.4 …`.
+pub fn parameters_text(names: &[&str], params: &[f64]) -> String {
+    names
+        .iter()
+        .zip(params)
+        .map(|(n, v)| format!("{n}={v:.6}"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+impl DesignResult {
+    /// Every number the design reports finite ([`crate::validate::finite_output`]), for the
+    /// command line and the Python package alike.
+    pub fn check_finite(&self, names: &[&str]) -> Result<(), crate::Error> {
+        let o = &self.confidence_optimum;
+        crate::validate::finite_output(
+            &format!("the design {}", parameters_text(names, &self.params)),
+            "ln|Π^U|, the KKT residual or the gradient check",
+            [self.logdet, o.value, o.kkt_residual, self.gradient_check],
+        )
+    }
 }

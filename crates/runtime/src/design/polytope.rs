@@ -10,9 +10,13 @@ use super::constraint::dot;
 use super::file::DesignSpec;
 use super::qp::{self, QpOutcome};
 use super::DesignError;
+use crate::display::Clip;
 
 /// Points within this (absolute, in parameter units) of a constraint count as on it.
 pub const FEASIBILITY_TOLERANCE: f64 = 1e-9;
+
+/// The most free parameters whose box corners are all tried as starts (2⁶ = 64 corners).
+pub const MAX_CORNER_DIM: usize = 6;
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Polytope {
@@ -40,8 +44,13 @@ impl Polytope {
                 .filter(|k| !free.contains(k))
                 .map(|k| c.coefficients[k] * base[k])
                 .sum();
-            g.push(free.iter().map(|&k| c.coefficients[k]).collect());
-            h.push(c.bound - fixed_part);
+            // Each row scaled to a largest coefficient of 1: the same set, and QPs whose rows
+            // the solver sees on one scale whatever the user wrote (`1e6 m1 <= 3e5`).
+            let row: Vec<f64> = free.iter().map(|&k| c.coefficients[k]).collect();
+            let scale = row.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            let scale = if scale > 0.0 { scale } else { 1.0 };
+            g.push(row.iter().map(|v| v / scale).collect());
+            h.push((c.bound - fixed_part) / scale);
             text.push(c.text.clone());
         }
         Self {
@@ -96,6 +105,30 @@ impl Polytope {
         self.violation(x) <= FEASIBILITY_TOLERANCE
     }
 
+    /// The corners of the box (each free parameter at its lower or upper bound, the all-lower
+    /// corner first) that satisfy the constraints; none beyond [`MAX_CORNER_DIM`] free
+    /// parameters.
+    pub fn feasible_corners(&self) -> Vec<Vec<f64>> {
+        let n = self.dim();
+        if n == 0 || n > MAX_CORNER_DIM {
+            return Vec::new();
+        }
+        (0..1usize << n)
+            .map(|bits| {
+                (0..n)
+                    .map(|j| {
+                        if bits >> j & 1 == 0 {
+                            self.lo[j]
+                        } else {
+                            self.hi[j]
+                        }
+                    })
+                    .collect::<Vec<f64>>()
+            })
+            .filter(|x| self.contains(x))
+            .collect()
+    }
+
     /// A Chebyshev centre (the centre of the largest ball inside, in parameter units): the
     /// multi-start's first, deterministic start; or [`DesignError::Infeasible`] naming the
     /// constraints when the set is empty.
@@ -135,9 +168,24 @@ impl Polytope {
                 }
             }
             QpOutcome::Infeasible => Err(self.infeasible(file)),
-            QpOutcome::Failed(m) => Err(DesignError::Failed(format!(
-                "finding a feasible design: {m}"
-            ))),
+            QpOutcome::Failed(m) => Err(self.solver_failed(file, "finding a feasible design", &m)),
+        }
+    }
+
+    /// The QP solver's failure, naming the file and the constraints it was solving under.
+    pub fn solver_failed(&self, file: &str, doing: &str, reason: &str) -> DesignError {
+        DesignError::Failed(format!(
+            "{file}: the QP solver failed {doing} ({reason}) under the bounds and {}",
+            self.constraints_text()
+        ))
+    }
+
+    fn constraints_text(&self) -> String {
+        if self.text.is_empty() {
+            "no constraints".to_string()
+        } else {
+            let quoted: Vec<String> = self.text.iter().map(|t| format!("'{}'", Clip(t))).collect();
+            format!("the constraints {}", quoted.join(", "))
         }
     }
 
@@ -149,31 +197,44 @@ impl Polytope {
     }
 
     fn infeasible(&self, file: &str) -> DesignError {
-        let constraints = if self.text.is_empty() {
-            "(no constraints)".to_string()
-        } else {
-            self.text.join(", ")
-        };
         DesignError::Infeasible(format!(
-            "{file}: the constraints are infeasible: no parameters within the bounds satisfy {constraints}"
+            "{file}: the constraints are infeasible: no parameters within the bounds satisfy {}",
+            self.constraints_text()
         ))
     }
 }
 
-/// Uniform draws from the polytope by rejection from its box: ChaCha8 seeded with `seed`, each
-/// coordinate lo + (hi − lo)·u with u = (next_u64 >> 11)·2⁻⁵³, a draw kept when it satisfies
+/// How a sampler draws each coordinate from the box.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Spread {
+    /// lo + (hi − lo)·u: uniform in the parameters (the random tools a design is compared with).
+    Uniform,
+    /// lo·(hi/lo)^u: uniform in ln p, every decade of a wide box as likely as any other (the
+    /// SQP's starts: in [1e-6, 1e6] a uniform start is almost surely above 1e4, where ln|Π^U| is
+    /// flat, and the light corner is never started from).
+    LogUniform,
+}
+
+/// Draws from the polytope by rejection from its box: ChaCha8 seeded with `seed`, each
+/// coordinate from u = (next_u64 >> 11)·2⁻⁵³ as [`Spread`] says, a draw kept when it satisfies
 /// every constraint. Sequential, so the same seed gives the same points on any machine.
 pub struct FeasibleSampler<'a> {
     polytope: &'a Polytope,
     rng: ChaCha8Rng,
+    spread: Spread,
     pub drawn: u64,
 }
 
 impl<'a> FeasibleSampler<'a> {
     pub fn new(polytope: &'a Polytope, seed: u64) -> Self {
+        Self::with_spread(polytope, seed, Spread::Uniform)
+    }
+
+    pub fn with_spread(polytope: &'a Polytope, seed: u64, spread: Spread) -> Self {
         Self {
             polytope,
             rng: ChaCha8Rng::seed_from_u64(seed),
+            spread,
             drawn: 0,
         }
     }
@@ -186,7 +247,13 @@ impl<'a> FeasibleSampler<'a> {
             let x: Vec<f64> = (0..p.dim())
                 .map(|j| {
                     let u = (self.rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
-                    p.lo[j] + (p.hi[j] - p.lo[j]) * u
+                    let (lo, hi) = (p.lo[j], p.hi[j]);
+                    match self.spread {
+                        Spread::Uniform => lo + (hi - lo) * u,
+                        Spread::LogUniform => {
+                            (lo.ln() + (hi.ln() - lo.ln()) * u).exp().clamp(lo, hi)
+                        }
+                    }
                 })
                 .collect();
             if p.g.iter().zip(&p.h).all(|(row, b)| dot(row, &x) <= *b) {

@@ -46,27 +46,38 @@ pub fn solve(hessian: Option<&[Vec<f64>]>, q: &[f64], g: &[Vec<f64>], h: &[f64])
     }
     let a = CscMatrix::new_from_triplets(g.len(), n, a.0, a.1, a.2);
     let cones: Vec<SupportedConeT<f64>> = vec![NonnegativeConeT(h.len())];
-    let settings = DefaultSettingsBuilder::default()
-        .verbose(false)
-        .tol_gap_abs(1e-11)
-        .tol_gap_rel(1e-11)
-        .tol_feas(1e-11)
-        .build()
-        .expect("valid Clarabel settings");
-    let mut solver = match DefaultSolver::new(&p, q, &a, h, &cones, settings) {
-        Ok(s) => s,
-        Err(e) => return QpOutcome::Failed(format!("Clarabel setup: {e}")),
-    };
-    solver.solve();
-    let s = &solver.solution;
-    match s.status {
-        SolverStatus::Solved | SolverStatus::AlmostSolved => QpOutcome::Solved {
+    // Tight tolerances first; a QP whose optimum is a degenerate vertex (every bound of a box
+    // corner active, with zero slack) can stall there ("InsufficientProgress", or
+    // "AlmostSolved": only to Clarabel's reduced accuracy, 5e-5), and Clarabel's own defaults
+    // (1e-8) then solve it. An almost-solved QP is the answer only if neither solves it.
+    let mut outcome = QpOutcome::Failed(String::new());
+    let mut almost = None;
+    for tolerance in [1e-11, 1e-8] {
+        let settings = DefaultSettingsBuilder::default()
+            .verbose(false)
+            .tol_gap_abs(tolerance)
+            .tol_gap_rel(tolerance)
+            .tol_feas(tolerance)
+            .build()
+            .expect("valid Clarabel settings");
+        let mut solver = match DefaultSolver::new(&p, q, &a, h, &cones, settings) {
+            Ok(s) => s,
+            Err(e) => return QpOutcome::Failed(format!("Clarabel setup: {e}")),
+        };
+        solver.solve();
+        let s = &solver.solution;
+        let solved = || QpOutcome::Solved {
             x: s.x.clone(),
             z: s.z.clone(),
-        },
-        SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
-            QpOutcome::Infeasible
+        };
+        match s.status {
+            SolverStatus::Solved => return solved(),
+            SolverStatus::AlmostSolved => almost = almost.or_else(|| Some(solved())),
+            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
+                return QpOutcome::Infeasible
+            }
+            other => outcome = QpOutcome::Failed(format!("Clarabel: {other:?}")),
         }
-        other => QpOutcome::Failed(format!("Clarabel: {other:?}")),
     }
+    almost.unwrap_or(outcome)
 }

@@ -25,7 +25,7 @@ pub struct SweepPoint {
 
 /// Parses `LEFT <= A..B:K` (or `>=`); K ≥ 2 values from A to B inclusive.
 pub fn parse_sweep(text: &str, names: &[&str]) -> Result<Sweep, String> {
-    let bad = |why: &str| format!("--sweep '{text}': {why}");
+    let bad = |why: &str| format!("--sweep '{}': {why}", crate::display::Clip(text));
     let (left, sense, right) = split_comparison(text).map_err(|e| bad(&e))?;
     let op = if matches!(sense, super::constraint::Sense::AtMost) {
         "<="
@@ -57,7 +57,9 @@ pub fn parse_sweep(text: &str, names: &[&str]) -> Result<Sweep, String> {
         .iter()
         .map(|v| format!("{} {op} {v}", left.trim()))
         .collect();
-    parse_constraint(&texts[0], names).map_err(|e| bad(&e))?;
+    for t in &texts {
+        parse_constraint(t, names).map_err(|e| bad(&e))?;
+    }
     Ok(Sweep {
         label: format!("{} {op}", left.trim()),
         values,

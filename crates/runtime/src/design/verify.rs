@@ -39,8 +39,22 @@ pub struct RandomTools {
     pub top: Vec<(Vec<f64>, f64)>,
 }
 
-/// Draws up to `n` feasible tools (rejection from the box, at most 1000·n draws) and keeps the
-/// `keep` most confident. Sequential and seeded: the same tools on every machine.
+/// The most draws from the box the random comparison makes (about 2 s): a thin feasible set
+/// with `samples = 10⁷` stops there, with the tools found, instead of drawing for minutes.
+pub const MAX_DRAWS: u64 = 100_000_000;
+
+/// How far the random comparison has got, as [`random_tools`] reports it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sampling {
+    pub feasible: usize,
+    pub requested: usize,
+    pub drawn: u64,
+    pub max_draws: u64,
+}
+
+/// Draws up to `n` feasible tools (rejection from the box, at most 1000·n and [`MAX_DRAWS`]
+/// draws) and keeps the `keep` most confident, telling `progress` every 2¹⁶ draws. Sequential
+/// and seeded: the same tools on every machine.
 pub fn random_tools(
     polytope: &Polytope,
     model: ModelKind,
@@ -48,14 +62,40 @@ pub fn random_tools(
     n: usize,
     keep: usize,
     seed: u64,
+    progress: &mut dyn FnMut(&Sampling),
+) -> RandomTools {
+    let max_draws = (1000 * n.max(1) as u64).min(MAX_DRAWS);
+    random_tools_within(polytope, model, tasks, (n, keep), seed, max_draws, progress)
+}
+
+/// [`random_tools`] with at most `max_draws` draws; `(n, keep)` as there.
+fn random_tools_within(
+    polytope: &Polytope,
+    model: ModelKind,
+    tasks: &ModelTasks,
+    (n, keep): (usize, usize),
+    seed: u64,
+    max_draws: u64,
+    progress: &mut dyn FnMut(&Sampling),
 ) -> RandomTools {
     let mut sampler = FeasibleSampler::new(polytope, seed);
-    let max_draws = 1000 * n.max(1) as u64;
     let mut top: Vec<(Vec<f64>, f64)> = Vec::with_capacity(keep + 1);
     let mut feasible = 0;
+    let mut next_report = 0;
     while feasible < n {
-        let Some(x) = sampler.next_point(max_draws) else {
-            break;
+        let batch_end = (next_report + (1 << 16)).min(max_draws);
+        let Some(x) = sampler.next_point(batch_end) else {
+            if sampler.drawn >= max_draws {
+                break;
+            }
+            next_report = sampler.drawn;
+            progress(&Sampling {
+                feasible,
+                requested: n,
+                drawn: sampler.drawn,
+                max_draws,
+            });
+            continue;
         };
         feasible += 1;
         let Ok(tool) = AnyTool::new(model, &polytope.full(&x)) else {
@@ -124,4 +164,36 @@ fn simulate(
         task_error_perturbed: p.task_error,
         sensitivity: (p.task_error - m.task_error).abs(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::design::file::DesignSpec;
+    use crate::task_file::TaskSpec;
+    use crate::TaskKind;
+
+    /// A feasible set of about 10⁻¹⁴ of its box: the draws stop at their budget, with what
+    /// they found, and progress heard of them every 2¹⁶ draws.
+    #[test]
+    fn a_thin_feasible_set_stops_at_the_draw_budget() {
+        let text = "constraints = [\"m1 + m2 <= 0.2000001\", \"m1 + m2 >= 0.2\", \
+                    \"l1 - l2 <= 0.0000001\", \"l1 - l2 >= 0\"]\n[bounds]\nm1 = [0.1, 0.6]\n\
+                    m2 = [0.1, 0.6]\nl1 = [0.1, 0.6]\nl2 = [0.1, 0.6]\n";
+        let spec = DesignSpec::parse(text, "thin.toml", &["m1", "m2", "l1", "l2"]).unwrap();
+        let polytope = Polytope::new(&spec);
+        let tasks = ModelTasks::new(&TaskSpec::builtin(TaskKind::Velocity));
+        let mut heard = Vec::new();
+        let r = random_tools_within(
+            &polytope,
+            ModelKind::Arm2,
+            &tasks,
+            (10_000_000, 5),
+            1,
+            300_000,
+            &mut |s| heard.push(s.drawn),
+        );
+        assert_eq!((r.requested, r.feasible, r.drawn), (10_000_000, 0, 300_000));
+        assert_eq!(heard, [65_536, 131_072, 196_608, 262_144]);
+    }
 }

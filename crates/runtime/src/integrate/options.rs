@@ -111,16 +111,16 @@ pub struct Stats {
 pub enum IntegrationError {
     /// The state or its derivative became NaN or infinite; `t` is the end of the step in which
     /// that happened (or `grid[0]` when `y0` or `f(t0, y0)` is not finite).
-    #[error("integration failed at t = {t} s: state became non-finite")]
+    #[error("integration failed at t = {} s: state became non-finite", crate::display::Short(*t))]
     NonFinite { t: f64 },
     /// The step size fell to `16·eps(t)` and the tolerances still could not be met, typically
     /// a singularity (finite-time blow-up) near `t`.
     #[error(
-        "integration failed at t = {t} s: step size {h:e} s reached the minimum 16·eps(t) without meeting the tolerances"
+        "integration failed at t = {} s: step size {h:e} s reached the minimum 16·eps(t) without meeting the tolerances", crate::display::Short(*t)
     )]
     StepSizeTooSmall { t: f64, h: f64 },
     /// More than `max_steps` step attempts.
-    #[error("integration failed at t = {t} s: exceeded the limit of {max_steps} step attempts")]
+    #[error("integration failed at t = {} s: exceeded the limit of {max_steps} step attempts", crate::display::Short(*t))]
     TooManySteps { t: f64, max_steps: usize },
     /// The output grid is unusable.
     #[error("invalid time grid: {reason}")]

@@ -98,7 +98,8 @@ impl FromStr for ModelKind {
             .find(|m| m.name() == s)
             .ok_or_else(|| {
                 format!(
-                    "unknown model '{s}': expected one of {}",
+                    "unknown model '{}': expected one of {}",
+                    crate::display::Clip(&s),
                     generated::MODEL_NAMES.join(", ")
                 )
             })

@@ -12,7 +12,7 @@ use crate::integrate::{
 use crate::Error;
 
 /// A grid state whose magnitude passes this is a diverging simulation, not a result.
-pub(crate) const DIVERGENCE_BOUND: f64 = 1e6;
+pub(crate) const DIVERGENCE_BOUND: f64 = crate::validate::STATE_BOUND;
 
 /// Compile-time check of the sizes: NX = 2N and NZ = NX + N.
 struct Dims<const N: usize, const NX: usize, const NZ: usize>;
@@ -216,6 +216,21 @@ pub struct Metrics {
     pub control_effort: f64,
 }
 
+impl Metrics {
+    /// The last line of defence before the metrics are printed ([`crate::validate::finite_output`]):
+    /// the task error, ∫F dt, ∫J dt, ln|Π^U| and ∫|U|² dt of `tool` all finite.
+    pub fn check_finite(&self, tool: &dyn std::fmt::Display) -> Result<(), Error> {
+        let values = [
+            self.task_error,
+            self.free_energy,
+            self.cost_j,
+            self.logdet,
+            self.control_effort,
+        ];
+        crate::validate::finite_output(tool, "the episode's metrics", values)
+    }
+}
+
 /// The trajectory on the output grid.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TrajectoryN<const N: usize> {
@@ -260,7 +275,7 @@ pub enum ModelSimulationError {
         tool: String,
         source: IntegrationError,
     },
-    #[error("simulation of {tool} diverged at t = {t} s: |state| = {magnitude:e} exceeds {DIVERGENCE_BOUND:e}")]
+    #[error("simulation of {tool} diverged at t = {} s: |state| = {magnitude:e} exceeds {DIVERGENCE_BOUND:e}", crate::display::Short(*t))]
     Diverged {
         tool: String,
         t: f64,
@@ -458,16 +473,19 @@ where
     })
 }
 
+/// The episode's options against their documented ranges ([`crate::validate`]): what every
+/// front end also checks up front, checked again here for the library's own callers.
 fn check_options<const N: usize, const NX: usize>(o: &EpisodeOptionsN<N, NX>) -> Result<(), Error> {
-    let positive = |name, value: f64| {
-        if value.is_finite() && value > 0.0 {
+    use crate::validate::{ATOL, DT, JOINT_VALUE, LEARNING_RATE, RTOL, TORQUE, T_END};
+    let within = |name, value: f64, range: crate::validate::Range| {
+        if range.contains(value) {
             Ok(())
         } else {
-            Err(Error::InvalidOption { name, value })
+            Err(Error::OutOfRange { name, value, range })
         }
     };
-    positive("end time t_end", o.t_end)?;
-    positive("output step dt", o.dt)?;
+    within("end time t_end", o.t_end, T_END)?;
+    within("output step dt", o.dt, DT)?;
     if o.dt > o.t_end {
         return Err(Error::InvalidOption {
             name: "output step dt (larger than t_end)",
@@ -475,29 +493,17 @@ fn check_options<const N: usize, const NX: usize>(o: &EpisodeOptionsN<N, NX>) ->
         });
     }
     check_grid(o.t_end, o.dt)?;
+    within("learning rate", o.learning_rate, LEARNING_RATE)?;
+    within("integrator rtol", o.integrator.rtol, RTOL)?;
+    within("integrator atol", o.integrator.atol, ATOL)?;
     for &v in o.x0.iter() {
-        if !v.is_finite() {
-            return Err(Error::InvalidOption {
-                name: "initial state X0",
-                value: v,
-            });
-        }
+        within("initial state X0", v, JOINT_VALUE)?;
     }
     for &v in o.u0.iter() {
-        if !v.is_finite() {
-            return Err(Error::InvalidOption {
-                name: "initial torque U0",
-                value: v,
-            });
-        }
+        within("initial torque U0", v, TORQUE)?;
     }
     for &v in o.total_perturbation().iter() {
-        if !v.is_finite() {
-            return Err(Error::InvalidOption {
-                name: "perturbation dT",
-                value: v,
-            });
-        }
+        within("perturbation dT", v, TORQUE)?;
     }
     Ok(())
 }

@@ -83,7 +83,7 @@ pub enum MpcSimulationError {
     Input(#[from] Error),
     #[error("MPC for {tool}: {source}")]
     Setup { tool: String, source: MpcError },
-    #[error("MPC for {tool} failed at t = {t} s: {source}")]
+    #[error("MPC for {tool} failed at t = {} s: {source}", crate::display::Short(*t))]
     Controller {
         tool: String,
         t: f64,
@@ -299,7 +299,7 @@ where
 }
 
 /// n when `total` = n · `step` for a whole n ≥ 1 (to 1e-9 relative), else `None`.
-fn whole_ratio(total: f64, step: f64) -> Option<usize> {
+pub(super) fn whole_ratio(total: f64, step: f64) -> Option<usize> {
     let n = (total / step).round();
     (total.is_finite() && step > 0.0 && n >= 1.0 && (n * step - total).abs() <= 1e-9 * total.abs())
         .then_some(n as usize)

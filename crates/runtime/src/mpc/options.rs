@@ -3,6 +3,8 @@
 
 use std::time::Duration;
 
+use crate::display::Short;
+
 /// The linear model the QP plans with.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MpcModel {
@@ -70,35 +72,58 @@ impl MpcOptions {
         if !(self.period.is_finite() && self.period > 0.0) {
             return invalid(format!(
                 "period = {} s: must be a finite number > 0",
-                self.period
+                Short(self.period)
             ));
         }
         if !(self.horizon.is_finite() && self.horizon >= self.period) {
             return invalid(format!(
                 "horizon = {} s: must be finite and at least the period ({} s)",
-                self.horizon, self.period
+                Short(self.horizon),
+                Short(self.period)
             ));
         }
         if self.torque_limit.is_nan() || self.torque_limit <= 0.0 {
             return invalid(format!(
                 "torque_limit = {} Nm: must be > 0 (or infinite for no bound)",
-                self.torque_limit
+                Short(self.torque_limit)
             ));
         }
         if !(self.observer_gain > 0.0 && self.observer_gain <= 1.0) {
             return invalid(format!(
                 "observer_gain = {}: must be in (0, 1]",
-                self.observer_gain
+                Short(self.observer_gain)
             ));
         }
         let steps = (self.horizon / self.period).round();
         if steps > MAX_HORIZON_STEPS as f64 {
             return invalid(format!(
-                "horizon / period = {} / {} = {steps} steps: at most {MAX_HORIZON_STEPS}",
-                self.horizon, self.period
+                "horizon / period = {} / {} = {} steps: at most {MAX_HORIZON_STEPS}",
+                Short(self.horizon),
+                Short(self.period),
+                Short(steps)
             ));
         }
         Ok(steps as usize)
+    }
+
+    /// What an episode of `t_end` s output every `dt` s checks of these options, before it runs:
+    /// the horizon's steps ([`MAX_HORIZON_STEPS`] at most), and t_end and dt whole numbers of
+    /// periods; the reason in words. The front ends call it before any episode starts.
+    pub fn check_grid(&self, t_end: f64, dt: f64) -> Result<(), String> {
+        self.horizon_steps().map_err(|e| match e {
+            MpcError::InvalidOptions { reason } => reason,
+            other => other.to_string(),
+        })?;
+        for (name, total) in [("t_end", t_end), ("dt", dt)] {
+            if super::episode::whole_ratio(total, self.period).is_none() {
+                return Err(format!(
+                    "{name} = {} s is not a whole number of MPC periods ({} s)",
+                    Short(total),
+                    Short(self.period)
+                ));
+            }
+        }
+        Ok(())
     }
 }
 

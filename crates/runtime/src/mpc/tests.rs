@@ -178,10 +178,7 @@ fn invalid_options_name_the_value() {
             },
             "torque_limit = 0",
         ),
-        (
-            MpcOptions { horizon: 1e6, ..d },
-            "horizon / period = 1000000",
-        ),
+        (MpcOptions { horizon: 1e6, ..d }, "horizon / period = 1e6"),
         (
             MpcOptions {
                 observer_gain: 0.0,

@@ -107,7 +107,7 @@ pub struct CsvWriter {
 impl CsvWriter {
     /// Creates (truncates) `path` and writes the header.
     pub fn create(path: &Path, header: &[&str]) -> Result<Self, WriteError> {
-        let file = File::create(path).map_err(WriteError::at(path))?;
+        let file = super::file::create_streaming(path).map_err(WriteError::at(path))?;
         let mut writer = Self {
             file,
             path: path.to_path_buf(),

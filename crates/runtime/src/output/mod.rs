@@ -1,7 +1,9 @@
 //! Result files: whole files written atomically ([`write_atomically`]) and CSV rows appended as
 //! they are computed ([`csv::CsvWriter`]), for the command line, the experiments and the reports.
+//! Neither replaces anything but a regular file nor leaves a temporary file behind ([`file`]).
 
 pub mod csv;
+pub mod file;
 
 use std::path::{Path, PathBuf};
 
@@ -23,11 +25,8 @@ impl WriteError {
     }
 }
 
-/// Writes a whole file or nothing: `X.partial` beside it, renamed into place.
+/// Writes a whole file or nothing, without replacing what is not a regular file
+/// ([`file::write_whole`]).
 pub fn write_atomically(path: &Path, contents: &str) -> Result<(), WriteError> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".partial");
-    let tmp = PathBuf::from(tmp);
-    std::fs::write(&tmp, contents).map_err(WriteError::at(&tmp))?;
-    std::fs::rename(&tmp, path).map_err(WriteError::at(path))
+    file::write_whole(path, contents.as_bytes()).map_err(WriteError::at(path))
 }

@@ -206,7 +206,7 @@ pub fn screen_rows(
         Ok(row) => {
             if let Err(e) = tasks.check(row.tool.model()) {
                 misfit = Some(format!(
-                    "{e} (tool '{}' of {tools_file} is a {} tool)",
+                    "{e} (tool '{}' of {tools_file} is an {} tool)",
                     row.label(),
                     row.tool.model()
                 ));

@@ -85,7 +85,7 @@ pub fn read_columns(
             c.len()
         )));
     }
-    check_keys(columns.iter().map(|(name, _)| name.as_str())).map_err(fatal)?;
+    check_keys(columns.iter().map(|(name, _)| name.as_str()), "column").map_err(fatal)?;
     if rows == 0 {
         return Err(fatal("no tools: the columns have no rows".into()));
     }

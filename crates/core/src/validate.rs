@@ -1,0 +1,92 @@
+//! The valid ranges the core checks itself: tool parameters ([`crate::ToolN::new`]), goals and
+//! precisions ([`crate::TaskN::validate`]). Why these ranges (the generated arithmetic's
+//! exponents, bounded from the IR) is in the runtime's `toolconf::validate`, which adds the
+//! ranges of the episode, integrator, MPC and design options and re-exports these.
+
+use core::fmt;
+
+use crate::display::Short;
+
+/// An interval of valid values, `[lo, hi]` or `(lo, hi]`, with the unit named in messages.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Range {
+    pub lo: f64,
+    pub hi: f64,
+    /// `(lo, hi]`: lo itself is not valid (a step or a rate of 0).
+    pub lo_open: bool,
+    pub unit: &'static str,
+}
+
+impl Range {
+    pub const fn closed(lo: f64, hi: f64, unit: &'static str) -> Self {
+        Self {
+            lo,
+            hi,
+            lo_open: false,
+            unit,
+        }
+    }
+
+    pub const fn above(lo: f64, hi: f64, unit: &'static str) -> Self {
+        Self {
+            lo,
+            hi,
+            lo_open: true,
+            unit,
+        }
+    }
+
+    /// Whether `x` is in the range (never NaN).
+    pub fn contains(&self, x: f64) -> bool {
+        let above_lo = if self.lo_open {
+            x > self.lo
+        } else {
+            x >= self.lo
+        };
+        above_lo && x <= self.hi
+    }
+
+    /// `x` if it is in the range, else the reason in words: `0 must be a number in [1e-6, 1e6] s`.
+    #[cfg(feature = "std")]
+    pub fn check(&self, x: f64) -> Result<f64, std::string::String> {
+        if self.contains(x) {
+            Ok(x)
+        } else {
+            Err(std::format!("{} must be a number in {self}", Short(x)))
+        }
+    }
+}
+
+/// A range's end: `1e6` rather than `1000000`.
+struct End(f64);
+
+impl fmt::Display for End {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.0.is_finite() && self.0.abs() >= 1e4 {
+            write!(f, "{:e}", self.0)
+        } else {
+            write!(f, "{}", Short(self.0))
+        }
+    }
+}
+
+impl fmt::Display for Range {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let open = if self.lo_open { "(" } else { "[" };
+        write!(f, "{open}{}, {}]", End(self.lo), End(self.hi))?;
+        if !self.unit.is_empty() {
+            write!(f, " {}", self.unit)?;
+        }
+        Ok(())
+    }
+}
+
+/// Every tool parameter, in its SI unit (kg, m, N/m, N s/m): see the runtime's `toolconf::validate` for why.
+pub const TOOL_PARAMETER: Range = Range::closed(1e-6, 1e6, "");
+/// Each entry of a precision matrix (a precision is also symmetric positive semi-definite).
+pub const PRECISION_ENTRY: Range = Range::closed(-1e6, 1e6, "");
+/// The episode's divergence bound: a state past it is a diverged simulation
+/// (the runtime's `DIVERGENCE_BOUND`).
+pub const STATE_BOUND: f64 = 1e6;
+/// Goals, initial angles and rates (rad, rad/s, rad/s²).
+pub const JOINT_VALUE: Range = Range::closed(-STATE_BOUND, STATE_BOUND, "");

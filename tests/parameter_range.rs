@@ -1,0 +1,135 @@
+//! The valid input ranges (crates/core/src/validate.rs, crates/runtime/src/validate.rs) keep the
+//! generated arithmetic finite: every generated function of every model, at every corner of the
+//! parameter box [1e-6, 1e6]^NP and at its centre in ln p, for every task with the paper's precisions and with precisions at
+//! their bound 1e6 and at 1e-6, at the equilibrium and at a state and torque at the divergence
+//! bound, gives finite numbers (the magnitude analysis behind the ranges is
+//! python/tests/test_parameter_range.py). ln|Π^U| is finite, or, where the corner makes Π^U too
+//! ill-conditioned for double precision, a typed error; over [1e-2, 1e2]^NP it is always
+//! computed. Just outside the box, a tool is refused.
+
+use nalgebra::{SMatrix, SVector};
+use toolconf::generated;
+use toolconf::model::{logdet_of, ArmModel, TaskN, ToolN};
+use toolconf::validate::{STATE_BOUND, TOOL_PARAMETER};
+use toolconf::model::Error;
+use toolconf::{TaskKind, Term};
+
+/// The corners of [lo, hi]^NP and its centre in ln p.
+fn points<const NP: usize>(lo: f64, hi: f64) -> Vec<[f64; NP]> {
+    let mut points: Vec<[f64; NP]> = (0..1usize << NP)
+        .map(|bits| std::array::from_fn(|j| if bits >> j & 1 == 0 { lo } else { hi }))
+        .collect();
+    points.push([(lo * hi).sqrt(); NP]);
+    points
+}
+
+/// The paper's task, and its precisions (on the terms it uses) all at `value`·I.
+fn tasks<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    kind: TaskKind,
+) -> Vec<TaskN<N>>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let paper = M::paper_task(kind);
+    let mut tasks = vec![paper];
+    for value in [1e6, 1e-6] {
+        let p = SMatrix::<f64, N, N>::identity() * value;
+        let mut t = paper;
+        let used = |term| if kind.uses(term) { p } else { SMatrix::zeros() };
+        t.precision_theta = used(Term::Theta);
+        t.precision_theta_dot = used(Term::ThetaDot);
+        t.precision_theta_ddot = used(Term::ThetaDdot);
+        t.precision_u = used(Term::U);
+        tasks.push(t);
+    }
+    tasks
+}
+
+fn finite(what: &str, at: &[f64], values: impl IntoIterator<Item = f64>) {
+    let values: Vec<f64> = values.into_iter().collect();
+    assert!(
+        values.iter().all(|v| v.is_finite()),
+        "{what} at p = {at:?}: {values:?}"
+    );
+}
+
+fn check<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>()
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let extreme_x = SVector::<f64, NX>::repeat(STATE_BOUND);
+    let extreme_u = SVector::<f64, N>::repeat(STATE_BOUND);
+    let (lo, hi) = (TOOL_PARAMETER.lo, TOOL_PARAMETER.hi);
+    let well_conditioned = |p: &[f64; NP]| p.iter().all(|v| (1e-2..=1e2).contains(v));
+    let mut corners = points::<NP>(lo, hi);
+    corners.extend(points::<NP>(1e-2, 1e2));
+    for p in corners {
+        let tool = ToolN::<M, N, NX, NP, NZ>::new(p).expect("a corner of the valid box");
+        let params = tool.params();
+        finite("A", &p, tool.state_matrix().iter().copied());
+        finite("B", &p, tool.input_matrix().iter().copied());
+        for (x, u) in [
+            (M::equilibrium_state(), SVector::zeros()),
+            (extreme_x, extreme_u),
+        ] {
+            finite("f(X, U)", &p, M::dynamics(&x, &u, &params).iter().copied());
+            let (fx, fu) = M::dynamics_jacobian(&x, &u, &params);
+            finite("∂f/∂X, ∂f/∂U", &p, fx.iter().chain(fu.iter()).copied());
+        }
+        for kind in TaskKind::ALL {
+            let s = tool.sensitivities(kind);
+            for m in [s.d_theta_du, s.d_theta_dot_du, s.d_theta_ddot_du]
+                .iter()
+                .flatten()
+            {
+                finite("a sensitivity", &p, m.iter().copied());
+            }
+            for task in tasks::<M, N, NX, NP, NZ>(kind) {
+                let pi = M::pi_u(&task, &params);
+                finite("Π^U", &p, pi.iter().copied());
+                match logdet_of(&pi) {
+                    Ok(logdet) => {
+                        finite("ln|Π^U|", &p, [logdet]);
+                        let gradient = M::logdet_gradient(&task, &params);
+                        finite("∂ln|Π^U|/∂p", &p, gradient.iter().copied());
+                    }
+                    Err(Error::IllConditioned { .. }) if !well_conditioned(&p) => {}
+                    Err(e) => panic!("{kind} at {p:?}: {e}"),
+                }
+            }
+        }
+    }
+    for (j, outside) in [
+        (0, TOOL_PARAMETER.lo * 0.999),
+        (NP - 1, TOOL_PARAMETER.hi * 1.001),
+    ] {
+        let mut p = [1.0; NP];
+        p[j] = outside;
+        assert!(matches!(
+            ToolN::<M, N, NX, NP, NZ>::new(p),
+            Err(Error::InvalidParameter { .. })
+        ));
+    }
+}
+
+macro_rules! range_tests {
+    ($(($marker:ident, $module:ident, $tool:ident, $name:literal, $title:literal)),* $(,)?) => {
+        mod generated_arithmetic_is_finite_over_the_valid_box {
+            use super::*;
+            $(
+                #[test]
+                fn $module() {
+                    check::<
+                        toolconf::model::$marker,
+                        { generated::$module::DOF },
+                        { generated::$module::STATE_DIM },
+                        { generated::$module::PARAMETER_COUNT },
+                        { generated::$module::STATE_DIM + generated::$module::DOF },
+                    >();
+                }
+            )*
+        }
+    };
+}
+
+toolconf::for_each_model!(range_tests);
