@@ -1,7 +1,7 @@
 //! `toolconf.confidence`: the closed-form control confidence of one tool or of many.
 
 use nalgebra::SMatrix;
-use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyFloat};
 use rayon::prelude::*;
@@ -207,12 +207,14 @@ pub fn named<const NP: usize>(names: [&str; NP], values: &[f64]) -> String {
 pub fn confidence<'py>(
     py: Python<'py>,
     model: &str,
-    params: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
+    params: &Bound<'py, PyAny>,
     task: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = model_kind(model).map_err(|f| f.into_pyerr(py))?;
     let spec = task_spec(task, None)?;
-    let shape = params.shape().to_vec();
+    // Any memory layout (an unaligned view, a Dask worker's buffer): read through numpy.require.
+    let (shape, values) = crate::arrays::values::<f64>(params, "float64")
+        .map_err(|e| Failure::Input(format!("params: {e}")).into_pyerr(py))?;
     let np = kind.parameter_names().len();
     let batch = match shape.as_slice() {
         [n] if *n == np => false,
@@ -226,7 +228,6 @@ pub fn confidence<'py>(
             .into_pyerr(py))
         }
     };
-    let values: Vec<f64> = params.as_array().iter().copied().collect();
     let c = detached(py, || ops(kind).confidences(&spec, &values))?;
     to_dict(py, c, batch)
 }

@@ -1,6 +1,6 @@
 //! `toolconf.simulate`: one closed-loop episode of any generated model.
 
-use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use toolconf::model::{episode, ArmModel, Metrics, ToolN};
@@ -89,25 +89,26 @@ where
 pub fn simulate<'py>(
     py: Python<'py>,
     model: &str,
-    params: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
+    params: &Bound<'py, PyAny>,
     task: &Bound<'py, PyAny>,
     method: &str,
     episode_options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = model_kind(model).map_err(|f| f.into_pyerr(py))?;
     let np = kind.parameter_names().len();
-    if params.shape() != [np] {
+    // Any memory layout (an unaligned view, a Dask worker's buffer): read through numpy.require.
+    let (shape, values) = crate::arrays::values::<f64>(params, "float64")
+        .map_err(|e| Failure::Input(format!("params: {e}")).into_pyerr(py))?;
+    if shape != [np] {
         return Err(Failure::Input(format!(
-            "params of shape {:?}: model {kind} takes one tool's {np} parameters ({}) as a 1-D \
+            "params of shape {shape:?}: model {kind} takes one tool's {np} parameters ({}) as a 1-D \
              array (rank many tools with toolconf.rank)",
-            params.shape(),
             kind.parameter_names().join(",")
         ))
         .into_pyerr(py));
     }
     let mut spec = task_spec(task, episode_options)?;
     spec.episode.method = Some(crate::task::method(method).map_err(|f| f.into_pyerr(py))?);
-    let values: Vec<f64> = params.as_array().iter().copied().collect();
     let e = detached(py, || ops(kind).episode(&spec, &values))?;
     to_dict(py, e)
 }

@@ -172,3 +172,29 @@ def test_a_parameter_outside_its_range_is_refused_with_the_range(cli):
     assert str(caught.value) == expected
     assert toolconf.ranges()["tool_parameter"] == {"low": 1e-6, "high": 1e6, "low_open": False,
                                                    "unit": ""}
+
+
+def _unaligned(values):
+    """`values` as float64 at an odd byte offset: unaligned, as an array unpickled from
+    out-of-band buffers can be."""
+    values = np.asarray(values, dtype=np.float64)
+    buffer = bytearray(values.nbytes + 1)
+    array = np.ndarray(values.shape, dtype=np.float64, buffer=buffer, offset=1)
+    array[...] = values
+    assert not array.flags.aligned
+    return array
+
+
+def test_arrays_in_any_memory_layout_give_the_same_numbers():
+    # An unaligned view once panicked in the extension ("The pointer must be aligned").
+    tools = np.array([PAPER_ARM, [0.2, 0.5, 0.4, 0.3], [0.6, 0.1, 0.3, 0.5]])
+    plain = toolconf.confidence("arm2", tools, "velocity")["logdet"]
+    strided = np.zeros((3, 8))
+    strided[:, ::2] = tools
+    for layout in (_unaligned(tools), strided[:, ::2], np.asfortranarray(tools)):
+        assert np.array_equal(toolconf.confidence("arm2", layout, "velocity")["logdet"], plain)
+    one = toolconf.confidence("arm2", tools[0], "velocity")["logdet"]
+    assert toolconf.confidence("arm2", _unaligned(tools[0]), "velocity")["logdet"] == one
+    episode = toolconf.simulate("arm2", _unaligned(PAPER_ARM), "velocity", t_end=1.0)
+    assert episode["task_error"] == toolconf.simulate("arm2", PAPER_ARM, "velocity",
+                                                      t_end=1.0)["task_error"]
