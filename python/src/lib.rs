@@ -5,6 +5,7 @@
 //!   one call (rayon, without the GIL).
 //! * [`simulate`]: one closed-loop episode's metrics and trajectory, any generated model.
 //! * [`rank`]: `toolconf rank` (screen by confidence, simulate, rank) as columns.
+//! * [`dynamics`]: a robot's own rigid-body dynamics Ẋ = [q̇; q̈] for one state or a batch.
 //! * [`task`]: a task given as a built-in name, a task file or a dict with a task file's keys,
 //!   all checked by the crate's task-file parser so errors name the key.
 //!
@@ -12,6 +13,7 @@
 //! episode raises `toolconf.SimulationError` with `tool`, `time` and `reason`.
 
 mod confidence;
+mod dynamics;
 mod errors;
 mod models;
 mod rank;
@@ -29,6 +31,7 @@ fn _toolconf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(confidence::confidence, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(rank::rank, m)?)?;
+    m.add_function(wrap_pyfunction!(dynamics::dynamics, m)?)?;
     m.add(
         "SimulationError",
         m.py().get_type::<errors::SimulationError>(),

@@ -9,7 +9,9 @@ The runtime is Rust (the ``toolconf`` crate); this package exposes it over NumPy
   trajectory.
 * ``rank(tools, task, screen=None, objective="free-energy")``: ``toolconf rank`` as a dict of
   columns (``pandas.DataFrame(toolconf.rank(...))``).
-* ``models()``: the generated models and their parameter names.
+* ``dynamics(model, params, state, control)``: a robot's own rigid-body dynamics
+  Ẋ = [q̇; q̈] (U the joint torques), for one state or a batch.
+* ``models()``: the generated models, their parameter names, equilibria and valid tools.
 
 A task is ``"position"``, ``"velocity"`` or ``"acceleration"`` (the paper's tasks 1-3), a task
 file's path, or a dict with a task file's keys. Bad input raises ``ValueError`` with the
@@ -17,6 +19,6 @@ command line's message; a failed episode raises ``SimulationError`` (``tool``, `
 ``reason``).
 """
 
-from ._toolconf import SimulationError, confidence, models, rank, simulate
+from ._toolconf import SimulationError, confidence, dynamics, models, rank, simulate
 
-__all__ = ["SimulationError", "confidence", "models", "rank", "simulate"]
+__all__ = ["SimulationError", "confidence", "dynamics", "models", "rank", "simulate"]

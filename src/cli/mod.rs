@@ -47,6 +47,22 @@ pub(crate) fn parse_model(s: &str) -> Result<toolconf::model::mixed::ModelKind, 
     s.parse()
 }
 
+/// A tool of `model` from `--params P1,P2,…` in the model's parameter order.
+pub(crate) fn tool_from_params(
+    model: toolconf::model::mixed::ModelKind,
+    text: &str,
+) -> Result<toolconf::model::mixed::AnyTool, output::CliError> {
+    let params = text
+        .split(',')
+        .map(|v| {
+            v.trim().parse::<f64>().map_err(|_| {
+                output::CliError::Usage(format!("--params {text}: '{v}' is not a number"))
+            })
+        })
+        .collect::<Result<Vec<f64>, _>>()?;
+    Ok(toolconf::model::mixed::AnyTool::new(model, &params)?)
+}
+
 pub(crate) fn parse_task(s: &str) -> Result<TaskKind, String> {
     toolconf::task::parse_task(s).map_err(|e| e.to_string())
 }

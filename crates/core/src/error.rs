@@ -8,6 +8,19 @@ pub enum Error {
     /// A tool parameter that is not a finite number > 0.
     #[error("invalid arm parameter {name} = {value}: must be a finite number > 0")]
     InvalidParameter { name: &'static str, value: f64 },
+    /// A tool parameter outside its model's domain (a URDF tool's centre of mass beyond the
+    /// stated bound; `generated::validity`), the domain in words. A parameter whose domain is
+    /// "> 0" is an [`Error::InvalidParameter`].
+    #[error("invalid tool parameter {name} = {value}: must be {domain}")]
+    ParameterOutOfDomain {
+        name: &'static str,
+        value: f64,
+        domain: &'static str,
+    },
+    /// A tool whose parameters break a constraint across them (c · p ≤ 0, e.g. the triangle
+    /// inequality of a rigid body's principal moments), by `excess` = c · p > 0.
+    #[error("invalid tool: {rule} does not hold (off by {excess:e})")]
+    ToolConstraint { rule: &'static str, excess: f64 },
     /// A goal that is not finite.
     #[error("invalid goal {name} = {value}: must be finite")]
     InvalidGoal { name: &'static str, value: f64 },

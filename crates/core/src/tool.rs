@@ -7,6 +7,7 @@ use core::marker::PhantomData;
 use nalgebra::{SMatrix, SVector};
 
 use crate::generated;
+use crate::generated::validity::Violation;
 use crate::generated::TaskKind;
 use crate::Error;
 
@@ -19,7 +20,7 @@ use super::ArmModel;
 /// 1–2, [I O](A²∂X/∂U + AB) = I in task 3). The formulas are `derive/tasks.toml`'s.
 pub type SensitivitiesN<const N: usize> = generated::TaskSensitivities<N>;
 
-/// One tool of model `M`: its parameters, each finite and > 0.
+/// One tool of model `M`: its parameters, valid by the model's rule ([`ArmModel::TOOL_RULE`]).
 ///
 /// The parameters are private so that every `ToolN` has passed [`ToolN::new`].
 pub struct ToolN<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> {
@@ -52,12 +53,31 @@ impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> ToolN
 where
     M: ArmModel<N, NX, NP, NZ>,
 {
-    /// Validates and builds a tool from its parameters in [`ArmModel::PARAMETER_NAMES`] order.
-    /// A non-positive, NaN or infinite value is an [`Error::InvalidParameter`] naming it.
+    /// Validates and builds a tool from its parameters in [`ArmModel::PARAMETER_NAMES`] order,
+    /// against the model's rule ([`ArmModel::TOOL_RULE`], from its description through the
+    /// generated `validity` module): a value outside its parameter's domain is an
+    /// [`Error::InvalidParameter`] naming it (domain "> 0": NaN, ±∞ and values ≤ 0) or an
+    /// [`Error::ParameterOutOfDomain`] (any other domain), a broken constraint across the
+    /// parameters an [`Error::ToolConstraint`].
     pub fn new(params: [f64; NP]) -> Result<Self, Error> {
-        for (name, value) in M::PARAMETER_NAMES.into_iter().zip(params) {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(Error::InvalidParameter { name, value });
+        let rule = &M::TOOL_RULE;
+        match rule.check(&params) {
+            Ok(()) => {}
+            Err(Violation::Domain { index, value }) => {
+                let (name, domain) = (M::PARAMETER_NAMES[index], &rule.domains[index]);
+                return Err(if domain.is_positive() {
+                    Error::InvalidParameter { name, value }
+                } else {
+                    Error::ParameterOutOfDomain {
+                        name,
+                        value,
+                        domain: domain.rule,
+                    }
+                });
+            }
+            Err(Violation::Constraint { index, excess }) => {
+                let rule = rule.constraints[index].rule;
+                return Err(Error::ToolConstraint { rule, excess });
             }
         }
         Ok(Self {
@@ -84,6 +104,17 @@ where
     /// Ẋ = f(X, U; p).
     pub fn dynamics(&self, x: &SVector<f64, NX>, u: &SVector<f64, N>) -> SVector<f64, NX> {
         M::dynamics(x, u, &self.params)
+    }
+
+    /// The robot's own rigid-body dynamics Ẋ = [q̇; q̈], M(q)q̈ + C(q, q̇)q̇ + g(q) = U with U the
+    /// joint torques ([`ArmModel::rigid_body_dynamics`]): for a URDF arm the plant without its
+    /// joint impedance, for the others the plant itself.
+    pub fn rigid_body_dynamics(
+        &self,
+        x: &SVector<f64, NX>,
+        u: &SVector<f64, N>,
+    ) -> SVector<f64, NX> {
+        M::rigid_body_dynamics(x, u, &self.params)
     }
 
     /// A at the equilibrium.

@@ -4,7 +4,7 @@
 //! ```toml
 //! objective = "confidence"            # maximise ln|Π^U| (default), or "free_energy": minimise ∫F dt
 //! constraints = ["l1 + l2 >= 0.7", "m1 + m2 <= 0.5"]
-//! [bounds]                            # every parameter not fixed needs bounds, lo > 0
+//! [bounds]                            # every parameter not fixed needs bounds in its domain (> 0)
 //! m1 = [0.1, 0.6]
 //! [fixed]                             # optional: parameters held at a value (e.g. a payload mass)
 //! mp = 0.2
@@ -25,6 +25,8 @@ use serde::Deserialize;
 
 use super::constraint::{parse_constraint, LinearConstraint};
 use super::DesignError;
+use crate::generated::validity::ParameterDomain;
+use crate::model::mixed::ModelKind;
 
 /// What the design optimises.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -105,17 +107,21 @@ struct RawSearch {
 }
 
 impl DesignSpec {
-    /// Reads and checks a design file for a model with parameters `names`.
-    pub fn from_file(path: &Path, names: &[&'static str]) -> Result<Self, DesignError> {
+    /// Reads and checks a design file for a tool of `model`.
+    pub fn from_file(path: &Path, model: ModelKind) -> Result<Self, DesignError> {
         let file = path.display().to_string();
         let text = std::fs::read_to_string(path).map_err(|e| {
             DesignError::input(&file, "", format!("cannot read the design file: {e}"))
         })?;
-        Self::parse(&text, &file, names)
+        Self::parse(&text, &file, model)
     }
 
-    /// Parses and checks design-file text; `file` names it in errors.
-    pub fn parse(text: &str, file: &str, names: &[&'static str]) -> Result<Self, DesignError> {
+    /// Parses and checks design-file text for a tool of `model`; `file` names it in errors.
+    /// Bounds and fixed values must lie in each parameter's domain, and the model's own
+    /// constraints (a URDF tool's triangle inequality, `generated::validity`) join the file's.
+    pub fn parse(text: &str, file: &str, model: ModelKind) -> Result<Self, DesignError> {
+        let names = model.parameter_names();
+        let domains = model.parameter_domains();
         let raw: RawDesign = toml::from_str(text).map_err(|e| {
             let line = e.span().map(|s| 1 + text[..s.start].matches('\n').count());
             let place = line.map(|l| format!("line {l}")).unwrap_or_default();
@@ -147,10 +153,15 @@ impl DesignSpec {
         let mut fixed = vec![None; names.len()];
         for (name, &value) in &raw.fixed {
             let k = known(format!("fixed.{name}"), name)?;
-            if !(value.is_finite() && value > 0.0) {
+            if !domains[k].contains(value) {
+                let what = if domains[k].is_positive() {
+                    "a positive number"
+                } else {
+                    domains[k].rule
+                };
                 return Err(err(
                     &format!("fixed.{name}"),
-                    format!("{value} is not a positive number"),
+                    format!("{value} is not {what}"),
                 ));
             }
             fixed[k] = Some(value);
@@ -165,7 +176,7 @@ impl DesignSpec {
                     format!("'{name}' is also fixed; give one of the two"),
                 ));
             }
-            bounds[k] = Some(check_bounds(range).map_err(|m| err(&key, m))?);
+            bounds[k] = Some(check_bounds(range, &domains[k]).map_err(|m| err(&key, m))?);
         }
         let mut out = Vec::with_capacity(names.len());
         for (k, name) in names.iter().enumerate() {
@@ -180,7 +191,7 @@ impl DesignSpec {
                 }
             }
         }
-        let constraints = raw
+        let mut constraints = raw
             .constraints
             .iter()
             .enumerate()
@@ -189,6 +200,7 @@ impl DesignSpec {
                     .map_err(|m| err(&format!("constraints[{i}]"), format!("'{c}': {m}")))
             })
             .collect::<Result<Vec<_>, _>>()?;
+        constraints.extend(model_constraints(model, &fixed).map_err(|m| err("fixed", m))?);
         Ok(Self {
             file: file.into(),
             objective,
@@ -202,16 +214,54 @@ impl DesignSpec {
     }
 }
 
-fn check_bounds(range: &[f64]) -> Result<(f64, f64), String> {
+/// The model's constraints across its parameters as design constraints (c · p ≤ 0), but those
+/// on fixed parameters only: they are checked here, once.
+fn model_constraints(
+    model: ModelKind,
+    fixed: &[Option<f64>],
+) -> Result<Vec<LinearConstraint>, String> {
+    let mut out = Vec::new();
+    for (coefficients, rule) in model.parameter_constraints() {
+        let on_free = coefficients
+            .iter()
+            .zip(fixed)
+            .any(|(&c, f)| c != 0.0 && f.is_none());
+        if on_free {
+            out.push(LinearConstraint {
+                coefficients: coefficients.to_vec(),
+                bound: 0.0,
+                text: rule.to_string(),
+            });
+            continue;
+        }
+        let value: f64 = coefficients
+            .iter()
+            .zip(fixed)
+            .map(|(c, f)| c * f.unwrap_or(0.0))
+            .sum();
+        if value > 0.0 {
+            return Err(format!("the fixed values break {rule}"));
+        }
+    }
+    Ok(out)
+}
+
+fn check_bounds(range: &[f64], domain: &ParameterDomain) -> Result<(f64, f64), String> {
     let &[lo, hi] = range else {
         return Err(format!("{range:?} is not [lo, hi]"));
     };
     if !(lo.is_finite() && hi.is_finite()) {
         return Err(format!("[{lo}, {hi}] is not finite"));
     }
-    if lo <= 0.0 {
+    if domain.is_positive() && lo <= 0.0 {
         return Err(format!(
             "[{lo}, {hi}] admits values <= 0; masses and lengths must be > 0 (give lo > 0)"
+        ));
+    }
+    if !(domain.contains(lo) && domain.contains(hi)) {
+        return Err(format!(
+            "[{lo}, {hi}] leaves the parameter's domain: it must be {}",
+            domain.rule
         ));
     }
     if lo > hi {

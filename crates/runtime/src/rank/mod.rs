@@ -14,7 +14,7 @@ mod screen;
 mod tasks;
 
 pub use screen::{screen_file, Candidate, Screen, ScreenError};
-pub use tasks::{AnyEpisode, Bound, ModelTasks, TaskTrace, TrajectoryTable};
+pub use tasks::{AnyEpisode, Bound, Linearisation, ModelTasks, TaskTrace, TrajectoryTable};
 
 use std::cmp::Ordering;
 use std::time::{Duration, Instant};
