@@ -4,8 +4,7 @@ here from the URDF file, independently of toolconf's reader: Pinocchio's ``aba``
 ``crba`` for B = [O; M⁻¹] at the equilibrium."""
 
 import math
-import tomllib
-import xml.etree.ElementTree as ET
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -13,58 +12,19 @@ import pytest
 
 import toolconf
 
-pin = pytest.importorskip("pinocchio")
+import pinocchio as pin  # in derive/requirements.txt: make test installs it; a missing pin fails here
 
 REPO = Path(__file__).resolve().parents[2]
-MODELS = REPO / "derive" / "models"
+sys.path.insert(0, str(REPO / "bench" / "peers"))
+import pin_robot  # noqa: E402
 # Normwise relative, per state: the issue's bound.
 TOLERANCE = 1e-10
 
 
-def description(name):
-    path = MODELS / f"{name}.toml"
-    with path.open("rb") as f:
-        d = tomllib.load(f)
-    return (path.parent / d["urdf"]["file"]).resolve(), d["urdf"]["flange"]
-
-
-def quarter_turn(angle):
-    """toolconf's reader takes URDF rotations within 1e-9 of a multiple of π/2 as exact (UR5 prints
-    π/2 as 1.57079632679): Pinocchio gets the same angles."""
-    k = round(angle / (math.pi / 2))
-    return k * (math.pi / 2) if abs(angle - k * (math.pi / 2)) < 1e-9 else angle
-
-
 def pinocchio_model(name, tool):
-    """The robot's URDF without the links below its flange, the tool a fixed link at the flange."""
-    urdf, flange = description(name)
-    root = ET.parse(urdf).getroot()
-    children = {}
-    for j in root.findall("joint"):
-        children.setdefault(j.find("parent").get("link"), []).append(j.find("child").get("link"))
-    below, stack = set(), list(children.get(flange, []))
-    while stack:
-        link = stack.pop()
-        below.add(link)
-        stack += children.get(link, [])
-    for e in list(root.findall("link")):
-        if e.get("name") in below:
-            root.remove(e)
-    for e in list(root.findall("joint")):
-        if e.find("child").get("link") in below:
-            root.remove(e)
-    for origin in root.iter("origin"):
-        if origin.get("rpy"):
-            origin.set("rpy", " ".join(repr(quarter_turn(float(v))) for v in origin.get("rpy").split()))
-    m, cx, cy, cz, ixx, iyy, izz = tool
-    root.append(ET.fromstring(
-        f'<link name="tool"><inertial><origin xyz="{cx!r} {cy!r} {cz!r}" rpy="0 0 0"/><mass value="{m!r}"/>'
-        f'<inertia ixx="{ixx!r}" ixy="0" ixz="0" iyy="{iyy!r}" iyz="0" izz="{izz!r}"/></inertial></link>'))
-    root.append(ET.fromstring(
-        f'<joint name="tool_joint" type="fixed"><parent link="{flange}"/><child link="tool"/>'
-        '<origin xyz="0 0 0" rpy="0 0 0"/></joint>'))
-    model = pin.buildModelFromXML(ET.tostring(root, encoding="unicode"))
-    return model, model.createData()
+    """The robot's URDF cut at its flange with the tool a fixed link there (bench/peers/pin_robot.py,
+    which builds it from the URDF file and the description alone)."""
+    return pin_robot.model_with_tool(name, tool)
 
 
 def random_tool(rng, name):
