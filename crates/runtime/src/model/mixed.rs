@@ -29,6 +29,11 @@ macro_rules! mixed_models {
                 match self { $(ModelKind::$marker => generated::$module::NAME,)* }
             }
 
+            /// The model's title (its description's `model.title`).
+            pub fn title(self) -> &'static str {
+                match self { $(ModelKind::$marker => $title,)* }
+            }
+
             /// The control dimension n (joints).
             pub fn dof(self) -> usize {
                 match self { $(ModelKind::$marker => generated::$module::DOF,)* }
