@@ -25,12 +25,7 @@ fn design(c: &mut Criterion) {
         "/examples/design/reach_and_budget.toml"
     ))
     .unwrap();
-    let spec = DesignSpec::parse(
-        &text,
-        "reach_and_budget.toml",
-        ModelKind::Arm2.parameter_names(),
-    )
-    .unwrap();
+    let spec = DesignSpec::parse(&text, "reach_and_budget.toml", ModelKind::Arm2).unwrap();
     let task = TaskSpec::builtin(TaskKind::Velocity);
     let tasks = ModelTasks::new(&task);
     let setting = Setting {

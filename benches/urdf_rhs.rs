@@ -35,7 +35,9 @@ fn tool(rng: &mut ChaCha8Rng) -> SVector<f64, 7> {
     ])
 }
 
-fn state<const NX: usize, const N: usize>(rng: &mut ChaCha8Rng) -> (SVector<f64, NX>, SVector<f64, N>) {
+fn state<const NX: usize, const N: usize>(
+    rng: &mut ChaCha8Rng,
+) -> (SVector<f64, NX>, SVector<f64, N>) {
     let x = SVector::from_fn(|i, _| {
         if i < N {
             rng.random_range(-3.0..3.0)
@@ -54,7 +56,13 @@ macro_rules! arm_benches {
                 .map(|_| {
                     let p = tool(&mut rng);
                     let (x, u) = state::<$nx, $n>(&mut rng);
-                    (x, u, p, $m::DynamicsCoefficients::new(&p), $m::DynamicsJacobianCoefficients::new(&p))
+                    (
+                        x,
+                        u,
+                        p,
+                        $m::DynamicsCoefficients::new(&p),
+                        $m::DynamicsJacobianCoefficients::new(&p),
+                    )
                 })
                 .collect();
             let mut group = c.benchmark_group(stringify!($m));

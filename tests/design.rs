@@ -6,6 +6,7 @@ use toolconf::design::file::DesignSpec;
 use toolconf::design::{confidence_optimum, design, DesignError, Setting};
 use toolconf::model::mixed::{AnyTool, ModelKind};
 use toolconf::rank::ModelTasks;
+use toolconf::select::mixed::MixedSampler;
 use toolconf::task_file::TaskSpec;
 use toolconf::TaskKind;
 
@@ -20,12 +21,18 @@ l2 = [0.1, 0.6]
 "#;
 
 fn spec(text: &str, model: ModelKind) -> DesignSpec {
-    DesignSpec::parse(text, "test.toml", model.parameter_names()).expect("valid design file")
+    DesignSpec::parse(text, "test.toml", model).expect("valid design file")
 }
 
-/// Central difference of ln|Π^U| in parameter j (step 1e-5 relative): O(h²) ≈ 1e-10 truncation.
+/// Central difference of ln|Π^U| in parameter j (step 1e-5 relative, or 1e-5 of the sampling
+/// box where the parameter is 0): O(h²) ≈ 1e-10 truncation.
 fn central_difference(tasks: &ModelTasks, model: ModelKind, p: &[f64], j: usize) -> f64 {
-    let h = 1e-5 * p[j];
+    let (lo, hi) = model.sample_box()[j];
+    let h = if p[j] != 0.0 {
+        1e-5 * p[j]
+    } else {
+        1e-5 * (hi - lo)
+    };
     let at = |d: f64| {
         let mut q = p.to_vec();
         q[j] += d;
@@ -44,12 +51,19 @@ fn gradient_agrees_with_finite_differences_for_every_model_and_task() {
         ] {
             let tasks = ModelTasks::new(&TaskSpec::builtin(kind));
             let k = model.parameter_names().len();
+            let mut sampler = MixedSampler::new(&[model], 3).unwrap();
             for i in 0..20 {
-                // A deterministic spread of tools over [0.1, 0.6]^k.
-                let p: Vec<f64> = (0..k)
-                    .map(|j| 0.1 + 0.5 * (((i * 7 + j * 3) % 11) as f64 / 10.0))
+                // A deterministic spread of tools over the model's sampling box ([0.1, 0.6]^k
+                // for the planar arms); where the model's rule refuses a point of it (a URDF
+                // tool's moments breaking the triangle inequality), a seeded draw instead.
+                let spread: Vec<f64> = model
+                    .sample_box()
+                    .iter()
+                    .enumerate()
+                    .map(|(j, &(lo, hi))| lo + (hi - lo) * (((i * 7 + j * 3) % 11) as f64 / 10.0))
                     .collect();
-                let tool = AnyTool::new(model, &p).unwrap();
+                let tool = AnyTool::new(model, &spread).unwrap_or_else(|_| sampler.next_tool());
+                let p: Vec<f64> = tool.named_parameters().iter().map(|(_, v)| *v).collect();
                 let (_, gradient) = tasks.logdet_and_gradient(&tool).unwrap();
                 assert_eq!(gradient.len(), k);
                 for (j, &derived) in gradient.iter().enumerate() {
@@ -292,9 +306,8 @@ fn same_seed_same_design_whatever_the_thread_count() {
 
 #[test]
 fn design_file_mistakes_name_the_key_and_value() {
-    let names = ModelKind::Arm2.parameter_names();
     let err = |text: &str| {
-        DesignSpec::parse(text, "d.toml", names)
+        DesignSpec::parse(text, "d.toml", ModelKind::Arm2)
             .unwrap_err()
             .to_string()
     };

@@ -267,7 +267,7 @@ const DESIGNS: &[&str] = &[
 const NAMES: &[&str] = &["m1", "m2", "l1", "l2"];
 
 fn check_design(text: &str) -> Result<(), TestCaseError> {
-    match DesignSpec::parse(text, "fuzz.toml", NAMES) {
+    match DesignSpec::parse(text, "fuzz.toml", ModelKind::Arm2) {
         Err(e) => one_line(&e.to_string(), "fuzz.toml"),
         Ok(spec) => {
             for &(lo, hi) in &spec.bounds {

@@ -1,6 +1,7 @@
 //! The valid input ranges (crates/core/src/validate.rs, crates/runtime/src/validate.rs) keep the
 //! generated arithmetic finite: every generated function of every model, at every corner of the
-//! parameter box [1e-6, 1e6]^NP and at its centre in ln p, for every task with the paper's precisions and with precisions at
+//! parameter box (each "> 0" parameter in [1e-6, 1e6], each signed one, a URDF tool's centre of
+//! mass, over its model's domain) that the model's rule admits, and at its centre, for every task with the paper's precisions and with precisions at
 //! their bound 1e6 and at 1e-6, at the equilibrium and at a state and torque at the divergence
 //! bound, gives finite numbers (the magnitude analysis behind the ranges is
 //! python/tests/test_parameter_range.py). ln|Π^U| is finite, or, where the corner makes Π^U too
@@ -11,16 +12,39 @@ use nalgebra::{SMatrix, SVector};
 use toolconf::generated;
 use toolconf::model::{logdet_of, ArmModel, TaskN, ToolN};
 use toolconf::validate::{STATE_BOUND, TOOL_PARAMETER};
+use toolconf::generated::validity::ToolRule;
 use toolconf::model::Error;
 use toolconf::{TaskKind, Term};
 
-/// The corners of [lo, hi]^NP and its centre in ln p.
-fn points<const NP: usize>(lo: f64, hi: f64) -> Vec<[f64; NP]> {
+/// The corners of the box `boxes` (one interval per parameter) that the model's rule admits
+/// (a URDF tool's principal moments obey the triangle inequality), and its centre: in ln p for a
+/// "> 0" parameter, the midpoint for a signed one (a centre of mass).
+fn points<const NP: usize>(rule: &ToolRule<NP>, boxes: [(f64, f64); NP]) -> Vec<[f64; NP]> {
     let mut points: Vec<[f64; NP]> = (0..1usize << NP)
-        .map(|bits| std::array::from_fn(|j| if bits >> j & 1 == 0 { lo } else { hi }))
+        .map(|bits| std::array::from_fn(|j| if bits >> j & 1 == 0 { boxes[j].0 } else { boxes[j].1 }))
         .collect();
-    points.push([(lo * hi).sqrt(); NP]);
+    points.push(std::array::from_fn(|j| {
+        let (lo, hi) = boxes[j];
+        if rule.domains[j].is_positive() {
+            (lo * hi).sqrt()
+        } else {
+            0.5 * (lo + hi)
+        }
+    }));
+    points.retain(|p| rule.check(p).is_ok());
     points
+}
+
+/// Per parameter: `positive` for a "> 0" domain, else the domain itself within ±1e6.
+fn boxes<const NP: usize>(rule: &ToolRule<NP>, positive: (f64, f64)) -> [(f64, f64); NP] {
+    std::array::from_fn(|j| {
+        let d = &rule.domains[j];
+        if d.is_positive() {
+            positive
+        } else {
+            (d.lo.max(-TOOL_PARAMETER.hi), d.hi.min(TOOL_PARAMETER.hi))
+        }
+    })
 }
 
 /// The paper's task, and its precisions (on the terms it uses) all at `value`·I.
@@ -59,10 +83,12 @@ where
 {
     let extreme_x = SVector::<f64, NX>::repeat(STATE_BOUND);
     let extreme_u = SVector::<f64, N>::repeat(STATE_BOUND);
-    let (lo, hi) = (TOOL_PARAMETER.lo, TOOL_PARAMETER.hi);
-    let well_conditioned = |p: &[f64; NP]| p.iter().all(|v| (1e-2..=1e2).contains(v));
-    let mut corners = points::<NP>(lo, hi);
-    corners.extend(points::<NP>(1e-2, 1e2));
+    let rule = &M::TOOL_RULE;
+    let positive: Vec<usize> = (0..NP).filter(|&j| rule.domains[j].is_positive()).collect();
+    let well_conditioned = |p: &[f64; NP]| positive.iter().all(|&j| (1e-2..=1e2).contains(&p[j]));
+    let mut corners = points(rule, boxes(rule, (TOOL_PARAMETER.lo, TOOL_PARAMETER.hi)));
+    corners.extend(points(rule, boxes(rule, (1e-2, 1e2))));
+    assert!(corners.len() > NP, "{} corners", corners.len());
     for p in corners {
         let tool = ToolN::<M, N, NX, NP, NZ>::new(p).expect("a corner of the valid box");
         let params = tool.params();
@@ -99,11 +125,12 @@ where
             }
         }
     }
+    let (first, last) = (positive[0], positive[positive.len() - 1]);
     for (j, outside) in [
-        (0, TOOL_PARAMETER.lo * 0.999),
-        (NP - 1, TOOL_PARAMETER.hi * 1.001),
+        (first, TOOL_PARAMETER.lo * 0.999),
+        (last, TOOL_PARAMETER.hi * 1.001),
     ] {
-        let mut p = [1.0; NP];
+        let mut p = points(rule, boxes(rule, (1.0, 1.0)))[0];
         p[j] = outside;
         assert!(matches!(
             ToolN::<M, N, NX, NP, NZ>::new(p),

@@ -79,6 +79,11 @@ class Model:
     impedance_stiffness: list[float] = field(default_factory=list)
     impedance_damping: list[float] = field(default_factory=list)
     impedance_source: str = ""
+    # urdf: which tools are valid and the box random tools are drawn from (urdf_model.tool_rule:
+    # per-parameter domains, linear constraints, sampling box), for the IR's model.tool_rule.
+    # None for the other kinds: their parameters are masses, lengths, ... (> 0, drawn from the
+    # paper's [0.1, 0.6]), the renderer's default (derive/render).
+    tool_rule: dict | None = None
 
     @property
     def state(self) -> list[Named]:
@@ -136,7 +141,7 @@ class Task:
 KNOWN_TERMS = ("theta", "theta_dot", "theta_ddot", "u")
 # A model's module, src/<model>.rs of the generated crate, must not clash with the crate's own
 # (templates/registry/src/: lib.rs, tasks.rs, trig.rs, powi.rs; `mod` is a Rust keyword).
-RESERVED_MODEL_NAMES = ("lib", "mod", "powi", "tasks", "trig")
+RESERVED_MODEL_NAMES = ("lib", "mod", "powi", "rigid_body", "tasks", "trig", "validity")
 KINEMATIC_TERMS = ("theta", "theta_dot", "theta_ddot")
 
 # The keys each table may have, as serde's deny_unknown_fields: a misspelt key is an error, not a
@@ -156,13 +161,14 @@ MODEL_KEYS = {
     "urdf": (("file", "string", True), ("base", "string", True), ("flange", "string", True),
              ("gravity", "numbers", True), ("source", "string", False)),
     "impedance": (("stiffness", "numbers", True), ("damping", "numbers", True), ("source", "string", False)),
+    "tool": (("com_bound", "number", False), ("sample", "table", False), ("source", "string", False)),
 }
 # parameters and coordinates are required except for kind "urdf", where the URDF and the tool
 # define them (_urdf_names).
 TOP_KEYS = (("model", "table", True), ("parameters", "tables", False), ("constants", "table", False),
             ("coordinates", "table", False), ("dynamics", "table", True), ("equilibrium", "table", True),
             ("goals", "table", False), ("printed", "table", False), ("urdf", "table", False),
-            ("impedance", "table", False))
+            ("impedance", "table", False), ("tool", "table", False))
 TASK_KEYS = (("name", "string", True), ("index", "integer", True), ("title", "string", False),
              ("doc", "string", False), ("terms", "strings", True), ("error", "string", True),
              ("sensitivity", "table", True),
@@ -287,6 +293,9 @@ def load_model(path: Path) -> Model:
         for key in ("parameters", "coordinates"):
             if key not in top.raw:
                 raise DescriptionError(path, key, "missing (required)")
+        for key in ("urdf", "impedance", "tool"):
+            if key in top.raw:
+                raise DescriptionError(path, key, "only for dynamics.kind = 'urdf'")
         coords = top.table("coordinates", MODEL_KEYS["coordinates"])
         parameters = [_named(p) for p in top.tables("parameters", NAMED)]
         q, q_dot, u = ([_named(c) for c in coords.tables(k, NAMED)] for k in ("q", "q_dot", "u"))
@@ -325,7 +334,7 @@ def _urdf_names(path: Path, top: _Table):
     """Kind "urdf": the chain from the URDF file, the tool's parameters (urdf_model.TOOL_PARAMETERS)
     and the coordinates named after the URDF's joints: q = the joint positions, U = their torques."""
     from .urdf import read_chain
-    from .urdf_model import TOOL_PARAMETERS
+    from .urdf_model import TOOL_PARAMETERS, tool_rule
     for key in ("parameters", "coordinates"):
         if key in top.raw:
             raise DescriptionError(path, key, "not allowed for dynamics.kind = 'urdf': the tool's parameters and the "
@@ -357,7 +366,8 @@ def _urdf_names(path: Path, top: _Table):
     extra = {"chain": chain, "urdf_gravity": [float(g) for g in urdf.get("gravity")],
              "impedance_stiffness": [float(v) for v in imp.get("stiffness")],
              "impedance_damping": [float(v) for v in imp.get("damping")],
-             "impedance_source": imp.get("source", "")}
+             "impedance_source": imp.get("source", ""),
+             "tool_rule": tool_rule(path, top.table("tool", MODEL_KEYS["tool"]))}
     return list(TOOL_PARAMETERS), q, q_dot, u, extra
 
 

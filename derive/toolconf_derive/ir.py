@@ -238,7 +238,7 @@ def model_document(m, x_e: list[str], u_e: list[str], tasks: list, functions: li
     """The IR of model `m` around its functions' IR (each `function_ir`'s shape), with the
     equilibrium as Rust literals and the tasks of tasks.toml."""
     printer = RustPrinter()
-    return {
+    document = {
         "schema": IR_SCHEMA,
         "generator": generator,
         "model": {
@@ -273,3 +273,8 @@ def model_document(m, x_e: list[str], u_e: list[str], tasks: list, functions: li
         "test_vectors": {"file": generator["vectors"], "per_function": vectors},
         "report": report,
     }
+    # Only where the description states one (a URDF tool): without it the renderer gives every
+    # parameter the planar arms' rule (> 0, drawn from [0.1, 0.6]), and their IR stays as it was.
+    if m.tool_rule is not None:
+        document["model"]["tool_rule"] = m.tool_rule
+    return document

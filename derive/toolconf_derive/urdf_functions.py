@@ -69,6 +69,17 @@ def build_functions(dv: UrdfDerivation) -> list[SeqFunction]:
     ns = dv.task_namespace_sx()
     for task in dv.tasks:
         fns += _task_functions(dv, task, ns, p)
+    kr = dv.rigid_coefficients(ps)
+    fns.append(SeqFunction(
+        "rigid_body_dynamics",
+        "The robot's own rigid-body dynamics X_dot = [q_dot; q_ddot], M(q) q_ddot + C(q, q_dot) q_dot + "
+        "g(q) = U, with U the joint torques (no impedance, no gravity feed-forward): what Pinocchio's "
+        "aba computes for the arm with the tool fixed at its flange.",
+        "rigid-body dynamics of the URDF chain (RNEA, CRBA)", [x, u, p], [SeqOutput("x_dot", "X_dot", 2 * n, 1)],
+        ca.Function("rigid_body_dynamics", [xs, us, ps], [dv.rigid_with(xs, us, kr)]),
+        lambda v: dv.reference_rigid_body.checked(v["x"], v["u"], v["params"]),
+        coefficients=dv.rigid_coefficients, code_with=dv.rigid_with, unhoisted=dv.rigid_inline,
+    ))
     return fns
 
 

@@ -28,6 +28,7 @@ constant torque K q^e + g(q^e; p).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Callable
@@ -52,6 +53,77 @@ TOOL_PARAMETERS = [
     Named("tool_iyy", "I_{yy}", "kg m^2", "tool's principal moment about its centre of mass, flange y axis"),
     Named("tool_izz", "I_{zz}", "kg m^2", "tool's principal moment about its centre of mass, flange z axis"),
 ]
+# Which tools are valid (generated/src/validity.rs; toolconf-core's ToolN::new refuses the rest)
+# and the box random tools are drawn from (the mixed sampler, the design tests). A rigid body:
+# mass > 0, principal moments > 0 obeying the triangle inequality (the largest at most the sum of
+# the other two, with urdf.py's relative slack for printed decimals), and its centre of mass
+# within `com_bound` of the flange along each axis (a description's `[tool] com_bound`).
+COM_BOUND = 1.0
+TRIANGLE_SLACK = 1e-9
+# A tool of 0.05-3 kg with its centre of mass within 5 cm of the flange axis and up to 25 cm out,
+# moments of a body a few centimetres to 30 cm across (a description's `[tool.sample]`).
+SAMPLE = {"tool_mass": (0.05, 3.0), "tool_com_x": (-0.05, 0.05), "tool_com_y": (-0.05, 0.05),
+          "tool_com_z": (0.0, 0.25), "tool_ixx": (1e-4, 0.02), "tool_iyy": (1e-4, 0.02), "tool_izz": (1e-4, 0.02)}
+_MOMENTS = ("tool_ixx", "tool_iyy", "tool_izz")
+
+
+def tool_rule(path, table) -> dict:
+    """The IR's `model.tool_rule` of a URDF tool: per parameter its domain (lo, hi, open ends;
+    None for no bound) and sampling box, and the linear constraints c . p <= 0 with their text.
+    `table` is the description's `[tool]` (urdf_model's defaults where it is silent)."""
+    from .description import DescriptionError
+    bound = table.get("com_bound", COM_BOUND)
+    # At most the runtime's tool-parameter range (toolconf::validate::TOOL_PARAMETER's 1e6), the
+    # magnitude over which the generated arithmetic is checked finite (tests/parameter_range.rs).
+    if not (isinstance(bound, (int, float)) and math.isfinite(bound) and 0 < bound <= 1e6):
+        raise DescriptionError(path, "tool.com_bound", f"{bound!r} must be a number in (0, 1e6] (m)")
+    names = [p.name for p in TOOL_PARAMETERS]
+    domains = [{"lo": -float(bound), "hi": float(bound), "lo_open": False, "hi_open": False}
+               if n.startswith("tool_com_") else {"lo": 0.0, "hi": None, "lo_open": True, "hi_open": True}
+               for n in names]
+    raw = table.get("sample", {})
+    for key in raw:
+        if key not in names:
+            raise DescriptionError(path, f"tool.sample.{key}", f"unknown parameter (known: {', '.join(names)})")
+    sample = []
+    for name, domain in zip(names, domains):
+        box = raw.get(name, SAMPLE[name])
+        key = f"tool.sample.{name}"
+        if not (isinstance(box, (list, tuple)) and len(box) == 2
+                and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in box)):
+            raise DescriptionError(path, key, f"must be [lo, hi], two finite numbers, got {box!r}")
+        lo, hi = float(box[0]), float(box[1])
+        if not lo < hi:
+            raise DescriptionError(path, key, f"[{lo}, {hi}] is empty or a point (need lo < hi)")
+        if not (_inside(lo, domain) and _inside(hi, domain)):
+            raise DescriptionError(path, key, f"[{lo}, {hi}] leaves the parameter's domain")
+        sample.append([lo, hi])
+    constraints = []
+    for k, moment in enumerate(_MOMENTS):
+        others = [m for m in _MOMENTS if m != moment]
+        coefficients = [0.0] * len(names)
+        coefficients[names.index(moment)] = 1.0
+        for m in others:
+            coefficients[names.index(m)] = -(1.0 + TRIANGLE_SLACK)
+        constraints.append({"coefficients": coefficients,
+                            "text": f"{moment} <= {others[0]} + {others[1]} (triangle inequality of the "
+                                    "principal moments)"})
+    centre = [(lo + hi) / 2 for lo, hi in sample]
+    for c in constraints:
+        if sum(a * x for a, x in zip(c["coefficients"], centre)) > 0:
+            raise DescriptionError(path, "tool.sample", f"the sampling box's centre violates {c['text']}: random "
+                                                        "tools could not be drawn from it")
+    return {"domains": domains, "constraints": constraints, "sample": sample,
+            "source": table.get("source", "")}
+
+
+def _inside(value: float, domain: dict) -> bool:
+    lo, hi = domain["lo"], domain["hi"]
+    above = lo is None or (value > lo if domain["lo_open"] else value >= lo)
+    below = hi is None or (value < hi if domain["hi_open"] else value <= hi)
+    return above and below
+
+
 # Code and reference graphs, both evaluated exactly, agree to this (normwise relative per output);
 # they differ only by the double rounding of constants folded while the graphs were built.
 AGREEMENT = 1e-10
@@ -218,7 +290,25 @@ class UrdfDerivation:
         self.dynamics_inline = ca.Function("dynamics", [x, u, p], [ca.cse(self.dynamics_with(x, u, inline))])
         self.jacobian_inline = ca.Function("dynamics_jacobian", [x, u, p],
                                            [ca.cse(e) for e in self.jacobian_with(x, u, inline)])
+        self._build_rigid_body()
         self._build_linearisation()
+
+    def _build_rigid_body(self):
+        """The robot's own rigid-body dynamics, U the joint torques and no impedance:
+        q_ddot = M^-1 (U - C q_dot - g) by CRBA + RNEA bias + LDL^T, its per-tool coefficients
+        the last body's ten numbers (toolconf.dynamics; Pinocchio's aba checks it)."""
+        n, x, u, p = self.n, self.x, self.u, self.p
+        k = ca.SX.sym("coefficients", 10)
+        q, qd = [x[i] for i in range(n)], [x[n + i] for i in range(n)]
+        trig = self._symbolic_trig(q)
+        last = [k[i] for i in range(10)]
+        mass = self.dyn.mass_matrix(q, trig, last)
+        bias = self.dyn.rnea(q, trig, qd, [0.0] * n, last)
+        acc = ldl_apply(ldl_factor(mass), [u[i] - bias[i] for i in range(n)])
+        self.rigid_coefficients = ca.Function("rigid_coefficients", [p], [ca.vertcat(*self._last(p))])
+        self.rigid_with = ca.Function("rigid_body_dynamics_with", [x, u, k], [ca.cse(ca.vertcat(*qd, *acc))])
+        self.rigid_inline = ca.Function("rigid_body_dynamics", [x, u, p],
+                                        [ca.cse(self.rigid_with(x, u, self.rigid_coefficients(p)))])
 
     def _gravity_stiffness(self, last):
         """dg/dq at q^e (a symmetric n x n list), by AD: the graph takes each revolute joint's
@@ -334,6 +424,10 @@ class UrdfDerivation:
         n, x, u, p = self.n, self.x, self.u, self.p
         f = self._reference_f(x, u, p, self._symbolic_trig([x[i] for i in range(n)]))
         self.reference_dynamics = ExactFunction(ca.Function("dynamics_ref", [x, u, p], [f]))
+        q, qd = [x[i] for i in range(n)], [x[n + i] for i in range(n)]
+        rigid = ca.vertcat(*qd, *aba(self.dyn, q, self._symbolic_trig(q), qd, [u[i] for i in range(n)],
+                                     self._last(p)))
+        self.reference_rigid_body = ExactFunction(ca.Function("rigid_body_dynamics_ref", [x, u, p], [rigid]))
         self.reference_jacobian = ExactFunction(ca.Function(
             "dynamics_jacobian_ref", [x, u, p], [ca.jacobian(f, x), ca.jacobian(f, u)]))
         # A, B at X^e by AD of the ABA graph, as a function of p alone: (sin, cos) symbols and

@@ -21,6 +21,8 @@ pub mod powi;
 /// The tasks of `derive/tasks.toml` ([`TaskKind`]) and what every model's task functions return.
 pub mod tasks;
 pub mod trig;
+/// Which tools each model accepts, and the box random tools are drawn from.
+pub mod validity;
 pub use tasks::{TaskDefaults, TaskKind, TaskSensitivities, Term, UnknownTask, TASK_CHOICES};
 
 /// 2-DOF arm in the vertical plane (the paper's generative process) (`derive/models/arm2.toml`).
@@ -37,6 +39,25 @@ pub mod msd;
 pub mod panda;
 /// Universal Robots UR5 (6-DOF) with a tool at the flange, under joint impedance (`derive/models/ur5.toml`).
 pub mod ur5;
+
+/// Each model's own rigid-body dynamics Ẋ = [q̇; q̈] = f(X, U; p), U the joint torques (or force):
+/// `rigid_body::<model>(x, u, params)`, the same signature as every model's `dynamics`.
+pub mod rigid_body {
+    /// `arm2`: the model's plant, which is its rigid-body dynamics.
+    pub use crate::arm2::dynamics as arm2;
+    /// `arm2_exact`: the model's plant, which is its rigid-body dynamics.
+    pub use crate::arm2_exact::dynamics as arm2_exact;
+    /// `arm2_payload`: the model's plant, which is its rigid-body dynamics.
+    pub use crate::arm2_payload::dynamics as arm2_payload;
+    /// `arm3`: the model's plant, which is its rigid-body dynamics.
+    pub use crate::arm3::dynamics as arm3;
+    /// `msd`: the model's plant, which is its rigid-body dynamics.
+    pub use crate::msd::dynamics as msd;
+    /// `panda`: the rigid-body dynamics alone (the model's plant adds joint impedance).
+    pub use crate::panda::rigid_body_dynamics as panda;
+    /// `ur5`: the rigid-body dynamics alone (the model's plant adds joint impedance).
+    pub use crate::ur5::rigid_body_dynamics as ur5;
+}
 
 /// The names of the generated models, in registry order.
 pub const MODEL_NAMES: [&str; 7] = [

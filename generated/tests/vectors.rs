@@ -737,13 +737,18 @@ mod panda {
                 );
                 vec![("gradient", rows(&gradient))]
             }
+            "rigid_body_dynamics" => {
+                let x_dot =
+                    m::rigid_body_dynamics(&input(i, "x"), &input(i, "u"), &input(i, "params"));
+                vec![("x_dot", rows(&x_dot))]
+            }
             _ => return None,
         })
     }
 
     #[test]
     fn functions_match_casadi_vectors() {
-        check("panda", 13, evaluate);
+        check("panda", 14, evaluate);
     }
 }
 
@@ -845,12 +850,17 @@ mod ur5 {
                 );
                 vec![("gradient", rows(&gradient))]
             }
+            "rigid_body_dynamics" => {
+                let x_dot =
+                    m::rigid_body_dynamics(&input(i, "x"), &input(i, "u"), &input(i, "params"));
+                vec![("x_dot", rows(&x_dot))]
+            }
             _ => return None,
         })
     }
 
     #[test]
     fn functions_match_casadi_vectors() {
-        check("ur5", 13, evaluate);
+        check("ur5", 14, evaluate);
     }
 }

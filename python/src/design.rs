@@ -69,9 +69,9 @@ pub fn design<'py>(
     let names: Vec<&'static str> = kind.parameter_names().to_vec();
     let design_spec = if let Ok(dict) = design.cast::<PyDict>() {
         let t = table(dict, "", DESIGN_DICT).map_err(|f| f.into_pyerr(py))?;
-        DesignSpec::from_table(t, DESIGN_DICT, &names)
+        DesignSpec::from_table(t, DESIGN_DICT, kind)
     } else if let Ok(path) = design.extract::<PathBuf>() {
-        DesignSpec::from_file(&path, &names)
+        DesignSpec::from_file(&path, kind)
     } else {
         return Err(PyValueError::new_err(format!(
             "design = {}: expected a design file's path or a dict with a design file's keys",

@@ -9,6 +9,7 @@
 //! * [`batch`]: `simulate_batch`, the episodes of many tools under many perturbations.
 //! * [`design`]: `toolconf design --json` as a dict.
 //! * [`blocks`]: the steps of `rank` that `toolconf.dask` spreads over a cluster.
+//! * [`dynamics`]: a robot's own rigid-body dynamics Ẋ = [q̇; q̈] for one state or a batch.
 //! * [`task`]: a task given as a built-in name, a task file or a dict with a task file's keys,
 //!   all checked by the crate's task-file parser so errors name the key.
 //!
@@ -20,6 +21,7 @@ mod batch;
 mod blocks;
 mod confidence;
 mod design;
+mod dynamics;
 mod errors;
 mod models;
 mod rank;
@@ -53,6 +55,7 @@ fn _toolconf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(blocks::merge_screens, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::episodes, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::rank_table, m)?)?;
+    m.add_function(wrap_pyfunction!(dynamics::dynamics, m)?)?;
     m.add(
         "SimulationError",
         m.py().get_type::<errors::SimulationError>(),

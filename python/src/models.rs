@@ -87,9 +87,12 @@ pub fn model_kind(name: &str) -> Result<ModelKind, Failure> {
     name.parse().map_err(Failure::Input)
 }
 
-/// The generated models: ``{name: {"title": str, "dof": int, "parameters": [str, ...]}}`` in
-/// registry order. ``parameters`` is the order ``confidence`` and ``simulate`` take a tool's
-/// parameters in (masses in kg, lengths in m, ...); ``dof`` is the number of joints (torques).
+/// The generated models: ``{name: {"title": str, "dof": int, "parameters": [str, ...],
+/// "equilibrium": {"q", "q_dot", "u"}, "domains": {...}}}`` in registry order. ``parameters`` is
+/// the order ``confidence`` and ``simulate`` take a tool's parameters in (masses in kg, lengths
+/// in m, ...); ``dof`` is the number of joints (torques); ``equilibrium`` the state and torque
+/// the model is linearised at; ``domains`` which tools are valid (each parameter's domain in
+/// words, the constraints across them, the box random tools are drawn from).
 #[pyfunction]
 pub fn models(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let out = PyDict::new(py);
@@ -98,6 +101,8 @@ pub fn models(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
         entry.set_item("title", title(kind))?;
         entry.set_item("dof", kind.dof())?;
         entry.set_item("parameters", kind.parameter_names().to_vec())?;
+        entry.set_item("equilibrium", crate::dynamics::equilibrium(py, kind)?)?;
+        entry.set_item("domains", crate::dynamics::domains(py, kind)?)?;
         out.set_item(kind.name(), entry)?;
     }
     Ok(out)

@@ -13,7 +13,9 @@ The runtime is Rust (the ``toolconf`` crate); this package exposes it over NumPy
   file, a pandas DataFrame, a dict of 1-D arrays or a NumPy structured array; a DataFrame for a
   DataFrame, else a dict of columns.
 * ``design(model, task, design)``: ``toolconf design --json``, which tool to build.
-* ``models()``: the generated models and their parameter names.
+* ``dynamics(model, params, state, control)``: a robot's own rigid-body dynamics
+  Ẋ = [q̇; q̈] (U the joint torques), for one state or a batch.
+* ``models()``: the generated models, their parameter names, equilibria and valid tools.
 * ``toolconf.dask`` (``pip install "./python[dask]"``): ``rank`` and ``simulate_batch`` on a
   Dask cluster, with the same results.
 * ``ranges()``: the valid range of every number the package and the command line take.
@@ -35,6 +37,7 @@ from ._toolconf import (
     SimulationError,
     confidence,
     design,
+    dynamics,
     models,
     ranges,
     simulate,
@@ -45,6 +48,7 @@ __all__ = [
     "SimulationError",
     "confidence",
     "design",
+    "dynamics",
     "models",
     "ranges",
     "rank",

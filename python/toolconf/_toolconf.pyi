@@ -13,10 +13,22 @@ a task file's path, or a dict with a task file's keys (``kind``, ``goal``, ``pre
 
 Params = Union[npt.ArrayLike, Sequence[float], Sequence[Sequence[float]]]
 
+class Equilibrium(TypedDict):
+    q: list[float]
+    q_dot: list[float]
+    u: list[float]
+
+class Domains(TypedDict):
+    parameters: dict[str, str]
+    constraints: list[str]
+    sample: dict[str, list[float]]
+
 class ModelInfo(TypedDict):
     title: str
     dof: int
     parameters: list[str]
+    equilibrium: Equilibrium
+    domains: Domains
 
 class SimulationError(RuntimeError):
     """An episode that failed: the integrator gave up or the state diverged."""
@@ -29,7 +41,14 @@ class SimulationError(RuntimeError):
     """Why, in words."""
 
 def models() -> dict[str, ModelInfo]:
-    """The generated models: ``{name: {"title", "dof", "parameters"}}`` in registry order."""
+    """The generated models: ``{name: {"title", "dof", "parameters", "equilibrium", "domains"}}``
+    in registry order."""
+
+def dynamics(model: str, params: Params, state: npt.ArrayLike, control: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    """The robot's own rigid-body dynamics Ẋ = [q̇; q̈], M(q) q̈ + C(q, q̇) q̇ + g(q) = U with U the
+    joint torques (for ``panda`` and ``ur5`` without the joint impedance of their plant): shape
+    (state size,) when every argument is 1-D, else (k, state size). Raises ``ValueError`` for bad
+    input."""
 
 class RangeInfo(TypedDict):
     low: float

@@ -1,19 +1,34 @@
-//! `toolconf confidence --arm M1,M2,L1,L2 --task T [--json]`.
+//! `toolconf confidence --arm M1,M2,L1,L2 --task T [--json]`, or `--model M --params P1,P2,…`
+//! for a tool of any generated model.
 
-use serde_json::json;
+use serde_json::{json, Value};
+use toolconf::model::mixed::ModelKind;
 use toolconf::model::Arm2;
 use toolconf::validate::finite_output;
+use toolconf::rank::{Linearisation, ModelTasks};
+use toolconf::task_file::TaskSpec;
 use toolconf::{control_confidence, Arm};
 
 use super::episode_args::TaskArgs;
 use super::output::{matrix_rows, print_matrix, CliError};
-use super::parse_arm;
+use super::{parse_arm, parse_model, tool_from_params};
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// The tool: link masses and lengths M1,M2,L1,L2 (kg, m), all > 0.
-    #[arg(long, value_parser = parse_arm, allow_hyphen_values = true)]
-    arm: Arm,
+    /// The tool: link masses and lengths M1,M2,L1,L2 (kg, m), all > 0, of the paper's arm.
+    #[arg(long, value_parser = parse_arm, allow_hyphen_values = true,
+          required_unless_present = "model", conflicts_with_all = ["model", "params"])]
+    arm: Option<Arm>,
+    /// A tool of any generated model instead of --arm (with --params).
+    #[arg(long, value_parser = parse_model, requires = "params", help = format!(
+        "A tool of any generated model instead of --arm: {} (with --params)",
+        toolconf::generated::MODEL_NAMES.join(", ")))]
+    model: Option<ModelKind>,
+    /// The model's parameters in its order, comma-separated (panda, ur5: tool_mass, tool_com_x,
+    /// tool_com_y, tool_com_z, tool_ixx, tool_iyy, tool_izz; `toolconf select --help` lists
+    /// every model's).
+    #[arg(long, requires = "model", allow_hyphen_values = true)]
+    params: Option<String>,
     #[command(flatten)]
     task: TaskArgs,
     /// Print one JSON object instead of text.
@@ -23,23 +38,31 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), CliError> {
     let spec = args.task.spec()?;
+    match (args.arm, args.model) {
+        (Some(arm), _) => run_arm(args, &arm, &spec),
+        (None, Some(model)) => run_model(args, model, &spec),
+        (None, None) => Err(CliError::Usage("give --arm or --model".into())),
+    }
+}
+
+fn run_arm(args: &Args, arm: &Arm, spec: &TaskSpec) -> Result<(), CliError> {
     let kind = spec.kind;
     let task = spec.task::<Arm2, 2, 4, 4, 6>()?;
-    let confidence = control_confidence(&args.arm, &task).map_err(toolconf::Error::from)?;
-    let s = args.arm.sensitivities(kind);
-    let a = args.arm.state_matrix();
-    let b = args.arm.input_matrix();
-    let arm = format!("arm {}", args.arm);
-    finite_output(&arm, "A", a.iter().copied())?;
-    finite_output(&arm, "B", b.iter().copied())?;
+    let confidence = control_confidence(arm, &task).map_err(toolconf::Error::from)?;
+    let s = arm.sensitivities(kind);
+    let a = arm.state_matrix();
+    let b = arm.input_matrix();
+    let label = format!("arm {arm}");
+    finite_output(&label, "A", a.iter().copied())?;
+    finite_output(&label, "B", b.iter().copied())?;
     for m in [s.d_theta_du, s.d_theta_dot_du, s.d_theta_ddot_du]
         .iter()
         .flatten()
     {
-        finite_output(&arm, "a sensitivity", m.iter().copied())?;
+        finite_output(&label, "a sensitivity", m.iter().copied())?;
     }
-    finite_output(&arm, "Π^U", confidence.pi_u.iter().copied())?;
-    finite_output(&arm, "ln|Π^U|", [confidence.logdet])?;
+    finite_output(&label, "Π^U", confidence.pi_u.iter().copied())?;
+    finite_output(&label, "ln|Π^U|", [confidence.logdet])?;
     if args.json {
         let mut sens = serde_json::Map::new();
         for (name, m) in [
@@ -51,8 +74,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
                 sens.insert(name.into(), matrix_rows(&m));
             }
         }
-        let mut out = json!({
-            "arm": args.arm,
+        let out = json!({
+            "arm": arm,
             "task": kind,
             "a": matrix_rows(&a),
             "b": matrix_rows(&b),
@@ -60,16 +83,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             "pi_u": matrix_rows(&confidence.pi_u),
             "logdet": confidence.logdet,
         });
-        if let Some(path) = &args.task.task_file {
-            out["task_file"] = json!(path);
-        }
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&out).expect("JSON of finite numbers")
-        );
+        print_json(args, out);
         return Ok(());
     }
-    outln!("arm: {}    task: {}", args.arm, spec.label());
+    outln!("arm: {arm}    task: {}", spec.label());
     print_matrix("A = df/dX at the equilibrium", &a);
     print_matrix("B = df/dU at the equilibrium", &b);
     for (name, m) in [
@@ -84,4 +101,71 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     print_matrix("Pi^U (control confidence)", &confidence.pi_u);
     outln!("ln|Pi^U| = {:.12}", confidence.logdet);
     Ok(())
+}
+
+/// A tool of any model, through the model-generic runtime: the numbers `rank` and Python's
+/// `toolconf.confidence` give it.
+fn run_model(args: &Args, model: ModelKind, spec: &TaskSpec) -> Result<(), CliError> {
+    let tool = tool_from_params(model, args.params.as_deref().unwrap_or_default())?;
+    let tasks = ModelTasks::new(spec);
+    tasks.check(model)?;
+    let l: Linearisation = tasks.linearisation(&tool)?;
+    l.check_finite(&tool)?;
+    if args.json {
+        let named: serde_json::Map<String, Value> = tool
+            .named_parameters()
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), json!(v)))
+            .collect();
+        let sens: serde_json::Map<String, Value> = l
+            .sensitivities
+            .iter()
+            .map(|(name, m)| (name.to_string(), json!(m)))
+            .collect();
+        let out = json!({
+            "model": model.name(),
+            "params": named,
+            "task": spec.kind,
+            "a": l.a,
+            "b": l.b,
+            "sensitivities": sens,
+            "pi_u": l.pi_u,
+            "logdet": l.logdet,
+        });
+        print_json(args, out);
+        return Ok(());
+    }
+    outln!("tool: {tool}    task: {}", spec.label());
+    print_rows("A = df/dX at the equilibrium", &l.a);
+    print_rows("B = df/dU at the equilibrium", &l.b);
+    for (name, m) in &l.sensitivities {
+        let title = match *name {
+            "d_theta_du" => "dtheta/dU",
+            "d_theta_dot_du" => "dtheta_dot/dU",
+            _ => "dtheta_ddot/dU",
+        };
+        print_rows(title, m);
+    }
+    print_rows("Pi^U (control confidence)", &l.pi_u);
+    outln!("ln|Pi^U| = {:.12}", l.logdet);
+    Ok(())
+}
+
+fn print_json(args: &Args, mut out: Value) {
+    if let Some(path) = &args.task.task_file {
+        out["task_file"] = json!(path);
+    }
+    outln!(
+        "{}",
+        serde_json::to_string_pretty(&out).expect("JSON of finite numbers")
+    );
+}
+
+/// A titled matrix given as rows, as [`print_matrix`] prints one.
+fn print_rows(title: &str, m: &[Vec<f64>]) {
+    outln!("{title}:");
+    for row in m {
+        let row: Vec<String> = row.iter().map(|x| format!("{x:>16.9e}")).collect();
+        outln!("  [{}]", row.join(" "));
+    }
 }

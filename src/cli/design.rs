@@ -60,7 +60,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let tasks = ModelTasks::new(&task);
     tasks.check(model)?;
     let names: Vec<&'static str> = model.parameter_names().to_vec();
-    let spec = DesignSpec::from_file(&args.design, &names)?;
+    let spec = DesignSpec::from_file(&args.design, model)?;
     let sweep = args
         .sweep
         .as_deref()

@@ -36,6 +36,7 @@ mod stdout;
 use std::process::ExitCode;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
+use toolconf::display::Clip;
 use toolconf::{Arm, TaskKind};
 
 /// Confidence-aware decision-making and control for tool selection.
@@ -68,6 +69,23 @@ pub(crate) fn parse_arm(s: &str) -> Result<Arm, String> {
 
 pub(crate) fn parse_model(s: &str) -> Result<toolconf::model::mixed::ModelKind, String> {
     s.parse()
+}
+
+/// A tool of `model` from `--params P1,P2,…` in the model's parameter order.
+pub(crate) fn tool_from_params(
+    model: toolconf::model::mixed::ModelKind,
+    text: &str,
+) -> Result<toolconf::model::mixed::AnyTool, output::CliError> {
+    let params = text
+        .split(',')
+        .map(|v| {
+            v.trim().parse::<f64>().map_err(|_| {
+                let (text, v) = (Clip(text), Clip(v.trim()));
+                output::CliError::Usage(format!("--params {text}: '{v}' is not a number"))
+            })
+        })
+        .collect::<Result<Vec<f64>, _>>()?;
+    Ok(toolconf::model::mixed::AnyTool::new(model, &params)?)
 }
 
 pub(crate) fn parse_task(s: &str) -> Result<TaskKind, String> {

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use serde_json::{json, Value};
 use toolconf::closed_loop::{Episode, Metrics, Plant};
 use toolconf::integrate::Method;
-use toolconf::model::mixed::{AnyTool, ModelKind};
+use toolconf::model::mixed::ModelKind;
 use toolconf::model::{episode_on, Arm2, Arm2Exact};
 use toolconf::mpc::{MpcModel, MpcOptions};
 use toolconf::rank::{ModelTasks, TrajectoryTable};
@@ -15,7 +15,7 @@ use toolconf::{Arm, Task};
 
 use super::episode_args::{two_link_options, EpisodeArgs, PlantArg, TaskArgs};
 use super::output::{check_output_file, write_atomically, CliError};
-use super::{parse_arm, parse_model};
+use super::{parse_arm, parse_model, tool_from_params};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -333,16 +333,7 @@ fn run_model(args: &Args, model: ModelKind, mut spec: TaskSpec) -> Result<(), Cl
                 .into(),
         ));
     }
-    let text = args.params.as_deref().unwrap_or_default();
-    let params = text
-        .split(',')
-        .map(|v| {
-            v.trim()
-                .parse::<f64>()
-                .map_err(|_| CliError::Usage(format!("--params {text}: '{v}' is not a number")))
-        })
-        .collect::<Result<Vec<f64>, _>>()?;
-    let tool = AnyTool::new(model, &params)?;
+    let tool = tool_from_params(model, args.params.as_deref().unwrap_or_default())?;
     args.episode.apply(&mut spec)?;
     spec.episode.method = Some(args.method.method.into());
     let tasks = ModelTasks::new(&spec);

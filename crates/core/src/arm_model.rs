@@ -21,6 +21,11 @@ pub trait ArmModel<const N: usize, const NX: usize, const NP: usize, const NZ: u
     const PARAMETER_NAMES: [&'static str; NP];
     /// The equilibrium state X^e the model is linearised at.
     const EQUILIBRIUM_STATE: [f64; NX];
+    /// The equilibrium torque U^e.
+    const EQUILIBRIUM_CONTROL: [f64; N];
+    /// Which tools are valid (each parameter's domain, constraints across them) and the box
+    /// random tools are drawn from: the model description's, `generated::validity::<name>`.
+    const TOOL_RULE: generated::validity::ToolRule<NP>;
 
     /// The parameter-only factors of [`ArmModel::dynamics`], computed once per tool.
     type DynamicsCoefficients: Copy + Debug + Send + Sync;
@@ -59,6 +64,15 @@ pub trait ArmModel<const N: usize, const NX: usize, const NP: usize, const NZ: u
     ) -> (SMatrix<f64, NX, NX>, SMatrix<f64, NX, N>) {
         Self::dynamics_jacobian_with(x, u, &Self::jacobian_coefficients(p))
     }
+    /// The robot's own rigid-body dynamics Ẋ = [q̇; q̈] with U the joint torques
+    /// (`generated::rigid_body::<name>`): a URDF arm's without the joint impedance its plant
+    /// [`ArmModel::dynamics`] adds; for the other models, whose plant is their rigid-body
+    /// dynamics, the same function.
+    fn rigid_body_dynamics(
+        x: &SVector<f64, NX>,
+        u: &SVector<f64, N>,
+        p: &SVector<f64, NP>,
+    ) -> SVector<f64, NX>;
     /// A = ∂f/∂X at the equilibrium.
     fn state_matrix(p: &SVector<f64, NP>) -> SMatrix<f64, NX, NX>;
     /// B = ∂f/∂U at the equilibrium.
@@ -100,6 +114,10 @@ macro_rules! arm_model {
                 generated::$module::PARAMETER_NAMES;
             const EQUILIBRIUM_STATE: [f64; generated::$module::STATE_DIM] =
                 generated::$module::EQUILIBRIUM_STATE;
+            const EQUILIBRIUM_CONTROL: [f64; generated::$module::DOF] =
+                generated::$module::EQUILIBRIUM_CONTROL;
+            const TOOL_RULE: generated::validity::ToolRule<{ generated::$module::PARAMETER_COUNT }> =
+                generated::validity::$module::RULE;
             type DynamicsCoefficients = generated::$module::DynamicsCoefficients;
             type JacobianCoefficients = generated::$module::DynamicsJacobianCoefficients;
 
@@ -136,6 +154,15 @@ macro_rules! arm_model {
                 SMatrix<f64, { generated::$module::STATE_DIM }, { generated::$module::DOF }>,
             ) {
                 generated::$module::dynamics_jacobian_with(x, u, k)
+            }
+
+            #[inline]
+            fn rigid_body_dynamics(
+                x: &SVector<f64, { generated::$module::STATE_DIM }>,
+                u: &SVector<f64, { generated::$module::DOF }>,
+                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
+            ) -> SVector<f64, { generated::$module::STATE_DIM }> {
+                generated::rigid_body::$module(x, u, p)
             }
 
             #[inline]

@@ -12,9 +12,23 @@ use crate::TaskKind;
 /// What can go wrong building a tool, a task or a controller, or computing ln|Π^U|.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum Error {
-    /// A tool parameter outside [`TOOL_PARAMETER`].
+    /// A tool parameter of a "> 0" domain (a mass, a length, a principal moment) outside
+    /// [`TOOL_PARAMETER`], where the generated arithmetic is known to stay finite.
     #[error("invalid arm parameter {name} = {}: must be a number in {}", Short(*value), TOOL_PARAMETER)]
     InvalidParameter { name: &'static str, value: f64 },
+    /// A tool parameter outside its model's domain (a URDF tool's centre of mass beyond the
+    /// stated bound; `generated::validity`), the domain in words. A parameter whose domain is
+    /// "> 0" is an [`Error::InvalidParameter`].
+    #[error("invalid tool parameter {name} = {}: must be {domain}", Short(*value))]
+    ParameterOutOfDomain {
+        name: &'static str,
+        value: f64,
+        domain: &'static str,
+    },
+    /// A tool whose parameters break a constraint across them (c · p ≤ 0, e.g. the triangle
+    /// inequality of a rigid body's principal moments), by `excess` = c · p > 0.
+    #[error("invalid tool: {rule} does not hold (off by {excess:e})")]
+    ToolConstraint { rule: &'static str, excess: f64 },
     /// A goal outside [`JOINT_VALUE`].
     #[error("invalid goal {name} = {}: must be a number in {}", Short(*value), JOINT_VALUE)]
     InvalidGoal { name: &'static str, value: f64 },

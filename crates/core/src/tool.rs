@@ -7,6 +7,7 @@ use core::marker::PhantomData;
 use nalgebra::{SMatrix, SVector};
 
 use crate::generated;
+use crate::generated::validity::Violation;
 use crate::generated::TaskKind;
 use crate::Error;
 
@@ -19,7 +20,8 @@ use super::ArmModel;
 /// 1–2, [I O](A²∂X/∂U + AB) = I in task 3). The formulas are `derive/tasks.toml`'s.
 pub type SensitivitiesN<const N: usize> = generated::TaskSensitivities<N>;
 
-/// One tool of model `M`: its parameters, each in [`crate::validate::TOOL_PARAMETER`].
+/// One tool of model `M`: its parameters, valid by the model's rule ([`ArmModel::TOOL_RULE`])
+/// and within [`crate::validate::TOOL_PARAMETER`].
 ///
 /// The parameters are private so that every `ToolN` has passed [`ToolN::new`].
 pub struct ToolN<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> {
@@ -52,14 +54,40 @@ impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> ToolN
 where
     M: ArmModel<N, NX, NP, NZ>,
 {
-    /// Validates and builds a tool from its parameters in [`ArmModel::PARAMETER_NAMES`] order.
-    /// A value outside [`crate::validate::TOOL_PARAMETER`] (so also a non-positive, NaN or
-    /// infinite one), where the generated arithmetic is not known to stay finite, is an
-    /// [`Error::InvalidParameter`] naming it. No allocation: tools are checked in bulk.
+    /// Validates and builds a tool from its parameters in [`ArmModel::PARAMETER_NAMES`] order,
+    /// against the model's rule ([`ArmModel::TOOL_RULE`], from its description through the
+    /// generated `validity` module): a value outside its parameter's domain is an
+    /// [`Error::InvalidParameter`] naming it (domain "> 0": NaN, ±∞, values ≤ 0, and values
+    /// outside [`crate::validate::TOOL_PARAMETER`], where the generated arithmetic is not known
+    /// to stay finite) or an [`Error::ParameterOutOfDomain`] (any other domain, which the
+    /// derivation keeps within ±1e6), a broken constraint across the parameters an
+    /// [`Error::ToolConstraint`]. No allocation: tools are checked in bulk.
     pub fn new(params: [f64; NP]) -> Result<Self, Error> {
-        for (name, value) in M::PARAMETER_NAMES.into_iter().zip(params) {
-            if !crate::validate::TOOL_PARAMETER.contains(value) {
+        let rule = &M::TOOL_RULE;
+        let positive = rule.domains.iter().map(|d| d.is_positive());
+        let in_range = |value: f64| crate::validate::TOOL_PARAMETER.contains(value);
+        for ((name, value), positive) in M::PARAMETER_NAMES.into_iter().zip(params).zip(positive) {
+            if positive && !in_range(value) {
                 return Err(Error::InvalidParameter { name, value });
+            }
+        }
+        match rule.check(&params) {
+            Ok(()) => {}
+            Err(Violation::Domain { index, value }) => {
+                let (name, domain) = (M::PARAMETER_NAMES[index], &rule.domains[index]);
+                return Err(if domain.is_positive() {
+                    Error::InvalidParameter { name, value }
+                } else {
+                    Error::ParameterOutOfDomain {
+                        name,
+                        value,
+                        domain: domain.rule,
+                    }
+                });
+            }
+            Err(Violation::Constraint { index, excess }) => {
+                let rule = rule.constraints[index].rule;
+                return Err(Error::ToolConstraint { rule, excess });
             }
         }
         Ok(Self {
@@ -86,6 +114,17 @@ where
     /// Ẋ = f(X, U; p).
     pub fn dynamics(&self, x: &SVector<f64, NX>, u: &SVector<f64, N>) -> SVector<f64, NX> {
         M::dynamics(x, u, &self.params)
+    }
+
+    /// The robot's own rigid-body dynamics Ẋ = [q̇; q̈], M(q)q̈ + C(q, q̇)q̇ + g(q) = U with U the
+    /// joint torques ([`ArmModel::rigid_body_dynamics`]): for a URDF arm the plant without its
+    /// joint impedance, for the others the plant itself.
+    pub fn rigid_body_dynamics(
+        &self,
+        x: &SVector<f64, NX>,
+        u: &SVector<f64, N>,
+    ) -> SVector<f64, NX> {
+        M::rigid_body_dynamics(x, u, &self.params)
     }
 
     /// A at the equilibrium.

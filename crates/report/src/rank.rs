@@ -13,6 +13,7 @@ use crate::stats::spearman;
 use crate::task_file::{PerJoint, PrecisionSpec, TaskSpec};
 use crate::{TaskKind, Term};
 use toolconf::rank::{score, ModelTasks, RankedTool, StageTimings, TaskTrace};
+use toolconf::model::mixed::ModelKind;
 
 /// What the report describes.
 pub struct ReportInput<'a> {
@@ -134,11 +135,12 @@ fn introduction(input: &ReportInput) -> Vec<Block> {
     vec![
         Block::Heading(1, format!("Ranking the tools of {}", input.tools_file)),
         Block::p(format!(
-            "Each tool is a robot arm, given by its link masses and lengths, that an \
+            "Each tool is {}, that an \
              active-inference controller drives to do one task: **{}**{}. {goal} The controller changes its torque U to lower a free energy F, a weighted sum of \
              squared errors (how far the arm is from the goal, how much torque it uses). \
              Following Anil Meera & Lanillos, *Confidence-Aware Decision-Making and Control \
              for Tool Selection*, each tool is judged by four numbers:",
+            what_a_tool_is(input.results),
             spec.label(),
             spec.description
                 .as_ref()
@@ -172,6 +174,31 @@ fn introduction(input: &ReportInput) -> Vec<Block> {
     .into_iter()
     .chain(task_table(input))
     .collect()
+}
+
+/// What the tools are, from their models: "a tool of `arm2` (2-DOF arm in the vertical plane
+/// ...), given by m1 (kg), m2 (kg), ...", one clause per model among the results.
+fn what_a_tool_is(results: &[RankedTool]) -> String {
+    let mut models: Vec<ModelKind> = results.iter().map(|r| r.row.tool.model()).collect();
+    models.sort();
+    models.dedup();
+    let clauses: Vec<String> = models
+        .iter()
+        .map(|m| {
+            let params: Vec<String> = m
+                .parameter_names()
+                .iter()
+                .zip(m.parameter_units())
+                .map(|(p, u)| format!("{p} ({u})"))
+                .collect();
+            format!(
+                "a tool of `{m}` ({}), given by {}",
+                m.title(),
+                params.join(", ")
+            )
+        })
+        .collect();
+    clauses.join("; or ")
 }
 
 fn objective_words(o: Objective) -> &'static str {
@@ -244,7 +271,10 @@ fn task_table(input: &ReportInput) -> Vec<Block> {
     );
     add(
         "initial joint angles [rad]",
-        given(vector(&e.initial_theta), "hanging straight down"),
+        given(
+            vector(&e.initial_theta),
+            "the model's equilibrium q^e (the planar arms: hanging straight down)",
+        ),
     );
     add(
         "initial joint velocities [rad/s]",

@@ -119,6 +119,11 @@ pub struct CsvRows {
     quote_line: u64,
     /// Bytes of the UTF-8 byte-order mark (which the `csv` crate skips) still possible.
     started: bool,
+    /// Inside a row (not at its first byte): a `#` there is data, not a comment.
+    in_row: bool,
+    /// In a comment line (`#` as a row's first byte, the reader's `comment(Some(b'#'))`), which
+    /// ends at its line break whatever quotes it holds.
+    comment: bool,
 }
 
 #[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
@@ -129,6 +134,16 @@ enum CsvState {
     Quoted,
     /// A quote inside a quoted cell: the cell's end, or the first of a doubled quote.
     QuoteInQuoted,
+}
+
+impl CsvRows {
+    /// The row ends at `at`, on the line break `byte`: the next byte starts a row.
+    fn row_ends(&mut self, at: usize, byte: u8) -> usize {
+        self.line += u64::from(byte == b'\n');
+        self.state = CsvState::FieldStart;
+        self.in_row = false;
+        at
+    }
 }
 
 impl Records for CsvRows {
@@ -143,15 +158,22 @@ impl Records for CsvRows {
                 i = 3;
             }
         }
+        if i < bytes.len() && !self.in_row {
+            self.comment = bytes[i] == b'#';
+            self.in_row = true;
+        }
+        if self.comment {
+            let k = memchr::memchr2(b'\n', b'\r', &bytes[i..])?;
+            self.comment = false;
+            return Some(self.row_ends(i + k, bytes[i + k]));
+        }
         // The common row, without a quote: its end is the next line break, found at memchr's
         // speed (SIMD), cell boundaries need not be followed.
         if matches!(self.state, FieldStart | Unquoted) {
             if let Some(k) = memchr::memchr3(b'\n', b'\r', b'"', &bytes[i..]) {
                 let at = i + k;
                 if bytes[at] != b'"' {
-                    self.line += u64::from(bytes[at] == b'\n');
-                    self.state = FieldStart;
-                    return Some(at);
+                    return Some(self.row_ends(at, bytes[at]));
                 }
             } else {
                 // No line break and no quote: whether the last byte ends a cell or not, the
@@ -200,13 +222,11 @@ impl Records for CsvRows {
                 (_, _) if terminator => (FieldStart, true),
                 (_, _) => (Unquoted, false),
             };
-            if byte == b'\n' {
-                self.line += 1;
-            }
-            self.state = next;
             if ends {
-                return Some(i);
+                return Some(self.row_ends(i, byte));
             }
+            self.line += u64::from(byte == b'\n');
+            self.state = next;
             i += 1;
         }
         None
@@ -394,6 +414,16 @@ mod tests {
         // A byte-order mark does not hide a quote at the start of the first cell.
         let e = read_all(b"\xEF\xBB\xBF\"name,m1\n", CsvRows::default(), 100).unwrap_err();
         assert_eq!(record_error(&e).unwrap().0, 1);
+    }
+
+    #[test]
+    fn csv_comment_lines_end_at_their_line_break_whatever_their_quotes() {
+        // As the reader's comment(Some(b'#')) skips them: a quote in a comment opens nothing.
+        let ok = b"name,m1\n# Wera, \"Kraftform 0.3 kg\nx,0.3\ny#2,0.4\n";
+        assert_eq!(read_all(ok, CsvRows::default(), 30).unwrap(), ok);
+        // A '#' inside a row is data: its quote still opens a cell.
+        let e = read_all(b"name,m1\nx#,\"open\n", CsvRows::default(), 100).unwrap_err();
+        assert!(record_error(&e).unwrap().1.contains("never closed"));
     }
 
     #[test]

@@ -1,10 +1,15 @@
 //! Tool files: the user's own tools, one per row, read as a stream.
 //!
-//! CSV (any extension but `.json`): a header row, then one tool per row. Columns: `model`
+//! CSV (any extension but `.json`): a header row, then one tool per row; a line that starts with
+//! `#` is a comment (a tool's source, say) wherever it stands. Columns: `model`
 //! (optional; an empty cell or no column means `arm2`), `name` (optional), and the parameter
 //! names of the models used (`m1,m2,l1,l2` for arm2 and arm2_exact, `m1,m2,m3,l1,l2,l3` for
-//! arm3). Rows of different models share the file; a row leaves the columns its model does not
-//! have empty.
+//! arm3, `tool_mass,tool_com_x,tool_com_y,tool_com_z,tool_ixx,tool_iyy,tool_izz` for the URDF
+//! arms `panda` and `ur5`). Rows of different models share the file; a row leaves the columns its
+//! model does not have empty. Each value must lie in its parameter's domain and the tool obey
+//! its model's rule (`generated::validity`: > 0 for masses and lengths; a URDF tool's centre of
+//! mass may be 0 or negative, within its bound, and its principal moments obey the triangle
+//! inequality).
 //!
 //! JSON (`.json`): an array of objects with the same keys, e.g.
 //! `[{"name": "hammer", "model": "arm2", "m1": 0.3, "m2": 0.4, "l1": 0.5, "l2": 0.2}]`.
@@ -130,6 +135,7 @@ fn read_csv<R: Read>(
     let bounded = RecordLimit::new(reader, CsvRows::default());
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
+        .comment(Some(b'#'))
         .from_reader(bounded);
     let header: Vec<String> = reader
         .headers()
@@ -271,8 +277,9 @@ fn check_keys<'a>(keys: impl Iterator<Item = &'a str>, noun: &str) -> Result<(),
     Ok(())
 }
 
-/// One row's tool from its cells: the model, then each of its parameters, each a finite
-/// number > 0; a parameter of another model must be empty.
+/// One row's tool from its cells: the model, then each of its parameters, each in its domain
+/// (a finite number > 0 for the planar arms; a URDF tool's centre of mass may be 0 or negative)
+/// and the tool valid by its model's rule; a parameter of another model must be empty.
 ///
 /// `present`: the parameter keys the row may give at all (its file's columns, its object's
 /// keys), in [`parameter_keys`] order, so that a file of one model does not look up every other
@@ -306,8 +313,9 @@ fn build_row<'a>(
         }
     };
     let names = model.parameter_names();
+    let domains = model.parameter_domains();
     let mut params = Vec::with_capacity(names.len());
-    for &key in names {
+    for (&key, domain) in names.iter().zip(domains) {
         let value = match cell(key) {
             Cell::Absent => {
                 return Err(format!(
@@ -321,7 +329,7 @@ fn build_row<'a>(
                 .map_err(|_| format!("{key} = '{}' is not a number{}", Clip(t), who()))?,
             Cell::Other(v) => return Err(format!("{key} = {} is not a number{}", Clip(&v), who())),
         };
-        if let Err(why) = crate::validate::TOOL_PARAMETER.check(value) {
+        if let Err(why) = crate::validate::tool_parameter(domain, value) {
             return Err(format!("{key} = {why}{}", who()));
         }
         params.push(value);

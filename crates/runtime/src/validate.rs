@@ -81,6 +81,26 @@ pub const RANGES: [(&str, Range); 16] = [
     ),
 ];
 
+/// One tool parameter against its model's domain (`generated::validity`) and, for a "> 0"
+/// domain (a mass, a length, a moment), [`TOOL_PARAMETER`]: the value, or why not in words
+/// (`0 must be a number in [1e-6, 1e6]`), as [`toolconf_core::ToolN::new`] judges it.
+pub fn tool_parameter(
+    domain: &crate::generated::validity::ParameterDomain,
+    value: f64,
+) -> Result<f64, String> {
+    if domain.is_positive() {
+        TOOL_PARAMETER.check(value)
+    } else if domain.contains(value) {
+        Ok(value)
+    } else {
+        Err(format!(
+            "{} must be {}",
+            crate::display::Short(value),
+            domain.rule
+        ))
+    }
+}
+
 /// The last line of defence at the output: every value of `quantity` finite, else
 /// [`crate::Error::NonFiniteResult`] naming the tool and the quantity, so that a front end never
 /// prints NaN, inf or (in JSON) null for a number.

@@ -204,7 +204,10 @@ fn render_one(
 }
 
 /// Renders the IR through each template; Rust outputs are formatted with rustfmt.
-pub fn render(source: &Value, templates: &[(String, String)]) -> Result<Vec<Rendered>, RenderError> {
+pub fn render(
+    source: &Value,
+    templates: &[(String, String)],
+) -> Result<Vec<Rendered>, RenderError> {
     let model = source
         .pointer("/model/name")
         .and_then(Value::as_str)
@@ -212,6 +215,7 @@ pub fn render(source: &Value, templates: &[(String, String)]) -> Result<Vec<Rend
     let tera = engine(templates)?;
     let mut ir = source.clone();
     ir["tasks"] = Value::from(tasks::tasks_with_rust(&ir)?);
+    ir["tool_rule_view"] = tool_rule_entry(&ir["model"])?;
     let context = Context::from_value(ir).map_err(|e| RenderError::Template(chain(&e)))?;
     let mut out: Vec<Rendered> = Vec::new();
     for (name, _) in templates.iter().filter(|(n, _)| !n.contains('/')) {
@@ -296,7 +300,157 @@ fn registry_entry(ir: &Value) -> Result<Value, RenderError> {
             .map(|fs| fs.iter().map(vector_test_entry).collect::<Vec<_>>())
             .unwrap_or_default(),
     );
+    entry["tool_rule"] = tool_rule_entry(model)?;
+    entry["rigid_body"] = rigid_body_entry(ir);
     Ok(entry)
+}
+
+/// The function that is a model's own rigid-body dynamics (U the joint torques): the URDF arms'
+/// `rigid_body_dynamics` (their plant adds joint impedance), else the model's plant `dynamics`,
+/// which for the other kinds is the equations of motion with U the torques (or force) itself.
+fn rigid_body_entry(ir: &Value) -> Value {
+    let has = |name: &str| {
+        ir.get("functions")
+            .and_then(Value::as_array)
+            .is_some_and(|fs| {
+                fs.iter()
+                    .any(|f| f.get("name").and_then(Value::as_str) == Some(name))
+            })
+    };
+    if has("rigid_body_dynamics") {
+        json!({"function": "rigid_body_dynamics", "doc": "the rigid-body dynamics alone (the model's plant adds joint impedance)"})
+    } else {
+        json!({"function": "dynamics", "doc": "the model's plant, which is its rigid-body dynamics"})
+    }
+}
+
+/// The planar arms' rule, for a model whose IR states none (`model.tool_rule`): every parameter
+/// (a mass, a length, a stiffness) finite and > 0, random tools drawn from the paper's
+/// [0.1, 0.6] ("Implementation details"), no constraint across parameters.
+fn default_tool_rule(count: usize) -> Value {
+    let positive = json!({"lo": 0.0, "hi": null, "lo_open": true, "hi_open": true});
+    json!({
+        "domains": vec![positive; count],
+        "constraints": [],
+        "sample": vec![json!([0.1, 0.6]); count],
+    })
+}
+
+/// The registry's view of a model's tool rule (templates/registry/src/validity.rs.tera): each
+/// domain's bounds as Rust literals and its rule in words, the constraints' coefficients and
+/// text, the sampling box; the IR's `model.tool_rule`, or [`default_tool_rule`].
+fn tool_rule_entry(model: &Value) -> Result<Value, RenderError> {
+    let parameters = model
+        .get("parameters")
+        .and_then(Value::as_array)
+        .cloned()
+        .unwrap_or_default();
+    let rule = model
+        .get("tool_rule")
+        .cloned()
+        .unwrap_or_else(|| default_tool_rule(parameters.len()));
+    let bad = |what: &str| RenderError::Template(format!("model.tool_rule: {what}"));
+    let list = |key: &str| -> Result<Vec<Value>, RenderError> {
+        rule.get(key)
+            .and_then(Value::as_array)
+            .cloned()
+            .ok_or_else(|| bad(&format!("no {key}")))
+    };
+    let (domains, sample) = (list("domains")?, list("sample")?);
+    if domains.len() != parameters.len() || sample.len() != parameters.len() {
+        return Err(bad("one domain and one sampling box per parameter"));
+    }
+    let mut rendered_domains = Vec::new();
+    for (d, p) in domains.iter().zip(&parameters) {
+        let unit = p.get("unit").and_then(Value::as_str).unwrap_or("");
+        rendered_domains.push(
+            domain_entry(d, unit).ok_or_else(|| bad("a domain needs lo, hi, lo_open, hi_open"))?,
+        );
+    }
+    let mut constraints = Vec::new();
+    for c in list("constraints")? {
+        let coefficients: Vec<String> = c
+            .get("coefficients")
+            .and_then(Value::as_array)
+            .filter(|a| a.len() == parameters.len())
+            .ok_or_else(|| bad("a constraint needs one coefficient per parameter"))?
+            .iter()
+            .map(|x| {
+                x.as_f64()
+                    .map(rust_f64)
+                    .ok_or_else(|| bad("a coefficient is not a number"))
+            })
+            .collect::<Result<_, _>>()?;
+        let text = c.get("text").and_then(Value::as_str).unwrap_or("");
+        constraints
+            .push(json!({"coefficients": coefficients, "rule": format!("{text:?}"), "text": text}));
+    }
+    let mut boxes = Vec::new();
+    for (b, d) in sample.iter().zip(&mut rendered_domains) {
+        match b
+            .as_array()
+            .map(|a| a.iter().map(Value::as_f64).collect::<Vec<_>>())
+            .as_deref()
+        {
+            Some([Some(lo), Some(hi)]) => {
+                boxes.push(json!({"lo": rust_f64(*lo), "hi": rust_f64(*hi)}));
+                d["sample"] = Value::from(format!("[{lo}, {hi}]"));
+            }
+            _ => return Err(bad("a sampling box is not [lo, hi]")),
+        }
+    }
+    for (d, p) in rendered_domains.iter_mut().zip(&parameters) {
+        d["name"] = p.get("name").cloned().unwrap_or(Value::Null);
+    }
+    Ok(json!({"domains": rendered_domains, "constraints": constraints, "sample": boxes}))
+}
+
+/// One domain: its bounds as Rust literals (a missing bound is infinite) and the rule in words,
+/// e.g. "a finite number > 0", "a finite number in [-1, 1] m".
+fn domain_entry(d: &Value, unit: &str) -> Option<Value> {
+    let bound = |key: &str| -> Option<Option<f64>> {
+        match d.get(key)? {
+            Value::Null => Some(None),
+            v => v.as_f64().map(Some),
+        }
+    };
+    let (lo, hi) = (bound("lo")?, bound("hi")?);
+    let (lo_open, hi_open) = (d.get("lo_open")?.as_bool()?, d.get("hi_open")?.as_bool()?);
+    let unit = if unit.is_empty() {
+        String::new()
+    } else {
+        format!(" {unit}")
+    };
+    let words = match (lo, hi) {
+        (None, None) => "a finite number".to_string(),
+        (Some(l), None) => format!(
+            "a finite number {} {l}{unit}",
+            if lo_open { ">" } else { ">=" }
+        ),
+        (None, Some(h)) => format!(
+            "a finite number {} {h}{unit}",
+            if hi_open { "<" } else { "<=" }
+        ),
+        (Some(l), Some(h)) => format!(
+            "a finite number in {}{l}, {h}{}{unit}",
+            if lo_open { "(" } else { "[" },
+            if hi_open { ")" } else { "]" }
+        ),
+    };
+    Some(json!({
+        "lo": lo.map_or("f64::NEG_INFINITY".to_string(), rust_f64),
+        "hi": hi.map_or("f64::INFINITY".to_string(), rust_f64),
+        "lo_open": lo_open,
+        "hi_open": hi_open,
+        "rule": format!("{words:?}"),
+        "words": words,
+    }))
+}
+
+/// An f64 as a Rust literal that reads back as the same double (`{:?}` is the shortest
+/// round-trip form and always has a `.` or an exponent).
+fn rust_f64(x: f64) -> String {
+    format!("{x:?}")
 }
 
 /// What the vector test needs of one generated function: its argument and output names, and

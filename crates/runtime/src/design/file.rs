@@ -4,7 +4,7 @@
 //! ```toml
 //! objective = "confidence"            # maximise ln|Π^U| (default), or "free_energy": minimise ∫F dt
 //! constraints = ["l1 + l2 >= 0.7", "m1 + m2 <= 0.5"]
-//! [bounds]                            # every parameter not fixed needs bounds, lo > 0
+//! [bounds]                            # every parameter not fixed needs bounds in its domain (> 0)
 //! m1 = [0.1, 0.6]
 //! [fixed]                             # optional: parameters held at a value (e.g. a payload mass)
 //! mp = 0.2
@@ -26,6 +26,8 @@ use serde::Deserialize;
 use super::constraint::{parse_constraint, LinearConstraint};
 use super::DesignError;
 use crate::display::{Clip, ClipMessage, ShortList};
+use crate::generated::validity::ParameterDomain;
+use crate::model::mixed::ModelKind;
 
 /// What the design optimises.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -106,26 +108,30 @@ struct RawSearch {
 }
 
 impl DesignSpec {
-    /// Reads and checks a design file for a model with parameters `names`.
-    pub fn from_file(path: &Path, names: &[&'static str]) -> Result<Self, DesignError> {
+    /// Reads and checks a design file for a tool of `model`.
+    pub fn from_file(path: &Path, model: ModelKind) -> Result<Self, DesignError> {
         let file = path.display().to_string();
         let text = crate::bounded_read::read_text_file(path, "design file")
             .map_err(|message| DesignError::input(&file, "", message))?;
-        Self::parse(&text, &file, names)
+        Self::parse(&text, &file, model)
     }
 
-    /// Parses and checks design-file text; `file` names it in errors.
-    pub fn parse(text: &str, file: &str, names: &[&'static str]) -> Result<Self, DesignError> {
+    /// Parses and checks design-file text for a tool of `model`; `file` names it in errors.
+    /// Bounds and fixed values must lie in each parameter's domain, and the model's own
+    /// constraints (a URDF tool's triangle inequality, `generated::validity`) join the file's.
+    pub fn parse(text: &str, file: &str, model: ModelKind) -> Result<Self, DesignError> {
         let raw: RawDesign = toml::from_str(text).map_err(|e| {
             let line = e.span().map(|s| 1 + text[..s.start].matches('\n').count());
             let place = line.map(|l| format!("line {l}")).unwrap_or_default();
             let message = e.message().trim().replace('\n', " ");
             DesignError::input(file, &place, ClipMessage(&message).to_string())
         })?;
-        Self::from_raw(raw, file, names)
+        Self::from_raw(raw, file, model)
     }
 
-    fn from_raw(raw: RawDesign, file: &str, names: &[&'static str]) -> Result<Self, DesignError> {
+    fn from_raw(raw: RawDesign, file: &str, model: ModelKind) -> Result<Self, DesignError> {
+        let names = model.parameter_names();
+        let domains = model.parameter_domains();
         let err =
             |key: &str, message: String| DesignError::input(file, &format!("key {key}"), message);
         let objective = match raw.objective.as_deref() {
@@ -156,7 +162,7 @@ impl DesignSpec {
         let mut fixed = vec![None; names.len()];
         for (name, &value) in &raw.fixed {
             let k = known(format!("fixed.{name}"), name)?;
-            if let Err(why) = crate::validate::TOOL_PARAMETER.check(value) {
+            if let Err(why) = crate::validate::tool_parameter(&domains[k], value) {
                 return Err(err(&format!("fixed.{name}"), why));
             }
             fixed[k] = Some(value);
@@ -171,7 +177,7 @@ impl DesignSpec {
                     format!("'{name}' is also fixed; give one of the two"),
                 ));
             }
-            bounds[k] = Some(check_bounds(range).map_err(|m| err(&key, m))?);
+            bounds[k] = Some(check_bounds(range, &domains[k]).map_err(|m| err(&key, m))?);
         }
         let mut out = Vec::with_capacity(names.len());
         for (k, name) in names.iter().enumerate() {
@@ -186,7 +192,7 @@ impl DesignSpec {
                 }
             }
         }
-        let constraints = raw
+        let mut constraints = raw
             .constraints
             .iter()
             .enumerate()
@@ -195,6 +201,7 @@ impl DesignSpec {
                     .map_err(|m| err(&format!("constraints[{i}]"), format!("'{}': {m}", Clip(c))))
             })
             .collect::<Result<Vec<_>, _>>()?;
+        constraints.extend(model_constraints(model, &fixed).map_err(|m| err("fixed", m))?);
         Ok(Self {
             file: file.into(),
             objective,
@@ -208,21 +215,59 @@ impl DesignSpec {
     }
 }
 
-/// `[lo, hi]` within [`crate::validate::TOOL_PARAMETER`], lo ≤ hi.
-fn check_bounds(range: &[f64]) -> Result<(f64, f64), String> {
+/// The model's constraints across its parameters as design constraints (c · p ≤ 0), but those
+/// on fixed parameters only: they are checked here, once.
+fn model_constraints(
+    model: ModelKind,
+    fixed: &[Option<f64>],
+) -> Result<Vec<LinearConstraint>, String> {
+    let mut out = Vec::new();
+    for (coefficients, rule) in model.parameter_constraints() {
+        let on_free = coefficients
+            .iter()
+            .zip(fixed)
+            .any(|(&c, f)| c != 0.0 && f.is_none());
+        if on_free {
+            out.push(LinearConstraint {
+                coefficients: coefficients.to_vec(),
+                bound: 0.0,
+                text: rule.to_string(),
+            });
+            continue;
+        }
+        let value: f64 = coefficients
+            .iter()
+            .zip(fixed)
+            .map(|(c, f)| c * f.unwrap_or(0.0))
+            .sum();
+        if value > 0.0 {
+            return Err(format!("the fixed values break {rule}"));
+        }
+    }
+    Ok(out)
+}
+
+fn check_bounds(range: &[f64], domain: &ParameterDomain) -> Result<(f64, f64), String> {
     let &[lo, hi] = range else {
         return Err(format!("{} is not [lo, hi]", ShortList(range)));
     };
-    let valid = crate::validate::TOOL_PARAMETER;
     let shown = ShortList(range);
-    if lo <= 0.0 {
+    if domain.is_positive() {
+        let valid = crate::validate::TOOL_PARAMETER;
+        if lo <= 0.0 {
+            return Err(format!(
+                "{shown} admits values <= 0; masses and lengths must be > 0 (give lo > 0)"
+            ));
+        }
+        if !(valid.contains(lo) && valid.contains(hi)) {
+            return Err(format!(
+                "{shown} goes outside {valid}, where every tool parameter must lie"
+            ));
+        }
+    } else if !(domain.contains(lo) && domain.contains(hi)) {
         return Err(format!(
-            "{shown} admits values <= 0; masses and lengths must be > 0 (give lo > 0)"
-        ));
-    }
-    if !(valid.contains(lo) && valid.contains(hi)) {
-        return Err(format!(
-            "{shown} goes outside {valid}, where every tool parameter must lie"
+            "{shown} leaves the parameter's domain: it must be {}",
+            domain.rule
         ));
     }
     if lo > hi {
@@ -263,7 +308,7 @@ impl DesignSpec {
     pub fn from_table(
         table: toml::Table,
         source: &str,
-        names: &[&'static str],
+        model: ModelKind,
     ) -> Result<Self, DesignError> {
         let raw: RawDesign = table.try_into().map_err(|e| {
             // As TaskSpec::from_table: toml names the place as a last line "in `bounds.m1`".
@@ -274,6 +319,6 @@ impl DesignSpec {
             };
             DesignError::input(source, &place, message.trim().replace('\n', " "))
         })?;
-        Self::from_raw(raw, source, names)
+        Self::from_raw(raw, source, model)
     }
 }

@@ -104,12 +104,18 @@ pub fn confidence_optimum(
     Ok((polytope, optimum))
 }
 
-/// Central differences of ln|Π^U| at the optimum (step 1e-6 of each parameter), for the
+/// Central differences of ln|Π^U| at the optimum (step 1e-6 of each parameter, or of its box
+/// where it is 0), for the
 /// report's gradient check: the largest |derived − difference| / max(|derived|, 1).
 pub fn gradient_check(setting: &Setting, polytope: &Polytope, optimum: &Optimum) -> f64 {
     let mut worst = 0.0_f64;
     for j in 0..optimum.x.len() {
-        let h = 1e-6 * optimum.x[j];
+        // Relative to the value, or to the box where the value is 0 (a centre of mass).
+        let h = if optimum.x[j] != 0.0 {
+            1e-6 * optimum.x[j]
+        } else {
+            1e-6 * (polytope.hi[j] - polytope.lo[j])
+        };
         let at = |delta: f64| {
             let mut x = optimum.x.clone();
             x[j] += delta;

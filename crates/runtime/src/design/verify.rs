@@ -180,7 +180,7 @@ mod tests {
         let text = "constraints = [\"m1 + m2 <= 0.2000001\", \"m1 + m2 >= 0.2\", \
                     \"l1 - l2 <= 0.0000001\", \"l1 - l2 >= 0\"]\n[bounds]\nm1 = [0.1, 0.6]\n\
                     m2 = [0.1, 0.6]\nl1 = [0.1, 0.6]\nl2 = [0.1, 0.6]\n";
-        let spec = DesignSpec::parse(text, "thin.toml", &["m1", "m2", "l1", "l2"]).unwrap();
+        let spec = DesignSpec::parse(text, "thin.toml", ModelKind::Arm2).unwrap();
         let polytope = Polytope::new(&spec);
         let tasks = ModelTasks::new(&TaskSpec::builtin(TaskKind::Velocity));
         let mut heard = Vec::new();

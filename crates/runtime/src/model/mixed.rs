@@ -8,6 +8,7 @@ use std::str::FromStr;
 
 use super::*;
 use crate::generated;
+use crate::generated::validity::ParameterDomain;
 use crate::Error;
 
 /// The types over every generated model ([`crate::for_each_model!`]): [`ModelKind`] names a
@@ -28,6 +29,11 @@ macro_rules! mixed_models {
                 match self { $(ModelKind::$marker => generated::$module::NAME,)* }
             }
 
+            /// The model's title (its description's `model.title`).
+            pub fn title(self) -> &'static str {
+                match self { $(ModelKind::$marker => $title,)* }
+            }
+
             /// The control dimension n (joints).
             pub fn dof(self) -> usize {
                 match self { $(ModelKind::$marker => generated::$module::DOF,)* }
@@ -36,6 +42,42 @@ macro_rules! mixed_models {
             /// The tool parameters' names, in the order a tool takes them.
             pub fn parameter_names(self) -> &'static [&'static str] {
                 match self { $(ModelKind::$marker => &generated::$module::PARAMETER_NAMES,)* }
+            }
+
+            /// The tool parameters' units (kg, m, kg m^2, ...), in the same order.
+            pub fn parameter_units(self) -> &'static [&'static str] {
+                match self { $(ModelKind::$marker => &generated::$module::PARAMETER_UNITS,)* }
+            }
+
+            /// Each tool parameter's domain (`generated::validity`), in the same order.
+            pub fn parameter_domains(self) -> &'static [ParameterDomain] {
+                match self { $(ModelKind::$marker => &generated::validity::$module::RULE.domains,)* }
+            }
+
+            /// The constraints across the tool parameters, each c · p ≤ 0 as (c, its text).
+            pub fn parameter_constraints(self) -> Vec<(&'static [f64], &'static str)> {
+                match self {
+                    $(ModelKind::$marker => generated::validity::$module::RULE
+                        .constraints
+                        .iter()
+                        .map(|c| (&c.coefficients[..], c.rule))
+                        .collect(),)*
+                }
+            }
+
+            /// The box random tools are drawn from, (lo, hi) per parameter.
+            pub fn sample_box(self) -> &'static [(f64, f64)] {
+                match self { $(ModelKind::$marker => &generated::validity::$module::RULE.sample,)* }
+            }
+
+            /// The equilibrium X^e = [q^e; q̇^e] the model is linearised at.
+            pub fn equilibrium_state(self) -> &'static [f64] {
+                match self { $(ModelKind::$marker => &generated::$module::EQUILIBRIUM_STATE,)* }
+            }
+
+            /// The equilibrium torque U^e.
+            pub fn equilibrium_control(self) -> &'static [f64] {
+                match self { $(ModelKind::$marker => &generated::$module::EQUILIBRIUM_CONTROL,)* }
             }
         }
 

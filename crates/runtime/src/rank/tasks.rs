@@ -96,6 +96,16 @@ macro_rules! model_tasks {
                 }
             }
 
+            /// A, B, the task's sensitivities, Π^U and ln|Π^U| of `tool` (`confidence --model`).
+            pub fn linearisation(&self, tool: &AnyTool) -> Result<Linearisation, Error> {
+                match tool {
+                    $(AnyTool::$marker(t) => match &self.$module {
+                        Ok(b) => linearisation_of(t, b, self.kind),
+                        Err(e) => Err(Error::Unsupported(e.to_string())),
+                    },)*
+                }
+            }
+
             /// The episode's metrics.
             pub fn simulate(&self, tool: &AnyTool) -> Result<Metrics, ModelSimulationError> {
                 match tool {
@@ -130,6 +140,70 @@ macro_rules! model_tasks {
 }
 
 crate::for_each_model!(model_tasks);
+
+/// A tool's linearisation and confidence with the sizes known only at run time (matrices as
+/// rows): what `toolconf confidence --model` prints.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Linearisation {
+    /// A = ∂f/∂X at the equilibrium.
+    pub a: Vec<Vec<f64>>,
+    /// B = ∂f/∂U at the equilibrium.
+    pub b: Vec<Vec<f64>>,
+    /// The task's sensitivities by name (`d_theta_du`, `d_theta_dot_du`, `d_theta_ddot_du`), the
+    /// terms it uses only.
+    pub sensitivities: Vec<(&'static str, Vec<Vec<f64>>)>,
+    /// Π^U (eq. control_conf).
+    pub pi_u: Vec<Vec<f64>>,
+    pub logdet: f64,
+}
+
+impl Linearisation {
+    /// Every number finite ([`crate::validate::finite_output`]), naming `tool` and the quantity.
+    pub fn check_finite(&self, tool: &dyn std::fmt::Display) -> Result<(), Error> {
+        use crate::validate::finite_output;
+        let flat = |m: &Vec<Vec<f64>>| m.iter().flatten().copied().collect::<Vec<f64>>();
+        finite_output(tool, "A", flat(&self.a))?;
+        finite_output(tool, "B", flat(&self.b))?;
+        for (_, m) in &self.sensitivities {
+            finite_output(tool, "a sensitivity", flat(m))?;
+        }
+        finite_output(tool, "Π^U", flat(&self.pi_u))?;
+        finite_output(tool, "ln|Π^U|", [self.logdet])
+    }
+}
+
+fn rows<const R: usize, const C: usize>(m: &nalgebra::SMatrix<f64, R, C>) -> Vec<Vec<f64>> {
+    (0..R)
+        .map(|i| (0..C).map(|j| m[(i, j)]).collect())
+        .collect()
+}
+
+fn linearisation_of<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    tool: &ToolN<M, N, NX, NP, NZ>,
+    bound: &Bound<N, NX>,
+    kind: TaskKind,
+) -> Result<Linearisation, Error>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let c = bound.task.control_confidence(tool)?;
+    let s = tool.sensitivities(kind);
+    let sensitivities = [
+        ("d_theta_du", s.d_theta_du),
+        ("d_theta_dot_du", s.d_theta_dot_du),
+        ("d_theta_ddot_du", s.d_theta_ddot_du),
+    ]
+    .into_iter()
+    .filter_map(|(name, m)| m.map(|m| (name, rows(&m))))
+    .collect();
+    Ok(Linearisation {
+        a: rows(&tool.state_matrix()),
+        b: rows(&tool.input_matrix()),
+        sensitivities,
+        pi_u: rows(&c.pi_u),
+        logdet: c.logdet,
+    })
+}
 
 fn unfit(e: &TaskFileError) -> ModelSimulationError {
     ModelSimulationError::Input(Error::Unsupported(e.to_string()))

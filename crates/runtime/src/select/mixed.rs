@@ -7,9 +7,13 @@
 //! (`ChaCha8Rng::seed_from_u64(seed)`), each draw u = (next_u64 >> 11)·2⁻⁵³ ∈ [0, 1). Per tool,
 //! first the model: with k models in the set, index min(⌊k·u⌋, k − 1) into the set as given
 //! (no draw when k = 1, so a set of only `arm2` is exactly `select::draw_tools`); then the
-//! model's parameters, each 0.1 + 0.5·u, in the model's parameter order (arm2: m1 m2 l1 l2;
-//! arm3: m1 m2 m3 l1 l2 l3). Draws happen before any parallel work, so results do not depend on
-//! the number of threads.
+//! model's parameters, each lo + (hi − lo)·u from the model's sampling box
+//! (`generated::validity`: [0.1, 0.6], so 0.1 + 0.5·u, for the planar arms' masses and lengths;
+//! a URDF tool's description gives its own), in the model's parameter order (arm2: m1 m2 l1 l2;
+//! arm3: m1 m2 m3 l1 l2 l3). A draw that breaks the model's rule (a URDF tool whose principal
+//! moments violate the triangle inequality) is drawn again, all its parameters; the planar arms
+//! have no such rule and never redraw. Draws happen before any parallel work, so results do not
+//! depend on the number of threads.
 //!
 //! # The task
 //!
@@ -25,7 +29,8 @@ use rand::{RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use super::PARAMETER_RANGE;
+/// Draws of one tool before [`MixedSampler`] takes the sampling box's centre instead.
+const MAX_REDRAWS: usize = 10_000;
 use crate::closed_loop::{EpisodeOptions, Metrics, Plant};
 use crate::model::mixed::{AnyTool, ModelKind};
 use crate::model::{
@@ -74,15 +79,25 @@ impl MixedSampler {
         (self.rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
     }
 
-    /// A tool of `model`, its parameters drawn in the model's order.
+    /// A tool of `model`: each parameter lo + (hi − lo)·u in the model's order, from its
+    /// sampling box ([`ModelKind::sample_box`]); a draw that breaks the model's rule (a URDF
+    /// tool's triangle inequality) is drawn again, whole.
     fn draw(&mut self, model: ModelKind) -> AnyTool {
-        let (lo, hi) = PARAMETER_RANGE;
-        let p: Vec<f64> = model
-            .parameter_names()
-            .iter()
-            .map(|_| lo + (hi - lo) * self.uniform())
-            .collect();
-        AnyTool::new(model, &p).expect("parameters drawn from [0.1, 0.6) are valid")
+        let sample = model.sample_box();
+        for _ in 0..MAX_REDRAWS {
+            let p: Vec<f64> = sample
+                .iter()
+                .map(|&(lo, hi)| lo + (hi - lo) * self.uniform())
+                .collect();
+            if let Ok(tool) = AnyTool::new(model, &p) {
+                return tool;
+            }
+        }
+        // The box's centre satisfies the rule (derive checks it), so this is never reached in
+        // practice; it keeps the stream finite whatever a description's box is.
+        let centre: Vec<f64> = sample.iter().map(|&(lo, hi)| 0.5 * (lo + hi)).collect();
+        AnyTool::new(model, &centre)
+            .expect("derive checks that the sampling box's centre is a valid tool")
     }
 
     /// The next tool: its model (if the set has more than one), then its parameters.

@@ -1,0 +1,85 @@
+"""A URDF arm with a tool at its flange as Pinocchio sees it, built from the model description
+(derive/models/<name>.toml) and the URDF file alone, without toolconf: what a Python user would
+write, and the independent reference of python/tests/test_dynamics.py.
+
+The URDF is cut at the description's flange (every link below it dropped, as toolconf's reader
+drops the hand) and the tool added as a fixed link: mass, centre of mass in the flange frame,
+principal moments along the flange axes. Rotations within 1e-9 of a multiple of pi/2 are given
+as that multiple, as toolconf's reader takes them (UR5 prints pi/2 as 1.57079632679).
+
+Needs numpy and pin (Pinocchio) only.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+ROOT = Path(__file__).resolve().parents[2]
+MODELS = ROOT / "derive" / "models"
+
+
+@dataclass(frozen=True)
+class Description:
+    """What a URDF model description says: the URDF, its flange, the equilibrium pose and the
+    joint impedance (K, D per joint)."""
+    urdf: Path
+    flange: str
+    q_e: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+
+
+def description(name: str) -> Description:
+    path = MODELS / f"{name}.toml"
+    with path.open("rb") as f:
+        d = tomllib.load(f)
+    env = {"__builtins__": {}, "pi": math.pi}
+    q_e = np.array([float(eval(str(v), env)) for v in d["equilibrium"]["q"]])  # noqa: S307 - our description
+    return Description((path.parent / d["urdf"]["file"]).resolve(), d["urdf"]["flange"], q_e,
+                       np.array(d["impedance"]["stiffness"], dtype=float),
+                       np.array(d["impedance"]["damping"], dtype=float))
+
+
+def quarter_turn(angle: float) -> float:
+    k = round(angle / (math.pi / 2))
+    return k * (math.pi / 2) if abs(angle - k * (math.pi / 2)) < 1e-9 else angle
+
+
+def model_with_tool(name: str, tool) -> tuple[pin.Model, pin.Data]:
+    """Pinocchio's model of robot `name` with `tool` = (mass, com_x, com_y, com_z, ixx, iyy, izz)
+    fixed at its flange."""
+    d = description(name)
+    root = ET.parse(d.urdf).getroot()
+    children: dict[str, list[str]] = {}
+    for j in root.findall("joint"):
+        children.setdefault(j.find("parent").get("link"), []).append(j.find("child").get("link"))
+    below, stack = set(), list(children.get(d.flange, []))
+    while stack:
+        link = stack.pop()
+        below.add(link)
+        stack += children.get(link, [])
+    for e in list(root.findall("link")):
+        if e.get("name") in below:
+            root.remove(e)
+    for e in list(root.findall("joint")):
+        if e.find("child").get("link") in below:
+            root.remove(e)
+    for origin in root.iter("origin"):
+        if origin.get("rpy"):
+            origin.set("rpy", " ".join(repr(quarter_turn(float(v))) for v in origin.get("rpy").split()))
+    m, cx, cy, cz, ixx, iyy, izz = (float(v) for v in tool)
+    root.append(ET.fromstring(
+        f'<link name="tool"><inertial><origin xyz="{cx!r} {cy!r} {cz!r}" rpy="0 0 0"/><mass value="{m!r}"/>'
+        f'<inertia ixx="{ixx!r}" ixy="0" ixz="0" iyy="{iyy!r}" iyz="0" izz="{izz!r}"/></inertial></link>'))
+    root.append(ET.fromstring(
+        f'<joint name="tool_joint" type="fixed"><parent link="{d.flange}"/><child link="tool"/>'
+        '<origin xyz="0 0 0" rpy="0 0 0"/></joint>'))
+    model = pin.buildModelFromXML(ET.tostring(root, encoding="unicode"))
+    return model, model.createData()

@@ -1,0 +1,260 @@
+//! `toolconf.dynamics`: a robot's own rigid-body dynamics Ẋ = [q̇; q̈], for one state or a batch.
+
+use std::marker::PhantomData;
+
+use nalgebra::SVector;
+use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use rayon::prelude::*;
+use toolconf::generated;
+use toolconf::model::mixed::ModelKind;
+use toolconf::model::{ArmModel, ToolN};
+
+use crate::errors::{detached, Failure};
+use crate::models::model_kind;
+
+/// Below this many states a batch runs on one thread.
+const MIN_STATES_PER_THREAD: usize = 512;
+
+/// One argument's values: one row shared by every state, or one row per state.
+struct Rows<'a> {
+    data: &'a [f64],
+    width: usize,
+    shared: bool,
+}
+
+impl Rows<'_> {
+    fn row(&self, i: usize) -> &[f64] {
+        let i = if self.shared { 0 } else { i };
+        &self.data[i * self.width..(i + 1) * self.width]
+    }
+}
+
+/// The rigid-body dynamics of one model, its sizes fixed.
+trait RigidBody: Sync {
+    /// Ẋ of `k` rows into `out` (k × NX, row major).
+    fn evaluate(
+        &self,
+        k: usize,
+        params: &Rows,
+        x: &Rows,
+        u: &Rows,
+        out: &mut [f64],
+    ) -> Result<(), Failure>;
+}
+
+struct Of<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(PhantomData<M>);
+
+impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> RigidBody
+    for Of<M, N, NX, NP, NZ>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    fn evaluate(
+        &self,
+        k: usize,
+        params: &Rows,
+        x: &Rows,
+        u: &Rows,
+        out: &mut [f64],
+    ) -> Result<(), Failure> {
+        let tools = (0..if params.shared { 1 } else { k })
+            .map(|i| {
+                ToolN::<M, N, NX, NP, NZ>::new(params.row(i).try_into().expect("NP values"))
+                    .map_err(|e| row_error(k, params.shared, i, e))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        for (i, v) in x.data.iter().chain(u.data).enumerate() {
+            if !v.is_finite() {
+                let what = if i < x.data.len() { "state" } else { "control" };
+                return Err(Failure::Input(format!("{what} entry {v} is not finite")));
+            }
+        }
+        out.par_chunks_exact_mut(NX)
+            .with_min_len(MIN_STATES_PER_THREAD)
+            .enumerate()
+            .try_for_each(|(i, row)| {
+                let tool = &tools[if params.shared { 0 } else { i }];
+                let xi = SVector::<f64, NX>::from_column_slice(x.row(i));
+                let ui = SVector::<f64, N>::from_column_slice(u.row(i));
+                let f = tool.rigid_body_dynamics(&xi, &ui);
+                if !f.iter().all(|v| v.is_finite()) {
+                    return Err(Failure::Input(format!(
+                        "state {i}: the dynamics are not finite there (|X| or |U| too large)"
+                    )));
+                }
+                row.copy_from_slice(f.as_slice());
+                Ok(())
+            })
+    }
+}
+
+fn row_error(k: usize, shared: bool, i: usize, e: toolconf::model::Error) -> Failure {
+    Failure::Input(if shared || k == 1 {
+        e.to_string()
+    } else {
+        format!("tool {i}: {e}")
+    })
+}
+
+/// One [`RigidBody`] per model of the generated registry.
+macro_rules! rigid_bodies {
+    ($(($marker:ident, $module:ident, $tool:ident, $name:literal, $title:literal)),* $(,)?) => {
+        fn of(kind: ModelKind) -> &'static dyn RigidBody {
+            match kind {
+                $(ModelKind::$marker => &Of::<
+                    toolconf::model::$marker,
+                    { generated::$module::DOF },
+                    { generated::$module::STATE_DIM },
+                    { generated::$module::PARAMETER_COUNT },
+                    { generated::$module::STATE_DIM + generated::$module::DOF },
+                >(PhantomData),)*
+            }
+        }
+    };
+}
+
+toolconf::for_each_model!(rigid_bodies);
+
+/// An argument of shape (width,) or (k, width): its rows and k (None for 1-D).
+fn rows<'a>(
+    name: &str,
+    shape: &[usize],
+    data: &'a [f64],
+    width: usize,
+    kind: ModelKind,
+    what: &str,
+) -> Result<(Rows<'a>, Option<usize>), Failure> {
+    match shape {
+        [w] if *w == width => Ok((
+            Rows {
+                data,
+                width,
+                shared: true,
+            },
+            None,
+        )),
+        [k, w] if *w == width => Ok((
+            Rows {
+                data,
+                width,
+                shared: false,
+            },
+            Some(*k),
+        )),
+        _ => Err(Failure::Input(format!(
+            "{name} of shape {shape:?}: model {kind} takes {width} {what}, as a 1-D array or a \
+             2-D array with one row per state"
+        ))),
+    }
+}
+
+/// The robot's own rigid-body dynamics, Ẋ = [q̇; q̈] with M(q) q̈ + C(q, q̇) q̇ + g(q) = U.
+///
+/// U is the joint torques themselves: for the URDF arms (``panda``, ``ur5``) this is the arm with
+/// the tool fixed at its flange, without the joint impedance their controllers' plant adds (what
+/// Pinocchio's ``aba`` computes); for the other models, whose plant is their rigid-body dynamics,
+/// it is that plant.
+///
+/// Args:
+///     model: a generated model's name (``toolconf.models()``).
+///     params: the tool's parameters in the model's order, a 1-D array (one tool for every
+///         state) or a 2-D array with one tool per state; each tool must obey the model's rule
+///         (``toolconf.models()[model]["domains"]``).
+///     state: X = [q; q̇], a 1-D array of the model's state size, or a 2-D array of one state
+///         per row.
+///     control: U (N m per joint), 1-D (the same for every state) or 2-D (one row per state).
+///
+/// Returns:
+///     numpy.ndarray: Ẋ, of shape (state size,) when every argument is 1-D, else (k, state size)
+///     for k rows.
+///
+/// Raises:
+///     ValueError: an unknown model, shapes that do not fit it or each other, a tool outside
+///         the model's rule (naming the parameter or constraint, and the row), a non-finite state
+///         or control, or a state where the dynamics are not finite.
+///
+/// A batch runs on rayon's threads without holding the GIL.
+#[pyfunction]
+pub fn dynamics<'py>(
+    py: Python<'py>,
+    model: &str,
+    params: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
+    state: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
+    control: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let kind = model_kind(model).map_err(|f| f.into_pyerr(py))?;
+    let (n, np) = (kind.dof(), kind.parameter_names().len());
+    let nx = 2 * n;
+    let flat = |a: &PyArrayLikeDyn<'py, f64, AllowTypeChange>| -> Vec<f64> {
+        a.as_array().iter().copied().collect()
+    };
+    let (p_data, x_data, u_data) = (flat(&params), flat(&state), flat(&control));
+    let shapes = (
+        params.shape().to_vec(),
+        state.shape().to_vec(),
+        control.shape().to_vec(),
+    );
+    let out =
+        detached(py, || {
+            let (p, kp) = rows("params", &shapes.0, &p_data, np, kind, "tool parameters")?;
+            let (x, kx) = rows(
+                "state",
+                &shapes.1,
+                &x_data,
+                nx,
+                kind,
+                "state entries [q; q_dot]",
+            )?;
+            let (u, ku) = rows("control", &shapes.2, &u_data, n, kind, "torques")?;
+            let counts: Vec<usize> = [kp, kx, ku].into_iter().flatten().collect();
+            if counts.windows(2).any(|w| w[0] != w[1]) {
+                return Err(Failure::Input(format!(
+                "params, state and control have {} rows: the 2-D ones must have the same number",
+                counts.iter().map(usize::to_string).collect::<Vec<_>>().join(", ")
+            )));
+            }
+            let k = counts.first().copied();
+            let mut out = vec![0.0; k.unwrap_or(1) * nx];
+            of(kind).evaluate(k.unwrap_or(1), &p, &x, &u, &mut out)?;
+            Ok((out, k))
+        })?;
+    let (data, k) = out;
+    let array = PyArray1::from_vec(py, data);
+    match k {
+        None => Ok(array.into_any()),
+        Some(k) => Ok(array.reshape([k, nx])?.into_any()),
+    }
+}
+
+/// ``models()[m]["equilibrium"]``: ``q``, ``q_dot`` (X^e = [q; q_dot]) and ``u`` (U^e), lists.
+pub fn equilibrium(py: Python<'_>, kind: ModelKind) -> PyResult<Bound<'_, PyDict>> {
+    let (x, n) = (kind.equilibrium_state(), kind.dof());
+    let out = PyDict::new(py);
+    out.set_item("q", x[..n].to_vec())?;
+    out.set_item("q_dot", x[n..].to_vec())?;
+    out.set_item("u", kind.equilibrium_control().to_vec())?;
+    Ok(out)
+}
+
+/// ``models()[m]["domains"]``: ``parameters`` (name → its domain in words), ``constraints``
+/// (texts) and ``sample`` (name → [lo, hi], the box random tools are drawn from).
+pub fn domains(py: Python<'_>, kind: ModelKind) -> PyResult<Bound<'_, PyDict>> {
+    let (parameters, sample) = (PyDict::new(py), PyDict::new(py));
+    for ((name, domain), (lo, hi)) in kind
+        .parameter_names()
+        .iter()
+        .zip(kind.parameter_domains())
+        .zip(kind.sample_box())
+    {
+        parameters.set_item(name, domain.rule)?;
+        sample.set_item(name, vec![*lo, *hi])?;
+    }
+    let out = PyDict::new(py);
+    out.set_item("parameters", parameters)?;
+    let constraints: Vec<&str> = kind.parameter_constraints().iter().map(|c| c.1).collect();
+    out.set_item("constraints", constraints)?;
+    out.set_item("sample", sample)?;
+    Ok(out)
+}
