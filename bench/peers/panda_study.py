@@ -5,7 +5,7 @@ error? The sweep behind docs/urdf.md, "Confidence and task error on the Panda".
 For random physical tools (solid boxes: 0.05-3 kg, centre of mass within 5 cm of the flange axis
 and up to 25 cm out, sides 1-30 cm; seeded) it takes ln|Pi^U| in closed form and simulates each
 tool's episode with the closed loop of urdf_loop.py (Pinocchio's aba, toolconf's controller,
-checked against `toolconf simulate` to 1e-13 at tight tolerances), integrated by SciPy's Radau
+its ln|Pi^U| equal to `toolconf rank`'s and its task error within 3.4e-7 of it on the wrist turn), integrated by SciPy's Radau
 with Pinocchio's ABA derivatives at rtol 1e-8, atol 1e-10: far below the tool-to-tool spread of
 the task error, which is ~1e-5 relative with the paper's precisions. Per setting it reports the
 spread of ln|Pi^U| (standard deviation, max - min), Spearman's rho between ln|Pi^U| and the task
