@@ -47,7 +47,10 @@ fn rank_task(kind: TaskKind) -> ModelTasks {
 fn closed_loop_rhs(c: &mut Criterion) {
     let tool = panda(&tools(1, 1)[0]);
     let mut z = SVector::<f64, 21>::zeros();
-    for (i, v) in toolconf::generated::panda::EQUILIBRIUM_STATE.iter().enumerate() {
+    for (i, v) in toolconf::generated::panda::EQUILIBRIUM_STATE
+        .iter()
+        .enumerate()
+    {
         z[i] = v + 0.01 * (i as f64 + 1.0);
     }
     let mut group = c.benchmark_group("panda_closed_loop_rhs");

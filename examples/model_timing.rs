@@ -40,7 +40,13 @@ fn parse_args() -> Result<Args, String> {
                 repeat = value()?
                     .parse()
                     .map_err(|e| format!("--repeat: {e}"))
-                    .and_then(|r: usize| if r > 0 { Ok(r) } else { Err("--repeat must be ≥ 1".into()) })?
+                    .and_then(|r: usize| {
+                        if r > 0 {
+                            Ok(r)
+                        } else {
+                            Err("--repeat must be ≥ 1".into())
+                        }
+                    })?
             }
             "--method" => method = Some(value()?.parse().map_err(|e| format!("--method {e}"))?),
             _ => return Err(format!("unknown argument {flag}")),
@@ -68,7 +74,9 @@ fn run() -> Result<Value, String> {
     let args = parse_args()?;
     let mut spec = match args.task.parse() {
         Ok(kind) => TaskSpec::builtin(kind),
-        Err(_) => TaskSpec::from_file(std::path::Path::new(&args.task)).map_err(|e| e.to_string())?,
+        Err(_) => {
+            TaskSpec::from_file(std::path::Path::new(&args.task)).map_err(|e| e.to_string())?
+        }
     };
     spec.episode.method = args.method.or(Some(Method::Fast));
     let tasks = ModelTasks::new(&spec);
@@ -113,7 +121,10 @@ fn run() -> Result<Value, String> {
 fn main() -> ExitCode {
     match run() {
         Ok(v) => {
-            println!("{}", serde_json::to_string_pretty(&v).expect("finite numbers"));
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&v).expect("finite numbers")
+            );
             ExitCode::SUCCESS
         }
         Err(e) => {
