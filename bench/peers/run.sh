@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Peer comparison: toolconf vs SciPy solve_ivp(RK45) vs CasADi cvodes on the same 100 tools.
+# Peer comparison: toolconf vs SciPy solve_ivp(RK45) vs CasADi cvodes on the same 100 tools;
+# with --urdf, the Panda against SciPy solve_ivp with Pinocchio's aba (bench/peers/urdf_peers.py).
 # Creates bench/peers/.venv from requirements.txt on first use, builds toolconf (release) and the
 # peer_timing example, and writes docs/performance.md (extra arguments go to compare.py).
 set -euo pipefail
@@ -12,5 +13,11 @@ if [[ ! -x "$venv/bin/python" || "$here/requirements.txt" -nt "$venv/bin/python"
   touch "$venv/bin/python"
 fi
 cd "$root"
+if [[ "${1:-}" == "--urdf" ]]; then
+  # The URDF arms: SciPy solve_ivp with Pinocchio's aba in the right-hand side (urdf_peers.py).
+  shift
+  cargo build --release --quiet --example model_timing
+  exec "$venv/bin/python" "$here/urdf_peers.py" "$@"
+fi
 cargo build --release --quiet --bin toolconf --example peer_timing
 exec "$venv/bin/python" "$here/compare.py" "$@"

@@ -3,7 +3,7 @@
 use std::marker::PhantomData;
 
 use nalgebra::SVector;
-use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
@@ -180,22 +180,22 @@ fn rows<'a>(
 pub fn dynamics<'py>(
     py: Python<'py>,
     model: &str,
-    params: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
-    state: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
-    control: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
+    params: &Bound<'py, PyAny>,
+    state: &Bound<'py, PyAny>,
+    control: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let kind = model_kind(model).map_err(|f| f.into_pyerr(py))?;
     let (n, np) = (kind.dof(), kind.parameter_names().len());
     let nx = 2 * n;
-    let flat = |a: &PyArrayLikeDyn<'py, f64, AllowTypeChange>| -> Vec<f64> {
-        a.as_array().iter().copied().collect()
+    // Any memory layout (an unaligned view, a Dask worker's buffer): read through numpy.require.
+    let read = |name: &str, a: &Bound<'py, PyAny>| {
+        crate::arrays::values::<f64>(a, "float64")
+            .map_err(|e| Failure::Input(format!("{name}: {e}")).into_pyerr(py))
     };
-    let (p_data, x_data, u_data) = (flat(&params), flat(&state), flat(&control));
-    let shapes = (
-        params.shape().to_vec(),
-        state.shape().to_vec(),
-        control.shape().to_vec(),
-    );
+    let (p_shape, p_data) = read("params", params)?;
+    let (x_shape, x_data) = read("state", state)?;
+    let (u_shape, u_data) = read("control", control)?;
+    let shapes = (p_shape, x_shape, u_shape);
     let out =
         detached(py, || {
             let (p, kp) = rows("params", &shapes.0, &p_data, np, kind, "tool parameters")?;

@@ -198,3 +198,8 @@ def test_arrays_in_any_memory_layout_give_the_same_numbers():
     episode = toolconf.simulate("arm2", _unaligned(PAPER_ARM), "velocity", t_end=1.0)
     assert episode["task_error"] == toolconf.simulate("arm2", PAPER_ARM, "velocity",
                                                       t_end=1.0)["task_error"]
+    tool, state = [0.5, 0.0, 0.0, 0.1, 1e-3, 1e-3, 1e-3], np.linspace(-0.5, 0.5, 14)
+    torque = np.linspace(-1.0, 1.0, 7)
+    plain = toolconf.dynamics("panda", tool, state, torque)
+    layouts = toolconf.dynamics("panda", _unaligned(tool), _unaligned(state), torque[::-1][::-1])
+    assert np.array_equal(layouts, plain)

@@ -115,7 +115,7 @@ def test_planar_models_dynamics_are_their_plant():
         (("panda", [0.5, 0, 0, 0.1, 5e-3, 1e-3, 1e-3], np.zeros(14), np.zeros(7)),
          "invalid tool: tool_ixx <= tool_iyy + tool_izz"),
         (("panda", [-0.5, 0, 0, 0.1, 1e-3, 1e-3, 1e-3], np.zeros(14), np.zeros(7)),
-         "invalid arm parameter tool_mass = -0.5: must be a finite number > 0"),
+         "invalid arm parameter tool_mass = -0.5: must be a number in [1e-6, 1e6]"),
         (("panda", [0.5, 0, 0, 0.1, 1e-3, 1e-3, 1e-3], np.full(14, np.nan), np.zeros(7)), "state entry NaN"),
         (("nope", [0.5], np.zeros(14), np.zeros(7)), "unknown model 'nope'"),
     ],

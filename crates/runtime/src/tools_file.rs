@@ -278,8 +278,8 @@ fn check_keys<'a>(keys: impl Iterator<Item = &'a str>, noun: &str) -> Result<(),
 }
 
 /// One row's tool from its cells: the model, then each of its parameters, each in its domain
-/// (a finite number > 0 for the planar arms; a URDF tool's centre of mass may be 0 or negative)
-/// and the tool valid by its model's rule; a parameter of another model must be empty.
+/// (in [1e-6, 1e6] for a "> 0" parameter, [`crate::validate::tool_parameter`]; a URDF tool's
+/// centre of mass may be 0 or negative) and the tool valid by its model's rule; a parameter of another model must be empty.
 ///
 /// `present`: the parameter keys the row may give at all (its file's columns, its object's
 /// keys), in [`parameter_keys`] order, so that a file of one model does not look up every other

@@ -1,0 +1,118 @@
+//! The Panda's closed loop (issue 23): one closed-loop right-hand side (plant and controller, what
+//! the integrators call), one episode per task at the paper's tolerances over 5 s on a population
+//! of tools, and 1000 Panda tools ranked (`rank`'s simulation stage) on 2 threads, all with
+//! `rank`'s default method `fast`.
+//!
+//! `cargo bench --bench urdf_episode`; goals (issue 23): an episode ≤ 2 ms, ≥ 100× SciPy's
+//! `solve_ivp` with Pinocchio's `aba` on the same loop (bench/peers/urdf_peers.py, which times the
+//! peers and toolconf on one population side by side, mean and percentiles).
+
+use std::hint::black_box;
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use nalgebra::SVector;
+use toolconf::integrate::Method;
+use toolconf::model::mixed::{AnyTool, ModelKind};
+use toolconf::model::{ClosedLoopN, Panda, PandaTool};
+use toolconf::rank::{simulate_all, Candidate, ModelTasks};
+use toolconf::select::mixed::MixedSampler;
+use toolconf::task_file::TaskSpec;
+use toolconf::tools_file::ToolRow;
+use toolconf::TaskKind;
+
+/// `n` Panda tools from the mixed sampler's box (`generated::validity::panda`), seeded.
+fn tools(n: usize, seed: u64) -> Vec<AnyTool> {
+    MixedSampler::new(&[ModelKind::Panda], seed)
+        .unwrap()
+        .tools(n)
+}
+
+fn panda(tool: &AnyTool) -> PandaTool {
+    match tool {
+        AnyTool::Panda(t) => *t,
+        _ => unreachable!("the sampler draws Panda tools only"),
+    }
+}
+
+/// The built-in task `kind` with `toolconf rank`'s default integration method, `fast` (the
+/// library's default, `auto`, runs ode45 on tasks 1 and 2, which the impedance makes stiff:
+/// ~28 000 right-hand sides per Panda episode instead of ~400).
+fn rank_task(kind: TaskKind) -> ModelTasks {
+    let mut spec = TaskSpec::builtin(kind);
+    spec.episode.method = Some(Method::Fast);
+    ModelTasks::new(&spec)
+}
+
+/// Ż of the closed loop at a state near the equilibrium, per task.
+fn closed_loop_rhs(c: &mut Criterion) {
+    let tool = panda(&tools(1, 1)[0]);
+    let mut z = SVector::<f64, 21>::zeros();
+    for (i, v) in toolconf::generated::panda::EQUILIBRIUM_STATE
+        .iter()
+        .enumerate()
+    {
+        z[i] = v + 0.01 * (i as f64 + 1.0);
+    }
+    let mut group = c.benchmark_group("panda_closed_loop_rhs");
+    for kind in TaskKind::ALL {
+        let task = <Panda as toolconf::model::ArmModel<7, 14, 7, 21>>::paper_task(kind);
+        let system = ClosedLoopN::<Panda, 7, 14, 7, 21>::new(&tool, &task, 1.0, 0.0).unwrap();
+        group.bench_function(kind.name(), |b| b.iter(|| system.rhs(black_box(&z))));
+    }
+    group.finish();
+}
+
+/// One episode per iteration, cycling through 50 tools: the mean over that population.
+fn episode(c: &mut Criterion) {
+    let population = tools(50, 2);
+    let mut group = c.benchmark_group("panda_episode");
+    group.sample_size(20);
+    for kind in TaskKind::ALL {
+        let tasks = rank_task(kind);
+        let mut i = 0;
+        group.bench_function(kind.name(), |b| {
+            b.iter(|| {
+                i = (i + 1) % population.len();
+                tasks.simulate(black_box(&population[i])).unwrap()
+            })
+        });
+    }
+    group.finish();
+}
+
+/// `rank`'s simulation stage on 1000 Panda tools, on a pool of 2 threads.
+fn rank_1000(c: &mut Criterion) {
+    let candidates: Vec<Candidate> = tools(1000, 3)
+        .into_iter()
+        .enumerate()
+        .map(|(i, tool)| Candidate {
+            row: ToolRow {
+                row: i + 1,
+                name: None,
+                tool,
+            },
+            logdet: Ok(0.0),
+        })
+        .collect();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    let mut group = c.benchmark_group("panda_rank_1000");
+    group.sample_size(10);
+    group.throughput(Throughput::Elements(1000));
+    for kind in [TaskKind::Position, TaskKind::Velocity] {
+        let tasks = rank_task(kind);
+        group.bench_function(kind.name(), |b| {
+            b.iter(|| {
+                pool.install(|| {
+                    simulate_all(candidates.clone(), &tasks, |_| Ok::<(), ()>(())).unwrap()
+                })
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, closed_loop_rhs, episode, rank_1000);
+criterion_main!(benches);
