@@ -27,7 +27,7 @@ pub enum Error {
     },
     /// A tool whose parameters break a constraint across them (c · p ≤ 0, e.g. the triangle
     /// inequality of a rigid body's principal moments), by `excess` = c · p > 0.
-    #[error("invalid tool: {rule} does not hold (off by {excess:e})")]
+    #[error("invalid tool: {rule} does not hold (off by {excess:.2e})")]
     ToolConstraint { rule: &'static str, excess: f64 },
     /// A goal outside [`JOINT_VALUE`].
     #[error("invalid goal {name} = {}: must be a number in {}", Short(*value), JOINT_VALUE)]
