@@ -64,25 +64,21 @@ where
     /// [`Error::ToolConstraint`]. No allocation: tools are checked in bulk.
     pub fn new(params: [f64; NP]) -> Result<Self, Error> {
         let rule = &M::TOOL_RULE;
-        let positive = rule.domains.iter().map(|d| d.is_positive());
-        let in_range = |value: f64| crate::validate::TOOL_PARAMETER.contains(value);
-        for ((name, value), positive) in M::PARAMETER_NAMES.into_iter().zip(params).zip(positive) {
-            if positive && !in_range(value) {
+        // A "> 0" domain within TOOL_PARAMETER first: that also refuses NaN, ±∞ and values ≤ 0,
+        // so a domain the rule finds broken below is always another kind.
+        let named = M::PARAMETER_NAMES.into_iter().zip(params).zip(&rule.domains);
+        for ((name, value), domain) in named {
+            if domain.is_positive() && !crate::validate::TOOL_PARAMETER.contains(value) {
                 return Err(Error::InvalidParameter { name, value });
             }
         }
         match rule.check(&params) {
             Ok(()) => {}
             Err(Violation::Domain { index, value }) => {
-                let (name, domain) = (M::PARAMETER_NAMES[index], &rule.domains[index]);
-                return Err(if domain.is_positive() {
-                    Error::InvalidParameter { name, value }
-                } else {
-                    Error::ParameterOutOfDomain {
-                        name,
-                        value,
-                        domain: domain.rule,
-                    }
+                return Err(Error::ParameterOutOfDomain {
+                    name: M::PARAMETER_NAMES[index],
+                    value,
+                    domain: rule.domains[index].rule,
                 });
             }
             Err(Violation::Constraint { index, excess }) => {
