@@ -21,3 +21,10 @@ pub fn values<T: Element + Copy>(
         .expect("numpy.require gives an aligned, C-contiguous array");
     Ok((shape, slice.to_vec()))
 }
+
+/// A float argument's shape and values, [`values`] as float64; a value NumPy cannot read as
+/// floats is a `ValueError` naming the argument (`params: could not convert …`).
+pub fn float_argument(name: &str, value: &Bound<'_, PyAny>) -> PyResult<(Vec<usize>, Vec<f64>)> {
+    values::<f64>(value, "float64")
+        .map_err(|e| crate::errors::Failure::Input(format!("{name}: {e}")).into_pyerr(value.py()))
+}

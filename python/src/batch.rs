@@ -111,8 +111,7 @@ pub fn simulate_batch<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = model_kind(model).map_err(|f| f.into_pyerr(py))?;
     let np = kind.parameter_names().len();
-    let (shape, values) = crate::arrays::values::<f64>(params, "float64")
-        .map_err(|e| Failure::Input(format!("params: {e}")).into_pyerr(py))?;
+    let (shape, values) = crate::arrays::float_argument("params", params)?;
     if !matches!(shape.as_slice(), [n] | [_, n] if *n == np) {
         return Err(Failure::Input(format!(
             "params of shape {shape:?}: model {kind} takes {np} parameters ({}), as a 2-D array \

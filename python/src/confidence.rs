@@ -212,9 +212,7 @@ pub fn confidence<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = model_kind(model).map_err(|f| f.into_pyerr(py))?;
     let spec = task_spec(task, None)?;
-    // Any memory layout (an unaligned view, a Dask worker's buffer): read through numpy.require.
-    let (shape, values) = crate::arrays::values::<f64>(params, "float64")
-        .map_err(|e| Failure::Input(format!("params: {e}")).into_pyerr(py))?;
+    let (shape, values) = crate::arrays::float_argument("params", params)?;
     let np = kind.parameter_names().len();
     let batch = match shape.as_slice() {
         [n] if *n == np => false,

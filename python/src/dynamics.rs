@@ -187,11 +187,7 @@ pub fn dynamics<'py>(
     let kind = model_kind(model).map_err(|f| f.into_pyerr(py))?;
     let (n, np) = (kind.dof(), kind.parameter_names().len());
     let nx = 2 * n;
-    // Any memory layout (an unaligned view, a Dask worker's buffer): read through numpy.require.
-    let read = |name: &str, a: &Bound<'py, PyAny>| {
-        crate::arrays::values::<f64>(a, "float64")
-            .map_err(|e| Failure::Input(format!("{name}: {e}")).into_pyerr(py))
-    };
+    let read = crate::arrays::float_argument;
     let (p_shape, p_data) = read("params", params)?;
     let (x_shape, x_data) = read("state", state)?;
     let (u_shape, u_data) = read("control", control)?;

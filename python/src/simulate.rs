@@ -96,9 +96,7 @@ pub fn simulate<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = model_kind(model).map_err(|f| f.into_pyerr(py))?;
     let np = kind.parameter_names().len();
-    // Any memory layout (an unaligned view, a Dask worker's buffer): read through numpy.require.
-    let (shape, values) = crate::arrays::values::<f64>(params, "float64")
-        .map_err(|e| Failure::Input(format!("params: {e}")).into_pyerr(py))?;
+    let (shape, values) = crate::arrays::float_argument("params", params)?;
     if shape != [np] {
         return Err(Failure::Input(format!(
             "params of shape {shape:?}: model {kind} takes one tool's {np} parameters ({}) as a 1-D \
