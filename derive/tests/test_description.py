@@ -7,6 +7,7 @@ tests/fixtures/pendulum.toml (or derive/tasks.toml) and runs derive.py on it.
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 import tempfile
@@ -14,6 +15,7 @@ import unittest
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "derive"))
 DERIVE = ROOT / "derive" / "derive.py"
 PENDULUM = (ROOT / "tests" / "fixtures" / "pendulum.toml").read_text()
 TASKS = (ROOT / "derive" / "tasks.toml").read_text()
@@ -168,6 +170,39 @@ class BrokenDescription(unittest.TestCase):
         for taken in ("tasks", "lib", "trig", "powi"):
             self.model_stops(edit(PENDULUM, f'name = "{name}"', f'name = "{taken}"'), "model.name",
                              "taken by the generated registry")
+
+    # Every name a description gives becomes a Rust name in the generated crate.
+    def test_rust_keywords_are_refused_as_names(self):
+        self.model_stops(edit(PENDULUM, 'name = "pendulum"', 'name = "fn"'), "model.name", "'fn' is a Rust keyword")
+        self.model_stops(edit(edit(PENDULUM, 'name = "l"', 'name = "type"'), "m*l**2", "m*type**2"),
+                         "parameters[1].name", "'type' is a Rust keyword")
+        self.tasks_stop(edit(TASKS, 'name = "velocity"', 'name = "loop"'), "task[1].name", "'loop' is a Rust keyword")
+
+    def test_names_must_be_ascii(self):
+        # Python's isidentifier() takes them, Rust cannot name a module file after them.
+        self.model_stops(edit(PENDULUM, 'name = "pendulum"', 'name = "péndulo"'), "model.name", "lower-case ASCII")
+        self.model_stops(edit(PENDULUM, 'name = "m"', 'name = "_m"'), "parameters[0].name", "a letter, then")
+
+    def test_a_parameter_named_after_a_tools_file_column(self):
+        self.model_stops(edit(edit(PENDULUM, 'name = "l"', 'name = "model"'), "m*l**2", "m*model**2"),
+                         "parameters[1].name", "a column of every tools file")
+
+    def test_a_constant_named_after_a_generated_constant(self):
+        self.model_stops(edit(edit(PENDULUM, "\ng = {", "\ndof = {"), "m*g*l", "m*dof*l"),
+                         "constants.dof", "the Rust constant DOF")
+
+    def test_a_name_the_generated_code_uses_itself(self):
+        # It would shadow the generated value: `let (sin_theta, cos_theta) = sin_cos(theta)` after
+        # `let cos_theta = u[0]` silently computes with the cosine instead of the torque.
+        self.model_stops(edit(edit(PENDULUM, 'name = "torque"', 'name = "cos_theta"'), "(torque -", "(cos_theta -"),
+                         "coordinates.u[0].name", "also a name the generated dynamics_with uses")
+        self.model_stops(edit(PENDULUM, 'name = "theta_dot", latex', 'name = "k0", latex'),
+                         "coordinates.q_dot[0].name", "also a name the generated")
+
+    def test_the_generated_constants_are_the_templates(self):
+        from toolconf_derive.ir import MODULE_CONSTANTS
+        template = (ROOT / "templates" / "model.rs.tera").read_text()
+        self.assertEqual(sorted(MODULE_CONSTANTS), sorted(re.findall(r"^pub const ([A-Z_]+):", template, re.M)))
 
 
 if __name__ == "__main__":

@@ -5,6 +5,7 @@ line and status 2, with nothing left behind (part of make test)."""
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -90,10 +91,22 @@ class MakeCrate(unittest.TestCase):
         self.assert_refused(self.run_make_crate(self.base / "out"), "a.toml", "b.toml", "pendulum")
         (self.models / "b.toml").unlink()
         self.assert_refused(self.run_make_crate(self.base / "out", "--name", "9lives"), "NAME", "9lives")
+        # Valid for Cargo, but the crate's own test could not name the crate it tests.
+        self.assert_refused(self.run_make_crate(self.base / "crate"), "OUT=", "'crate' is a Rust keyword")
+        self.assert_refused(self.run_make_crate(self.base / "out", "--name", "nalgebra"), "NAME", "a crate the generated")
         self.assert_refused(self.run_make_crate(self.base / "out", "--tasks", str(self.base / "none.toml")),
                             "TASKS", "none.toml")
         foreign = self.base / "descriptions"  # a folder with other files in it
         self.assert_refused(self.run_make_crate(foreign), "other files")
+
+    def test_the_taken_crate_names_are_the_templates_dependencies(self):
+        sys.path.insert(0, str(ROOT / "derive"))
+        from make_crate import TAKEN_CRATE_NAMES
+        manifest = (ROOT / "templates" / "registry" / "Cargo.toml.tera").read_text()
+        sections = re.findall(r"^\[(?:dev-)?dependencies\]\n((?:(?!\[).*\n)*)", manifest, re.M)
+        dependencies = {m for body in sections for m in re.findall(r"^([a-z][a-z0-9_-]*) =", body, re.M)}
+        self.assertTrue(dependencies)
+        self.assertLessEqual(dependencies, set(TAKEN_CRATE_NAMES))
 
     def test_make_without_models_or_out_is_a_usage_line(self):
         r = subprocess.run(["make", "--no-print-directory", "crate", f"OUT={self.base / 'x'}"], cwd=ROOT,

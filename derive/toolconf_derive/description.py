@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -142,6 +143,17 @@ KNOWN_TERMS = ("theta", "theta_dot", "theta_ddot", "u")
 # A model's module, src/<model>.rs of the generated crate, must not clash with the crate's own
 # (templates/registry/src/: lib.rs, tasks.rs, trig.rs, powi.rs; `mod` is a Rust keyword).
 RESERVED_MODEL_NAMES = ("lib", "mod", "powi", "rigid_body", "tasks", "trig", "validity")
+RUST_NAME = re.compile(r"[a-z][a-z0-9_]*")
+# Every edition's strict and reserved keywords (the Rust Reference, "Keywords"), which no
+# generated `let`, `fn` or `mod` may be named.
+RUST_KEYWORDS = frozenset((
+    "as", "break", "const", "continue", "crate", "else", "enum", "extern", "false", "fn", "for", "if",
+    "impl", "in", "let", "loop", "match", "mod", "move", "mut", "pub", "ref", "return", "self", "static",
+    "struct", "super", "trait", "true", "type", "unsafe", "use", "where", "while", "async", "await", "dyn",
+    "abstract", "become", "box", "do", "final", "macro", "override", "priv", "typeof", "unsized", "virtual",
+    "yield", "try", "gen"))
+# The columns a tools file has besides the parameters' (crates/runtime/src/tools_file.rs).
+TOOL_FILE_COLUMNS = ("name", "model")
 KINEMATIC_TERMS = ("theta", "theta_dot", "theta_ddot")
 
 # The keys each table may have, as serde's deny_unknown_fields: a misspelt key is an error, not a
@@ -372,8 +384,28 @@ def _urdf_names(path: Path, top: _Table):
 
 
 def _check_identifier(name: str, path: Path, key: str) -> None:
-    if not name.isidentifier() or name != name.lower():
-        raise DescriptionError(path, key, f"'{name}' must be a lower-case identifier (it becomes a Rust name)")
+    # ASCII: Rust cannot name a module file `é.rs` (E0754), and Python's isidentifier() would let
+    # NFKC-equal spellings through as different names.
+    if not RUST_NAME.fullmatch(name):
+        raise DescriptionError(path, key, f"'{name}' must be a lower-case ASCII name: a letter, then letters, "
+                                          "digits or _ (it becomes a Rust name)")
+    if name in RUST_KEYWORDS:
+        raise DescriptionError(path, key, f"'{name}' is a Rust keyword (the name becomes a Rust name); rename it")
+
+
+def name_keys(m: Model) -> dict[str, str]:
+    """Each name the description gives a parameter, constant or coordinate, with its key."""
+    groups = (("parameters", m.parameters), ("constants", m.constants), ("coordinates.q", m.q),
+              ("coordinates.q_dot", m.q_dot), ("coordinates.u", m.u))
+    keys: dict[str, str] = {}
+    for label, entries in groups:
+        for i, n in enumerate(entries):
+            key = f"constants.{n.name}" if label == "constants" else f"{label}[{i}].name"
+            _check_identifier(n.name, m.path, key)
+            if n.name in keys:
+                raise DescriptionError(m.path, key, f"'{n.name}' is already the name of {keys[n.name]}")
+            keys[n.name] = key
+    return keys
 
 
 def _validate_names(m: Model) -> None:
@@ -384,16 +416,11 @@ def _validate_names(m: Model) -> None:
                                                    f"({', '.join(n + '.rs' for n in RESERVED_MODEL_NAMES)})")
     if m.dof < 1:
         raise DescriptionError(path, "model.dof", f"must be at least 1, got {m.dof}")
-    groups = (("parameters", m.parameters), ("constants", m.constants), ("coordinates.q", m.q),
-              ("coordinates.q_dot", m.q_dot), ("coordinates.u", m.u))
-    seen: dict[str, str] = {}
-    for label, entries in groups:
-        for i, n in enumerate(entries):
-            key = f"constants.{n.name}" if label == "constants" else f"{label}[{i}].name"
-            _check_identifier(n.name, path, key)
-            if n.name in seen:
-                raise DescriptionError(path, key, f"'{n.name}' is already the name of {seen[n.name]}")
-            seen[n.name] = key
+    name_keys(m)
+    for i, p in enumerate(m.parameters):
+        if p.name in TOOL_FILE_COLUMNS:
+            raise DescriptionError(path, f"parameters[{i}].name", f"'{p.name}' is a column of every tools file "
+                                                                  f"({', '.join(TOOL_FILE_COLUMNS)}); rename the parameter")
 
 
 def _check_length(path: Path, key: str, seq: list, want: int, what: str) -> None:

@@ -9,6 +9,7 @@ import sympy as sp
 
 from .cost import cost, total
 from .crosscheck import check_against_casadi
+from .description import DescriptionError
 from .functions import Arg, Function
 from .hoist import hoist
 from .rust_printer import RustPrinter, float_literal
@@ -23,8 +24,53 @@ def _rust_type(shape: tuple[int, int]) -> str:
     return f"SVector<f64, {r}>" if c == 1 else f"SMatrix<f64, {r}, {c}>"
 
 
+# The constants templates/model.rs.tera declares in every model's module (a test keeps the list
+# and the template in step); a description constant's Rust name must not be one of them.
+MODULE_CONSTANTS = ("NAME", "DOF", "STATE_DIM", "PARAMETER_COUNT", "PARAMETER_NAMES", "PARAMETER_UNITS",
+                    "STATE_NAMES", "CONTROL_NAMES", "EQUILIBRIUM_STATE", "EQUILIBRIUM_CONTROL")
+
+
 def _const_name(name: str) -> str:
     return name.upper()
+
+
+def _scopes(f: dict) -> list[tuple[str, list[str]]]:
+    """The names each Rust scope of one function's IR declares (arguments and lets), as
+    templates/model.rs.tera and include/sequence.tera render them."""
+    def lets(body: dict) -> list[str]:
+        names = [e["name"] for key in ("constants", "bindings", "compounds", "temporaries") for e in body.get(key, [])]
+        names += [t[side] for t in body.get("trig", []) for side in ("sin", "cos") if t[side] != "_"]
+        names += [slot["name"] for slot in (body.get("sequence") or {}).get("slots", [])]
+        return names
+    body = lets(f) + [o["name"] for o in f["outputs"]]
+    c = f.get("coefficients")
+    if c is None:
+        return [(f["name"], [a["name"] for a in f["args"]] + body)]
+    return [(f["name"] + "_with", [a["name"] for a in c["args"]] + body),
+            (f"{c['struct']}::new", ["params"] + lets(c))]
+
+
+def check_rust_names(m, functions: list[dict]) -> None:
+    """Every name in a generated scope is declared once: a description name equal to one the
+    generated code uses (an argument such as `x`, an output such as `a`, a temporary `t3`, the
+    `sin_q` of a joint angle) would shadow it and silently change the arithmetic."""
+    keys = {n.name: f"parameters[{i}].name" for i, n in enumerate(m.parameters)}
+    keys |= {n.name: f"constants.{n.name}" for n in m.constants}
+    for label, entries in (("coordinates.q", m.q), ("coordinates.q_dot", m.q_dot), ("coordinates.u", m.u)):
+        keys |= {n.name: f"{label}[{i}].name" for i, n in enumerate(entries)}
+    for c in m.constants:
+        if _const_name(c.name) in MODULE_CONSTANTS:
+            raise DescriptionError(m.path, keys[c.name], f"'{c.name}' becomes the Rust constant {_const_name(c.name)}, "
+                                                         "which every generated model already declares; rename it")
+    for scope, names in (s for f in functions for s in _scopes(f)):
+        seen: set[str] = set()
+        for name in names:
+            if name in seen:
+                if name in keys:
+                    raise DescriptionError(m.path, keys[name], f"'{name}' is also a name the generated {scope} uses "
+                                                               "for its own values; rename it")
+                raise ValueError(f"{m.name}: the generated {scope} declares '{name}' twice")
+            seen.add(name)
 
 
 def _temporaries(prefix: str):
@@ -237,6 +283,7 @@ def model_document(m, x_e: list[str], u_e: list[str], tasks: list, functions: li
                    report: dict, vectors: int) -> dict:
     """The IR of model `m` around its functions' IR (each `function_ir`'s shape), with the
     equilibrium as Rust literals and the tasks of tasks.toml."""
+    check_rust_names(m, functions)
     printer = RustPrinter()
     document = {
         "schema": IR_SCHEMA,
