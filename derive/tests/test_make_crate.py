@@ -50,22 +50,25 @@ class MakeCrate(unittest.TestCase):
         self.assertEqual(sorted(p.name for p in self.base.iterdir()), ["descriptions"])
 
     def test_a_renamed_description_outside_the_repository_makes_a_crate_that_passes_its_test(self):
-        shutil.copy(PENDULUM, self.models / "my_renamed_copy.toml")
+        # The model is my_pendulum, the crate my-pendulum: its library my_pendulum has a module
+        # my_pendulum, which the crate's own test must still tell apart.
+        (self.models / "my_renamed_copy.toml").write_text(
+            PENDULUM.read_text().replace('name = "pendulum"', 'name = "my_pendulum"', 1))
         before = git_status()
         out = self.base / "my-pendulum"
         r = self.run_make_crate(out)
         self.assertEqual(r.returncode, 0, r.stderr)
         # The module is named by the description's model.name, not by its file.
-        self.assertTrue((out / "src" / "pendulum.rs").is_file())
+        self.assertTrue((out / "src" / "my_pendulum.rs").is_file())
         self.assertFalse((out / "src" / "my_renamed_copy.rs").exists())
-        for name in ["Cargo.toml", "pendulum.json", "pendulum.vectors.json", "pendulum.md", "src/lib.rs",
+        for name in ["Cargo.toml", "my_pendulum.json", "my_pendulum.vectors.json", "my_pendulum.md", "src/lib.rs",
                      "src/tasks.rs", "src/trig.rs", "src/powi.rs", "tests/vectors.rs"]:
             self.assertTrue((out / name).is_file(), name)
         manifest = (out / "Cargo.toml").read_text()
         self.assertIn('name = "my-pendulum"', manifest)
         self.assertIn("\n[workspace]\n", manifest)
         self.assertIn("#![no_std]", (out / "src" / "lib.rs").read_text())
-        self.assertIn("pub mod pendulum;", (out / "src" / "lib.rs").read_text())
+        self.assertIn("pub mod my_pendulum;", (out / "src" / "lib.rs").read_text())
         test = subprocess.run(["cargo", "test", "--quiet", "--manifest-path", str(out / "Cargo.toml")],
                               cwd=self.base, capture_output=True, text=True,
                               env={**os.environ, "CARGO_TARGET_DIR": str(TARGET)})

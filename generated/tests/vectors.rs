@@ -99,9 +99,12 @@ fn check(model: &str, functions: usize, evaluate: Evaluator) {
     );
 }
 
+// One module per model; each names the crate as `::toolconf_generated`, since a model may share
+// the crate's name (`make crate NAME=arm` of a model `arm`).
+
 mod arm2 {
     use super::*;
-    use toolconf_generated::arm2 as m;
+    use ::toolconf_generated::arm2 as m;
 
     fn evaluate(name: &str, i: &Value) -> Option<Vec<(&'static str, Vec<f64>)>> {
         Some(match name {
@@ -209,7 +212,7 @@ mod arm2 {
 
 mod arm2_exact {
     use super::*;
-    use toolconf_generated::arm2_exact as m;
+    use ::toolconf_generated::arm2_exact as m;
 
     fn evaluate(name: &str, i: &Value) -> Option<Vec<(&'static str, Vec<f64>)>> {
         Some(match name {
@@ -317,7 +320,7 @@ mod arm2_exact {
 
 mod arm2_payload {
     use super::*;
-    use toolconf_generated::arm2_payload as m;
+    use ::toolconf_generated::arm2_payload as m;
 
     fn evaluate(name: &str, i: &Value) -> Option<Vec<(&'static str, Vec<f64>)>> {
         Some(match name {
@@ -425,7 +428,7 @@ mod arm2_payload {
 
 mod arm3 {
     use super::*;
-    use toolconf_generated::arm3 as m;
+    use ::toolconf_generated::arm3 as m;
 
     fn evaluate(name: &str, i: &Value) -> Option<Vec<(&'static str, Vec<f64>)>> {
         Some(match name {
@@ -533,7 +536,7 @@ mod arm3 {
 
 mod msd {
     use super::*;
-    use toolconf_generated::msd as m;
+    use ::toolconf_generated::msd as m;
 
     fn evaluate(name: &str, i: &Value) -> Option<Vec<(&'static str, Vec<f64>)>> {
         Some(match name {
@@ -641,7 +644,7 @@ mod msd {
 
 mod panda {
     use super::*;
-    use toolconf_generated::panda as m;
+    use ::toolconf_generated::panda as m;
 
     fn evaluate(name: &str, i: &Value) -> Option<Vec<(&'static str, Vec<f64>)>> {
         Some(match name {
@@ -754,7 +757,7 @@ mod panda {
 
 mod ur5 {
     use super::*;
-    use toolconf_generated::ur5 as m;
+    use ::toolconf_generated::ur5 as m;
 
     fn evaluate(name: &str, i: &Value) -> Option<Vec<(&'static str, Vec<f64>)>> {
         Some(match name {
