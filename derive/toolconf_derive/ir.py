@@ -9,7 +9,7 @@ import sympy as sp
 
 from .cost import cost, total
 from .crosscheck import check_against_casadi
-from .description import DescriptionError
+from .description import DescriptionError, name_keys
 from .functions import Arg, Function
 from .hoist import hoist
 from .rust_printer import RustPrinter, float_literal
@@ -54,10 +54,7 @@ def check_rust_names(m, functions: list[dict]) -> None:
     """Every name in a generated scope is declared once: a description name equal to one the
     generated code uses (an argument such as `x`, an output such as `a`, a temporary `t3`, the
     `sin_q` of a joint angle) would shadow it and silently change the arithmetic."""
-    keys = {n.name: f"parameters[{i}].name" for i, n in enumerate(m.parameters)}
-    keys |= {n.name: f"constants.{n.name}" for n in m.constants}
-    for label, entries in (("coordinates.q", m.q), ("coordinates.q_dot", m.q_dot), ("coordinates.u", m.u)):
-        keys |= {n.name: f"{label}[{i}].name" for i, n in enumerate(entries)}
+    keys = name_keys(m)
     for c in m.constants:
         if _const_name(c.name) in MODULE_CONSTANTS:
             raise DescriptionError(m.path, keys[c.name], f"'{c.name}' becomes the Rust constant {_const_name(c.name)}, "
