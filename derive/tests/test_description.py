@@ -200,7 +200,7 @@ class BrokenDescription(unittest.TestCase):
                          "coordinates.q_dot[0].name", "also a name the generated")
 
     def test_the_generated_constants_are_the_templates(self):
-        from toolconf_derive.ir import MODULE_CONSTANTS
+        from toolconf_derive.description import MODULE_CONSTANTS
         template = (ROOT / "templates" / "model.rs.tera").read_text()
         self.assertEqual(sorted(MODULE_CONSTANTS), sorted(re.findall(r"^pub const ([A-Z_]+):", template, re.M)))
 

@@ -51,9 +51,13 @@ class MakeCrate(unittest.TestCase):
 
     def test_a_renamed_description_outside_the_repository_makes_a_crate_that_passes_its_test(self):
         # The model is my_pendulum, the crate my-pendulum: its library my_pendulum has a module
-        # my_pendulum, which the crate's own test must still tell apart.
-        (self.models / "my_renamed_copy.toml").write_text(
-            PENDULUM.read_text().replace('name = "pendulum"', 'name = "my_pendulum"', 1))
+        # my_pendulum, which the crate's own test must still tell apart. Its torque is called t0,
+        # the name of the first temporary, which the temporaries then skip.
+        text = PENDULUM.read_text().replace('name = "pendulum"', 'name = "my_pendulum"', 1)
+        text = text.replace('name = "torque"', 'name = "t0"', 1).replace("(torque -", "(t0 -", 1)
+        self.assertIn('name = "t0"', text)
+        self.assertIn("(t0 -", text)
+        (self.models / "my_renamed_copy.toml").write_text(text)
         before = git_status()
         out = self.base / "my-pendulum"
         r = self.run_make_crate(out)

@@ -143,6 +143,10 @@ KNOWN_TERMS = ("theta", "theta_dot", "theta_ddot", "u")
 # A model's module, src/<model>.rs of the generated crate, must not clash with the crate's own
 # (templates/registry/src/: lib.rs, tasks.rs, trig.rs, powi.rs; `mod` is a Rust keyword).
 RESERVED_MODEL_NAMES = ("lib", "mod", "powi", "rigid_body", "tasks", "trig", "validity")
+# The constants templates/model.rs.tera declares in every model's module (a test keeps the list
+# and the template in step); a description constant `g` becomes the Rust constant `G` beside them.
+MODULE_CONSTANTS = ("NAME", "DOF", "STATE_DIM", "PARAMETER_COUNT", "PARAMETER_NAMES", "PARAMETER_UNITS",
+                    "STATE_NAMES", "CONTROL_NAMES", "EQUILIBRIUM_STATE", "EQUILIBRIUM_CONTROL")
 RUST_NAME = re.compile(r"[a-z][a-z0-9_]*")
 # Every edition's strict and reserved keywords (the Rust Reference, "Keywords"), which no
 # generated `let`, `fn` or `mod` may be named.
@@ -393,6 +397,11 @@ def _check_identifier(name: str, path: Path, key: str) -> None:
         raise DescriptionError(path, key, f"'{name}' is a Rust keyword (the name becomes a Rust name); rename it")
 
 
+def rust_constant(name: str) -> str:
+    """The Rust name of a description constant: `g` is `G` in the generated module."""
+    return name.upper()
+
+
 def name_keys(m: Model) -> dict[str, str]:
     """Each name the description gives a parameter, constant or coordinate, with its key."""
     groups = (("parameters", m.parameters), ("constants", m.constants), ("coordinates.q", m.q),
@@ -421,6 +430,10 @@ def _validate_names(m: Model) -> None:
         if p.name in TOOL_FILE_COLUMNS:
             raise DescriptionError(path, f"parameters[{i}].name", f"'{p.name}' is a column of every tools file "
                                                                   f"({', '.join(TOOL_FILE_COLUMNS)}); rename the parameter")
+    for c in m.constants:
+        if rust_constant(c.name) in MODULE_CONSTANTS:
+            raise DescriptionError(path, f"constants.{c.name}", f"'{c.name}' becomes the Rust constant {rust_constant(c.name)}, "
+                                                                "which every generated model already declares; rename it")
 
 
 def _check_length(path: Path, key: str, seq: list, want: int, what: str) -> None:

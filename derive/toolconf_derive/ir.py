@@ -9,7 +9,7 @@ import sympy as sp
 
 from .cost import cost, total
 from .crosscheck import check_against_casadi
-from .description import DescriptionError, name_keys
+from .description import DescriptionError, name_keys, rust_constant
 from .functions import Arg, Function
 from .hoist import hoist
 from .rust_printer import RustPrinter, float_literal
@@ -22,16 +22,6 @@ IR_SCHEMA = 4
 def _rust_type(shape: tuple[int, int]) -> str:
     r, c = shape
     return f"SVector<f64, {r}>" if c == 1 else f"SMatrix<f64, {r}, {c}>"
-
-
-# The constants templates/model.rs.tera declares in every model's module (a test keeps the list
-# and the template in step); a description constant's Rust name must not be one of them.
-MODULE_CONSTANTS = ("NAME", "DOF", "STATE_DIM", "PARAMETER_COUNT", "PARAMETER_NAMES", "PARAMETER_UNITS",
-                    "STATE_NAMES", "CONTROL_NAMES", "EQUILIBRIUM_STATE", "EQUILIBRIUM_CONTROL")
-
-
-def _const_name(name: str) -> str:
-    return name.upper()
 
 
 def _scopes(f: dict) -> list[tuple[str, list[str]]]:
@@ -55,10 +45,6 @@ def check_rust_names(m, functions: list[dict]) -> None:
     generated code uses (an argument such as `x`, an output such as `a`, a temporary `t3`, the
     `sin_q` of a joint angle) would shadow it and silently change the arithmetic."""
     keys = name_keys(m)
-    for c in m.constants:
-        if _const_name(c.name) in MODULE_CONSTANTS:
-            raise DescriptionError(m.path, keys[c.name], f"'{c.name}' becomes the Rust constant {_const_name(c.name)}, "
-                                                         "which every generated model already declares; rename it")
     for scope, names in (s for f in functions for s in _scopes(f)):
         seen: set[str] = set()
         for name in names:
@@ -70,8 +56,10 @@ def check_rust_names(m, functions: list[dict]) -> None:
             seen.add(name)
 
 
-def _temporaries(prefix: str):
-    return (sp.Symbol(f"{prefix}{i}", real=True) for i in range(10**6))
+def _temporaries(prefix: str, taken: set[str]):
+    """t0, t1, ... without the model's own names: a control named `t0` keeps its name, and the
+    temporaries skip it (check_rust_names then finds every scope's names distinct)."""
+    return (sp.Symbol(f"{prefix}{i}", real=True) for i in range(10**6) if f"{prefix}{i}" not in taken)
 
 
 def _trig_symbols(angle: sp.Symbol) -> tuple[sp.Symbol, sp.Symbol]:
@@ -106,10 +94,7 @@ def _code(entries: list[sp.Expr], d: Derivation, args: list, declared: set[str],
           angles: list[sp.Symbol] = (), compounds: list[tuple[sp.Symbol, sp.Expr]] = ()) -> dict:
     """CSE'd Rust for `entries`: the constants and argument elements it reads, the joint angles'
     sin_cos it needs, its temporaries, the reduced entries and what they cost per call."""
-    replacements, reduced = sp.cse(entries, symbols=_temporaries(prefix), order="canonical")
-    clash = declared & {str(t) for t, _ in replacements}
-    if clash:
-        raise ValueError(f"CSE temporaries clash with model names: {sorted(clash)}")
+    replacements, reduced = sp.cse(entries, symbols=_temporaries(prefix, declared), order="canonical")
     used = set()
     for _, e in replacements:
         used |= e.free_symbols
@@ -139,7 +124,7 @@ def _code(entries: list[sp.Expr], d: Derivation, args: list, declared: set[str],
                     access = f"{arg.name}[{i}]" if arg.shape[1] == 1 else f"{arg.name}[({i}, {j})]"
                 bindings.append({"name": s.name, "arg": arg.name, "access": access})
     return {
-        "constants": [{"name": c.name, "rust": _const_name(c.name)} for c in d.constants if c in used],
+        "constants": [{"name": c.name, "rust": rust_constant(c.name)} for c in d.constants if c in used],
         "bindings": bindings,
         "trig": trig,
         "compounds": compound_code,
@@ -292,7 +277,7 @@ def model_document(m, x_e: list[str], u_e: list[str], tasks: list, functions: li
             "dof": m.dof,
             "state_dim": m.state_dim,
             "parameters": [{"name": p.name, "latex": p.latex, "unit": p.unit, "doc": p.doc} for p in m.parameters],
-            "constants": [{"name": c.name, "rust": _const_name(c.name), "value": c.value, "unit": c.unit,
+            "constants": [{"name": c.name, "rust": rust_constant(c.name), "value": c.value, "unit": c.unit,
                            "doc": c.doc} for c in m.constants],
             "state": [{"name": s.name, "latex": s.latex} for s in m.state],
             "control": [{"name": s.name, "latex": s.latex} for s in m.u],
