@@ -6,7 +6,7 @@ PY_DEV := $(VENV)/.python-dev-installed
 # Deterministic derivation: the same inputs give byte-identical generated files.
 export PYTHONHASHSEED := 0
 
-.PHONY: run test derive drift-check venv clean-venv bench python-test crate on-robot-test
+.PHONY: run test derive render drift-check venv clean-venv bench python-test crate on-robot-test
 
 ## make run: build in release mode and reproduce the paper's Results (results/report.md).
 run:
@@ -61,6 +61,12 @@ $(PY_DEV): python/requirements-dev.txt $(PY)
 ## -> rustfmt, into generated/ (and the renderer's fixture in tests/fixtures/).
 derive: $(PY)
 	$(PY) derive/pipeline.py
+
+## make render: re-render generated/ from its committed IR (generated/*.json) through templates/
+## (Tera + rustfmt), with no derivation and no Python: what to run after a change to templates/ or
+## derive/render. cargo test's tests/render_ensure.rs fails, naming the file and line, until it is.
+render:
+	cargo run --quiet -p toolconf-render -- --crate generated
 
 ## make crate MODELS=<folder> OUT=<folder> [TASKS=<file>] [NAME=<crate>]: derive the model descriptions in
 ## MODELS (with derive/tasks.toml, or TASKS) into a standalone no_std crate at OUT, with its own

@@ -2211,166 +2211,9 @@ pub fn dynamics_with(
     x_dot
 }
 
-/// The parameter-only factors of [`dynamics_jacobian`], computed once per tool: [`dynamics_jacobian_with`]
-/// then only combines them with the state and control (derive/toolconf_derive/hoist.py).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct DynamicsJacobianCoefficients {
-    pub k: [f64; 17],
-}
-
-impl DynamicsJacobianCoefficients {
-    /// - `params`: tool parameters `[tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]`
-    ///
-    /// Cost, once per tool: 131 operations, weighted 131 (43 ADD, 59 MUL, 1 NEG, 28 SUB) (derive/toolconf_derive/cost.py).
-    #[inline]
-    #[must_use]
-    pub fn new(params: &SVector<f64, 7>) -> Self {
-        let params_0 = params[0];
-        let params_1 = params[1];
-        let params_2 = params[2];
-        let params_3 = params[3];
-        let params_4 = params[4];
-        let params_5 = params[5];
-        let params_6 = params[6];
-        let s2_0 = 0.735522 + params_0;
-        let s4_1 = params_0 * params_1;
-        let s4_2 = 0.007735484874 + s4_1;
-        let s6_3 = params_0 * params_2;
-        let s6_4 = (-0.0031274395439999996) + s6_3;
-        let s9_5 = params_3 + 0.107;
-        let s10_6 = params_0 * s9_5;
-        let s10_7 = 0.045305948634 + s10_6;
-        let s12_8 = params_1 * params_1;
-        let s13_9 = params_2 * params_2;
-        let s12_10 = s12_8 + s13_9;
-        let s13_11 = s9_5 * s9_5;
-        let s13_12 = s12_10 + s13_11;
-        let s14_13 = params_1 * params_1;
-        let s14_14 = s13_12 - s14_13;
-        let s14_15 = params_0 * s14_14;
-        let s11_16 = params_4 + s14_15;
-        let s10_17 = 0.015320008390949585 + s11_16;
-        let s14_18 = params_2 * params_2;
-        let s13_19 = s13_12 - s14_18;
-        let s13_20 = params_0 * s13_19;
-        let s11_21 = params_5 + s13_20;
-        let s10_22 = 0.012899064612428355 + s11_21;
-        let s12_23 = params_0 * s12_10;
-        let s11_24 = params_6 + s12_23;
-        let s10_25 = 0.004909651967360946 + s11_24;
-        let s11_26 = params_1 * params_2;
-        let s11_27 = params_0 * s11_26;
-        let s10_28 = (-0.000395108718315752) - s11_27;
-        let s11_29 = params_1 * s9_5;
-        let s11_30 = params_0 * s11_29;
-        let s10_31 = (-0.001672482661783778) - s11_30;
-        let s9_32 = params_2 * s9_5;
-        let s9_33 = params_0 * s9_32;
-        let s10_34 = (-0.000548359106408232) - s9_33;
-        let s5_35 = params_0 * params_2;
-        let s4_36 = (-0.0031274395439999996) + s5_35;
-        let s5_37 = (-9.81) * s4_36;
-        let s7_38 = params_3 + 0.107;
-        let s7_39 = params_0 * s7_38;
-        let s6_40 = 0.045305948634 + s7_39;
-        let s7_41 = 4.2475144558350945e-16 * s6_40;
-        let s5_42 = s5_37 - s7_41;
-        let s7_43 = 0.7071067811865476 * s5_42;
-        let s6_44 = (-4.247514455835095e-16) * s6_40;
-        let s3_45 = params_0 * params_1;
-        let s2_46 = 0.007735484874 + s3_45;
-        let s3_47 = (-9.81) * s2_46;
-        let s6_48 = s6_44 - s3_47;
-        let s3_49 = 0.7071067811865475 * s6_48;
-        let s7_50 = s7_43 - s3_49;
-        let s13_51 = 0.17194142915235003 + s7_50;
-        let s7_52 = 6.123233995736766e-17 * s13_51;
-        let s16_53 = 4.2475144558350945e-16 * s2_46;
-        let s17_54 = (-4.247514455835095e-16) * s4_36;
-        let s16_55 = s16_53 - s17_54;
-        let s3_56 = 1.0528376042612343e-17 - s16_55;
-        let s0_57 = 0.735522 + params_0;
-        let s4_58 = (-3.003446274908884e-16) * s0_57;
-        let s1_59 = 3.003446274908884e-16 * s0_57;
-        let s4_60 = s4_58 + s1_59;
-        let s17_61 = 0.088 * s4_60;
-        let s3_62 = s3_56 - s17_61;
-        let s7_63 = s7_52 - s3_62;
-        let s1_64 = 0.384 * s4_60;
-        let s7_65 = s7_63 + s1_64;
-        let s1_66 = (-0.7071067811865475) * s7_65;
-        let s3_67 = 6.123233995736766e-17 * s3_62;
-        let s13_68 = s13_51 + s3_67;
-        let s19_69 = 0.4938694651269 + s13_68;
-        let s18_70 = (-0.9663053001273) + s19_69;
-        let s3_71 = (-0.0825) * s4_60;
-        let s18_72 = s18_70 - s3_71;
-        let s3_73 = (-0.7071067811865476) * s18_72;
-        let s1_74 = s1_66 - s3_73;
-        let s11_75 = 0.879084414092543 + s1_74;
-        let s9_76 = 0.015683962507388537 + s11_75;
-        let s1_77 = (-0.316) * s4_60;
-        let s9_78 = s9_76 - s1_77;
-        let s9_79 = (-0.7071067811865475) * s9_78;
-        let s7_80 = (-0.7071067811865476) * s7_65;
-        let s18_81 = (-0.7071067811865475) * s18_72;
-        let s7_82 = s7_80 + s18_81;
-        let s3_83 = (-0.8790844140925428) + s7_82;
-        let s4_84 = 0.0825 * s4_60;
-        let s3_85 = s3_83 - s4_84;
-        let s1_86 = 0.015683962507388533 - s3_85;
-        let s1_87 = 0.7071067811865476 * s1_86;
-        let s9_88 = s9_79 + s1_87;
-        let s9_89 = -s9_88;
-        let s8_90 = 0.7071067811865475 * s5_42;
-        let s14_91 = 0.7071067811865476 * s6_48;
-        let s8_92 = s8_90 + s14_91;
-        let s21_93 = 0.9833702597779501 + s8_92;
-        let s8_94 = (-0.86328) * s0_57;
-        let s21_95 = s21_93 - s8_94;
-        let s20_96 = 0.46226374360362 - s21_95;
-        let s18_97 = 3.67526164252905 - s20_96;
-        let s8_98 = (-3.0034462749088843e-16) * s0_57;
-        let s14_99 = 3.0034462749088833e-16 * s0_57;
-        let s8_100 = s8_98 - s14_99;
-        let s20_101 = (-1.001081681336155e-15) + s8_100;
-        let s15_102 = (-9.81) * s0_57;
-        let s8_103 = 16.34890455 - s15_102;
-        let s15_104 = 6.123233995736766e-17 * s8_103;
-        let s15_105 = s20_101 + s15_104;
-        let s13_106 = (-0.0825) * s15_105;
-        let s12_107 = 6.123233995736766e-17 * s20_101;
-        let s12_108 = s12_107 - s8_103;
-        let s0_109 = (-12.026530260000001) + s12_108;
-        let s17_110 = 0.384 * s0_109;
-        let s13_111 = s13_106 - s17_110;
-        let s18_112 = s18_97 + s13_111;
-        let s4_113 = (-2.1056638289254273) - s18_112;
-        let s13_114 = (-35.19724995) + s0_109;
-        let s0_115 = (-0.7071067811865476) * s13_114;
-        let s17_116 = (-0.7071067811865475) * s15_105;
-        let s0_117 = s0_115 + s17_116;
-        let s7_118 = 0.0825 * s0_117;
-        let s4_119 = s4_113 - s7_118;
-        let s1_120 = 0.1429776049922478 + s4_119;
-        let s10_121 = (-0.7071067811865475) * s13_114;
-        let s2_122 = (-0.7071067811865476) * s15_105;
-        let s10_123 = s10_121 - s2_122;
-        let s4_124 = 22.395913943048576 + s10_123;
-        let s11_125 = (-0.316) * s4_124;
-        let s1_126 = s1_120 - s11_125;
-        let s9_127 = (-471.23889803846896) + s1_126;
-        let s3_128 = (-1413.7166941154069) + s18_112;
-        let s19_129 = 235.61944901923448 + s21_95;
-        let s19_130 = 39.269908169872416 + s16_55;
-        Self {
-            k: [
-                s2_0, s4_2, s6_4, s10_7, s10_17, s10_22, s10_25, s10_28, s10_31, s10_34, s9_89,
-                s9_127, s3_85, s3_128, s19_69, s19_129, s19_130,
-            ],
-        }
-    }
-}
+/// The parameter-only factors of [`dynamics_jacobian`]: the same numbers as those of
+/// [`dynamics`], so the same type.
+pub type DynamicsJacobianCoefficients = DynamicsCoefficients;
 
 /// Jacobians (df/dX, df/dU) of the plant at any state and control: -M^-1 [K + dID/dq, D + dID/dq_dot] at q_ddot = f and M^-1, with ID the inverse dynamics.
 ///
@@ -2380,7 +2223,7 @@ impl DynamicsJacobianCoefficients {
 /// - `u`: control U = [panda_joint1_torque panda_joint2_torque panda_joint3_torque panda_joint4_torque panda_joint5_torque panda_joint6_torque panda_joint7_torque]
 /// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]
 ///
-/// Cost per call: 11403 operations, weighted 12663, plus 6 `sin_cos`: [`DynamicsJacobianCoefficients::new`] (131, weighted 131), then [`dynamics_jacobian_with`] (11272, weighted 12532). Build the coefficients once per tool and call [`dynamics_jacobian_with`] where it is called often.
+/// Cost per call: 11403 operations, weighted 12663, plus 6 `sin_cos`: [`DynamicsCoefficients::new`] (131, weighted 131), then [`dynamics_jacobian_with`] (11272, weighted 12532). Build the coefficients once per tool and call [`dynamics_jacobian_with`] where it is called often.
 /// The same closed form with the parameters inline (not hoisted) would take 11430 operations, weighted 12690 (2771 ADD, 180 DIV, 6037 MUL, 91 NEG, 2351 SUB), plus 6 `sin_cos`.
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
@@ -2390,10 +2233,10 @@ pub fn dynamics_jacobian(
     u: &SVector<f64, 7>,
     params: &SVector<f64, 7>,
 ) -> (SMatrix<f64, 14, 14>, SMatrix<f64, 14, 7>) {
-    dynamics_jacobian_with(x, u, &DynamicsJacobianCoefficients::new(params))
+    dynamics_jacobian_with(x, u, &DynamicsCoefficients::new(params))
 }
 
-/// [`dynamics_jacobian`] with the tool's [`DynamicsJacobianCoefficients`] computed beforehand.
+/// [`dynamics_jacobian`] with the tool's [`DynamicsCoefficients`] computed beforehand.
 ///
 /// Cost per call: 11272 operations, weighted 12532 (2722 ADD, 180 DIV, 5965 MUL, 91 NEG, 2314 SUB), plus 6 `sin_cos` (derive/toolconf_derive/cost.py).
 #[inline]
@@ -2401,7 +2244,7 @@ pub fn dynamics_jacobian(
 pub fn dynamics_jacobian_with(
     x: &SVector<f64, 14>,
     u: &SVector<f64, 7>,
-    coefficients: &DynamicsJacobianCoefficients,
+    coefficients: &DynamicsCoefficients,
 ) -> (SMatrix<f64, 14, 14>, SMatrix<f64, 14, 7>) {
     let x_1 = x[1];
     let x_2 = x[2];

@@ -1635,149 +1635,9 @@ pub fn dynamics_with(
     x_dot
 }
 
-/// The parameter-only factors of [`dynamics_jacobian`], computed once per tool: [`dynamics_jacobian_with`]
-/// then only combines them with the state and control (derive/toolconf_derive/hoist.py).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct DynamicsJacobianCoefficients {
-    pub k: [f64; 16],
-}
-
-impl DynamicsJacobianCoefficients {
-    /// - `params`: tool parameters `[tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]`
-    ///
-    /// Cost, once per tool: 114 operations, weighted 114 (41 ADD, 54 MUL, 4 NEG, 15 SUB) (derive/toolconf_derive/cost.py).
-    #[inline]
-    #[must_use]
-    pub fn new(params: &SVector<f64, 7>) -> Self {
-        let params_0 = params[0];
-        let params_1 = params[1];
-        let params_3 = params[3];
-        let params_2 = params[2];
-        let params_4 = params[4];
-        let params_6 = params[6];
-        let params_5 = params[5];
-        let s2_0 = 0.1879 + params_0;
-        let s3_1 = params_0 * params_1;
-        let s5_2 = params_3 + 0.0823;
-        let s6_3 = params_0 * s5_2;
-        let s7_4 = params_0 * params_2;
-        let s7_5 = -s7_4;
-        let s9_6 = params_1 * params_1;
-        let s10_7 = s5_2 * s5_2;
-        let s9_8 = s9_6 + s10_7;
-        let s10_9 = params_2 * params_2;
-        let s10_10 = s9_8 + s10_9;
-        let s11_11 = params_1 * params_1;
-        let s11_12 = s10_10 - s11_11;
-        let s11_13 = params_0 * s11_12;
-        let s8_14 = params_4 + s11_13;
-        let s8_15 = 0.0171364731454 + s8_14;
-        let s11_16 = s5_2 * s5_2;
-        let s10_17 = s10_10 - s11_16;
-        let s10_18 = params_0 * s10_17;
-        let s8_19 = params_6 + s10_18;
-        let s7_20 = 0.0171364731454 + s8_19;
-        let s9_21 = params_0 * s9_8;
-        let s8_22 = params_5 + s9_21;
-        let s7_23 = 0.033822 + s8_22;
-        let s7_24 = params_1 * s5_2;
-        let s7_25 = params_0 * s7_24;
-        let s7_26 = -s7_25;
-        let s7_27 = params_1 * params_2;
-        let s7_28 = params_0 * s7_27;
-        let s5_29 = s5_2 * params_2;
-        let s5_30 = params_0 * s5_29;
-        let s3_31 = params_3 + 0.0823;
-        let s3_32 = params_0 * s3_31;
-        let s4_33 = (-6.006892549817768e-16) * s3_32;
-        let s6_34 = params_0 * params_2;
-        let s9_35 = (-9.81) * s6_34;
-        let s4_36 = s4_33 + s9_35;
-        let s0_37 = 0.1879 + params_0;
-        let s9_38 = (-0.9285165000000001) * s0_37;
-        let s4_39 = s4_36 - s9_38;
-        let s9_40 = 6.123233995736766e-17 * s4_39;
-        let s10_41 = (-5.685523798402517e-17) * s0_37;
-        let s6_42 = (-6.006892549817768e-16) * s6_34;
-        let s1_43 = params_0 * params_1;
-        let s2_44 = (-6.006892549817768e-16) * s1_43;
-        let s6_45 = s6_42 + s2_44;
-        let s10_46 = s10_41 - s6_45;
-        let s9_47 = s9_40 + s10_46;
-        let s12_48 = (-6.006892549817768e-16) * s0_37;
-        let s12_49 = (-7.322402018227859e-16) + s12_48;
-        let s13_50 = 0.093 * s12_49;
-        let s9_51 = s9_47 + s13_50;
-        let s13_52 = 6.123233995736766e-17 * s9_51;
-        let s1_53 = (-9.81) * s1_43;
-        let s3_54 = (-6.006892549817768e-16) * s3_32;
-        let s1_55 = s1_53 - s3_54;
-        let s7_56 = (-6.006892549817768e-16) * s0_37;
-        let s7_57 = (-7.322402018227859e-16) + s7_56;
-        let s3_58 = 6.123233995736766e-17 * s7_57;
-        let s8_59 = (-9.81) * s0_37;
-        let s8_60 = (-11.958390000000001) + s8_59;
-        let s3_61 = s3_58 + s8_60;
-        let s2_62 = 0.093 * s3_61;
-        let s2_63 = s1_55 - s2_62;
-        let s13_64 = s13_52 - s2_63;
-        let s0_65 = 6.123233995736766e-17 * s13_64;
-        let s2_66 = 6.123233995736766e-17 * s2_63;
-        let s2_67 = s2_66 + s9_51;
-        let s8_68 = 6.123233995736766e-17 * s8_60;
-        let s8_69 = s8_68 - s7_57;
-        let s7_70 = 0.39225 * s8_69;
-        let s2_71 = s2_67 - s7_70;
-        let s0_72 = s0_65 + s2_71;
-        let s11_73 = (-7.322402018227859e-16) + s12_49;
-        let s12_74 = 6.123233995736766e-17 * s11_73;
-        let s14_75 = (-11.958390000000001) + s3_61;
-        let s12_76 = s12_74 + s14_75;
-        let s15_77 = (-22.31775) + s12_76;
-        let s3_78 = 6.123233995736766e-17 * s15_77;
-        let s14_79 = 6.123233995736766e-17 * s14_75;
-        let s14_80 = s14_79 - s11_73;
-        let s3_81 = s3_78 - s14_80;
-        let s11_82 = (-0.1197) * s3_81;
-        let s0_83 = s0_72 + s11_82;
-        let s2_84 = 6.123233995736766e-17 * s2_71;
-        let s2_85 = s2_84 - s13_64;
-        let s14_86 = 6.123233995736766e-17 * s14_80;
-        let s14_87 = s14_86 + s15_77;
-        let s7_88 = (-0.1197) * s14_87;
-        let s8_89 = 0.425 * s8_69;
-        let s7_90 = s7_88 + s8_89;
-        let s2_91 = s2_85 - s7_90;
-        let s2_92 = 6.123233995736766e-17 * s2_91;
-        let s0_93 = s0_83 + s2_92;
-        let s7_94 = 82.33533000000001 - s14_87;
-        let s7_95 = 6.123233995736766e-17 * s7_94;
-        let s14_96 = (-5.0415849170620525e-15) + s3_81;
-        let s7_97 = s7_95 + s14_96;
-        let s2_98 = 0.13585 * s7_97;
-        let s0_99 = s0_93 + s2_98;
-        let s0_100 = -s0_99;
-        let s5_101 = 6.123233995736766e-17 * s10_46;
-        let s5_102 = s5_101 - s4_39;
-        let s7_103 = (-5.5794375) + s5_102;
-        let s9_104 = 0.39225 * s12_76;
-        let s7_105 = s7_103 + s9_104;
-        let s2_106 = (-1.411643776777375e-15) + s7_105;
-        let s15_107 = 0.425 * s3_81;
-        let s2_108 = s2_106 + s15_107;
-        let s0_109 = (-1624.203401905923) + s2_108;
-        let s0_110 = 1624.203401905923 + s7_105;
-        let s0_111 = (-915.7742585214247) + s5_102;
-        let s0_112 = (-549.7787143782137) + s1_55;
-        let s6_113 = -s6_45;
-        Self {
-            k: [
-                s2_0, s3_1, s6_3, s7_5, s8_15, s7_20, s7_23, s7_26, s7_28, s5_30, s0_100, s0_109,
-                s0_110, s0_111, s0_112, s6_113,
-            ],
-        }
-    }
-}
+/// The parameter-only factors of [`dynamics_jacobian`]: the same numbers as those of
+/// [`dynamics`], so the same type.
+pub type DynamicsJacobianCoefficients = DynamicsCoefficients;
 
 /// Jacobians (df/dX, df/dU) of the plant at any state and control: -M^-1 [K + dID/dq, D + dID/dq_dot] at q_ddot = f and M^-1, with ID the inverse dynamics.
 ///
@@ -1787,7 +1647,7 @@ impl DynamicsJacobianCoefficients {
 /// - `u`: control U = [shoulder_pan_joint_torque shoulder_lift_joint_torque elbow_joint_torque wrist_1_joint_torque wrist_2_joint_torque wrist_3_joint_torque]
 /// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]
 ///
-/// Cost per call: 6014 operations, weighted 6945, plus 5 `sin_cos`: [`DynamicsJacobianCoefficients::new`] (114, weighted 114), then [`dynamics_jacobian_with`] (5900, weighted 6831). Build the coefficients once per tool and call [`dynamics_jacobian_with`] where it is called often.
+/// Cost per call: 6014 operations, weighted 6945, plus 5 `sin_cos`: [`DynamicsCoefficients::new`] (114, weighted 114), then [`dynamics_jacobian_with`] (5900, weighted 6831). Build the coefficients once per tool and call [`dynamics_jacobian_with`] where it is called often.
 /// The same closed form with the parameters inline (not hoisted) would take 6039 operations, weighted 6970 (1479 ADD, 133 DIV, 3199 MUL, 67 NEG, 1161 SUB), plus 5 `sin_cos`.
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
@@ -1797,10 +1657,10 @@ pub fn dynamics_jacobian(
     u: &SVector<f64, 6>,
     params: &SVector<f64, 7>,
 ) -> (SMatrix<f64, 12, 12>, SMatrix<f64, 12, 6>) {
-    dynamics_jacobian_with(x, u, &DynamicsJacobianCoefficients::new(params))
+    dynamics_jacobian_with(x, u, &DynamicsCoefficients::new(params))
 }
 
-/// [`dynamics_jacobian`] with the tool's [`DynamicsJacobianCoefficients`] computed beforehand.
+/// [`dynamics_jacobian`] with the tool's [`DynamicsCoefficients`] computed beforehand.
 ///
 /// Cost per call: 5900 operations, weighted 6831 (1427 ADD, 133 DIV, 3132 MUL, 67 NEG, 1141 SUB), plus 5 `sin_cos` (derive/toolconf_derive/cost.py).
 #[inline]
@@ -1808,7 +1668,7 @@ pub fn dynamics_jacobian(
 pub fn dynamics_jacobian_with(
     x: &SVector<f64, 12>,
     u: &SVector<f64, 6>,
-    coefficients: &DynamicsJacobianCoefficients,
+    coefficients: &DynamicsCoefficients,
 ) -> (SMatrix<f64, 12, 12>, SMatrix<f64, 12, 6>) {
     let x_1 = x[1];
     let x_2 = x[2];

@@ -1,0 +1,183 @@
+//! What the registry templates (templates/registry/, rendered once over all models into the
+//! crate around them) see: each model's Rust names, the vector test's calls, the tool rules, the
+//! tasks, and the package.
+
+use serde::Serialize;
+
+use crate::ir::{Function, Ir};
+use crate::tasks::{
+    binding_pattern, camel_case, string_literal, task_choices, task_list, TaskView,
+};
+use crate::tool_rule::{tool_rule_view, ToolRuleView};
+use crate::RenderError;
+
+/// The crate the registry renders: its package name, and whether it is a crate of its own
+/// (`make crate`: an empty `[workspace]` table, so that no enclosing workspace claims it) or a
+/// member of toolconf's workspace (`generated/`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Package {
+    pub name: String,
+    pub standalone: bool,
+}
+
+impl Package {
+    /// toolconf's own generated crate, `generated/`.
+    pub fn in_repository() -> Self {
+        Self {
+            name: "toolconf-generated".into(),
+            standalone: false,
+        }
+    }
+}
+
+/// The function that is a model's own rigid-body dynamics (U the joint torques), for
+/// `generated::rigid_body`.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct RigidBody {
+    pub function: &'static str,
+    pub doc: &'static str,
+}
+
+/// What the vector test needs of one generated function: its argument and output names, and
+/// the pattern binding its outputs.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct VectorTestView<'a> {
+    pub name: &'a str,
+    pub args: Vec<&'a str>,
+    pub outputs: Vec<&'a str>,
+    pub pattern: String,
+}
+
+/// The registry's view of one model: what the runtime needs to name and size it. The marker
+/// type is the model's name in CamelCase (`arm2_exact` → `Arm2Exact`), its tool type that plus
+/// `Tool`, and the title a Rust literal.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RegistryModel<'a> {
+    pub name: &'a str,
+    pub title: &'a str,
+    pub title_literal: String,
+    pub marker: String,
+    pub tool: String,
+    /// The model description it was derived from.
+    pub description: &'a str,
+    pub parameter_count: usize,
+    pub functions: Vec<VectorTestView<'a>>,
+    pub function_count: usize,
+    pub tool_rule: ToolRuleView,
+    pub rigid_body: RigidBody,
+}
+
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct PackageView {
+    pub name: String,
+    /// The crate's name as Rust code names it (`toolconf_generated`).
+    pub lib: String,
+    pub standalone: bool,
+    /// The command and the task definitions every model was derived by.
+    pub command: String,
+    pub tasks: String,
+    /// The models' descriptions and names, `, `-separated.
+    pub descriptions: String,
+    pub model_names: String,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RegistryContext<'a> {
+    pub models: Vec<RegistryModel<'a>>,
+    pub model_count: usize,
+    pub tasks: Vec<TaskView<'a>>,
+    pub task_count: usize,
+    pub task_choices: String,
+    pub package: PackageView,
+}
+
+pub fn registry_context<'a>(
+    irs: &'a [Ir],
+    package: &Package,
+) -> Result<RegistryContext<'a>, RenderError> {
+    let models = irs
+        .iter()
+        .map(registry_model)
+        .collect::<Result<Vec<_>, _>>()?;
+    let tasks = task_list(irs)?;
+    let list = |items: Vec<&str>| items.join(", ");
+    Ok(RegistryContext {
+        model_count: models.len(),
+        task_count: tasks.len(),
+        task_choices: task_choices(&tasks),
+        package: PackageView {
+            name: package.name.clone(),
+            lib: package.name.replace('-', "_"),
+            standalone: package.standalone,
+            command: shared_generator(irs, "command", |ir| &ir.generator.command)?,
+            tasks: shared_generator(irs, "tasks", |ir| &ir.generator.tasks)?,
+            descriptions: list(models.iter().map(|m| m.description).collect()),
+            model_names: list(models.iter().map(|m| m.name).collect()),
+        },
+        models,
+        tasks,
+    })
+}
+
+fn registry_model(ir: &Ir) -> Result<RegistryModel<'_>, RenderError> {
+    let m = &ir.model;
+    let marker = camel_case(&m.name);
+    Ok(RegistryModel {
+        name: &m.name,
+        title: &m.title,
+        title_literal: string_literal(&m.title),
+        tool: format!("{marker}Tool"),
+        marker,
+        description: &ir.generator.model,
+        parameter_count: m.parameters.len(),
+        functions: ir.functions.iter().map(vector_test_view).collect(),
+        function_count: ir.functions.len(),
+        tool_rule: tool_rule_view(m)?,
+        rigid_body: rigid_body(&ir.functions),
+    })
+}
+
+/// The URDF arms' `rigid_body_dynamics` (their plant adds joint impedance), else the model's
+/// plant `dynamics`, which for the other kinds is the equations of motion with U the torques
+/// (or force) itself.
+fn rigid_body(functions: &[Function]) -> RigidBody {
+    if functions.iter().any(|f| f.name == "rigid_body_dynamics") {
+        RigidBody {
+            function: "rigid_body_dynamics",
+            doc: "the rigid-body dynamics alone (the model's plant adds joint impedance)",
+        }
+    } else {
+        RigidBody {
+            function: "dynamics",
+            doc: "the model's plant, which is its rigid-body dynamics",
+        }
+    }
+}
+
+fn vector_test_view(f: &Function) -> VectorTestView<'_> {
+    let outputs: Vec<String> = f.outputs.iter().map(|o| o.name.clone()).collect();
+    VectorTestView {
+        name: &f.name,
+        args: f.args.iter().map(|a| a.name.as_str()).collect(),
+        outputs: f.outputs.iter().map(|o| o.name.as_str()).collect(),
+        pattern: binding_pattern(&outputs),
+    }
+}
+
+/// The same `generator` entry of every IR (the command, the task definitions), or an error
+/// naming the first model that differs.
+fn shared_generator(
+    irs: &[Ir],
+    key: &str,
+    of: impl Fn(&Ir) -> &String,
+) -> Result<String, RenderError> {
+    let first = irs.first().map(|ir| of(ir).clone()).unwrap_or_default();
+    match irs.iter().find(|ir| *of(ir) != first) {
+        Some(ir) => Err(RenderError::Template(format!(
+            "model {:?} has generator.{key} {:?}, the first model {first:?}: the models of one crate come from one run",
+            ir.model.name,
+            of(ir)
+        ))),
+        None => Ok(first),
+    }
+}

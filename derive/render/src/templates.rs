@@ -1,0 +1,117 @@
+//! Loading the templates: the per-model ones with their variants and macros, and the registry's
+//! tree laid out as the crate it renders to.
+
+use std::path::{Path, PathBuf};
+
+use crate::ir::Ir;
+use crate::RenderError;
+
+/// Loads every `*.tera` file of a folder, in name order, then those of its sub-folders but
+/// `registry/` as `<folder>/<file>` ([`load_variants`]): macros a template imports and per-model
+/// variants of the top-level templates (`urdf/`).
+pub fn load_templates(dir: &Path) -> Result<Vec<(String, String)>, RenderError> {
+    let mut all = load_folder(dir)?;
+    all.extend(load_variants(dir)?);
+    Ok(all)
+}
+
+/// Every `*.tera` file directly in `dir`, in name order.
+fn load_folder(dir: &Path) -> Result<Vec<(String, String)>, RenderError> {
+    let io = |source| RenderError::Io {
+        path: dir.into(),
+        source,
+    };
+    let mut names: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(io)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "tera"))
+        .collect();
+    names.sort();
+    names
+        .into_iter()
+        .map(|p| {
+            let text = std::fs::read_to_string(&p).map_err(|source| RenderError::Io {
+                path: p.clone(),
+                source,
+            })?;
+            let name = p
+                .file_name()
+                .unwrap_or_default()
+                .to_string_lossy()
+                .into_owned();
+            Ok((name, text))
+        })
+        .collect()
+}
+
+/// Loads every `*.tera` file under `dir` and its sub-folders, in path order, each named by its
+/// path relative to `dir` with `/` between folders (`src/lib.rs.tera`): the registry templates,
+/// laid out as the crate they render to.
+pub fn load_template_tree(dir: &Path) -> Result<Vec<(String, String)>, RenderError> {
+    let mut out = Vec::new();
+    let mut pending = vec![PathBuf::new()];
+    while let Some(relative) = pending.pop() {
+        let folder = dir.join(&relative);
+        let io = |source| RenderError::Io {
+            path: folder.clone(),
+            source,
+        };
+        for entry in std::fs::read_dir(&folder).map_err(io)? {
+            let entry = entry.map_err(io)?;
+            let name = relative.join(entry.file_name());
+            if entry.file_type().map_err(io)?.is_dir() {
+                pending.push(name);
+            } else if name.extension().is_some_and(|x| x == "tera") {
+                let path = dir.join(&name);
+                let text = std::fs::read_to_string(&path)
+                    .map_err(|source| RenderError::Io { path, source })?;
+                let parts: Vec<String> = name
+                    .components()
+                    .map(|c| c.as_os_str().to_string_lossy().into_owned())
+                    .collect();
+                out.push((parts.join("/"), text));
+            }
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
+/// The template that renders `name` for this model: a variant `<folder>/<name>` (loaded by
+/// [`load_variants`]) when the IR's `templates` list names one, else `name` itself. A URDF
+/// model's report is not the closed forms' (templates/urdf/report.md.tera).
+pub fn variant<'a>(ir: &Ir, name: &'a str, templates: &'a [(String, String)]) -> &'a str {
+    let wanted = ir.templates.as_deref().unwrap_or_default();
+    templates
+        .iter()
+        .map(|(n, _)| n.as_str())
+        .find(|n| wanted.iter().any(|w| w == n) && n.rsplit('/').next() == Some(name))
+        .unwrap_or(name)
+}
+
+/// Every `*.tera` file in the sub-folders of `dir` other than `registry/`, named
+/// `<folder>/<file>`.
+fn load_variants(dir: &Path) -> Result<Vec<(String, String)>, RenderError> {
+    let io = |source| RenderError::Io {
+        path: dir.into(),
+        source,
+    };
+    let mut folders: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(io)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_dir() && p.file_name().is_some_and(|n| n != "registry"))
+        .collect();
+    folders.sort();
+    let mut out = Vec::new();
+    for folder in folders {
+        let prefix = folder
+            .file_name()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .into_owned();
+        for (name, text) in load_folder(&folder)? {
+            out.push((format!("{prefix}/{name}"), text));
+        }
+    }
+    Ok(out)
+}
