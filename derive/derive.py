@@ -23,6 +23,7 @@ from toolconf_derive.description import DescriptionError, load_model, load_tasks
 from toolconf_derive.functions import build_functions  # noqa: E402
 from toolconf_derive.exact import ExactEvaluationError  # noqa: E402
 from toolconf_derive.ir import IR_SCHEMA, model_ir, vectors_document  # noqa: E402
+from toolconf_derive.ir_types import Generator, as_json  # noqa: E402
 from toolconf_derive.numeric import CasadiModel  # noqa: E402
 from toolconf_derive.report import report_data  # noqa: E402
 from toolconf_derive.sequence import SequenceError  # noqa: E402
@@ -41,8 +42,9 @@ def shown(path: Path, root: Path) -> str:
     return str(resolved.relative_to(root)) if resolved.is_relative_to(root) else str(path)
 
 
-def write(path: Path, document: dict) -> None:
-    path.write_text(json.dumps(document, indent=1, ensure_ascii=False) + "\n")
+def write(path: Path, document) -> None:
+    """`document` (ir_types' dataclasses, or a dict of them) as JSON."""
+    path.write_text(json.dumps(as_json(document), indent=1, ensure_ascii=False) + "\n")
 
 
 def main() -> int:
@@ -78,19 +80,19 @@ def main() -> int:
         tasks = load_tasks(args.tasks)
         # Names, not the paths written to: the same bytes wherever --out points (the drift check
         # derives into a temporary folder and compares).
-        generator = {
-            "command": args.command,
-            "model": shown(args.model, root),
-            "tasks": shown(args.tasks, root),
-            "ir": out.name,
-            "vectors": vectors_out.name,
-            "derive": "derive/derive.py (SymPy derives, CasADi checks)",
-            "render": "derive/render (Tera) + rustfmt",
-        }
+        generator = Generator(
+            command=args.command,
+            model=shown(args.model, root),
+            tasks=shown(args.tasks, root),
+            ir=out.name,
+            vectors=vectors_out.name,
+            derive="derive/derive.py (SymPy derives, CasADi checks)",
+            render="derive/render (Tera) + rustfmt",
+        )
         if model.dynamics_kind == "urdf":
             # CasADi SX, not SymPy (derive/toolconf_derive/urdf_model.py); each test vector is
             # checked in 50-digit arithmetic on two graphs of thousands of instructions, so fewer.
-            generator["derive"] = "derive/derive.py (CasADi SX: RNEA/CRBA/LDL^T, checked against ABA)"
+            generator.derive = "derive/derive.py (CasADi SX: RNEA/CRBA/LDL^T, checked against ABA)"
             ir, vectors = urdf_documents(model, tasks, generator, min(args.vectors, URDF_VECTORS), IR_SCHEMA)
         else:
             d = derive(model, tasks)
@@ -111,7 +113,7 @@ def main() -> int:
         print(f"derive: cannot write {err.filename}: {err.strerror}", file=sys.stderr)
         return 1
     checked = sum(len(f["vectors"]) for f in vectors["functions"])
-    print(f"derive: {model.name}: {len(ir['functions'])} functions, {checked} points checked SymPy = CasADi "
+    print(f"derive: {model.name}: {len(ir.functions)} functions, {checked} points checked SymPy = CasADi "
           f"-> {out}, {vectors_out}")
     return 0
 

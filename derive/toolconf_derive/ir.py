@@ -1,12 +1,14 @@
 """The intermediate representation: one JSON document per model that the Tera renderer turns into
 Rust and a report. It carries the CSE'd expressions (printed as Rust f64 code), the shapes, the
-docs, and the CasADi test vectors; the renderer needs nothing else."""
+docs, and the CasADi test vectors; the renderer needs nothing else. The document is built of
+ir_types' dataclasses, the mirror of the types the renderer reads it into (derive/render/src/ir.rs)."""
 
 from __future__ import annotations
 
 import numpy as np
 import sympy as sp
 
+from . import ir_types as irt
 from .cost import cost, total
 from .crosscheck import check_against_casadi
 from .description import DescriptionError, name_keys, rust_constant
@@ -24,23 +26,21 @@ def _rust_type(shape: tuple[int, int]) -> str:
     return f"SVector<f64, {r}>" if c == 1 else f"SMatrix<f64, {r}, {c}>"
 
 
-def _scopes(f: dict) -> list[tuple[str, list[str]]]:
+def _scopes(f: irt.Function) -> list[tuple[str, list[str]]]:
     """The names each Rust scope of one function's IR declares (arguments and lets), as
-    templates/model.rs.tera and include/sequence.tera render them."""
-    def lets(body: dict) -> list[str]:
-        names = [e["name"] for key in ("constants", "bindings", "compounds", "temporaries") for e in body.get(key, [])]
-        names += [t[side] for t in body.get("trig", []) for side in ("sin", "cos") if t[side] != "_"]
-        names += [slot["name"] for slot in (body.get("sequence") or {}).get("slots", [])]
-        return names
-    body = lets(f) + [o["name"] for o in f["outputs"]]
-    c = f.get("coefficients")
+    templates/model.rs.tera renders them."""
+    body = [e.name for e in f.constants + f.bindings + f.compounds + f.temporaries]
+    body += [side for t in f.trig for side in (t.sin, t.cos) if side != "_"]
+    body += [slot.name for slot in (f.sequence.slots if f.sequence else [])]
+    body += [o.name for o in f.outputs]
+    c = f.coefficients
     if c is None:
-        return [(f["name"], [a["name"] for a in f["args"]] + body)]
-    return [(f["name"] + "_with", [a["name"] for a in c["args"]] + body),
-            (f"{c['struct']}::new", ["params"] + lets(c))]
+        return [(f.name, [a.name for a in f.args] + body)]
+    return [(f.name + "_with", [a.name for a in c.args] + body),
+            (f"{c.struct}::new", ["params"] + [e.name for e in c.constants + c.bindings + c.temporaries])]
 
 
-def check_rust_names(m, functions: list[dict]) -> None:
+def check_rust_names(m, functions: list[irt.Function]) -> None:
     """Every name in a generated scope is declared once: a description name equal to one the
     generated code uses (an argument such as `x`, an output such as `a`, a temporary `t3`, the
     `sin_q` of a joint angle) would shadow it and silently change the arithmetic."""
@@ -105,15 +105,14 @@ def _code(entries: list[sp.Expr], d: Derivation, args: list, declared: set[str],
     for symbol, definition in compounds:
         if symbol in used:
             used |= definition.free_symbols
-            compound_code.append({"name": symbol.name, "rust": printer(definition)})
+            compound_code.append(irt.Let(symbol.name, printer(definition)))
             compound_definitions.append(definition)
     trig = []
     for q in angles:
         s, c = _trig_symbols(q)
         if s in used or c in used:
             used.add(q)
-            trig.append({"angle": q.name, "sin": s.name if s in used else "_",
-                         "cos": c.name if c in used else "_"})
+            trig.append(irt.Trig(q.name, s.name if s in used else "_", c.name if c in used else "_"))
     bindings = []
     for arg in args:
         for s, i, j in arg.reads:
@@ -122,13 +121,13 @@ def _code(entries: list[sp.Expr], d: Derivation, args: list, declared: set[str],
                     access = f"coefficients.k[{i}]"
                 else:
                     access = f"{arg.name}[{i}]" if arg.shape[1] == 1 else f"{arg.name}[({i}, {j})]"
-                bindings.append({"name": s.name, "arg": arg.name, "access": access})
+                bindings.append(irt.Binding(s.name, arg.name, access))
     return {
-        "constants": [{"name": c.name, "rust": rust_constant(c.name)} for c in d.constants if c in used],
+        "constants": [irt.Let(c.name, rust_constant(c.name)) for c in d.constants if c in used],
         "bindings": bindings,
         "trig": trig,
         "compounds": compound_code,
-        "temporaries": [{"name": str(t), "rust": printer(e)} for t, e in replacements],
+        "temporaries": [irt.Let(str(t), printer(e)) for t, e in replacements],
         "reduced": [printer(e) for e in reduced],
         "cost": cost(compound_definitions + [e for _, e in replacements] + list(reduced)) | {"sin_cos": len(trig)},
         "compound_cost": cost(compound_definitions),
@@ -139,7 +138,7 @@ def _struct_name(function: str) -> str:
     return "".join(w.capitalize() for w in function.split("_")) + "Coefficients"
 
 
-def function_ir(fn: Function, d: Derivation) -> dict:
+def function_ir(fn: Function, d: Derivation) -> irt.Function:
     declared = {s.name for s in d.params + list(d.constants) + d.x + d.u}
     for arg in fn.args:
         declared |= {s.name for s, _, _ in arg.reads}
@@ -165,15 +164,16 @@ def function_ir(fn: Function, d: Derivation) -> dict:
         k = Arg("coefficients", "", (len(hoisted.symbols), 1), [(s, i, 0) for i, s in enumerate(hoisted.symbols)],
                 False, None)
         coefficient_code = _code(hoisted.values, d, params, declared, "s")
-        coefficients = {
-            "struct": _struct_name(fn.name),
-            "count": len(hoisted.symbols),
-            "constants": coefficient_code["constants"],
-            "bindings": coefficient_code["bindings"],
-            "temporaries": coefficient_code["temporaries"],
-            "values": coefficient_code["reduced"],
-            "cost": coefficient_code["cost"],
-        }
+        coefficients = irt.Coefficients(
+            struct=_struct_name(fn.name),
+            count=len(hoisted.symbols),
+            constants=coefficient_code["constants"],
+            bindings=coefficient_code["bindings"],
+            temporaries=coefficient_code["temporaries"],
+            values=coefficient_code["reduced"],
+            cost=irt.Cost(**coefficient_code["cost"]),
+            args=[],
+        )
         entries = hoisted.entries
         call_args = [a for a in fn.args if a.name != "params"] + [k]
     code = _code(entries, d, call_args, declared, "t", angles, compounds)
@@ -181,45 +181,42 @@ def function_ir(fn: Function, d: Derivation) -> dict:
     if coefficients is not None:
         # What one call of `name(x, u, params)` would take with the parameters inline (the same
         # sin_cos and angle sums), to set against the coefficients' once-per-tool cost.
-        unhoisted = total(hoisted.unhoisted, code["compound_cost"]) | {"sin_cos": code["cost"]["sin_cos"]}
+        unhoisted = irt.Cost(**(total(hoisted.unhoisted, code["compound_cost"]) | {"sin_cos": code["cost"]["sin_cos"]}))
 
-    outputs = []
-    for out in fn.outputs:
-        outputs.append({
-            "name": out.name, "doc": out.doc, "rows": out.value.rows, "cols": out.value.cols,
-            "rust_type": _rust_type(out.value.shape), "symmetric": out.symmetric, "entries": [],
-        })
+    outputs = [irt.Output(name=out.name, doc=out.doc, rows=out.value.rows, cols=out.value.cols,
+                          rust_type=_rust_type(out.value.shape), symmetric=out.symmetric, entries=[])
+               for out in fn.outputs]
     for (oi, r, c), e in zip(where, code["reduced"]):
-        outputs[oi]["entries"].append({"row": r, "col": c, "rust": e})
+        outputs[oi].entries.append(irt.Entry(row=r, col=c, rust=e))
 
-    bound_args = {b["arg"] for b in code["bindings"]}
+    bound_args = {b.arg for b in code["bindings"]}
     if coefficients is not None:
-        coefficients["args"] = [
-            {"name": a.name, "rust_type": "&" + (coefficients["struct"] if a.name == "coefficients"
-                                                 else _rust_type(a.shape)),
-             "used": a.name in bound_args}
+        coefficients.args = [
+            irt.CoefficientArg(name=a.name, rust_type="&" + (coefficients.struct if a.name == "coefficients"
+                                                             else _rust_type(a.shape)),
+                               used=a.name in bound_args)
             for a in call_args
         ]
-    return {
-        "name": fn.name,
-        "doc": fn.doc,
-        "equation": fn.equation,
-        "args": [
-            {"name": a.name, "doc": a.doc, "rows": a.shape[0], "cols": a.shape[1],
-             "rust_type": _rust_type(a.shape), "symmetric": a.symmetric,
-             "used": a.name in bound_args or (coefficients is not None and a.name == "params")}
+    return irt.Function(
+        name=fn.name,
+        doc=fn.doc,
+        equation=fn.equation,
+        args=[
+            irt.Arg(name=a.name, doc=a.doc, rows=a.shape[0], cols=a.shape[1], rust_type=_rust_type(a.shape),
+                    symmetric=a.symmetric,
+                    used=a.name in bound_args or (coefficients is not None and a.name == "params"))
             for a in fn.args
         ],
-        "coefficients": coefficients,
-        "cost": code["cost"],
-        "unhoisted_cost": unhoisted,
-        "outputs": outputs,
-        "constants": code["constants"],
-        "bindings": code["bindings"],
-        "trig": code["trig"],
-        "compounds": code["compounds"],
-        "temporaries": code["temporaries"],
-    }
+        coefficients=coefficients,
+        cost=irt.Cost(**code["cost"]),
+        unhoisted_cost=unhoisted,
+        outputs=outputs,
+        constants=code["constants"],
+        bindings=code["bindings"],
+        trig=code["trig"],
+        compounds=code["compounds"],
+        temporaries=code["temporaries"],
+    )
 
 
 def test_vectors(fn: Function, d: Derivation, count: int) -> list[dict]:
@@ -241,9 +238,10 @@ def test_vectors(fn: Function, d: Derivation, count: int) -> list[dict]:
     ]
 
 
-def vectors_document(d: Derivation, functions: list[Function], generator: dict, count: int) -> dict:
+def vectors_document(d: Derivation, functions: list[Function], generator: irt.Generator, count: int) -> dict:
     """The test vectors file (generated/<model>.vectors.json), kept out of the IR so that a change
-    to a derivation reads as an IR and code diff, not as thousands of changed numbers."""
+    to a derivation reads as an IR and code diff, not as thousands of changed numbers. The
+    renderer does not read it (the generated crate's tests/vectors.rs does)."""
     return {
         "schema": IR_SCHEMA,
         "generator": generator,
@@ -253,7 +251,8 @@ def vectors_document(d: Derivation, functions: list[Function], generator: dict, 
     }
 
 
-def model_ir(d: Derivation, functions: list[Function], generator: dict, report: dict, vectors: int) -> dict:
+def model_ir(d: Derivation, functions: list[Function], generator: irt.Generator, report: irt.ClosedFormReport,
+             vectors: int) -> irt.Ir:
     """The IR; `vectors` is the number of test vectors per function, which live in their own file."""
     printer = RustPrinter()
     return model_document(d.model, [printer(v) for v in d.x_e], [printer(v) for v in d.u_e],
@@ -261,49 +260,47 @@ def model_ir(d: Derivation, functions: list[Function], generator: dict, report: 
                           vectors)
 
 
-def model_document(m, x_e: list[str], u_e: list[str], tasks: list, functions: list[dict], generator: dict,
-                   report: dict, vectors: int) -> dict:
-    """The IR of model `m` around its functions' IR (each `function_ir`'s shape), with the
-    equilibrium as Rust literals and the tasks of tasks.toml."""
+def model_document(m, x_e: list[str], u_e: list[str], tasks: list, functions: list[irt.Function],
+                   generator: irt.Generator, report: irt.ClosedFormReport | irt.UrdfReport, vectors: int,
+                   templates: list[str] | None = None) -> irt.Ir:
+    """The IR of model `m` around its functions' IR, with the equilibrium as Rust literals and the
+    tasks of tasks.toml; `templates` names the template variants it renders through."""
     check_rust_names(m, functions)
     printer = RustPrinter()
-    document = {
-        "schema": IR_SCHEMA,
-        "generator": generator,
-        "model": {
-            "name": m.name,
-            "title": m.title,
-            "source": m.source,
-            "dof": m.dof,
-            "state_dim": m.state_dim,
-            "parameters": [{"name": p.name, "latex": p.latex, "unit": p.unit, "doc": p.doc} for p in m.parameters],
-            "constants": [{"name": c.name, "rust": rust_constant(c.name), "value": c.value, "unit": c.unit,
-                           "doc": c.doc} for c in m.constants],
-            "state": [{"name": s.name, "latex": s.latex} for s in m.state],
-            "control": [{"name": s.name, "latex": s.latex} for s in m.u],
-            "equilibrium": {"x": x_e, "u": u_e},
-        },
-        "tasks": [
-            {
-                "name": t.name, "index": t.index, "title": t.title, "doc": t.doc,
-                "terms": t.terms, "sensitivity_terms": t.sensitivity_terms, "error": t.error,
-                "sensitivity_function": t.sensitivity_function,
-                "confidence_function": t.confidence_function,
-                "gradient_function": t.gradient_function,
-                "goals": [{"term": term, "rust": [printer(sp.sympify(v)) for v in
-                                                  m.goals.get(t.name, {}).get(term, ["0"] * m.dof)]}
-                          for term in t.sensitivity_terms],
-                "precisions": [{"term": term, "rust": float_literal(t.default_precision[term]),
-                                "value": t.default_precision[term]} for term in t.terms],
-            }
+    return irt.Ir(
+        schema=IR_SCHEMA,
+        generator=generator,
+        model=irt.Model(
+            name=m.name,
+            title=m.title,
+            source=m.source,
+            dof=m.dof,
+            state_dim=m.state_dim,
+            parameters=[irt.Parameter(p.name, p.latex, p.unit, p.doc) for p in m.parameters],
+            constants=[irt.Constant(c.name, rust_constant(c.name), c.value, c.unit, c.doc) for c in m.constants],
+            state=[irt.Variable(s.name, s.latex) for s in m.state],
+            control=[irt.Variable(s.name, s.latex) for s in m.u],
+            equilibrium=irt.Equilibrium(x=x_e, u=u_e),
+            # Only where the description states one (a URDF tool): without it the renderer gives
+            # every parameter the planar arms' rule (> 0, drawn from [0.1, 0.6]).
+            tool_rule=None if m.tool_rule is None else irt.ToolRule.of(m.tool_rule),
+        ),
+        tasks=[
+            irt.Task(
+                name=t.name, index=t.index, title=t.title, doc=t.doc,
+                terms=t.terms, sensitivity_terms=t.sensitivity_terms, error=t.error,
+                sensitivity_function=t.sensitivity_function,
+                confidence_function=t.confidence_function,
+                gradient_function=t.gradient_function,
+                goals=[irt.Goal(term, [printer(sp.sympify(v)) for v in m.goals.get(t.name, {}).get(term, ["0"] * m.dof)])
+                       for term in t.sensitivity_terms],
+                precisions=[irt.Precision(term, float_literal(t.default_precision[term]), t.default_precision[term])
+                            for term in t.terms],
+            )
             for t in tasks
         ],
-        "functions": functions,
-        "test_vectors": {"file": generator["vectors"], "per_function": vectors},
-        "report": report,
-    }
-    # Only where the description states one (a URDF tool): without it the renderer gives every
-    # parameter the planar arms' rule (> 0, drawn from [0.1, 0.6]), and their IR stays as it was.
-    if m.tool_rule is not None:
-        document["model"]["tool_rule"] = m.tool_rule
-    return document
+        functions=functions,
+        test_vectors=irt.TestVectors(file=generator.vectors, per_function=vectors),
+        report=report,
+        templates=templates,
+    )

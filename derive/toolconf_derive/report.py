@@ -6,6 +6,7 @@ from __future__ import annotations
 import mpmath
 import sympy as sp
 
+from . import ir_types as irt
 from .symbolic import TERM_LATEX, Derivation, cofactor_determinant, parse, tidy
 
 # The tool at which the report states d ln|Pi^U|/dp: the middle of the paper's box [0.1, 0.6].
@@ -16,39 +17,39 @@ def _latex(d: Derivation, e) -> str:
     return sp.latex(e, symbol_names=d.symbol_latex, mat_str="bmatrix", mat_delim="")
 
 
-def _compare(d: Derivation, label: str, derived: sp.Matrix, printed_rows: list[list[str]]) -> list[dict]:
+def _compare(d: Derivation, label: str, derived: sp.Matrix, printed_rows: list[list[str]]) -> list[irt.Comparison]:
     symbols = {str(s): s for s in d.params + list(d.constants)}
     rows = []
     for i, row in enumerate(printed_rows):
         for j, text in enumerate(row):
             printed = parse(d.model, text, symbols, f"printed.{label}[{i}][{j}]")
             difference = tidy(derived[i, j] - printed)
-            rows.append({
-                "entry": f"{label}[{i + 1},{j + 1}]",
-                "derived": _latex(d, derived[i, j]),
-                "printed": _latex(d, printed),
-                "equal": difference == 0,
-                "difference": _latex(d, difference),
-            })
+            rows.append(irt.Comparison(
+                entry=f"{label}[{i + 1},{j + 1}]",
+                derived=_latex(d, derived[i, j]),
+                printed=_latex(d, printed),
+                equal=difference == 0,
+                difference=_latex(d, difference),
+            ))
     return rows
 
 
-def _equations(d: Derivation) -> list[dict]:
+def _equations(d: Derivation) -> list[irt.Equation]:
     m = d.model
     if d.lagrangian is None:
-        return [{"lhs": rf"\ddot{{{c.latex}}}", "rhs": _latex(d, e)} for c, e in zip(m.q, d.q_ddot)]
+        return [irt.Equation(rf"\ddot{{{c.latex}}}", _latex(d, e)) for c, e in zip(m.q, d.q_ddot)]
     lag = d.lagrangian
     return [
-        {"lhs": "T", "rhs": _latex(d, lag["T"])},
-        {"lhs": "V", "rhs": _latex(d, lag["V"])},
-        {"lhs": "M(q) = \\partial^2 T / \\partial \\dot q^2", "rhs": _latex(d, lag["M"])},
-        {"lhs": "Q", "rhs": _latex(d, lag["Q"])},
-        {"lhs": "\\ddot q", "rhs": "M(q)^{-1}\\left(Q - \\frac{\\partial (M \\dot q)}{\\partial q}\\dot q"
-         " + \\frac{\\partial T}{\\partial q} - \\frac{\\partial V}{\\partial q}\\right)"},
+        irt.Equation("T", _latex(d, lag["T"])),
+        irt.Equation("V", _latex(d, lag["V"])),
+        irt.Equation("M(q) = \\partial^2 T / \\partial \\dot q^2", _latex(d, lag["M"])),
+        irt.Equation("Q", _latex(d, lag["Q"])),
+        irt.Equation("\\ddot q", "M(q)^{-1}\\left(Q - \\frac{\\partial (M \\dot q)}{\\partial q}\\dot q"
+                     " + \\frac{\\partial T}{\\partial q} - \\frac{\\partial V}{\\partial q}\\right)"),
     ]
 
 
-def _gradient(d: Derivation, t, substitute: dict) -> dict:
+def _gradient(d: Derivation, t, substitute: dict) -> irt.GradientReport:
     """d ln|Pi^U|/dp with the default precisions: its values at the reference tool (50-digit
     mpmath, printed to 6 digits, so the same text on every machine) and, for one joint, the
     closed form (for more joints it runs to pages; the generated code has it, CSE'd)."""
@@ -60,16 +61,16 @@ def _gradient(d: Derivation, t, substitute: dict) -> dict:
     closed = None
     if d.model.dof == 1:
         pi = t.confidence.subs(substitute)
-        closed = [{"name": p.name, "latex": _latex(d, tidy(sp.diff(sp.log(cofactor_determinant(pi)), p)))}
+        closed = [irt.GradientClosedForm(p.name, _latex(d, tidy(sp.diff(sp.log(cofactor_determinant(pi)), p))))
                   for p in d.params]
-    return {
-        "reference": f"{float(REFERENCE_PARAMETER)}",
-        "values": [{"name": p.name, "value": v} for p, v in zip(d.params, shown)],
-        "closed": closed,
-    }
+    return irt.GradientReport(
+        reference=f"{float(REFERENCE_PARAMETER)}",
+        values=[irt.GradientValue(p.name, v) for p, v in zip(d.params, shown)],
+        closed=closed,
+    )
 
 
-def report_data(d: Derivation) -> dict:
+def report_data(d: Derivation) -> irt.ClosedFormReport:
     m = d.model
     n = m.dof
     comparisons = []
@@ -90,46 +91,46 @@ def report_data(d: Derivation) -> dict:
             rf" \frac{{\partial {TERM_LATEX[term]}}}{{\partial U}}"
             for term in task.sensitivity_terms
         ) + r" + P^{U}"
-        tasks.append({
-            "name": task.name,
-            "index": task.index,
-            "title": task.title,
-            "doc": task.doc,
-            "sensitivities": [
-                {"term": term, "what": rf"\frac{{\partial {TERM_LATEX[term]}}}{{\partial U}}",
-                 "formula": task.sensitivity[term], "latex": _latex(d, t.sensitivity[term])}
+        tasks.append(irt.TaskReport(
+            name=task.name,
+            index=task.index,
+            title=task.title,
+            doc=task.doc,
+            sensitivities=[
+                irt.SensitivityReport(term=term, what=rf"\frac{{\partial {TERM_LATEX[term]}}}{{\partial U}}",
+                                      formula=task.sensitivity[term], latex=_latex(d, t.sensitivity[term]))
                 for term in task.sensitivity_terms
             ],
-            "confidence_formula": formula,
-            "default_precisions": ", ".join(
+            confidence_formula=formula,
+            default_precisions=", ".join(
                 f"P^{{{TERM_LATEX[term]}}} = {sp.latex(sp.nsimplify(task.default_precision[term]))} I"
                 for term in task.terms
             ),
-            "confidence_default": _latex(d, confidence_default),
-            "gradient": _gradient(d, t, {s: defaults[term][i, j] for term, reads in t.precision_reads.items()
-                                         for s, i, j in reads}),
-            "remarks": [
-                {
-                    "what": rf"\frac{{\partial {TERM_LATEX[r['remark'].term]}}}{{\partial U}}",
-                    "text": " ".join(r["remark"].text.split()),
-                    "alternative_formula": r["remark"].alternative,
-                    "alternative": _latex(d, r["alternative"]),
-                    "used": _latex(d, r["used"]),
-                    "equal": (r["alternative"] - r["used"]).applyfunc(tidy) == sp.zeros(n, n),
-                }
+            confidence_default=_latex(d, confidence_default),
+            gradient=_gradient(d, t, {s: defaults[term][i, j] for term, reads in t.precision_reads.items()
+                                      for s, i, j in reads}),
+            remarks=[
+                irt.Remark(
+                    what=rf"\frac{{\partial {TERM_LATEX[r['remark'].term]}}}{{\partial U}}",
+                    text=" ".join(r["remark"].text.split()),
+                    alternative_formula=r["remark"].alternative,
+                    alternative=_latex(d, r["alternative"]),
+                    used=_latex(d, r["used"]),
+                    equal=(r["alternative"] - r["used"]).applyfunc(tidy) == sp.zeros(n, n),
+                )
                 for r in t.remarks
             ],
-        })
+        ))
 
-    return {
-        "printed_where": m.printed_where,
-        "equations": _equations(d),
-        "equation_refs": m.equations,
-        "equilibrium_x": _latex(d, d.x_e.T),
-        "equilibrium_u": _latex(d, d.u_e.T),
-        "a": _latex(d, d.a),
-        "b": _latex(d, d.b),
-        "comparisons": comparisons,
-        "differences": [c for c in comparisons if not c["equal"]],
-        "tasks": tasks,
-    }
+    return irt.ClosedFormReport(
+        printed_where=m.printed_where,
+        equations=_equations(d),
+        equation_refs=m.equations,
+        equilibrium_x=_latex(d, d.x_e.T),
+        equilibrium_u=_latex(d, d.u_e.T),
+        a=_latex(d, d.a),
+        b=_latex(d, d.b),
+        comparisons=comparisons,
+        differences=[c for c in comparisons if not c.equal],
+        tasks=tasks,
+    )

@@ -1,6 +1,6 @@
 """CasADi SX functions as the IR's straight-line code: CasADi's own instruction list, one step per
 instruction on CasADi's work slots, beside the same bindings and trig as the SymPy closed forms;
-templates/include/sequence.tera renders it.
+templates/model.rs.tera renders it (derive/render/src/functions.rs).
 
 For models too large for closed forms (URDF arms, urdf_model.py). Every instruction becomes one
 binary or unary f64 operation on named values or literals: +, -, *, /, negation. The sine and

@@ -13,6 +13,7 @@ import time
 import casadi as ca
 import numpy as np
 
+from . import ir_types as irt
 from .description import Model
 from .exact import ExactFunction
 from .functions import _sample_control, _sample_precision, _sample_state, TERM_DOC
@@ -172,12 +173,19 @@ def test_vectors(fn: SeqFunction, count: int) -> list[dict]:
     return vectors
 
 
-def _arg_ir(a: SeqArg, used: bool) -> dict:
-    return {"name": a.name, "doc": a.doc, "rows": a.rows, "cols": a.cols, "rust_type": _rust_type((a.rows, a.cols)),
-            "symmetric": a.symmetric, "used": used}
+def _arg_ir(a: SeqArg, used: bool) -> irt.Arg:
+    return irt.Arg(name=a.name, doc=a.doc, rows=a.rows, cols=a.cols, rust_type=_rust_type((a.rows, a.cols)),
+                   symmetric=a.symmetric, used=used)
 
 
-def function_ir(fn: SeqFunction) -> dict:
+def _body_ir(body: dict) -> dict:
+    """sequence.instructions' bindings, trig and sequence as the IR's types."""
+    return {"bindings": [irt.Binding(**b) for b in body["bindings"]], "trig": [irt.Trig(**t) for t in body["trig"]],
+            "sequence": irt.Sequence(slots=[irt.Slot(**w) for w in body["sequence"]["slots"]],
+                                     steps=[irt.Step(**w) for w in body["sequence"]["steps"]])}
+
+
+def function_ir(fn: SeqFunction) -> irt.Function:
     coefficients, unhoisted = None, None
     if fn.coefficients is not None:
         k_count = fn.coefficients.size1_out(0)
@@ -194,13 +202,13 @@ def function_ir(fn: SeqFunction) -> dict:
         made["temporaries"] = temporaries
         bound = {b["arg"] for b in body["bindings"]}
         struct = _struct_name(fn.name)
-        coefficients = {
-            "struct": struct, "count": k_count, "constants": [], "bindings": made["bindings"],
-            "temporaries": made["temporaries"], "values": values, "cost": made["cost"],
-            "args": [{"name": a.name, "rust_type": "&" + _rust_type((a.rows, a.cols)), "used": a.name in bound}
-                     for a in call] + [{"name": "coefficients", "rust_type": "&" + struct,
-                                        "used": "coefficients" in bound}],
-        }
+        coefficients = irt.Coefficients(
+            struct=struct, count=k_count, constants=[], bindings=[irt.Binding(**b) for b in made["bindings"]],
+            temporaries=[irt.Let(**t) for t in made["temporaries"]], values=values, cost=irt.Cost(**made["cost"]),
+            args=[irt.CoefficientArg(name=a.name, rust_type="&" + _rust_type((a.rows, a.cols)), used=a.name in bound)
+                  for a in call] + [irt.CoefficientArg(name="coefficients", rust_type="&" + struct,
+                                                       used="coefficients" in bound)],
+        )
         unhoisted = instruction_count(fn.unhoisted)
         args = [_arg_ir(a, a.name in bound or a.name == "params") for a in fn.args]
     else:
@@ -210,22 +218,24 @@ def function_ir(fn: SeqFunction) -> dict:
         args = [_arg_ir(a, a.name in bound) for a in fn.args]
     outputs = []
     for out, entries in zip(fn.outputs, body["outputs"]):
-        outputs.append({"name": out.name, "doc": out.doc, "rows": out.rows, "cols": out.cols,
-                        "rust_type": _rust_type((out.rows, out.cols)), "symmetric": out.symmetric,
-                        "entries": sorted(entries, key=lambda e: (e["row"], e["col"]))})
+        outputs.append(irt.Output(name=out.name, doc=out.doc, rows=out.rows, cols=out.cols,
+                                  rust_type=_rust_type((out.rows, out.cols)), symmetric=out.symmetric,
+                                  entries=[irt.Entry(**e) for e in sorted(entries, key=lambda e: (e["row"], e["col"]))]))
     fn.stats["cost"] = body["cost"]
     if coefficients:
-        fn.stats["coefficient_cost"] = coefficients["cost"]
+        fn.stats["coefficient_cost"] = made["cost"]
         fn.stats["unhoisted_cost"] = unhoisted
-    return {
-        "name": fn.name, "doc": fn.doc, "equation": fn.equation, "args": args, "coefficients": coefficients,
-        "cost": body["cost"], "unhoisted_cost": unhoisted, "outputs": outputs, "constants": [],
-        "bindings": body["bindings"], "trig": body["trig"], "compounds": [], "temporaries": [],
-        "sequence": body["sequence"],
-    }
+    code = _body_ir(body)
+    return irt.Function(
+        name=fn.name, doc=fn.doc, equation=fn.equation, args=args, coefficients=coefficients,
+        cost=irt.Cost(**body["cost"]), unhoisted_cost=None if unhoisted is None else irt.Cost(**unhoisted),
+        outputs=outputs, constants=[], bindings=code["bindings"], trig=code["trig"], compounds=[], temporaries=[],
+        sequence=code["sequence"],
+    )
 
 
-def vectors_document(model: Model, functions: list[SeqFunction], generator: dict, count: int, schema: int) -> dict:
+def vectors_document(model: Model, functions: list[SeqFunction], generator: irt.Generator, count: int,
+                     schema: int) -> dict:
     return {
         "schema": schema,
         "generator": generator,
@@ -274,7 +284,7 @@ def singular_joints(dv: UrdfDerivation, p: np.ndarray, name: str) -> None:
                                    f"eigenvalue along joints {', '.join(joints)}; give them stiffness")
 
 
-def report_data(dv: UrdfDerivation, functions: list[SeqFunction]) -> dict:
+def report_data(dv: UrdfDerivation, functions: list[SeqFunction]) -> irt.UrdfReport:
     import mpmath
     n, m = dv.n, dv.model
     fmt = lambda v: mpmath.nstr(mpmath.mpf(v), 6)  # noqa: E731
@@ -295,31 +305,32 @@ def report_data(dv: UrdfDerivation, functions: list[SeqFunction]) -> dict:
                 eye = np.eye(n)
                 precision = {t: task.default_precision[t] * eye for t in task.terms}
                 pi = dv.reference_confidence(task, p, precision)
-                logdets.append({"task": task.name, "value": fmt(mpmath.log(mpmath.det(pi.m)))})
-        tools.append({"name": name, "parameters": ", ".join(f"{q.name} = {fmt(v)}" for q, v in zip(m.parameters, p)),
-                      "gravity_sv": ", ".join(fmt(v) for v in sv_g), "stiffness_sv": ", ".join(fmt(v) for v in sv_s),
-                      "logdets": logdets})
-    bodies = [{"joint": b.joint, "kind": b.kind, "axis": " ".join(f"{v:g}" for v in b.axis),
-               "mass": f"{b.mass:g}", "stiffness": f"{k:g}", "damping": f"{d:g}"}
+                logdets.append(irt.Logdet(task=task.name, value=fmt(mpmath.log(mpmath.det(pi.m)))))
+        tools.append(irt.ReportTool(
+            name=name, parameters=", ".join(f"{q.name} = {fmt(v)}" for q, v in zip(m.parameters, p)),
+            gravity_sv=", ".join(fmt(v) for v in sv_g), stiffness_sv=", ".join(fmt(v) for v in sv_s),
+            logdets=logdets))
+    bodies = [irt.Body(joint=b.joint, kind=b.kind, axis=" ".join(f"{v:g}" for v in b.axis),
+                       mass=f"{b.mass:g}", stiffness=f"{k:g}", damping=f"{d:g}")
               for b, k, d in zip(dv.chain.bodies, dv.stiffness, dv.damping)]
     costs = []
     for fn in functions:
         c = fn.stats["cost"]
-        row = {"name": fn.name, "ops": c["ops"], "weighted": c["weighted"], "sin_cos": c["sin_cos"],
-               "agreement": f"{fn.stats['agreement']:.1e}"}
-        if "coefficient_cost" in fn.stats:
-            row["coefficients"] = fn.stats["coefficient_cost"]["ops"]
-            row["unhoisted"] = fn.stats["unhoisted_cost"]["ops"]
-        costs.append(row)
-    return {
-        "urdf": str(dv.chain.path), "robot": dv.chain.robot, "base": dv.chain.base, "flange": dv.chain.flange,
-        "gravity": ", ".join(f"{g:g}" for g in dv.dyn.gravity), "impedance_source": m.impedance_source,
-        "equilibrium": ", ".join(m.equilibrium_q), "bodies": bodies, "tools": tools, "costs": costs,
-        "equation_refs": m.equations,
-    }
+        hoisted = "coefficient_cost" in fn.stats
+        costs.append(irt.CostRow(
+            name=fn.name, ops=c["ops"], weighted=c["weighted"], sin_cos=c["sin_cos"],
+            agreement=f"{fn.stats['agreement']:.1e}",
+            coefficients=fn.stats["coefficient_cost"]["ops"] if hoisted else None,
+            unhoisted=fn.stats["unhoisted_cost"]["ops"] if hoisted else None))
+    return irt.UrdfReport(
+        urdf=str(dv.chain.path), robot=dv.chain.robot, base=dv.chain.base, flange=dv.chain.flange,
+        gravity=", ".join(f"{g:g}" for g in dv.dyn.gravity), impedance_source=m.impedance_source,
+        equilibrium=", ".join(m.equilibrium_q), bodies=bodies, tools=tools, costs=costs,
+        equation_refs=m.equations,
+    )
 
 
-def urdf_documents(model: Model, tasks, generator: dict, vectors: int, schema: int) -> tuple[dict, dict]:
+def urdf_documents(model: Model, tasks, generator: irt.Generator, vectors: int, schema: int) -> tuple[irt.Ir, dict]:
     """The IR and the test vectors of a URDF model."""
     from .ir import model_document
     from .rust_printer import float_literal
@@ -336,6 +347,6 @@ def urdf_documents(model: Model, tasks, generator: dict, vectors: int, schema: i
     irs = [function_ir(fn) for fn in functions]
     x_e = [float_literal(v) for v in dv.x_e]
     u_e = [float_literal(v) for v in dv.u_e]
-    ir = model_document(model, x_e, u_e, tasks, irs, generator, report_data(dv, functions), vectors)
-    ir["templates"] = ["urdf/report.md.tera"]
+    ir = model_document(model, x_e, u_e, tasks, irs, generator, report_data(dv, functions), vectors,
+                        templates=["urdf/report.md.tera"])
     return ir, document
