@@ -148,7 +148,7 @@ class BrokenDescription(unittest.TestCase):
 
     def test_unbalanced_bracket_in_a_task_formula(self):
         self.tasks_stop(edit(TASKS, 'sensitivity.theta_ddot = "IO @ (A @ A', 'sensitivity.theta_ddot = "IO @ ((A @ A'),
-                        "task[2].sensitivity.theta_ddot", "was never closed")
+                        "task[2].sensitivity.theta_ddot", "is never closed")
 
     def test_task_formula_of_the_wrong_shape(self):
         self.tasks_stop(edit(TASKS, 'sensitivity.theta_dot = "-IO @ inv(A) @ B"', 'sensitivity.theta_dot = "IO"'),

@@ -1,7 +1,9 @@
 """Model and task descriptions: the TOML files under derive/ read into plain data.
 
-Nothing here derives anything; the expressions stay strings so that SymPy (symbolic.py) and
-CasADi (numeric.py) each parse them on their own, which keeps the cross-check independent.
+Nothing here derives anything. The expressions are checked against the grammar of expression.py
+as they are read (a description is data, never code) and stay strings, so that SymPy
+(symbolic.py) and CasADi (numeric.py) each build them in their own arithmetic, which keeps the
+cross-check independent.
 """
 
 from __future__ import annotations
@@ -12,6 +14,9 @@ import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from .expression import (FORMULA_DEGREE, FORMULA_FUNCTIONS, Expression, ExpressionError, parse,
+                         python_number)
 
 
 class DescriptionError(ValueError):
@@ -483,6 +488,7 @@ def _validate_model(m: Model) -> None:
     _validate_names(m)
     _validate_shapes(m)
     _validate_dynamics(m)
+    _validate_expressions(m)
 
 
 def _task(path: Path, t: _Table) -> Task:
@@ -513,8 +519,96 @@ def _task(path: Path, t: _Table) -> Task:
 def load_tasks(path: Path) -> list[Task]:
     top = _Table(path, "", read_toml(path), (("task", "tables", True),))
     tasks = [_task(path, t) for t in top.tables("task", TASK_KEYS)]
+    for t in tasks:
+        _validate_task_expressions(path, t)
     names = [t.name for t in tasks]
     for t in tasks:
         if names.count(t.name) > 1:
             raise DescriptionError(path, f"{t.key}.name", f"'{t.name}' names two tasks")
     return tasks
+
+
+# --- the expressions a description holds (the grammar of expression.py) ----------------------------
+
+# The names tasks.toml's formulas may use besides inv (see that file's header).
+FORMULA_NAMES = ("A", "B", "I", "O", "IO", "OI", "E", "dX_dU")
+# The largest magnitude of a description's value (a constant, an equilibrium, a goal) and of a
+# precision: beyond it a number means nothing physical, and it would only overflow later.
+MAX_VALUE = 1e6
+MAX_PRECISION = 1e6
+
+
+def expression(path: Path | str, key: str, text: str, names=(), **grammar) -> Expression:
+    """`text` parsed by expression.py's grammar over `names`, or a DescriptionError naming the key."""
+    try:
+        return parse(text, names, **grammar)
+    except ExpressionError as err:
+        raise DescriptionError(path, key, f"{err} in '{text}'") from err
+
+
+def value(path: Path | str, key: str, text: str) -> float:
+    """A value that must be a number (pi/2, 1e-3, sqrt(2)/2) within +-MAX_VALUE: its double."""
+    v = expression(path, key, text).value
+    if v is None or abs(v) > MAX_VALUE:
+        raise DescriptionError(path, key, f"'{text}' is not a number within [-{MAX_VALUE:g}, {MAX_VALUE:g}]")
+    return v
+
+
+def task_formula(task: Task, key: str, text: str, namespace: dict):
+    """A task formula (`key` under the task's table) built on `namespace`: the names of
+    FORMULA_NAMES and inv, as matrices and a function of any matrix arithmetic."""
+    names = {k: v for k, v in namespace.items() if k not in FORMULA_FUNCTIONS}
+    full_key = f"{task.key}.{key}" if task.key else key
+    tree = expression(task.path, full_key, text, names, functions=FORMULA_FUNCTIONS, constants={},
+                      max_degree=FORMULA_DEGREE)
+    try:
+        return tree.evaluate(names, {f: namespace[f] for f in FORMULA_FUNCTIONS}, python_number)
+    except Exception as err:  # a shape or a singular inverse, in whichever arithmetic: the formula's error
+        raise DescriptionError(task.path, full_key, f"cannot evaluate '{text}': {err}") from err
+
+
+def sensitivity(task: Task, term: str, namespace: dict):
+    """d term / dU by the task's formula (sensitivity.<term>) on `namespace`."""
+    return task_formula(task, f"sensitivity.{term}", task.sensitivity[term], namespace)
+
+
+def _validate_expressions(m: Model) -> None:
+    """Every expression of the description in the grammar, each value a number in range; a URDF
+    arm's equilibrium is at rest under its own gravity feed-forward (q_dot^e = 0, U^e = 0)."""
+    names = [n.name for n in m.parameters + m.constants + m.q + m.q_dot + m.u]
+    for c in m.constants:
+        if not math.isfinite(c.value) or abs(c.value) > MAX_VALUE:
+            raise DescriptionError(m.path, f"constants.{c.name}.value",
+                                   f"{c.value!r} is not a number within [-{MAX_VALUE:g}, {MAX_VALUE:g}]")
+    if m.dynamics_kind == "explicit":
+        for i, text in enumerate(m.q_ddot):
+            expression(m.path, f"dynamics.q_ddot[{i}]", text, names)
+    for label, texts in (("q", m.equilibrium_q), ("q_dot", m.equilibrium_q_dot), ("u", m.equilibrium_u)):
+        for i, text in enumerate(texts):
+            v = value(m.path, f"equilibrium.{label}[{i}]", text)
+            if m.dynamics_kind == "urdf" and label != "q" and v != 0:
+                raise DescriptionError(m.path, f"equilibrium.{label}[{i}]",
+                                       f"'{text}' is not 0: a URDF arm's equilibrium is at rest (q_dot = 0) with "
+                                       "U = 0, the impedance and gravity feed-forward holding it")
+    for task, terms in m.goals.items():
+        for term, values in terms.items():
+            for i, text in enumerate(values):
+                value(m.path, f"goals.{task}.{term}[{i}]", text)
+    printed_names = [n.name for n in m.parameters + m.constants]
+    for label, matrix in (("A", m.printed_a), ("B", m.printed_b)):
+        for i, row in enumerate(matrix or []):
+            for j, text in enumerate(row):
+                expression(m.path, f"printed.{label}[{i}][{j}]", text, printed_names)
+
+
+def _validate_task_expressions(path: Path, t: Task) -> None:
+    for term, text in t.sensitivity.items():
+        expression(path, f"{t.key}.sensitivity.{term}", text, FORMULA_NAMES, functions=FORMULA_FUNCTIONS,
+                   constants={}, max_degree=FORMULA_DEGREE)
+    for i, r in enumerate(t.remarks):
+        expression(path, f"{t.key}.remarks[{i}].alternative", r.alternative, FORMULA_NAMES,
+                   functions=FORMULA_FUNCTIONS, constants={}, max_degree=FORMULA_DEGREE)
+    for term, v in t.default_precision.items():
+        if not (0 <= v <= MAX_PRECISION):
+            raise DescriptionError(path, f"{t.key}.defaults.precision.{term}",
+                                   f"{v!r} is not within [0, {MAX_PRECISION:g}]")

@@ -12,6 +12,7 @@ from . import ir_types as irt
 from .cost import cost, total
 from .crosscheck import check_against_casadi
 from .description import DescriptionError, name_keys, rust_constant
+from .expression import sympy_expression
 from .functions import Arg, Function
 from .hoist import hoist
 from .rust_printer import RustPrinter, float_literal
@@ -292,7 +293,7 @@ def model_document(m, x_e: list[str], u_e: list[str], tasks: list, functions: li
                 sensitivity_function=t.sensitivity_function,
                 confidence_function=t.confidence_function,
                 gradient_function=t.gradient_function,
-                goals=[irt.Goal(term, [printer(sp.sympify(v)) for v in m.goals.get(t.name, {}).get(term, ["0"] * m.dof)])
+                goals=[irt.Goal(term, [printer(sympy_expression(v, {}, rational=False)) for v in m.goals.get(t.name, {}).get(term, ["0"] * m.dof)])
                        for term in t.sensitivity_terms],
                 precisions=[irt.Precision(term, float_literal(t.default_precision[term]), t.default_precision[term])
                             for term in t.terms],

@@ -22,8 +22,9 @@ import mpmath
 import numpy as np
 
 from .chain import casadi_chain
-from .description import Model, Task
+from .description import Model, Task, expression, sensitivity, value
 from .exact import Exact, ExactFunction
+from .expression import python_number
 
 
 class CasadiModel:
@@ -42,7 +43,7 @@ class CasadiModel:
             names[s.name] = self.p[i]
         for c in model.constants:
             names[c.name] = c.value
-        functions = {"sin": ca.sin, "cos": ca.cos, "sqrt": ca.sqrt, "pi": math.pi}
+        functions = {"sin": ca.sin, "cos": ca.cos, "sqrt": ca.sqrt}
         if model.dynamics_kind == "planar_chain":
             q_ddot = casadi_chain(
                 [names[c.name] for c in model.q], [names[c.name] for c in model.q_dot], [names[c.name] for c in model.u],
@@ -50,15 +51,17 @@ class CasadiModel:
                 names[model.gravity], names[model.payload] if model.payload else None,
             )
         else:
-            q_ddot = [eval(e, {"__builtins__": {}, **functions}, names) for e in model.q_ddot]  # noqa: S307
+            q_ddot = [expression(model.path, f"dynamics.q_ddot[{i}]", e, names).evaluate(
+                {**names, "pi": math.pi}, functions, python_number) for i, e in enumerate(model.q_ddot)]
         f = ca.vertcat(self.x[n:], *q_ddot)
         self.dynamics = ExactFunction(ca.Function("dynamics", [self.x, self.u, self.p], [f]))
         self.jacobian = ExactFunction(ca.Function(
             "dynamics_jacobian", [self.x, self.u, self.p], [ca.jacobian(f, self.x), ca.jacobian(f, self.u)]
         ))
-        plain = {"__builtins__": {}, "pi": math.pi}
-        self.x_e = np.array([float(eval(v, plain)) for v in model.equilibrium_q + model.equilibrium_q_dot])  # noqa: S307
-        self.u_e = np.array([float(eval(v, plain)) for v in model.equilibrium_u])  # noqa: S307
+        def values(label: str, texts: list[str]) -> list[float]:
+            return [value(model.path, f"equilibrium.{label}[{i}]", v) for i, v in enumerate(texts)]
+        self.x_e = np.array(values("q", model.equilibrium_q) + values("q_dot", model.equilibrium_q_dot))
+        self.u_e = np.array(values("u", model.equilibrium_u))
 
     def linearisation(self, p: np.ndarray) -> tuple[Exact, Exact]:
         """A and B at the equilibrium, exactly (the equilibrium is taken as its doubles)."""
@@ -78,8 +81,7 @@ class CasadiModel:
 
     def sensitivity_exact(self, task: Task, p: np.ndarray) -> dict[str, "Exact"]:
         ns = self.task_namespace(p)
-        return {term: eval(task.sensitivity[term], {"__builtins__": {}}, dict(ns))  # noqa: S307
-                for term in task.sensitivity_terms}
+        return {term: sensitivity(task, term, ns) for term in task.sensitivity_terms}
 
     def control_confidence(self, task: Task, p: np.ndarray, precision: dict[str, np.ndarray]) -> Exact:
         """Pi^U = sum over the task's terms of S^T P S, plus P^U (eq. control_conf and the closed forms after it)."""
@@ -110,7 +112,7 @@ class CasadiModel:
         precisions = {t: ca.SX.sym(f"p_{t}", n, n) for t in task.sensitivity_terms + ["u"]}
         pi = precisions["u"]
         for term in task.sensitivity_terms:
-            s = eval(task.sensitivity[term], {"__builtins__": {}}, dict(ns))  # noqa: S307
+            s = sensitivity(task, term, ns)
             pi = pi + s.T @ precisions[term] @ s
         gradient = ca.gradient(ca.log(ca.det(pi)), self.p)
         inputs = [self.p] + [precisions[t] for t in task.sensitivity_terms + ["u"]]

@@ -26,7 +26,8 @@ class RustPrinter:
         self.names = names or {}
 
     def __call__(self, expr: sp.Expr) -> str:
-        return self.print(sp.sympify(expr))[0]
+        # strict: a number or SymPy object, never text (text is read by expression.py).
+        return self.print(sp.sympify(expr, strict=True))[0]
 
     def wrap(self, printed: tuple[str, int], at_least: int) -> str:
         code, prec = printed

@@ -7,13 +7,13 @@ matrices are only read in paper.py, for comparison.
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 
 import sympy as sp
 
 from .chain import sympy_chain
-from .description import DescriptionError, Model, Task
+from .description import DescriptionError, Model, Task, sensitivity, task_formula
+from .expression import ExpressionError, sympy_expression
 
 TERM_LATEX = {
     "theta": r"\theta",
@@ -32,47 +32,17 @@ def tidy_matrix(m: sp.Matrix) -> sp.Matrix:
     return m.applyfunc(tidy)
 
 
-# What an expression in a description may use besides the model's declared names.
-BUILTINS = {"sin": sp.sin, "cos": sp.cos, "sqrt": sp.sqrt, "pi": sp.pi}
-OPENING, CLOSING = "([{", ")]}"
-# A name in an expression: not part of a number (the e of 1e-3) nor of another name.
-NAME = re.compile(r"(?<![\w.])[A-Za-z_]\w*")
-
-
-def bracket_problem(text: str) -> str | None:
-    """Why the brackets of `text` do not balance (positions count characters from 1), or None."""
-    stack: list[tuple[str, int]] = []
-    for i, ch in enumerate(text, 1):
-        if ch in OPENING:
-            stack.append((ch, i))
-        elif ch in CLOSING:
-            if not stack:
-                return f"unbalanced brackets: '{ch}' at character {i} closes nothing"
-            opened, at = stack.pop()
-            if OPENING.index(opened) != CLOSING.index(ch):
-                return f"unbalanced brackets: '{ch}' at character {i} closes '{opened}' from character {at}"
-    if stack:
-        opened, at = stack[-1]
-        return f"unbalanced brackets: '{opened}' at character {at} is never closed"
-    return None
-
-
-def parse(model: Model, text: str, symbols: dict[str, sp.Symbol], key: str) -> sp.Expr:
-    """`text` as a SymPy expression over `symbols` and BUILTINS; anything else is an error naming
-    the description's `key`. Names are checked before SymPy sees the text, as SymPy would read an
-    unknown name as a new symbol and a few (E, I, N, S, gamma...) as its own objects."""
-    problem = bracket_problem(text)
-    if problem:
-        raise DescriptionError(model.path, key, f"{problem} in '{text}'")
-    for name in NAME.findall(text):
-        if name not in symbols and name not in BUILTINS:
-            known = ", ".join(list(symbols) + list(BUILTINS))
-            raise DescriptionError(model.path, key, f"'{name}' is not defined (known here: {known}) in '{text}'")
+def parse(model: Model, text: str, symbols: dict[str, sp.Symbol], key: str, rational: bool = True) -> sp.Expr:
+    """`text` as a SymPy expression over `symbols`, sin, cos, sqrt and pi, built from the grammar's
+    tree (expression.py: a description is data, never code); anything else, or a result that is
+    not finite (x/(l - l)), is an error naming the description's `key`."""
     try:
-        return sp.sympify(text, locals={**symbols, **BUILTINS}, rational=True)
-    except (sp.SympifyError, SyntaxError, TypeError, ValueError) as err:
-        reason = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
-        raise DescriptionError(model.path, key, f"cannot parse '{text}': {reason}") from err
+        e = sympy_expression(text, symbols, rational)
+    except ExpressionError as err:
+        raise DescriptionError(model.path, key, f"{err} in '{text}'") from err
+    if e.has(sp.zoo, sp.nan, sp.oo, -sp.oo):
+        raise DescriptionError(model.path, key, f"'{text}' is not finite ({e})")
+    return e
 
 
 def symmetric_matrix(name: str, n: int) -> tuple[sp.Matrix, list[tuple[sp.Symbol, int, int]]]:
@@ -97,13 +67,6 @@ def task_namespace(a: sp.Matrix, b: sp.Matrix, n: int, inv) -> dict:
         "IO": sp.Matrix.hstack(eye, zero), "OI": sp.Matrix.hstack(zero, eye),
         "E": e, "dX_dU": a_inv @ (e - b),
     }
-
-
-def evaluate_formula(formula: str, namespace: dict, task: Task, key: str):
-    try:
-        return eval(formula, {"__builtins__": {}}, dict(namespace))  # noqa: S307 - formulas come from tasks.toml
-    except Exception as err:  # any error in a formula is a description error
-        raise DescriptionError(task.path, f"{task.key}.{key}", f"cannot evaluate '{formula}': {err}") from err
 
 
 @dataclass
@@ -184,12 +147,17 @@ def derive(model: Model, tasks: list[Task]) -> Derivation:
     x_e, u_e = equilibrium(model)
     at_e = dict(zip(x, x_e)) | dict(zip(u, u_e))
     residual = tidy_matrix(f.subs(at_e))
+    if any(r.has(sp.zoo, sp.nan, sp.oo, -sp.oo) for r in residual):
+        raise DescriptionError(model.path, "equilibrium", f"f(X^e, U^e) = {list(residual)} is not finite there")
     if any(r != 0 for r in residual):
         raise DescriptionError(model.path, "equilibrium",
                                f"not an equilibrium: f(X^e, U^e) = {list(residual)} is not zero")
 
     a = tidy_matrix(f_x.subs(at_e))
     b = tidy_matrix(f_u.subs(at_e))
+    if any(e.has(sp.zoo, sp.nan, sp.oo, -sp.oo) for e in list(a) + list(b)):
+        raise DescriptionError(model.path, "equilibrium", "A or B is not finite there (a division by zero in "
+                                                          "the derivatives at the equilibrium)")
     if a.det() == 0:
         raise DescriptionError(model.path, "equilibrium", "A is singular there; the task sensitivities need A^-1")
     check_goals(model, tasks)
@@ -226,7 +194,7 @@ def derive_task(task: Task, ns: dict, n: int) -> TaskDerivation:
     sens = {}
     for term in task.sensitivity_terms:
         key = f"sensitivity.{term}"
-        sens[term] = tidy_matrix(sp.Matrix(evaluate_formula(task.sensitivity[term], ns, task, key)))
+        sens[term] = tidy_matrix(sp.Matrix(sensitivity(task, term, ns)))
         if sens[term].shape != (n, n):
             raise DescriptionError(task.path, f"{task.key}.{key}",
                                    f"is {sens[term].shape[0]}x{sens[term].shape[1]}, not {n}x{n}")
@@ -239,7 +207,7 @@ def derive_task(task: Task, ns: dict, n: int) -> TaskDerivation:
         confidence = confidence + s.T @ precision[term] @ s
     remarks = []
     for i, r in enumerate(task.remarks):
-        alt = tidy_matrix(sp.Matrix(evaluate_formula(r.alternative, ns, task, f"remarks[{i}].alternative")))
+        alt = tidy_matrix(sp.Matrix(task_formula(task, f"remarks[{i}].alternative", r.alternative, ns)))
         remarks.append({"remark": r, "alternative": alt, "used": sens[r.term]})
     return TaskDerivation(task, sens, precision, reads, confidence, remarks)
 

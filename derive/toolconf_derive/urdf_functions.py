@@ -14,7 +14,7 @@ import casadi as ca
 import numpy as np
 
 from . import ir_types as irt
-from .description import Model
+from .description import Model, sensitivity
 from .exact import ExactFunction
 from .functions import _sample_control, _sample_precision, _sample_state, TERM_DOC
 from .ir import _rust_type, _struct_name
@@ -87,7 +87,7 @@ def build_functions(dv: UrdfDerivation) -> list[SeqFunction]:
 def _task_functions(dv: UrdfDerivation, task, ns, p_arg) -> list[SeqFunction]:
     n, ps = dv.n, dv.p
     terms = task.sensitivity_terms
-    sens = {t: eval(task.sensitivity[t], {"__builtins__": {}}, dict(ns)).sx() for t in terms}  # noqa: S307
+    sens = {t: sensitivity(task, t, ns).sx() for t in terms}
     out = [SeqFunction(
         task.sensitivity_function,
         f"{task.title}: the sensitivities d(task variable)/dU the controller uses, "

@@ -38,7 +38,7 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from .description import Model, Named, Task
+from .description import Model, Named, Task, sensitivity
 from .exact import DIGITS, Exact, ExactFunction
 from .functions import _grid_uniform
 from .rigid_body import ChainDynamics, aba, ldl_apply, ldl_factor
@@ -457,7 +457,7 @@ class UrdfDerivation:
 
     def reference_sensitivity(self, task: Task, p) -> dict:
         ns = self.reference_namespace(p)
-        return {t: eval(task.sensitivity[t], {"__builtins__": {}}, dict(ns)) for t in task.sensitivity_terms}  # noqa: S307
+        return {t: sensitivity(task, t, ns) for t in task.sensitivity_terms}
 
     def reference_confidence(self, task: Task, p, precision: dict) -> Exact:
         s = self.reference_sensitivity(task, p)
@@ -474,7 +474,7 @@ class UrdfDerivation:
             with mpmath.workdps(DIGITS):
                 a, b = self.reference_ab.exact_at([params])
                 ns = exact_namespace(a, b, self.n)
-                s = {t: eval(task.sensitivity[t], {"__builtins__": {}}, dict(ns)) for t in task.sensitivity_terms}  # noqa: S307
+                s = {t: sensitivity(task, t, ns) for t in task.sensitivity_terms}
                 pi = Exact.of(precision["u"])
                 for t in task.sensitivity_terms:
                     pi = pi + s[t].T @ Exact.of(precision[t]) @ s[t]
