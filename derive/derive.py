@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import warnings
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
@@ -48,6 +49,24 @@ def write(path: Path, document) -> None:
 
 
 def main() -> int:
+    """derive.py's run behind a last resort: whatever goes wrong unforeseen is one line and status
+    1 (a traceback is no message for a user)."""
+    # Overflow and invalid values are checked where they matter (crosscheck, exact) and reported
+    # as one line; NumPy's own warnings would only add lines to it.
+    warnings.filterwarnings("ignore", category=RuntimeWarning)
+    try:
+        return run()
+    except Exception as err:  # noqa: BLE001 - the last resort, every expected error is handled in run()
+        reason = one_line(str(err)) or "no message"
+        print(f"derive: error: {' '.join(sys.argv[1:2])}: {type(err).__name__}: {reason[:300]}", file=sys.stderr)
+        return 1
+
+
+def one_line(text: str) -> str:
+    return " ".join(text.split())
+
+
+def run() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("model", type=Path, help="model description (TOML)")
     ap.add_argument("--tasks", type=Path, default=HERE / "tasks.toml", help="task definitions (TOML)")
@@ -104,8 +123,13 @@ def main() -> int:
         print(f"derive: {err}", file=sys.stderr)
         return 2
     except (DerivationMismatch, ExactEvaluationError, UrdfMismatch, SequenceError) as err:
-        print(f"derive: {err}", file=sys.stderr)
+        # A check that failed: the model's file, the function and output, the first line of why.
+        print(f"derive: {args.model}: {one_line(str(err).splitlines()[0] if str(err) else type(err).__name__)}",
+              file=sys.stderr)
         return 1
+    except RecursionError:
+        print(f"derive: {args.model}: an expression nested too deeply to derive", file=sys.stderr)
+        return 2
     try:
         write(out, ir)
         write(vectors_out, vectors)

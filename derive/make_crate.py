@@ -30,11 +30,10 @@ import signal
 import subprocess
 import sys
 import tempfile
-import tomllib
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from toolconf_derive.description import RUST_KEYWORDS
+from toolconf_derive.description import RUST_KEYWORDS, DescriptionError, load_tasks, read_toml
 
 ROOT = Path(__file__).resolve().parent.parent
 TASKS = ROOT / "derive" / "tasks.toml"
@@ -81,10 +80,10 @@ def duplicate_model_names(found: list[Path]) -> None:
     seen: dict[str, Path] = {}
     for path in found:
         try:
-            with path.open("rb") as f:
-                name = tomllib.load(f).get("model", {}).get("name")
-        except (OSError, tomllib.TOMLDecodeError):
+            model = read_toml(path).get("model", {})
+        except DescriptionError:
             continue
+        name = model.get("name") if isinstance(model, dict) else None
         if isinstance(name, str):
             if name in seen:
                 raise Refused(f"{seen[name]} and {path} both describe the model '{name}' (model.name)")
@@ -108,9 +107,8 @@ def previous_crate(out: Path) -> bool:
 
 def _dof(path: Path) -> int:
     try:
-        with path.open("rb") as f:
-            return int(tomllib.load(f).get("model", {}).get("dof", 1))
-    except (OSError, tomllib.TOMLDecodeError, TypeError, ValueError):
+        return int(read_toml(path).get("model", {}).get("dof", 1))
+    except (DescriptionError, AttributeError, TypeError, ValueError, OverflowError):
         return 1
 
 
@@ -154,8 +152,10 @@ def make_crate(models: Path, out: Path, tasks: Path, name: str | None) -> int:
     package = crate_name(out, name)
     found = descriptions(models)
     duplicate_model_names(found)
-    if not tasks.is_file():
-        raise Refused(f"TASKS={tasks}: no such file")
+    try:
+        load_tasks(tasks)  # read as derive.py reads it: a FIFO, a device or bad TOML is one line now
+    except DescriptionError as err:
+        raise Refused(f"TASKS={err}") from err
     if not out.parent.is_dir():
         raise Refused(f"OUT={out}: the folder {out.parent} does not exist")
     replace = previous_crate(out)
@@ -192,6 +192,10 @@ def main() -> int:
         return 2
     except OSError as err:
         print(f"make crate: cannot write {err.filename}: {err.strerror}", file=sys.stderr)
+        return 1
+    except Exception as err:  # noqa: BLE001 - the last resort: one line, never a traceback
+        reason = " ".join(str(err).split()) or "no message"
+        print(f"make crate: error: {type(err).__name__}: {reason[:300]}", file=sys.stderr)
         return 1
 
 

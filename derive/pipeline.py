@@ -180,5 +180,15 @@ def main() -> int:
     return 0
 
 
+def guarded() -> int:
+    """main() behind a last resort: an unforeseen error is one line and status 1, not a traceback."""
+    try:
+        return main()
+    except Exception as err:  # noqa: BLE001 - SystemExit (the expected failures) passes through
+        reason = " ".join(str(err).split()) or "no message"
+        print(f"pipeline: error: {type(err).__name__}: {reason[:300]}", file=sys.stderr)
+        return 1
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(guarded())

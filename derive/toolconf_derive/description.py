@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import stat
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -259,20 +260,60 @@ class _Table:
 MAX_DESCRIPTION_BYTES = 1 << 20
 
 
-def read_toml(path: Path) -> dict:
-    """The parsed file; a missing, unreadable or too large file or a TOML syntax error is a
-    DescriptionError."""
+def _not_a_file(mode: int) -> str | None:
+    """What a file of this mode is when it is not a regular file (read, it would block or never end)."""
+    for test, what in ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO"), (stat.S_ISSOCK, "a socket"),
+                       (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device")):
+        if test(mode):
+            return what
+    return None if stat.S_ISREG(mode) else "not a regular file"
+
+
+def read_text(path: Path | str, limit: int, what: str) -> str:
+    """The UTF-8 text of the regular file `path`, at most `limit` bytes. Opened without blocking
+    (a FIFO's open would wait for a writer) and checked on the opened descriptor (what is read is
+    what was checked); a folder, FIFO, socket or device, a larger file, an unreadable one or one
+    that is not UTF-8 is a DescriptionError saying so, with `what` the file is meant to be."""
     try:
-        with open(path, "rb") as f:
-            data = f.read(MAX_DESCRIPTION_BYTES + 1)
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+    except OSError as err:
+        try:
+            kind = _not_a_file(os.stat(path).st_mode)
+        except OSError:
+            kind = None
+        problem = f"{kind}, not {what}" if kind else f"cannot read: {err.strerror}"
+        raise DescriptionError(path, "", problem) from err
+    try:
+        kind = _not_a_file(os.fstat(fd).st_mode)
+        if kind:
+            raise DescriptionError(path, "", f"{kind}, not {what}")
+        chunks, total = [], 0
+        while total <= limit:
+            chunk = os.read(fd, min(1 << 16, limit + 1 - total))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            total += len(chunk)
     except OSError as err:
         raise DescriptionError(path, "", f"cannot read: {err.strerror}") from err
-    if len(data) > MAX_DESCRIPTION_BYTES:
-        raise DescriptionError(path, "", f"larger than {MAX_DESCRIPTION_BYTES} bytes (1 MiB), "
-                                         "more than any description needs")
+    finally:
+        os.close(fd)
+    if total > limit:
+        raise DescriptionError(path, "", f"larger than {limit} bytes ({limit / (1 << 20):g} MiB), more than "
+                                         f"{what} needs")
+    data = b"".join(chunks)
     try:
-        return tomllib.loads(data.decode())
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as err:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise DescriptionError(path, "", f"not UTF-8 text: {err.reason} at byte {err.start}") from err
+
+
+def read_toml(path: Path, what: str = "a description file") -> dict:
+    """The parsed file (read_text's rules); a TOML syntax error is a DescriptionError."""
+    text = read_text(path, MAX_DESCRIPTION_BYTES, what)
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
         raise DescriptionError(path, "", f"not valid TOML: {err}") from err
     except RecursionError as err:
         # tomllib recurses once per nested array or table: `q = [[[[…` thousands deep.
@@ -351,6 +392,11 @@ def load_model(path: Path) -> Model:
     return model
 
 
+# A URDF arm's gravity (m/s^2) and joint impedance gains (N m/rad, N m s/rad): physical ranges.
+MAX_GRAVITY = 1e3
+MAX_GAIN = 1e6
+
+
 def _urdf_names(path: Path, top: _Table):
     """Kind "urdf": the chain from the URDF file, the tool's parameters (urdf_model.TOOL_PARAMETERS)
     and the coordinates named after the URDF's joints: q = the joint positions, U = their torques."""
@@ -367,6 +413,9 @@ def _urdf_names(path: Path, top: _Table):
     imp = top.table("impedance", MODEL_KEYS["impedance"])
     if len(urdf.get("gravity")) != 3:
         raise DescriptionError(path, "urdf.gravity", f"must be 3 numbers (m/s^2, in the base frame), got {urdf.get('gravity')!r}")
+    for i, g in enumerate(urdf.get("gravity")):
+        if abs(g) > MAX_GRAVITY:
+            raise DescriptionError(path, f"urdf.gravity[{i}]", f"{g!r} is outside [-{MAX_GRAVITY:g}, {MAX_GRAVITY:g}] m/s^2")
     chain = read_chain(Path(os.path.normpath(path.parent / urdf.get("file"))), urdf.get("base"), urdf.get("flange"))
     dof = top.raw["model"]["dof"]
     if dof != chain.dof:
@@ -378,8 +427,9 @@ def _urdf_names(path: Path, top: _Table):
             raise DescriptionError(path, f"impedance.{key}", f"has {len(values)} entries, the chain from "
                                                              f"'{chain.base}' to '{chain.flange}' has {chain.dof} joints")
         for i, v in enumerate(values):
-            if v < 0:
-                raise DescriptionError(path, f"impedance.{key}[{i}]", f"{v} is negative ({chain.joint_names[i]})")
+            if not 0 <= v <= MAX_GAIN:
+                raise DescriptionError(path, f"impedance.{key}[{i}]",
+                                       f"{v!r} is not within [0, {MAX_GAIN:g}] ({chain.joint_names[i]})")
     q = [Named(j, rf"q_{{{i + 1}}}", "rad" if b.kind == "revolute" else "m", f"position of joint {j}")
          for i, (j, b) in enumerate(zip(chain.joint_names, chain.bodies))]
     q_dot = [Named(f"{j}_dot", rf"\dot{{q}}_{{{i + 1}}}") for i, j in enumerate(chain.joint_names)]
@@ -517,7 +567,7 @@ def _task(path: Path, t: _Table) -> Task:
 
 
 def load_tasks(path: Path) -> list[Task]:
-    top = _Table(path, "", read_toml(path), (("task", "tables", True),))
+    top = _Table(path, "", read_toml(path, "a task file"), (("task", "tables", True),))
     tasks = [_task(path, t) for t in top.tables("task", TASK_KEYS)]
     for t in tasks:
         _validate_task_expressions(path, t)

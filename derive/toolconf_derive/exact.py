@@ -118,6 +118,10 @@ class ExactFunction:
             ours, theirs = ours.to_numpy(), np.array(theirs, dtype=float)
             scale = max(float(np.max(np.abs(theirs))), 1e-300)
             err = float(np.max(np.abs(ours - theirs)))
+            if not (np.all(np.isfinite(ours)) and np.all(np.isfinite(theirs))):
+                raise ExactEvaluationError(
+                    f"{self.f.name()}: output {k}: not finite in double precision at these inputs (the "
+                    "description's values overflow it)")
             if not err <= max(INTERPRETER_TOLERANCE * scale, 1e-14, floor):
                 raise ExactEvaluationError(
                     f"{self.f.name()}: output {k}: the exact interpretation and CasADi differ by {err:.3e} "

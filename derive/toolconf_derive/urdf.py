@@ -2,7 +2,8 @@
 link to the flange link, each with the rigid body it carries (its link and every link fixed to it
 merged in), and the flange's pose in the last body's frame.
 
-Only the kinematic and inertial data are read (Python's xml.etree: URDF is small and plain XML).
+Only the kinematic and inertial data are read (xml.etree through defusedxml: URDF is small and
+plain XML, and entity declarations, which no URDF needs, are refused).
 Everything beyond the flange is dropped (the tool replaces the hand). Refused, each with one line
 naming the file, the joint or link and the reason (a DescriptionError, status 2 from derive.py):
 floating, planar and mimic joints (and any unknown type) between the base and the flange; a
@@ -21,12 +22,15 @@ offset; the check against Pinocchio, which uses the literal angles, passes at 1e
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+
+import defusedxml.ElementTree as SafeET
+from defusedxml import DefusedXmlException
 from dataclasses import dataclass
 from pathlib import Path
 
 import mpmath
 
-from .description import DescriptionError
+from .description import DescriptionError, read_text
 
 DIGITS = 50
 SNAP = mpmath.mpf("1e-9")
@@ -35,6 +39,14 @@ SUPPORTED = ("revolute", "continuous", "prismatic", "fixed")
 # n^3 (the Jacobian's solves) and a 7-joint arm already emits 2 MB of Rust.
 MAX_BYTES = 4 * 1024 * 1024
 MAX_JOINTS = 12
+MAX_LINKS = 256
+# Physical ranges of what is read (a robot arm, SI units): beyond them a number is a typo or an
+# attack, and 1e300 would only overflow in the derivation's products.
+MAX_MASS = 1e4          # kg
+MAX_INERTIA = 1e5       # kg m^2, each entry
+MAX_LENGTH = 100.0      # m, each coordinate of an origin
+MAX_ANGLE = 100.0       # rad, each rpy angle
+MAX_AXIS = 1e6          # each entry of an axis before it is normalised
 MOVING = ("revolute", "continuous", "prismatic")
 
 
@@ -84,7 +96,9 @@ class _Inertial:
     inertia: mpmath.matrix
 
 
-def _floats(path: Path, where: str, text: str | None, n: int, default: str) -> list[mpmath.mpf]:
+def _floats(path: Path, where: str, text: str | None, n: int, default: str, bound: float,
+            unit: str = "") -> list[mpmath.mpf]:
+    """`n` numbers, each within +-`bound` (its physical range, in `unit`)."""
     words = (text if text is not None else default).split()
     try:
         values = [float(w) for w in words]
@@ -92,14 +106,16 @@ def _floats(path: Path, where: str, text: str | None, n: int, default: str) -> l
         values = []
     if len(values) != n or not all(mpmath.isfinite(v) for v in values):
         raise DescriptionError(path, where, f"'{text}' is not {n} finite numbers")
+    if any(abs(v) > bound for v in values):
+        raise DescriptionError(path, where, f"'{text}' is outside [-{bound:g}, {bound:g}]{' ' + unit if unit else ''}")
     return [mpmath.mpf(v) for v in values]
 
 
-def _number(path: Path, where: str, element, attribute: str) -> mpmath.mpf:
+def _number(path: Path, where: str, element, attribute: str, bound: float, unit: str) -> mpmath.mpf:
     text = element.get(attribute) if element is not None else None
     if text is None:
         raise DescriptionError(path, where, f"missing {attribute}")
-    return _floats(path, f"{where} {attribute}", text, 1, "")[0]
+    return _floats(path, f"{where} {attribute}", text, 1, "", bound, unit)[0]
 
 
 def _snap(x: mpmath.mpf) -> mpmath.mpf:
@@ -124,8 +140,10 @@ def rpy_rotation(rpy: list[mpmath.mpf]) -> mpmath.matrix:
 
 def _origin(path: Path, where: str, element) -> tuple[mpmath.matrix, mpmath.matrix]:
     origin = element.find("origin") if element is not None else None
-    xyz = _floats(path, f"{where} origin xyz", origin.get("xyz") if origin is not None else None, 3, "0 0 0")
-    rpy = _floats(path, f"{where} origin rpy", origin.get("rpy") if origin is not None else None, 3, "0 0 0")
+    xyz = _floats(path, f"{where} origin xyz", origin.get("xyz") if origin is not None else None, 3, "0 0 0",
+                  MAX_LENGTH, "m")
+    rpy = _floats(path, f"{where} origin rpy", origin.get("rpy") if origin is not None else None, 3, "0 0 0",
+                  MAX_ANGLE, "rad")
     return rpy_rotation(rpy), mpmath.matrix(xyz)
 
 
@@ -156,13 +174,13 @@ def _inertial(path: Path, link, carried: bool) -> _Inertial:
         if carried:
             raise DescriptionError(path, where, "has no <inertial>, but a moving joint carries it")
         return zero
-    mass = _number(path, f"{where} mass", element.find("mass"), "value")
+    mass = _number(path, f"{where} mass", element.find("mass"), "value", MAX_MASS, "kg")
     if mass < 0 or (carried and mass == 0):
         raise DescriptionError(path, where, f"mass {mpmath.nstr(mass, 17)} must be > 0")
     tensor = element.find("inertia")
     if tensor is None:
         raise DescriptionError(path, where, "<inertial> has no <inertia>")
-    i = {k: _number(path, f"{where} inertia", tensor, k) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
+    i = {k: _number(path, f"{where} inertia", tensor, k, MAX_INERTIA, "kg m^2") for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
     local = mpmath.matrix([[i["ixx"], i["ixy"], i["ixz"]], [i["ixy"], i["iyy"], i["iyz"]],
                            [i["ixz"], i["iyz"], i["izz"]]])
     _check_inertia(path, where, local, mass == 0)
@@ -203,12 +221,18 @@ class _Tree:
     def __init__(self, path: Path, text: str):
         self.path = path
         try:
-            root = ET.fromstring(text)
+            # defusedxml: no entities, no external references (a "billion laughs" is refused).
+            root = SafeET.fromstring(text)
         except ET.ParseError as err:
             raise DescriptionError(path, "", f"not valid XML: {err}") from err
+        except DefusedXmlException as err:
+            raise DescriptionError(path, "", f"refused XML: {err}") from err
         if root.tag != "robot":
             raise DescriptionError(path, "", f"the root element is <{root.tag}>, not <robot>")
         self.robot = root.get("name", "")
+        if len(root.findall("link")) > MAX_LINKS:
+            raise DescriptionError(path, "", f"{len(root.findall('link'))} links; a URDF the derivation reads has at "
+                                             f"most {MAX_LINKS}")
         self.links = {}
         for link in root.findall("link"):
             name = link.get("name")
@@ -289,15 +313,7 @@ def _fixed_subtree(tree: _Tree, link: str, on_path: set[str], flange: str) -> _I
 
 
 def read_chain(path: Path, base: str, flange: str) -> Chain:
-    try:
-        size = path.stat().st_size
-        if size > MAX_BYTES:
-            raise DescriptionError(path, "", f"is {size} bytes; a URDF the derivation reads is at most {MAX_BYTES}")
-        text = path.read_text()
-    except OSError as err:
-        raise DescriptionError(path, "", f"cannot read: {err.strerror}") from err
-    except UnicodeDecodeError as err:
-        raise DescriptionError(path, "", f"not text (UTF-8): {err.reason} at byte {err.start}") from err
+    text = read_text(path, MAX_BYTES, "a URDF file")
     with mpmath.workdps(DIGITS):
         return _chain(_Tree(path, text), base, flange)
 
@@ -305,7 +321,7 @@ def read_chain(path: Path, base: str, flange: str) -> Chain:
 def _axis(path: Path, joint) -> mpmath.matrix:
     element = joint.find("axis")
     a = mpmath.matrix(_floats(path, f"joint '{joint.get('name')}' axis", element.get("xyz") if element is not None
-                              else None, 3, "1 0 0"))
+                              else None, 3, "1 0 0", MAX_AXIS))
     norm = mpmath.sqrt((a.T * a)[0])
     if norm == 0:
         raise DescriptionError(path, f"joint '{joint.get('name')}'", "axis is zero")
