@@ -16,8 +16,7 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .expression import (FORMULA_DEGREE, FORMULA_FUNCTIONS, Expression, ExpressionError, parse,
-                         python_number)
+from .expression import FORMULA_FUNCTIONS, Expression, ExpressionError, formula, parse, python_number
 
 
 class DescriptionError(ValueError):
@@ -604,13 +603,20 @@ def value(path: Path | str, key: str, text: str) -> float:
     return v
 
 
+def formula_expression(path: Path | str, key: str, text: str, names) -> Expression:
+    """A task formula parsed (expression.formula's grammar), or a DescriptionError naming the key."""
+    try:
+        return formula(text, names)
+    except ExpressionError as err:
+        raise DescriptionError(path, key, f"{err} in '{text}'") from err
+
+
 def task_formula(task: Task, key: str, text: str, namespace: dict):
     """A task formula (`key` under the task's table) built on `namespace`: the names of
     FORMULA_NAMES and inv, as matrices and a function of any matrix arithmetic."""
     names = {k: v for k, v in namespace.items() if k not in FORMULA_FUNCTIONS}
     full_key = f"{task.key}.{key}" if task.key else key
-    tree = expression(task.path, full_key, text, names, functions=FORMULA_FUNCTIONS, constants={},
-                      max_degree=FORMULA_DEGREE)
+    tree = formula_expression(task.path, full_key, text, names)
     try:
         return tree.evaluate(names, {f: namespace[f] for f in FORMULA_FUNCTIONS}, python_number)
     except Exception as err:  # a shape or a singular inverse, in whichever arithmetic: the formula's error
@@ -653,11 +659,9 @@ def _validate_expressions(m: Model) -> None:
 
 def _validate_task_expressions(path: Path, t: Task) -> None:
     for term, text in t.sensitivity.items():
-        expression(path, f"{t.key}.sensitivity.{term}", text, FORMULA_NAMES, functions=FORMULA_FUNCTIONS,
-                   constants={}, max_degree=FORMULA_DEGREE)
+        formula_expression(path, f"{t.key}.sensitivity.{term}", text, FORMULA_NAMES)
     for i, r in enumerate(t.remarks):
-        expression(path, f"{t.key}.remarks[{i}].alternative", r.alternative, FORMULA_NAMES,
-                   functions=FORMULA_FUNCTIONS, constants={}, max_degree=FORMULA_DEGREE)
+        formula_expression(path, f"{t.key}.remarks[{i}].alternative", r.alternative, FORMULA_NAMES)
     for term, v in t.default_precision.items():
         if not (0 <= v <= MAX_PRECISION):
             raise DescriptionError(path, f"{t.key}.defaults.precision.{term}",

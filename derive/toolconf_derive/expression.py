@@ -31,7 +31,7 @@ MAX_CHARACTERS = 20_000
 MAX_NODES = 5_000
 MAX_DEPTH = 32
 MAX_EXPONENT = 16
-MAX_DEGREE = 64
+MAX_DEGREE = 32
 MAX_NUMBER_CHARACTERS = 100
 
 # What a description's scalar expressions may call (arity), and the named numbers.
@@ -113,14 +113,14 @@ def bracket_problem(text: str) -> str | None:
 
 class _Parser:
     def __init__(self, text: str, names, functions: dict[str, int], constants: dict[str, float],
-                 max_degree: int):
+                 max_degree: int, max_number: float):
         if len(text) > MAX_CHARACTERS:
             raise ExpressionError(f"longer than {MAX_CHARACTERS} characters ({len(text)})")
         problem = bracket_problem(text)
         if problem:
             raise ExpressionError(problem)
         self.text, self.names, self.functions, self.constants = text, names, functions, constants
-        self.max_degree = max_degree
+        self.max_degree, self.max_number = max_degree, max_number
         self.tokens = self._tokens(text)
         self.at, self.nodes, self.depth = 0, 0, 0
 
@@ -246,7 +246,10 @@ class _Parser:
             if len(text) > MAX_NUMBER_CHARACTERS:
                 raise ExpressionError(f"the number at character {where} has more than {MAX_NUMBER_CHARACTERS} "
                                       "characters")
-            return self.node("number", text=text, value=_constant(float(text), f"the number {text}"))
+            value = _constant(float(text), f"the number {text}")
+            if abs(value) > self.max_number:
+                raise ExpressionError(f"the number {text} at character {where} is larger than {self.max_number:g}")
+            return self.node("number", text=text, value=value)
         if kind == "name":
             return self.name(text, where)
         if (kind, text) == ("op", "("):
@@ -335,14 +338,15 @@ def _evaluate(node: Node, values: dict, functions: dict, number):
 
 
 def parse(text: str, names, functions: dict[str, int] | None = None, constants: dict[str, float] | None = None,
-          max_degree: int = MAX_DEGREE) -> Expression:
+          max_degree: int = MAX_DEGREE, max_number: float = math.inf) -> Expression:
     """`text` as an Expression over `names` (any container of allowed names), `functions`
     (name -> number of arguments; default sin, cos, sqrt) and `constants` (named numbers; default
-    pi); anything else is an ExpressionError saying what and where (characters count from 1)."""
+    pi), `max_degree` and `max_number` (the largest number written); anything else is an
+    ExpressionError saying what and where (characters count from 1)."""
     if not isinstance(text, str):
         raise ExpressionError(f"must be a string, got {text!r}")
     parser = _Parser(text, names, SCALAR_FUNCTIONS if functions is None else functions,
-                     SCALAR_CONSTANTS if constants is None else constants, max_degree)
+                     SCALAR_CONSTANTS if constants is None else constants, max_degree, max_number)
     return Expression(text, parser.whole())
 
 
@@ -381,18 +385,14 @@ def number_value(text: str) -> float:
     return value
 
 
-# Task formulas: products of a few matrices (tasks.toml's are of degree <= 5). The bound keeps
-# the symbolic inverse and simplification of a hostile formula short.
+# Task formulas: products of a few matrices (tasks.toml's are of degree <= 5) and numbers. The
+# bounds keep the symbolic inverse and simplification of a hostile formula short, and its values
+# finite in double precision.
 FORMULA_FUNCTIONS = {"inv": 1}
 FORMULA_DEGREE = 8
+FORMULA_NUMBER = 1e6
 
 
 def formula(text: str, names) -> Expression:
     """A task formula over the matrix names of `names` and inv(...)."""
-    return parse(text, names, FORMULA_FUNCTIONS, {}, FORMULA_DEGREE)
-
-
-def evaluate_formula(text: str, namespace: dict):
-    """A task formula built on `namespace` (names and `inv`, in any matrix arithmetic)."""
-    names = {k: v for k, v in namespace.items() if k not in FORMULA_FUNCTIONS}
-    return formula(text, names).evaluate(names, {"inv": namespace["inv"]}, python_number)
+    return parse(text, names, FORMULA_FUNCTIONS, {}, FORMULA_DEGREE, FORMULA_NUMBER)
