@@ -49,9 +49,21 @@ TOKENS = ["m", "l", "g", "theta", "theta_dot", "torque", "pi", "sin", "cos", "sq
           "9**9**9", "1/0", RUN, "Π", "\0"]
 
 
+LEAVES = st.sampled_from(["m", "l", "g", "theta", "torque", "pi", "A", "B", "I", "IO", "0", "2", "0.5", "1e-3",
+                          "1e6", "1e308", "16"])
+GRAMMATICAL = st.recursive(LEAVES, lambda inner: st.one_of(
+    st.tuples(inner, st.sampled_from(["+", "-", "*", "/", "**", "@"]), inner).map(" ".join),
+    inner.map(lambda e: f"-{e}"), inner.map(lambda e: f"({e})"),
+    st.tuples(st.sampled_from(["sin", "cos", "sqrt", "inv"]), inner).map(lambda t: f"{t[0]}({t[1]})")),
+    max_leaves=12)
+
+
 @st.composite
 def expressions(draw) -> str:
-    """A text of tokens, sometimes one token repeated (long sums, deep nesting)."""
+    """A text of the grammar (which may still be refused: 1e308**16, x/(2-2), names of the other
+    place), or of tokens, sometimes one repeated (long sums, deep nesting)."""
+    if draw(st.integers(0, 2)) == 0:
+        return draw(GRAMMATICAL)
     parts = draw(st.lists(st.sampled_from(TOKENS), max_size=24))
     if draw(st.integers(0, 7)) == 0:
         parts.insert(draw(st.integers(0, len(parts))), draw(st.sampled_from(["(", "-", "m+", "m*", "**1"]))

@@ -178,7 +178,7 @@ class Refusals(unittest.TestCase):
                       _joint(f"j{i}", "revolute", "base" if i == 0 else f"l{i - 1}", f"l{i}", "0 0 0.1")]
         parts += [_link("flange"), _joint("fix", "fixed", "l12", "flange")]
         self.stops(_robot(*parts), "link 'flange'", "13 moving joints")
-        self.stops(_robot(*GOOD) + " " * (4 * 1024 * 1024), "", "a URDF the derivation reads is at most")
+        self.stops(_robot(*GOOD) + " " * (4 * 1024 * 1024), "", "larger than 4194304 bytes (4 MiB), more than a URDF file needs")
 
     def test_not_xml(self):
         self.stops("<robot><link name='a'></robot>", "", "not valid XML")
