@@ -190,6 +190,9 @@ class Refuses(unittest.TestCase):
         self.refused("x +", "ends where a number, name or '(' is expected")
         self.refused("x y", "unexpected 'y' at character 3")
 
+    def test_the_matrix_product_is_only_for_task_formulas(self):
+        self.refused("x @ y", "'@' at character 3 is the matrix product, which only task formulas have")
+
     def test_division_by_a_number_zero(self):
         for text in ("1/0", "x/0", "x/(2-2)", "x/0.0", "0**-1"):
             with self.subTest(text):
@@ -218,13 +221,18 @@ class Refuses(unittest.TestCase):
 
     def test_task_formulas_have_only_their_names_and_inv(self):
         names = FORMULA_NAMES
-        grammar = {"functions": {"inv": 1}, "constants": {}, "max_degree": 8, "max_number": 1e6}
+        grammar = {"functions": {"inv": 1}, "constants": {}, "max_degree": 8, "max_number": 1e6, "matrices": True}
         self.refused("A.T", "unexpected character '.'", names, **grammar)
         self.refused("sin(A)", "'sin' is not defined", names, **grammar)
         self.refused("A @ pi", "'pi' is not defined", names, **grammar)
         self.refused(" @ ".join(["A"] * 9), "polynomial degree 9, more than 8", names, **grammar)
         self.refused("inv(A, B)", "inv() takes 1 argument(s), got 2", names, **grammar)
-        self.refused("A @ 9**9**9", "larger than 16", names, **grammar)
+        self.refused("A @ 9**9**9", "a task formula has no powers", names, **grammar)
+        # One meaning in NumPy, SymPy, CasADi and mpmath alike.
+        self.refused("A * B", "'*' at character 3 multiplies two matrices: write '@'", names, **grammar)
+        self.refused("A / B", "'/' at character 3 divides by a matrix", names, **grammar)
+        self.refused("A + 1", "'+' at character 3 adds a number and a matrix", names, **grammar)
+        self.assertIsNone(parse("2 * A / 4 - (1 + 1) * B", names, **grammar).value)
         self.refused("1e308 * A", "the number 1e308 at character 1 is larger than 1e+06", names, **grammar)
 
     def test_a_task_formula_that_fails_in_its_arithmetic_names_the_key(self):

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 import re
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 MAX_CHARACTERS = 20_000
@@ -113,14 +114,14 @@ def bracket_problem(text: str) -> str | None:
 
 class _Parser:
     def __init__(self, text: str, names, functions: dict[str, int], constants: dict[str, float],
-                 max_degree: int, max_number: float):
+                 max_degree: int, max_number: float, matrices: bool):
         if len(text) > MAX_CHARACTERS:
             raise ExpressionError(f"longer than {MAX_CHARACTERS} characters ({len(text)})")
         problem = bracket_problem(text)
         if problem:
             raise ExpressionError(problem)
         self.text, self.names, self.functions, self.constants = text, names, functions, constants
-        self.max_degree, self.max_number = max_degree, max_number
+        self.max_degree, self.max_number, self.matrices = max_degree, max_number, matrices
         self.tokens = self._tokens(text)
         self.at, self.nodes, self.depth = 0, 0, 0
 
@@ -163,18 +164,16 @@ class _Parser:
             raise ExpressionError(f"of polynomial degree {fields['degree']}, more than {self.max_degree}")
         return Node(kind, **fields)
 
+    @contextmanager
     def nested(self):
-        parser = self
-
-        class Level:
-            def __enter__(self):
-                parser.depth += 1
-                if parser.depth > MAX_DEPTH:
-                    raise ExpressionError(f"nested more than {MAX_DEPTH} deep")
-
-            def __exit__(self, *_):
-                parser.depth -= 1
-        return Level()
+        """One level deeper (a bracket, a unary sign, an exponent): Python's recursion stays short."""
+        self.depth += 1
+        if self.depth > MAX_DEPTH:
+            raise ExpressionError(f"nested more than {MAX_DEPTH} deep")
+        try:
+            yield
+        finally:
+            self.depth -= 1
 
     # --- grammar --------------------------------------------------------------------------------
 
@@ -197,21 +196,39 @@ class _Parser:
     def chain(self, kind: str, operators: tuple, operand) -> Node:
         """A left-associative run of `operators`, kept flat (a 5000-term sum is no deep tree)."""
         first = operand()
-        rest = []
+        rest, places = [], []
         while self.peek()[0] == "op" and self.peek()[1] in operators:
-            op = self.take()[1]
+            _, op, where = self.take()
             rest.append((op, operand()))
+            places.append(where)
         if not rest:
             return first
         value = first.value
-        for op, x in rest:
+        for (op, x), where in zip(rest, places):
             if op == "/" and x.value == 0:
                 raise ExpressionError("division by zero")
+            self.check_operands(op, where, value, x)
             value = None if value is None or x.value is None else _fold(op, value, x.value)
         degrees = [first.degree] + [x.degree for _, x in rest]
         degree = max(degrees) if kind == "sum" else sum(degrees)
         return self.node(kind, args=(first,), rest=tuple(rest), degree=degree,
                          value=None if value is None else _constant(value, "the value"))
+
+    def check_operands(self, op: str, where: int, left: float | None, right: Node) -> None:
+        """One meaning in every arithmetic: `@` only between matrices (task formulas); there, `*`
+        and `/` only with a number (NumPy's `*` of matrices is elementwise, SymPy's a product)
+        and no number added to a matrix (NumPy would broadcast it)."""
+        if not self.matrices:
+            if op == "@":
+                raise ExpressionError(f"'@' at character {where} is the matrix product, which only task formulas have")
+            return
+        numbers = (left is not None, right.value is not None)
+        if op == "*" and not any(numbers):
+            raise ExpressionError(f"'*' at character {where} multiplies two matrices: write '@'")
+        if op == "/" and not numbers[1]:
+            raise ExpressionError(f"'/' at character {where} divides by a matrix: write inv(...)")
+        if op in "+-" and numbers[0] != numbers[1]:
+            raise ExpressionError(f"'{op}' at character {where} adds a number and a matrix")
 
     def unary(self) -> Node:
         kind, text, _ = self.peek()
@@ -228,6 +245,8 @@ class _Parser:
         kind, text, where = self.peek()
         if (kind, text) != ("op", "**"):
             return base
+        if self.matrices:
+            raise ExpressionError(f"'**' at character {where}: a task formula has no powers (write A @ A)")
         self.take()
         with self.nested():
             exponent = self.unary()
@@ -338,15 +357,16 @@ def _evaluate(node: Node, values: dict, functions: dict, number):
 
 
 def parse(text: str, names, functions: dict[str, int] | None = None, constants: dict[str, float] | None = None,
-          max_degree: int = MAX_DEGREE, max_number: float = math.inf) -> Expression:
+          max_degree: int = MAX_DEGREE, max_number: float = math.inf, matrices: bool = False) -> Expression:
     """`text` as an Expression over `names` (any container of allowed names), `functions`
     (name -> number of arguments; default sin, cos, sqrt) and `constants` (named numbers; default
-    pi), `max_degree` and `max_number` (the largest number written); anything else is an
-    ExpressionError saying what and where (characters count from 1)."""
+    pi), `max_degree` and `max_number` (the largest number written), and whether its names are
+    `matrices` (task formulas: `@`, no `**`); anything else is an ExpressionError saying what and
+    where (characters count from 1)."""
     if not isinstance(text, str):
         raise ExpressionError(f"must be a string, got {text!r}")
     parser = _Parser(text, names, SCALAR_FUNCTIONS if functions is None else functions,
-                     SCALAR_CONSTANTS if constants is None else constants, max_degree, max_number)
+                     SCALAR_CONSTANTS if constants is None else constants, max_degree, max_number, matrices)
     return Expression(text, parser.whole())
 
 
@@ -395,4 +415,4 @@ FORMULA_NUMBER = 1e6
 
 def formula(text: str, names) -> Expression:
     """A task formula over the matrix names of `names` and inv(...)."""
-    return parse(text, names, FORMULA_FUNCTIONS, {}, FORMULA_DEGREE, FORMULA_NUMBER)
+    return parse(text, names, FORMULA_FUNCTIONS, {}, FORMULA_DEGREE, FORMULA_NUMBER, matrices=True)

@@ -40,6 +40,8 @@ def parse(model: Model, text: str, symbols: dict[str, sp.Symbol], key: str, rati
         e = sympy_expression(text, symbols, rational)
     except ExpressionError as err:
         raise DescriptionError(model.path, key, f"{err} in '{text}'") from err
+    except (TypeError, ValueError, ArithmeticError) as err:  # SymPy refusing what the grammar let through
+        raise DescriptionError(model.path, key, f"cannot build '{text}': {err}") from err
     if e.has(sp.zoo, sp.nan, sp.oo, -sp.oo):
         raise DescriptionError(model.path, key, f"'{text}' is not finite ({e})")
     return e

@@ -9,7 +9,8 @@ naming the file, the joint or link and the reason (a DescriptionError, status 2 
 floating, planar and mimic joints (and any unknown type) between the base and the flange; a
 moving joint that leaves the chain (a branch); a link with two parents (a loop); a body carried
 by a moving joint without an <inertial>, or with mass <= 0; an inertia that is not positive
-definite or whose principal moments violate the triangle inequality.
+definite or whose principal moments violate the triangle inequality; a number outside its
+physical range (MAX_MASS, MAX_INERTIA, MAX_LENGTH, MAX_ANGLE) or more than MAX_LINKS links.
 
 Numbers: the file's decimals are read as doubles (correctly rounded, the same on every machine);
 rotations (URDF rpy) and the merging of fixed links are done in 50-digit mpmath and rounded once,
