@@ -8,9 +8,11 @@ import hashlib
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
+import time
 import unittest
 from pathlib import Path
 
@@ -106,6 +108,19 @@ class MakeCrate(unittest.TestCase):
         self.assert_owned(out)
         if before is not None:
             self.assertEqual(git_status(), before)
+        # Terminated while making it anew: the old crate is as it was, and no temporary is left.
+        kept = files_under(out)
+        run = subprocess.Popen([*MAKE_CRATE, "--models", str(self.models), "--out", str(out)], cwd=self.base,
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        deadline = time.monotonic() + 120
+        while not any(p.name.startswith(".my-pendulum-partial-") for p in self.base.iterdir()):
+            self.assertIsNone(run.poll(), "make crate ended before it was signalled")
+            self.assertLess(time.monotonic(), deadline)
+            time.sleep(0.01)
+        run.send_signal(signal.SIGTERM)
+        self.assertEqual(run.wait(timeout=300), 128 + signal.SIGTERM)
+        self.assertEqual(files_under(out), kept)
+        self.assertEqual(sorted(p.name for p in self.base.iterdir()), ["descriptions", "my-pendulum"])
         # A file of the user's in it, or a file of the crate the user changed: not replaced.
         (out / "notes.txt").write_text("mine")
         r = self.run_make_crate(out)
