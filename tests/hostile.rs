@@ -187,6 +187,9 @@ fn cases() -> Vec<Case> {
         case("reproduce two outputs through a link", &["reproduce", "--quick", "--only", "fig2", "--out", "out"], 2, &["--out out (its fig2_confidence_vs_error.csv) and --out out (its report.md)"])
             .file("out/report.md", "my notes\n")
             .link("out/fig2_confidence_vs_error.csv", "report.md"),
+        // A link among reproduce's outputs is the user's: written through, never removed.
+        case("reproduce into a link to /dev/null", &["reproduce", "--quick", "--only", "fig2", "--out", "out"], 0, &[])
+            .link("out/fig2_confidence_vs_error.csv", "/dev/null"),
         case("--csv /dev/full", &["simulate", "--arm", ARM, "--task", "position", "--csv", "/dev/full"], 1, &["/dev/full", "No space left"]),
         case("rank --csv /dev/full", &["rank", "--tools", d, "--task", "position", "--screen", "1", "--csv", "/dev/full"], 1, &["No space left"]),
         case("--csv /dev/null", &["simulate", "--arm", ARM, "--task", "position", "--csv", "/dev/null"], 0, &[]),
@@ -344,6 +347,11 @@ fn check(c: &Case, dir: &Path, out: &Output) -> Result<(), String> {
     for (name, text) in &c.files {
         if std::fs::read(dir.join(name)).ok().as_ref() != Some(text) {
             return Err(format!("{name} changed"));
+        }
+    }
+    for (name, _) in &c.links {
+        if !std::fs::symlink_metadata(dir.join(name)).is_ok_and(|m| m.file_type().is_symlink()) {
+            return Err(format!("{name} is no longer a symbolic link"));
         }
     }
     for name in &c.absent {

@@ -414,7 +414,12 @@ pub fn reproduce(config: &Config) -> Result<Summary, ReproduceError> {
     Ok(summary)
 }
 
+/// Removes an earlier run's regular file at `path`; a link, a device or a FIFO is the user's, and
+/// stays (it is written through, or in place, by the output rule).
 fn remove_if_present(path: &Path) -> Result<(), ReproduceError> {
+    if !std::fs::symlink_metadata(path).is_ok_and(|m| m.is_file()) {
+        return Ok(());
+    }
     match std::fs::remove_file(path) {
         Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(ReproduceError::io(path)(e)),
         _ => Ok(()),
