@@ -465,3 +465,141 @@ fn simulate_model_rejects_bad_parameters_and_two_link_only_options() {
         assert!(!err.contains("panicked"), "{err}");
     }
 }
+
+/// A folder of the test's own, empty.
+fn scratch(name: &str) -> std::path::PathBuf {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli-{name}"));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The temporary files in `dir`.
+fn partials(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.to_string_lossy().ends_with(".partial"))
+        .collect()
+}
+
+/// Waits for `child` at most `limit`; one that runs longer is killed and fails the test.
+fn wait_bounded(
+    child: &mut std::process::Child,
+    limit: std::time::Duration,
+) -> std::process::ExitStatus {
+    let deadline = std::time::Instant::now() + limit;
+    loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            return status;
+        }
+        if std::time::Instant::now() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("still running after {limit:?}");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+}
+
+#[cfg(unix)]
+#[test]
+fn sigterm_during_rank_csv_keeps_the_old_file_and_leaves_no_temporary() {
+    use std::process::Stdio;
+    use std::time::{Duration, Instant};
+    let dir = scratch("sigterm");
+    // Enough tools that the simulation stage lasts well past the first rows.
+    let mut tools = String::from("name,m1,m2,l1,l2\n");
+    for i in 0..3000 {
+        tools += &format!("t{i},0.3,0.4,{},0.2\n", 0.2 + f64::from(i % 60) * 0.005);
+    }
+    std::fs::write(dir.join("tools.csv"), tools).unwrap();
+    let old = b"row,name\n1,my previous results\n";
+    std::fs::write(dir.join("results.csv"), old).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_toolconf"))
+        .args(["rank", "--tools", "tools.csv", "--task", "position"])
+        .args(["--csv", "results.csv"])
+        .current_dir(&dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // Signalled once rows are being written: the temporary holds the header and a row.
+    let deadline = Instant::now() + Duration::from_secs(120);
+    let rows = |p: &std::path::Path| {
+        std::fs::read(p).map_or(0, |b| b.iter().filter(|&&c| c == b'\n').count())
+    };
+    while !partials(&dir).iter().any(|p| rows(p) >= 2) {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the run ended before it was signalled"
+        );
+        assert!(Instant::now() < deadline, "no rows written after 120 s");
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    assert_eq!(std::fs::read(dir.join("results.csv")).unwrap(), old);
+    // SAFETY: kill(2) on the child's own pid.
+    assert_eq!(unsafe { libc::kill(child.id() as i32, libc::SIGTERM) }, 0);
+    let status = wait_bounded(&mut child, Duration::from_secs(30));
+    assert_eq!(status.code(), Some(128 + libc::SIGTERM), "{status:?}");
+    assert_eq!(std::fs::read(dir.join("results.csv")).unwrap(), old);
+    assert_eq!(partials(&dir), Vec::<std::path::PathBuf>::new());
+}
+
+#[cfg(unix)]
+#[test]
+fn a_fifo_nothing_reads_is_refused_at_once_and_stays_a_fifo() {
+    use std::os::unix::fs::FileTypeExt;
+    use std::process::Stdio;
+    let dir = scratch("fifo");
+    std::fs::create_dir(dir.join("r")).unwrap();
+    let drawer = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/tools/drawer.csv");
+    for (fifo, args) in [
+        (
+            "r/report.md",
+            vec![
+                "rank", "--tools", drawer, "--task", "position", "--screen", "1", "--report", "r",
+            ],
+        ),
+        (
+            "out.csv",
+            vec![
+                "simulate",
+                "--arm",
+                "0.3,0.4,0.5,0.2",
+                "--task",
+                "position",
+                "--csv",
+                "out.csv",
+            ],
+        ),
+    ] {
+        let path = std::ffi::CString::new(dir.join(fifo).to_str().unwrap()).unwrap();
+        // SAFETY: a NUL-terminated path.
+        assert_eq!(unsafe { libc::mkfifo(path.as_ptr(), 0o644) }, 0);
+        let mut child = Command::new(env!("CARGO_BIN_EXE_toolconf"))
+            .args(&args)
+            .current_dir(&dir)
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let status = wait_bounded(&mut child, std::time::Duration::from_secs(60));
+        let mut stderr = String::new();
+        std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut stderr).unwrap();
+        assert_eq!(status.code(), Some(2), "{fifo}: {stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        let name = fifo.rsplit('/').next().unwrap();
+        assert!(
+            stderr.contains(name) && stderr.contains("a FIFO that no process reads"),
+            "{stderr}"
+        );
+        assert!(std::fs::symlink_metadata(dir.join(fifo))
+            .unwrap()
+            .file_type()
+            .is_fifo());
+    }
+    assert!(!dir.join("r/report.html").exists());
+}

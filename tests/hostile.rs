@@ -41,6 +41,10 @@ struct Case {
     status: i32,
     /// Fragments the stderr line must hold (for a failing status).
     says: Vec<&'static str>,
+    /// Paths that must not exist afterwards (an output refused before any work).
+    absent: Vec<&'static str>,
+    /// Symbolic links to make (name, target).
+    links: Vec<(&'static str, &'static str)>,
 }
 
 #[derive(Clone, Copy, PartialEq)]
@@ -58,6 +62,8 @@ fn case(name: &'static str, args: &[&str], status: i32, says: &[&'static str]) -
         env: Vec::new(),
         status,
         says: says.to_vec(),
+        absent: Vec::new(),
+        links: Vec::new(),
     }
 }
 
@@ -69,6 +75,16 @@ impl Case {
 
     fn to_full(mut self) -> Self {
         self.stdout = Sink::Full;
+        self
+    }
+
+    fn link(mut self, name: &'static str, target: &'static str) -> Self {
+        self.links.push((name, target));
+        self
+    }
+
+    fn absent(mut self, path: &'static str) -> Self {
+        self.absent.push(path);
         self
     }
 
@@ -147,7 +163,33 @@ fn cases() -> Vec<Case> {
         case("rank --csv a folder", &["rank", "--tools", d, "--task", "position", "--csv", "out"], 2, &["is a folder"]),
         case("--csv a missing folder", &["simulate", "--arm", ARM, "--task", "position", "--csv", "no/such.csv"], 2, &["its folder no"]),
         case("--csv a link", &["simulate", "--arm", ARM, "--task", "position", "--csv", "link.csv"], 0, &[]),
-        case("--csv a dangling link", &["simulate", "--arm", ARM, "--task", "position", "--csv", "dangling.csv"], 2, &["link to a file that does not exist"]),
+        case("--csv a dangling link", &["simulate", "--arm", ARM, "--task", "position", "--csv", "dangling.csv"], 2, &["--csv dangling.csv: a link to nothing: dangling.csv -> missing.csv"]),
+        case("--report a dangling link", &["rank", "--tools", d, "--task", "position", "--report", "dangling.csv"], 2, &["--report dangling.csv: a link to nothing: dangling.csv -> missing.csv"]),
+        case("--out a dangling link", &["reproduce", "--quick", "--out", "dangling.csv"], 2, &["a link to nothing"]),
+        // An output that is an input, or another output: refused before any work, the input
+        // as it was (every file a case gives is checked afterwards).
+        case("rank --csv the --tools file", &["rank", "--tools", "three.csv", "--task", "position", "--csv", "three.csv"], 2, &["--csv three.csv is the same file as --tools three.csv"])
+            .file("three.csv", THREE),
+        case("rank --csv the --task file", &["rank", "--tools", "three.csv", "--task", "task.toml", "--csv", "./task.toml"], 2, &["--csv ./task.toml", "--task task.toml"])
+            .file("three.csv", THREE)
+            .file("task.toml", "kind = \"position\"\n"),
+        case("rank --csv a link to the --tools file", &["rank", "--tools", "target.csv", "--task", "position", "--csv", "link.csv"], 2, &["--csv link.csv is the same file as --tools target.csv"]),
+        case("rank --report over the --tools file", &["rank", "--tools", "out/report.md", "--task", "position", "--report", "out"], 2, &["--report out (its report.md) is the same file as --tools out/report.md"])
+            .file("out/report.md", THREE),
+        case("simulate --csv the --task-file", &["simulate", "--arm", ARM, "--task-file", "g.toml", "--csv", "g.toml"], 2, &["--csv g.toml is the same file as --task-file g.toml"])
+            .file("g.toml", "kind = \"position\"\n"),
+        case("design --report over the --design file", &["design", "--task", "velocity", "--design", "report.md", "--report", "."], 2, &["--report . (its report.md) is the same file as --design report.md"])
+            .file("report.md", THIN),
+        case("rank --csv X --report X", &["rank", "--tools", d, "--task", "position", "--csv", "x", "--report", "x"], 2, &["--csv x and --report x are the same file"])
+            .absent("x"),
+        case("rank --csv into its own report", &["rank", "--tools", d, "--task", "position", "--csv", "out/report.html", "--report", "out"], 2, &["--csv out/report.html and --report out (its report.html)"])
+            .absent("out/report.html"),
+        case("reproduce two outputs through a link", &["reproduce", "--quick", "--only", "fig2", "--out", "out"], 2, &["--out out (its fig2_confidence_vs_error.csv) and --out out (its report.md)"])
+            .file("out/report.md", "my notes\n")
+            .link("out/fig2_confidence_vs_error.csv", "report.md"),
+        // A link among reproduce's outputs is the user's: written through, never removed.
+        case("reproduce into a link to /dev/null", &["reproduce", "--quick", "--only", "fig2", "--out", "out"], 0, &[])
+            .link("out/fig2_confidence_vs_error.csv", "/dev/null"),
         case("--csv /dev/full", &["simulate", "--arm", ARM, "--task", "position", "--csv", "/dev/full"], 1, &["/dev/full", "No space left"]),
         case("rank --csv /dev/full", &["rank", "--tools", d, "--task", "position", "--screen", "1", "--csv", "/dev/full"], 1, &["No space left"]),
         case("--csv /dev/null", &["simulate", "--arm", ARM, "--task", "position", "--csv", "/dev/null"], 0, &[]),
@@ -302,6 +344,21 @@ fn check(c: &Case, dir: &Path, out: &Output) -> Result<(), String> {
             serde_json::from_str(&stdout).map_err(|e| format!("stdout is not JSON: {e}"))?;
         no_null_numbers(&v, "")?;
     }
+    for (name, text) in &c.files {
+        if std::fs::read(dir.join(name)).ok().as_ref() != Some(text) {
+            return Err(format!("{name} changed"));
+        }
+    }
+    for (name, _) in &c.links {
+        if !std::fs::symlink_metadata(dir.join(name)).is_ok_and(|m| m.file_type().is_symlink()) {
+            return Err(format!("{name} is no longer a symbolic link"));
+        }
+    }
+    for name in &c.absent {
+        if std::fs::symlink_metadata(dir.join(name)).is_ok() {
+            return Err(format!("{name} was created"));
+        }
+    }
     let left = leftovers(dir);
     if !left.is_empty() {
         return Err(format!("temporary files left: {left:?}"));
@@ -342,6 +399,9 @@ fn hostile_inputs_end_in_their_status_with_one_line_and_harm_nothing() {
         std::os::unix::fs::symlink("/dev/zero", dir.join("zero.json")).unwrap();
         for (name, text) in &c.files {
             std::fs::write(dir.join(name), text).unwrap();
+        }
+        for (name, target) in &c.links {
+            std::os::unix::fs::symlink(target, dir.join(name)).unwrap();
         }
         let started = Instant::now();
         let out = run(c, &dir);

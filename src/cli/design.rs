@@ -14,7 +14,7 @@ use toolconf::model::mixed::ModelKind;
 use toolconf::rank::ModelTasks;
 use toolconf_report::design::{parameters_text, write_report, ReportInput};
 
-use super::output::{check_output_folder, CliError};
+use super::output::{check_files, CliError, RunFiles};
 use super::rank::task_spec;
 
 #[derive(clap::Args)]
@@ -54,9 +54,16 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         .parse()
         .map_err(|e| CliError::Usage(format!("--model: {e}")))?;
     let task = task_spec(&args.task)?;
-    if let Some(dir) = &args.report {
-        check_output_folder("--report", dir)?;
+    let mut files = RunFiles::new();
+    files.input("--design", &args.design);
+    if !task.file.is_empty() {
+        files.input("--task", std::path::Path::new(&args.task));
     }
+    if let Some(dir) = &args.report {
+        let report = toolconf_report::design::report_files(args.sweep.is_some());
+        files.output_folder("--report", dir, report);
+    }
+    check_files(&files)?;
     let tasks = ModelTasks::new(&task);
     tasks.check(model)?;
     let names: Vec<&'static str> = model.parameter_names().to_vec();

@@ -97,6 +97,9 @@ pub fn run() -> ExitCode {
         Ok(cli) => cli,
         Err(code) => return code,
     };
+    // Ctrl-C, SIGTERM or SIGHUP then keep the old output files and remove the temporaries; the
+    // signals' default (the process ends, the temporaries stay) is all a failure here costs.
+    let _ = toolconf::output::partial::remove_on_interrupt();
     if let Some(note) = toolconf::threads::cap_pool() {
         errln!("toolconf: note: {note}");
     }

@@ -2,6 +2,7 @@
 
 use nalgebra::SMatrix;
 use serde_json::Value;
+pub use toolconf::output::run_files::RunFiles;
 
 /// A matrix as a JSON list of rows.
 pub fn matrix_rows<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> Value {
@@ -115,15 +116,9 @@ pub fn write_atomically(path: &std::path::Path, contents: &str) -> Result<(), Cl
     })
 }
 
-/// `--csv FILE` (or another output file flag) checked before any work: a folder, a link to
-/// nothing or a missing folder is bad input (status 2), not a failed run.
-pub fn check_output_file(flag: &str, path: &std::path::Path) -> Result<(), CliError> {
-    toolconf::output::file::check_file(path)
-        .map_err(|m| CliError::Usage(format!("{flag} {}: {m}", path.display())))
-}
-
-/// `--report DIR` (or `--out DIR`) checked before any work: an existing file is bad input.
-pub fn check_output_folder(flag: &str, path: &std::path::Path) -> Result<(), CliError> {
-    toolconf::output::file::check_folder(path)
-        .map_err(|m| CliError::Usage(format!("{flag} {}: {m}", path.display())))
+/// A run's input and output files checked before any work ([`RunFiles::check`]): an output
+/// that is a folder, a link to nothing or in a missing folder, that is an input, or that is
+/// another output of the run, is bad input (status 2), not a failed run.
+pub fn check_files(files: &RunFiles) -> Result<(), CliError> {
+    files.check().map_err(CliError::Usage)
 }

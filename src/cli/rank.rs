@@ -22,7 +22,7 @@ use toolconf::TaskKind;
 use toolconf_report::progress::{self, ProgressBar};
 use toolconf_report::rank::{write_report, ReportInput};
 
-use super::output::{add_outcome, check_output_file, check_output_folder, CliError};
+use super::output::{add_outcome, check_files, CliError, RunFiles};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -228,12 +228,18 @@ struct Counts {
 
 pub fn run(args: &Args) -> Result<(), CliError> {
     let mut spec = task_spec(&args.task)?;
+    let mut files = RunFiles::new();
+    files.input("--tools", &args.tools);
+    if !spec.file.is_empty() {
+        files.input("--task", Path::new(&args.task));
+    }
     if let Some(path) = &args.csv {
-        check_output_file("--csv", path)?;
+        files.output_file("--csv", path);
     }
     if let Some(dir) = &args.report {
-        check_output_folder("--report", dir)?;
+        files.output_folder("--report", dir, &toolconf_report::rank::REPORT_FILES);
     }
+    check_files(&files)?;
     spec.episode.method = Some(args.method.method.into());
     let tasks = ModelTasks::new(&spec);
     let objective = Objective::from(args.objective);
@@ -327,6 +333,9 @@ fn simulate_streaming(
         }
     })?;
     bar.finish_and_clear();
+    if let Some(w) = csv {
+        w.finish()?;
+    }
     Ok((results, timing))
 }
 

@@ -4,9 +4,11 @@
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-use toolconf_report::experiments::{experiment_ids, reproduce, Config, Plan, ReproduceError};
+use toolconf_report::experiments::{
+    experiment_ids, output_files, reproduce, Config, Plan, ReproduceError,
+};
 
-use super::output::{check_output_folder, CliError};
+use super::output::{check_files, CliError, RunFiles};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -43,7 +45,6 @@ fn parse_experiment(s: &str) -> Result<String, String> {
 }
 
 pub fn run(args: &Args) -> Result<(), CliError> {
-    check_output_folder("--out", &args.out)?;
     let mut command = format!(
         "toolconf reproduce --out {} --seed {}",
         args.out.display(),
@@ -81,6 +82,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         command,
         method,
     };
+    let planned = output_files(&config).map_err(|e| CliError::Usage(e.to_string()))?;
+    check_files(RunFiles::new().output_folder("--out", &args.out, &planned))?;
     let summary = reproduce(&config).map_err(|e| match e {
         ReproduceError::Io { path, source } => CliError::Io { path, source },
         other => CliError::Io {

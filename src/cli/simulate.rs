@@ -14,7 +14,7 @@ use toolconf::validate::finite_output;
 use toolconf::{Arm, Task};
 
 use super::episode_args::{two_link_options, EpisodeArgs, PlantArg, TaskArgs};
-use super::output::{check_output_file, write_atomically, CliError};
+use super::output::{check_files, write_atomically, CliError, RunFiles};
 use super::{parse_arm, parse_model, tool_from_params};
 
 #[derive(clap::Args)]
@@ -127,9 +127,14 @@ impl MpcArgs {
 
 pub fn run(args: &Args) -> Result<(), CliError> {
     let spec = args.task.spec()?;
-    if let Some(path) = &args.csv {
-        check_output_file("--csv", path)?;
+    let mut files = RunFiles::new();
+    if let Some(path) = &args.task.task_file {
+        files.input("--task-file", path);
     }
+    if let Some(path) = &args.csv {
+        files.output_file("--csv", path);
+    }
+    check_files(&files)?;
     let arm = match (args.arm, args.model) {
         (Some(arm), _) => arm,
         (None, Some(model)) => return run_model(args, model, spec),

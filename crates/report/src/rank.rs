@@ -12,8 +12,8 @@ use crate::select::Objective;
 use crate::stats::spearman;
 use crate::task_file::{PerJoint, PrecisionSpec, TaskSpec};
 use crate::{TaskKind, Term};
-use toolconf::rank::{score, ModelTasks, RankedTool, StageTimings, TaskTrace};
 use toolconf::model::mixed::ModelKind;
+use toolconf::rank::{score, ModelTasks, RankedTool, StageTimings, TaskTrace};
 
 /// What the report describes.
 pub struct ReportInput<'a> {
@@ -37,6 +37,10 @@ pub struct ReportInput<'a> {
 /// How many tools the report lists, and how many of the best and worst it plots over time.
 const LISTED: usize = 50;
 const TRACED: usize = 3;
+
+/// The files [`write_report`] writes into its folder (checked against the run's other files
+/// before any work: [`toolconf::output::run_files`]).
+pub const REPORT_FILES: [&str; 4] = ["report.md", "report.html", CONFIDENCE_SVG, TRAJECTORY_SVG];
 
 /// Writes the report into `dir` (created if needed); returns the files written.
 pub fn write_report(dir: &Path, input: &ReportInput) -> Result<Vec<PathBuf>, ReproduceError> {

@@ -147,7 +147,7 @@ fn simulate_every_task(
         .collect();
     let mut csv = CsvWriter::create(&ctx.path(CSV), &HEADER)?;
     let options = [ctx.options];
-    map_ordered(
+    let results = map_ordered(
         &items,
         ctx.progress,
         1,
@@ -169,7 +169,9 @@ fn simulate_every_task(
             ]);
             csv.row(row).map_err(ReproduceError::from)
         },
-    )
+    )?;
+    csv.finish()?;
+    Ok(results)
 }
 
 fn introduction(tools: usize, plan: &Plan) -> Block {

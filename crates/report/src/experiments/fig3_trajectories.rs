@@ -200,6 +200,7 @@ fn write_sample(
         row.extend([Cell::from(logdets[i]), Cell::from(role)]);
         tools_csv.row(row)?;
     }
+    tools_csv.finish()?;
     Ok(())
 }
 
@@ -217,7 +218,7 @@ fn simulate_pair(
         .flat_map(|(role, tool)| [0.0, ctx.plan.perturbation].map(|dt| (role, tool, dt)))
         .collect();
     let mut csv = CsvWriter::create(&ctx.path(CSV), &HEADER)?;
-    map_ordered(
+    let runs = map_ordered(
         &items,
         ctx.progress,
         1,
@@ -237,7 +238,9 @@ fn simulate_pair(
             }
         },
         |run| write_run(&mut csv, run),
-    )
+    )?;
+    csv.finish()?;
+    Ok(runs)
 }
 
 /// One run's trajectory rows (or its error).

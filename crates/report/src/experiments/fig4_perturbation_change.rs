@@ -81,6 +81,7 @@ impl Experiment for Fig4 {
                 csv.row(row)
             },
         )?;
+        csv.finish()?;
 
         let mut panels = Vec::new();
         let mut rows = Vec::new();

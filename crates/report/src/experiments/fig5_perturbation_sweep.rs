@@ -191,6 +191,7 @@ fn simulate_sweep(
             Ok::<(), ReproduceError>(())
         },
     )?;
+    csv.finish()?;
     Ok((results, listed.len()))
 }
 

@@ -149,7 +149,7 @@ impl Fig6 {
         let header: Vec<&str> = header.iter().map(String::as_str).collect();
         let mut csv = CsvWriter::create(&ctx.path(CSV), &header)?;
         let mut next = 0usize;
-        map_ordered(
+        let done = map_ordered(
             &trials,
             ctx.progress,
             plan.fig6_tools as u64,
@@ -175,7 +175,9 @@ impl Fig6 {
                 next += 1;
                 write_trial(&mut csv, k, t)
             },
-        )
+        )?;
+        csv.finish()?;
+        Ok(done)
     }
 }
 

@@ -230,7 +230,7 @@ impl Fig7 {
         let mut csv = CsvWriter::create(&ctx.path(CSV), &header)?;
         let mut choices_csv = CsvWriter::create(&ctx.path(CHOICES_CSV), &CHOICES_HEADER)?;
         let mut next = 0usize;
-        map_ordered(
+        let done = map_ordered(
             &trials,
             ctx.progress,
             2 * plan.fig7_tools as u64,
@@ -258,7 +258,10 @@ impl Fig7 {
                 next += 1;
                 write_trial(&mut csv, &mut choices_csv, rules, k, t)
             },
-        )
+        )?;
+        csv.finish()?;
+        choices_csv.finish()?;
+        Ok(done)
     }
 }
 

@@ -15,8 +15,9 @@
 //!
 //! Tools are drawn before any parallel work; episodes run on rayon in ordered chunks
 //! ([`batch::map_ordered`]) and each chunk's rows are appended in input order, one `write_all`
-//! per row ([`csv::CsvWriter`]). The files are therefore byte-identical whatever the thread count,
-//! and an interrupted run leaves complete rows. Figures and the report are written whole
+//! per row ([`csv::CsvWriter`]), into a temporary file renamed over the CSV when the experiment
+//! has finished it. The files are therefore byte-identical whatever the thread count, and an
+//! interrupted run keeps the file that was there. Figures and the report are written whole
 //! (`.X.*.partial`, then renamed: [`toolconf::output::file`]).
 //!
 //! # Extending
@@ -301,11 +302,12 @@ impl Summary {
     }
 }
 
-/// Runs the selected experiments one after the other (each in parallel inside), then writes
-/// `report.md` and `report.html`.
-pub fn reproduce(config: &Config) -> Result<Summary, ReproduceError> {
-    let all = experiments();
-    let selected: Vec<&dyn Experiment> = match &config.only {
+/// The experiments `config` selects, in report order.
+fn select<'a>(
+    all: &'a [Box<dyn Experiment>],
+    config: &Config,
+) -> Result<Vec<&'a dyn Experiment>, ReproduceError> {
+    Ok(match &config.only {
         None => all
             .iter()
             .filter(|e| config.plan.mpc || !e.needs_mpc())
@@ -322,7 +324,27 @@ pub fn reproduce(config: &Config) -> Result<Summary, ReproduceError> {
                 .map(|e| e.as_ref())
                 .collect()
         }
-    };
+    })
+}
+
+/// The files [`reproduce`] writes into its folder under `config`: every selected experiment's,
+/// and the report (checked against each other before any work:
+/// [`toolconf::output::run_files`]).
+pub fn output_files(config: &Config) -> Result<Vec<String>, ReproduceError> {
+    let all = experiments();
+    let mut files: Vec<String> = select(&all, config)?
+        .iter()
+        .flat_map(|e| e.outputs())
+        .collect();
+    files.extend(["report.md".into(), "report.html".into()]);
+    Ok(files)
+}
+
+/// Runs the selected experiments one after the other (each in parallel inside), then writes
+/// `report.md` and `report.html`.
+pub fn reproduce(config: &Config) -> Result<Summary, ReproduceError> {
+    let all = experiments();
+    let selected = select(&all, config)?;
     let out = config.out_dir.as_path();
     toolconf::output::file::create_folder(out).map_err(ReproduceError::io(out))?;
     let report_md = out.join("report.md");
@@ -392,7 +414,12 @@ pub fn reproduce(config: &Config) -> Result<Summary, ReproduceError> {
     Ok(summary)
 }
 
+/// Removes an earlier run's regular file at `path`; a link, a device or a FIFO is the user's, and
+/// stays (it is written through, or in place, by the output rule).
 fn remove_if_present(path: &Path) -> Result<(), ReproduceError> {
+    if !std::fs::symlink_metadata(path).is_ok_and(|m| m.is_file()) {
+        return Ok(());
+    }
     match std::fs::remove_file(path) {
         Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(ReproduceError::io(path)(e)),
         _ => Ok(()),

@@ -164,7 +164,7 @@ fn run_both_controllers(ctx: &Context, tools: &[Arm]) -> Result<Vec<Item>, Repro
         .flat_map(|&k| (0..tools.len()).map(move |i| (k, i)))
         .collect();
     let mut csv = CsvWriter::create(&ctx.path(CSV), &HEADER)?;
-    map_ordered(
+    let done = map_ordered(
         &items,
         ctx.progress,
         4,
@@ -186,7 +186,9 @@ fn run_both_controllers(ctx: &Context, tools: &[Arm]) -> Result<Vec<Item>, Repro
             }
         },
         |item| write_item(&mut csv, item, &dts),
-    )
+    )?;
+    csv.finish()?;
+    Ok(done)
 }
 
 /// One timed episode: controller 0 is active inference, 1 the MPC baseline.

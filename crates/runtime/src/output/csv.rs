@@ -1,15 +1,16 @@
 //! CSV rows written as they are computed: the header and each row are one `write_all` on an
-//! unbuffered file, so an interrupted run leaves whole rows only.
+//! unbuffered file, the temporary beside the target ([`super::file::create_streaming`]), renamed
+//! over it at [`CsvWriter::finish`]: an interrupted or failed run keeps the file that was there.
 //!
 //! Numbers are written exactly (Rust's shortest round-trip form, in exponent notation outside
 //! 1e-4 ≤ |x| < 1e16); a non-finite number becomes an empty cell, so no file ever holds `NaN` or
 //! `inf`. Text cells are quoted when they hold a comma or a quote (RFC 4180); line breaks inside
 //! text become spaces, so every row is one line.
 
-use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use super::file::Streaming;
 use super::WriteError;
 
 /// One cell of a row.
@@ -97,15 +98,15 @@ fn format_row(cells: &[Cell]) -> String {
     line
 }
 
-/// An open CSV file with a fixed header.
+/// An open CSV file with a fixed header; its rows reach the target at [`CsvWriter::finish`].
 pub struct CsvWriter {
-    file: File,
+    file: Streaming,
     path: PathBuf,
     columns: usize,
 }
 
 impl CsvWriter {
-    /// Creates (truncates) `path` and writes the header.
+    /// Starts the file at `path` (its temporary, for a new or regular file) with the header.
     pub fn create(path: &Path, header: &[&str]) -> Result<Self, WriteError> {
         let file = super::file::create_streaming(path).map_err(WriteError::at(path))?;
         let mut writer = Self {
@@ -131,6 +132,11 @@ impl CsvWriter {
         self.file
             .write_all(format_row(&cells).as_bytes())
             .map_err(WriteError::at(&self.path))
+    }
+
+    /// Renames the whole file over its target (writes nothing more to a device).
+    pub fn finish(self) -> Result<(), WriteError> {
+        self.file.finish().map_err(WriteError::at(&self.path))
     }
 }
 

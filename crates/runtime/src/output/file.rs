@@ -2,24 +2,29 @@
 //!
 //! What a path names decides how it is written:
 //! * nothing yet, or a regular file: a temporary file beside it (`.NAME.XXXXXX.partial`),
-//!   renamed over it once whole, so that a reader sees the old file or the whole new one;
+//!   renamed over it once whole, so that a reader sees the old file or the whole new one; a
+//!   file written row by row ([`create_streaming`]) too, its rows going to the temporary;
 //! * a symbolic link: written through to its target by the same rules, and the link stays a
-//!   link (a link to nothing is refused, as a link to a folder is);
+//!   link (a link to nothing is refused, as "a link to nothing: PATH -> TARGET", as a link to a
+//!   folder is);
 //! * a device, a FIFO, a socket, or a name of an open descriptor (`/dev/stdout`, `/dev/fd/N`,
 //!   anything under `/proc`): written in place, never replaced: `--csv /dev/null` discards,
 //!   `--csv /dev/full` fails with "No space left on device" and the device stays a device, even
-//!   for root;
+//!   for root. A FIFO is opened without blocking: one nothing reads is refused, not waited on;
 //! * a folder: refused, as "is a folder, not a file".
 //!
-//! The temporary file is removed on every failure path (the `tempfile` crate removes it when it
-//! is dropped unrenamed); only a process killed outright (SIGKILL, or Ctrl-C, which ends the
-//! process without unwinding) can leave one, named `.NAME.*.partial` beside the target.
+//! The temporary file is removed on every failure path, and on SIGINT, SIGTERM or SIGHUP where
+//! the command line asked for it ([`super::partial::remove_on_interrupt`]); only a process
+//! killed outright (SIGKILL) can leave one, named `.NAME.*.partial` beside the target.
 //! [`check_file`] and [`check_folder`] tell the command line, before any work, whether a path can
-//! be written at all, so that a bad path is bad input (status 2), not a failed run.
+//! be written at all, so that a bad path is bad input (status 2), not a failed run; which outputs
+//! clash with each other or with an input is [`super::run_files`]'s.
 
 use std::fs::{self, File, OpenOptions, Permissions};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
+
+use super::partial::Partial;
 
 /// How a path is to be written.
 #[derive(Debug)]
@@ -34,13 +39,22 @@ enum Target {
     InPlace,
 }
 
-fn refused(message: &str) -> io::Error {
+pub(crate) fn refused(message: &str) -> io::Error {
     io::Error::new(io::ErrorKind::InvalidInput, message.to_string())
+}
+
+/// The words for a symbolic link whose target does not exist.
+fn link_to_nothing(path: &Path) -> io::Error {
+    let target = fs::read_link(path).map_or_else(|_| "?".into(), |t| t.display().to_string());
+    refused(&format!(
+        "a link to nothing: {} -> {target}",
+        path.display()
+    ))
 }
 
 /// Whether `path` names an open descriptor (`/dev/stdout` is a link to `/proc/self/fd/1`):
 /// what it leads to is the descriptor's file, which a rename would not reach.
-fn names_a_descriptor(path: &Path) -> bool {
+pub(crate) fn names_a_descriptor(path: &Path) -> bool {
     ["/proc", "/dev/fd", "/dev/stdout", "/dev/stderr"]
         .iter()
         .any(|p| path.starts_with(p))
@@ -63,9 +77,7 @@ fn target(path: &Path) -> io::Result<Target> {
     };
     let (meta, resolved) = if meta.file_type().is_symlink() {
         match fs::metadata(path) {
-            Err(e) if e.kind() == io::ErrorKind::NotFound => {
-                return Err(refused("is a symbolic link to a file that does not exist"))
-            }
+            Err(e) if e.kind() == io::ErrorKind::NotFound => return Err(link_to_nothing(path)),
             Err(e) => return Err(e),
             Ok(m) if m.is_file() => (m, fs::canonicalize(path)?),
             Ok(m) => (m, path.to_path_buf()),
@@ -90,6 +102,8 @@ fn target(path: &Path) -> io::Result<Target> {
 pub fn check_file(path: &Path) -> Result<(), String> {
     match target(path) {
         Err(e) => Err(e.to_string()),
+        #[cfg(unix)]
+        Ok(Target::InPlace) if is_fifo(path) => hold_fifo(path).map_err(|e| e.to_string()),
         Ok(Target::InPlace) => Ok(()),
         Ok(Target::Replace { path, .. }) => {
             let folder = parent(&path);
@@ -107,7 +121,13 @@ pub fn check_folder(path: &Path) -> Result<(), String> {
     match fs::metadata(path) {
         Ok(m) if m.is_dir() => Ok(()),
         Ok(_) => Err("is a file, not a folder".into()),
-        Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(()),
+        Err(e) if e.kind() == io::ErrorKind::NotFound => {
+            // `create_dir_all` onto a link to nothing says only "File exists".
+            match fs::symlink_metadata(path) {
+                Ok(m) if m.file_type().is_symlink() => Err(link_to_nothing(path).to_string()),
+                _ => Ok(()),
+            }
+        }
         Err(e) => Err(e.to_string()),
     }
 }
@@ -119,50 +139,127 @@ pub fn create_folder(dir: &Path) -> io::Result<()> {
     fs::create_dir_all(dir)
 }
 
-fn parent(path: &Path) -> &Path {
+pub(crate) fn parent(path: &Path) -> &Path {
     match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     }
 }
 
-/// Writes `contents` as the whole file at `path`, by the module's rules.
-pub fn write_whole(path: &Path, contents: &[u8]) -> io::Result<()> {
-    let (path, permissions) = match target(path)? {
-        Target::InPlace => {
-            let mut file = OpenOptions::new().write(true).open(path)?;
-            return file.write_all(contents).and_then(|()| file.flush());
-        }
-        Target::Replace { path, permissions } => (path, permissions),
-    };
-    let name = path
-        .file_name()
-        .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
-    let prefix = format!(".{name}.");
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(&prefix).suffix(".partial");
+/// Opens a device, FIFO or descriptor name to be written where it is. A FIFO is opened without
+/// blocking, so that one nothing reads is refused ("no process reads this FIFO"), not waited
+/// on; once open, writes block as usual.
+fn open_in_place(path: &Path) -> io::Result<File> {
+    let mut options = OpenOptions::new();
+    options.write(true);
     #[cfg(unix)]
-    if permissions.is_none() {
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(Permissions::from_mode(0o666));
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NONBLOCK);
     }
-    let mut tmp = builder.tempfile_in(parent(&path))?;
-    if let Some(p) = permissions {
-        tmp.as_file().set_permissions(p)?;
-    }
-    tmp.write_all(contents)?;
-    tmp.flush()?;
-    tmp.persist(&path).map(drop).map_err(|e| e.error)
+    let file = options.open(path).map_err(|e| {
+        #[cfg(unix)]
+        if e.raw_os_error() == Some(libc::ENXIO) && is_fifo(path) {
+            return refused("is a FIFO that no process reads");
+        }
+        e
+    })?;
+    #[cfg(unix)]
+    blocking(&file)?;
+    Ok(file)
 }
 
-/// Opens `path` to be written row by row (a CSV whose rows appear as they are computed): a
-/// regular file is truncated, a device or FIFO written in place, a link written through; a
-/// folder or a link to nothing is refused.
-pub fn create_streaming(path: &Path) -> io::Result<File> {
-    match target(path)? {
-        Target::InPlace => OpenOptions::new().write(true).open(path),
-        Target::Replace { path, .. } => File::create(path),
+/// FIFOs opened by [`check_file`], open until the process ends: closing one would tell its
+/// reader the output had ended before it was written.
+#[cfg(unix)]
+static HELD_FIFOS: std::sync::Mutex<Vec<File>> = std::sync::Mutex::new(Vec::new());
+
+/// Whether a process reads the FIFO at `path` now: opened without blocking, and held.
+#[cfg(unix)]
+fn hold_fifo(path: &Path) -> io::Result<()> {
+    let file = open_in_place(path)?;
+    HELD_FIFOS
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+        .push(file);
+    Ok(())
+}
+
+#[cfg(unix)]
+fn is_fifo(path: &Path) -> bool {
+    use std::os::unix::fs::FileTypeExt;
+    fs::metadata(path).is_ok_and(|m| m.file_type().is_fifo())
+}
+
+/// Clears `O_NONBLOCK` on an open file (a full pipe then waits for its reader, as any write).
+#[cfg(unix)]
+fn blocking(file: &File) -> io::Result<()> {
+    use std::os::fd::AsRawFd;
+    let fd = file.as_raw_fd();
+    // SAFETY: fcntl on a descriptor this function's caller owns and keeps open.
+    let flags = unsafe { libc::fcntl(fd, libc::F_GETFL) };
+    // SAFETY: as above; only the O_NONBLOCK bit changes.
+    if flags < 0 || unsafe { libc::fcntl(fd, libc::F_SETFL, flags & !libc::O_NONBLOCK) } < 0 {
+        return Err(io::Error::last_os_error());
     }
+    Ok(())
+}
+
+/// Writes `contents` as the whole file at `path`, by the module's rules.
+pub fn write_whole(path: &Path, contents: &[u8]) -> io::Result<()> {
+    let mut out = create_streaming(path)?;
+    out.write_all(contents)?;
+    out.finish()
+}
+
+/// A file being written: rows go to a temporary file renamed over the target at
+/// [`Streaming::finish`] (dropped unfinished, the temporary goes and the old file stays), or,
+/// for a device or FIFO, to the file itself.
+pub struct Streaming {
+    out: Out,
+}
+
+enum Out {
+    Replace(Partial),
+    InPlace(File),
+}
+
+impl Streaming {
+    /// Makes the file whole: renames the temporary over the target (or flushes a device).
+    pub fn finish(self) -> io::Result<()> {
+        match self.out {
+            Out::Replace(partial) => partial.persist(),
+            Out::InPlace(mut file) => file.flush(),
+        }
+    }
+}
+
+impl Write for Streaming {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        match &mut self.out {
+            Out::Replace(partial) => partial.as_file().write(buf),
+            Out::InPlace(file) => file.write(buf),
+        }
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        match &mut self.out {
+            Out::Replace(partial) => partial.as_file().flush(),
+            Out::InPlace(file) => file.flush(),
+        }
+    }
+}
+
+/// Opens `path` to be written row by row (a CSV whose rows are appended as they are computed),
+/// by the module's rules: the rows of a new or regular file go to its temporary until
+/// [`Streaming::finish`]; a device or FIFO is written in place; a link is written through; a
+/// folder or a link to nothing is refused.
+pub fn create_streaming(path: &Path) -> io::Result<Streaming> {
+    let out = match target(path)? {
+        Target::InPlace => Out::InPlace(open_in_place(path)?),
+        Target::Replace { path, permissions } => Out::Replace(Partial::create(&path, permissions)?),
+    };
+    Ok(Streaming { out })
 }
 
 #[cfg(test)]
@@ -213,7 +310,15 @@ mod tests {
         let dangling = dir.join("dangling.csv");
         std::os::unix::fs::symlink(dir.join("missing.csv"), &dangling).unwrap();
         let e = write_whole(&dangling, b"x").unwrap_err();
-        assert!(e.to_string().contains("link to a file that does not exist"));
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "a link to nothing: {} -> {}",
+                dangling.display(),
+                dir.join("missing.csv").display()
+            )
+        );
+        assert_eq!(check_folder(&dangling), Err(e.to_string()));
         assert_eq!(entries(&dir), ["dangling.csv", "link.csv", "target.csv"]);
         fs::remove_dir_all(&dir).unwrap();
     }
@@ -251,6 +356,59 @@ mod tests {
             assert_eq!(fs::read(&path).unwrap(), b"x\n");
             fs::remove_file(&path).unwrap();
         }
+    }
+
+    #[test]
+    fn rows_go_to_the_temporary_and_an_unfinished_file_keeps_the_old_one() {
+        let dir = scratch("streaming");
+        let path = dir.join("rows.csv");
+        fs::write(&path, b"old\n").unwrap();
+        let mut out = create_streaming(&path).unwrap();
+        out.write_all(b"row 1\n").unwrap();
+        assert_eq!(fs::read(&path).unwrap(), b"old\n");
+        assert_eq!(entries(&dir).len(), 2, "{:?}", entries(&dir));
+        drop(out);
+        assert_eq!(fs::read(&path).unwrap(), b"old\n");
+        assert_eq!(entries(&dir), ["rows.csv"]);
+        let mut out = create_streaming(&path).unwrap();
+        out.write_all(b"row 1\nrow 2\n").unwrap();
+        out.finish().unwrap();
+        assert_eq!(fs::read(&path).unwrap(), b"row 1\nrow 2\n");
+        assert_eq!(entries(&dir), ["rows.csv"]);
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_nothing_reads_is_refused_not_waited_on() {
+        let dir = scratch("fifo");
+        let fifo = dir.join("report.md");
+        let c = std::ffi::CString::new(fifo.as_os_str().as_encoded_bytes()).unwrap();
+        // SAFETY: a NUL-terminated path.
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o644) }, 0);
+        assert_eq!(
+            check_file(&fifo),
+            Err("is a FIFO that no process reads".into())
+        );
+        let e = write_whole(&fifo, b"x").unwrap_err();
+        assert_eq!(e.to_string(), "is a FIFO that no process reads");
+        // With a reader it is written in place, and stays a FIFO.
+        let reader = std::thread::spawn({
+            let fifo = fifo.clone();
+            move || fs::read(fifo).unwrap()
+        });
+        let written = loop {
+            match write_whole(&fifo, b"through the pipe") {
+                Err(e) if e.to_string().contains("no process reads") => std::thread::yield_now(),
+                other => break other,
+            }
+        };
+        written.unwrap();
+        assert_eq!(reader.join().unwrap(), b"through the pipe");
+        use std::os::unix::fs::FileTypeExt;
+        assert!(fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo());
+        assert_eq!(entries(&dir), ["report.md"]);
+        fs::remove_dir_all(&dir).unwrap();
     }
 
     #[cfg(target_os = "linux")]

@@ -1,9 +1,14 @@
-//! Result files: whole files written atomically ([`write_atomically`]) and CSV rows appended as
-//! they are computed ([`csv::CsvWriter`]), for the command line, the experiments and the reports.
-//! Neither replaces anything but a regular file nor leaves a temporary file behind ([`file`]).
+//! Result files, one rule for the command line, the experiments and the reports: whole files
+//! written atomically ([`write_atomically`]) and CSV rows appended as they are computed
+//! ([`csv::CsvWriter`]), both through a temporary file renamed over the target only when whole,
+//! and only over a new path or a regular file ([`file`]); no output that is an input or another
+//! output of the same run ([`run_files`]); an interrupted run keeps the old files
+//! ([`partial`]).
 
 pub mod csv;
 pub mod file;
+pub mod partial;
+pub mod run_files;
 
 use std::path::{Path, PathBuf};
 
