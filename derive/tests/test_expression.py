@@ -38,6 +38,7 @@ from toolconf_derive.expression import (  # noqa: E402
     MAX_DEPTH,
     MAX_EXPONENT,
     MAX_NODES,
+    MAX_TERMS,
     ExpressionError,
     number_value,
     parse,
@@ -209,6 +210,10 @@ class Refuses(unittest.TestCase):
         self.refused("sqrt(-1)", "is not a real number")
         self.refused("(-8)**(1/3)", "is not a real number")
         self.refused("*".join(["(x+y)**16"] * 5), "polynomial degree 80, more than 32")
+        # Within the degree bound, a product of sums still expands in bounded work: 2**13 terms.
+        self.refused("*".join(["(x+y)"] * 13), f"expands to more than {MAX_TERMS} terms")
+        self.refused("(a+b+c+d+e+f)**16", f"expands to more than {MAX_TERMS} terms", names=tuple("abcdef"))
+        self.assertIsNone(parse("*".join(["(x+y)"] * 12), ("x", "y")).value)
 
     def test_size_and_depth(self):
         self.refused("+".join(["x"] * 200_000), f"longer than {MAX_CHARACTERS} characters")

@@ -16,8 +16,9 @@ CasADi, mpmath, NumPy, floats) with Python's operators in the order Python appli
 the result is the object `eval` of the same text gave.
 
 Bounds keep a hostile text cheap: its length, its number of nodes, its nesting depth, the
-exponent of ** (a number, |e| <= MAX_EXPONENT), its polynomial degree, the characters of a
-number; a number, or a part that is a number (pi*1e400, 1e308*1e308), must be finite, and a
+exponent of ** (a number, |e| <= MAX_EXPONENT), its polynomial degree, the number of terms
+its full expansion can have (the degree alone lets (x+y)*(x+y)*... expand to 2**32 terms), the
+characters of a number; a number, or a part that is a number (pi*1e400, 1e308*1e308), must be finite, and a
 division by what is a number must not divide by zero.
 """
 
@@ -33,6 +34,9 @@ MAX_NODES = 5_000
 MAX_DEPTH = 32
 MAX_EXPONENT = 16
 MAX_DEGREE = 32
+# No expansion larger than the longest sum the node bound lets one write out: SymPy expands
+# 5000 terms in about 3 s, so the derivation's own expansions stay bounded.
+MAX_TERMS = MAX_NODES
 MAX_NUMBER_CHARACTERS = 100
 
 # What a description's scalar expressions may call (arity), and the named numbers.
@@ -52,13 +56,15 @@ class Node:
     """One node of the tree. kind: "number" (text), "name" (text), "neg"/"pos" (args[0]),
     "sum"/"product" (args[0], then (operator, operand) pairs in rest), "pow" (args), "call"
     (text = function, args). `value` is the node's double when it is a number (else None),
-    `degree` its polynomial degree (a name 1, a number 0)."""
+    `degree` its polynomial degree (a name 1, a number 0), `terms` an upper bound of the terms of
+    its full expansion (a function call counts as one: its arguments are bounded as nodes)."""
     kind: str
     text: str = ""
     args: tuple = ()
     rest: tuple = ()
     value: float | None = None
     degree: int = 0
+    terms: int = 1
 
 
 def _constant(value: float, what: str) -> float:
@@ -162,6 +168,8 @@ class _Parser:
             raise ExpressionError(f"more than {MAX_NODES} numbers, names and operators")
         if fields.get("degree", 0) > self.max_degree:
             raise ExpressionError(f"of polynomial degree {fields['degree']}, more than {self.max_degree}")
+        if fields.get("terms", 1) > MAX_TERMS:
+            raise ExpressionError(f"expands to more than {MAX_TERMS} terms")
         return Node(kind, **fields)
 
     @contextmanager
@@ -211,7 +219,9 @@ class _Parser:
             value = None if value is None or x.value is None else _fold(op, value, x.value)
         degrees = [first.degree] + [x.degree for _, x in rest]
         degree = max(degrees) if kind == "sum" else sum(degrees)
-        return self.node(kind, args=(first,), rest=tuple(rest), degree=degree,
+        terms = [first.terms] + [x.terms for _, x in rest]
+        terms = sum(terms) if kind == "sum" else math.prod(min(t, MAX_TERMS + 1) for t in terms)
+        return self.node(kind, args=(first,), rest=tuple(rest), degree=degree, terms=terms,
                          value=None if value is None else _constant(value, "the value"))
 
     def check_operands(self, op: str, where: int, left: float | None, right: Node) -> None:
@@ -237,7 +247,8 @@ class _Parser:
             with self.nested():
                 x = self.unary()
             value = None if x.value is None else (-x.value if text == "-" else x.value)
-            return self.node("neg" if text == "-" else "pos", args=(x,), value=value, degree=x.degree)
+            return self.node("neg" if text == "-" else "pos", args=(x,), value=value, degree=x.degree,
+                             terms=x.terms)
         return self.power()
 
     def power(self) -> Node:
@@ -256,8 +267,11 @@ class _Parser:
             raise ExpressionError(f"the exponent {exponent.value:g} at character {where} is larger than "
                                   f"{MAX_EXPONENT} in magnitude")
         value = None if base.value is None else _constant(_fold("**", base.value, exponent.value), "the power")
-        degree = base.degree * max(1, math.ceil(abs(exponent.value)))
-        return self.node("pow", args=(base, exponent), value=value, degree=degree)
+        power = math.ceil(abs(exponent.value))
+        degree = base.degree * max(1, power)
+        # The multinomial expansion of a k-term base to the e-th power has C(k + e - 1, e) terms.
+        terms = math.comb(base.terms + power - 1, power) if power >= 1 else base.terms
+        return self.node("pow", args=(base, exponent), value=value, degree=degree, terms=terms)
 
     def atom(self) -> Node:
         kind, text, where = self.take()
