@@ -51,7 +51,12 @@ def _client(client):
         return client
     import distributed
 
-    return distributed.default_client()
+    try:
+        return distributed.default_client()
+    except ValueError:
+        # distributed's message is five lines; the package's errors are one.
+        raise ValueError("client = None and no distributed.Client is running: start one "
+                         "(distributed.Client(cluster)) or pass client=") from None
 
 
 def _threads(client) -> int:
