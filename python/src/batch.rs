@@ -56,7 +56,7 @@ where
             })?;
         tools.push(tool);
     }
-    let pairs = k.checked_mul(bound.len()).unwrap_or(usize::MAX);
+    let pairs = k.saturating_mul(bound.len());
     // Allocated before any episode runs: no hours of work lost to an allocation after them.
     let mut rows = crate::arrays::with_capacity(pairs, &what)?;
     (0..pairs)
@@ -247,6 +247,9 @@ fn episode_tables<'py>(
         .collect()
 }
 
+/// A metric's column: its key and how it is read.
+type Column<T> = (&'static str, fn(&Metrics) -> T);
+
 fn to_dict(
     py: Python<'_>,
     rows: Vec<Result<Metrics, String>>,
@@ -266,7 +269,7 @@ fn to_dict(
     };
     set("tool", ints(&|i, _| (first_tool + i / p) as i64)?)?;
     set("perturbation", ints(&|i, _| (i % p) as i64)?)?;
-    let floats: [(&str, fn(&Metrics) -> f64); 5] = [
+    let floats: [Column<f64>; 5] = [
         ("task_error", |m| m.task_error),
         ("free_energy", |m| m.free_energy),
         ("cost_j", |m| m.cost_j),
@@ -278,7 +281,7 @@ fn to_dict(
         let column = crate::arrays::collect(column, &what)?;
         set(key, PyArray1::from_vec(py, column).into_any())?;
     }
-    let counts: [(&str, fn(&Metrics) -> usize); 5] = [
+    let counts: [Column<usize>; 5] = [
         ("rhs_evals", |m| m.rhs_evals),
         ("steps", |m| m.steps),
         ("rejected_steps", |m| m.rejected_steps),

@@ -169,13 +169,13 @@ impl Confidences {
         // The message says what all the arrays need, not the one that failed.
         let sensitivities_used = used.iter().filter(|u| **u).count();
         let per_tool = nx * nx + nx * n + (sensitivities_used + 1) * n * n + 1;
-        let total = k.checked_mul(per_tool).unwrap_or(usize::MAX);
+        let total = k.saturating_mul(per_tool);
         let failed = |_| {
             let what = format!("confidence of {k} {model} tools");
             crate::arrays::out_of_memory::<f64>(total, &what)
         };
         let room = |per_tool: usize| {
-            let values = k.checked_mul(per_tool).unwrap_or(usize::MAX);
+            let values = k.saturating_mul(per_tool);
             crate::arrays::with_capacity(values, "").map_err(failed)
         };
         let names = ["d_theta_du", "d_theta_dot_du", "d_theta_ddot_du"];

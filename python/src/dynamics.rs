@@ -217,7 +217,7 @@ pub fn dynamics<'py>(
             let k = counts.first().copied();
             let rows = k.unwrap_or(1);
             let what = format!("dynamics of {rows} states");
-            let mut out = crate::arrays::zeros(rows.checked_mul(nx).unwrap_or(usize::MAX), &what)?;
+            let mut out = crate::arrays::zeros(rows.saturating_mul(nx), &what)?;
             of(kind).evaluate(k.unwrap_or(1), &p, &x, &u, &mut out)?;
             Ok((out, k))
         })?;

@@ -316,3 +316,10 @@ def test_objects_text_and_odd_values_as_params(value, error, message):
         toolconf.confidence("arm2", value, "position")
     assert str(caught.value).startswith(message), str(caught.value)
     assert type(caught.value) is error
+
+
+def test_a_column_name_with_a_line_break_stays_one_line():
+    with pytest.raises(ValueError) as caught:
+        toolconf.rank({"\n": 1.0}, "position")
+    assert str(caught.value) == "tools dict, column '\\n': has shape []; a column is 1-D, one " \
+                                "value per tool"

@@ -240,3 +240,17 @@ def test_complex_and_boolean_params_are_refused_as_toolconf_refuses_them(dask_cl
         with pytest.raises(TypeError) as got:
             tdask.simulate_batch("arm2", params, "position", client=dask_client)
         assert str(got.value) == str(expected.value)
+
+
+def test_without_a_client_the_error_is_one_line(monkeypatch):
+    import distributed
+
+    def no_client():
+        # distributed's own words when no client runs (the session's cluster may be running).
+        raise ValueError("No clients found\nStart a client and point it to the scheduler address\n")
+
+    monkeypatch.setattr(distributed, "default_client", no_client)
+    with pytest.raises(ValueError) as caught:
+        tdask.simulate_batch("arm2", np.full((2, 4), 0.3), "position")
+    assert str(caught.value) == ("client = None and no distributed.Client is running: start one "
+                                 "(distributed.Client(cluster)) or pass client=")
