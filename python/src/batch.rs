@@ -10,7 +10,7 @@ use toolconf::task_file::TaskSpec;
 
 use crate::errors::{detached, Failure};
 use crate::models::{model_kind, ops};
-use crate::task::task_spec;
+use crate::task::{portable_spec, task_spec};
 
 /// Every tool of `params` (k × NP, row major) under every task of `specs` (one per
 /// perturbation): k × P results, tool-major, each the episode's metrics or its error message.
@@ -36,10 +36,14 @@ where
             Ok((task, options))
         })
         .collect::<Result<Vec<_>, Failure>>()?;
-    let tools = params
-        .chunks_exact(NP)
-        .enumerate()
-        .map(|(i, p)| {
+    let k = params.len() / NP;
+    let what = format!(
+        "simulate_batch of {k} tools × {} perturbations",
+        bound.len()
+    );
+    let mut tools = crate::arrays::with_capacity(k, &what)?;
+    for (i, p) in params.chunks_exact(NP).enumerate() {
+        let tool =
             ToolN::<M, N, NX, NP, NZ>::new(p.try_into().expect("NP values")).map_err(|e| {
                 Failure::Input(match first_tool {
                     None => e.to_string(),
@@ -49,18 +53,21 @@ where
                         crate::confidence::named(M::PARAMETER_NAMES, p)
                     ),
                 })
-            })
-        })
-        .collect::<Result<Vec<_>, Failure>>()?;
-    let pairs = tools.len() * bound.len();
-    Ok((0..pairs)
+            })?;
+        tools.push(tool);
+    }
+    let pairs = k.saturating_mul(bound.len());
+    // Allocated before any episode runs: no hours of work lost to an allocation after them.
+    let mut rows = crate::arrays::with_capacity(pairs, &what)?;
+    (0..pairs)
         .into_par_iter()
         .with_min_len(1)
         .map(|i| {
             let (tool, (task, options)) = (&tools[i / bound.len()], &bound[i % bound.len()]);
             toolconf::model::simulate(tool, task, options).map_err(|e| e.to_string())
         })
-        .collect())
+        .collect_into_vec(&mut rows);
+    Ok(rows)
 }
 
 /// The episodes of many tools, each under every perturbation: one row of metrics per
@@ -82,7 +89,8 @@ where
 ///         runs each tool once under the task's own ``perturbation``.
 ///     method: the integrator, as in ``simulate``.
 ///     first_tool: the index of ``params``' first row in a larger array, for the ``tool``
-///         column and errors (``toolconf.dask.simulate_batch`` sends chunks); 0 by default.
+///         column and errors (``toolconf.dask.simulate_batch`` sends chunks); 0 by default (or None),
+///         an integer in [0, 2⁶³ − 1 − the number of tools] (``tool`` is int64).
 ///     **episode_options: ``simulate``'s (the keys of a task file's ``[episode]`` table), for
 ///         every episode; ``perturbation`` only when ``perturbations`` is not given.
 ///
@@ -96,8 +104,12 @@ where
 /// Raises:
 ///     ValueError: bad input (model, parameters, task, perturbation or episode option), naming
 ///         the tool's row or the key, before any episode runs.
+///     TypeError: a ``params`` of booleans, complex numbers or text; a ``first_tool`` that is
+///         not an integer.
+///     MemoryError: rows for every (tool, perturbation) that do not fit in memory, before any
+///         episode runs.
 #[pyfunction]
-#[pyo3(signature = (model, params, task, perturbations=None, method="fast", first_tool=0, **episode_options))]
+#[pyo3(signature = (model, params, task, perturbations=None, method="fast", first_tool=None, **episode_options))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_batch<'py>(
     py: Python<'py>,
@@ -106,8 +118,50 @@ pub fn simulate_batch<'py>(
     task: &Bound<'py, PyAny>,
     perturbations: Option<&Bound<'py, PyAny>>,
     method: &str,
-    first_tool: usize,
+    first_tool: Option<&Bound<'py, PyAny>>,
     episode_options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let arguments = (model, params, task, perturbations, method, first_tool);
+    run(py, arguments, episode_options, task_spec)
+}
+
+/// ``simulate_batch`` on a block of tools of ``toolconf.dask.simulate_batch``: the same, with
+/// the task as ``_portable_task`` sent it (a task file as its text).
+#[pyfunction]
+#[pyo3(name = "_simulate_batch", signature = (model, params, task, perturbations=None, method="fast", first_tool=None, **episode_options))]
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_batch_block<'py>(
+    py: Python<'py>,
+    model: &str,
+    params: &Bound<'py, PyAny>,
+    task: &Bound<'py, PyAny>,
+    perturbations: Option<&Bound<'py, PyAny>>,
+    method: &str,
+    first_tool: Option<&Bound<'py, PyAny>>,
+    episode_options: Option<&Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let arguments = (model, params, task, perturbations, method, first_tool);
+    run(py, arguments, episode_options, portable_spec)
+}
+
+/// `simulate_batch`'s positional arguments: model, params, task, perturbations, method and
+/// first_tool.
+type Arguments<'a, 'py> = (
+    &'a str,
+    &'a Bound<'py, PyAny>,
+    &'a Bound<'py, PyAny>,
+    Option<&'a Bound<'py, PyAny>>,
+    &'a str,
+    Option<&'a Bound<'py, PyAny>>,
+);
+
+/// The checks in order (model, params, first_tool, method, task and perturbations), then the
+/// episodes; `read_task` reads the task with one perturbation's episode options.
+fn run<'py>(
+    py: Python<'py>,
+    (model, params, task, perturbations, method, first_tool): Arguments<'_, 'py>,
+    episode_options: Option<&Bound<'py, PyDict>>,
+    read_task: fn(&Bound<'py, PyAny>, Option<&Bound<'py, PyDict>>) -> PyResult<TaskSpec>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = model_kind(model).map_err(|f| f.into_pyerr(py))?;
     let np = kind.parameter_names().len();
@@ -120,16 +174,23 @@ pub fn simulate_batch<'py>(
         ))
         .into_pyerr(py));
     }
+    // The `tool` column is int64: the last tool's index must fit.
+    let last = i64::MAX as i128 - (values.len() / np) as i128;
+    let first_tool = match first_tool.filter(|f| !f.is_none()) {
+        Some(f) => crate::integers::integer("first_tool", f, 0, last)
+            .map_err(|f| f.into_pyerr(py))? as usize,
+        None => 0,
+    };
     let method = crate::task::method(method).map_err(|f| f.into_pyerr(py))?;
     let mut specs = Vec::new();
     for options in episode_tables(py, perturbations, episode_options)? {
-        let mut spec = task_spec(task, Some(&options))?;
+        let mut spec = read_task(task, Some(&options))?;
         spec.episode.method = Some(method);
         specs.push(spec);
     }
     let first = (shape.len() == 2).then_some(first_tool);
     let rows = detached(py, || ops(kind).batch(&specs, &values, first))?;
-    to_dict(py, rows, specs.len(), first_tool)
+    to_dict(py, rows, specs.len(), first_tool).map_err(|f| f.into_pyerr(py))
 }
 
 /// The episode options of each perturbation: `options` with `perturbation` set, or `options`
@@ -186,64 +247,57 @@ fn episode_tables<'py>(
         .collect()
 }
 
+/// A metric's column: its key and how it is read.
+type Column<T> = (&'static str, fn(&Metrics) -> T);
+
 fn to_dict(
     py: Python<'_>,
     rows: Vec<Result<Metrics, String>>,
     perturbations: usize,
     first_tool: usize,
-) -> PyResult<Bound<'_, PyDict>> {
+) -> Result<Bound<'_, PyDict>, Failure> {
+    let what = format!("simulate_batch's {} rows", rows.len());
     let out = PyDict::new(py);
-    let p = perturbations;
-    let tool: Vec<i64> = (0..rows.len())
-        .map(|i| (first_tool + i / p) as i64)
-        .collect();
-    let perturbation: Vec<i64> = (0..rows.len()).map(|i| (i % p) as i64).collect();
-    out.set_item("tool", PyArray1::from_vec(py, tool))?;
-    out.set_item("perturbation", PyArray1::from_vec(py, perturbation))?;
-    let floats = |f: fn(&Metrics) -> f64| {
-        PyArray1::from_vec(
-            py,
-            rows.iter()
-                .map(|r| r.as_ref().map_or(f64::NAN, f))
-                .collect(),
-        )
+    let set = |key: &str, value: Bound<'_, PyAny>| {
+        out.set_item(key, value)
+            .map_err(|e| Failure::python("simulate_batch", e))
     };
-    for (key, f) in [
-        (
-            "task_error",
-            (|m: &Metrics| m.task_error) as fn(&Metrics) -> f64,
-        ),
+    let p = perturbations;
+    let ints = |f: &dyn Fn(usize, &Result<Metrics, String>) -> i64| {
+        let column = crate::arrays::collect(rows.iter().enumerate().map(|(i, r)| f(i, r)), &what)?;
+        Ok::<_, Failure>(PyArray1::from_vec(py, column).into_any())
+    };
+    set("tool", ints(&|i, _| (first_tool + i / p) as i64)?)?;
+    set("perturbation", ints(&|i, _| (i % p) as i64)?)?;
+    let floats: [Column<f64>; 5] = [
+        ("task_error", |m| m.task_error),
         ("free_energy", |m| m.free_energy),
         ("cost_j", |m| m.cost_j),
         ("logdet", |m| m.logdet),
         ("control_effort", |m| m.control_effort),
-    ] {
-        out.set_item(key, floats(f))?;
+    ];
+    for (key, f) in floats {
+        let column = rows.iter().map(|r| r.as_ref().map_or(f64::NAN, f));
+        let column = crate::arrays::collect(column, &what)?;
+        set(key, PyArray1::from_vec(py, column).into_any())?;
     }
-    let counts = |f: fn(&Metrics) -> usize| {
-        PyArray1::from_vec(
-            py,
-            rows.iter()
-                .map(|r| r.as_ref().map_or(-1, |m| f(m) as i64))
-                .collect(),
-        )
-    };
-    for (key, f) in [
-        (
-            "rhs_evals",
-            (|m: &Metrics| m.rhs_evals) as fn(&Metrics) -> usize,
-        ),
+    let counts: [Column<usize>; 5] = [
+        ("rhs_evals", |m| m.rhs_evals),
         ("steps", |m| m.steps),
         ("rejected_steps", |m| m.rejected_steps),
         ("jacobian_evals", |m| m.jacobian_evals),
         ("factorisations", |m| m.factorisations),
-    ] {
-        out.set_item(key, counts(f))?;
+    ];
+    for (key, f) in counts {
+        set(key, ints(&|_, r| r.as_ref().map_or(-1, |m| f(m) as i64))?)?;
     }
-    let errors: Vec<Option<&str>> = rows
-        .iter()
-        .map(|r| r.as_ref().err().map(String::as_str))
-        .collect();
-    out.set_item("error", errors)?;
+    let errors: Vec<Option<&str>> = crate::arrays::collect(
+        rows.iter().map(|r| r.as_ref().err().map(String::as_str)),
+        &what,
+    )?;
+    let errors = errors
+        .into_pyobject(py)
+        .map_err(|e| Failure::python("simulate_batch", e))?;
+    set("error", errors.into_any())?;
     Ok(out)
 }

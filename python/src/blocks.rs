@@ -22,11 +22,8 @@ use crate::rank::{objective, screen_limit};
 use crate::table::{
     block_to_py, candidates_from_py, candidates_to_py, outcomes_from_py, ranked_to_py, Outcome,
 };
-use crate::task::task_spec;
+use crate::task::{portable_spec, TASK_TEXT};
 use crate::tools::Tools;
-
-/// The first item of a task file sent as text: `(TASK_TEXT, file name, text)`.
-const TASK_TEXT: &str = "toolconf task file";
 
 /// The task as workers can read it: a built-in name or a dict as it is, a task file as
 /// ``("toolconf task file", name, text)``. Checks the options first, in ``toolconf.rank``'s
@@ -35,7 +32,7 @@ const TASK_TEXT: &str = "toolconf task file";
 #[pyo3(name = "_portable_task", signature = (task, screen=None, objective="free-energy", method="fast"))]
 pub fn portable_task<'py>(
     task: &Bound<'py, PyAny>,
-    screen: Option<i64>,
+    screen: Option<&Bound<'py, PyAny>>,
     objective: &str,
     method: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
@@ -47,21 +44,15 @@ pub fn portable_task<'py>(
     if spec.file.is_empty() || task.cast::<PyDict>().is_ok() || task.cast::<PyTuple>().is_ok() {
         return Ok(task.clone());
     }
-    let text = std::fs::read_to_string(&spec.file).map_err(|e| {
-        Failure::Input(format!("{}: cannot read the task file: {e}", spec.file)).into_pyerr(py)
-    })?;
+    let text =
+        toolconf::bounded_read::read_text_file(std::path::Path::new(&spec.file), "task file")
+            .map_err(|m| Failure::Input(format!("{}: {m}", spec.file)).into_pyerr(py))?;
     Ok(PyTuple::new(py, [TASK_TEXT, spec.file.as_str(), text.as_str()])?.into_any())
 }
 
-/// A task as [`task_spec`] takes it, or as [`portable_task`] sent it.
+/// A task as [`crate::task::task_spec`] takes it, or as [`portable_task`] sent it.
 fn block_task(task: &Bound<'_, PyAny>) -> PyResult<TaskSpec> {
-    if let Ok((marker, file, text)) = task.extract::<(String, String, String)>() {
-        if marker == TASK_TEXT {
-            return TaskSpec::parse(&text, &file)
-                .map_err(|e| Failure::input(e).into_pyerr(task.py()));
-        }
-    }
-    task_spec(task, None)
+    portable_spec(task, None)
 }
 
 /// The cheap stage over one block of a table (a Dask partition), its rows numbered from
@@ -79,7 +70,7 @@ pub fn screen_block<'py>(
     tools: &Bound<'py, PyAny>,
     task: &Bound<'py, PyAny>,
     first_row: usize,
-    screen: Option<i64>,
+    screen: Option<&Bound<'py, PyAny>>,
     skip_bad_rows: bool,
     source: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -118,7 +109,7 @@ pub fn merge_screens<'py>(
     py: Python<'py>,
     blocks: &Bound<'py, PyList>,
     task: &Bound<'py, PyAny>,
-    screen: Option<i64>,
+    screen: Option<&Bound<'py, PyAny>>,
     source: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let limit = screen_limit(screen).map_err(|f| f.into_pyerr(py))?;

@@ -16,6 +16,8 @@ use crate::task::task_spec;
 
 /// Below this many tools a batch runs on one thread: spreading it costs more than it saves.
 const MIN_TOOLS_PER_THREAD: usize = 256;
+/// The results of one chunk of tools, before they are copied into the output arrays.
+const CHUNK_BYTES: usize = 8 << 20;
 
 /// The results for k tools, each array flat in C order (tool, row, column).
 pub struct Confidences {
@@ -83,7 +85,9 @@ fn push_c_order<const R: usize, const C: usize>(out: &mut Vec<f64>, m: &SMatrix<
 
 /// Π^U = Σ Sᵀ P S + P^U (eq. control_conf) and ln|Π^U| of every tool in `params` (k × NP, row
 /// major) for `spec` bound to model `M`, with A, B and the sensitivities; rayon's threads share
-/// the tools, and the first bad tool in order is the error.
+/// the tools, and the first bad tool in order is the error. The output is allocated once, before
+/// the work, and fallibly (`MemoryError`, not an abort, when it does not fit); the tools are
+/// computed in chunks of a few MiB of matrices, so nothing else grows with k.
 pub fn confidences<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
     spec: &TaskSpec,
     params: &[f64],
@@ -95,72 +99,119 @@ where
     let task = task.validated().map_err(Failure::input)?;
     let kind = task.task().kind;
     let k = params.len() / NP;
-    let results: Vec<Result<One<N, NX>, toolconf::Error>> = params
-        .par_chunks_exact(NP)
-        .with_min_len(MIN_TOOLS_PER_THREAD)
-        .map(|p| {
-            let tool = ToolN::<M, N, NX, NP, NZ>::new(p.try_into().expect("NP values"))?;
-            let c = task.control_confidence(&tool)?;
-            let one = One {
-                a: tool.state_matrix(),
-                b: tool.input_matrix(),
-                sensitivities: tool.sensitivities(kind),
-                pi_u: c.pi_u,
-                logdet: c.logdet,
-            };
-            one.check_finite(&tool)?;
-            Ok(one)
-        })
-        .collect();
-    let names = ["d_theta_du", "d_theta_dot_du", "d_theta_ddot_du"];
-    let mut sensitivities: [Vec<f64>; 3] = std::array::from_fn(|_| Vec::with_capacity(k * N * N));
-    let mut out = Confidences {
-        k,
-        n: N,
-        nx: NX,
-        a: Vec::with_capacity(k * NX * NX),
-        b: Vec::with_capacity(k * NX * N),
-        sensitivities: Vec::new(),
-        pi_u: Vec::with_capacity(k * N * N),
-        logdet: Vec::with_capacity(k),
-    };
-    for (i, r) in results.into_iter().enumerate() {
-        let one = r.map_err(|e| {
-            let row = &params[i * NP..(i + 1) * NP];
-            let message = if k == 1 {
-                e.to_string()
-            } else {
-                format!("tool {i} ({}): {e}", named(M::PARAMETER_NAMES, row))
-            };
-            match Failure::from_error(e) {
-                Failure::Run(_) => Failure::Run(message),
-                _ => Failure::Input(message),
-            }
-        })?;
-        push_c_order(&mut out.a, &one.a);
-        push_c_order(&mut out.b, &one.b);
-        push_c_order(&mut out.pi_u, &one.pi_u);
-        out.logdet.push(one.logdet);
-        let s = &one.sensitivities;
-        for (all, m) in
-            sensitivities
-                .iter_mut()
-                .zip([s.d_theta_du, s.d_theta_dot_du, s.d_theta_ddot_du])
-        {
-            if let Some(m) = m {
-                push_c_order(all, &m);
-            }
+    // Bad input before any allocation: a bad tool is a ValueError however many tools there are.
+    for (i, p) in params.chunks_exact(NP).enumerate() {
+        if let Err(e) = ToolN::<M, N, NX, NP, NZ>::new(p.try_into().expect("NP values")) {
+            return Err(tool_error(M::PARAMETER_NAMES, params, k, i, e.into()));
         }
     }
-    // A term the task does not use has no sensitivity (the command line leaves it out too).
     let used = [Term::Theta, Term::ThetaDot, Term::ThetaDdot].map(|t| kind.uses(t));
-    out.sensitivities = names
-        .into_iter()
-        .zip(sensitivities)
-        .zip(used)
-        .filter_map(|((name, s), used)| used.then_some((name, s)))
-        .collect();
+    let mut out = Confidences::allocate(k, N, NX, used, M::NAME)?;
+    let chunk = (CHUNK_BYTES / std::mem::size_of::<Result<One<N, NX>, toolconf::Error>>()).max(1);
+    for (c, tools) in params.chunks(chunk * NP).enumerate() {
+        let mut results: Vec<Result<One<N, NX>, toolconf::Error>> =
+            crate::arrays::with_capacity(tools.len() / NP, "confidence")?;
+        tools
+            .par_chunks_exact(NP)
+            .with_min_len(MIN_TOOLS_PER_THREAD)
+            .map(|p| {
+                let tool = ToolN::<M, N, NX, NP, NZ>::new(p.try_into().expect("NP values"))?;
+                let c = task.control_confidence(&tool)?;
+                let one = One {
+                    a: tool.state_matrix(),
+                    b: tool.input_matrix(),
+                    sensitivities: tool.sensitivities(kind),
+                    pi_u: c.pi_u,
+                    logdet: c.logdet,
+                };
+                one.check_finite(&tool)?;
+                Ok(one)
+            })
+            .collect_into_vec(&mut results);
+        for (j, r) in results.into_iter().enumerate() {
+            let i = c * chunk + j;
+            let one = r.map_err(|e| tool_error(M::PARAMETER_NAMES, params, k, i, e))?;
+            out.push(&one);
+        }
+    }
     Ok(out)
+}
+
+/// Tool `i`'s error: named by its row and parameters in a batch, bad input or a failed run.
+fn tool_error<const NP: usize>(
+    names: [&str; NP],
+    params: &[f64],
+    k: usize,
+    i: usize,
+    e: toolconf::Error,
+) -> Failure {
+    let row = &params[i * NP..(i + 1) * NP];
+    let message = if k == 1 {
+        e.to_string()
+    } else {
+        format!("tool {i} ({}): {e}", named(names, row))
+    };
+    match Failure::from_error(e) {
+        Failure::Run(_) => Failure::Run(message),
+        _ => Failure::Input(message),
+    }
+}
+
+impl Confidences {
+    /// Room for k tools' results (the sensitivities of the `used` terms only), or `MemoryError`.
+    fn allocate(
+        k: usize,
+        n: usize,
+        nx: usize,
+        used: [bool; 3],
+        model: &str,
+    ) -> Result<Self, Failure> {
+        // The message says what all the arrays need, not the one that failed.
+        let sensitivities_used = used.iter().filter(|u| **u).count();
+        let per_tool = nx * nx + nx * n + (sensitivities_used + 1) * n * n + 1;
+        let total = k.saturating_mul(per_tool);
+        let failed = |_| {
+            let what = format!("confidence of {k} {model} tools");
+            crate::arrays::out_of_memory::<f64>(total, &what)
+        };
+        let room = |per_tool: usize| {
+            let values = k.saturating_mul(per_tool);
+            crate::arrays::with_capacity(values, "").map_err(failed)
+        };
+        let names = ["d_theta_du", "d_theta_dot_du", "d_theta_ddot_du"];
+        let mut sensitivities = Vec::new();
+        for (name, used) in names.into_iter().zip(used) {
+            if used {
+                sensitivities.push((name, room(n * n)?));
+            }
+        }
+        Ok(Confidences {
+            k,
+            n,
+            nx,
+            a: room(nx * nx)?,
+            b: room(nx * n)?,
+            sensitivities,
+            pi_u: room(n * n)?,
+            logdet: room(1)?,
+        })
+    }
+
+    /// Appends one tool's results (within the room [`Confidences::allocate`] made).
+    fn push<const N: usize, const NX: usize>(&mut self, one: &One<N, NX>) {
+        push_c_order(&mut self.a, &one.a);
+        push_c_order(&mut self.b, &one.b);
+        push_c_order(&mut self.pi_u, &one.pi_u);
+        self.logdet.push(one.logdet);
+        let s = &one.sensitivities;
+        // A term the task does not use has no sensitivity (the command line leaves it out too).
+        let present = [s.d_theta_du, s.d_theta_dot_du, s.d_theta_ddot_du]
+            .into_iter()
+            .flatten();
+        for ((_, all), m) in self.sensitivities.iter_mut().zip(present) {
+            push_c_order(all, &m);
+        }
+    }
 }
 
 /// `m1=0.3 m2=0.4 …`, as the crate prints a tool.
@@ -199,6 +250,8 @@ pub fn named<const NP: usize>(names: [&str; NP], values: &[f64]) -> String {
 ///     ValueError: an unknown model, a parameter outside [1e-6, 1e6] (naming the
 ///         tool's row), a wrong number of parameters, or a bad task (naming the key), with the
 ///         command line's message.
+///     TypeError: ``params`` of booleans, complex numbers or text.
+///     MemoryError: an output that does not fit in memory (10⁶ Panda tools need 3 GB).
 ///     RuntimeError: a tool whose Π^U is too ill-conditioned for its ln|Π^U| to be computed
 ///         (its parameters span too many decades), the command line's status 1.
 ///

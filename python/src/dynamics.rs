@@ -59,12 +59,13 @@ where
         u: &Rows,
         out: &mut [f64],
     ) -> Result<(), Failure> {
-        let tools = (0..if params.shared { 1 } else { k })
-            .map(|i| {
-                ToolN::<M, N, NX, NP, NZ>::new(params.row(i).try_into().expect("NP values"))
-                    .map_err(|e| row_error(k, params.shared, i, e))
-            })
-            .collect::<Result<Vec<_>, _>>()?;
+        let count = if params.shared { 1 } else { k };
+        let mut tools = crate::arrays::with_capacity(count, &format!("dynamics of {k} states"))?;
+        for i in 0..count {
+            let tool = ToolN::<M, N, NX, NP, NZ>::new(params.row(i).try_into().expect("NP values"))
+                .map_err(|e| row_error(k, params.shared, i, e))?;
+            tools.push(tool);
+        }
         for (i, v) in x.data.iter().chain(u.data).enumerate() {
             if !v.is_finite() {
                 let what = if i < x.data.len() { "state" } else { "control" };
@@ -174,6 +175,8 @@ fn rows<'a>(
 ///     ValueError: an unknown model, shapes that do not fit it or each other, a tool outside
 ///         the model's rule (naming the parameter or constraint, and the row), a non-finite state
 ///         or control, or a state where the dynamics are not finite.
+///     TypeError: an argument of booleans, complex numbers or text.
+///     MemoryError: a batch that does not fit in memory.
 ///
 /// A batch runs on rayon's threads without holding the GIL.
 #[pyfunction]
@@ -212,7 +215,9 @@ pub fn dynamics<'py>(
             )));
             }
             let k = counts.first().copied();
-            let mut out = vec![0.0; k.unwrap_or(1) * nx];
+            let rows = k.unwrap_or(1);
+            let what = format!("dynamics of {rows} states");
+            let mut out = crate::arrays::zeros(rows.saturating_mul(nx), &what)?;
             of(kind).evaluate(k.unwrap_or(1), &p, &x, &u, &mut out)?;
             Ok((out, k))
         })?;

@@ -1,8 +1,10 @@
-//! Rust errors as Python exceptions: bad input is `ValueError` with the command line's message;
-//! a failed episode is `toolconf.SimulationError` with the tool, the time and the reason.
+//! Rust errors as Python exceptions: bad input is `ValueError` (`TypeError` for a Python value
+//! of the wrong type) with the command line's message; an output that cannot be allocated is
+//! `MemoryError`; a failed episode is `toolconf.SimulationError` with the tool, the time and the
+//! reason.
 
 use pyo3::create_exception;
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyMemoryError, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use toolconf::model::ModelSimulationError;
 
@@ -20,9 +22,16 @@ create_exception!(
 pub enum Failure {
     /// Bad input: the message the command line prints (after `toolconf: error: `).
     Input(String),
+    /// A Python value of the wrong type (a complex or boolean array where numbers are expected).
+    Type(String),
+    /// An allocation sized by the input that failed, raised as `MemoryError` (an abort would
+    /// take the interpreter down).
+    Memory(String),
     /// A run that failed other than by an episode (a result that is not finite: the command
     /// line's status 1), raised as `RuntimeError`.
     Run(String),
+    /// A Python exception that is not a failure of the input (`KeyboardInterrupt`), as it is.
+    Raised(PyErr),
     /// A failed episode.
     Simulation {
         message: String,
@@ -35,6 +44,31 @@ pub enum Failure {
 impl Failure {
     pub fn input(e: impl std::fmt::Display) -> Self {
         Failure::Input(e.to_string())
+    }
+
+    /// A Python exception raised while reading an argument, prefixed with `context` (the
+    /// argument's name): `MemoryError` and `TypeError` stay themselves, any other `Exception`
+    /// is bad input (`ValueError`), and what is not an `Exception` passes through.
+    pub fn python(context: &str, e: PyErr) -> Self {
+        Python::attach(|py| {
+            if !e.is_instance_of::<pyo3::exceptions::PyException>(py) {
+                return Failure::Raised(e);
+            }
+            // The exception's own words: its type is the one raised, or said by the message.
+            let words = e
+                .value(py)
+                .str()
+                .map(|s| s.to_string())
+                .unwrap_or_else(|_| e.to_string());
+            let message = format!("{context}: {}", toolconf::display::ClipMessage(&words));
+            if e.is_instance_of::<PyMemoryError>(py) {
+                Failure::Memory(message)
+            } else if e.is_instance_of::<PyTypeError>(py) {
+                Failure::Type(message)
+            } else {
+                Failure::Input(message)
+            }
+        })
     }
 
     /// A crate error: bad input, or a result that is not finite (a failed run).
@@ -73,6 +107,9 @@ impl Failure {
     pub fn into_pyerr(self, py: Python<'_>) -> PyErr {
         match self {
             Failure::Input(message) => PyValueError::new_err(message),
+            Failure::Type(message) => PyTypeError::new_err(message),
+            Failure::Memory(message) => PyMemoryError::new_err(message),
+            Failure::Raised(e) => e,
             Failure::Run(message) => PyRuntimeError::new_err(message),
             Failure::Simulation {
                 message,

@@ -13,8 +13,10 @@
 //! * [`task`]: a task given as a built-in name, a task file or a dict with a task file's keys,
 //!   all checked by the crate's task-file parser so errors name the key.
 //!
-//! Bad input raises `ValueError` with the one-line message the command line prints; a failed
-//! episode raises `toolconf.SimulationError` with `tool`, `time` and `reason`.
+//! Bad input raises `ValueError` with the one-line message the command line prints (`TypeError`
+//! for a Python value of the wrong type: a bool, a complex or boolean array); an output that
+//! does not fit in memory raises `MemoryError`; a failed episode raises
+//! `toolconf.SimulationError` with `tool`, `time` and `reason`.
 
 mod arrays;
 mod batch;
@@ -23,6 +25,7 @@ mod confidence;
 mod design;
 mod dynamics;
 mod errors;
+mod integers;
 mod models;
 mod rank;
 mod simulate;
@@ -49,6 +52,7 @@ fn _toolconf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(rank::rank, m)?)?;
     m.add_function(wrap_pyfunction!(batch::simulate_batch, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::simulate_batch_block, m)?)?;
     m.add_function(wrap_pyfunction!(design::design, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::portable_task, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::screen_block, m)?)?;

@@ -78,8 +78,9 @@ fn run(
 ///
 /// Raises:
 ///     ValueError: a bad tools file or row (naming the file, the line or tool and the value),
-///         a bad task (naming the key), an unknown objective, or ``screen < 1``; the command
-///         line's message.
+///         a bad task (naming the key), an unknown objective, or ``screen`` outside
+///         [1, 2⁶⁴ − 1]; the command line's message.
+///     TypeError: a ``screen`` that is not an integer (a bool, a float).
 #[pyfunction]
 #[pyo3(signature = (tools, task, screen=None, objective="free-energy", skip_bad_rows=false, method="fast", source=None))]
 #[allow(clippy::too_many_arguments)]
@@ -87,7 +88,7 @@ pub fn rank<'py>(
     py: Python<'py>,
     tools: &Bound<'py, PyAny>,
     task: &Bound<'py, PyAny>,
-    screen: Option<i64>,
+    screen: Option<&Bound<'py, PyAny>>,
     objective: &str,
     skip_bad_rows: bool,
     method: &str,
@@ -104,12 +105,14 @@ pub fn rank<'py>(
     ranked_to_py(py, &outcomes)
 }
 
-/// `screen=K` as a limit: K ≥ 1, or every tool.
-pub fn screen_limit(screen: Option<i64>) -> Result<Option<usize>, Failure> {
-    match screen {
-        Some(k) if k < 1 => Err(Failure::Input(format!("screen = {k}: must be at least 1"))),
-        k => Ok(k.map(|k| k as usize)),
-    }
+/// `screen=K` as a limit: K in [1, 2⁶⁴ − 1] (the command line's `--screen`), or every tool.
+pub fn screen_limit(screen: Option<&Bound<'_, PyAny>>) -> Result<Option<usize>, Failure> {
+    let Some(screen) = screen.filter(|s| !s.is_none()) else {
+        return Ok(None);
+    };
+    let k = crate::integers::integer("screen", screen, 1, u64::MAX.into())?;
+    // More than there can be tools: every tool.
+    Ok(Some(usize::try_from(k).unwrap_or(usize::MAX)))
 }
 
 /// One `UserWarning` per bad row skipped, in row order.

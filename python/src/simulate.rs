@@ -83,6 +83,7 @@ where
 ///
 /// Raises:
 ///     ValueError: bad input (model, parameters, task or episode option), naming the value.
+///     TypeError: ``params`` of booleans, complex numbers or text.
 ///     toolconf.SimulationError: the episode failed; ``tool``, ``time`` and ``reason`` say how.
 #[pyfunction]
 #[pyo3(signature = (model, params, task, method="fast", **episode_options))]

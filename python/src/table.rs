@@ -189,7 +189,7 @@ fn numeric_column<T: numpy::Element + Copy>(
 ) -> Result<Vec<T>, Failure> {
     let value: Bound<'_, PyAny> = column(block, key)?;
     let (shape, values) = crate::arrays::values(&value, dtype)
-        .map_err(|e| Failure::Input(format!("tools block, column '{key}': {e}")))?;
+        .map_err(|e| Failure::python(&format!("tools block, column '{key}'"), e))?;
     if shape.len() != 1 {
         return Err(Failure::Input(format!(
             "tools block, column '{key}': not 1-D"

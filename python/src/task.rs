@@ -50,6 +50,37 @@ pub fn task_spec(
     spec.map_err(|f| f.into_pyerr(py))
 }
 
+/// The first item of a task file sent as text (`toolconf.dask` to its workers):
+/// `(TASK_TEXT, file name, text)`.
+pub const TASK_TEXT: &str = "toolconf task file";
+
+/// A task as [`task_spec`] takes it, or a task file sent as text (`(TASK_TEXT, file name,
+/// text)`, what `toolconf._portable_task` makes of a path), read as that file would be: its
+/// errors name the file, and `episode` goes over its `[episode]` table.
+pub fn portable_spec(
+    task: &Bound<'_, PyAny>,
+    episode: Option<&Bound<'_, PyDict>>,
+) -> PyResult<TaskSpec> {
+    let py = task.py();
+    let Ok((marker, file, text)) = task.extract::<(String, String, String)>() else {
+        return task_spec(task, episode);
+    };
+    if marker != TASK_TEXT {
+        return task_spec(task, episode);
+    }
+    let spec = TaskSpec::parse(&text, &file).map_err(|e| Failure::input(e).into_pyerr(py))?;
+    let episode = match episode {
+        Some(kwargs) if !kwargs.is_empty() => {
+            table(kwargs, "episode", DICT_SOURCE).map_err(|f| f.into_pyerr(py))?
+        }
+        _ => return Ok(spec),
+    };
+    // The text parsed, so it is a table; read it again as one to put the options over it.
+    let mut t: toml::Table = toml::from_str(&text).map_err(|e| Failure::input(e).into_pyerr(py))?;
+    merge_episode(&mut t, episode);
+    TaskSpec::from_table(t, &file).map_err(|e| Failure::input(e).into_pyerr(py))
+}
+
 /// A built-in task's name, else a task file (as `toolconf rank --task` reads its argument).
 fn named(name: &Path, episode: Option<toml::Table>) -> Result<TaskSpec, Failure> {
     if let Some(kind) = name.to_str().and_then(|s| s.parse::<TaskKind>().ok()) {

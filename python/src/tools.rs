@@ -105,7 +105,7 @@ impl Tools {
 /// The columns of `items` (`(name, values)` pairs), in order.
 fn columns(items: &Bound<'_, PyAny>, source: &str) -> Result<Vec<(String, Column)>, Failure> {
     let py = items.py();
-    let failed = |e: PyErr| Failure::Input(format!("{source}: {e}"));
+    let failed = |e: PyErr| Failure::python(source, e);
     let numpy = py.import("numpy").map_err(failed)?;
     let mut out = Vec::new();
     for item in items.try_iter().map_err(failed)? {
@@ -122,7 +122,8 @@ fn columns(items: &Bound<'_, PyAny>, source: &str) -> Result<Vec<(String, Column
                 short_repr(&key)
             )));
         };
-        let bad = |why: String| Failure::Input(format!("{source}, column '{name}': {why}"));
+        let context = format!("{source}, column '{}'", toolconf::display::Clip(&name));
+        let bad = |e: PyErr| Failure::python(&format!("{context}: not an array"), e);
         // An array stays as it is; a list is taken as objects, cell by cell (NumPy would turn
         // ['a', nan] into the text 'nan').
         let array = if value.hasattr("__array__").unwrap_or(false) {
@@ -132,14 +133,14 @@ fn columns(items: &Bound<'_, PyAny>, source: &str) -> Result<Vec<(String, Column
             kwargs.set_item("dtype", "object").map_err(failed)?;
             numpy.call_method("asarray", (&value,), Some(&kwargs))
         }
-        .map_err(|e| bad(format!("not an array: {e}")))?;
+        .map_err(bad)?;
         let shape: Vec<usize> = array
             .getattr("shape")
             .and_then(|s| s.extract())
             .map_err(failed)?;
         if shape.len() != 1 {
-            return Err(bad(format!(
-                "has shape {shape:?}; a column is 1-D, one value per tool"
+            return Err(Failure::Input(format!(
+                "{context}: has shape {shape:?}; a column is 1-D, one value per tool"
             )));
         }
         let kind: String = array
@@ -147,6 +148,22 @@ fn columns(items: &Bound<'_, PyAny>, source: &str) -> Result<Vec<(String, Column
             .and_then(|d| d.getattr("kind"))
             .and_then(|k| k.extract())
             .map_err(failed)?;
+        // A whole array of booleans or complex numbers is refused as every array argument of
+        // the package is; a list's odd cell is its row's error (as a file's cell is).
+        if matches!(kind.as_str(), "b" | "c") {
+            let dtype = array
+                .getattr("dtype")
+                .and_then(|d| d.str())
+                .map_err(failed)?;
+            return Err(Failure::Type(format!(
+                "{context}: an array of {} (dtype {dtype}); a column holds numbers or text",
+                if kind == "b" {
+                    "booleans"
+                } else {
+                    "complex numbers"
+                }
+            )));
+        }
         let column = if matches!(kind.as_str(), "f" | "i" | "u") {
             let (_, values) = crate::arrays::values(&array, "float64").map_err(failed)?;
             Column::Numbers(values)

@@ -203,3 +203,123 @@ def test_arrays_in_any_memory_layout_give_the_same_numbers():
     plain = toolconf.dynamics("panda", tool, state, torque)
     layouts = toolconf.dynamics("panda", _unaligned(tool), _unaligned(state), torque[::-1][::-1])
     assert np.array_equal(layouts, plain)
+
+
+# One exception rule for every argument: ValueError for a value the command line would refuse
+# (with its message), TypeError for a Python value of the wrong type; never OverflowError,
+# IndexError, or a complex or boolean array taken as numbers.
+
+SHORT = {"kind": "position", "episode": {"t_end": 0.2}}
+
+
+@pytest.mark.parametrize("screen, message", [
+    (0, "screen = 0: must be at least 1"),
+    (-1, "screen = -1: must be at least 1"),
+    (-(2**70), "screen = -1180591620717411303424: must be at least 1"),
+    (10**20, "screen = 100000000000000000000: must be at most 18446744073709551615"),
+    (2**64, "screen = 18446744073709551616: must be at most 18446744073709551615"),
+])
+def test_screen_outside_the_command_lines_range_is_a_value_error(screen, message):
+    with pytest.raises(ValueError) as caught:
+        toolconf.rank(DRAWER, SHORT, screen=screen)
+    assert str(caught.value) == message
+
+
+def test_screen_takes_what_the_command_line_takes(cli_json):
+    # --screen is a u64 ≥ 1: 2**63 and 2**64 - 1 keep every tool, as no screen does.
+    every = toolconf.rank(DRAWER, "position")
+    expected = cli_json("rank", "--tools", DRAWER, "--task", "position", "--screen", 2**63)
+    assert list(every["name"]) == [row["name"] for row in expected["tools"]]
+    for screen in (2**63, 2**64 - 1, np.uint64(2**63), np.int64(12)):
+        got = toolconf.rank(DRAWER, "position", screen=screen)
+        assert list(got["name"]) == list(every["name"])
+        assert np.array_equal(got["free_energy"], every["free_energy"], equal_nan=True)
+
+
+@pytest.mark.parametrize("screen", [True, 2.0, "3", np.float64(3.0)])
+def test_screen_that_is_not_an_integer_is_a_type_error(screen):
+    with pytest.raises(TypeError, match=r"^screen = .*: expected an integer"):
+        toolconf.rank(DRAWER, SHORT, screen=screen)
+
+
+@pytest.mark.parametrize("first_tool, message", [
+    (-1, "first_tool = -1: must be at least 0"),
+    (2**70, "first_tool = 1180591620717411303424: must be at most 9223372036854775805"),
+    (2**63 - 1, "first_tool = 9223372036854775807: must be at most 9223372036854775805"),
+])
+def test_first_tool_outside_its_range_is_a_value_error(first_tool, message):
+    # Two tools: the last one's index (first_tool + 1) must fit the int64 `tool` column.
+    with pytest.raises(ValueError) as caught:
+        toolconf.simulate_batch("arm2", np.full((2, 4), 0.3), "position", first_tool=first_tool)
+    assert str(caught.value) == message
+
+
+def test_first_tool_at_its_bound_numbers_the_rows():
+    out = toolconf.simulate_batch("arm2", np.full((2, 4), 0.3), SHORT, first_tool=2**63 - 3)
+    assert out["tool"].tolist() == [2**63 - 3, 2**63 - 2]
+    with pytest.raises(TypeError, match=r"^first_tool = True: expected an integer, not a bool"):
+        toolconf.simulate_batch("arm2", np.full((2, 4), 0.3), SHORT, first_tool=True)
+
+
+PANDA_TOOL = [0.5, 0.0, 0.0, 0.1, 1e-3, 1e-3, 1e-3]
+
+
+def array_calls(bad):
+    """Every array argument of every function, given `bad` (a function of the valid value)."""
+    tools = np.array([PAPER_ARM, PAPER_ARM])
+    state, torque = np.linspace(-0.5, 0.5, 14), np.linspace(-1.0, 1.0, 7)
+    return {
+        "confidence params": lambda: toolconf.confidence("arm2", bad(tools), "position"),
+        "simulate params": lambda: toolconf.simulate("arm2", bad(tools[0]), SHORT),
+        "simulate_batch params": lambda: toolconf.simulate_batch("arm2", bad(tools), SHORT),
+        "dynamics params": lambda: toolconf.dynamics("panda", bad(PANDA_TOOL), state, torque),
+        "dynamics state": lambda: toolconf.dynamics("panda", PANDA_TOOL, bad(state), torque),
+        "dynamics control": lambda: toolconf.dynamics("panda", PANDA_TOOL, state, bad(torque)),
+        "rank column": lambda: toolconf.rank({"m1": bad(tools[:, 0]), "m2": tools[:, 1],
+                                               "l1": tools[:, 2], "l2": tools[:, 3]}, SHORT),
+    }
+
+
+@pytest.mark.parametrize("call", list(array_calls(lambda v: v)))
+@pytest.mark.parametrize("dtype, words", [("complex128", "complex numbers"), (bool, "booleans")])
+def test_complex_and_boolean_arrays_are_type_errors_everywhere(call, dtype, words):
+    # A complex array once lost its imaginary part (with only a warning); booleans were 1 and 0
+    # to confidence but refused by rank.
+    argument = call.split()[1]
+    as_dtype = array_calls(lambda v: np.asarray(v).astype(dtype))[call]
+    with pytest.raises(TypeError) as caught:
+        as_dtype()
+    message = str(caught.value)
+    assert words in message and f"(dtype {np.dtype(dtype)})" in message, message
+    assert message.startswith("tools dict, column 'm1'" if argument == "column" else argument)
+
+
+@pytest.mark.parametrize("value, error, message", [
+    ([0.3, None, 0.5, 0.2], TypeError, "params: None (NoneType) is not a real number"),
+    ([0.3, True, 0.5, 0.2], TypeError, "params: True (bool) is not a real number"),
+    ([0.3, "0.4", 0.5, 0.2], TypeError, "params: '0.4' (str) is not a real number"),
+    (np.array(["0.3", "0.4"]), TypeError, "params: an array of text (dtype <U3); expected real"),
+    ("0.3", TypeError, "params: an array of text"),
+    (b"0.3", TypeError, "params: an array of text"),
+    ([0.3, 2**70, 0.5, 0.2], ValueError,
+     "invalid arm parameter m2 = 1.1805916207174113e21: must be a number"),
+    ([0.3, 10**400, 0.5, 0.2], ValueError, "params: int too large to convert to float"),
+    ([0.3, 0.4, [0.5], 0.2], TypeError, "params: [0.5] (list) is not a real number"),
+    ([[0.3, 0.4, 0.5, 0.2], [0.3]], TypeError,
+     "params: [0.3, 0.4, 0.5, 0.2] (list) is not a real number"),
+    (np.datetime64("2024-01-01"), TypeError, "params: an array of dates or times"),
+    (0.3, ValueError, "params of shape []: model arm2 takes 4 parameters"),
+    (np.float64(np.nan), ValueError, "params of shape []"),
+])
+def test_objects_text_and_odd_values_as_params(value, error, message):
+    with pytest.raises(error) as caught:
+        toolconf.confidence("arm2", value, "position")
+    assert str(caught.value).startswith(message), str(caught.value)
+    assert type(caught.value) is error
+
+
+def test_a_column_name_with_a_line_break_stays_one_line():
+    with pytest.raises(ValueError) as caught:
+        toolconf.rank({"\n": 1.0}, "position")
+    assert str(caught.value) == "tools dict, column '\\n': has shape []; a column is 1-D, one " \
+                                "value per tool"

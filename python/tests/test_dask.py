@@ -194,3 +194,63 @@ def test_simulate_batch_errors_equal_toolconfs(dask_client):
         assert str(got.value) == str(expected.value)
     empty = tdask.simulate_batch("arm2", np.empty((0, 4)), "position", client=dask_client)
     arrays_equal(empty, toolconf.simulate_batch("arm2", np.empty((0, 4)), "position"))
+
+
+def test_simulate_batch_with_a_task_file_equals_toolconfs(dask_client, tmp_path):
+    # The task file is read on the client and sent as text, with the episode options put over
+    # its [episode] on the workers, as toolconf.simulate_batch puts them over the file's.
+    task = tmp_path / "task.toml"
+    task.write_text('kind = "velocity"\n[goal]\ntheta_dot = [0.2, -0.1]\n[precision]\n'
+                    'theta_dot = 40.0\n[episode]\nt_end = 2.0\nlearning_rate = 2.0\n')
+    rng = np.random.default_rng(11)
+    params = np.vstack([0.1 + 0.5 * rng.random((7, 4)), GIANT])
+    for perturbations, options in [(None, {}), ([-0.4, [0.3, 0.0]], {"dt": 0.1})]:
+        expected = toolconf.simulate_batch("arm2", params, task, perturbations, **options)
+        got = tdask.simulate_batch("arm2", params, task, perturbations, client=dask_client,
+                                   tools_per_task=3, **options)
+        arrays_equal(got, expected)
+        assert np.isfinite(got["free_energy"][:7 * (1 if perturbations is None else 2)]).all()
+    # Its errors name the file, as toolconf.simulate_batch's do.
+    task.write_text('kind = "velocity"\n[episode]\nt_end = -1.0\n')
+    with pytest.raises(ValueError) as expected:
+        toolconf.simulate_batch("arm2", params, task)
+    with pytest.raises(ValueError) as got:
+        tdask.simulate_batch("arm2", params, task, client=dask_client)
+    assert str(got.value) == str(expected.value) and str(task) in str(got.value)
+
+
+@pytest.mark.parametrize("value, error, message", [
+    (-5, ValueError, "must be at least 1"),
+    (0, ValueError, "must be at least 1"),
+    (True, TypeError, "expected an integer, not a bool"),
+    (2.0, TypeError, "expected an integer"),
+])
+def test_block_sizes_below_one_or_not_integers_are_refused(value, error, message):
+    # Checked before any cluster is looked for: -5 was an IndexError, 0 the default.
+    with pytest.raises(error, match=f"^tools_per_task = {value!r}: {message}"):
+        tdask.simulate_batch("arm2", np.full((4, 4), 0.3), "position", tools_per_task=value)
+    with pytest.raises(error, match=f"^episodes_per_task = {value!r}: {message}"):
+        tdask.rank(partitioned(tools(), CUTS), "position", screen=3, episodes_per_task=value)
+
+
+def test_complex_and_boolean_params_are_refused_as_toolconf_refuses_them(dask_client):
+    for params in (np.full((4, 4), 0.3 + 0.1j), np.ones((4, 4), dtype=bool)):
+        with pytest.raises(TypeError) as expected:
+            toolconf.simulate_batch("arm2", params, "position")
+        with pytest.raises(TypeError) as got:
+            tdask.simulate_batch("arm2", params, "position", client=dask_client)
+        assert str(got.value) == str(expected.value)
+
+
+def test_without_a_client_the_error_is_one_line(monkeypatch):
+    import distributed
+
+    def no_client():
+        # distributed's own words when no client runs (the session's cluster may be running).
+        raise ValueError("No clients found\nStart a client and point it to the scheduler address\n")
+
+    monkeypatch.setattr(distributed, "default_client", no_client)
+    with pytest.raises(ValueError) as caught:
+        tdask.simulate_batch("arm2", np.full((2, 4), 0.3), "position")
+    assert str(caught.value) == ("client = None and no distributed.Client is running: start one "
+                                 "(distributed.Client(cluster)) or pass client=")

@@ -22,8 +22,10 @@ The runtime is Rust (the ``toolconf`` crate); this package exposes it over NumPy
 
 A task is ``"position"``, ``"velocity"`` or ``"acceleration"`` (the paper's tasks 1-3), a task
 file's path, or a dict with a task file's keys. Bad input (a value outside ``ranges()``
-included) raises ``ValueError`` with the command line's message; a failed episode raises
-``SimulationError`` (``tool``, ``time``, ``reason``).
+included) raises ``ValueError`` with the command line's message, and a Python value of the wrong
+type ``TypeError`` (a bool or a float for an integer; an array of booleans, complex numbers or
+text for numbers); an output that does not fit in memory raises ``MemoryError``; a failed
+episode raises ``SimulationError`` (``tool``, ``time``, ``reason``).
 """
 
 import os
@@ -90,7 +92,8 @@ def rank(
             ``row N`` (1-based, the result's ``row``) where a file's names the line, e.g.
             ``tools DataFrame, row 7: m2 = 'heavy' is not a number (tool 'mallet')``.
         task: a built-in task name, a task file's path, or a dict with a task file's keys.
-        screen: simulate only the K most confident tools (K ≥ 1); ``None`` simulates all.
+        screen: simulate only the K most confident tools (an integer in [1, 2⁶⁴ − 1], as the
+            command line's ``--screen``); ``None`` simulates all.
         objective: ``"free-energy"`` (the paper's ∫F dt, the default), ``"cost-j"`` (∫J dt) or
             ``"confidence"`` (ln|Π^U|).
         skip_bad_rows: warn about a bad row (``UserWarning``) and go on without it, instead of
@@ -112,7 +115,9 @@ def rank(
     Raises:
         ValueError: a bad tools file, table or row (naming the file or table, the line or row
             and the value), a bad task (naming the key), an unknown objective, or
-            ``screen < 1``; the command line's message.
+            ``screen`` outside [1, 2⁶⁴ − 1]; the command line's message.
+        TypeError: a ``screen`` that is not an integer, or a column of booleans or complex
+            numbers.
     """
     native, source, frame = native_tools(tools)
     table = _toolconf.rank(native, task, screen, objective, skip_bad_rows, method, source)

@@ -1,4 +1,10 @@
-"""Type stubs of the native module (python/src/*.rs)."""
+"""Type stubs of the native module (python/src/*.rs).
+
+Every function raises ``ValueError`` for bad input (the command line's message), ``TypeError``
+for a Python value of the wrong type (a bool where an integer is expected; an array of
+booleans, complex numbers, text or other objects where numbers are), and ``MemoryError`` when an
+output sized by the input does not fit in memory.
+"""
 
 import os
 from typing import Any, Literal, Mapping, Optional, Sequence, TypedDict, Union
@@ -110,7 +116,7 @@ def rank(
     ``model``, the parameters, ``logdet``, ``task_error``, ``free_energy``, ``cost_j``,
     ``rhs_evals``, ``error``. ``tools`` is a tools file or columns in memory (``source`` names
     them in errors). ``toolconf.rank`` wraps this for DataFrames and structured arrays. Raises
-    ``ValueError`` for bad input."""
+    ``ValueError`` for bad input (``screen`` outside [1, 2⁶⁴ − 1] included)."""
 
 def simulate_batch(
     model: str,
@@ -118,7 +124,7 @@ def simulate_batch(
     task: Task,
     perturbations: Optional[Union[Sequence[Union[float, Sequence[float]]], npt.ArrayLike]] = None,
     method: Literal["fast", "explicit", "auto", "stiff"] = "fast",
-    first_tool: int = 0,
+    first_tool: Optional[int] = 0,
     *,
     t_end: Optional[float] = ...,
     dt: Optional[float] = ...,
@@ -135,7 +141,20 @@ def simulate_batch(
     ``perturbation`` (indices), ``task_error``, ``free_energy``, ``cost_j``, ``logdet``,
     ``control_effort`` (NaN for a failed episode), ``rhs_evals``, ``steps``,
     ``rejected_steps``, ``jacobian_evals``, ``factorisations`` (-1 for one) and ``error``.
-    A failed episode never stops the batch; bad input raises ``ValueError``."""
+    A failed episode never stops the batch; bad input raises ``ValueError``. ``first_tool`` is
+    an integer in [0, 2⁶³ − 1 − the number of tools] (``tool`` is int64)."""
+
+def _simulate_batch(
+    model: str,
+    params: Params,
+    task: "PortableTask",
+    perturbations: Optional[Union[Sequence[Union[float, Sequence[float]]], npt.ArrayLike]] = None,
+    method: str = "fast",
+    first_tool: Optional[int] = 0,
+    **episode_options: Any,
+) -> Columns:
+    """``simulate_batch`` on one block of ``toolconf.dask.simulate_batch``, the task as
+    ``_portable_task`` sent it (a task file as its text)."""
 
 def design(
     model: str,

@@ -27,6 +27,7 @@ with one thread per worker), or the processes of one machine compete for its cor
 """
 
 import math
+import operator
 import warnings
 from typing import TYPE_CHECKING, Any, Literal, Optional
 
@@ -50,7 +51,12 @@ def _client(client):
         return client
     import distributed
 
-    return distributed.default_client()
+    try:
+        return distributed.default_client()
+    except ValueError:
+        # distributed's message is five lines; the package's errors are one.
+        raise ValueError("client = None and no distributed.Client is running: start one "
+                         "(distributed.Client(cluster)) or pass client=") from None
 
 
 def _threads(client) -> int:
@@ -82,8 +88,9 @@ def _kept_episodes(screened, task, objective, method):
 
 
 def _batch(model, params, task, perturbations, method, first_tool, episode_options):
-    return _toolconf.simulate_batch(model, params, task, perturbations, method, first_tool,
-                                    **episode_options)
+    # The private twin of toolconf.simulate_batch: it also reads a task file sent as text.
+    return _toolconf._simulate_batch(model, params, task, perturbations, method, first_tool,
+                                     **episode_options)
 
 
 def _slice(block, start, stop):
@@ -92,6 +99,28 @@ def _slice(block, start, stop):
 
 def _blocks(n, per_block):
     return [(start, min(start + per_block, n)) for start in range(0, n, per_block)]
+
+
+def _per_block(name, value):
+    """A block size given by the caller (``tools_per_task``, ``episodes_per_task``): None (the
+    default) or an integer ≥ 1, else ``TypeError`` or ``ValueError`` naming it, as the native
+    functions check their integer arguments."""
+    if value is None:
+        return None
+    if isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name} = {value!r}: expected an integer, not a bool")
+    try:
+        value = operator.index(value)
+    except TypeError:
+        raise TypeError(f"{name} = {_short(value)}: expected an integer") from None
+    if value < 1:
+        raise ValueError(f"{name} = {value}: must be at least 1")
+    return value
+
+
+def _short(value):
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def rank(
@@ -120,17 +149,21 @@ def rank(
             read here and sent to the workers as text.
         client: the ``distributed.Client`` to run on (default: the current one).
         episodes_per_task: how many episodes one cluster task runs (each on its worker's rayon
-            threads); by default the kept tools are cut into about four blocks per worker
-            thread. Without a screen each partition is one block.
+            threads), an integer ≥ 1; by default the kept tools are cut into about four blocks
+            per worker thread. Without a screen each partition is one block.
 
     Returns:
         pandas.DataFrame: ``toolconf.rank``'s columns, best first.
 
     Raises:
-        ValueError: as ``toolconf.rank``, for the first bad row in row order.
+        ValueError: as ``toolconf.rank``, for the first bad row in row order; an
+            ``episodes_per_task`` below 1.
+        TypeError: as ``toolconf.rank``; an ``episodes_per_task`` that is not an integer.
     """
     import pandas
     from dask import delayed
+
+    episodes_per_task = _per_block("episodes_per_task", episodes_per_task)
 
     if not hasattr(ddf, "to_delayed"):
         raise ValueError(f"ddf = {type(ddf).__name__}: toolconf.dask.rank takes a dask DataFrame "
@@ -207,27 +240,31 @@ def simulate_batch(
         params: a 2-D NumPy array (one tool per row), or a ``dask.array`` whose row chunks are
             the blocks.
         client: the ``distributed.Client`` to run on (default: the current one).
-        tools_per_task: the tools of one block (NumPy ``params``); by default about four blocks
-            per worker thread.
+        tools_per_task: the tools of one block (NumPy ``params``), an integer ≥ 1; by default
+            about four blocks per worker thread.
 
     Returns:
         dict of arrays and the ``error`` list, as ``toolconf.simulate_batch``.
 
     Raises:
-        ValueError: as ``toolconf.simulate_batch`` (the first bad tool in row order).
+        ValueError: as ``toolconf.simulate_batch`` (the first bad tool in row order); a
+            ``tools_per_task`` below 1.
+        TypeError: as ``toolconf.simulate_batch``; a ``tools_per_task`` that is not an integer.
     """
+    tools_per_task = _per_block("tools_per_task", tools_per_task)
     client = _client(client)
     task = _toolconf._portable_task(task, None, "free-energy", method)
-    blocks, shape = _param_blocks(client, params, tools_per_task)
+    blocks, shape, dtype = _param_blocks(client, params, tools_per_task)
     # Everything but the tools' values is checked here, before the cluster runs anything: on
-    # no tools, and if that fails, again on tools of the real shape, whose check fails at the
-    # same place (before any episode) with the message toolconf.simulate_batch would give.
+    # no tools of the same dtype, and if that fails, again on tools of the real shape, whose
+    # check fails at the same place (before any episode) with the message
+    # toolconf.simulate_batch would give.
     try:
-        empty = _toolconf.simulate_batch(model, np.empty((0, shape[1])), task, perturbations,
-                                         method, **episode_options)
+        empty = _toolconf._simulate_batch(model, np.empty((0, shape[1]), dtype=dtype), task,
+                                          perturbations, method, **episode_options)
     except ValueError:
-        _toolconf.simulate_batch(model, np.broadcast_to(0.0, shape), task, perturbations,
-                                 method, **episode_options)
+        _toolconf._simulate_batch(model, np.broadcast_to(np.zeros((), dtype), shape), task,
+                                  perturbations, method, **episode_options)
         raise
     if shape[0] == 0:
         return empty
@@ -243,19 +280,20 @@ def simulate_batch(
 
 
 def _param_blocks(client, params, tools_per_task):
-    """``([(block, rows), ...], shape)``: a dask array's row chunks (as futures), or a NumPy
-    array cut into blocks of ``tools_per_task`` rows."""
+    """``([(block, rows), ...], shape, dtype)``: a dask array's row chunks (as futures), or a
+    NumPy array cut into blocks of ``tools_per_task`` rows. The dtype stays the caller's, so
+    that the native check refuses a complex or boolean array as toolconf.simulate_batch does."""
     if hasattr(params, "to_delayed") and hasattr(params, "chunks"):
         if params.ndim != 2:
             raise ValueError(f"params of shape {list(params.shape)}: a dask array of tools is "
                              "2-D, one tool per row")
         params = params.rechunk({1: -1})
         futures = client.compute(list(params.to_delayed()[:, 0]))
-        return list(zip(futures, params.chunks[0])), params.shape
-    array = np.asarray(params, dtype="float64")
+        return list(zip(futures, params.chunks[0])), params.shape, params.dtype
+    array = np.asarray(params)
     if array.ndim != 2:
         raise ValueError(f"params of shape {list(array.shape)}: toolconf.dask.simulate_batch "
                          "takes a 2-D array, one tool per row")
     n = array.shape[0]
     per_block = tools_per_task or max(1, math.ceil(n / (4 * _threads(client))))
-    return [(array[a:b], b - a) for a, b in _blocks(n, per_block)], array.shape
+    return [(array[a:b], b - a) for a, b in _blocks(n, per_block)], array.shape, array.dtype
