@@ -36,6 +36,23 @@ const MAX_RELATIVE_STEP: f64 = 1e6;
 /// of 240 random design files the optima that had not converged were at 0.6 to 2.)
 pub const KKT_TOLERANCE: f64 = 1e-5;
 
+/// A QP that failed: the solver's words and the rows of [`Polytope::all_rows`] active when it
+/// did ([`QpOutcome::Failed`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct QpFailure {
+    pub reason: String,
+    pub tight: Vec<usize>,
+}
+
+impl From<&str> for QpFailure {
+    fn from(reason: &str) -> Self {
+        Self {
+            reason: reason.into(),
+            tight: Vec::new(),
+        }
+    }
+}
+
 /// φ and ∇φ at free parameters x, or None where φ is undefined (Π^U not positive definite).
 pub type Objective<'a> = dyn FnMut(&[f64]) -> Option<(f64, Vec<f64>)> + 'a;
 
@@ -67,7 +84,7 @@ pub fn maximise(
     polytope: &Polytope,
     starts: &[Vec<f64>],
     objective: &mut Objective,
-) -> Result<Option<Optimum>, String> {
+) -> Result<Option<Optimum>, QpFailure> {
     let mut best: Option<Optimum> = None;
     let mut failure = None;
     for (k, x0) in starts.iter().enumerate() {
@@ -95,7 +112,7 @@ pub fn climb(
     polytope: &Polytope,
     x0: &[f64],
     objective: &mut Objective,
-) -> Result<Option<Optimum>, String> {
+) -> Result<Option<Optimum>, QpFailure> {
     let n = polytope.dim();
     let (g_rows, h) = polytope.all_rows();
     let Some((mut value, mut grad)) = objective(x0) else {
@@ -288,7 +305,7 @@ fn scaled_step(
     grad: &[f64],
     g_rows: &[Vec<f64>],
     h: &[f64],
-) -> Result<Step, String> {
+) -> Result<Step, QpFailure> {
     let n = x.len();
     let scaled_b: Vec<Vec<f64>> = (0..n)
         .map(|i| (0..n).map(|j| x[i] * b[i][j] * x[j]).collect())
@@ -308,7 +325,7 @@ fn scaled_step(
     let (sigma, z) = match qp::solve(Some(&scaled_b), &q, &rows, &rhs) {
         QpOutcome::Solved { x: sigma, z } => (sigma, z),
         QpOutcome::Infeasible => return Err("the QP is infeasible".into()),
-        QpOutcome::Failed(reason) => return Err(reason),
+        QpOutcome::Failed { reason, tight } => return Err(QpFailure { reason, tight }),
     };
     Ok(Step {
         d: sigma.iter().zip(x).map(|(s, xj)| s * xj).collect(),
@@ -386,6 +403,7 @@ mod tests {
             g: vec![w.to_vec()],
             h: vec![1.0],
             text: vec!["x + 2y + 4z <= 1".into()],
+            names: vec!["x", "y", "z"],
         };
         let mut f = |x: &[f64]| -> Option<(f64, Vec<f64>)> {
             Some((

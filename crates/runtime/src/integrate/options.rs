@@ -131,7 +131,7 @@ pub enum IntegrationError {
     /// An episode's work budget ([`crate::model::budget`]) ran out: the integrator's
     /// [`IntegrationError::TooManySteps`] at the episode's own limit, with the episode's
     /// reading of why (the state or the step size there).
-    #[error("episode stopped after {attempts} step attempts at t = {} s: {why}", crate::display::Short(*t))]
+    #[error("episode stopped after {attempts} step attempts at t = {t:.3e} s: {why}")]
     OutOfWork {
         t: f64,
         attempts: usize,

@@ -49,14 +49,14 @@ pub fn diagnosis<const N: usize>(state: &[f64], h: f64, dt: f64) -> String {
     if state.len() >= 2 * N {
         if let Some((i, x)) = outside(&state[N..2 * N], JOINT_RATE) {
             return format!(
-                "the state left the joints' range, θ̇{i} = {} rad/s (valid starts are in {JOINT_RATE})",
-                Short(x)
+                "the state left the joints' range, θ̇{i} = {x:.3e} rad/s (valid starts are in \
+                 {JOINT_RATE})"
             );
         }
         if let Some((i, x)) = outside(&state[..N], JOINT_ANGLE) {
             return format!(
-                "the state left the joints' range, θ{i} = {} rad (valid starts are in {JOINT_ANGLE})",
-                Short(x)
+                "the state left the joints' range, θ{i} = {x:.3e} rad (valid starts are in \
+                 {JOINT_ANGLE})"
             );
         }
     }
@@ -107,11 +107,11 @@ mod tests {
         let rate = diagnosis::<2>(&[0.1, 20.0, 3.0, -5e4, 1.0, 1.0], 1e-9, 0.05);
         assert_eq!(
             rate,
-            "the state left the joints' range, θ̇2 = -5e4 rad/s (valid starts are in [-100, 100] rad/s)"
+            "the state left the joints' range, θ̇2 = -5.000e4 rad/s (valid starts are in [-100, 100] rad/s)"
         );
         let angle = diagnosis::<2>(&[0.1, 20.0, 3.0, 5.0, 1.0, 1.0], 1e-9, 0.05);
         assert!(
-            angle.contains("θ2 = 20 rad (valid starts are in [-4π, 4π] rad)"),
+            angle.contains("θ2 = 2.000e1 rad (valid starts are in [-4π, 4π] rad)"),
             "{angle}"
         );
         let step = diagnosis::<2>(&[0.1, 0.2, 3.0, 5.0, 1e5, 1.0], 2e-8, 0.05);
