@@ -161,7 +161,7 @@ impl Polytope {
         rhs.push(0.0);
         let mut cost = vec![0.0; n + 1];
         cost[n] = -1.0;
-        match qp::solve(None, &cost, &rows, &rhs) {
+        match qp::solve_robustly(None, &cost, &rows, &rhs) {
             QpOutcome::Solved { x, .. } => {
                 let x = x[..n].to_vec();
                 if self.violation(&x) <= 1e-7 {

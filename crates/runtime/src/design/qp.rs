@@ -65,7 +65,21 @@ const ATTEMPTS: [Attempt; 4] = [
 ];
 
 /// Minimises ½ xᵀHx + qᵀx subject to G x ≤ h; `hessian` is n×n symmetric (None: an LP).
+/// With tight tolerances, then Clarabel's defaults.
 pub fn solve(hessian: Option<&[Vec<f64>]>, q: &[f64], g: &[Vec<f64>], h: &[f64]) -> QpOutcome {
+    solve_with(&ATTEMPTS[..2], hessian, q, g, h)
+}
+
+/// [`solve`], then the robust attempts (regularised, then rescaled) before it fails: for a QP
+/// whose failure would end the run. (Not for every QP of the search: a climb that a failed QP
+/// stops is ended by the best of the other starts, as it always was, and the designs that
+/// solved stay the same.)
+pub fn solve_robustly(
+    hessian: Option<&[Vec<f64>]>,
+    q: &[f64],
+    g: &[Vec<f64>],
+    h: &[f64],
+) -> QpOutcome {
     solve_with(&ATTEMPTS, hessian, q, g, h)
 }
 
@@ -90,6 +104,12 @@ fn solve_with(
     }
     let mut almost = None;
     let mut failures: Vec<String> = Vec::new();
+    let names = [
+        "tight tolerances",
+        "Clarabel's defaults",
+        "regularised",
+        "rescaled",
+    ];
     let mut last_x = None;
     for attempt in attempts {
         if attempt.robust && almost.is_some() {
@@ -117,10 +137,10 @@ fn solve_with(
     failures.dedup();
     QpOutcome::Failed {
         reason: format!(
-            "Clarabel: {} after {} attempts (tight tolerances, Clarabel's defaults, regularised, \
-             rescaled)",
+            "Clarabel: {} after {} attempts ({})",
             failures.join(", then "),
-            attempts.len()
+            attempts.len(),
+            names[..attempts.len().min(names.len())].join(", ")
         ),
         tight: last_x.map_or_else(Vec::new, |x| tight_rows(g, h, &x)),
     }

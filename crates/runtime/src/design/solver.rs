@@ -85,10 +85,24 @@ pub fn maximise(
     starts: &[Vec<f64>],
     objective: &mut Objective,
 ) -> Result<Option<Optimum>, QpFailure> {
+    match climb_all(polytope, starts, objective, false) {
+        // Every start's climb failed: once more, with the QP solver's fallbacks.
+        Err(_) => climb_all(polytope, starts, objective, true),
+        found => found,
+    }
+}
+
+/// [`maximise`] with the QPs solved by [`qp::solve`], or also its fallbacks (`robust`).
+fn climb_all(
+    polytope: &Polytope,
+    starts: &[Vec<f64>],
+    objective: &mut Objective,
+    robust: bool,
+) -> Result<Option<Optimum>, QpFailure> {
     let mut best: Option<Optimum> = None;
     let mut failure = None;
     for (k, x0) in starts.iter().enumerate() {
-        match climb(polytope, x0, objective) {
+        match climb_with(polytope, x0, objective, robust) {
             Ok(Some(mut o)) => {
                 o.start = k;
                 if best.as_ref().map_or(true, |b| o.value > b.value) {
@@ -112,6 +126,15 @@ pub fn climb(
     polytope: &Polytope,
     x0: &[f64],
     objective: &mut Objective,
+) -> Result<Option<Optimum>, QpFailure> {
+    climb_with(polytope, x0, objective, false)
+}
+
+fn climb_with(
+    polytope: &Polytope,
+    x0: &[f64],
+    objective: &mut Objective,
+    robust: bool,
 ) -> Result<Option<Optimum>, QpFailure> {
     let n = polytope.dim();
     let (g_rows, h) = polytope.all_rows();
@@ -137,7 +160,7 @@ pub fn climb(
     let mut iterations = 0;
     while iterations < MAX_ITERATIONS {
         iterations += 1;
-        let step = match scaled_step(&b, &x, &grad, &g_rows, &h) {
+        let step = match scaled_step(&b, &x, &grad, &g_rows, &h, robust) {
             Ok(step) => step,
             Err(reason) if kkt.is_none() => return Err(reason),
             // As for a failed line search below: restart B once, then stop.
@@ -305,6 +328,7 @@ fn scaled_step(
     grad: &[f64],
     g_rows: &[Vec<f64>],
     h: &[f64],
+    robust: bool,
 ) -> Result<Step, QpFailure> {
     let n = x.len();
     let scaled_b: Vec<Vec<f64>> = (0..n)
@@ -322,7 +346,12 @@ fn scaled_step(
         // of up to 1e12 (x = 1e-6 under hi = 1e6) would set the solver's scale.
         rhs.push(((hi - dot(r, x)) / scale).clamp(0.0, MAX_RELATIVE_STEP));
     }
-    let (sigma, z) = match qp::solve(Some(&scaled_b), &q, &rows, &rhs) {
+    let solve = if robust {
+        qp::solve_robustly
+    } else {
+        qp::solve
+    };
+    let (sigma, z) = match solve(Some(&scaled_b), &q, &rows, &rhs) {
         QpOutcome::Solved { x: sigma, z } => (sigma, z),
         QpOutcome::Infeasible => return Err("the QP is infeasible".into()),
         QpOutcome::Failed { reason, tight } => return Err(QpFailure { reason, tight }),
