@@ -215,7 +215,9 @@ fn an_unconverged_optimum_is_reported_as_such() {
     assert!(
         matches!(
             tasks.logdet(&tool),
-            Err(toolconf::Error::Core(toolconf::model::Error::IllConditioned { .. }))
+            Err(toolconf::Error::Core(
+                toolconf::model::Error::IllConditioned { .. }
+            ))
         ),
         "{q:?}"
     );
@@ -351,5 +353,9 @@ fn the_gradient_check_holds_where_a_parameter_sits_at_zero_or_a_bound() {
     });
     assert!(at_zero_or_bound.count() >= 1, "{:?}", optimum.x);
     let check = toolconf::design::gradient_check(&setting, &polytope, &optimum);
-    assert!(check < 1e-5, "gradient vs finite differences {check:e} at {:?}", optimum.x);
+    assert!(
+        check < 1e-5,
+        "gradient vs finite differences {check:e} at {:?}",
+        optimum.x
+    );
 }
