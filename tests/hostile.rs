@@ -100,6 +100,8 @@ fn cases() -> Vec<Case> {
     let drawer = repo("examples/tools/drawer.csv");
     let design = repo("examples/design/reach_and_budget.toml");
     let d = drawer.as_str();
+    let panda_tools = repo("examples/tools/panda_tools.csv");
+    let panda_task = std::fs::read_to_string(repo("examples/tasks/panda_wrist_turn.toml")).unwrap();
     let long_name = "n".repeat(70_000);
     let v = vec![
         // 1. Panics: a long tool name, an unwritable stdout.
@@ -133,6 +135,17 @@ fn cases() -> Vec<Case> {
             .file("p.toml", "kind = \"position\"\n[precision]\ntheta = 1e300\n"),
         case("goal 1e300", &["simulate", "--arm", ARM, "--task-file", "g.toml"], 2, &["g.toml", "key goal.theta", "1e300"])
             .file("g.toml", "kind = \"position\"\n[goal]\ntheta = [1e300, 0.0]\n"),
+        // Starts and goals a joint can have: an angle of 1e6 rad cost 10⁶ step attempts a tool.
+        case("Panda initial_theta 1e6", &["rank", "--tools", &panda_tools, "--task", "far.toml"], 2, &["far.toml", "key episode.initial_theta", "1e6 must be a number in [-4π, 4π] rad"])
+            .file("far.toml", format!("{}initial_theta = [1e6, 0.0, 0.0, -1.5, 0.0, 1.5, 0.8]\n", panda_task)),
+        case("goal rate 1e3", &["simulate", "--arm", ARM, "--task-file", "fast.toml"], 2, &["fast.toml", "key goal.theta_dot", "[-100, 100] rad/s"])
+            .file("fast.toml", "kind = \"velocity\"\n[goal]\ntheta_dot = [0.0, 1e3]\n"),
+        case("goal acceleration 1e5", &["simulate", "--arm", ARM, "--task-file", "jerk.toml"], 2, &["jerk.toml", "key goal.theta_ddot", "[-1e4, 1e4] rad/s²"])
+            .file("jerk.toml", "kind = \"acceleration\"\n[goal]\ntheta_ddot = [0.0, 1e5]\n"),
+        // The work budget: within range, but dynamics no episode can follow (ode45 on a
+        // micrometre arm; a millimetre arm flung past any joint's rate) stop after 10⁵ attempts.
+        case("an episode out of work", &["simulate", "--arm", "1e-6,1e-6,1e-6,1e-6", "--task", "position", "--method", "explicit"], 1, &["episode stopped after 100000 step attempts", "the step size had fallen to"]),
+        case("an episode out of the joints' range", &["simulate", "--arm", "1e-3,1e-3,1e-3,1e-3", "--task", "position", "--method", "explicit"], 1, &["episode stopped after 100000 step attempts", "the state left the joints' range, θ̇"]),
         case("tools file 1e200", &["rank", "--tools", "big.csv", "--task", "position"], 2, &["big.csv, line 2", "l1 = 1e200"])
             .file("big.csv", "name,m1,m2,l1,l2\ngiant,0.3,0.3,1e200,1e200\n"),
         // 4. Exit codes: bad options are 2 before any work, in every command.

@@ -168,7 +168,7 @@ def stated():
     low, high = ranges["tool_parameter"]["low"], ranges["tool_parameter"]["high"]
     assert low * high == 1.0, "the analysis takes the parameter box symmetric in log10"
     return (math.log10(high), math.log10(ranges["precision_entry"]["high"]),
-            math.log10(ranges["joint_value"]["high"]))
+            math.log10(ranges["state"]["high"]))
 
 
 def closed_form_models():

@@ -6,7 +6,7 @@
 use core::fmt;
 
 use crate::display::Short;
-use crate::validate::{JOINT_VALUE, PRECISION_ENTRY, TOOL_PARAMETER};
+use crate::validate::{Range, PRECISION_ENTRY, TOOL_PARAMETER};
 use crate::TaskKind;
 
 /// What can go wrong building a tool, a task or a controller, or computing ln|Π^U|.
@@ -29,9 +29,14 @@ pub enum Error {
     /// inequality of a rigid body's principal moments), by `excess` = c · p > 0.
     #[error("invalid tool: {rule} does not hold (off by {excess:.2e})")]
     ToolConstraint { rule: &'static str, excess: f64 },
-    /// A goal outside [`JOINT_VALUE`].
-    #[error("invalid goal {name} = {}: must be a number in {}", Short(*value), JOINT_VALUE)]
-    InvalidGoal { name: &'static str, value: f64 },
+    /// A goal outside its range ([`crate::validate::JOINT_ANGLE`], `JOINT_RATE` or
+    /// `JOINT_ACCELERATION`).
+    #[error("invalid goal {name} = {}: must be a number in {range}", Short(*value))]
+    InvalidGoal {
+        name: &'static str,
+        value: f64,
+        range: Range,
+    },
     /// A precision matrix that is not in range, symmetric and positive semi-definite.
     #[error("invalid precision {name}: {problem}")]
     InvalidPrecision {

@@ -45,18 +45,19 @@ impl<const N: usize> TaskN<N> {
         }
     }
 
-    /// Checks goals are in [`crate::validate::JOINT_VALUE`] and precisions in
+    /// Checks goals are in their ranges ([`crate::validate::JOINT_ANGLE`], rates and
+    /// accelerations likewise) and precisions in
     /// [`crate::validate::PRECISION_ENTRY`], symmetric and positive semi-definite, and that they
     /// can make Π^U positive definite at all ([`Error::ConfidenceRank`]).
     pub fn validate(&self) -> Result<(), Error> {
-        for (name, goal) in [
-            ("theta_g", &self.goal_theta),
-            ("theta_dot_g", &self.goal_theta_dot),
-            ("theta_ddot_g", &self.goal_theta_ddot),
+        use crate::validate::{JOINT_ACCELERATION, JOINT_ANGLE, JOINT_RATE};
+        for (name, goal, range) in [
+            ("theta_g", &self.goal_theta, JOINT_ANGLE),
+            ("theta_dot_g", &self.goal_theta_dot, JOINT_RATE),
+            ("theta_ddot_g", &self.goal_theta_ddot, JOINT_ACCELERATION),
         ] {
-            let valid = |v: &f64| crate::validate::JOINT_VALUE.contains(*v);
-            if let Some(&value) = goal.iter().find(|v| !valid(v)) {
-                return Err(Error::InvalidGoal { name, value });
+            if let Some(&value) = goal.iter().find(|v| !range.contains(**v)) {
+                return Err(Error::InvalidGoal { name, value, range });
             }
         }
         for (name, p) in [

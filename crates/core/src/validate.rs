@@ -3,6 +3,7 @@
 //! exponents, bounded from the IR) is in the runtime's `toolconf::validate`, which adds the
 //! ranges of the episode, integrator, MPC and design options and re-exports these.
 
+use core::f64::consts::PI;
 use core::fmt;
 
 use crate::display::Short;
@@ -57,12 +58,15 @@ impl Range {
     }
 }
 
-/// A range's end: `1e6` rather than `1000000`.
+/// A range's end: `1e6` rather than `1000000`, `4π` rather than `12.566370614359172`.
 struct End(f64);
 
 impl fmt::Display for End {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if self.0.is_finite() && self.0.abs() >= 1e4 {
+        let multiple = (1..=16).find(|&k| f64::from(k) * PI == self.0.abs());
+        if let Some(k) = multiple {
+            write!(f, "{}{k}π", if self.0 < 0.0 { "-" } else { "" })
+        } else if self.0.is_finite() && self.0.abs() >= 1e4 {
             write!(f, "{:e}", self.0)
         } else {
             write!(f, "{}", Short(self.0))
@@ -88,5 +92,16 @@ pub const PRECISION_ENTRY: Range = Range::closed(-1e6, 1e6, "");
 /// The episode's divergence bound: a state past it is a diverged simulation
 /// (the runtime's `DIVERGENCE_BOUND`).
 pub const STATE_BOUND: f64 = 1e6;
-/// Goals, initial angles and rates (rad, rad/s, rad/s²).
-pub const JOINT_VALUE: Range = Range::closed(-STATE_BOUND, STATE_BOUND, "");
+/// Joint angles, the initial θ₀ and the goal θ_g, in rad (m for a prismatic joint or the
+/// mass-spring-damper): |θ| ≤ 4π, two full turns either way of the zero pose. Every revolute
+/// joint of the shipped arms travels less (the UR5's ±2π is the widest), and the controller's
+/// error θ − θ_g is not wrapped, so an angle further out asks the arm to unwind whole turns
+/// rather than reach a pose: with θ₀ = 10⁶ an episode spent 10⁶ step attempts doing so.
+pub const JOINT_ANGLE: Range = Range::closed(-4.0 * PI, 4.0 * PI, "rad");
+/// Joint rates, the initial θ̇₀ and the goal θ̇_g: |θ̇| ≤ 100 rad/s (about 950 rpm), some
+/// thirty times the fastest rated joint of the shipped arms (the UR5's and Panda's wrists turn
+/// at ≈ 3 rad/s).
+pub const JOINT_RATE: Range = Range::closed(-100.0, 100.0, "rad/s");
+/// Joint accelerations, the goal θ̈_g: |θ̈| ≤ 10⁴ rad/s², enough to reach [`JOINT_RATE`]'s
+/// bound from rest in 10 ms (the shipped arms are rated at 10-40 rad/s²).
+pub const JOINT_ACCELERATION: Range = Range::closed(-1e4, 1e4, "rad/s²");

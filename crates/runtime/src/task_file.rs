@@ -318,13 +318,14 @@ impl TaskSpec {
             );
             return Err((key, message));
         }
-        for (key, v) in [
-            ("goal.theta", &self.goal_theta),
-            ("goal.theta_dot", &self.goal_theta_dot),
-            ("goal.theta_ddot", &self.goal_theta_ddot),
+        use crate::validate::{JOINT_ACCELERATION, JOINT_ANGLE, JOINT_RATE};
+        for (key, v, range) in [
+            ("goal.theta", &self.goal_theta, JOINT_ANGLE),
+            ("goal.theta_dot", &self.goal_theta_dot, JOINT_RATE),
+            ("goal.theta_ddot", &self.goal_theta_ddot, JOINT_ACCELERATION),
         ] {
             if let Some(v) = v {
-                in_range(v, crate::validate::JOINT_VALUE).map_err(|m| (key.to_string(), m))?;
+                in_range(v, range).map_err(|m| (key.to_string(), m))?;
             }
         }
         for (key, p) in [
@@ -486,7 +487,9 @@ impl EpisodeSpec {
     /// Every option against its documented range ([`crate::validate`]), dt against t_end and
     /// the grid's size, the defaults standing in for what is not given. Returns (key, message).
     pub fn check(&self) -> Result<(), (&'static str, String)> {
-        use crate::validate::{ATOL, DT, JOINT_VALUE, LEARNING_RATE, RTOL, TORQUE, T_END};
+        use crate::validate::{
+            ATOL, DT, JOINT_ANGLE, JOINT_RATE, LEARNING_RATE, RTOL, TORQUE, T_END,
+        };
         let within = |key: &'static str, v: Option<f64>, range: crate::validate::Range| match v {
             Some(x) => range.check(x).map(|_| ()).map_err(|m| (key, m)),
             None => Ok(()),
@@ -518,12 +521,16 @@ impl EpisodeSpec {
                 None => {}
             }
         }
-        for (key, v) in [
-            ("episode.initial_theta", &self.initial_theta),
-            ("episode.initial_theta_dot", &self.initial_theta_dot),
+        for (key, v, range) in [
+            ("episode.initial_theta", &self.initial_theta, JOINT_ANGLE),
+            (
+                "episode.initial_theta_dot",
+                &self.initial_theta_dot,
+                JOINT_RATE,
+            ),
         ] {
             if let Some(v) = v {
-                in_range(v, JOINT_VALUE).map_err(|m| (key, m))?;
+                in_range(v, range).map_err(|m| (key, m))?;
             }
         }
         Ok(())

@@ -15,10 +15,17 @@
 //! and the dynamics stay below 10⁷⁰) or falls below 10⁻⁵⁴ unless it is 0, and Π^U's entries stay
 //! below 10⁶⁷, so that ln|Π^U|'s determinant cannot overflow either. At k = 9 the bound reaches
 //! 10³⁰³: no margin. Hence [1e-6, 1e6] for every tool parameter (a microgram to a thousand
-//! tonnes, a micrometre to a thousand kilometres) and 1e6 for |P|. States, goals and torques
-//! are bounded by the episode's divergence bound (10⁶: a state beyond it is a diverged
-//! simulation, so no start or goal may lie there). `tests/parameter_range.rs` evaluates every
-//! generated function at the corners of that box and checks that every output is finite.
+//! tonnes, a micrometre to a thousand kilometres) and 1e6 for |P|. The states the generated
+//! code sees, and the torques, are bounded by the episode's divergence bound (10⁶: a state
+//! beyond it is a diverged simulation). `tests/parameter_range.rs` evaluates every generated
+//! function at the corners of that box and checks that every output is finite.
+//!
+//! Starts and goals are bounded by what a joint does, not by what the arithmetic survives:
+//! angles within two turns ([`JOINT_ANGLE`]), rates within 100 rad/s ([`JOINT_RATE`]),
+//! accelerations within 10⁴ rad/s² ([`JOINT_ACCELERATION`]). A start far outside them is
+//! valid arithmetic but no task: the controller spends the episode unwinding it, and the
+//! integrator the episode's whole work budget following it
+//! ([`crate::model::episode_budget`]).
 //!
 //! Finite is not the same as accurate: a tool whose parameters span many decades (1e-4 and 1e4
 //! in one tool) can make Π^U so ill-conditioned that its determinant has no correct digit.
@@ -27,8 +34,15 @@
 
 use core::fmt;
 
-pub use toolconf_core::validate::{Range, JOINT_VALUE, PRECISION_ENTRY, STATE_BOUND, TOOL_PARAMETER};
+pub use toolconf_core::validate::{
+    Range, JOINT_ACCELERATION, JOINT_ANGLE, JOINT_RATE, PRECISION_ENTRY, STATE_BOUND,
+    TOOL_PARAMETER,
+};
 
+/// Any state an episode reaches, the divergence bound: past it a simulation has diverged.
+/// Not an input of its own (starts are within [`JOINT_ANGLE`] and [`JOINT_RATE`]), but the
+/// box over which the generated code is shown to stay finite.
+pub const STATE: Range = Range::closed(-STATE_BOUND, STATE_BOUND, "");
 /// Torques: the initial torque U0 and the perturbation ΔT.
 pub const TORQUE: Range = Range::closed(-STATE_BOUND, STATE_BOUND, "N m");
 /// The controller's learning rate γ.
@@ -59,10 +73,13 @@ pub const CONSTRAINT_COEFFICIENT: Range = Range::closed(-1e6, 1e6, "");
 pub const CONSTRAINT_BOUND: Range = Range::closed(-1e12, 1e12, "");
 
 /// Every documented range by its name (as `toolconf.ranges()` and the README give them).
-pub const RANGES: [(&str, Range); 16] = [
+pub const RANGES: [(&str, Range); 19] = [
     ("tool_parameter", TOOL_PARAMETER),
     ("precision_entry", PRECISION_ENTRY),
-    ("joint_value", JOINT_VALUE),
+    ("joint_angle", JOINT_ANGLE),
+    ("joint_rate", JOINT_RATE),
+    ("joint_acceleration", JOINT_ACCELERATION),
+    ("state", STATE),
     ("torque", TORQUE),
     ("learning_rate", LEARNING_RATE),
     ("t_end", T_END),

@@ -93,7 +93,7 @@ pub fn confidence_optimum(
     starts.extend(polytope.feasible_corners());
     let mut objective = |x: &[f64]| setting.confidence(&polytope, x);
     let optimum = solver::maximise(&polytope, &starts, &mut objective)
-        .map_err(|reason| polytope.solver_failed(&spec.file, "climbing ln|Π^U|", &reason))?
+        .map_err(|f| polytope.solver_failed(&spec.file, "climbing ln|Π^U|", &f.reason, &f.tight))?
         .ok_or_else(|| {
             DesignError::Input(format!(
                 "{}: ln|Π^U| is undefined at every start: for the tools there, the task's \
@@ -104,27 +104,46 @@ pub fn confidence_optimum(
     Ok((polytope, optimum))
 }
 
-/// Central differences of ln|Π^U| at the optimum (step 1e-6 of each parameter, or of its box
-/// where it is 0), for the
-/// report's gradient check: the largest |derived − difference| / max(|derived|, 1).
+/// Finite differences of ln|Π^U| at the optimum, for the report's gradient check: the largest
+/// |derived − difference| / max(|derived|, 1) over the free parameters.
+///
+/// The step is h = 10⁻⁶·s with s the parameter's scale: |x| where its box excludes 0 (then
+/// |x| ≥ the nearer bound > 0), else max(|x|, the box's width), so that a centre of mass at or
+/// a rounding error away from 0 is not stepped by nothing. Inside the box the difference is
+/// central; where x ± h leaves it (a parameter at its bound, where the model may not be
+/// defined beyond) it is one-sided into the box, of the same second order:
+/// f′(x) ≈ (−3f(x) + 4f(x + σh) − f(x + 2σh)) / (2σh), σ = ±1.
 pub fn gradient_check(setting: &Setting, polytope: &Polytope, optimum: &Optimum) -> f64 {
     let mut worst = 0.0_f64;
     for j in 0..optimum.x.len() {
-        // Relative to the value, or to the box where the value is 0 (a centre of mass).
-        let h = if optimum.x[j] != 0.0 {
-            1e-6 * optimum.x[j]
+        let (x, lo, hi) = (optimum.x[j], polytope.lo[j], polytope.hi[j]);
+        let scale = if lo > 0.0 || hi < 0.0 {
+            x.abs()
         } else {
-            1e-6 * (polytope.hi[j] - polytope.lo[j])
+            x.abs().max(hi - lo)
         };
+        let h = 1e-6 * scale;
         let at = |delta: f64| {
             let mut x = optimum.x.clone();
             x[j] += delta;
             setting.confidence(polytope, &x).map(|v| v.0)
         };
-        if let (Some(plus), Some(minus)) = (at(h), at(-h)) {
-            let fd = (plus - minus) / (2.0 * h);
-            worst =
-                worst.max((optimum.gradient[j] - fd).abs() / optimum.gradient[j].abs().max(1.0));
+        let difference = if x - h >= lo && x + h <= hi || x - 2.0 * h < lo && x + 2.0 * h > hi {
+            at(h)
+                .zip(at(-h))
+                .map(|(plus, minus)| (plus - minus) / (2.0 * h))
+        } else {
+            let sigma = if x - h < lo { 1.0 } else { -1.0 };
+            let one_sided =
+                |f0: f64, f1: f64, f2: f64| (-3.0 * f0 + 4.0 * f1 - f2) / (2.0 * sigma * h);
+            at(0.0)
+                .zip(at(sigma * h))
+                .zip(at(2.0 * sigma * h))
+                .map(|((f0, f1), f2)| one_sided(f0, f1, f2))
+        };
+        if let Some(fd) = difference {
+            let derived = optimum.gradient[j];
+            worst = worst.max((derived - fd).abs() / derived.abs().max(1.0));
         }
     }
     worst

@@ -30,6 +30,8 @@ pub struct Polytope {
     pub g: Vec<Vec<f64>>,
     pub h: Vec<f64>,
     pub text: Vec<String>,
+    /// The free parameters' names, for messages.
+    pub names: Vec<&'static str>,
 }
 
 impl Polytope {
@@ -54,6 +56,7 @@ impl Polytope {
             text.push(c.text.clone());
         }
         Self {
+            names: free.iter().map(|&k| spec.names[k]).collect(),
             lo: free.iter().map(|&k| spec.bounds[k].0).collect(),
             hi: free.iter().map(|&k| spec.bounds[k].1).collect(),
             free,
@@ -158,7 +161,7 @@ impl Polytope {
         rhs.push(0.0);
         let mut cost = vec![0.0; n + 1];
         cost[n] = -1.0;
-        match qp::solve(None, &cost, &rows, &rhs) {
+        match qp::solve_robustly(None, &cost, &rows, &rhs) {
             QpOutcome::Solved { x, .. } => {
                 let x = x[..n].to_vec();
                 if self.violation(&x) <= 1e-7 {
@@ -168,16 +171,49 @@ impl Polytope {
                 }
             }
             QpOutcome::Infeasible => Err(self.infeasible(file)),
-            QpOutcome::Failed(m) => Err(self.solver_failed(file, "finding a feasible design", &m)),
+            QpOutcome::Failed { reason, tight } => {
+                // The centre's LP has the rows of all_rows (and r ≥ 0 last).
+                let tight: Vec<usize> = tight.into_iter().filter(|&i| i < h.len()).collect();
+                Err(self.solver_failed(file, "finding a feasible design", &reason, &tight))
+            }
         }
     }
 
-    /// The QP solver's failure, naming the file and the constraints it was solving under.
-    pub fn solver_failed(&self, file: &str, doing: &str, reason: &str) -> DesignError {
+    /// The QP solver's failure, naming the file and the constraints it was solving under, and
+    /// first those that were active when it failed (`tight`: rows of [`Polytope::all_rows`]).
+    pub fn solver_failed(
+        &self,
+        file: &str,
+        doing: &str,
+        reason: &str,
+        tight: &[usize],
+    ) -> DesignError {
+        let near = if tight.is_empty() {
+            String::new()
+        } else {
+            let rows: Vec<String> = tight.iter().map(|&i| self.row_text(i)).collect();
+            format!(" at {}", rows.join(", "))
+        };
         DesignError::Failed(format!(
-            "{file}: the QP solver failed {doing} ({reason}) under the bounds and {}",
+            "{file}: the QP solver failed {doing}{near} ({reason}) under the bounds and {}",
             self.constraints_text()
         ))
+    }
+
+    /// Row `i` of [`Polytope::all_rows`] in words: a constraint as the file gives it, or a
+    /// bound (`tool_com_z >= 0`).
+    pub fn row_text(&self, i: usize) -> String {
+        let m = self.text.len();
+        if i < m {
+            return format!("'{}'", Clip(&self.text[i]));
+        }
+        let j = (i - m) / 2;
+        let name = self.names.get(j).copied().unwrap_or("?");
+        match ((i - m) % 2, self.hi.get(j), self.lo.get(j)) {
+            (0, Some(hi), _) => format!("the bound {name} <= {}", crate::display::Short(*hi)),
+            (_, _, Some(lo)) => format!("the bound {name} >= {}", crate::display::Short(*lo)),
+            _ => format!("row {i}"),
+        }
     }
 
     fn constraints_text(&self) -> String {

@@ -36,6 +36,23 @@ const MAX_RELATIVE_STEP: f64 = 1e6;
 /// of 240 random design files the optima that had not converged were at 0.6 to 2.)
 pub const KKT_TOLERANCE: f64 = 1e-5;
 
+/// A QP that failed: the solver's words and the rows of [`Polytope::all_rows`] active when it
+/// did ([`QpOutcome::Failed`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct QpFailure {
+    pub reason: String,
+    pub tight: Vec<usize>,
+}
+
+impl From<&str> for QpFailure {
+    fn from(reason: &str) -> Self {
+        Self {
+            reason: reason.into(),
+            tight: Vec::new(),
+        }
+    }
+}
+
 /// φ and ∇φ at free parameters x, or None where φ is undefined (Π^U not positive definite).
 pub type Objective<'a> = dyn FnMut(&[f64]) -> Option<(f64, Vec<f64>)> + 'a;
 
@@ -67,11 +84,25 @@ pub fn maximise(
     polytope: &Polytope,
     starts: &[Vec<f64>],
     objective: &mut Objective,
-) -> Result<Option<Optimum>, String> {
+) -> Result<Option<Optimum>, QpFailure> {
+    match climb_all(polytope, starts, objective, false) {
+        // Every start's climb failed: once more, with the QP solver's fallbacks.
+        Err(_) => climb_all(polytope, starts, objective, true),
+        found => found,
+    }
+}
+
+/// [`maximise`] with the QPs solved by [`qp::solve`], or also its fallbacks (`robust`).
+fn climb_all(
+    polytope: &Polytope,
+    starts: &[Vec<f64>],
+    objective: &mut Objective,
+    robust: bool,
+) -> Result<Option<Optimum>, QpFailure> {
     let mut best: Option<Optimum> = None;
     let mut failure = None;
     for (k, x0) in starts.iter().enumerate() {
-        match climb(polytope, x0, objective) {
+        match climb_with(polytope, x0, objective, robust) {
             Ok(Some(mut o)) => {
                 o.start = k;
                 if best.as_ref().map_or(true, |b| o.value > b.value) {
@@ -95,7 +126,16 @@ pub fn climb(
     polytope: &Polytope,
     x0: &[f64],
     objective: &mut Objective,
-) -> Result<Option<Optimum>, String> {
+) -> Result<Option<Optimum>, QpFailure> {
+    climb_with(polytope, x0, objective, false)
+}
+
+fn climb_with(
+    polytope: &Polytope,
+    x0: &[f64],
+    objective: &mut Objective,
+    robust: bool,
+) -> Result<Option<Optimum>, QpFailure> {
     let n = polytope.dim();
     let (g_rows, h) = polytope.all_rows();
     let Some((mut value, mut grad)) = objective(x0) else {
@@ -120,7 +160,7 @@ pub fn climb(
     let mut iterations = 0;
     while iterations < MAX_ITERATIONS {
         iterations += 1;
-        let step = match scaled_step(&b, &x, &grad, &g_rows, &h) {
+        let step = match scaled_step(&b, &x, &grad, &g_rows, &h, robust) {
             Ok(step) => step,
             Err(reason) if kkt.is_none() => return Err(reason),
             // As for a failed line search below: restart B once, then stop.
@@ -288,7 +328,8 @@ fn scaled_step(
     grad: &[f64],
     g_rows: &[Vec<f64>],
     h: &[f64],
-) -> Result<Step, String> {
+    robust: bool,
+) -> Result<Step, QpFailure> {
     let n = x.len();
     let scaled_b: Vec<Vec<f64>> = (0..n)
         .map(|i| (0..n).map(|j| x[i] * b[i][j] * x[j]).collect())
@@ -305,10 +346,15 @@ fn scaled_step(
         // of up to 1e12 (x = 1e-6 under hi = 1e6) would set the solver's scale.
         rhs.push(((hi - dot(r, x)) / scale).clamp(0.0, MAX_RELATIVE_STEP));
     }
-    let (sigma, z) = match qp::solve(Some(&scaled_b), &q, &rows, &rhs) {
+    let solve = if robust {
+        qp::solve_robustly
+    } else {
+        qp::solve
+    };
+    let (sigma, z) = match solve(Some(&scaled_b), &q, &rows, &rhs) {
         QpOutcome::Solved { x: sigma, z } => (sigma, z),
         QpOutcome::Infeasible => return Err("the QP is infeasible".into()),
-        QpOutcome::Failed(reason) => return Err(reason),
+        QpOutcome::Failed { reason, tight } => return Err(QpFailure { reason, tight }),
     };
     Ok(Step {
         d: sigma.iter().zip(x).map(|(s, xj)| s * xj).collect(),
@@ -386,6 +432,7 @@ mod tests {
             g: vec![w.to_vec()],
             h: vec![1.0],
             text: vec!["x + 2y + 4z <= 1".into()],
+            names: vec!["x", "y", "z"],
         };
         let mut f = |x: &[f64]| -> Option<(f64, Vec<f64>)> {
             Some((

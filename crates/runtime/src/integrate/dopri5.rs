@@ -212,6 +212,8 @@ where
                 return Err(IntegrationError::TooManySteps {
                     t,
                     max_steps: s.max_steps,
+                    h: abs_h,
+                    state: y.as_slice().to_vec(),
                 });
             }
             let t_new = if done { tf } else { t + h };
@@ -469,7 +471,9 @@ mod tests {
         };
         let result = solve_grid(decay, &vector![1.0], &[0.0, 10.0], &options, |_, _, _| {});
         match result {
-            Err(IntegrationError::TooManySteps { t, max_steps: 5 }) => assert!(t > 0.0 && t < 10.0),
+            Err(IntegrationError::TooManySteps {
+                t, max_steps: 5, ..
+            }) => assert!(t > 0.0 && t < 10.0),
             other => panic!("{other:?}"),
         }
     }

@@ -119,9 +119,24 @@ pub enum IntegrationError {
         "integration failed at t = {} s: step size {h:e} s reached the minimum 16·eps(t) without meeting the tolerances", crate::display::Short(*t)
     )]
     StepSizeTooSmall { t: f64, h: f64 },
-    /// More than `max_steps` step attempts.
-    #[error("integration failed at t = {} s: exceeded the limit of {max_steps} step attempts", crate::display::Short(*t))]
-    TooManySteps { t: f64, max_steps: usize },
+    /// More than `max_steps` step attempts; `h` is the step size about to be tried at `t`,
+    /// `state` the solution there (what the dynamics were doing when the work ran out).
+    #[error("integration failed at t = {} s: exceeded the limit of {max_steps} step attempts (step size {h:e} s)", crate::display::Short(*t))]
+    TooManySteps {
+        t: f64,
+        max_steps: usize,
+        h: f64,
+        state: Vec<f64>,
+    },
+    /// An episode's work budget ([`crate::model::budget`]) ran out: the integrator's
+    /// [`IntegrationError::TooManySteps`] at the episode's own limit, with the episode's
+    /// reading of why (the state or the step size there).
+    #[error("episode stopped after {attempts} step attempts at t = {t:.3e} s: {why}")]
+    OutOfWork {
+        t: f64,
+        attempts: usize,
+        why: String,
+    },
     /// The output grid is unusable.
     #[error("invalid time grid: {reason}")]
     InvalidGrid { reason: String },
@@ -136,7 +151,8 @@ impl IntegrationError {
         match self {
             IntegrationError::NonFinite { t }
             | IntegrationError::StepSizeTooSmall { t, .. }
-            | IntegrationError::TooManySteps { t, .. } => Some(*t),
+            | IntegrationError::TooManySteps { t, .. }
+            | IntegrationError::OutOfWork { t, .. } => Some(*t),
             IntegrationError::InvalidGrid { .. } | IntegrationError::InvalidOptions { .. } => None,
         }
     }

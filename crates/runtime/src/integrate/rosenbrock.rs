@@ -457,6 +457,8 @@ where
                 return Err(IntegrationError::TooManySteps {
                     t,
                     max_steps: s.max_steps,
+                    h: abs_h,
+                    state: y.as_slice().to_vec(),
                 });
             }
             let t_new = if done { tf } else { t + abs_h };
@@ -1018,7 +1020,9 @@ mod tests {
             |_, _, _| {},
         );
         match e {
-            Err(IntegrationError::TooManySteps { t, max_steps: 5 }) => assert!(t > 0.0 && t < 10.0),
+            Err(IntegrationError::TooManySteps {
+                t, max_steps: 5, ..
+            }) => assert!(t > 0.0 && t < 10.0),
             other => panic!("{other:?}"),
         }
         // y' = y², y(0) = 1 blows up at t = 1. A linearly implicit step can land just past the

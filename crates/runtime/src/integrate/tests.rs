@@ -121,10 +121,12 @@ fn messages_name_time_and_reason() {
     let e = IntegrationError::TooManySteps {
         t: 2.0,
         max_steps: 7,
+        h: 1e-3,
+        state: vec![1.0],
     };
     assert_eq!(
         e.to_string(),
-        "integration failed at t = 2 s: exceeded the limit of 7 step attempts"
+        "integration failed at t = 2 s: exceeded the limit of 7 step attempts (step size 1e-3 s)"
     );
     let e = solve_err(&[0.0, 0.0], &Options::default());
     assert!(

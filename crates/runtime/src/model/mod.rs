@@ -19,6 +19,7 @@
 //! cannot write `NX + N` in a type; the core's `arm_model!` macro sets it and [`ClosedLoopN::new`]
 //! checks `NX == 2N` and `NZ == NX + N` at compile time (a post-monomorphisation assertion).
 
+pub mod budget;
 pub mod mixed;
 pub(crate) mod runtime;
 

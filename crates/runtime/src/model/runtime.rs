@@ -413,6 +413,13 @@ where
     if integrator.method == Method::Auto && task.kind.error_term() != Term::ThetaDdot {
         integrator.method = Method::Explicit;
     }
+    let cap = integrator.max_steps;
+    integrator.max_steps = super::budget::episode_budget(
+        (grid.len() - 1) as f64,
+        integrator.rtol,
+        integrator.atol,
+        cap,
+    );
     let stats = solve_grid_with_jacobian(rhs, jacobian, &z0, &grid, &integrator, |_, t, z| {
         let (_, theta_ddot) = system.rhs_and_acceleration(z);
         let theta = z.fixed_rows::<N>(0).into_owned();
@@ -441,7 +448,7 @@ where
             tr.u.push(u);
         }
     })
-    .map_err(EpisodeFailure::Integration)?;
+    .map_err(|e| EpisodeFailure::Integration(out_of_work::<N>(e, cap, options.dt)))?;
 
     if let Some((t, magnitude)) = divergence {
         return Err(EpisodeFailure::Diverged { t, magnitude });
@@ -473,10 +480,32 @@ where
     })
 }
 
+/// [`IntegrationError::TooManySteps`] at the episode's budget (below the integrator's own limit
+/// `cap`) as [`IntegrationError::OutOfWork`], with the reason read from where it stopped.
+pub(crate) fn out_of_work<const N: usize>(
+    e: IntegrationError,
+    cap: usize,
+    dt: f64,
+) -> IntegrationError {
+    match e {
+        IntegrationError::TooManySteps {
+            t,
+            max_steps,
+            h,
+            state,
+        } if max_steps < cap => IntegrationError::OutOfWork {
+            t,
+            attempts: max_steps,
+            why: super::budget::diagnosis::<N>(&state, h, dt),
+        },
+        e => e,
+    }
+}
+
 /// The episode's options against their documented ranges ([`crate::validate`]): what every
 /// front end also checks up front, checked again here for the library's own callers.
 fn check_options<const N: usize, const NX: usize>(o: &EpisodeOptionsN<N, NX>) -> Result<(), Error> {
-    use crate::validate::{ATOL, DT, JOINT_VALUE, LEARNING_RATE, RTOL, TORQUE, T_END};
+    use crate::validate::{ATOL, DT, JOINT_ANGLE, JOINT_RATE, LEARNING_RATE, RTOL, TORQUE, T_END};
     let within = |name, value: f64, range: crate::validate::Range| {
         if range.contains(value) {
             Ok(())
@@ -496,8 +525,13 @@ fn check_options<const N: usize, const NX: usize>(o: &EpisodeOptionsN<N, NX>) ->
     within("learning rate", o.learning_rate, LEARNING_RATE)?;
     within("integrator rtol", o.integrator.rtol, RTOL)?;
     within("integrator atol", o.integrator.atol, ATOL)?;
-    for &v in o.x0.iter() {
-        within("initial state X0", v, JOINT_VALUE)?;
+    // X0 = [θ0; θ̇0].
+    for (i, &v) in o.x0.iter().enumerate() {
+        if i < N {
+            within("initial angle θ0", v, JOINT_ANGLE)?;
+        } else {
+            within("initial rate θ̇0", v, JOINT_RATE)?;
+        }
     }
     for &v in o.u0.iter() {
         within("initial torque U0", v, TORQUE)?;

@@ -13,6 +13,7 @@ use nalgebra::SVector;
 use super::{MpcError, MpcN, MpcOptions};
 use crate::closed_loop::{EpisodeOptions, Plant};
 use crate::integrate::{solve_grid, IntegrationError};
+use crate::model::budget::{diagnosis, episode_budget};
 use crate::model::{
     ActiveInferenceN, Arm2, Arm2Exact, ArmModel, EpisodeOptionsN, TaskN, ToolN, TrajectoryN,
 };
@@ -253,22 +254,32 @@ where
     let mut u = control(&mut mpc, &x, 0.0)?;
     sample(0.0, &x, &u);
     let mut rhs_evals = 0;
+    // One work budget for the whole episode (a control period is at most an output step), shared
+    // by the periods' integrations: what one period spends, the next may not.
+    let mut integrator = options.integrator;
+    let cap = integrator.max_steps;
+    let budget = episode_budget(steps as f64, integrator.rtol, integrator.atol, cap);
+    let mut spent = 0;
     for k in 0..steps {
         let (t0, t1) = (k as f64 * period, (k + 1) as f64 * period);
         let held = u + perturbation;
         let mut next = x;
+        integrator.max_steps = budget.saturating_sub(spent).max(1);
         let stats = solve_grid(
             |_, x: &SVector<f64, NX>| P::dynamics_with(x, &held, &plant),
             &x,
             &[t0, t1],
-            &options.integrator,
+            &integrator,
             |i, _, y| {
                 if i == 1 {
                     next = *y;
                 }
             },
         )
-        .map_err(MpcFailure::Integration)?;
+        .map_err(|e| {
+            MpcFailure::Integration(mpc_out_of_work::<N>(e, spent, budget < cap, options.dt))
+        })?;
+        spent += stats.steps + stats.rejected;
         rhs_evals += stats.rhs_evals;
         x = next;
         u = control(&mut mpc, &x, t1)?;
@@ -296,6 +307,30 @@ where
         metrics,
         trajectory,
     })
+}
+
+/// A period's [`IntegrationError::TooManySteps`] as the episode's
+/// [`IntegrationError::OutOfWork`] when the shared budget (`binding`: below the integrator's own
+/// limit) ran out, counting the attempts of the periods before it (`spent`).
+fn mpc_out_of_work<const N: usize>(
+    e: IntegrationError,
+    spent: usize,
+    binding: bool,
+    dt: f64,
+) -> IntegrationError {
+    match e {
+        IntegrationError::TooManySteps {
+            t,
+            max_steps,
+            h,
+            state,
+        } if binding => IntegrationError::OutOfWork {
+            t,
+            attempts: spent + max_steps,
+            why: diagnosis::<N>(&state, h, dt),
+        },
+        e => e,
+    }
 }
 
 /// n when `total` = n · `step` for a whole n ≥ 1 (to 1e-9 relative), else `None`.
