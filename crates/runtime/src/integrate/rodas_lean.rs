@@ -1,5 +1,5 @@
 //! Rodas5P with less work per step: the stepper of [`super::Method::Fast`], for throughput on
-//! populations of tools (issue 14). The method, tableau, error norm and step-size rules are those
+//! populations of tools. The method, tableau, error norm and step-size rules are those
 //! of [`super::rosenbrock`] (`rodas.f`'s transformed form, `ode45`'s step control); what differs
 //! is only how a step is computed:
 //!
