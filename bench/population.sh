@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Ranking throughput on a population (issue 14): the old path (ode45, Method::Explicit) and the
+# Ranking throughput on a population: the old path (ode45, Method::Explicit) and the
 # new default (Method::Fast) side by side in one run of examples/population.rs (one thread, the
 # methods alternating tool by tool), with mean/p50/p90/p99/max per tool, mean RHS, Jacobians and
 # LU factorisations, and the worst relative error and ranking swaps against an rtol-1e-10

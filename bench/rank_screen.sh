@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Both stages of `toolconf rank --screen K` on a large tools file (issue 14): writes
+# Both stages of `toolconf rank --screen K` on a large tools file: writes
 # target/rank_screen/tools_N.csv (N arm2 tools, every parameter uniform on [0.1, 0.6) as
 # draw_tools draws them, from Python's random.Random(SEED), six decimals), then runs
 # `toolconf rank --screen K --json` (release) on each task and prints both stages' wall time and

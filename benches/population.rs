@@ -1,4 +1,4 @@
-//! Ranking throughput (issue 14): 2000 random tools (`draw_tools(2000, 1)`, the paper's
+//! Ranking throughput: 2000 random tools (`draw_tools(2000, 1)`, the paper's
 //! parameter range) per task on one thread, `ode45` (`Method::Explicit`, the old default) and
 //! `Method::Fast` (the default of select, rank and reproduce) side by side. Criterion's
 //! throughput is per tool, so its "elem/s" is tools per second and the time per element the mean

@@ -18,7 +18,7 @@ fn default_reproduce(c: &mut Criterion) {
         only: None,
         progress: false,
         command: "toolconf reproduce --out <bench scratch dir> --seed 0".into(),
-        // The command line's default since issue 14 (`--method explicit` is ode45's numbers).
+        // The command line's default (`--method explicit` is ode45's numbers).
         method: toolconf::integrate::Method::Fast,
     };
     let mut group = c.benchmark_group("reproduce");

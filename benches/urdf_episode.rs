@@ -1,9 +1,9 @@
-//! The Panda's closed loop (issue 23): one closed-loop right-hand side (plant and controller, what
+//! The Panda's closed loop: one closed-loop right-hand side (plant and controller, what
 //! the integrators call), one episode per task at the paper's tolerances over 5 s on a population
 //! of tools, and 1000 Panda tools ranked (`rank`'s simulation stage) on 2 threads, all with
 //! `rank`'s default method `fast`.
 //!
-//! `cargo bench --bench urdf_episode`; goals (issue 23): an episode ≤ 2 ms, ≥ 100× SciPy's
+//! `cargo bench --bench urdf_episode`; goals: an episode ≤ 2 ms, ≥ 100× SciPy's
 //! `solve_ivp` with Pinocchio's `aba` on the same loop (bench/peers/urdf_peers.py, which times the
 //! peers and toolconf on one population side by side, mean and percentiles).
 

@@ -1,9 +1,9 @@
-//! The generated right-hand sides of the URDF arms (issue 23, phase 1): one Panda / UR5
+//! The generated right-hand sides of the URDF arms: one Panda / UR5
 //! `dynamics_with`, its Jacobian, the per-tool coefficients, the latency of a chain of dependent
 //! calls, and the finite-difference Jacobian the stiff integrators would otherwise need
 //! (NX + N more right-hand sides), each over a population of 1000 random states and tools.
 //!
-//! `cargo bench --bench urdf_rhs`; goal (issue 23): one Panda RHS ≤ 1 µs.
+//! `cargo bench --bench urdf_rhs`; goal: one Panda RHS ≤ 1 µs.
 
 use std::hint::black_box;
 

@@ -1,4 +1,4 @@
-//! Issue 14's "SIMD across tools" direction, measured: several tools' DP5 episodes advanced in
+//! "SIMD across tools", measured: several tools' DP5 episodes advanced in
 //! f64 lanes, each lane with its own step size, a finished lane refilled with the next tool.
 //!
 //! The same lane code runs at width 1 (the scalar baseline), 4 and 8, compiled for baseline

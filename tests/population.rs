@@ -1,4 +1,4 @@
-//! `Method::Fast` (the default of select, rank and reproduce, issue 14) on a population of random
+//! `Method::Fast` (the default of select, rank and reproduce) on a population of random
 //! tools against a tight reference (DP5 at rtol 1e-10, atol 1e-12) and against `ode45`
 //! (`Method::Explicit`) at the same default tolerances: every tool's task error within 1e-4
 //! relative and the same ranking by it; ∫F and ∫J no further from the reference than `ode45`'s

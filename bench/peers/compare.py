@@ -18,7 +18,7 @@ task error are outside the timing).
 Writes the tables into docs/performance.md between the `peers` markers (the rest of the file is
 left alone) and prints them. Run through bench/peers/run.sh, which creates the environment.
 
-`--population` (issue 14) instead times the population that `bench/population.sh` ranks,
+`--population` instead times the population that `bench/population.sh` ranks,
 `toolconf select --task position --tools 2000 --seed 1 --json` (`draw_tools(2000, 1)`), on one
 thread: per task the mean over tools and p50/p90/p99/max of the per-tool time of SciPy RK45,
 CasADi cvodes, toolconf `--method explicit` (ode45-faithful DP5) and toolconf `--method fast`
@@ -351,7 +351,7 @@ def main() -> None:
 
 
 # --------------------------------------------------------------------------------------------
-# The population (issue 14).
+# The population: ranking throughput per tool.
 
 POP_METHODS = ("explicit", "fast")
 

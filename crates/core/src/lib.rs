@@ -38,7 +38,7 @@ mod confidence;
 mod controller;
 pub mod display;
 mod error;
-mod linalg;
+pub mod linalg;
 mod task;
 mod tool;
 pub mod validate;

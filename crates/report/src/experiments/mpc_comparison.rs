@@ -1,4 +1,4 @@
-//! Issue 5: the paper's active-inference controller (AIC) against the MPC baseline (default
+//! The paper's active-inference controller (AIC) against the MPC baseline (default
 //! options: re-linearised, offset-free, 1 s horizon, ±5 N m) on the same random tools, per task:
 //! task error, ∫J, control effort, sensitivity to ΔT, compute time, and whether the two rank the
 //! tools alike (Spearman's ρ between AIC's ∫F and MPC's J*). Runs with `reproduce --mpc`.
@@ -66,7 +66,7 @@ impl Experiment for MpcComparison {
     }
 
     fn title(&self) -> &'static str {
-        "Active inference against the MPC baseline (issue 5)"
+        "Active inference against the MPC baseline"
     }
 
     fn outputs(&self) -> Vec<String> {

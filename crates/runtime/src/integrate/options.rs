@@ -11,7 +11,7 @@ pub enum Method {
     /// DP5 until its stiffness detection fires, Rodas5P from there on.
     #[default]
     Auto,
-    /// Throughput on populations of tools (issue 14): DP5 with a quicker stiffness test
+    /// Throughput on populations of tools: DP5 with a quicker stiffness test
     /// (10 steps at the stability boundary instead of `DOPRI5`'s 15), then Rodas5P with less
     /// work per step (the `rodas_lean` module, the same method as [`Method::Stiff`] up to
     /// rounding). Not `ode45`'s numbers once the test fires: [`Method::Explicit`] keeps those.

@@ -1,5 +1,5 @@
 //! Rodas5P with less work per step: the stepper of [`super::Method::Fast`], for throughput on
-//! populations of tools (issue 14). The method, tableau, error norm and step-size rules are those
+//! populations of tools. The method, tableau, error norm and step-size rules are those
 //! of [`super::rosenbrock`] (`rodas.f`'s transformed form, `ode45`'s step control); what differs
 //! is only how a step is computed:
 //!
@@ -8,8 +8,9 @@
 //!   arguments cost one vector addition each instead of a sum over all earlier stages;
 //! * the `h·d_i·∂f/∂t` terms are skipped when `∂f/∂t = 0` (the closed loop is autonomous), and
 //!   stages 6–8 have `d_i = 0` anyway;
-//! * the LU factorisation keeps the pivots' reciprocals: each of the eight solves per attempt
-//!   multiplies instead of dividing (six divisions fewer per solve, on the critical path);
+//! * the solves use the LU factorisation's stored pivot reciprocals
+//!   ([`Lu::solve_by_reciprocals`]): each of the eight solves per attempt multiplies instead of
+//!   dividing (six divisions fewer per solve, on the critical path);
 //! * the dense output's `q_r = Σ_j h_rj·k_j` are formed once per step that contains output
 //!   points, not once per point.
 //!
@@ -17,6 +18,7 @@
 //! associated differently), which `tests/population.rs` checks against the tight reference.
 
 use nalgebra::{SMatrix, SVector};
+use toolconf_core::linalg::Lu;
 
 use super::rosenbrock::{run, Problem, Start, Stepper, Tableau, RODAS5P};
 use super::{IntegrationError, Settings, Stats};
@@ -25,72 +27,6 @@ use super::{IntegrationError, Settings, Stats};
 const S: usize = 8;
 /// The first stage evaluated at `t + h` on the successive solutions (0-based).
 const LAST_ROW: usize = 5;
-
-/// `P·A = L·U` with partial pivoting and the reciprocals of U's diagonal.
-struct Lu<const D: usize> {
-    lu: SMatrix<f64, D, D>,
-    rows: [usize; D],
-    inverse_pivots: [f64; D],
-}
-
-impl<const D: usize> Lu<D> {
-    /// The factorisation, or `None` for an exactly zero pivot column (singular matrix).
-    #[inline]
-    fn new(mut a: SMatrix<f64, D, D>) -> Option<Self> {
-        let mut rows = [0; D];
-        let mut inverse_pivots = [0.0; D];
-        for (i, r) in rows.iter_mut().enumerate() {
-            *r = i;
-        }
-        for k in 0..D {
-            let mut pivot = k;
-            for i in k + 1..D {
-                if a[(i, k)].abs() > a[(pivot, k)].abs() {
-                    pivot = i;
-                }
-            }
-            if a[(pivot, k)] == 0.0 {
-                return None;
-            }
-            if pivot != k {
-                a.swap_rows(k, pivot);
-                rows.swap(k, pivot);
-            }
-            let inverse = 1.0 / a[(k, k)];
-            inverse_pivots[k] = inverse;
-            for i in k + 1..D {
-                let l = a[(i, k)] * inverse;
-                a[(i, k)] = l;
-                for j in k + 1..D {
-                    a[(i, j)] -= l * a[(k, j)];
-                }
-            }
-        }
-        Some(Self {
-            lu: a,
-            rows,
-            inverse_pivots,
-        })
-    }
-
-    /// x with `A·x = b`.
-    #[inline(always)]
-    fn solve(&self, b: &SVector<f64, D>) -> SVector<f64, D> {
-        let mut x = SVector::<f64, D>::from_fn(|i, _| b[self.rows[i]]);
-        for i in 0..D {
-            for j in 0..i {
-                x[i] -= self.lu[(i, j)] * x[j];
-            }
-        }
-        for i in (0..D).rev() {
-            for j in i + 1..D {
-                x[i] -= self.lu[(i, j)] * x[j];
-            }
-            x[i] *= self.inverse_pivots[i];
-        }
-        x
-    }
-}
 
 /// Rodas5P's structure that [`attempt`] relies on, checked by a unit test: stages from
 /// `LAST_ROW` on are at `α = 1` with `d = 0`, and their argument rows are the previous row plus
@@ -164,7 +100,7 @@ impl<const D: usize> Stepper<D, S> for Lean {
         };
         let mut b = *f0;
         time_term(&mut b, 0);
-        k[0] = lu.solve(&b);
+        k[0] = lu.solve_by_reciprocals(&b);
         for i in 1..LAST_ROW {
             let mut u = *y;
             for j in 0..i {
@@ -175,7 +111,7 @@ impl<const D: usize> Stepper<D, S> for Lean {
             for j in 0..i {
                 b += k[j] * (tab.c[i][j] * r);
             }
-            k[i] = lu.solve(&b);
+            k[i] = lu.solve_by_reciprocals(&b);
         }
         let mut u = *y;
         for j in 0..LAST_ROW {
@@ -189,7 +125,7 @@ impl<const D: usize> Stepper<D, S> for Lean {
             for j in 0..i {
                 b += k[j] * (tab.c[i][j] * r);
             }
-            k[i] = lu.solve(&b);
+            k[i] = lu.solve_by_reciprocals(&b);
         }
         LeanStep {
             y_new: u + k[S - 1],
@@ -303,14 +239,5 @@ mod tests {
         // Rounding of differently associated sums, amplified through the two jumps (measured
         // 2.4e-10): six orders below the tolerance, with exactly the same steps.
         assert!(worst <= 1e-9, "{worst:e}");
-    }
-
-    #[test]
-    fn lu_solves_a_pivoting_system() {
-        let a = nalgebra::matrix![0.0, 2.0, 1.0; 1.0, 1.0, 0.0; 3.0, 0.0, 1.0];
-        let x = nalgebra::vector![1.0, -2.0, 0.5];
-        let lu = Lu::new(a).unwrap();
-        assert!((lu.solve(&(a * x)) - x).amax() < 1e-15);
-        assert!(Lu::new(nalgebra::matrix![1.0, 2.0; 2.0, 4.0]).is_none());
     }
 }

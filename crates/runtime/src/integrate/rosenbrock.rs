@@ -32,7 +32,7 @@
 //! `E` per attempt, eight solves and seven new right-hand-side evaluations per attempt, plus
 //! `f(t_new, y_new)` at the start of the next step.
 //!
-//! The LU factorisation (partial pivoting, on the stack) is this module's own: nalgebra's needs
+//! The LU factorisation (partial pivoting, on the stack) is the core's [`Lu`]: nalgebra's needs
 //! the bound `Const<D>: DimMin<Const<D>>`, which would have to be added to [`super::solve_grid`]
 //! and so to every caller generic over the dimension.
 //!
@@ -55,6 +55,7 @@
 //! `q_r = Σ_j h_rj·k_j`: order 4, exact at both ends.
 
 use nalgebra::{SMatrix, SVector};
+use toolconf_core::linalg::Lu;
 
 use super::{eps_at, IntegrationError, Settings, Stats};
 
@@ -154,65 +155,6 @@ pub(super) const RODAS5P: Tableau<8> = Tableau {
     ],
     exponent: 0.2,
 };
-
-/// `P·A = L·U` with partial pivoting, for `D × D` matrices on the stack.
-struct Lu<const D: usize> {
-    /// L below the diagonal (unit diagonal implied), U on and above it.
-    lu: SMatrix<f64, D, D>,
-    /// Row i of `P·A` is row `rows[i]` of A.
-    rows: [usize; D],
-}
-
-impl<const D: usize> Lu<D> {
-    /// The factorisation, or `None` for a singular matrix (an exactly zero pivot column).
-    fn new(mut a: SMatrix<f64, D, D>) -> Option<Self> {
-        let mut rows = [0; D];
-        for (i, r) in rows.iter_mut().enumerate() {
-            *r = i;
-        }
-        for k in 0..D {
-            let mut pivot = k;
-            for i in k + 1..D {
-                if a[(i, k)].abs() > a[(pivot, k)].abs() {
-                    pivot = i;
-                }
-            }
-            if a[(pivot, k)] == 0.0 {
-                return None;
-            }
-            if pivot != k {
-                a.swap_rows(k, pivot);
-                rows.swap(k, pivot);
-            }
-            let inverse = 1.0 / a[(k, k)];
-            for i in k + 1..D {
-                let l = a[(i, k)] * inverse;
-                a[(i, k)] = l;
-                for j in k + 1..D {
-                    a[(i, j)] -= l * a[(k, j)];
-                }
-            }
-        }
-        Some(Self { lu: a, rows })
-    }
-
-    /// x with `A·x = b`.
-    fn solve(&self, b: &SVector<f64, D>) -> SVector<f64, D> {
-        let mut x = SVector::<f64, D>::from_fn(|i, _| b[self.rows[i]]);
-        for i in 0..D {
-            for j in 0..i {
-                x[i] -= self.lu[(i, j)] * x[j];
-            }
-        }
-        for i in (0..D).rev() {
-            for j in i + 1..D {
-                x[i] -= self.lu[(i, j)] * x[j];
-            }
-            x[i] /= self.lu[(i, i)];
-        }
-        x
-    }
-}
 
 /// One attempted step.
 struct Attempt<const D: usize, const S: usize> {
@@ -1043,41 +985,5 @@ mod tests {
             }
             other => panic!("{other:?}"),
         }
-    }
-
-    #[test]
-    fn lu_solves_like_nalgebra_and_reports_singular_matrices() {
-        use super::Lu;
-        use nalgebra::SMatrix;
-        // Deterministic pseudo-random 6×6 matrices, some needing row exchanges.
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
-        for case in 0..200 {
-            let mut a = SMatrix::<f64, 6, 6>::from_fn(|_, _| next());
-            if case % 3 == 0 {
-                a[(0, 0)] = 0.0;
-            }
-            let b = SVector::<f64, 6>::from_fn(|_, _| next());
-            let x = Lu::new(a).unwrap().solve(&b);
-            let expected = a.lu().solve(&b).unwrap();
-            let scale = expected.amax().max(1.0);
-            assert!((x - expected).amax() < 1e-10 * scale, "{x} vs {expected}");
-            assert!(
-                (a * x - b).amax() < 1e-12 * scale * a.amax().max(1.0),
-                "residual"
-            );
-        }
-        let singular = matrix![1.0, 2.0; 2.0, 4.0];
-        assert!(Lu::new(singular).is_none());
-        assert!(Lu::new(Matrix1::new(0.0)).is_none());
-        assert_eq!(
-            Lu::new(Matrix1::new(4.0)).unwrap().solve(&vector![2.0]),
-            vector![0.5]
-        );
     }
 }

@@ -93,7 +93,7 @@ pub fn evaluate(
 }
 
 /// The MPC baseline's episode on `plant` for every tool, in parallel, in the tools' order: the
-/// cost it achieves, ∫J dt, is the objective J* (issue 5), the conventional optimal-control
+/// cost it achieves, ∫J dt, is the objective J* of the MPC baseline, the conventional optimal-control
 /// ranking.
 pub fn evaluate_mpc(
     tools: &[Arm],
