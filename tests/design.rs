@@ -4,8 +4,8 @@
 
 use toolconf::design::file::DesignSpec;
 use toolconf::design::{confidence_optimum, design, DesignError, Setting};
-use toolconf::model::mixed::{AnyTool, ModelKind};
 use toolconf::rank::ModelTasks;
+use toolconf::registry::{AnyTool, ModelKind};
 use toolconf::select::mixed::MixedSampler;
 use toolconf::task_file::TaskSpec;
 use toolconf::TaskKind;
@@ -215,7 +215,9 @@ fn an_unconverged_optimum_is_reported_as_such() {
     assert!(
         matches!(
             tasks.logdet(&tool),
-            Err(toolconf::Error::Core(toolconf::model::Error::IllConditioned { .. }))
+            Err(toolconf::Error::Core(
+                toolconf::model::Error::IllConditioned { .. }
+            ))
         ),
         "{q:?}"
     );

@@ -1,170 +1,45 @@
 //! `toolconf.confidence`: the closed-form control confidence of one tool or of many.
 
-use nalgebra::SMatrix;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyFloat};
-use rayon::prelude::*;
-use toolconf::model::{ArmModel, SensitivitiesN, ToolN};
+use toolconf::registry::{Confidences, ModelKind};
 use toolconf::task_file::TaskSpec;
-use toolconf::validate::finite_output;
-use toolconf::Term;
 
 use crate::errors::{detached, Failure};
-use crate::models::{model_kind, ops};
+use crate::models::model_kind;
 use crate::task::task_spec;
 
-/// Below this many tools a batch runs on one thread: spreading it costs more than it saves.
-const MIN_TOOLS_PER_THREAD: usize = 256;
-
-/// The results for k tools, each array flat in C order (tool, row, column).
-pub struct Confidences {
-    pub k: usize,
-    pub n: usize,
-    pub nx: usize,
-    /// A = ∂f/∂X at the equilibrium (k × NX × NX).
-    pub a: Vec<f64>,
-    /// B = ∂f/∂U at the equilibrium (k × NX × N).
-    pub b: Vec<f64>,
-    /// The task's sensitivities by name (each k × N × N); a term the task does not use is absent.
-    pub sensitivities: Vec<(&'static str, Vec<f64>)>,
-    /// Π^U (k × N × N).
-    pub pi_u: Vec<f64>,
-    /// ln|Π^U| (k).
-    pub logdet: Vec<f64>,
-}
-
-/// One tool's matrices (on the stack: a batch allocates only its output arrays).
-struct One<const N: usize, const NX: usize> {
-    a: SMatrix<f64, NX, NX>,
-    b: SMatrix<f64, NX, N>,
-    sensitivities: SensitivitiesN<N>,
-    pi_u: SMatrix<f64, N, N>,
-    logdet: f64,
-}
-
-impl<const N: usize, const NX: usize> One<N, NX> {
-    /// The last line of defence before the arrays reach Python: every number finite
-    /// ([`toolconf::validate::finite_output`]).
-    fn check_finite<M, const NP: usize, const NZ: usize>(
-        &self,
-        tool: &ToolN<M, N, NX, NP, NZ>,
-    ) -> Result<(), toolconf::Error>
-    where
-        M: ArmModel<N, NX, NP, NZ>,
-    {
-        let s = &self.sensitivities;
-        let sensitivities = [s.d_theta_du, s.d_theta_dot_du, s.d_theta_ddot_du];
-        let finite = |m: &[f64]| m.iter().all(|v| v.is_finite());
-        if finite(self.a.as_slice())
-            && finite(self.b.as_slice())
-            && finite(self.pi_u.as_slice())
-            && self.logdet.is_finite()
-            && sensitivities.iter().flatten().all(|m| finite(m.as_slice()))
-        {
-            // The common case, without naming the tool: a batch checks millions.
-            return Ok(());
-        }
-        let tool = format!("{}({tool})", M::NAME);
-        finite_output(&tool, "A", self.a.iter().copied())?;
-        finite_output(&tool, "B", self.b.iter().copied())?;
-        for m in sensitivities.iter().flatten() {
-            finite_output(&tool, "a sensitivity", m.iter().copied())?;
-        }
-        finite_output(&tool, "Π^U", self.pi_u.iter().copied())?;
-        finite_output(&tool, "ln|Π^U|", [self.logdet])
-    }
-}
-
-/// Appends `m` to `out` in C order (row by row; nalgebra stores columns).
-fn push_c_order<const R: usize, const C: usize>(out: &mut Vec<f64>, m: &SMatrix<f64, R, C>) {
-    out.extend((0..R).flat_map(|i| (0..C).map(move |j| m[(i, j)])));
-}
-
 /// Π^U = Σ Sᵀ P S + P^U (eq. control_conf) and ln|Π^U| of every tool in `params` (k × NP, row
-/// major) for `spec` bound to model `M`, with A, B and the sensitivities; rayon's threads share
-/// the tools, and the first bad tool in order is the error.
-pub fn confidences<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+/// major) for `spec` bound to model `kind`, with A, B and the sensitivities (the registry's
+/// batch: rayon's threads share the tools, and the first bad tool in order is the error).
+pub fn confidences(
+    kind: ModelKind,
     spec: &TaskSpec,
     params: &[f64],
-) -> Result<Confidences, Failure>
-where
-    M: ArmModel<N, NX, NP, NZ>,
-{
-    let task = spec.task::<M, N, NX, NP, NZ>().map_err(Failure::input)?;
-    let task = task.validated().map_err(Failure::input)?;
-    let kind = task.task().kind;
-    let k = params.len() / NP;
-    let results: Vec<Result<One<N, NX>, toolconf::Error>> = params
-        .par_chunks_exact(NP)
-        .with_min_len(MIN_TOOLS_PER_THREAD)
-        .map(|p| {
-            let tool = ToolN::<M, N, NX, NP, NZ>::new(p.try_into().expect("NP values"))?;
-            let c = task.control_confidence(&tool)?;
-            let one = One {
-                a: tool.state_matrix(),
-                b: tool.input_matrix(),
-                sensitivities: tool.sensitivities(kind),
-                pi_u: c.pi_u,
-                logdet: c.logdet,
-            };
-            one.check_finite(&tool)?;
-            Ok(one)
-        })
-        .collect();
-    let names = ["d_theta_du", "d_theta_dot_du", "d_theta_ddot_du"];
-    let mut sensitivities: [Vec<f64>; 3] = std::array::from_fn(|_| Vec::with_capacity(k * N * N));
-    let mut out = Confidences {
-        k,
-        n: N,
-        nx: NX,
-        a: Vec::with_capacity(k * NX * NX),
-        b: Vec::with_capacity(k * NX * N),
-        sensitivities: Vec::new(),
-        pi_u: Vec::with_capacity(k * N * N),
-        logdet: Vec::with_capacity(k),
-    };
-    for (i, r) in results.into_iter().enumerate() {
-        let one = r.map_err(|e| {
-            let row = &params[i * NP..(i + 1) * NP];
-            let message = if k == 1 {
-                e.to_string()
-            } else {
-                format!("tool {i} ({}): {e}", named(M::PARAMETER_NAMES, row))
-            };
-            match Failure::from_error(e) {
-                Failure::Run(_) => Failure::Run(message),
-                _ => Failure::Input(message),
-            }
-        })?;
-        push_c_order(&mut out.a, &one.a);
-        push_c_order(&mut out.b, &one.b);
-        push_c_order(&mut out.pi_u, &one.pi_u);
-        out.logdet.push(one.logdet);
-        let s = &one.sensitivities;
-        for (all, m) in
-            sensitivities
-                .iter_mut()
-                .zip([s.d_theta_du, s.d_theta_dot_du, s.d_theta_ddot_du])
-        {
-            if let Some(m) = m {
-                push_c_order(all, &m);
-            }
-        }
+) -> Result<Confidences, Failure> {
+    let task = kind.model().bind(spec).map_err(Failure::input)?;
+    if let Some(e) = task.validation_error() {
+        return Err(Failure::input(e));
     }
-    // A term the task does not use has no sensitivity (the command line leaves it out too).
-    let used = [Term::Theta, Term::ThetaDot, Term::ThetaDdot].map(|t| kind.uses(t));
-    out.sensitivities = names
-        .into_iter()
-        .zip(sensitivities)
-        .zip(used)
-        .filter_map(|((name, s), used)| used.then_some((name, s)))
-        .collect();
-    Ok(out)
+    let np = kind.parameter_names().len();
+    let k = params.len() / np;
+    task.confidences(params).map_err(|(i, e)| {
+        let row = &params[i * np..(i + 1) * np];
+        let message = if k == 1 {
+            e.to_string()
+        } else {
+            format!("tool {i} ({}): {e}", named(kind.parameter_names(), row))
+        };
+        match Failure::from_error(e) {
+            Failure::Run(_) => Failure::Run(message),
+            _ => Failure::Input(message),
+        }
+    })
 }
 
 /// `m1=0.3 m2=0.4 …`, as the crate prints a tool.
-pub fn named<const NP: usize>(names: [&str; NP], values: &[f64]) -> String {
+pub fn named(names: &[&str], values: &[f64]) -> String {
     let parts: Vec<String> = names
         .iter()
         .zip(values)
@@ -226,7 +101,7 @@ pub fn confidence<'py>(
             .into_pyerr(py))
         }
     };
-    let c = detached(py, || ops(kind).confidences(&spec, &values))?;
+    let c = detached(py, || confidences(kind, &spec, &values))?;
     to_dict(py, c, batch)
 }
 

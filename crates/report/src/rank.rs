@@ -13,7 +13,7 @@ use crate::stats::spearman;
 use crate::task_file::{PerJoint, PrecisionSpec, TaskSpec};
 use crate::{TaskKind, Term};
 use toolconf::rank::{score, ModelTasks, RankedTool, StageTimings, TaskTrace};
-use toolconf::model::mixed::ModelKind;
+use toolconf::registry::ModelKind;
 
 /// What the report describes.
 pub struct ReportInput<'a> {

@@ -31,7 +31,7 @@ use serde_json::{Map, Value};
 
 use crate::bounded_read::{record_error, CsvRows, JsonElements, RecordLimit};
 use crate::display::{Clip, ClipMessage, Short};
-use crate::model::mixed::{AnyTool, ModelKind};
+use crate::registry::{AnyTool, ModelKind};
 
 /// One tool read from a file.
 #[derive(Debug, Clone, PartialEq)]
