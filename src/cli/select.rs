@@ -61,7 +61,7 @@ fn tool_json(r: &ToolResult) -> Value {
 }
 
 pub fn run(args: &Args) -> Result<(), CliError> {
-    if args.models != [ModelKind::Arm2] {
+    if args.models != [ModelKind::PAPER_ARM] {
         if args.mpc {
             return Err(toolconf::Error::Unsupported(
                 "--mpc ranks 2-link tools only (the MPC baseline is built on the 2-link model); drop --models or --mpc".into(),

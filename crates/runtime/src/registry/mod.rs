@@ -191,6 +191,12 @@ impl ModelKind {
         all
     };
 
+    /// The paper's 2-link arm (`arm2`): the model where none is named (a tools file without a
+    /// `model` column, `select` without `--models`), whose tools the typed 2-link API
+    /// ([`crate::Arm`], [`crate::closed_loop::Plant`]) runs.
+    pub const PAPER_ARM: ModelKind =
+        ModelKind::builtin(<crate::model::Arm2 as ArmModel<2, 4, 4, 6>>::NAME);
+
     const fn builtin(name: &str) -> Self {
         ModelKind(registry_index(name) as u16)
     }
