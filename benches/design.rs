@@ -14,8 +14,8 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use toolconf::design::file::DesignSpec;
 use toolconf::design::polytope::Polytope;
 use toolconf::design::{confidence_optimum, verify, Setting};
-use toolconf::model::mixed::{AnyTool, ModelKind};
 use toolconf::rank::ModelTasks;
+use toolconf::registry::{AnyTool, ModelKind};
 use toolconf::task_file::TaskSpec;
 use toolconf::TaskKind;
 

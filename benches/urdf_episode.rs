@@ -12,9 +12,9 @@ use std::hint::black_box;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use nalgebra::SVector;
 use toolconf::integrate::Method;
-use toolconf::model::mixed::{AnyTool, ModelKind};
 use toolconf::model::{ClosedLoopN, Panda, PandaTool};
 use toolconf::rank::{simulate_all, Candidate, ModelTasks};
+use toolconf::registry::{AnyTool, ModelKind};
 use toolconf::select::mixed::MixedSampler;
 use toolconf::task_file::TaskSpec;
 use toolconf::tools_file::ToolRow;
@@ -28,10 +28,8 @@ fn tools(n: usize, seed: u64) -> Vec<AnyTool> {
 }
 
 fn panda(tool: &AnyTool) -> PandaTool {
-    match tool {
-        AnyTool::Panda(t) => *t,
-        _ => unreachable!("the sampler draws Panda tools only"),
-    }
+    tool.downcast::<Panda, 7, 14, 7, 21>()
+        .expect("the sampler draws Panda tools only")
 }
 
 /// The built-in task `kind` with `toolconf rank`'s default integration method, `fast` (the

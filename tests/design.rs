@@ -4,8 +4,8 @@
 
 use toolconf::design::file::DesignSpec;
 use toolconf::design::{confidence_optimum, design, DesignError, Setting};
-use toolconf::model::mixed::{AnyTool, ModelKind};
 use toolconf::rank::ModelTasks;
+use toolconf::registry::{AnyTool, ModelKind};
 use toolconf::select::mixed::MixedSampler;
 use toolconf::task_file::TaskSpec;
 use toolconf::TaskKind;

@@ -8,11 +8,11 @@ use nalgebra::SMatrix;
 use proptest::prelude::*;
 use serde_json::Value;
 use toolconf::closed_loop::{self, EpisodeOptions, Metrics, Plant};
-use toolconf::model::mixed::{AnyTool, ModelKind};
 use toolconf::model::{
     self, control_confidence, simulate, simulate_on, Arm2, Arm2Exact, Arm2Tool, Arm3, Arm3Tool,
     ArmModel, EpisodeOptionsN,
 };
+use toolconf::registry::{AnyTool, ModelKind};
 use toolconf::select::mixed::{draw_mixed_tools, evaluate_mixed, MixedObjective, MixedResult};
 use toolconf::select::{draw_tools, PARAMETER_RANGE};
 use toolconf::{Arm, Error, Task, TaskKind};
@@ -316,7 +316,7 @@ fn a_set_of_only_arm2_is_the_two_link_stream() {
     let mixed = draw_mixed_tools(&[ModelKind::Arm2], 20, 5).unwrap();
     let plain = draw_tools(20, 5);
     for (m, p) in mixed.iter().zip(&plain) {
-        assert_eq!(*m, AnyTool::Arm2(*p));
+        assert_eq!(*m, AnyTool::from(*p));
     }
     assert!(draw_mixed_tools(&[], 3, 0).is_err());
 }
@@ -351,8 +351,12 @@ fn mixed_evaluation_matches_each_models_own_runtime_and_choices() {
     let options = EpisodeOptions::default();
     let results = evaluate_mixed(&tools, TaskKind::Velocity, &options, Plant::Paper);
     for r in &results {
-        match r.tool {
-            AnyTool::Arm2(t) => {
+        let (arm2, arm3) = (
+            r.tool.downcast::<Arm2, 2, 4, 4, 6>(),
+            r.tool.downcast::<Arm3, 3, 6, 6, 9>(),
+        );
+        match (arm2, arm3) {
+            (Some(t), _) => {
                 let p = t.params();
                 let arm = Arm::new([p[0], p[1], p[2], p[3]]).unwrap();
                 let reference =
@@ -360,12 +364,12 @@ fn mixed_evaluation_matches_each_models_own_runtime_and_choices() {
                         .unwrap();
                 assert_eq!(bits(&reference.metrics), bits(r.episode.as_ref().unwrap()));
             }
-            AnyTool::Arm3(t) => {
+            (_, Some(t)) => {
                 let task = Arm3::paper_task(TaskKind::Velocity);
                 let m = simulate(&t, &task, &EpisodeOptionsN::paper::<Arm3, 6, 9>()).unwrap();
                 assert_eq!(bits(&m), bits(r.episode.as_ref().unwrap()));
             }
-            other => unreachable!("{other} was not drawn"),
+            _ => unreachable!("{} was not drawn", r.tool),
         }
         let per_joint = r.logdet_per_joint().unwrap();
         assert_eq!(

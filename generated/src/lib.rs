@@ -70,6 +70,196 @@ pub const MODEL_NAMES: [&str; 7] = [
     "ur5",
 ];
 
+/// The most tool parameters of any model: a tool of any model fits in this many.
+pub const MAX_PARAMETER_COUNT: usize = 7;
+
+/// A constraint c · p ≤ 0 across a model's tool parameters, with its length known only at run
+/// time (the typed one is `validity::<model>::RULE`'s).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Constraint {
+    pub coefficients: &'static [f64],
+    /// The constraint in words, with the parameters' names.
+    pub rule: &'static str,
+}
+
+impl Constraint {
+    /// Constraint `index` of `rule`.
+    #[must_use]
+    pub const fn of<const NP: usize>(rule: &'static validity::ToolRule<NP>, index: usize) -> Self {
+        let c = &rule.constraints[index];
+        Self {
+            coefficients: &c.coefficients,
+            rule: c.rule,
+        }
+    }
+}
+
+/// What a model is, without its functions: the sizes, names, units, tool rule, equilibrium and
+/// tasks of one generated model, with every length known only at run time. A runtime's model
+/// registry reads these rather than matching on models.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ModelInfo {
+    /// The model's name, its module in this crate.
+    pub name: &'static str,
+    /// The description's `model.title`.
+    pub title: &'static str,
+    /// The model description it was derived from.
+    pub description: &'static str,
+    /// N, the joints (torques).
+    pub dof: usize,
+    /// NX = 2N, the state X = [θ; θ̇].
+    pub state_dim: usize,
+    /// The tool parameters, in the order every function takes them.
+    pub parameter_names: &'static [&'static str],
+    /// Their units (kg, m, kg m^2, ...), in the same order.
+    pub parameter_units: &'static [&'static str],
+    pub state_names: &'static [&'static str],
+    pub control_names: &'static [&'static str],
+    /// Each tool parameter's domain, in the same order.
+    pub domains: &'static [validity::ParameterDomain],
+    /// The constraints across the tool parameters.
+    pub constraints: &'static [Constraint],
+    /// The box random tools are drawn from, (lo, hi) per parameter.
+    pub sample: &'static [(f64, f64)],
+    /// The equilibrium X^e = [q^e; q̇^e] the model is linearised at.
+    pub equilibrium_state: &'static [f64],
+    /// The equilibrium torque U^e.
+    pub equilibrium_control: &'static [f64],
+    /// The tasks the model offers.
+    pub tasks: &'static [TaskKind],
+}
+
+/// Every generated model's [`ModelInfo`], in registry order (that of [`MODEL_NAMES`]).
+pub static MODELS: [ModelInfo; 7] = [
+    ModelInfo {
+        name: arm2::NAME,
+        title: "2-DOF arm in the vertical plane (the paper's generative process)",
+        description: "derive/models/arm2.toml",
+        dof: arm2::DOF,
+        state_dim: arm2::STATE_DIM,
+        parameter_names: &arm2::PARAMETER_NAMES,
+        parameter_units: &arm2::PARAMETER_UNITS,
+        state_names: &arm2::STATE_NAMES,
+        control_names: &arm2::CONTROL_NAMES,
+        domains: &validity::arm2::RULE.domains,
+        constraints: &[],
+        sample: &validity::arm2::RULE.sample,
+        equilibrium_state: &arm2::EQUILIBRIUM_STATE,
+        equilibrium_control: &arm2::EQUILIBRIUM_CONTROL,
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
+    },
+    ModelInfo {
+        name: arm2_exact::NAME,
+        title: "2-DOF arm in the vertical plane, exact Lagrangian dynamics",
+        description: "derive/models/arm2_exact.toml",
+        dof: arm2_exact::DOF,
+        state_dim: arm2_exact::STATE_DIM,
+        parameter_names: &arm2_exact::PARAMETER_NAMES,
+        parameter_units: &arm2_exact::PARAMETER_UNITS,
+        state_names: &arm2_exact::STATE_NAMES,
+        control_names: &arm2_exact::CONTROL_NAMES,
+        domains: &validity::arm2_exact::RULE.domains,
+        constraints: &[],
+        sample: &validity::arm2_exact::RULE.sample,
+        equilibrium_state: &arm2_exact::EQUILIBRIUM_STATE,
+        equilibrium_control: &arm2_exact::EQUILIBRIUM_CONTROL,
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
+    },
+    ModelInfo {
+        name: arm2_payload::NAME,
+        title: "2-DOF arm in the vertical plane holding a point payload at the tip, Lagrangian dynamics",
+        description: "derive/models/arm2_payload.toml",
+        dof: arm2_payload::DOF,
+        state_dim: arm2_payload::STATE_DIM,
+        parameter_names: &arm2_payload::PARAMETER_NAMES,
+        parameter_units: &arm2_payload::PARAMETER_UNITS,
+        state_names: &arm2_payload::STATE_NAMES,
+        control_names: &arm2_payload::CONTROL_NAMES,
+        domains: &validity::arm2_payload::RULE.domains,
+        constraints: &[],
+        sample: &validity::arm2_payload::RULE.sample,
+        equilibrium_state: &arm2_payload::EQUILIBRIUM_STATE,
+        equilibrium_control: &arm2_payload::EQUILIBRIUM_CONTROL,
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
+    },
+    ModelInfo {
+        name: arm3::NAME,
+        title: "3-DOF arm in the vertical plane, Lagrangian dynamics",
+        description: "derive/models/arm3.toml",
+        dof: arm3::DOF,
+        state_dim: arm3::STATE_DIM,
+        parameter_names: &arm3::PARAMETER_NAMES,
+        parameter_units: &arm3::PARAMETER_UNITS,
+        state_names: &arm3::STATE_NAMES,
+        control_names: &arm3::CONTROL_NAMES,
+        domains: &validity::arm3::RULE.domains,
+        constraints: &[],
+        sample: &validity::arm3::RULE.sample,
+        equilibrium_state: &arm3::EQUILIBRIUM_STATE,
+        equilibrium_control: &arm3::EQUILIBRIUM_CONTROL,
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
+    },
+    ModelInfo {
+        name: msd::NAME,
+        title: "Mass-spring-damper driven by a force",
+        description: "derive/models/msd.toml",
+        dof: msd::DOF,
+        state_dim: msd::STATE_DIM,
+        parameter_names: &msd::PARAMETER_NAMES,
+        parameter_units: &msd::PARAMETER_UNITS,
+        state_names: &msd::STATE_NAMES,
+        control_names: &msd::CONTROL_NAMES,
+        domains: &validity::msd::RULE.domains,
+        constraints: &[],
+        sample: &validity::msd::RULE.sample,
+        equilibrium_state: &msd::EQUILIBRIUM_STATE,
+        equilibrium_control: &msd::EQUILIBRIUM_CONTROL,
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
+    },
+    ModelInfo {
+        name: panda::NAME,
+        title: "Franka Emika Panda (7-DOF) with a tool at the flange, under joint impedance",
+        description: "derive/models/panda.toml",
+        dof: panda::DOF,
+        state_dim: panda::STATE_DIM,
+        parameter_names: &panda::PARAMETER_NAMES,
+        parameter_units: &panda::PARAMETER_UNITS,
+        state_names: &panda::STATE_NAMES,
+        control_names: &panda::CONTROL_NAMES,
+        domains: &validity::panda::RULE.domains,
+        constraints: &[
+            Constraint::of(&validity::panda::RULE, 0),
+            Constraint::of(&validity::panda::RULE, 1),
+            Constraint::of(&validity::panda::RULE, 2),
+        ],
+        sample: &validity::panda::RULE.sample,
+        equilibrium_state: &panda::EQUILIBRIUM_STATE,
+        equilibrium_control: &panda::EQUILIBRIUM_CONTROL,
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
+    },
+    ModelInfo {
+        name: ur5::NAME,
+        title: "Universal Robots UR5 (6-DOF) with a tool at the flange, under joint impedance",
+        description: "derive/models/ur5.toml",
+        dof: ur5::DOF,
+        state_dim: ur5::STATE_DIM,
+        parameter_names: &ur5::PARAMETER_NAMES,
+        parameter_units: &ur5::PARAMETER_UNITS,
+        state_names: &ur5::STATE_NAMES,
+        control_names: &ur5::CONTROL_NAMES,
+        domains: &validity::ur5::RULE.domains,
+        constraints: &[
+            Constraint::of(&validity::ur5::RULE, 0),
+            Constraint::of(&validity::ur5::RULE, 1),
+            Constraint::of(&validity::ur5::RULE, 2),
+        ],
+        sample: &validity::ur5::RULE.sample,
+        equilibrium_state: &ur5::EQUILIBRIUM_STATE,
+        equilibrium_control: &ur5::EQUILIBRIUM_CONTROL,
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
+    },
+];
+
 /// Calls `$callback!` once with every generated model, as a comma-separated list of
 /// `(Marker, module, Tool, "name", "title")`: the marker type a runtime implements the model
 /// on, the model's module in this crate, the name of the tool type alias, the model's name and

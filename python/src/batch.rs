@@ -5,11 +5,12 @@ use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
-use toolconf::model::{ArmModel, Metrics, ToolN};
+use toolconf::model::Metrics;
+use toolconf::registry::ModelKind;
 use toolconf::task_file::TaskSpec;
 
 use crate::errors::{detached, Failure};
-use crate::models::{model_kind, ops};
+use crate::models::model_kind;
 use crate::task::{portable_spec, task_spec};
 
 /// Every tool of `params` (k × NP, row major) under every task of `specs` (one per
@@ -20,40 +21,41 @@ use crate::task::{portable_spec, task_spec};
 /// episode is its row's error only. Episodes
 /// run on rayon's threads, each a pure function of its tool and task, so the rows do not depend
 /// on the number of threads.
-pub fn batch<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+pub fn batch(
+    kind: ModelKind,
     specs: &[TaskSpec],
     params: &[f64],
     first_tool: Option<usize>,
-) -> Result<Vec<Result<Metrics, String>>, Failure>
-where
-    M: ArmModel<N, NX, NP, NZ>,
-{
+) -> Result<Vec<Result<Metrics, String>>, Failure> {
+    let model = kind.model();
     let bound = specs
         .iter()
         .map(|spec| {
-            let task = spec.task::<M, N, NX, NP, NZ>().map_err(Failure::input)?;
-            let options = spec.episode::<M, N, NX, NP, NZ>().map_err(Failure::input)?;
-            Ok((task, options))
+            let task = model.bind(spec).map_err(Failure::input)?;
+            match task.episode_error() {
+                Some(e) => Err(Failure::input(e)),
+                None => Ok(task),
+            }
         })
         .collect::<Result<Vec<_>, Failure>>()?;
-    let k = params.len() / NP;
+    let np = kind.parameter_names().len();
+    let k = params.len() / np;
     let what = format!(
         "simulate_batch of {k} tools × {} perturbations",
         bound.len()
     );
-    let mut tools = crate::arrays::with_capacity(k, &what)?;
-    for (i, p) in params.chunks_exact(NP).enumerate() {
-        let tool =
-            ToolN::<M, N, NX, NP, NZ>::new(p.try_into().expect("NP values")).map_err(|e| {
-                Failure::Input(match first_tool {
-                    None => e.to_string(),
-                    Some(first) => format!(
-                        "tool {} ({}): {e}",
-                        first + i,
-                        crate::confidence::named(M::PARAMETER_NAMES, p)
-                    ),
-                })
-            })?;
+    let mut tools: Vec<&[f64]> = crate::arrays::with_capacity(k, &what)?;
+    for (i, p) in params.chunks_exact(np).enumerate() {
+        let tool = model.check_tool(p).map(|()| p).map_err(|e| {
+            Failure::Input(match first_tool {
+                None => e.to_string(),
+                Some(first) => format!(
+                    "tool {} ({}): {e}",
+                    first + i,
+                    crate::confidence::named(kind.parameter_names(), p)
+                ),
+            })
+        })?;
         tools.push(tool);
     }
     let pairs = k.saturating_mul(bound.len());
@@ -63,8 +65,8 @@ where
         .into_par_iter()
         .with_min_len(1)
         .map(|i| {
-            let (tool, (task, options)) = (&tools[i / bound.len()], &bound[i % bound.len()]);
-            toolconf::model::simulate(tool, task, options).map_err(|e| e.to_string())
+            let (tool, task) = (tools[i / bound.len()], &bound[i % bound.len()]);
+            task.simulate(tool).map_err(|e| e.to_string())
         })
         .collect_into_vec(&mut rows);
     Ok(rows)
@@ -189,7 +191,7 @@ fn run<'py>(
         specs.push(spec);
     }
     let first = (shape.len() == 2).then_some(first_tool);
-    let rows = detached(py, || ops(kind).batch(&specs, &values, first))?;
+    let rows = detached(py, || batch(kind, &specs, &values, first))?;
     to_dict(py, rows, specs.len(), first_tool).map_err(|f| f.into_pyerr(py))
 }
 

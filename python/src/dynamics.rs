@@ -1,122 +1,12 @@
 //! `toolconf.dynamics`: a robot's own rigid-body dynamics Ẋ = [q̇; q̈], for one state or a batch.
 
-use std::marker::PhantomData;
-
-use nalgebra::SVector;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use rayon::prelude::*;
-use toolconf::generated;
-use toolconf::model::mixed::ModelKind;
-use toolconf::model::{ArmModel, ToolN};
+use toolconf::registry::{BatchError, ModelKind, Rows};
 
 use crate::errors::{detached, Failure};
 use crate::models::model_kind;
-
-/// Below this many states a batch runs on one thread.
-const MIN_STATES_PER_THREAD: usize = 512;
-
-/// One argument's values: one row shared by every state, or one row per state.
-struct Rows<'a> {
-    data: &'a [f64],
-    width: usize,
-    shared: bool,
-}
-
-impl Rows<'_> {
-    fn row(&self, i: usize) -> &[f64] {
-        let i = if self.shared { 0 } else { i };
-        &self.data[i * self.width..(i + 1) * self.width]
-    }
-}
-
-/// The rigid-body dynamics of one model, its sizes fixed.
-trait RigidBody: Sync {
-    /// Ẋ of `k` rows into `out` (k × NX, row major).
-    fn evaluate(
-        &self,
-        k: usize,
-        params: &Rows,
-        x: &Rows,
-        u: &Rows,
-        out: &mut [f64],
-    ) -> Result<(), Failure>;
-}
-
-struct Of<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(PhantomData<M>);
-
-impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> RigidBody
-    for Of<M, N, NX, NP, NZ>
-where
-    M: ArmModel<N, NX, NP, NZ>,
-{
-    fn evaluate(
-        &self,
-        k: usize,
-        params: &Rows,
-        x: &Rows,
-        u: &Rows,
-        out: &mut [f64],
-    ) -> Result<(), Failure> {
-        let count = if params.shared { 1 } else { k };
-        let mut tools = crate::arrays::with_capacity(count, &format!("dynamics of {k} states"))?;
-        for i in 0..count {
-            let tool = ToolN::<M, N, NX, NP, NZ>::new(params.row(i).try_into().expect("NP values"))
-                .map_err(|e| row_error(k, params.shared, i, e))?;
-            tools.push(tool);
-        }
-        for (i, v) in x.data.iter().chain(u.data).enumerate() {
-            if !v.is_finite() {
-                let what = if i < x.data.len() { "state" } else { "control" };
-                return Err(Failure::Input(format!("{what} entry {v} is not finite")));
-            }
-        }
-        out.par_chunks_exact_mut(NX)
-            .with_min_len(MIN_STATES_PER_THREAD)
-            .enumerate()
-            .try_for_each(|(i, row)| {
-                let tool = &tools[if params.shared { 0 } else { i }];
-                let xi = SVector::<f64, NX>::from_column_slice(x.row(i));
-                let ui = SVector::<f64, N>::from_column_slice(u.row(i));
-                let f = tool.rigid_body_dynamics(&xi, &ui);
-                if !f.iter().all(|v| v.is_finite()) {
-                    return Err(Failure::Input(format!(
-                        "state {i}: the dynamics are not finite there (|X| or |U| too large)"
-                    )));
-                }
-                row.copy_from_slice(f.as_slice());
-                Ok(())
-            })
-    }
-}
-
-fn row_error(k: usize, shared: bool, i: usize, e: toolconf::model::Error) -> Failure {
-    Failure::Input(if shared || k == 1 {
-        e.to_string()
-    } else {
-        format!("tool {i}: {e}")
-    })
-}
-
-/// One [`RigidBody`] per model of the generated registry.
-macro_rules! rigid_bodies {
-    ($(($marker:ident, $module:ident, $tool:ident, $name:literal, $title:literal)),* $(,)?) => {
-        fn of(kind: ModelKind) -> &'static dyn RigidBody {
-            match kind {
-                $(ModelKind::$marker => &Of::<
-                    toolconf::model::$marker,
-                    { generated::$module::DOF },
-                    { generated::$module::STATE_DIM },
-                    { generated::$module::PARAMETER_COUNT },
-                    { generated::$module::STATE_DIM + generated::$module::DOF },
-                >(PhantomData),)*
-            }
-        }
-    };
-}
-
-toolconf::for_each_model!(rigid_bodies);
 
 /// An argument of shape (width,) or (k, width): its rows and k (None for 1-D).
 fn rows<'a>(
@@ -218,7 +108,15 @@ pub fn dynamics<'py>(
             let rows = k.unwrap_or(1);
             let what = format!("dynamics of {rows} states");
             let mut out = crate::arrays::zeros(rows.saturating_mul(nx), &what)?;
-            of(kind).evaluate(k.unwrap_or(1), &p, &x, &u, &mut out)?;
+            kind.model()
+                .rigid_body_dynamics(rows, &p, &x, &u, &mut out)
+                .map_err(|e| match e {
+                    BatchError::OutOfMemory { bytes } => {
+                        crate::arrays::out_of_memory::<f64>(bytes / 8, &what)
+                    }
+                    BatchError::Input(message) => Failure::Input(message),
+                    BatchError::Tool(i, e) => Failure::Input(format!("tool {i}: {e}")),
+                })?;
             Ok((out, k))
         })?;
     let (data, k) = out;

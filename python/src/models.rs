@@ -1,86 +1,10 @@
-//! The generated models, and calling the generic runtime with one model's sizes.
-
-use std::marker::PhantomData;
+//! The models of the registry (`toolconf::registry`), by name.
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use toolconf::generated;
-use toolconf::model::mixed::ModelKind;
-use toolconf::model::{ArmModel, Metrics};
-use toolconf::task_file::TaskSpec;
+use toolconf::registry::ModelKind;
 
-use crate::confidence::Confidences;
 use crate::errors::Failure;
-use crate::simulate::Episode;
-
-/// What the Python functions need of one model, with the model's sizes fixed: each generated
-/// model gets one [`Ops`] (through [`ops`]), so the functions dispatch once, by name.
-pub trait ModelOps: Sync {
-    /// A, B, sensitivities, Π^U and ln|Π^U| of `k` tools (`params`: k × NP, row-major).
-    fn confidences(&self, spec: &TaskSpec, params: &[f64]) -> Result<Confidences, Failure>;
-    /// One episode of the tool `params` (NP values).
-    fn episode(&self, spec: &TaskSpec, params: &[f64]) -> Result<Episode, Failure>;
-    /// The metrics of every tool of `params` (k × NP) under every task of `specs`, tool-major
-    /// (bad tools named from `first_tool`, or unnumbered for a single 1-D tool).
-    fn batch(
-        &self,
-        specs: &[TaskSpec],
-        params: &[f64],
-        first_tool: Option<usize>,
-    ) -> Result<Vec<Result<Metrics, String>>, Failure>;
-}
-
-/// [`ModelOps`] of model `M`.
-pub struct Ops<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
-    PhantomData<M>,
-);
-
-impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> ModelOps
-    for Ops<M, N, NX, NP, NZ>
-where
-    M: ArmModel<N, NX, NP, NZ>,
-{
-    fn confidences(&self, spec: &TaskSpec, params: &[f64]) -> Result<Confidences, Failure> {
-        crate::confidence::confidences::<M, N, NX, NP, NZ>(spec, params)
-    }
-
-    fn episode(&self, spec: &TaskSpec, params: &[f64]) -> Result<Episode, Failure> {
-        crate::simulate::episode_of::<M, N, NX, NP, NZ>(spec, params)
-    }
-
-    fn batch(
-        &self,
-        specs: &[TaskSpec],
-        params: &[f64],
-        first_tool: Option<usize>,
-    ) -> Result<Vec<Result<Metrics, String>>, Failure> {
-        crate::batch::batch::<M, N, NX, NP, NZ>(specs, params, first_tool)
-    }
-}
-
-/// One [`Ops`] per model of the generated registry (`toolconf::for_each_model!`).
-macro_rules! model_ops {
-    ($(($marker:ident, $module:ident, $tool:ident, $name:literal, $title:literal)),* $(,)?) => {
-        /// The operations of `kind`.
-        pub fn ops(kind: ModelKind) -> &'static dyn ModelOps {
-            match kind {
-                $(ModelKind::$marker => &Ops::<
-                    toolconf::model::$marker,
-                    { generated::$module::DOF },
-                    { generated::$module::STATE_DIM },
-                    { generated::$module::PARAMETER_COUNT },
-                    { generated::$module::STATE_DIM + generated::$module::DOF },
-                >(PhantomData),)*
-            }
-        }
-
-        fn title(kind: ModelKind) -> &'static str {
-            match kind { $(ModelKind::$marker => $title,)* }
-        }
-    };
-}
-
-toolconf::for_each_model!(model_ops);
 
 /// A model by name, or the error naming the models there are.
 pub fn model_kind(name: &str) -> Result<ModelKind, Failure> {
@@ -98,7 +22,7 @@ pub fn models(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let out = PyDict::new(py);
     for kind in ModelKind::ALL {
         let entry = PyDict::new(py);
-        entry.set_item("title", title(kind))?;
+        entry.set_item("title", kind.title())?;
         entry.set_item("dof", kind.dof())?;
         entry.set_item("parameters", kind.parameter_names().to_vec())?;
         entry.set_item("equilibrium", crate::dynamics::equilibrium(py, kind)?)?;

@@ -3,11 +3,12 @@
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use toolconf::model::{episode, ArmModel, Metrics, ToolN};
+use toolconf::model::Metrics;
+use toolconf::registry::{AnyTool, ModelKind};
 use toolconf::task_file::TaskSpec;
 
 use crate::errors::{detached, Failure};
-use crate::models::{model_kind, ops};
+use crate::models::model_kind;
 use crate::task::task_spec;
 
 /// An episode's metrics and its trajectory on the output grid, each series flat in C order
@@ -19,31 +20,28 @@ pub struct Episode {
     pub series: [(&'static str, Vec<f64>); 4],
 }
 
-/// One episode of the tool `params` on `spec` bound to model `M`, with the trajectory: the
-/// generic runtime (`toolconf::model::episode`), which every model shares.
-pub fn episode_of<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
-    spec: &TaskSpec,
-    params: &[f64],
-) -> Result<Episode, Failure>
-where
-    M: ArmModel<N, NX, NP, NZ>,
-{
-    let tool = ToolN::<M, N, NX, NP, NZ>::new(params.try_into().expect("NP values"))
-        .map_err(Failure::input)?;
-    let task = spec.task::<M, N, NX, NP, NZ>().map_err(Failure::input)?;
-    let mut options = spec.episode::<M, N, NX, NP, NZ>().map_err(Failure::input)?;
-    options.record_trajectory = true;
-    let e = episode(&tool, &task, &options).map_err(Failure::episode)?;
+/// One episode of the tool `params` on `spec` bound to model `kind`, with the trajectory: the
+/// generic runtime, which every model shares, through the registry.
+pub fn episode_of(kind: ModelKind, spec: &TaskSpec, params: &[f64]) -> Result<Episode, Failure> {
+    let tool = AnyTool::new(kind, params).map_err(Failure::input)?;
+    let task = kind.model().bind(spec).map_err(Failure::input)?;
+    if let Some(e) = task.episode_error() {
+        return Err(Failure::input(e));
+    }
+    let e = task.episode(params, true).map_err(Failure::episode)?;
     e.metrics
-        .check_finite(&format!("{}({tool})", M::NAME))
+        .check_finite(&tool.to_string())
         .map_err(Failure::from_error)?;
     let tr = e.trajectory.expect("a recorded episode has a trajectory");
-    let flat = |s: &[nalgebra::SVector<f64, N>]| -> Vec<f64> {
-        s.iter().flat_map(|v| v.iter().copied()).collect()
+    // Per joint on the grid as (time, joint), C order.
+    let flat = |s: &[Vec<f64>]| -> Vec<f64> {
+        (0..tr.t.len())
+            .flat_map(|i| s.iter().map(move |joint| joint[i]))
+            .collect()
     };
     Ok(Episode {
         metrics: e.metrics,
-        n: N,
+        n: kind.dof(),
         series: [
             ("theta", flat(&tr.theta)),
             ("theta_dot", flat(&tr.theta_dot)),
@@ -108,7 +106,7 @@ pub fn simulate<'py>(
     }
     let mut spec = task_spec(task, episode_options)?;
     spec.episode.method = Some(crate::task::method(method).map_err(|f| f.into_pyerr(py))?);
-    let e = detached(py, || ops(kind).episode(&spec, &values))?;
+    let e = detached(py, || episode_of(kind, &spec, &values))?;
     to_dict(py, e)
 }
 

@@ -10,9 +10,9 @@
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use toolconf::model::mixed::{AnyTool, ModelKind};
 use toolconf::model::Metrics;
 use toolconf::rank::{objective_value, order_by_score, Candidate, ModelTasks, RankedTool};
+use toolconf::registry::{AnyTool, ModelKind};
 use toolconf::select::Objective;
 use toolconf::tools_file::ToolRow;
 

@@ -2,11 +2,11 @@
 //! for a tool of any generated model.
 
 use serde_json::{json, Value};
-use toolconf::model::mixed::ModelKind;
 use toolconf::model::Arm2;
-use toolconf::validate::finite_output;
 use toolconf::rank::{Linearisation, ModelTasks};
+use toolconf::registry::ModelKind;
 use toolconf::task_file::TaskSpec;
+use toolconf::validate::finite_output;
 use toolconf::{control_confidence, Arm};
 
 use super::episode_args::TaskArgs;

@@ -67,15 +67,15 @@ pub(crate) fn parse_arm(s: &str) -> Result<Arm, String> {
     toolconf::arm::parse(s).map_err(|e| e.to_string())
 }
 
-pub(crate) fn parse_model(s: &str) -> Result<toolconf::model::mixed::ModelKind, String> {
+pub(crate) fn parse_model(s: &str) -> Result<toolconf::registry::ModelKind, String> {
     s.parse()
 }
 
 /// A tool of `model` from `--params P1,P2,…` in the model's parameter order.
 pub(crate) fn tool_from_params(
-    model: toolconf::model::mixed::ModelKind,
+    model: toolconf::registry::ModelKind,
     text: &str,
-) -> Result<toolconf::model::mixed::AnyTool, output::CliError> {
+) -> Result<toolconf::registry::AnyTool, output::CliError> {
     let params = text
         .split(',')
         .map(|v| {
@@ -85,7 +85,7 @@ pub(crate) fn tool_from_params(
             })
         })
         .collect::<Result<Vec<f64>, _>>()?;
-    Ok(toolconf::model::mixed::AnyTool::new(model, &params)?)
+    Ok(toolconf::registry::AnyTool::new(model, &params)?)
 }
 
 pub(crate) fn parse_task(s: &str) -> Result<TaskKind, String> {

@@ -10,12 +10,12 @@ use std::time::Instant;
 
 use serde_json::{json, Map, Value};
 use toolconf::display::Clip;
-use toolconf::model::mixed::ModelKind;
 use toolconf::output::csv::{Cell, CsvWriter};
 use toolconf::rank::{
     ranking, screen_file, simulate_all_timed, Candidate, ConfidenceTiming, ModelTasks, RankedTool,
     Screen, ScreenError, SimulationTiming, StageTimings,
 };
+use toolconf::registry::ModelKind;
 use toolconf::select::Objective;
 use toolconf::task_file::TaskSpec;
 use toolconf::TaskKind;

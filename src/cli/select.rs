@@ -7,9 +7,9 @@ use rayon::prelude::*;
 use serde_json::{json, Value};
 use toolconf::closed_loop::{EpisodeOptions, Plant};
 use toolconf::integrate::Method;
-use toolconf::model::mixed::ModelKind;
 use toolconf::model::Arm2;
 use toolconf::rank::ModelTasks;
+use toolconf::registry::ModelKind;
 use toolconf::select::mixed::{draw_mixed_tools, evaluate_mixed, MixedObjective, MixedResult};
 use toolconf::select::{
     choose_by_mpc_cost, draw_tools, evaluate, evaluate_mpc, Objective, ToolResult,
@@ -61,7 +61,7 @@ fn tool_json(r: &ToolResult) -> Value {
 }
 
 pub fn run(args: &Args) -> Result<(), CliError> {
-    if args.models != [ModelKind::Arm2] {
+    if args.models != [ModelKind::PAPER_ARM] {
         if args.mpc {
             return Err(toolconf::Error::Unsupported(
                 "--mpc ranks 2-link tools only (the MPC baseline is built on the 2-link model); drop --models or --mpc".into(),
@@ -153,7 +153,13 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         let p = r.arm.params();
         outln!(
             "{:>5}  {:>7.4} {:>7.4} {:>7.4} {:>7.4}  {:>12} {}",
-            r.index, p[0], p[1], p[2], p[3], logdet, metrics
+            r.index,
+            p[0],
+            p[1],
+            p[2],
+            p[3],
+            logdet,
+            metrics
         );
     }
     if let Some(mpc) = &mpc {
@@ -225,7 +231,7 @@ fn with_flags(args: &Args, mut spec: TaskSpec) -> Result<TaskSpec, CliError> {
 fn evaluate_on_file(
     args: &Args,
     spec: TaskSpec,
-    tools: &[toolconf::model::mixed::AnyTool],
+    tools: &[toolconf::registry::AnyTool],
 ) -> Result<Vec<MixedResult>, CliError> {
     if args.episode.plant != PlantArg::Paper {
         return Err(CliError::Usage(

@@ -12,8 +12,8 @@ use crate::select::Objective;
 use crate::stats::spearman;
 use crate::task_file::{PerJoint, PrecisionSpec, TaskSpec};
 use crate::{TaskKind, Term};
-use toolconf::model::mixed::ModelKind;
 use toolconf::rank::{score, ModelTasks, RankedTool, StageTimings, TaskTrace};
+use toolconf::registry::ModelKind;
 
 /// What the report describes.
 pub struct ReportInput<'a> {

@@ -40,6 +40,7 @@ pub mod model;
 pub mod mpc;
 pub mod output;
 pub mod rank;
+pub mod registry;
 pub mod select;
 pub mod stats;
 pub mod task;

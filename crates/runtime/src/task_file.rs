@@ -623,9 +623,9 @@ fn check_precision(p: &PrecisionSpec) -> Result<(), String> {
             Clip(&format!("{lengths:?}"))
         ));
     }
-    let most = crate::model::mixed::ModelKind::ALL
+    let most = crate::generated::MODELS
         .iter()
-        .map(|m| m.dof())
+        .map(|m| m.dof)
         .max()
         .unwrap_or(0);
     if n > most {

@@ -31,7 +31,7 @@ use serde_json::{Map, Value};
 
 use crate::bounded_read::{record_error, CsvRows, JsonElements, RecordLimit};
 use crate::display::{Clip, ClipMessage, Short};
-use crate::model::mixed::{AnyTool, ModelKind};
+use crate::registry::{AnyTool, ModelKind};
 
 /// One tool read from a file.
 #[derive(Debug, Clone, PartialEq)]
@@ -301,7 +301,7 @@ fn build_row<'a>(
             .map_or(String::new(), |n| format!(" (tool '{}')", Clip(n)))
     };
     let model = match cell("model") {
-        Cell::Absent => ModelKind::Arm2,
+        Cell::Absent => ModelKind::PAPER_ARM,
         Cell::Text(t) => t.parse().map_err(|e: String| format!("{e}{}", who()))?,
         Cell::Number(x) => {
             let x = Short(x);

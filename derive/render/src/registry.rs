@@ -60,11 +60,15 @@ pub struct RegistryModel<'a> {
     pub tool: String,
     /// The model description it was derived from.
     pub description: &'a str,
+    /// `description` as a Rust string literal.
+    pub description_literal: String,
     pub parameter_count: usize,
     pub functions: Vec<VectorTestView<'a>>,
     pub function_count: usize,
     pub tool_rule: ToolRuleView,
     pub rigid_body: RigidBody,
+    /// The tasks the model offers, as `TaskKind` variants (`TaskKind::Position`).
+    pub task_variants: Vec<String>,
 }
 
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
@@ -85,6 +89,8 @@ pub struct PackageView {
 pub struct RegistryContext<'a> {
     pub models: Vec<RegistryModel<'a>>,
     pub model_count: usize,
+    /// The most tool parameters of any model: the inline storage of a tool of any model.
+    pub max_parameter_count: usize,
     pub tasks: Vec<TaskView<'a>>,
     pub task_count: usize,
     pub task_choices: String,
@@ -103,6 +109,7 @@ pub fn registry_context<'a>(
     let list = |items: Vec<&str>| items.join(", ");
     Ok(RegistryContext {
         model_count: models.len(),
+        max_parameter_count: models.iter().map(|m| m.parameter_count).max().unwrap_or(0),
         task_count: tasks.len(),
         task_choices: task_choices(&tasks),
         package: PackageView {
@@ -129,11 +136,17 @@ fn registry_model(ir: &Ir) -> Result<RegistryModel<'_>, RenderError> {
         tool: format!("{marker}Tool"),
         marker,
         description: &ir.generator.model,
+        description_literal: string_literal(&ir.generator.model),
         parameter_count: m.parameters.len(),
         functions: ir.functions.iter().map(vector_test_view).collect(),
         function_count: ir.functions.len(),
         tool_rule: tool_rule_view(m)?,
         rigid_body: rigid_body(&ir.functions),
+        task_variants: ir
+            .tasks
+            .iter()
+            .map(|t| format!("TaskKind::{}", camel_case(&t.name)))
+            .collect(),
     })
 }
 

@@ -27,7 +27,7 @@ use super::constraint::{parse_constraint, LinearConstraint};
 use super::DesignError;
 use crate::display::{Clip, ClipMessage, ShortList};
 use crate::generated::validity::ParameterDomain;
-use crate::model::mixed::ModelKind;
+use crate::registry::ModelKind;
 
 /// What the design optimises.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -9,7 +9,7 @@
 
 use rayon::prelude::*;
 
-use crate::model::mixed::AnyTool;
+use crate::registry::AnyTool;
 
 use super::polytope::Polytope;
 use super::{DesignError, Setting};

@@ -22,8 +22,8 @@ pub mod solver;
 pub mod sweep;
 pub mod verify;
 
-use crate::model::mixed::{AnyTool, ModelKind};
 use crate::rank::ModelTasks;
+use crate::registry::{AnyTool, ModelKind};
 use crate::task_file::TaskSpec;
 
 use file::{DesignObjective, DesignSpec};

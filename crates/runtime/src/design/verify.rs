@@ -4,8 +4,8 @@
 
 use rayon::prelude::*;
 
-use crate::model::mixed::{AnyTool, ModelKind};
 use crate::rank::ModelTasks;
+use crate::registry::{AnyTool, ModelKind};
 use crate::task_file::{PerJoint, TaskSpec};
 
 use super::polytope::{FeasibleSampler, Polytope};

@@ -12,7 +12,7 @@
 //! * [`ToolN`] (validated parameters), [`TaskN`] (goals and precisions), [`control_confidence`]
 //!   (Π^U and ln|Π^U|), [`ActiveInferenceN`], [`ClosedLoopN`], [`simulate`]/[`simulate_on`]
 //!   (metrics) and [`episode`]/[`episode_on`] (metrics and trajectory).
-//! * [`mixed`] draws and ranks tool sets that mix models.
+//! * [`crate::registry`] puts every model behind one object-safe trait, for code over all models.
 //!
 //! The sizes are N (joints = torques), NX = 2N (state X = [θ; θ̇]), NP (tool parameters) and
 //! NZ = NX + N (closed-loop state Z = [X; U]). NZ is a parameter of its own because stable Rust
@@ -20,7 +20,6 @@
 //! checks `NX == 2N` and `NZ == NX + N` at compile time (a post-monomorphisation assertion).
 
 pub mod budget;
-pub mod mixed;
 pub(crate) mod runtime;
 
 pub use toolconf_core::*;

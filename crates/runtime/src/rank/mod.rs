@@ -17,7 +17,7 @@ pub use screen::{
     check_screened, screen_file, screen_rows, Candidate, EachRow, Screen, ScreenError,
     ScreenedBlock,
 };
-pub use tasks::{AnyEpisode, Bound, Linearisation, ModelTasks, TaskTrace, TrajectoryTable};
+pub use tasks::{AnyEpisode, Linearisation, ModelTasks, TaskTrace, TrajectoryTable};
 
 use std::cmp::Ordering;
 use std::time::{Duration, Instant};

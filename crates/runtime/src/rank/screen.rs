@@ -261,7 +261,7 @@ pub fn check_screened(
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
-    use crate::model::mixed::{AnyTool, ModelKind};
+    use crate::registry::{AnyTool, ModelKind};
 
     pub(in crate::rank) fn candidate(row: usize, logdet: Result<f64, Error>) -> Candidate {
         Candidate {

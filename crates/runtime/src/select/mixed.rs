@@ -32,27 +32,9 @@ use rayon::prelude::*;
 /// Draws of one tool before [`MixedSampler`] takes the sampling box's centre instead.
 const MAX_REDRAWS: usize = 10_000;
 use crate::closed_loop::{EpisodeOptions, Metrics, Plant};
-use crate::model::mixed::{AnyTool, ModelKind};
-use crate::model::{
-    control_confidence, simulate, simulate_on, Arm2, Arm2Exact, ArmModel, EpisodeOptionsN,
-    ModelSimulationError, TaskN, ToolN,
-};
+use crate::model::{control_confidence, simulate_on, Arm2, Arm2Exact, ModelSimulationError, TaskN};
+use crate::registry::{paper_options, AnyTool, ModelKind};
 use crate::{Error, TaskKind};
-
-/// ln|Π^U| and the episode's metrics of one tool.
-type Evaluation = (Result<f64, Error>, Result<Metrics, ModelSimulationError>);
-
-/// [`evaluate`] over every generated model ([`crate::for_each_model!`]).
-macro_rules! evaluate_any {
-    ($(($marker:ident, $module:ident, $tool:ident, $name:literal, $title:literal)),* $(,)?) => {
-        /// ln|Π^U| and the episode of `tool` on its own model's paper-style `kind` task.
-        fn evaluate(tool: &AnyTool, kind: TaskKind, common: &EpisodeOptions) -> Evaluation {
-            match tool { $(AnyTool::$marker(t) => evaluate_one(t, kind, common),)* }
-        }
-    };
-}
-
-crate::for_each_model!(evaluate_any);
 
 /// A seeded stream of tools of several models (see the module docs for the mapping).
 pub struct MixedSampler {
@@ -146,46 +128,6 @@ impl MixedResult {
     }
 }
 
-/// `common`'s horizon, grid, perturbation, learning rate, integrator and recording, with model
-/// `M`'s equilibrium as X0 and U0 = `common.u0[0]` on every joint (0.1 by default).
-/// `common.x0` and `common.plant` are not used.
-fn options_for<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
-    common: &EpisodeOptions,
-) -> EpisodeOptionsN<N, NX>
-where
-    M: ArmModel<N, NX, NP, NZ>,
-{
-    EpisodeOptionsN {
-        t_end: common.t_end,
-        dt: common.dt,
-        x0: M::equilibrium_state(),
-        u0: nalgebra::SVector::repeat(common.u0[0]),
-        perturbation: common.perturbation,
-        joint_perturbation: nalgebra::SVector::zeros(),
-        learning_rate: common.learning_rate,
-        integrator: common.integrator,
-        record_trajectory: common.record_trajectory,
-    }
-}
-
-fn evaluate_one<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
-    tool: &ToolN<M, N, NX, NP, NZ>,
-    kind: TaskKind,
-    common: &EpisodeOptions,
-) -> Evaluation
-where
-    M: ArmModel<N, NX, NP, NZ>,
-{
-    let task = M::paper_task(kind);
-    let options = options_for::<M, N, NX, NP, NZ>(common);
-    (
-        control_confidence(tool, &task)
-            .map(|c| c.logdet)
-            .map_err(Error::from),
-        simulate(tool, &task, &options),
-    )
-}
-
 /// Evaluates every tool on its own model's paper-style `kind` task, in parallel; the result
 /// order is the tools' order. `common` gives the horizon, grid, perturbation, learning rate and
 /// integrator (`options_for`); `plant` [`Plant::Exact`] simulates the arm2 tools on the exact
@@ -201,18 +143,26 @@ pub fn evaluate_mixed(
         .par_iter()
         .enumerate()
         .map(|(index, tool)| {
-            let (logdet, episode) = match tool {
-                AnyTool::Arm2(t) if plant == Plant::Exact => {
+            // The paper's 2-link arm on the exact plant: the typed 2-link runtime.
+            let exact = match plant {
+                Plant::Exact => tool.downcast::<Arm2, 2, 4, 4, 6>(),
+                Plant::Paper => None,
+            };
+            let (logdet, episode) = match exact {
+                Some(t) => {
                     let task = TaskN::paper(kind);
-                    let options = options_for::<Arm2, 2, 4, 4, 6>(common);
+                    let options = paper_options::<Arm2, 2, 4, 4, 6>(common);
                     (
-                        control_confidence(t, &task)
+                        control_confidence(&t, &task)
                             .map(|c| c.logdet)
                             .map_err(Error::from),
-                        simulate_on::<Arm2, Arm2Exact, 2, 4, 4, 6>(t, &task, &options),
+                        simulate_on::<Arm2, Arm2Exact, 2, 4, 4, 6>(&t, &task, &options),
                     )
                 }
-                other => evaluate(other, kind, common),
+                None => tool
+                    .model()
+                    .model()
+                    .paper_evaluation(tool.parameters(), kind, common),
             };
             MixedResult {
                 index,

@@ -110,7 +110,7 @@ pub fn read_columns(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::mixed::ModelKind;
+    use crate::registry::ModelKind;
 
     fn numbers(name: &str, v: &[f64]) -> (String, Column) {
         (name.into(), Column::Numbers(v.to_vec()))

@@ -1,0 +1,183 @@
+//! What the registry's models return, with the sizes known only at run time: matrices as rows
+//! or flat arrays, trajectories per joint.
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::model::{Metrics, TrajectoryN};
+use crate::Error;
+
+/// A tool's linearisation and confidence with the sizes known only at run time (matrices as
+/// rows): what `toolconf confidence --model` prints.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Linearisation {
+    /// A = ∂f/∂X at the equilibrium.
+    pub a: Vec<Vec<f64>>,
+    /// B = ∂f/∂U at the equilibrium.
+    pub b: Vec<Vec<f64>>,
+    /// The task's sensitivities by name (`d_theta_du`, `d_theta_dot_du`, `d_theta_ddot_du`), the
+    /// terms it uses only.
+    pub sensitivities: Vec<(&'static str, Vec<Vec<f64>>)>,
+    /// Π^U (eq. control_conf).
+    pub pi_u: Vec<Vec<f64>>,
+    pub logdet: f64,
+}
+
+impl Linearisation {
+    /// Every number finite ([`crate::validate::finite_output`]), naming `tool` and the quantity.
+    pub fn check_finite(&self, tool: &dyn std::fmt::Display) -> Result<(), Error> {
+        use crate::validate::finite_output;
+        let flat = |m: &Vec<Vec<f64>>| m.iter().flatten().copied().collect::<Vec<f64>>();
+        finite_output(tool, "A", flat(&self.a))?;
+        finite_output(tool, "B", flat(&self.b))?;
+        for (_, m) in &self.sensitivities {
+            finite_output(tool, "a sensitivity", flat(m))?;
+        }
+        finite_output(tool, "Π^U", flat(&self.pi_u))?;
+        finite_output(tool, "ln|Π^U|", [self.logdet])
+    }
+}
+
+/// `m` as rows.
+pub(super) fn rows<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> Vec<Vec<f64>> {
+    (0..R)
+        .map(|i| (0..C).map(|j| m[(i, j)]).collect())
+        .collect()
+}
+
+/// One episode of a tool of any model: its metrics, the constant torque perturbation on each
+/// joint, and the trajectory if it was recorded.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AnyEpisode {
+    pub metrics: Metrics,
+    pub perturbation: Vec<f64>,
+    pub trajectory: Option<TrajectoryTable>,
+}
+
+/// A trajectory on the output grid with the joint count known only at run time:
+/// `theta[j][i]` is joint j at `t[i]`, and likewise θ̇, θ̈ (the plant's) and U.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrajectoryTable {
+    pub t: Vec<f64>,
+    pub theta: Vec<Vec<f64>>,
+    pub theta_dot: Vec<Vec<f64>>,
+    pub theta_ddot: Vec<Vec<f64>>,
+    pub u: Vec<Vec<f64>>,
+}
+
+impl TrajectoryTable {
+    /// The table of a trajectory with N joints known at compile time.
+    pub fn from_trajectory<const N: usize>(tr: &TrajectoryN<N>) -> Self {
+        TrajectoryTable {
+            t: tr.t.clone(),
+            theta: per_joint(&tr.theta),
+            theta_dot: per_joint(&tr.theta_dot),
+            theta_ddot: per_joint(&tr.theta_ddot),
+            u: per_joint(&tr.u),
+        }
+    }
+
+    /// As CSV: `t`, then θ, θ̇, θ̈ and U of each joint (`theta1, …, u<n>`), one row per time.
+    pub fn to_csv(&self) -> String {
+        // (prefix, suffix, values): the columns theta1, …, theta1_dot, …, u<n>.
+        let blocks = [
+            ("theta", "", &self.theta),
+            ("theta", "_dot", &self.theta_dot),
+            ("theta", "_ddot", &self.theta_ddot),
+            ("u", "", &self.u),
+        ];
+        let mut header = vec!["t".to_string()];
+        for (prefix, suffix, block) in blocks {
+            header.extend((1..=block.len()).map(|j| format!("{prefix}{j}{suffix}")));
+        }
+        let mut out = header.join(",") + "\n";
+        for i in 0..self.t.len() {
+            let mut row = vec![self.t[i].to_string()];
+            for (_, _, block) in blocks {
+                row.extend(block.iter().map(|joint| joint[i].to_string()));
+            }
+            out += &(row.join(",") + "\n");
+        }
+        out
+    }
+}
+
+/// `series[i][j]` (time i, joint j) as `out[j][i]`.
+pub(super) fn per_joint<const N: usize>(series: &[SVector<f64, N>]) -> Vec<Vec<f64>> {
+    (0..N)
+        .map(|j| series.iter().map(|v| v[j]).collect())
+        .collect()
+}
+
+/// The task variable of one episode on the output grid, per joint, with the goal.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TaskTrace {
+    pub t: Vec<f64>,
+    /// `value[j][i]`: joint j at `t[i]`.
+    pub value: Vec<Vec<f64>>,
+    pub goal: Vec<f64>,
+}
+
+/// Why a batch over many tools or states gave no result.
+#[derive(Debug)]
+pub enum BatchError {
+    /// Tool `i` (in the order given) is bad or its result is not finite.
+    Tool(usize, Error),
+    /// Bad input other than a tool's parameters, in words.
+    Input(String),
+    /// The output, `bytes` long, cannot be allocated: an error to report, never an abort.
+    OutOfMemory { bytes: usize },
+}
+
+/// An empty vector with room for `n` values, or [`BatchError::OutOfMemory`] of `total` values
+/// (what the whole output needs, not only this part of it).
+pub(super) fn room<T>(n: usize, total: usize) -> Result<Vec<T>, BatchError> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n)
+        .map_err(|_| BatchError::OutOfMemory {
+            bytes: total.saturating_mul(std::mem::size_of::<T>()),
+        })?;
+    Ok(v)
+}
+
+/// The linearisation and confidence of k tools, each array flat in C order (tool, row, column).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Confidences {
+    pub k: usize,
+    pub n: usize,
+    pub nx: usize,
+    /// A = ∂f/∂X at the equilibrium (k × NX × NX).
+    pub a: Vec<f64>,
+    /// B = ∂f/∂U at the equilibrium (k × NX × N).
+    pub b: Vec<f64>,
+    /// The task's sensitivities by name (each k × N × N); a term the task does not use is absent.
+    pub sensitivities: Vec<(&'static str, Vec<f64>)>,
+    /// Π^U (k × N × N).
+    pub pi_u: Vec<f64>,
+    /// ln|Π^U| (k).
+    pub logdet: Vec<f64>,
+}
+
+/// Appends `m` to `out` in C order (row by row; nalgebra stores columns).
+pub(super) fn push_c_order<const R: usize, const C: usize>(
+    out: &mut Vec<f64>,
+    m: &SMatrix<f64, R, C>,
+) {
+    out.extend((0..R).flat_map(|i| (0..C).map(move |j| m[(i, j)])));
+}
+
+/// One argument of a batch, a run-time matrix of `width` columns: one row shared by every
+/// item, or one row per item.
+#[derive(Debug, Clone, Copy)]
+pub struct Rows<'a> {
+    pub data: &'a [f64],
+    pub width: usize,
+    pub shared: bool,
+}
+
+impl Rows<'_> {
+    /// Item `i`'s row.
+    pub fn row(&self, i: usize) -> &[f64] {
+        let i = if self.shared { 0 } else { i };
+        &self.data[i * self.width..(i + 1) * self.width]
+    }
+}
