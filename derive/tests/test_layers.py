@@ -16,7 +16,7 @@ from pathlib import Path
 DERIVE = Path(__file__).resolve().parent.parent
 PACKAGE = DERIVE / "toolconf_derive"
 # The modules below the description readers: they import nothing of the package.
-LEAVES = ("errors", "expression")
+LEAVES = ("errors", "expression", "quantities")
 
 
 @functools.cache
