@@ -17,6 +17,19 @@ DERIVE = Path(__file__).resolve().parent.parent
 PACKAGE = DERIVE / "toolconf_derive"
 # The modules below the description readers: they import nothing of the package.
 LEAVES = ("errors", "expression", "quantities")
+# The README's picture of the layers ("The pipeline"), top to bottom: a module imports only from
+# the rows below its own.
+LAYERS = (
+    ("urdf_functions",),
+    ("ir", "report", "urdf_model"),
+    ("functions", "hoist", "sequence"),
+    ("symbolic", "numeric", "rigid_body"),
+    ("description",),
+    ("urdf_description",),
+    ("urdf",),
+    ("files",),
+    ("errors", "quantities", "expression", "exact", "chain", "cost", "crosscheck", "ir_types", "rust_printer"),
+)
 
 
 @functools.cache
@@ -103,6 +116,13 @@ class Layers(unittest.TestCase):
         graph = package_graph()
         for leaf in LEAVES:
             self.assertEqual(graph[leaf], set(), f"{leaf}.py is a leaf module")
+
+    def test_each_module_imports_only_from_the_layers_below(self):
+        row = {m: len(LAYERS) - i for i, layer in enumerate(LAYERS) for m in layer}
+        self.assertEqual(sorted(row), sorted(package_modules()), "every module has one row in LAYERS")
+        upward = [f"{m} -> {i}" for m, imported in package_graph().items() for i in sorted(imported)
+                  if row[i] >= row[m]]
+        self.assertEqual(upward, [], "an import from the same or a higher layer")
 
     def test_the_description_reader_is_below_the_urdf_rules(self):
         graph = package_graph()

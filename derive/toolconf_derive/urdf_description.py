@@ -22,6 +22,54 @@ URDF_KEYS = {
     "impedance": (("stiffness", "numbers", True), ("damping", "numbers", True), ("source", "string", False)),
     "tool": (("com_bound", "number", False), ("sample", "table", False), ("source", "string", False)),
 }
+# A URDF arm's gravity (m/s^2) and joint impedance gains (N m/rad, N m s/rad): physical ranges.
+MAX_GRAVITY = 1e3
+MAX_GAIN = 1e6
+
+
+def urdf_names(path: Path, top: Table):
+    """Kind "urdf": the chain from the URDF file, the tool's parameters (TOOL_PARAMETERS) and the
+    coordinates named after the URDF's joints: q = the joint positions, U = their torques; with
+    the model's URDF fields (its chain, gravity, impedance and tool rule)."""
+    for key in ("parameters", "coordinates"):
+        if key in top.raw:
+            raise DescriptionError(path, key, "not allowed for dynamics.kind = 'urdf': the tool's parameters and the "
+                                              "URDF's joints define them")
+    for key in ("urdf", "impedance"):
+        if key not in top.raw:
+            raise DescriptionError(path, key, "missing (required for dynamics.kind = 'urdf')")
+    urdf = top.table("urdf", URDF_KEYS["urdf"])
+    imp = top.table("impedance", URDF_KEYS["impedance"])
+    if len(urdf.get("gravity")) != 3:
+        raise DescriptionError(path, "urdf.gravity", f"must be 3 numbers (m/s^2, in the base frame), got {urdf.get('gravity')!r}")
+    for i, g in enumerate(urdf.get("gravity")):
+        if abs(g) > MAX_GRAVITY:
+            raise DescriptionError(path, f"urdf.gravity[{i}]", f"{g!r} is outside [-{MAX_GRAVITY:g}, {MAX_GRAVITY:g}] m/s^2")
+    chain = read_chain(Path(os.path.normpath(path.parent / urdf.get("file"))), urdf.get("base"), urdf.get("flange"))
+    dof = top.raw["model"]["dof"]
+    if dof != chain.dof:
+        raise DescriptionError(path, "model.dof", f"is {dof}, the chain from '{chain.base}' to '{chain.flange}' "
+                                                  f"has {chain.dof} moving joints")
+    for key in ("stiffness", "damping"):
+        values = imp.get(key)
+        if len(values) != chain.dof:
+            raise DescriptionError(path, f"impedance.{key}", f"has {len(values)} entries, the chain from "
+                                                             f"'{chain.base}' to '{chain.flange}' has {chain.dof} joints")
+        for i, v in enumerate(values):
+            if not 0 <= v <= MAX_GAIN:
+                raise DescriptionError(path, f"impedance.{key}[{i}]",
+                                       f"{v!r} is not within [0, {MAX_GAIN:g}] ({chain.joint_names[i]})")
+    q = [Named(j, rf"q_{{{i + 1}}}", "rad" if b.kind == "revolute" else "m", f"position of joint {j}")
+         for i, (j, b) in enumerate(zip(chain.joint_names, chain.bodies))]
+    q_dot = [Named(f"{j}_dot", rf"\dot{{q}}_{{{i + 1}}}") for i, j in enumerate(chain.joint_names)]
+    u = [Named(f"{j}_torque", rf"U_{{{i + 1}}}") for i, j in enumerate(chain.joint_names)]
+    extra = {"chain": chain, "urdf_gravity": [float(g) for g in urdf.get("gravity")],
+             "impedance_stiffness": [float(v) for v in imp.get("stiffness")],
+             "impedance_damping": [float(v) for v in imp.get("damping")],
+             "impedance_source": imp.get("source", ""),
+             "tool_rule": tool_rule(path, top.table("tool", URDF_KEYS["tool"]))}
+    return list(TOOL_PARAMETERS), q, q_dot, u, extra
+
 
 TOOL_PARAMETERS = [
     Named("tool_mass", "m_t", "kg", "mass of the tool"),
@@ -100,52 +148,3 @@ def _inside(value: float, domain: dict) -> bool:
     above = lo is None or (value > lo if domain["lo_open"] else value >= lo)
     below = hi is None or (value < hi if domain["hi_open"] else value <= hi)
     return above and below
-
-
-# A URDF arm's gravity (m/s^2) and joint impedance gains (N m/rad, N m s/rad): physical ranges.
-MAX_GRAVITY = 1e3
-MAX_GAIN = 1e6
-
-
-def urdf_names(path: Path, top: Table):
-    """Kind "urdf": the chain from the URDF file, the tool's parameters (TOOL_PARAMETERS) and the
-    coordinates named after the URDF's joints: q = the joint positions, U = their torques; with
-    the model's URDF fields (its chain, gravity, impedance and tool rule)."""
-    for key in ("parameters", "coordinates"):
-        if key in top.raw:
-            raise DescriptionError(path, key, "not allowed for dynamics.kind = 'urdf': the tool's parameters and the "
-                                              "URDF's joints define them")
-    for key in ("urdf", "impedance"):
-        if key not in top.raw:
-            raise DescriptionError(path, key, "missing (required for dynamics.kind = 'urdf')")
-    urdf = top.table("urdf", URDF_KEYS["urdf"])
-    imp = top.table("impedance", URDF_KEYS["impedance"])
-    if len(urdf.get("gravity")) != 3:
-        raise DescriptionError(path, "urdf.gravity", f"must be 3 numbers (m/s^2, in the base frame), got {urdf.get('gravity')!r}")
-    for i, g in enumerate(urdf.get("gravity")):
-        if abs(g) > MAX_GRAVITY:
-            raise DescriptionError(path, f"urdf.gravity[{i}]", f"{g!r} is outside [-{MAX_GRAVITY:g}, {MAX_GRAVITY:g}] m/s^2")
-    chain = read_chain(Path(os.path.normpath(path.parent / urdf.get("file"))), urdf.get("base"), urdf.get("flange"))
-    dof = top.raw["model"]["dof"]
-    if dof != chain.dof:
-        raise DescriptionError(path, "model.dof", f"is {dof}, the chain from '{chain.base}' to '{chain.flange}' "
-                                                  f"has {chain.dof} moving joints")
-    for key in ("stiffness", "damping"):
-        values = imp.get(key)
-        if len(values) != chain.dof:
-            raise DescriptionError(path, f"impedance.{key}", f"has {len(values)} entries, the chain from "
-                                                             f"'{chain.base}' to '{chain.flange}' has {chain.dof} joints")
-        for i, v in enumerate(values):
-            if not 0 <= v <= MAX_GAIN:
-                raise DescriptionError(path, f"impedance.{key}[{i}]",
-                                       f"{v!r} is not within [0, {MAX_GAIN:g}] ({chain.joint_names[i]})")
-    q = [Named(j, rf"q_{{{i + 1}}}", "rad" if b.kind == "revolute" else "m", f"position of joint {j}")
-         for i, (j, b) in enumerate(zip(chain.joint_names, chain.bodies))]
-    q_dot = [Named(f"{j}_dot", rf"\dot{{q}}_{{{i + 1}}}") for i, j in enumerate(chain.joint_names)]
-    u = [Named(f"{j}_torque", rf"U_{{{i + 1}}}") for i, j in enumerate(chain.joint_names)]
-    extra = {"chain": chain, "urdf_gravity": [float(g) for g in urdf.get("gravity")],
-             "impedance_stiffness": [float(v) for v in imp.get("stiffness")],
-             "impedance_damping": [float(v) for v in imp.get("damping")],
-             "impedance_source": imp.get("source", ""),
-             "tool_rule": tool_rule(path, top.table("tool", URDF_KEYS["tool"]))}
-    return list(TOOL_PARAMETERS), q, q_dot, u, extra
