@@ -20,7 +20,8 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 from toolconf_derive.crosscheck import DerivationMismatch  # noqa: E402
-from toolconf_derive.description import DescriptionError, load_model, load_tasks  # noqa: E402
+from toolconf_derive.description import load_model, load_tasks  # noqa: E402
+from toolconf_derive.errors import DescriptionError  # noqa: E402
 from toolconf_derive.functions import build_functions  # noqa: E402
 from toolconf_derive.exact import ExactEvaluationError  # noqa: E402
 from toolconf_derive.ir import IR_SCHEMA, model_ir, vectors_document  # noqa: E402

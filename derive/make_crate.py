@@ -40,7 +40,9 @@ import tempfile
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from toolconf_derive.description import RUST_KEYWORDS, DescriptionError, load_tasks, read_toml
+from toolconf_derive.description import RUST_KEYWORDS, load_tasks
+from toolconf_derive.errors import DescriptionError
+from toolconf_derive.files import read_toml
 
 ROOT = Path(__file__).resolve().parent.parent
 TASKS = ROOT / "derive" / "tasks.toml"

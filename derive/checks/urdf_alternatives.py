@@ -27,7 +27,7 @@ sys.path.insert(0, str(HERE))
 from toolconf_derive.description import load_model, load_tasks  # noqa: E402
 from toolconf_derive.rigid_body import aba  # noqa: E402
 from toolconf_derive.sequence import instructions  # noqa: E402
-from toolconf_derive.urdf_model import UrdfDerivation  # noqa: E402
+from toolconf_derive.urdf_model import UrdfDerivation, _sample_tool  # noqa: E402
 
 
 def rust_function(name: str, f: ca.Function, args: list[tuple[str, int]], outputs: list[tuple[str, int, int]]) -> str:
@@ -94,7 +94,6 @@ def main() -> int:
     (out / "src" / "trig.rs").write_text(trig)
     # The coefficients of a few tools, computed here (CasADi, double), for the timing inputs.
     import numpy as np
-    from toolconf_derive.urdf_model import _sample_tool
     rng = np.random.default_rng(1)
     tools = []
     for _ in range(16):

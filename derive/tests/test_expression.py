@@ -27,12 +27,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from toolconf_derive.description import (  # noqa: E402
     FORMULA_NAMES,
-    DescriptionError,
     Task,
     load_model,
     load_tasks,
     task_formula,
 )
+from toolconf_derive.errors import DescriptionError  # noqa: E402
 from toolconf_derive.expression import (  # noqa: E402
     MAX_CHARACTERS,
     MAX_DEPTH,

@@ -27,7 +27,8 @@ from hypothesis import strategies as st
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from toolconf_derive.description import DescriptionError, load_model, load_tasks, sensitivity  # noqa: E402
+from toolconf_derive.description import load_model, load_tasks, sensitivity  # noqa: E402
+from toolconf_derive.errors import DescriptionError  # noqa: E402
 from toolconf_derive.numeric import CasadiModel  # noqa: E402
 from toolconf_derive.symbolic import parse  # noqa: E402
 from toolconf_derive.urdf import read_chain  # noqa: E402

@@ -23,12 +23,9 @@ from hypothesis import strategies as st
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from toolconf_derive.description import (  # noqa: E402
-    MAX_DESCRIPTION_BYTES,
-    DescriptionError,
-    load_model,
-    load_tasks,
-)
+from toolconf_derive.description import load_model, load_tasks  # noqa: E402
+from toolconf_derive.errors import DescriptionError  # noqa: E402
+from toolconf_derive.files import MAX_DESCRIPTION_BYTES  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 BASES = {

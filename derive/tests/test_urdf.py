@@ -29,7 +29,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "derive"))
 
-from toolconf_derive.description import DescriptionError, load_model, load_tasks  # noqa: E402
+from toolconf_derive.description import load_model, load_tasks  # noqa: E402
+from toolconf_derive.errors import DescriptionError  # noqa: E402
 from toolconf_derive.numeric import CasadiModel  # noqa: E402
 from toolconf_derive.rigid_body import ChainDynamics, ldl_apply, ldl_factor  # noqa: E402
 from toolconf_derive.urdf import read_chain  # noqa: E402

@@ -9,47 +9,15 @@ cross-check independent.
 from __future__ import annotations
 
 import math
-import os
 import re
-import stat
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .errors import DescriptionError
 from .expression import FORMULA_FUNCTIONS, Expression, ExpressionError, formula, parse, python_number
-
-
-class DescriptionError(ValueError):
-    """A model or task description that cannot be used: one line naming the file, the key and
-    the problem (derive.py prints it and exits with status 2)."""
-
-    def __init__(self, path: Path | str, key: str, problem: str):
-        self.path, self.key, self.problem = str(path), key, problem
-        # One line whatever the problem quotes (equations may span lines in the TOML), and short
-        # whatever it repeats (a key or value of 100 kB is shown by its start and length).
-        key, problem = clip(one_line(key), 80), clip(one_line(problem), 300)
-        super().__init__(f"{path}: {key}: {problem}" if key else f"{path}: {problem}")
-
-
-def one_line(text: str) -> str:
-    return " ".join(text.split())
-
-
-def clip(text: str, most: int) -> str:
-    return text if len(text) <= most else f"{text[:most]}… ({len(text)} characters)"
-
-
-@dataclass(frozen=True)
-class Named:
-    name: str
-    latex: str
-    unit: str = ""
-    doc: str = ""
-
-
-@dataclass(frozen=True)
-class Constant(Named):
-    value: float = 0.0
+from .files import Table, read_toml
+from .quantities import Constant, Named
+from .urdf_description import URDF_KEYS, urdf_names
 
 
 @dataclass(frozen=True)
@@ -85,7 +53,7 @@ class Model:
     impedance_stiffness: list[float] = field(default_factory=list)
     impedance_damping: list[float] = field(default_factory=list)
     impedance_source: str = ""
-    # urdf: which tools are valid and the box random tools are drawn from (urdf_model.tool_rule:
+    # urdf: which tools are valid and the box random tools are drawn from (urdf_description.tool_rule:
     # per-parameter domains, linear constraints, sampling box), for the IR's model.tool_rule.
     # None for the other kinds: their parameters are masses, lengths, ... (> 0, drawn from the
     # paper's [0.1, 0.6]), the renderer's default (derive/render).
@@ -179,13 +147,10 @@ MODEL_KEYS = {
     "link": (("mass", "string", True), ("length", "string", True)),
     "equilibrium": (("q", "values", True), ("q_dot", "values", True), ("u", "values", True)),
     "printed": (("where", "string", False), ("A", "matrix", False), ("B", "matrix", False)),
-    "urdf": (("file", "string", True), ("base", "string", True), ("flange", "string", True),
-             ("gravity", "numbers", True), ("source", "string", False)),
-    "impedance": (("stiffness", "numbers", True), ("damping", "numbers", True), ("source", "string", False)),
-    "tool": (("com_bound", "number", False), ("sample", "table", False), ("source", "string", False)),
+    **URDF_KEYS,
 }
 # parameters and coordinates are required except for kind "urdf", where the URDF and the tool
-# define them (_urdf_names).
+# define them (urdf_description.urdf_names).
 TOP_KEYS = (("model", "table", True), ("parameters", "tables", False), ("constants", "table", False),
             ("coordinates", "table", False), ("dynamics", "table", True), ("equilibrium", "table", True),
             ("goals", "table", False), ("printed", "table", False), ("urdf", "table", False),
@@ -198,132 +163,11 @@ DEFAULTS_KEYS = (("precision", "table", True),)
 REMARK_KEYS = (("term", "string", True), ("alternative", "string", True), ("text", "string", True))
 
 
-def _is_matrix(v) -> bool:
-    return isinstance(v, list) and all(isinstance(r, list) and all(isinstance(x, str) for x in r) for r in v)
-
-
-_TYPES = {
-    "string": ("a string", lambda v: isinstance(v, str)),
-    "integer": ("an integer", lambda v: isinstance(v, int) and not isinstance(v, bool)),
-    "number": ("a number", lambda v: isinstance(v, (int, float)) and not isinstance(v, bool)),
-    "table": ("a table", lambda v: isinstance(v, dict)),
-    "tables": ("an array of tables", lambda v: isinstance(v, list) and all(isinstance(x, dict) for x in v)),
-    "strings": ("an array of strings", lambda v: isinstance(v, list) and all(isinstance(x, str) for x in v)),
-    "values": ("an array of numbers or expression strings",
-               lambda v: isinstance(v, list) and all(isinstance(x, (str, int, float)) and not isinstance(x, bool)
-                                                     for x in v)),
-    "matrix": ("an array of rows of expression strings", _is_matrix),
-    "numbers": ("an array of finite numbers",
-                lambda v: isinstance(v, list) and all(isinstance(x, (int, float)) and not isinstance(x, bool)
-                                                      and math.isfinite(x) for x in v)),
-}
-
-
-class _Table:
-    """One TOML table being read: unknown keys, missing keys and wrong types stop the derivation
-    with the file and the key's full name (e.g. `coordinates.q[1].latex`)."""
-
-    def __init__(self, path: Path, key: str, raw, spec: tuple):
-        self.path, self.key = path, key
-        if not isinstance(raw, dict):
-            raise DescriptionError(path, key, "must be a table")
-        known = [k for k, _, _ in spec]
-        for k in raw:
-            if k not in known:
-                raise DescriptionError(path, self.sub(k), f"unknown key (known here: {', '.join(known)})")
-        for k, kind, required in spec:
-            if k not in raw:
-                if required:
-                    raise DescriptionError(path, self.sub(k), "missing (required)")
-                continue
-            name, ok = _TYPES[kind]
-            if not ok(raw[k]):
-                raise DescriptionError(path, self.sub(k), f"must be {name}, got {raw[k]!r}")
-        self.raw = raw
-
-    def sub(self, k: str) -> str:
-        return f"{self.key}.{k}" if self.key else k
-
-    def get(self, k: str, default=None):
-        return self.raw.get(k, default)
-
-    def table(self, k: str, spec: tuple) -> "_Table":
-        return _Table(self.path, self.sub(k), self.raw.get(k, {}), spec)
-
-    def tables(self, k: str, spec: tuple) -> list["_Table"]:
-        return [_Table(self.path, f"{self.sub(k)}[{i}]", t, spec) for i, t in enumerate(self.raw.get(k, []))]
-
-
-# The largest description file read (a model is a few kB): `/dev/zero` or a stray large file is
-# one line and status 2, not an exhausted memory.
-MAX_DESCRIPTION_BYTES = 1 << 20
-
-
-def _not_a_file(mode: int) -> str | None:
-    """What a file of this mode is when it is not a regular file (read, it would block or never end)."""
-    for test, what in ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO"), (stat.S_ISSOCK, "a socket"),
-                       (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device")):
-        if test(mode):
-            return what
-    return None if stat.S_ISREG(mode) else "not a regular file"
-
-
-def read_text(path: Path | str, limit: int, what: str) -> str:
-    """The UTF-8 text of the regular file `path`, at most `limit` bytes. Opened without blocking
-    (a FIFO's open would wait for a writer) and checked on the opened descriptor (what is read is
-    what was checked); a folder, FIFO, socket or device, a larger file, an unreadable one or one
-    that is not UTF-8 is a DescriptionError saying so, with `what` the file is meant to be."""
-    try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
-    except OSError as err:
-        try:
-            kind = _not_a_file(os.stat(path).st_mode)
-        except OSError:
-            kind = None
-        problem = f"{kind}, not {what}" if kind else f"cannot read: {err.strerror}"
-        raise DescriptionError(path, "", problem) from err
-    try:
-        kind = _not_a_file(os.fstat(fd).st_mode)
-        if kind:
-            raise DescriptionError(path, "", f"{kind}, not {what}")
-        chunks, total = [], 0
-        while total <= limit:
-            chunk = os.read(fd, min(1 << 16, limit + 1 - total))
-            if not chunk:
-                break
-            chunks.append(chunk)
-            total += len(chunk)
-    except OSError as err:
-        raise DescriptionError(path, "", f"cannot read: {err.strerror}") from err
-    finally:
-        os.close(fd)
-    if total > limit:
-        raise DescriptionError(path, "", f"larger than {limit} bytes ({limit / (1 << 20):g} MiB), more than "
-                                         f"{what} needs")
-    data = b"".join(chunks)
-    try:
-        return data.decode("utf-8")
-    except UnicodeDecodeError as err:
-        raise DescriptionError(path, "", f"not UTF-8 text: {err.reason} at byte {err.start}") from err
-
-
-def read_toml(path: Path, what: str = "a description file") -> dict:
-    """The parsed file (read_text's rules); a TOML syntax error is a DescriptionError."""
-    text = read_text(path, MAX_DESCRIPTION_BYTES, what)
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        raise DescriptionError(path, "", f"not valid TOML: {err}") from err
-    except RecursionError as err:
-        # tomllib recurses once per nested array or table: `q = [[[[…` thousands deep.
-        raise DescriptionError(path, "", "nested too deeply to be a description") from err
-
-
-def _named(t: _Table) -> Named:
+def _named(t: Table) -> Named:
     return Named(name=t.get("name"), latex=t.get("latex", t.get("name")), unit=t.get("unit", ""), doc=t.get("doc", ""))
 
 
-def _constants(top: _Table) -> list[Constant]:
+def _constants(top: Table) -> list[Constant]:
     table = top.table("constants", tuple((k, "table", True) for k in top.get("constants", {})))
     out = []
     for name in table.raw:
@@ -333,7 +177,7 @@ def _constants(top: _Table) -> list[Constant]:
     return out
 
 
-def _goals(top: _Table) -> dict[str, dict[str, list[str]]]:
+def _goals(top: Table) -> dict[str, dict[str, list[str]]]:
     goals = top.table("goals", tuple((k, "table", True) for k in top.get("goals", {})))
     out = {}
     for task in goals.raw:
@@ -343,13 +187,13 @@ def _goals(top: _Table) -> dict[str, dict[str, list[str]]]:
 
 
 def load_model(path: Path) -> Model:
-    top = _Table(path, "", read_toml(path), TOP_KEYS)
+    top = Table(path, "", read_toml(path), TOP_KEYS)
     m = top.table("model", MODEL_KEYS["model"])
     dyn = top.table("dynamics", MODEL_KEYS["dynamics"])
     eq = top.table("equilibrium", MODEL_KEYS["equilibrium"])
     printed = top.table("printed", MODEL_KEYS["printed"])
     if dyn.get("kind") == "urdf":
-        parameters, q, q_dot, u, urdf = _urdf_names(path, top)
+        parameters, q, q_dot, u, urdf = urdf_names(path, top)
     else:
         for key in ("parameters", "coordinates"):
             if key not in top.raw:
@@ -389,56 +233,6 @@ def load_model(path: Path) -> Model:
     )
     _validate_model(model)
     return model
-
-
-# A URDF arm's gravity (m/s^2) and joint impedance gains (N m/rad, N m s/rad): physical ranges.
-MAX_GRAVITY = 1e3
-MAX_GAIN = 1e6
-
-
-def _urdf_names(path: Path, top: _Table):
-    """Kind "urdf": the chain from the URDF file, the tool's parameters (urdf_model.TOOL_PARAMETERS)
-    and the coordinates named after the URDF's joints: q = the joint positions, U = their torques."""
-    from .urdf import read_chain
-    from .urdf_model import TOOL_PARAMETERS, tool_rule
-    for key in ("parameters", "coordinates"):
-        if key in top.raw:
-            raise DescriptionError(path, key, "not allowed for dynamics.kind = 'urdf': the tool's parameters and the "
-                                              "URDF's joints define them")
-    for key in ("urdf", "impedance"):
-        if key not in top.raw:
-            raise DescriptionError(path, key, "missing (required for dynamics.kind = 'urdf')")
-    urdf = top.table("urdf", MODEL_KEYS["urdf"])
-    imp = top.table("impedance", MODEL_KEYS["impedance"])
-    if len(urdf.get("gravity")) != 3:
-        raise DescriptionError(path, "urdf.gravity", f"must be 3 numbers (m/s^2, in the base frame), got {urdf.get('gravity')!r}")
-    for i, g in enumerate(urdf.get("gravity")):
-        if abs(g) > MAX_GRAVITY:
-            raise DescriptionError(path, f"urdf.gravity[{i}]", f"{g!r} is outside [-{MAX_GRAVITY:g}, {MAX_GRAVITY:g}] m/s^2")
-    chain = read_chain(Path(os.path.normpath(path.parent / urdf.get("file"))), urdf.get("base"), urdf.get("flange"))
-    dof = top.raw["model"]["dof"]
-    if dof != chain.dof:
-        raise DescriptionError(path, "model.dof", f"is {dof}, the chain from '{chain.base}' to '{chain.flange}' "
-                                                  f"has {chain.dof} moving joints")
-    for key in ("stiffness", "damping"):
-        values = imp.get(key)
-        if len(values) != chain.dof:
-            raise DescriptionError(path, f"impedance.{key}", f"has {len(values)} entries, the chain from "
-                                                             f"'{chain.base}' to '{chain.flange}' has {chain.dof} joints")
-        for i, v in enumerate(values):
-            if not 0 <= v <= MAX_GAIN:
-                raise DescriptionError(path, f"impedance.{key}[{i}]",
-                                       f"{v!r} is not within [0, {MAX_GAIN:g}] ({chain.joint_names[i]})")
-    q = [Named(j, rf"q_{{{i + 1}}}", "rad" if b.kind == "revolute" else "m", f"position of joint {j}")
-         for i, (j, b) in enumerate(zip(chain.joint_names, chain.bodies))]
-    q_dot = [Named(f"{j}_dot", rf"\dot{{q}}_{{{i + 1}}}") for i, j in enumerate(chain.joint_names)]
-    u = [Named(f"{j}_torque", rf"U_{{{i + 1}}}") for i, j in enumerate(chain.joint_names)]
-    extra = {"chain": chain, "urdf_gravity": [float(g) for g in urdf.get("gravity")],
-             "impedance_stiffness": [float(v) for v in imp.get("stiffness")],
-             "impedance_damping": [float(v) for v in imp.get("damping")],
-             "impedance_source": imp.get("source", ""),
-             "tool_rule": tool_rule(path, top.table("tool", MODEL_KEYS["tool"]))}
-    return list(TOOL_PARAMETERS), q, q_dot, u, extra
 
 
 def _check_identifier(name: str, path: Path, key: str) -> None:
@@ -527,7 +321,7 @@ def _validate_dynamics(m: Model) -> None:
         if m.gravity not in {c.name for c in m.constants}:
             raise DescriptionError(path, "dynamics.gravity", f"must name a constant, got {m.gravity!r}")
     elif m.dynamics_kind == "urdf":
-        pass  # checked against the URDF when it was read (_urdf_names)
+        pass  # checked against the URDF when it was read (urdf_description)
     else:
         raise DescriptionError(path, "dynamics.kind",
                                f"'{m.dynamics_kind}' is not known (known: explicit, planar_chain, urdf)")
@@ -540,7 +334,7 @@ def _validate_model(m: Model) -> None:
     _validate_expressions(m)
 
 
-def _task(path: Path, t: _Table) -> Task:
+def _task(path: Path, t: Table) -> Task:
     terms = list(t.get("terms"))
     for i, term in enumerate(terms):
         if term not in KNOWN_TERMS:
@@ -566,7 +360,7 @@ def _task(path: Path, t: _Table) -> Task:
 
 
 def load_tasks(path: Path) -> list[Task]:
-    top = _Table(path, "", read_toml(path, "a task file"), (("task", "tables", True),))
+    top = Table(path, "", read_toml(path, "a task file"), (("task", "tables", True),))
     tasks = [_task(path, t) for t in top.tables("task", TASK_KEYS)]
     for t in tasks:
         _validate_task_expressions(path, t)

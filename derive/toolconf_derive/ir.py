@@ -11,7 +11,8 @@ import sympy as sp
 from . import ir_types as irt
 from .cost import cost, total
 from .crosscheck import check_against_casadi
-from .description import DescriptionError, name_keys, rust_constant
+from .description import name_keys, rust_constant
+from .errors import DescriptionError
 from .expression import sympy_expression
 from .functions import Arg, Function
 from .hoist import hoist

@@ -102,7 +102,7 @@ class ToolRule:
 
     @classmethod
     def of(cls, rule: dict) -> "ToolRule":
-        """The rule urdf_model.tool_rule gives as a dict."""
+        """The rule urdf_description.tool_rule gives as a dict."""
         return cls(domains=[Domain(**d) for d in rule["domains"]],
                    constraints=[Constraint(**c) for c in rule["constraints"]],
                    sample=rule["sample"], source=rule["source"])

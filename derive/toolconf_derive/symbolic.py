@@ -12,7 +12,8 @@ from dataclasses import dataclass
 import sympy as sp
 
 from .chain import sympy_chain
-from .description import DescriptionError, Model, Task, sensitivity, task_formula
+from .description import Model, Task, sensitivity, task_formula
+from .errors import DescriptionError
 from .expression import ExpressionError, sympy_expression
 
 TERM_LATEX = {

@@ -31,7 +31,8 @@ from pathlib import Path
 
 import mpmath
 
-from .description import DescriptionError, read_text
+from .errors import DescriptionError
+from .files import read_text
 
 DIGITS = 50
 SNAP = mpmath.mpf("1e-9")

@@ -15,10 +15,12 @@ import numpy as np
 
 from . import ir_types as irt
 from .description import Model, sensitivity
+from .errors import DescriptionError
 from .exact import ExactFunction
 from .functions import _sample_control, _sample_precision, _sample_state, TERM_DOC
-from .ir import _rust_type, _struct_name
+from .ir import _rust_type, _struct_name, model_document
 from .rigid_body import ldl_logdet
+from .rust_printer import float_literal
 from .sequence import as_lets, instruction_count, instructions
 from .urdf_model import AGREEMENT, SeqArg, SeqFunction, SeqOutput, UrdfDerivation, UrdfMismatch, _sample_tool
 
@@ -267,7 +269,6 @@ def report_tool(mass: float, com, sides) -> np.ndarray:
 def singular_joints(dv: UrdfDerivation, p: np.ndarray, name: str) -> None:
     """A is singular exactly when dg/dq + K is: refuse naming the joints of its null space."""
     import mpmath
-    from .description import DescriptionError
     a, b = dv.reference_ab(p)
     n = dv.n
     with mpmath.workdps(50):
@@ -332,13 +333,10 @@ def report_data(dv: UrdfDerivation, functions: list[SeqFunction]) -> irt.UrdfRep
 
 def urdf_documents(model: Model, tasks, generator: irt.Generator, vectors: int, schema: int) -> tuple[irt.Ir, dict]:
     """The IR and the test vectors of a URDF model."""
-    from .ir import model_document
-    from .rust_printer import float_literal
     dv = UrdfDerivation(model, model.chain, tasks)
     residual = dv.reference_dynamics(dv.x_e, dv.u_e, report_tool(*REPORT_TOOLS[1][1:]))[0].to_numpy()
     # Not exactly zero: the graphs' constants were folded in double while they were built.
     if not float(np.max(np.abs(residual))) <= EQUILIBRIUM_RESIDUAL:
-        from .description import DescriptionError
         raise DescriptionError(model.path, "equilibrium", f"not an equilibrium: f(X^e, U^e) = {residual.ravel()}")
     for name, mass, com, sides in REPORT_TOOLS:
         singular_joints(dv, report_tool(mass, com, sides), name)

@@ -28,7 +28,6 @@ constant torque K q^e + g(q^e; p).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Callable
@@ -38,91 +37,12 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from .description import Model, Named, Task, sensitivity
+from .description import Model, Task, sensitivity
 from .exact import DIGITS, Exact, ExactFunction
 from .functions import _grid_uniform
 from .rigid_body import ChainDynamics, aba, ldl_apply, ldl_factor
+from .symbolic import parse
 from .urdf import Chain
-
-TOOL_PARAMETERS = [
-    Named("tool_mass", "m_t", "kg", "mass of the tool"),
-    Named("tool_com_x", "c_x", "m", "tool's centre of mass, x in the flange frame"),
-    Named("tool_com_y", "c_y", "m", "tool's centre of mass, y in the flange frame"),
-    Named("tool_com_z", "c_z", "m", "tool's centre of mass, z in the flange frame"),
-    Named("tool_ixx", "I_{xx}", "kg m^2", "tool's principal moment about its centre of mass, flange x axis"),
-    Named("tool_iyy", "I_{yy}", "kg m^2", "tool's principal moment about its centre of mass, flange y axis"),
-    Named("tool_izz", "I_{zz}", "kg m^2", "tool's principal moment about its centre of mass, flange z axis"),
-]
-# Which tools are valid (generated/src/validity.rs; toolconf-core's ToolN::new refuses the rest)
-# and the box random tools are drawn from (the mixed sampler, the design tests). A rigid body:
-# mass > 0, principal moments > 0 obeying the triangle inequality (the largest at most the sum of
-# the other two, with urdf.py's relative slack for printed decimals), and its centre of mass
-# within `com_bound` of the flange along each axis (a description's `[tool] com_bound`).
-COM_BOUND = 1.0
-TRIANGLE_SLACK = 1e-9
-# A tool of 0.05-3 kg with its centre of mass within 5 cm of the flange axis and up to 25 cm out,
-# moments of a body a few centimetres to 30 cm across (a description's `[tool.sample]`).
-SAMPLE = {"tool_mass": (0.05, 3.0), "tool_com_x": (-0.05, 0.05), "tool_com_y": (-0.05, 0.05),
-          "tool_com_z": (0.0, 0.25), "tool_ixx": (1e-4, 0.02), "tool_iyy": (1e-4, 0.02), "tool_izz": (1e-4, 0.02)}
-_MOMENTS = ("tool_ixx", "tool_iyy", "tool_izz")
-
-
-def tool_rule(path, table) -> dict:
-    """The IR's `model.tool_rule` of a URDF tool: per parameter its domain (lo, hi, open ends;
-    None for no bound) and sampling box, and the linear constraints c . p <= 0 with their text.
-    `table` is the description's `[tool]` (urdf_model's defaults where it is silent)."""
-    from .description import DescriptionError
-    bound = table.get("com_bound", COM_BOUND)
-    # At most the runtime's tool-parameter range (toolconf::validate::TOOL_PARAMETER's 1e6), the
-    # magnitude over which the generated arithmetic is checked finite (tests/parameter_range.rs).
-    if not (isinstance(bound, (int, float)) and math.isfinite(bound) and 0 < bound <= 1e6):
-        raise DescriptionError(path, "tool.com_bound", f"{bound!r} must be a number in (0, 1e6] (m)")
-    names = [p.name for p in TOOL_PARAMETERS]
-    domains = [{"lo": -float(bound), "hi": float(bound), "lo_open": False, "hi_open": False}
-               if n.startswith("tool_com_") else {"lo": 0.0, "hi": None, "lo_open": True, "hi_open": True}
-               for n in names]
-    raw = table.get("sample", {})
-    for key in raw:
-        if key not in names:
-            raise DescriptionError(path, f"tool.sample.{key}", f"unknown parameter (known: {', '.join(names)})")
-    sample = []
-    for name, domain in zip(names, domains):
-        box = raw.get(name, SAMPLE[name])
-        key = f"tool.sample.{name}"
-        if not (isinstance(box, (list, tuple)) and len(box) == 2
-                and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in box)):
-            raise DescriptionError(path, key, f"must be [lo, hi], two finite numbers, got {box!r}")
-        lo, hi = float(box[0]), float(box[1])
-        if not lo < hi:
-            raise DescriptionError(path, key, f"[{lo}, {hi}] is empty or a point (need lo < hi)")
-        if not (_inside(lo, domain) and _inside(hi, domain)):
-            raise DescriptionError(path, key, f"[{lo}, {hi}] leaves the parameter's domain")
-        sample.append([lo, hi])
-    constraints = []
-    for k, moment in enumerate(_MOMENTS):
-        others = [m for m in _MOMENTS if m != moment]
-        coefficients = [0.0] * len(names)
-        coefficients[names.index(moment)] = 1.0
-        for m in others:
-            coefficients[names.index(m)] = -(1.0 + TRIANGLE_SLACK)
-        constraints.append({"coefficients": coefficients,
-                            "text": f"{moment} <= {others[0]} + {others[1]} (triangle inequality of the "
-                                    "principal moments)"})
-    centre = [(lo + hi) / 2 for lo, hi in sample]
-    for c in constraints:
-        if sum(a * x for a, x in zip(c["coefficients"], centre)) > 0:
-            raise DescriptionError(path, "tool.sample", f"the sampling box's centre violates {c['text']}: random "
-                                                        "tools could not be drawn from it")
-    return {"domains": domains, "constraints": constraints, "sample": sample,
-            "source": table.get("source", "")}
-
-
-def _inside(value: float, domain: dict) -> bool:
-    lo, hi = domain["lo"], domain["hi"]
-    above = lo is None or (value > lo if domain["lo_open"] else value >= lo)
-    below = hi is None or (value < hi if domain["hi_open"] else value <= hi)
-    return above and below
-
 
 # Code and reference graphs, both evaluated exactly, agree to this (normwise relative per output);
 # they differ only by the double rounding of constants folded while the graphs were built.
@@ -558,7 +478,6 @@ class MatrixAlgebra:
 def equilibrium_values(model: Model) -> list[float]:
     """q^e as the doubles nearest the description's values (pi, sqrt... allowed): the same double
     the runtime's EQUILIBRIUM_STATE holds, whose sine and cosine the derivation takes exactly."""
-    from .symbolic import parse
     with mpmath.workdps(DIGITS):
         return [float(mpmath.mpf(sp.N(parse(model, v, {}, f"equilibrium.q[{i}]"), 40)))
                 for i, v in enumerate(model.equilibrium_q)]

@@ -112,7 +112,7 @@ pub struct Equilibrium {
     pub u: Vec<String>,
 }
 
-/// A description's rule for its tools (urdf_model.tool_rule).
+/// A description's rule for its tools (urdf_description.tool_rule).
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ToolRule {
