@@ -1,6 +1,6 @@
 //! Which tools are valid, per model: each tool parameter's domain, the linear constraints across
 //! parameters, and the box random tools are drawn from. A model description states them (a URDF
-//! arm's `[tool]`: derive/toolconf_derive/urdf_model.py's `tool_rule`); a model whose description
+//! arm's `[tool]`: derive/toolconf_derive/urdf_description.py's `tool_rule`); a model whose description
 //! states none takes the planar arms' rule, every parameter finite and > 0, drawn from the paper's
 //! [0.1, 0.6] ("Implementation details"). toolconf-core's `ToolN::new` checks [`ToolRule::check`]
 //! for every tool, so a new description brings its own rule with it.
