@@ -8,7 +8,7 @@
 //!   file or of columns in memory ([`tools`]).
 //! * [`batch`]: `simulate_batch`, the episodes of many tools under many perturbations.
 //! * [`design`]: `toolconf design --json` as a dict.
-//! * [`blocks`]: the steps of `rank` that `toolconf.dask` spreads over a cluster.
+//! * [`dask_steps`]: the steps of `rank` that `toolconf.dask` spreads over a cluster.
 //! * [`dynamics`]: a robot's own rigid-body dynamics Ẋ = [q̇; q̈] for one state or a batch.
 //! * [`task`]: a task given as a built-in name, a task file or a dict with a task file's keys,
 //!   all checked by the crate's task-file parser so errors name the key.
@@ -20,8 +20,8 @@
 
 mod arrays;
 mod batch;
-mod blocks;
 mod confidence;
+mod dask_steps;
 mod design;
 mod dynamics;
 mod errors;
@@ -29,8 +29,8 @@ mod integers;
 mod models;
 mod rank;
 mod simulate;
-mod table;
 mod task;
+mod tool_tables;
 mod tools;
 
 use pyo3::prelude::*;
@@ -54,11 +54,11 @@ fn _toolconf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(batch::simulate_batch, m)?)?;
     m.add_function(wrap_pyfunction!(batch::simulate_batch_block, m)?)?;
     m.add_function(wrap_pyfunction!(design::design, m)?)?;
-    m.add_function(wrap_pyfunction!(blocks::portable_task, m)?)?;
-    m.add_function(wrap_pyfunction!(blocks::screen_block, m)?)?;
-    m.add_function(wrap_pyfunction!(blocks::merge_screens, m)?)?;
-    m.add_function(wrap_pyfunction!(blocks::episodes, m)?)?;
-    m.add_function(wrap_pyfunction!(blocks::rank_table, m)?)?;
+    m.add_function(wrap_pyfunction!(dask_steps::portable_task, m)?)?;
+    m.add_function(wrap_pyfunction!(dask_steps::screen_block, m)?)?;
+    m.add_function(wrap_pyfunction!(dask_steps::merge_screens, m)?)?;
+    m.add_function(wrap_pyfunction!(dask_steps::episodes, m)?)?;
+    m.add_function(wrap_pyfunction!(dask_steps::rank_table, m)?)?;
     m.add_function(wrap_pyfunction!(dynamics::dynamics, m)?)?;
     m.add(
         "SimulationError",

@@ -8,8 +8,8 @@ use toolconf::select::Objective;
 use toolconf::task_file::TaskSpec;
 
 use crate::errors::{detached, Failure};
-use crate::table::{ranked_to_py, Outcome};
 use crate::task::task_spec;
+use crate::tool_tables::{ranked_to_py, Outcome};
 use crate::tools::Tools;
 
 pub fn objective(name: &str) -> Result<Objective, Failure> {

@@ -167,7 +167,7 @@ def design(
     and the ``verification`` episodes; with ``sweep``, the front. Raises ``ValueError`` for
     bad input or infeasible constraints, ``RuntimeError`` for a design that failed."""
 
-# The steps toolconf.dask spreads over a cluster (python/src/blocks.rs); blocks are dicts of
+# The steps toolconf.dask spreads over a cluster (python/src/dask_steps.rs); blocks are dicts of
 # columns (Columns) that pickle exactly.
 
 PortableTask = Union[str, Mapping[str, Any], tuple[str, str, str]]

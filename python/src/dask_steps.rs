@@ -8,7 +8,7 @@
 //! 3. [`episodes`] on the workers: the kept tools' episodes, a block at a time.
 //! 4. [`rank_table`] on the client: the simulated blocks ranked into one table.
 //!
-//! Blocks are dicts of NumPy columns ([`crate::table`]), which pickle exactly. A task file is
+//! Blocks are dicts of NumPy columns ([`crate::tool_tables`]), which pickle exactly. A task file is
 //! sent as its text ([`portable_task`]), so workers need not see the client's files and its
 //! errors still name the file.
 
@@ -19,10 +19,10 @@ use toolconf::task_file::TaskSpec;
 
 use crate::errors::{detached, Failure};
 use crate::rank::{objective, screen_limit};
-use crate::table::{
+use crate::task::{portable_spec, TASK_TEXT};
+use crate::tool_tables::{
     block_to_py, candidates_from_py, candidates_to_py, outcomes_from_py, ranked_to_py, Outcome,
 };
-use crate::task::{portable_spec, TASK_TEXT};
 use crate::tools::Tools;
 
 /// The task as workers can read it: a built-in name or a dict as it is, a task file as
