@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::experiments::common::wants_log;
+use crate::experiments::figure_parts::wants_log;
 use crate::experiments::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use crate::experiments::report::{to_html, to_markdown, Block};
 use crate::experiments::{write_atomically, ReproduceError};

@@ -9,8 +9,8 @@ use crate::stats::{fit_exponential, summary};
 use crate::{Task, TaskKind};
 
 use super::batch::{map_ordered, run_tool, ToolRuns};
-use super::common::{arm_cells, files_block, task_label, wants_log, PAPER_TASKS};
 use super::csv::{Cell, CsvWriter};
+use super::figure_parts::{arm_cells, files_block, task_label, wants_log, PAPER_TASKS};
 use super::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::{negative_correlation_rule, num, Correlation};

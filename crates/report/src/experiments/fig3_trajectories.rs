@@ -10,8 +10,8 @@ use crate::select::draw_tools;
 use crate::{Arm, Task, TaskKind};
 
 use super::batch::map_ordered;
-use super::common::{arm_cells, dt_label, ARM_COLUMNS};
 use super::csv::{Cell, CsvWriter};
+use super::figure_parts::{arm_cells, dt_label, ARM_COLUMNS};
 use super::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::num;

@@ -8,8 +8,8 @@ use crate::select::draw_tools;
 use crate::{Task, TaskKind};
 
 use super::batch::{map_ordered, run_tool};
-use super::common::{arm_cells, dt_label, files_block, task_label, wants_log};
 use super::csv::{Cell, CsvWriter};
+use super::figure_parts::{arm_cells, dt_label, files_block, task_label, wants_log};
 use super::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use super::report::{Block, Section, Verdict};
 use super::verdict::{mean_sd, negative_correlation_rule, Correlation};

@@ -9,8 +9,8 @@ use crate::stats::summary;
 use crate::{Task, TaskKind};
 
 use super::batch::{map_ordered, run_tool, ToolRuns};
-use super::common::{arm_cells, dt_label, files_block, wants_log};
 use super::csv::{Cell, CsvWriter};
+use super::figure_parts::{arm_cells, dt_label, files_block, wants_log};
 use super::plot::{self, diverging, Colour, Legend, Panel, Series, XyPanel};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::{mean_sd, negative_correlation_rule, num, p_value, Comparison, Correlation};

@@ -9,8 +9,8 @@ use crate::select::{draw_tools, evaluate, ToolResult};
 use crate::{Arm, Task, TaskKind};
 
 use super::batch::map_ordered;
-use super::common::{arm_cells, files_block, ARM_COLUMNS};
 use super::csv::{Cell, CsvWriter};
+use super::figure_parts::{arm_cells, files_block, ARM_COLUMNS};
 use super::objectives::{choices, decision_rules, DecisionRule, Trial};
 use super::plot::{self, Colour, GridPanel, Panel};
 use super::report::{Block, Outcome, Section, Verdict};

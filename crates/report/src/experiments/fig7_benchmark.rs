@@ -10,8 +10,8 @@ use crate::stats::summary;
 use crate::{Arm, Task, TaskKind};
 
 use super::batch::map_ordered;
-use super::common::{arm_cells, dt_label, files_block, ARM_COLUMNS};
 use super::csv::{Cell, CsvWriter};
+use super::figure_parts::{arm_cells, dt_label, files_block, ARM_COLUMNS};
 use super::objectives::{choices, decision_rules, DecisionRule, MpcCost, Trial};
 use super::plot::{self, BoxPanel, Panel};
 use super::report::{Block, Outcome, Section, Verdict};

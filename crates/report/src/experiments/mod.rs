@@ -27,7 +27,6 @@
 //! [`objectives::decision_rules`], which the selection experiments (Figs. 6 and 7) iterate over.
 
 pub mod batch;
-pub(crate) mod common;
 /// The CSV writer, the runtime's ([`toolconf::output::csv`]).
 pub use toolconf::output::csv;
 mod exact_plant;
@@ -37,6 +36,7 @@ mod fig4_perturbation_change;
 mod fig5_perturbation_sweep;
 mod fig6_selection_grid;
 mod fig7_benchmark;
+pub(crate) mod figure_parts;
 mod mpc_comparison;
 pub mod objectives;
 pub mod plot;

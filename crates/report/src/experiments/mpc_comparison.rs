@@ -14,8 +14,8 @@ use crate::stats::summary;
 use crate::{Arm, Task, TaskKind};
 
 use super::batch::map_ordered;
-use super::common::{arm_cells, files_block, task_label, PAPER_TASKS};
 use super::csv::{Cell, CsvWriter};
+use super::figure_parts::{arm_cells, files_block, task_label, PAPER_TASKS};
 use super::report::{Block, Section};
 use super::verdict::{num, Correlation};
 use super::{Context, Experiment, Plan, ReproduceError};
