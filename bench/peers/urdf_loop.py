@@ -1,6 +1,6 @@
 """toolconf's closed loop for a URDF arm, written as a Python user would write it: Pinocchio's
 `aba` in the right-hand side, SciPy's `solve_ivp`, numpy for the rest. The same loop as
-toolconf's (crates/runtime/src/model/runtime.rs, crates/core/src/controller.rs):
+toolconf's (crates/runtime/src/model/closed_loop_n.rs, crates/core/src/controller.rs):
 
     plant       tau = U + dT + K (q^e - q) - D q_dot + g(q^e),   q_ddot = aba(q, q_dot, tau)
     controller  U_dot = -gamma [K_th (q - q^g) + K_thd (q_dot - q_dot^g) + K_thdd (q_ddot - q_ddot^g) + P^U U]

@@ -34,7 +34,7 @@ use serde::Deserialize;
 
 use crate::bounded_read::read_text_file;
 use crate::display::{Clip, ClipMessage, Short, ShortList, ShortRows as Rows};
-use crate::model::runtime::check_grid;
+use crate::model::closed_loop_n::check_grid;
 use crate::model::{ArmModel, EpisodeOptionsN, TaskN};
 use crate::{TaskKind, Term};
 

@@ -2,7 +2,7 @@
 //! the plant [`Plant`] picks, its errors naming the arm (`arm m1=…`).
 
 use super::system::Plant;
-use crate::model::runtime::run_episode;
+use crate::model::closed_loop_n::run_episode;
 use crate::model::{Arm2, Arm2Exact, EpisodeN, EpisodeOptionsN, ModelSimulationError, TrajectoryN};
 use crate::{Arm, Task};
 

@@ -20,11 +20,11 @@
 //! checks `NX == 2N` and `NZ == NX + N` at compile time (a post-monomorphisation assertion).
 
 pub mod budget;
-pub(crate) mod runtime;
+pub(crate) mod closed_loop_n;
 
 pub use toolconf_core::*;
 
-pub use runtime::{
+pub use closed_loop_n::{
     episode, episode_on, simulate, simulate_on, ClosedLoopN, EpisodeN, EpisodeOptionsN, Metrics,
     ModelSimulationError, TrajectoryN, MAX_GRID_POINTS,
 };

@@ -180,7 +180,7 @@ where
     // The QP log holds one entry per control period: refuse horizons too long to keep.
     for step in [options.dt, mpc_options.period] {
         if step > 0.0 {
-            crate::model::runtime::check_grid(options.t_end, step)?;
+            crate::model::closed_loop_n::check_grid(options.t_end, step)?;
         }
     }
     let period = mpc_options.period;
