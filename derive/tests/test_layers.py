@@ -28,7 +28,7 @@ LAYERS = (
     ("urdf_description",),
     ("urdf",),
     ("files",),
-    ("errors", "quantities", "expression", "exact", "chain", "cost", "crosscheck", "ir_types", "rust_printer"),
+    ("errors", "quantities", "expression", "exact", "planar_chain", "cost", "crosscheck", "ir_types", "rust_printer"),
 )
 
 

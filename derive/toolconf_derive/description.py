@@ -46,7 +46,7 @@ class Model:
     printed_where: str = ""
     printed_a: list[list[str]] | None = None
     printed_b: list[list[str]] | None = None
-    # urdf: the chain read from the URDF file (urdf.Chain), its gravity vector, the joint
+    # urdf: the chain read from the URDF file (urdf.UrdfChain), its gravity vector, the joint
     # impedance (stiffness K, damping D per joint) and where the impedance values come from.
     chain: object = None
     urdf_gravity: list[float] = field(default_factory=list)

@@ -21,7 +21,7 @@ import casadi as ca
 import mpmath
 import numpy as np
 
-from .chain import casadi_chain
+from .planar_chain import casadi_chain
 from .description import Model, Task, expression, sensitivity, value
 from .exact import Exact, ExactFunction
 from .expression import python_number

@@ -1,4 +1,4 @@
-"""Rigid-body dynamics of a serial chain (urdf.Chain) on CasADi SX: inverse dynamics by the
+"""Rigid-body dynamics of a serial chain (urdf.UrdfChain) on CasADi SX: inverse dynamics by the
 recursive Newton-Euler algorithm (RNEA), the joint-space inertia M(q) by the composite-rigid-body
 algorithm (CRBA), an LDL^T solve for the accelerations, and, independently, the articulated-body
 algorithm (ABA, Featherstone 2008, ch. 7) in 6-D spatial algebra.
@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import casadi as ca
 
-from .urdf import Chain
+from .urdf import UrdfChain
 
 
 def _zero(x) -> bool:
@@ -156,7 +156,7 @@ class ChainDynamics:
     """The chain's rigid-body algorithms; `last` (10 barycentric numbers, SX or float) replaces
     the last body's own inertia, so that a tool can be added to it."""
 
-    def __init__(self, chain: Chain, gravity: list[float]):
+    def __init__(self, chain: UrdfChain, gravity: list[float]):
         self.chain = chain
         self.n = chain.dof
         self.gravity = [float(g) for g in gravity]

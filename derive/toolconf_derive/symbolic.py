@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from .chain import sympy_chain
+from .planar_chain import sympy_chain
 from .description import Model, Task, sensitivity, task_formula
 from .errors import DescriptionError
 from .expression import ExpressionError, sympy_expression

@@ -71,7 +71,7 @@ class Body:
 
 
 @dataclass(frozen=True)
-class Chain:
+class UrdfChain:
     path: Path
     robot: str
     base: str
@@ -314,7 +314,7 @@ def _fixed_subtree(tree: _Tree, link: str, on_path: set[str], flange: str) -> _I
     return total
 
 
-def read_chain(path: Path, base: str, flange: str) -> Chain:
+def read_chain(path: Path, base: str, flange: str) -> UrdfChain:
     text = read_text(path, MAX_BYTES, "a URDF file")
     with mpmath.workdps(DIGITS):
         return _chain(_Tree(path, text), base, flange)
@@ -330,7 +330,7 @@ def _axis(path: Path, joint) -> mpmath.matrix:
     return a / norm
 
 
-def _chain(tree: _Tree, base: str, flange: str) -> Chain:
+def _chain(tree: _Tree, base: str, flange: str) -> UrdfChain:
     path = tree.path
     joints = tree.path_to(base, flange)
     on_path = {j.find("child").get("link") for j in joints} | {base}
@@ -363,9 +363,9 @@ def _chain(tree: _Tree, base: str, flange: str) -> Chain:
                 current = _merged(current, _moved(subtree, rotation, translation))
             pending_r, pending_t = rotation, translation
     bodies.append(_body(joint_of_body, current))
-    return Chain(path, tree.robot, base, flange, bodies,
-                 tuple(tuple(float(pending_r[i, k]) for k in range(3)) for i in range(3)),
-                 tuple(float(pending_t[i]) for i in range(3)))
+    return UrdfChain(path, tree.robot, base, flange, bodies,
+                     tuple(tuple(float(pending_r[i, k]) for k in range(3)) for i in range(3)),
+                     tuple(float(pending_t[i]) for i in range(3)))
 
 
 def _body(joint_data, inertial: _Inertial) -> Body:

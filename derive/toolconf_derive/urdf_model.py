@@ -42,7 +42,7 @@ from .exact import DIGITS, Exact, ExactFunction
 from .functions import _grid_uniform
 from .rigid_body import ChainDynamics, aba, ldl_apply, ldl_factor
 from .symbolic import parse
-from .urdf import Chain
+from .urdf import UrdfChain
 
 # Code and reference graphs, both evaluated exactly, agree to this (normwise relative per output);
 # they differ only by the double rounding of constants folded while the graphs were built.
@@ -129,7 +129,7 @@ def _column(v):
 class UrdfDerivation:
     """The code and reference graphs of one URDF model (see the module docs)."""
 
-    def __init__(self, model: Model, chain: Chain, tasks: list[Task]):
+    def __init__(self, model: Model, chain: UrdfChain, tasks: list[Task]):
         self.model, self.chain, self.tasks = model, chain, tasks
         n = self.n = chain.dof
         self.dyn = ChainDynamics(chain, model.urdf_gravity)
