@@ -22,6 +22,8 @@ pub enum QpOutcome {
 /// How one attempt differs from Clarabel's defaults.
 #[derive(Debug, Clone, Copy)]
 struct Attempt {
+    /// What the failure message calls it.
+    name: &'static str,
     tolerance: f64,
     max_iter: u32,
     /// Clarabel's remedies for a KKT system that loses accuracy (its settings'
@@ -39,24 +41,28 @@ struct Attempt {
 /// those on the rescaled problem. An almost-solved QP is the answer only if none solves it.
 const ATTEMPTS: [Attempt; 4] = [
     Attempt {
+        name: "tight tolerances",
         tolerance: 1e-11,
         max_iter: 200,
         robust: false,
         rescale: false,
     },
     Attempt {
+        name: "Clarabel's defaults",
         tolerance: 1e-8,
         max_iter: 200,
         robust: false,
         rescale: false,
     },
     Attempt {
+        name: "regularised",
         tolerance: 1e-8,
         max_iter: 1000,
         robust: true,
         rescale: false,
     },
     Attempt {
+        name: "rescaled",
         tolerance: 1e-8,
         max_iter: 1000,
         robust: true,
@@ -104,12 +110,6 @@ fn solve_with(
     }
     let mut almost = None;
     let mut failures: Vec<String> = Vec::new();
-    let names = [
-        "tight tolerances",
-        "Clarabel's defaults",
-        "regularised",
-        "rescaled",
-    ];
     let mut last_x = None;
     for attempt in attempts {
         if attempt.robust && almost.is_some() {
@@ -140,7 +140,11 @@ fn solve_with(
             "Clarabel: {} after {} attempts ({})",
             failures.join(", then "),
             attempts.len(),
-            names[..attempts.len().min(names.len())].join(", ")
+            attempts
+                .iter()
+                .map(|a| a.name)
+                .collect::<Vec<_>>()
+                .join(", ")
         ),
         tight: last_x.map_or_else(Vec::new, |x| tight_rows(g, h, &x)),
     }
