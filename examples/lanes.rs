@@ -347,11 +347,8 @@ fn lane_loop(arm: &toolconf::Arm, task: &TaskN<2>) -> (Loop<1>, ClosedLoopN<Arm2
     let p = Loop {
         k: coeff.k.map(|k| L([k])),
         gains: [m(&gains[0]), m(&gains[1]), m(&gains[2]), m(&gains[3])],
-        goals: [
-            v(&t.goal_theta),
-            v(&t.goal_theta_dot),
-            v(&t.goal_theta_ddot),
-        ],
+        // The goals of the terms read from X and Ẋ, in term order (the control's is zero).
+        goals: std::array::from_fn(|i| v(&t.goal[i])),
     };
     (p, cl)
 }

@@ -6,6 +6,7 @@ use proptest::prelude::*;
 use toolconf::closed_loop::{simulate, EpisodeOptions, Metrics, Plant};
 use toolconf::model::{Arm2, ArmModel};
 use toolconf::select::{draw_tools, evaluate, Objective};
+use toolconf::Term;
 use toolconf::{Arm, Task, TaskKind, Vector2};
 
 const ARMS: [[f64; 4]; 3] = [
@@ -81,22 +82,25 @@ fn trajectory_is_on_the_paper_grid_and_starts_at_the_initial_conditions() {
     assert_eq!(tr.t[100], 5.0);
     assert!((tr.t[1] - 0.05).abs() < 1e-15);
     assert_eq!(
-        tr.theta[0],
+        tr.of(Term::Theta)[0],
         Arm2::equilibrium_state().fixed_rows::<2>(0).into_owned()
     );
-    assert_eq!(tr.u[0], Vector2::new(0.1, 0.1));
+    assert_eq!(tr.of(Term::U)[0], Vector2::new(0.1, 0.1));
     // The recorded task error is the sum of the per-sample errors on this trajectory.
     let task = Task::paper(TaskKind::Position);
     let sum: f64 = tr
-        .theta
+        .of(Term::Theta)
         .iter()
-        .map(|th| (th - task.goal_theta).dot(&(task.precision_theta * (th - task.goal_theta))))
+        .map(|th| {
+            (th - task.goal[Term::Theta.index()])
+                .dot(&(task.precision[Term::Theta.index()] * (th - task.goal[Term::Theta.index()])))
+        })
         .sum();
     assert!((sum - episode.metrics.task_error).abs() <= 1e-12 * sum);
     // θ2 approaches its goal π/6 under task 1.
     assert!(
-        (tr.theta[100][1] - std::f64::consts::FRAC_PI_6).abs()
-            < (tr.theta[0][1] - std::f64::consts::FRAC_PI_6).abs()
+        (tr.of(Term::Theta)[100][1] - std::f64::consts::FRAC_PI_6).abs()
+            < (tr.of(Term::Theta)[0][1] - std::f64::consts::FRAC_PI_6).abs()
     );
 }
 

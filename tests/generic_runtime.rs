@@ -3,6 +3,7 @@
 //! deterministically.
 
 use std::process::Command;
+use toolconf::Term;
 
 use nalgebra::SMatrix;
 use proptest::prelude::*;
@@ -160,7 +161,10 @@ fn arm3_runs_every_task_with_finite_metrics() {
     // Task 3: Π^U = P^θ̈ + P^U exactly (∂θ̈/∂U = I), whatever the tool.
     let task = Arm3::paper_task(TaskKind::Acceleration);
     let c = control_confidence(&tool, &task).unwrap();
-    assert_eq!(c.pi_u, task.precision_theta_ddot + task.precision_u);
+    assert_eq!(
+        c.pi_u,
+        task.precision[Term::ThetaDdot.index()] + task.precision[Term::U.index()]
+    );
     assert_eq!(c.pi_u, SMatrix::<f64, 3, 3>::identity() * 10.0);
     assert!((c.logdet - 3.0 * 10f64.ln()).abs() < 1e-14);
     assert!((c.logdet_per_joint() - 10f64.ln()).abs() < 1e-15);
@@ -170,12 +174,18 @@ fn arm3_runs_every_task_with_finite_metrics() {
 fn arm3_goals_extend_the_two_link_ones() {
     let two = Arm2::paper_task(TaskKind::Position);
     let three = Arm3::paper_task(TaskKind::Position);
-    assert_eq!(three.goal_theta[2], two.goal_theta[1]);
-    assert_eq!(three.goal_theta[0], two.goal_theta[0]);
+    assert_eq!(
+        three.goal[Term::Theta.index()][2],
+        two.goal[Term::Theta.index()][1]
+    );
+    assert_eq!(
+        three.goal[Term::Theta.index()][0],
+        two.goal[Term::Theta.index()][0]
+    );
     let v = Arm3::paper_task(TaskKind::Velocity);
-    assert_eq!(v.goal_theta_dot.as_slice(), &[0.0, 0.0, 2.0]);
+    assert_eq!(v.goal[Term::ThetaDot.index()].as_slice(), &[0.0, 0.0, 2.0]);
     let a = Arm3::paper_task(TaskKind::Acceleration);
-    assert_eq!(a.goal_theta_ddot.as_slice(), &[0.0, 0.0, 0.1]);
+    assert_eq!(a.goal[Term::ThetaDdot.index()].as_slice(), &[0.0, 0.0, 0.1]);
     assert_eq!(Arm3::NAME, "arm3");
     assert_eq!(Arm3::PARAMETER_NAMES, ["m1", "m2", "m3", "l1", "l2", "l3"]);
 }
@@ -223,7 +233,7 @@ fn invalid_input_gives_typed_errors() {
     let tool = Arm3Tool::new([0.3, 0.25, 0.2, 0.4, 0.35, 0.3]).unwrap();
     // All-zero precisions: Π^U = 0 for every tool, refused as such.
     let mut task = Arm3::paper_task(TaskKind::Acceleration);
-    task.precision_theta_ddot = SMatrix::zeros();
+    task.precision[Term::ThetaDdot.index()] = SMatrix::zeros();
     assert!(matches!(
         control_confidence(&tool, &task),
         Err(model::Error::ConfidenceRank {
@@ -233,34 +243,35 @@ fn invalid_input_gives_typed_errors() {
         })
     ));
     // Rank 2 of 3 in all is still singular for every tool.
-    task.precision_theta_ddot = SMatrix::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, 0.0));
+    task.precision[Term::ThetaDdot.index()] =
+        SMatrix::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, 0.0));
     assert!(matches!(
         control_confidence(&tool, &task),
         Err(model::Error::ConfidenceRank { rank: 2, .. })
     ));
     // Not positive semi-definite.
     let mut task = Arm3::paper_task(TaskKind::Velocity);
-    task.precision_theta_dot[(2, 2)] = -1.0;
+    task.precision[Term::ThetaDot.index()][(2, 2)] = -1.0;
     assert!(matches!(
         control_confidence(&tool, &task),
         Err(model::Error::InvalidPrecision {
-            name: "P_theta_dot",
+            term: Term::ThetaDot,
             ..
         })
     ));
     // Not symmetric.
     let mut task = Arm3::paper_task(TaskKind::Position);
-    task.precision_theta[(0, 2)] = 3.0;
+    task.precision[Term::Theta.index()][(0, 2)] = 3.0;
     assert!(matches!(
         control_confidence(&tool, &task),
         Err(model::Error::InvalidPrecision {
-            name: "P_theta",
+            term: Term::Theta,
             ..
         })
     ));
     // A non-finite goal.
     let mut task = Arm3::paper_task(TaskKind::Position);
-    task.goal_theta[1] = f64::NAN;
+    task.goal[Term::Theta.index()][1] = f64::NAN;
     assert!(matches!(
         control_confidence(&tool, &task),
         Err(model::Error::InvalidGoal { .. })
@@ -545,7 +556,7 @@ fn validated_task_gives_the_same_confidence_as_the_checked_api() {
         );
     }
     let mut bad = Task::paper(TaskKind::Position);
-    bad.precision_u[(0, 1)] = 5.0;
+    bad.precision[Term::U.index()][(0, 1)] = 5.0;
     let expected = bad.validate().unwrap_err().to_string();
     assert_eq!(bad.validated().unwrap_err().to_string(), expected);
 }

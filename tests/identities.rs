@@ -4,6 +4,7 @@
 use nalgebra::{SMatrix, SVector};
 use proptest::prelude::*;
 use toolconf::model::{self, Arm2, ArmModel};
+use toolconf::Term;
 use toolconf::{control_confidence, Arm, Error, Matrix2, Task, TaskKind, Vector2};
 
 fn arm_strategy() -> impl Strategy<Value = Arm> {
@@ -60,11 +61,11 @@ proptest! {
     fn task3_acceleration_sensitivity_is_the_identity(arm in arm_strategy()) {
         // [I O](A² A⁻¹(E − B) + AB) = [I O] A E = I for every arm: task 3's confidence is the
         // same for every tool, as the paper finds.
-        let s = arm.sensitivities(TaskKind::Acceleration).d_theta_ddot_du.expect("task 3 uses θ̈");
+        let s = arm.sensitivities(TaskKind::Acceleration).of(Term::ThetaDdot).expect("task 3 uses θ̈");
         prop_assert_eq!(s, Matrix2::identity());
         let task = Task::paper(TaskKind::Acceleration);
         let c = control_confidence(&arm, &task).unwrap();
-        prop_assert_eq!(c.pi_u, task.precision_theta_ddot + task.precision_u);
+        prop_assert_eq!(c.pi_u, task.precision[Term::ThetaDdot.index()] + task.precision[Term::U.index()]);
     }
 
     #[test]
@@ -74,21 +75,21 @@ proptest! {
         let e = SMatrix::<f64, 4, 2>::from_row_slice(&[1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0]);
         let dx_du = a_inv * (e - arm.input_matrix());
         let s = arm.sensitivities(TaskKind::Position);
-        let d_theta = s.d_theta_du.unwrap();
+        let d_theta = s.of(Term::Theta).unwrap();
         let scale = d_theta.amax();
         for i in 0..2 {
             for j in 0..2 {
                 prop_assert!(rel(d_theta[(i, j)], dx_du[(i, j)], scale) < 1e-12);
             }
         }
-        prop_assert_eq!(s.d_theta_dot_du.unwrap(), Matrix2::identity());
+        prop_assert_eq!(s.of(Term::ThetaDot).unwrap(), Matrix2::identity());
         prop_assert!((dx_du.fixed_view::<2, 2>(2, 0) - Matrix2::identity()).amax() < 1e-12);
     }
 
     #[test]
     fn task2_velocity_sensitivity_is_the_position_block(arm in arm_strategy()) {
         let a_inv_b = arm.state_matrix().try_inverse().unwrap() * arm.input_matrix();
-        let s = arm.sensitivities(TaskKind::Velocity).d_theta_dot_du.unwrap();
+        let s = arm.sensitivities(TaskKind::Velocity).of(Term::ThetaDot).unwrap();
         let expected = -a_inv_b.fixed_view::<2, 2>(0, 0).into_owned();
         prop_assert!((s - expected).amax() <= 1e-12 * expected.amax());
         // The strict velocity block [O I]A⁻¹B vanishes: why the paper uses the position block.
@@ -183,20 +184,20 @@ fn invalid_arms_are_errors_naming_the_parameter() {
 fn invalid_tasks_are_errors() {
     let arm = Arm::new([0.3, 0.4, 0.5, 0.2]).unwrap();
     let mut task = Task::paper(TaskKind::Position);
-    task.precision_theta[(0, 1)] = 3.0;
+    task.precision[Term::Theta.index()][(0, 1)] = 3.0;
     assert!(matches!(
         control_confidence(&arm, &task),
         Err(model::Error::InvalidPrecision { .. })
     ));
     let mut task = Task::paper(TaskKind::Position);
-    task.goal_theta[1] = f64::NAN;
+    task.goal[Term::Theta.index()][1] = f64::NAN;
     assert!(matches!(
         control_confidence(&arm, &task),
         Err(model::Error::InvalidGoal { .. })
     ));
     // Precisions that leave Π^U singular for every tool are refused as such...
     let mut task = Task::paper(TaskKind::Acceleration);
-    task.precision_theta_ddot = Matrix2::zeros();
+    task.precision[Term::ThetaDdot.index()] = Matrix2::zeros();
     assert!(matches!(
         control_confidence(&arm, &task),
         Err(model::Error::ConfidenceRank {
@@ -210,10 +211,10 @@ fn invalid_tasks_are_errors() {
     // row of ∂θ/∂U, whose first entry −(2/3)(l1²(m1 + 3m2) − 3)/(g l1 (m1 + 2m2)) vanishes at
     // l1 = 1, m1 + 3m2 = 3: r ∥ e₂ and Π^U is singular.
     let mut task = Task::paper(TaskKind::Position);
-    task.precision_theta = Matrix2::new(1.0, 0.0, 0.0, 0.0);
-    task.precision_theta_dot = Matrix2::zeros();
-    task.precision_theta_ddot = Matrix2::zeros();
-    task.precision_u = Matrix2::new(0.0, 0.0, 0.0, 1.0);
+    task.precision[Term::Theta.index()] = Matrix2::new(1.0, 0.0, 0.0, 0.0);
+    task.precision[Term::ThetaDot.index()] = Matrix2::zeros();
+    task.precision[Term::ThetaDdot.index()] = Matrix2::zeros();
+    task.precision[Term::U.index()] = Matrix2::new(0.0, 0.0, 0.0, 1.0);
     assert!(control_confidence(&arm, &task).is_ok());
     let singular = Arm::new([1.5, 0.5, 1.0, 0.3]).unwrap();
     assert!(matches!(

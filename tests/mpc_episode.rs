@@ -1,6 +1,7 @@
 //! The MPC baseline in closed loop with the nonlinear plant.
 
 use std::f64::consts::FRAC_PI_2;
+use toolconf::Term;
 
 use toolconf::closed_loop::EpisodeOptions;
 use toolconf::mpc::{simulate_mpc, Mpc, MpcEpisodeError, MpcModel, MpcOptions};
@@ -14,7 +15,7 @@ fn arm() -> Arm {
 /// MPC plans with is accurate.
 fn near_task() -> Task {
     let mut task = Task::paper(TaskKind::Position);
-    task.goal_theta = Vector2::new(-FRAC_PI_2 + 0.2, -FRAC_PI_2 + 0.1);
+    task.goal[Term::Theta.index()] = Vector2::new(-FRAC_PI_2 + 0.2, -FRAC_PI_2 + 0.1);
     task
 }
 
@@ -34,16 +35,16 @@ fn reaches_the_near_goal(mpc_options: &MpcOptions) {
     let episode = simulate_mpc(&arm(), &near_task(), &options, mpc_options).unwrap();
     let tr = episode.trajectory.unwrap();
     assert_eq!(tr.t.len(), 101);
-    let goal = near_task().goal_theta;
-    let start_error = (tr.theta[0] - goal).norm();
-    let end_error = (tr.theta[100] - goal).norm();
+    let goal = near_task().goal[Term::Theta.index()];
+    let start_error = (tr.of(Term::Theta)[0] - goal).norm();
+    let end_error = (tr.of(Term::Theta)[100] - goal).norm();
     assert!(
         end_error < 0.2 * start_error,
         "θ(5) = {} vs goal {goal}",
-        tr.theta[100]
+        tr.of(Term::Theta)[100]
     );
     assert!(
-        tr.u.iter().all(|u| u.amax() <= 5.0 + 1e-6),
+        tr.of(Term::U).iter().all(|u| u.amax() <= 5.0 + 1e-6),
         "torque bound violated"
     );
     let m = episode.metrics;
@@ -61,7 +62,7 @@ fn the_first_torque_is_the_controllers_answer_at_the_initial_state() {
     let episode = simulate_mpc(&arm(), &near_task(), &options, &MpcOptions::default()).unwrap();
     let mut mpc = Mpc::new(&arm(), &near_task(), &MpcOptions::default()).unwrap();
     assert_eq!(
-        episode.trajectory.unwrap().u[0],
+        episode.trajectory.unwrap().of(Term::U)[0],
         mpc.control(&options.x0).unwrap()
     );
 }
@@ -105,26 +106,26 @@ fn local_mpc_with_observer_reaches_the_papers_position_goal_and_holds_it_when_pe
         let episode = simulate_mpc(&arm(), &task, &options, &MpcOptions::default()).unwrap();
         let tr = episode.trajectory.unwrap();
         assert!(
-            tr.u.iter().all(|u| u.amax() <= 5.0 + 1e-6),
+            tr.of(Term::U).iter().all(|u| u.amax() <= 5.0 + 1e-6),
             "ΔT={perturbation}: torque bound violated"
         );
-        let (theta, theta_dot) = (tr.theta[100], tr.theta_dot[100]);
-        let error = (theta - task.goal_theta).amax();
+        let (theta, theta_dot) = (tr.of(Term::Theta)[100], tr.of(Term::ThetaDot)[100]);
+        let error = (theta - task.goal[Term::Theta.index()]).amax();
         // J's own optimum is not θ^g: with P^U = I and P^θ = 100 I, holding the arm against
         // gravity costs torque, and the optimal static pose sits ≈ 0.05 rad off the goal.
         assert!(
             error < 0.1,
             "ΔT={perturbation}: θ(5) = {theta} vs {}",
-            task.goal_theta
+            task.goal[Term::Theta.index()]
         );
         assert!(
             theta_dot.amax() < 0.1,
             "ΔT={perturbation}: θ̇(5) = {theta_dot}"
         );
         // After the swing-up (≈ 3 s) it stays near the goal.
-        for (t, th) in tr.t.iter().zip(&tr.theta).skip(60) {
+        for (t, th) in tr.t.iter().zip(tr.of(Term::Theta)).skip(60) {
             assert!(
-                (th - task.goal_theta).amax() < 0.15,
+                (th - task.goal[Term::Theta.index()]).amax() < 0.15,
                 "ΔT={perturbation}: θ({t}) = {th}"
             );
         }
@@ -146,7 +147,7 @@ fn observer_estimate_converges_to_the_perturbation_near_the_equilibrium() {
     // accurate. (At the near goal, 0.2 rad away, the equilibrium model's linear gravity is off
     // by ≈ 3e-3 N m, and d̂ absorbs that too: it estimates all of the model's input mismatch.)
     let mut hold = near_task();
-    hold.goal_theta = Vector2::repeat(-FRAC_PI_2);
+    hold.goal[Term::Theta.index()] = Vector2::repeat(-FRAC_PI_2);
     for (model, task, perturbation) in [
         (MpcModel::Local, near_task(), -0.1),
         (MpcModel::Local, near_task(), -0.8),

@@ -2,6 +2,7 @@
 //! pinned by an insta snapshot: a change in the derivation that moves any number is a reviewed diff.
 
 use std::fmt::Write;
+use toolconf::Term;
 
 use toolconf::{control_confidence, Arm, Task, TaskKind};
 
@@ -36,9 +37,9 @@ fn linearisation_sensitivities_and_confidence_table() {
             let c = control_confidence(&arm, &Task::paper(kind)).unwrap();
             writeln!(out, " task {kind}").unwrap();
             for (name, m) in [
-                ("dtheta/dU", s.d_theta_du),
-                ("dthetadot/dU", s.d_theta_dot_du),
-                ("dthetaddot/dU", s.d_theta_ddot_du),
+                ("dtheta/dU", s.of(Term::Theta)),
+                ("dthetadot/dU", s.of(Term::ThetaDot)),
+                ("dthetaddot/dU", s.of(Term::ThetaDdot)),
             ] {
                 if let Some(m) = m {
                     out += &row(name, m.transpose().iter().copied());

@@ -10,10 +10,10 @@
 
 use nalgebra::{SMatrix, SVector};
 use toolconf::generated;
-use toolconf::model::{logdet_of, ArmModel, TaskN, ToolN};
-use toolconf::validate::{STATE_BOUND, TOOL_PARAMETER};
 use toolconf::generated::validity::ToolRule;
 use toolconf::model::Error;
+use toolconf::model::{logdet_of, ArmModel, TaskN, ToolN};
+use toolconf::validate::{STATE_BOUND, TOOL_PARAMETER};
 use toolconf::{TaskKind, Term};
 
 /// The corners of the box `boxes` (one interval per parameter) that the model's rule admits
@@ -21,7 +21,15 @@ use toolconf::{TaskKind, Term};
 /// "> 0" parameter, the midpoint for a signed one (a centre of mass).
 fn points<const NP: usize>(rule: &ToolRule<NP>, boxes: [(f64, f64); NP]) -> Vec<[f64; NP]> {
     let mut points: Vec<[f64; NP]> = (0..1usize << NP)
-        .map(|bits| std::array::from_fn(|j| if bits >> j & 1 == 0 { boxes[j].0 } else { boxes[j].1 }))
+        .map(|bits| {
+            std::array::from_fn(|j| {
+                if bits >> j & 1 == 0 {
+                    boxes[j].0
+                } else {
+                    boxes[j].1
+                }
+            })
+        })
         .collect();
     points.push(std::array::from_fn(|j| {
         let (lo, hi) = boxes[j];
@@ -60,10 +68,10 @@ where
         let p = SMatrix::<f64, N, N>::identity() * value;
         let mut t = paper;
         let used = |term| if kind.uses(term) { p } else { SMatrix::zeros() };
-        t.precision_theta = used(Term::Theta);
-        t.precision_theta_dot = used(Term::ThetaDot);
-        t.precision_theta_ddot = used(Term::ThetaDdot);
-        t.precision_u = used(Term::U);
+        t.precision[Term::Theta.index()] = used(Term::Theta);
+        t.precision[Term::ThetaDot.index()] = used(Term::ThetaDot);
+        t.precision[Term::ThetaDdot.index()] = used(Term::ThetaDdot);
+        t.precision[Term::U.index()] = used(Term::U);
         tasks.push(t);
     }
     tasks
@@ -104,9 +112,13 @@ where
         }
         for kind in TaskKind::ALL {
             let s = tool.sensitivities(kind);
-            for m in [s.d_theta_du, s.d_theta_dot_du, s.d_theta_ddot_du]
-                .iter()
-                .flatten()
+            for m in [
+                s.of(Term::Theta),
+                s.of(Term::ThetaDot),
+                s.of(Term::ThetaDdot),
+            ]
+            .iter()
+            .flatten()
             {
                 finite("a sensitivity", &p, m.iter().copied());
             }

@@ -4,6 +4,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use toolconf::Term;
 
 use serde_json::Value;
 use toolconf::model::{Arm2, Arm2Tool, ClosedLoopN, TaskN};
@@ -153,13 +154,19 @@ fn fine_step_task_error(arm: [f64; 4]) -> f64 {
     let p = |s: f64| nalgebra::Matrix2::identity() * s;
     let task = TaskN::<2> {
         kind: TaskKind::Position,
-        goal_theta: nalgebra::Vector2::new(0.9, -0.3),
-        goal_theta_dot: nalgebra::Vector2::zeros(),
-        goal_theta_ddot: nalgebra::Vector2::zeros(),
-        precision_theta: nalgebra::Matrix2::new(90.0, 15.0, 15.0, 40.0),
-        precision_theta_dot: p(30.0),
-        precision_theta_ddot: p(0.5),
-        precision_u: p(2.0),
+        // θ, θ̇, θ̈, U.
+        goal: [
+            nalgebra::Vector2::new(0.9, -0.3),
+            nalgebra::Vector2::zeros(),
+            nalgebra::Vector2::zeros(),
+            nalgebra::Vector2::zeros(),
+        ],
+        precision: [
+            nalgebra::Matrix2::new(90.0, 15.0, 15.0, 40.0),
+            p(30.0),
+            p(0.5),
+            p(2.0),
+        ],
     };
     let tool = Arm2Tool::new(arm).unwrap();
     let system = ClosedLoopN::<Arm2, 2, 4, 4, 6>::with_perturbation(
@@ -172,7 +179,7 @@ fn fine_step_task_error(arm: [f64; 4]) -> f64 {
     let mut z = nalgebra::SVector::<f64, 6>::from([-1.4, -1.6, 0.0, 0.0, 0.05, 0.15]);
     let error = |z: &nalgebra::SVector<f64, 6>| {
         let e = nalgebra::Vector2::new(z[0] - 0.9, z[1] + 0.3);
-        e.dot(&(task.precision_theta * e))
+        e.dot(&(task.precision[Term::Theta.index()] * e))
     };
     let (steps_per_output, outputs, h) = (500, 60, 1e-4);
     let mut sum = error(&z);

@@ -69,6 +69,28 @@ class Model:
 
 
 @dataclass(frozen=True)
+class TermDef:
+    """A free-energy term (eq. free_energy) as derive/tasks.toml's [[term]] gives it."""
+    name: str
+    symbol: str
+    latex: str
+    doc: str
+    label: str
+    unit: str
+    # Where its value is read (READS): a block of n rows of the state X, of its rate X_dot, or the
+    # control U; a term read from the control has no sensitivity dU/dU to derive.
+    source: str
+    block: int
+    # The documented range (toolconf.ranges()) a goal of it lies in; None: it has no goal (the
+    # control's prior mean eta^U is 0, as in the paper).
+    goal_range: str | None
+
+    @property
+    def has_sensitivity(self) -> bool:
+        return self.source != "control"
+
+
+@dataclass(frozen=True)
 class Remark:
     term: str
     alternative: str
@@ -87,14 +109,37 @@ class Task:
     sensitivity: dict[str, str]
     remarks: list[Remark] = field(default_factory=list)
     default_precision: dict[str, float] = field(default_factory=dict)
+    # Every term tasks.toml defines, in its order (the runtime's `Term`), and the order J's
+    # summands are added in (its cost_order).
+    all_terms: tuple[TermDef, ...] = ()
+    cost_order: tuple[str, ...] = ()
     # Where the task is defined, for messages: the file and its key (task[0]).
     path: Path | str = ""
     key: str = ""
 
     @property
     def sensitivity_terms(self) -> list[str]:
-        """The kinematic terms (theta, theta_dot, theta_ddot) this task's controller uses, in order."""
-        return [t for t in ("theta", "theta_dot", "theta_ddot") if t in self.terms]
+        """The terms with a sensitivity d/dU (all but the control) this task's controller uses,
+        in the order of the term list."""
+        return [t.name for t in self.all_terms if t.has_sensitivity and t.name in self.terms]
+
+    @property
+    def control_term(self) -> str:
+        """The name of the term read from the control U (its precision is P^U)."""
+        return next(t.name for t in self.all_terms if not t.has_sensitivity)
+
+    @property
+    def precision_terms(self) -> list[str]:
+        """The terms whose precisions the task's confidence takes: its sensitivity terms, then the
+        control's."""
+        return self.sensitivity_terms + [self.control_term]
+
+    def term(self, name: str) -> TermDef:
+        return next(t for t in self.all_terms if t.name == name)
+
+    def argument_doc(self, name: str) -> str:
+        """`the joint angles theta`: a term in a generated function's argument documentation."""
+        return f"{self.term(name).doc} {name}"
 
     @property
     def sensitivity_function(self) -> str:
@@ -112,7 +157,6 @@ class Task:
         return f"{self.name}_logdet_gradient"
 
 
-KNOWN_TERMS = ("theta", "theta_dot", "theta_ddot", "u")
 # A model's module, src/<model>.rs of the generated crate, must not clash with the crate's own
 # (templates/registry/src/: lib.rs, tasks.rs, trig.rs, powi.rs; `mod` is a Rust keyword).
 RESERVED_MODEL_NAMES = ("lib", "mod", "powi", "rigid_body", "tasks", "trig", "validity")
@@ -131,7 +175,6 @@ RUST_KEYWORDS = frozenset((
     "yield", "try", "gen"))
 # The columns a tools file has besides the parameters' (crates/runtime/src/tools_file.rs).
 TOOL_FILE_COLUMNS = ("name", "model")
-KINEMATIC_TERMS = ("theta", "theta_dot", "theta_ddot")
 
 # The keys each table may have, as serde's deny_unknown_fields: a misspelt key is an error, not a
 # silently ignored setting. (name, type, required); types are checked by _TYPES.
@@ -161,6 +204,14 @@ TASK_KEYS = (("name", "string", True), ("index", "integer", True), ("title", "st
              ("defaults", "table", False), ("remarks", "tables", False))
 DEFAULTS_KEYS = (("precision", "table", True),)
 REMARK_KEYS = (("term", "string", True), ("alternative", "string", True), ("text", "string", True))
+TERM_KEYS = (("name", "string", True), ("symbol", "string", True), ("latex", "string", True),
+             ("doc", "string", True), ("label", "string", True), ("unit", "string", True), ("read", "string", True),
+             ("goal_range", "string", False))
+# How a term's value is read, as tasks.toml writes it (white space aside): (source, block).
+READS = {"IO @ X": ("state", 0), "OI @ X": ("state", 1), "IO @ X_dot": ("state_rate", 0),
+         "OI @ X_dot": ("state_rate", 1), "U": ("control", 0)}
+# The documented ranges a goal may be checked against (crates/core/src/validate.rs).
+GOAL_RANGES = ("joint_angle", "joint_rate", "joint_acceleration")
 
 
 def _named(t: Table) -> Named:
@@ -181,7 +232,8 @@ def _goals(top: Table) -> dict[str, dict[str, list[str]]]:
     goals = top.table("goals", tuple((k, "table", True) for k in top.get("goals", {})))
     out = {}
     for task in goals.raw:
-        terms = goals.table(task, tuple((t, "values", False) for t in KINEMATIC_TERMS))
+        # Which terms a goal may be given for is the task list's to say (symbolic.check_goals).
+        terms = goals.table(task, tuple((t, "values", False) for t in goals.get(task, {})))
         out[task] = {term: [str(v) for v in values] for term, values in terms.raw.items()}
     return out
 
@@ -334,12 +386,42 @@ def _validate_model(m: Model) -> None:
     _validate_expressions(m)
 
 
-def _task(path: Path, t: Table) -> Task:
+def _term(path: Path, t: Table) -> TermDef:
+    read = " ".join(t.get("read").split())
+    if read not in READS:
+        raise DescriptionError(path, t.sub("read"), f"'{t.get('read')}' is not a way to read a term "
+                               f"(known: {', '.join(READS)})")
+    goal_range = t.get("goal_range")
+    if goal_range is not None and goal_range not in GOAL_RANGES:
+        raise DescriptionError(path, t.sub("goal_range"), f"'{goal_range}' is not a goal range "
+                               f"(known: {', '.join(GOAL_RANGES)})")
+    source, block = READS[read]
+    if (source == "control") != (goal_range is None):
+        raise DescriptionError(path, t.sub("goal_range"), "the control's term has no goal (its prior mean is 0) "
+                               "and every other term has one")
+    _check_identifier(t.get("name"), path, t.sub("name"))
+    return TermDef(name=t.get("name"), symbol=t.get("symbol"), latex=t.get("latex"), doc=t.get("doc"),
+                   label=t.get("label"), unit=t.get("unit"), source=source, block=block, goal_range=goal_range)
+
+
+def load_terms(path: Path, top: Table) -> tuple[TermDef, ...]:
+    """tasks.toml's [[term]] list: names unique, read in distinct ways, exactly one the control."""
+    terms = tuple(_term(path, t) for t in top.tables("term", TERM_KEYS))
+    for i, t in enumerate(terms):
+        if any(o.name == t.name or (o.source, o.block) == (t.source, t.block) for o in terms[:i]):
+            raise DescriptionError(path, f"term[{i}]", f"'{t.name}' repeats an earlier term's name or reading")
+    if sum(not t.has_sensitivity for t in terms) != 1:
+        raise DescriptionError(path, "term", "exactly one term must be read from the control U")
+    return terms
+
+
+def _task(path: Path, t: Table, all_terms: tuple[TermDef, ...], cost_order: tuple[str, ...]) -> Task:
+    known = [k.name for k in all_terms]
     terms = list(t.get("terms"))
     for i, term in enumerate(terms):
-        if term not in KNOWN_TERMS:
-            raise DescriptionError(path, t.sub(f"terms[{i}]"), f"unknown term '{term}' (known: {', '.join(KNOWN_TERMS)})")
-    used = [s for s in KINEMATIC_TERMS if s in terms]
+        if term not in known:
+            raise DescriptionError(path, t.sub(f"terms[{i}]"), f"unknown term '{term}' (known: {', '.join(known)})")
+    used = [k.name for k in all_terms if k.has_sensitivity and k.name in terms]
     if t.get("error") not in used:
         raise DescriptionError(path, t.sub("error"), f"'{t.get('error')}' is not one of the task's kinematic terms {used}")
     # Only the task's kinematic terms have a sensitivity; an extra one is an unknown key.
@@ -356,12 +438,19 @@ def _task(path: Path, t: Table) -> Task:
     _check_identifier(t.get("name"), path, t.sub("name"))
     return Task(name=t.get("name"), index=t.get("index"), title=t.get("title", ""), doc=t.get("doc", ""),
                 terms=terms, error=t.get("error"), sensitivity=dict(sens.raw), remarks=remarks,
-                default_precision={k: float(v) for k, v in precision.raw.items()}, path=path, key=t.key)
+                default_precision={k: float(v) for k, v in precision.raw.items()}, path=path, key=t.key,
+                all_terms=all_terms, cost_order=cost_order)
 
 
 def load_tasks(path: Path) -> list[Task]:
-    top = Table(path, "", read_toml(path, "a task file"), (("task", "tables", True),))
-    tasks = [_task(path, t) for t in top.tables("task", TASK_KEYS)]
+    top = Table(path, "", read_toml(path, "a task file"),
+                (("term", "tables", True), ("cost_order", "strings", True), ("task", "tables", True)))
+    all_terms = load_terms(path, top)
+    order = top.get("cost_order")
+    if sorted(order) != sorted(t.name for t in all_terms):
+        raise DescriptionError(path, "cost_order", f"{order} must name every term once "
+                               f"({', '.join(t.name for t in all_terms)})")
+    tasks = [_task(path, t, all_terms, tuple(order)) for t in top.tables("task", TASK_KEYS)]
     for t in tasks:
         _validate_task_expressions(path, t)
     names = [t.name for t in tasks]

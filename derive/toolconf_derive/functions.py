@@ -18,13 +18,6 @@ from .exact import Exact
 from .numeric import CasadiModel
 from .symbolic import Derivation
 
-TERM_DOC = {
-    "theta": "joint angles theta",
-    "theta_dot": "joint velocities theta_dot",
-    "theta_ddot": "joint accelerations theta_ddot",
-    "u": "control U",
-}
-
 
 @dataclass
 class Arg:
@@ -194,25 +187,25 @@ def build_functions(d: Derivation, cm: CasadiModel) -> list[Function]:
         ))
 
         prec_args = [
-            Arg(f"p_{t}", f"precision P of the {TERM_DOC[t]} (symmetric; the upper triangle is read)", (n, n),
+            Arg(f"p_{t}", f"precision P of {task.argument_doc(t)} (symmetric; the upper triangle is read)", (n, n),
                 td.precision_reads[t], True, _sample_precision(n))
-            for t in terms + ["u"]
+            for t in task.precision_terms
         ]
 
         def conf_eval(v, task=task, terms=terms):
-            prec = {t: v[f"p_{t}"] for t in terms + ["u"]}
+            prec = {t: v[f"p_{t}"] for t in task.precision_terms}
             return [cm.control_confidence(task, v["params"], prec)]
 
         fns.append(Function(
             task.confidence_function,
             f"{task.title}: the control confidence Pi^U = d2F/dU2 = "
-            + " + ".join(f"S_{t}^T P_{t} S_{t}" for t in terms) + " + P_u.",
+            + " + ".join(f"S_{t}^T P_{t} S_{t}" for t in terms) + f" + P_{task.control_term}.",
             "eq. (control_conf) and the closed forms after it", [p] + prec_args,
             [Output("pi_u", "Pi^U (symmetric)", td.confidence, symmetric=True)], conf_eval,
         ))
 
         def gradient_eval(v, task=task, terms=terms):
-            return cm.logdet_gradient(task).checked(v["params"], *[v[f"p_{t}"] for t in terms + ["u"]],
+            return cm.logdet_gradient(task).checked(v["params"], *[v[f"p_{t}"] for t in task.precision_terms],
                                                       cancelling=True)
 
         fns.append(Function(

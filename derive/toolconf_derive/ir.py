@@ -20,7 +20,7 @@ from .rust_printer import RustPrinter, float_literal
 from .symbolic import Derivation
 
 # 4: each function carries its cost (cost.py).
-IR_SCHEMA = 4
+IR_SCHEMA = 5
 
 
 def _rust_type(shape: tuple[int, int]) -> str:
@@ -287,6 +287,9 @@ def model_document(m, x_e: list[str], u_e: list[str], tasks: list, functions: li
             # every parameter the planar arms' rule (> 0, drawn from [0.1, 0.6]).
             tool_rule=None if m.tool_rule is None else irt.ToolRule.of(m.tool_rule),
         ),
+        terms=[irt.Term(t.name, t.symbol, t.latex, t.doc, t.label, t.unit, irt.TermRead(t.source, t.block), t.goal_range)
+               for t in (tasks[0].all_terms if tasks else ())],
+        cost_order=list(tasks[0].cost_order if tasks else ()),
         tasks=[
             irt.Task(
                 name=t.name, index=t.index, title=t.title, doc=t.doc,

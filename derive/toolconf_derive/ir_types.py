@@ -124,6 +124,27 @@ class Model:
 
 
 @dataclass
+class TermRead:
+    """Where a term's value is read: `block` (n rows) of the state X (`state`), of its rate
+    (`state_rate`), or the control (`control`, block 0)."""
+    source: str
+    block: int
+
+
+@dataclass
+class Term:
+    """A free-energy term of tasks.toml's [[term]] list."""
+    name: str
+    symbol: str
+    latex: str
+    doc: str
+    label: str
+    unit: str
+    read: TermRead
+    goal_range: str | None = omitted()
+
+
+@dataclass
 class Goal:
     term: str
     rust: list[str]
@@ -413,6 +434,9 @@ class Ir:
     schema: int
     generator: Generator
     model: Model
+    terms: list[Term]
+    # The order J's summands are added in (tasks.toml's cost_order).
+    cost_order: list[str]
     tasks: list[Task]
     functions: list[Function]
     test_vectors: TestVectors

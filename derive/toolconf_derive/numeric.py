@@ -86,7 +86,7 @@ class CasadiModel:
     def control_confidence(self, task: Task, p: np.ndarray, precision: dict[str, np.ndarray]) -> Exact:
         """Pi^U = sum over the task's terms of S^T P S, plus P^U (eq. control_conf and the closed forms after it)."""
         s = self.sensitivity_exact(task, p)
-        pi = Exact.of(precision["u"])
+        pi = Exact.of(precision[task.control_term])
         for term in task.sensitivity_terms:
             pi = pi + s[term].T @ Exact.of(precision[term]) @ s[term]
         return pi
@@ -109,12 +109,12 @@ class CasadiModel:
             "IO": ca.horzcat(eye, zero), "OI": ca.horzcat(zero, eye),
             "E": e, "dX_dU": ca.inv_minor(a) @ (e - b),
         }
-        precisions = {t: ca.SX.sym(f"p_{t}", n, n) for t in task.sensitivity_terms + ["u"]}
-        pi = precisions["u"]
+        precisions = {t: ca.SX.sym(f"p_{t}", n, n) for t in task.precision_terms}
+        pi = precisions[task.control_term]
         for term in task.sensitivity_terms:
             s = sensitivity(task, term, ns)
             pi = pi + s.T @ precisions[term] @ s
         gradient = ca.gradient(ca.log(ca.det(pi)), self.p)
-        inputs = [self.p] + [precisions[t] for t in task.sensitivity_terms + ["u"]]
+        inputs = [self.p] + [precisions[t] for t in task.precision_terms]
         cache[task.name] = ExactFunction(ca.Function(f"{task.name}_logdet_gradient", inputs, [gradient]))
         return cache[task.name]

@@ -7,7 +7,7 @@ import mpmath
 import sympy as sp
 
 from . import ir_types as irt
-from .symbolic import TERM_LATEX, Derivation, cofactor_determinant, parse, tidy
+from .symbolic import Derivation, cofactor_determinant, parse, tidy
 
 # The tool at which the report states d ln|Pi^U|/dp: the middle of the paper's box [0.1, 0.6].
 REFERENCE_PARAMETER = sp.Rational(7, 20)
@@ -87,8 +87,8 @@ def report_data(d: Derivation) -> irt.ClosedFormReport:
             {s: defaults[term][i, j] for term, reads in t.precision_reads.items() for s, i, j in reads}
         ).applyfunc(tidy)
         formula = " + ".join(
-            rf"\left(\frac{{\partial {TERM_LATEX[term]}}}{{\partial U}}\right)^{{T}} P^{{{TERM_LATEX[term]}}}"
-            rf" \frac{{\partial {TERM_LATEX[term]}}}{{\partial U}}"
+            rf"\left(\frac{{\partial {task.term(term).latex}}}{{\partial U}}\right)^{{T}} P^{{{task.term(term).latex}}}"
+            rf" \frac{{\partial {task.term(term).latex}}}{{\partial U}}"
             for term in task.sensitivity_terms
         ) + r" + P^{U}"
         tasks.append(irt.TaskReport(
@@ -97,13 +97,13 @@ def report_data(d: Derivation) -> irt.ClosedFormReport:
             title=task.title,
             doc=task.doc,
             sensitivities=[
-                irt.SensitivityReport(term=term, what=rf"\frac{{\partial {TERM_LATEX[term]}}}{{\partial U}}",
+                irt.SensitivityReport(term=term, what=rf"\frac{{\partial {task.term(term).latex}}}{{\partial U}}",
                                       formula=task.sensitivity[term], latex=_latex(d, t.sensitivity[term]))
                 for term in task.sensitivity_terms
             ],
             confidence_formula=formula,
             default_precisions=", ".join(
-                f"P^{{{TERM_LATEX[term]}}} = {sp.latex(sp.nsimplify(task.default_precision[term]))} I"
+                f"P^{{{task.term(term).latex}}} = {sp.latex(sp.nsimplify(task.default_precision[term]))} I"
                 for term in task.terms
             ),
             confidence_default=_latex(d, confidence_default),
@@ -111,7 +111,7 @@ def report_data(d: Derivation) -> irt.ClosedFormReport:
                                       for s, i, j in reads}),
             remarks=[
                 irt.Remark(
-                    what=rf"\frac{{\partial {TERM_LATEX[r['remark'].term]}}}{{\partial U}}",
+                    what=rf"\frac{{\partial {task.term(r['remark'].term).latex}}}{{\partial U}}",
                     text=" ".join(r["remark"].text.split()),
                     alternative_formula=r["remark"].alternative,
                     alternative=_latex(d, r["alternative"]),

@@ -16,13 +16,6 @@ from .description import Model, Task, sensitivity, task_formula
 from .errors import DescriptionError
 from .expression import ExpressionError, sympy_expression
 
-TERM_LATEX = {
-    "theta": r"\theta",
-    "theta_dot": r"\dot{\theta}",
-    "theta_ddot": r"\ddot{\theta}",
-    "u": "U",
-}
-
 
 def tidy(e: sp.Expr) -> sp.Expr:
     """A canonical, readable form of a rational expression in the parameters."""
@@ -117,7 +110,7 @@ class Derivation:
         for t in self.tasks:
             for term, reads in t.precision_reads.items():
                 for s, i, j in reads:
-                    table[s] = rf"P^{{{TERM_LATEX[term]}}}_{{{i + 1}{j + 1}}}"
+                    table[s] = rf"P^{{{t.task.term(term).latex}}}_{{{i + 1}{j + 1}}}"
         return table
 
 
@@ -186,7 +179,12 @@ def check_goals(model: Model, tasks: list[Task]) -> None:
         if name not in by_name:
             raise DescriptionError(model.path, f"goals.{name}",
                                    f"no task is named '{name}' (tasks: {', '.join(by_name)})")
+        known = [t.name for t in by_name[name].all_terms if t.goal_range is not None]
         for term, values in terms.items():
+            if term not in known:
+                raise DescriptionError(model.path, f"goals.{name}.{term}",
+                                       f"unknown key: a goal is given for a term of the task definitions "
+                                       f"({', '.join(known)})")
             if term not in by_name[name].sensitivity_terms:
                 raise DescriptionError(model.path, f"goals.{name}.{term}", f"task '{name}' does not use {term}")
             for i, v in enumerate(values):
@@ -202,9 +200,9 @@ def derive_task(task: Task, ns: dict, n: int) -> TaskDerivation:
             raise DescriptionError(task.path, f"{task.key}.{key}",
                                    f"is {sens[term].shape[0]}x{sens[term].shape[1]}, not {n}x{n}")
     precision, reads = {}, {}
-    for term in task.sensitivity_terms + ["u"]:
+    for term in task.precision_terms:
         precision[term], reads[term] = symmetric_matrix(f"p_{term}", n)
-    confidence = precision["u"]
+    confidence = precision[task.control_term]
     for term in task.sensitivity_terms:
         s = sens[term]
         confidence = confidence + s.T @ precision[term] @ s

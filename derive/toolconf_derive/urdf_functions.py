@@ -17,7 +17,7 @@ from . import ir_types as irt
 from .description import Model, sensitivity
 from .errors import DescriptionError
 from .exact import ExactFunction
-from .functions import _sample_control, _sample_precision, _sample_state, TERM_DOC
+from .functions import _sample_control, _sample_precision, _sample_state
 from .ir import _rust_type, _struct_name, model_document
 from .rigid_body import ldl_logdet
 from .rust_printer import float_literal
@@ -99,17 +99,17 @@ def _task_functions(dv: UrdfDerivation, task, ns, p_arg) -> list[SeqFunction]:
         ca.Function(task.sensitivity_function, [ps], [ca.cse(ca.sparsify(sens[t])) for t in terms]),
         lambda v, task=task: [dv.reference_sensitivity(task, v["params"])[t] for t in task.sensitivity_terms],
     )]
-    inputs = {t: ca.SX.sym(f"p_{t}", n, n) for t in terms + ["u"]}
+    inputs = {t: ca.SX.sym(f"p_{t}", n, n) for t in task.precision_terms}
     full = {t: ca.triu(s) + ca.triu(s, False).T for t, s in inputs.items()}
-    pi = full["u"]
+    pi = full[task.control_term]
     for t in terms:
         pi = pi + sens[t].T @ full[t] @ sens[t]
-    prec_args = [SeqArg(f"p_{t}", f"precision P of the {TERM_DOC[t]} (symmetric; the upper triangle is read)",
-                        n, n, True, _sample_precision(n)) for t in terms + ["u"]]
-    symbols = [inputs[t] for t in terms + ["u"]]
+    prec_args = [SeqArg(f"p_{t}", f"precision P of {task.argument_doc(t)} (symmetric; the upper triangle is read)",
+                        n, n, True, _sample_precision(n)) for t in task.precision_terms]
+    symbols = [inputs[t] for t in task.precision_terms]
 
     def precisions(v):
-        return {t: v[f"p_{t}"] for t in terms + ["u"]}
+        return {t: v[f"p_{t}"] for t in task.precision_terms}
 
     out.append(SeqFunction(
         task.confidence_function,

@@ -381,7 +381,7 @@ class UrdfDerivation:
 
     def reference_confidence(self, task: Task, p, precision: dict) -> Exact:
         s = self.reference_sensitivity(task, p)
-        pi = Exact.of(precision["u"])
+        pi = Exact.of(precision[task.control_term])
         for t in task.sensitivity_terms:
             pi = pi + s[t].T @ Exact.of(precision[t]) @ s[t]
         return pi
@@ -395,7 +395,7 @@ class UrdfDerivation:
                 a, b = self.reference_ab.exact_at([params])
                 ns = exact_namespace(a, b, self.n)
                 s = {t: sensitivity(task, t, ns) for t in task.sensitivity_terms}
-                pi = Exact.of(precision["u"])
+                pi = Exact.of(precision[task.control_term])
                 for t in task.sensitivity_terms:
                     pi = pi + s[t].T @ Exact.of(precision[t]) @ s[t]
                 return mpmath.log(mpmath.det(pi.m))

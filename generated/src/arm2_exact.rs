@@ -101,31 +101,46 @@ pub mod acceleration {
 pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
     match task {
         super::TaskKind::Position => super::TaskDefaults {
-            goal_theta: position::GOAL_THETA,
-            goal_theta_dot: position::GOAL_THETA_DOT,
-            goal_theta_ddot: position::GOAL_THETA_DDOT,
-            precision_theta: position::PRECISION_THETA,
-            precision_theta_dot: position::PRECISION_THETA_DOT,
-            precision_theta_ddot: position::PRECISION_THETA_DDOT,
-            precision_u: position::PRECISION_U,
+            goal: [
+                position::GOAL_THETA,
+                position::GOAL_THETA_DOT,
+                position::GOAL_THETA_DDOT,
+                [0.0; DOF],
+            ],
+            precision: [
+                position::PRECISION_THETA,
+                position::PRECISION_THETA_DOT,
+                position::PRECISION_THETA_DDOT,
+                position::PRECISION_U,
+            ],
         },
         super::TaskKind::Velocity => super::TaskDefaults {
-            goal_theta: [0.0; DOF],
-            goal_theta_dot: velocity::GOAL_THETA_DOT,
-            goal_theta_ddot: velocity::GOAL_THETA_DDOT,
-            precision_theta: 0.0,
-            precision_theta_dot: velocity::PRECISION_THETA_DOT,
-            precision_theta_ddot: velocity::PRECISION_THETA_DDOT,
-            precision_u: velocity::PRECISION_U,
+            goal: [
+                [0.0; DOF],
+                velocity::GOAL_THETA_DOT,
+                velocity::GOAL_THETA_DDOT,
+                [0.0; DOF],
+            ],
+            precision: [
+                0.0,
+                velocity::PRECISION_THETA_DOT,
+                velocity::PRECISION_THETA_DDOT,
+                velocity::PRECISION_U,
+            ],
         },
         super::TaskKind::Acceleration => super::TaskDefaults {
-            goal_theta: [0.0; DOF],
-            goal_theta_dot: [0.0; DOF],
-            goal_theta_ddot: acceleration::GOAL_THETA_DDOT,
-            precision_theta: 0.0,
-            precision_theta_dot: 0.0,
-            precision_theta_ddot: acceleration::PRECISION_THETA_DDOT,
-            precision_u: acceleration::PRECISION_U,
+            goal: [
+                [0.0; DOF],
+                [0.0; DOF],
+                acceleration::GOAL_THETA_DDOT,
+                [0.0; DOF],
+            ],
+            precision: [
+                0.0,
+                0.0,
+                acceleration::PRECISION_THETA_DDOT,
+                acceleration::PRECISION_U,
+            ],
         },
     }
 }
@@ -142,75 +157,92 @@ pub fn task_sensitivities(
         super::TaskKind::Position => {
             let (d_theta_du, d_theta_dot_du, d_theta_ddot_du) = position_sensitivity(params);
             super::TaskSensitivities {
-                d_theta_du: Some(d_theta_du),
-                d_theta_dot_du: Some(d_theta_dot_du),
-                d_theta_ddot_du: Some(d_theta_ddot_du),
+                d_du: [
+                    Some(d_theta_du),
+                    Some(d_theta_dot_du),
+                    Some(d_theta_ddot_du),
+                    None,
+                ],
             }
         }
         super::TaskKind::Velocity => {
             let (d_theta_dot_du, d_theta_ddot_du) = velocity_sensitivity(params);
             super::TaskSensitivities {
-                d_theta_du: None,
-                d_theta_dot_du: Some(d_theta_dot_du),
-                d_theta_ddot_du: Some(d_theta_ddot_du),
+                d_du: [None, Some(d_theta_dot_du), Some(d_theta_ddot_du), None],
             }
         }
         super::TaskKind::Acceleration => {
             let d_theta_ddot_du = acceleration_sensitivity(params);
             super::TaskSensitivities {
-                d_theta_du: None,
-                d_theta_dot_du: None,
-                d_theta_ddot_du: Some(d_theta_ddot_du),
+                d_du: [None, None, Some(d_theta_ddot_du), None],
             }
         }
     }
 }
 
 /// The control confidence Π^U of `task` for a tool (each task's `<task>_control_confidence`
-/// below), given the precisions of all four terms; a task reads only its own terms' ones.
+/// below), given the precisions of every term by [`super::Term::index`]; a task reads only its
+/// own terms' ones.
 #[inline]
 #[must_use]
-#[allow(unused_variables)]
 pub fn task_control_confidence(
     task: super::TaskKind,
     params: &SVector<f64, PARAMETER_COUNT>,
-    p_theta: &SMatrix<f64, DOF, DOF>,
-    p_theta_dot: &SMatrix<f64, DOF, DOF>,
-    p_theta_ddot: &SMatrix<f64, DOF, DOF>,
-    p_u: &SMatrix<f64, DOF, DOF>,
+    precision: &[SMatrix<f64, DOF, DOF>; super::TERMS],
 ) -> SMatrix<f64, DOF, DOF> {
+    use super::Term;
     match task {
-        super::TaskKind::Position => {
-            position_control_confidence(params, p_theta, p_theta_dot, p_theta_ddot, p_u)
-        }
-        super::TaskKind::Velocity => {
-            velocity_control_confidence(params, p_theta_dot, p_theta_ddot, p_u)
-        }
-        super::TaskKind::Acceleration => acceleration_control_confidence(params, p_theta_ddot, p_u),
+        super::TaskKind::Position => position_control_confidence(
+            params,
+            &precision[Term::Theta as usize],
+            &precision[Term::ThetaDot as usize],
+            &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::Velocity => velocity_control_confidence(
+            params,
+            &precision[Term::ThetaDot as usize],
+            &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::Acceleration => acceleration_control_confidence(
+            params,
+            &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
     }
 }
 
 /// d ln|Π^U| / dp of `task` for a tool (each task's `<task>_logdet_gradient` below), given
-/// the precisions of all four terms; a task reads only its own terms' ones.
+/// the precisions of every term by [`super::Term::index`]; a task reads only its own terms'
+/// ones.
 #[inline]
 #[must_use]
-#[allow(unused_variables)]
 pub fn task_logdet_gradient(
     task: super::TaskKind,
     params: &SVector<f64, PARAMETER_COUNT>,
-    p_theta: &SMatrix<f64, DOF, DOF>,
-    p_theta_dot: &SMatrix<f64, DOF, DOF>,
-    p_theta_ddot: &SMatrix<f64, DOF, DOF>,
-    p_u: &SMatrix<f64, DOF, DOF>,
+    precision: &[SMatrix<f64, DOF, DOF>; super::TERMS],
 ) -> SVector<f64, PARAMETER_COUNT> {
+    use super::Term;
     match task {
-        super::TaskKind::Position => {
-            position_logdet_gradient(params, p_theta, p_theta_dot, p_theta_ddot, p_u)
-        }
-        super::TaskKind::Velocity => {
-            velocity_logdet_gradient(params, p_theta_dot, p_theta_ddot, p_u)
-        }
-        super::TaskKind::Acceleration => acceleration_logdet_gradient(params, p_theta_ddot, p_u),
+        super::TaskKind::Position => position_logdet_gradient(
+            params,
+            &precision[Term::Theta as usize],
+            &precision[Term::ThetaDot as usize],
+            &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::Velocity => velocity_logdet_gradient(
+            params,
+            &precision[Term::ThetaDot as usize],
+            &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::Acceleration => acceleration_logdet_gradient(
+            params,
+            &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
     }
 }
 
@@ -611,7 +643,7 @@ pub fn position_sensitivity(
 /// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
-/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
 /// Cost per call: 63 operations, weighted 107 (9 ADD, 6 DIV, 30 MUL, 4 NEG, 2 POW, 12 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -672,7 +704,7 @@ pub fn position_control_confidence(
 /// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
-/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
 /// Cost per call: 448 operations, weighted 721 (25 ADD, 38 DIV, 290 MUL, 10 NEG, 7 POW, 78 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -873,7 +905,7 @@ pub fn velocity_sensitivity(params: &SVector<f64, 4>) -> (SMatrix<f64, 2, 2>, SM
 /// - `params`: tool parameters `[m1 m2 l1 l2]`
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
-/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
 /// Cost per call: 37 operations, weighted 82 (7 ADD, 6 DIV, 17 MUL, 3 POW, 4 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -925,7 +957,7 @@ pub fn velocity_control_confidence(
 /// - `params`: tool parameters `[m1 m2 l1 l2]`
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
-/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
 /// Cost per call: 171 operations, weighted 228 (15 ADD, 7 DIV, 107 MUL, 9 NEG, 8 POW, 25 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -1058,7 +1090,7 @@ pub fn acceleration_sensitivity(_params: &SVector<f64, 4>) -> SMatrix<f64, 2, 2>
 ///
 /// - `params`: tool parameters `[m1 m2 l1 l2]`
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
-/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
 /// Cost per call: 3 operations, weighted 3 (3 ADD).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -1090,7 +1122,7 @@ pub fn acceleration_control_confidence(
 ///
 /// - `params`: tool parameters `[m1 m2 l1 l2]`
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
-/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
 /// Cost per call: 0 operations, weighted 0.
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)

@@ -101,31 +101,46 @@ pub mod acceleration {
 pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
     match task {
         super::TaskKind::Position => super::TaskDefaults {
-            goal_theta: position::GOAL_THETA,
-            goal_theta_dot: position::GOAL_THETA_DOT,
-            goal_theta_ddot: position::GOAL_THETA_DDOT,
-            precision_theta: position::PRECISION_THETA,
-            precision_theta_dot: position::PRECISION_THETA_DOT,
-            precision_theta_ddot: position::PRECISION_THETA_DDOT,
-            precision_u: position::PRECISION_U,
+            goal: [
+                position::GOAL_THETA,
+                position::GOAL_THETA_DOT,
+                position::GOAL_THETA_DDOT,
+                [0.0; DOF],
+            ],
+            precision: [
+                position::PRECISION_THETA,
+                position::PRECISION_THETA_DOT,
+                position::PRECISION_THETA_DDOT,
+                position::PRECISION_U,
+            ],
         },
         super::TaskKind::Velocity => super::TaskDefaults {
-            goal_theta: [0.0; DOF],
-            goal_theta_dot: velocity::GOAL_THETA_DOT,
-            goal_theta_ddot: velocity::GOAL_THETA_DDOT,
-            precision_theta: 0.0,
-            precision_theta_dot: velocity::PRECISION_THETA_DOT,
-            precision_theta_ddot: velocity::PRECISION_THETA_DDOT,
-            precision_u: velocity::PRECISION_U,
+            goal: [
+                [0.0; DOF],
+                velocity::GOAL_THETA_DOT,
+                velocity::GOAL_THETA_DDOT,
+                [0.0; DOF],
+            ],
+            precision: [
+                0.0,
+                velocity::PRECISION_THETA_DOT,
+                velocity::PRECISION_THETA_DDOT,
+                velocity::PRECISION_U,
+            ],
         },
         super::TaskKind::Acceleration => super::TaskDefaults {
-            goal_theta: [0.0; DOF],
-            goal_theta_dot: [0.0; DOF],
-            goal_theta_ddot: acceleration::GOAL_THETA_DDOT,
-            precision_theta: 0.0,
-            precision_theta_dot: 0.0,
-            precision_theta_ddot: acceleration::PRECISION_THETA_DDOT,
-            precision_u: acceleration::PRECISION_U,
+            goal: [
+                [0.0; DOF],
+                [0.0; DOF],
+                acceleration::GOAL_THETA_DDOT,
+                [0.0; DOF],
+            ],
+            precision: [
+                0.0,
+                0.0,
+                acceleration::PRECISION_THETA_DDOT,
+                acceleration::PRECISION_U,
+            ],
         },
     }
 }
@@ -142,75 +157,92 @@ pub fn task_sensitivities(
         super::TaskKind::Position => {
             let (d_theta_du, d_theta_dot_du, d_theta_ddot_du) = position_sensitivity(params);
             super::TaskSensitivities {
-                d_theta_du: Some(d_theta_du),
-                d_theta_dot_du: Some(d_theta_dot_du),
-                d_theta_ddot_du: Some(d_theta_ddot_du),
+                d_du: [
+                    Some(d_theta_du),
+                    Some(d_theta_dot_du),
+                    Some(d_theta_ddot_du),
+                    None,
+                ],
             }
         }
         super::TaskKind::Velocity => {
             let (d_theta_dot_du, d_theta_ddot_du) = velocity_sensitivity(params);
             super::TaskSensitivities {
-                d_theta_du: None,
-                d_theta_dot_du: Some(d_theta_dot_du),
-                d_theta_ddot_du: Some(d_theta_ddot_du),
+                d_du: [None, Some(d_theta_dot_du), Some(d_theta_ddot_du), None],
             }
         }
         super::TaskKind::Acceleration => {
             let d_theta_ddot_du = acceleration_sensitivity(params);
             super::TaskSensitivities {
-                d_theta_du: None,
-                d_theta_dot_du: None,
-                d_theta_ddot_du: Some(d_theta_ddot_du),
+                d_du: [None, None, Some(d_theta_ddot_du), None],
             }
         }
     }
 }
 
 /// The control confidence Π^U of `task` for a tool (each task's `<task>_control_confidence`
-/// below), given the precisions of all four terms; a task reads only its own terms' ones.
+/// below), given the precisions of every term by [`super::Term::index`]; a task reads only its
+/// own terms' ones.
 #[inline]
 #[must_use]
-#[allow(unused_variables)]
 pub fn task_control_confidence(
     task: super::TaskKind,
     params: &SVector<f64, PARAMETER_COUNT>,
-    p_theta: &SMatrix<f64, DOF, DOF>,
-    p_theta_dot: &SMatrix<f64, DOF, DOF>,
-    p_theta_ddot: &SMatrix<f64, DOF, DOF>,
-    p_u: &SMatrix<f64, DOF, DOF>,
+    precision: &[SMatrix<f64, DOF, DOF>; super::TERMS],
 ) -> SMatrix<f64, DOF, DOF> {
+    use super::Term;
     match task {
-        super::TaskKind::Position => {
-            position_control_confidence(params, p_theta, p_theta_dot, p_theta_ddot, p_u)
-        }
-        super::TaskKind::Velocity => {
-            velocity_control_confidence(params, p_theta_dot, p_theta_ddot, p_u)
-        }
-        super::TaskKind::Acceleration => acceleration_control_confidence(params, p_theta_ddot, p_u),
+        super::TaskKind::Position => position_control_confidence(
+            params,
+            &precision[Term::Theta as usize],
+            &precision[Term::ThetaDot as usize],
+            &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::Velocity => velocity_control_confidence(
+            params,
+            &precision[Term::ThetaDot as usize],
+            &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::Acceleration => acceleration_control_confidence(
+            params,
+            &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
     }
 }
 
 /// d ln|Π^U| / dp of `task` for a tool (each task's `<task>_logdet_gradient` below), given
-/// the precisions of all four terms; a task reads only its own terms' ones.
+/// the precisions of every term by [`super::Term::index`]; a task reads only its own terms'
+/// ones.
 #[inline]
 #[must_use]
-#[allow(unused_variables)]
 pub fn task_logdet_gradient(
     task: super::TaskKind,
     params: &SVector<f64, PARAMETER_COUNT>,
-    p_theta: &SMatrix<f64, DOF, DOF>,
-    p_theta_dot: &SMatrix<f64, DOF, DOF>,
-    p_theta_ddot: &SMatrix<f64, DOF, DOF>,
-    p_u: &SMatrix<f64, DOF, DOF>,
+    precision: &[SMatrix<f64, DOF, DOF>; super::TERMS],
 ) -> SVector<f64, PARAMETER_COUNT> {
+    use super::Term;
     match task {
-        super::TaskKind::Position => {
-            position_logdet_gradient(params, p_theta, p_theta_dot, p_theta_ddot, p_u)
-        }
-        super::TaskKind::Velocity => {
-            velocity_logdet_gradient(params, p_theta_dot, p_theta_ddot, p_u)
-        }
-        super::TaskKind::Acceleration => acceleration_logdet_gradient(params, p_theta_ddot, p_u),
+        super::TaskKind::Position => position_logdet_gradient(
+            params,
+            &precision[Term::Theta as usize],
+            &precision[Term::ThetaDot as usize],
+            &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::Velocity => velocity_logdet_gradient(
+            params,
+            &precision[Term::ThetaDot as usize],
+            &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::Acceleration => acceleration_logdet_gradient(
+            params,
+            &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
     }
 }
 
@@ -687,7 +719,7 @@ pub fn position_sensitivity(
 /// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
-/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
 /// Cost per call: 73 operations, weighted 117 (14 ADD, 6 DIV, 35 MUL, 4 NEG, 2 POW, 12 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -753,7 +785,7 @@ pub fn position_control_confidence(
 /// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
-/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
 /// Cost per call: 541 operations, weighted 842 (34 ADD, 42 DIV, 346 MUL, 15 NEG, 7 POW, 97 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -979,7 +1011,7 @@ pub fn velocity_sensitivity(params: &SVector<f64, 5>) -> (SMatrix<f64, 2, 2>, SM
 /// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
-/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
 /// Cost per call: 40 operations, weighted 85 (9 ADD, 6 DIV, 18 MUL, 3 POW, 4 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -1033,7 +1065,7 @@ pub fn velocity_control_confidence(
 /// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
-/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
 /// Cost per call: 210 operations, weighted 267 (24 ADD, 7 DIV, 124 MUL, 19 NEG, 8 POW, 28 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -1179,7 +1211,7 @@ pub fn acceleration_sensitivity(_params: &SVector<f64, 5>) -> SMatrix<f64, 2, 2>
 ///
 /// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
-/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
 /// Cost per call: 3 operations, weighted 3 (3 ADD).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -1211,7 +1243,7 @@ pub fn acceleration_control_confidence(
 ///
 /// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
-/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
 /// Cost per call: 0 operations, weighted 0.
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)

@@ -23,7 +23,9 @@ pub mod tasks;
 pub mod trig;
 /// Which tools each model accepts, and the box random tools are drawn from.
 pub mod validity;
-pub use tasks::{TaskDefaults, TaskKind, TaskSensitivities, Term, UnknownTask, TASK_CHOICES};
+pub use tasks::{
+    Read, TaskDefaults, TaskKind, TaskSensitivities, Term, UnknownTask, TASK_CHOICES, TERMS,
+};
 
 /// 2-DOF arm in the vertical plane (the paper's generative process) (`derive/models/arm2.toml`).
 pub mod arm2;

@@ -152,31 +152,46 @@ pub mod acceleration {
 pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
     match task {
         super::TaskKind::Position => super::TaskDefaults {
-            goal_theta: position::GOAL_THETA,
-            goal_theta_dot: position::GOAL_THETA_DOT,
-            goal_theta_ddot: position::GOAL_THETA_DDOT,
-            precision_theta: position::PRECISION_THETA,
-            precision_theta_dot: position::PRECISION_THETA_DOT,
-            precision_theta_ddot: position::PRECISION_THETA_DDOT,
-            precision_u: position::PRECISION_U,
+            goal: [
+                position::GOAL_THETA,
+                position::GOAL_THETA_DOT,
+                position::GOAL_THETA_DDOT,
+                [0.0; DOF],
+            ],
+            precision: [
+                position::PRECISION_THETA,
+                position::PRECISION_THETA_DOT,
+                position::PRECISION_THETA_DDOT,
+                position::PRECISION_U,
+            ],
         },
         super::TaskKind::Velocity => super::TaskDefaults {
-            goal_theta: [0.0; DOF],
-            goal_theta_dot: velocity::GOAL_THETA_DOT,
-            goal_theta_ddot: velocity::GOAL_THETA_DDOT,
-            precision_theta: 0.0,
-            precision_theta_dot: velocity::PRECISION_THETA_DOT,
-            precision_theta_ddot: velocity::PRECISION_THETA_DDOT,
-            precision_u: velocity::PRECISION_U,
+            goal: [
+                [0.0; DOF],
+                velocity::GOAL_THETA_DOT,
+                velocity::GOAL_THETA_DDOT,
+                [0.0; DOF],
+            ],
+            precision: [
+                0.0,
+                velocity::PRECISION_THETA_DOT,
+                velocity::PRECISION_THETA_DDOT,
+                velocity::PRECISION_U,
+            ],
         },
         super::TaskKind::Acceleration => super::TaskDefaults {
-            goal_theta: [0.0; DOF],
-            goal_theta_dot: [0.0; DOF],
-            goal_theta_ddot: acceleration::GOAL_THETA_DDOT,
-            precision_theta: 0.0,
-            precision_theta_dot: 0.0,
-            precision_theta_ddot: acceleration::PRECISION_THETA_DDOT,
-            precision_u: acceleration::PRECISION_U,
+            goal: [
+                [0.0; DOF],
+                [0.0; DOF],
+                acceleration::GOAL_THETA_DDOT,
+                [0.0; DOF],
+            ],
+            precision: [
+                0.0,
+                0.0,
+                acceleration::PRECISION_THETA_DDOT,
+                acceleration::PRECISION_U,
+            ],
         },
     }
 }
@@ -193,75 +208,92 @@ pub fn task_sensitivities(
         super::TaskKind::Position => {
             let (d_theta_du, d_theta_dot_du, d_theta_ddot_du) = position_sensitivity(params);
             super::TaskSensitivities {
-                d_theta_du: Some(d_theta_du),
-                d_theta_dot_du: Some(d_theta_dot_du),
-                d_theta_ddot_du: Some(d_theta_ddot_du),
+                d_du: [
+                    Some(d_theta_du),
+                    Some(d_theta_dot_du),
+                    Some(d_theta_ddot_du),
+                    None,
+                ],
             }
         }
         super::TaskKind::Velocity => {
             let (d_theta_dot_du, d_theta_ddot_du) = velocity_sensitivity(params);
             super::TaskSensitivities {
-                d_theta_du: None,
-                d_theta_dot_du: Some(d_theta_dot_du),
-                d_theta_ddot_du: Some(d_theta_ddot_du),
+                d_du: [None, Some(d_theta_dot_du), Some(d_theta_ddot_du), None],
             }
         }
         super::TaskKind::Acceleration => {
             let d_theta_ddot_du = acceleration_sensitivity(params);
             super::TaskSensitivities {
-                d_theta_du: None,
-                d_theta_dot_du: None,
-                d_theta_ddot_du: Some(d_theta_ddot_du),
+                d_du: [None, None, Some(d_theta_ddot_du), None],
             }
         }
     }
 }
 
 /// The control confidence Π^U of `task` for a tool (each task's `<task>_control_confidence`
-/// below), given the precisions of all four terms; a task reads only its own terms' ones.
+/// below), given the precisions of every term by [`super::Term::index`]; a task reads only its
+/// own terms' ones.
 #[inline]
 #[must_use]
-#[allow(unused_variables)]
 pub fn task_control_confidence(
     task: super::TaskKind,
     params: &SVector<f64, PARAMETER_COUNT>,
-    p_theta: &SMatrix<f64, DOF, DOF>,
-    p_theta_dot: &SMatrix<f64, DOF, DOF>,
-    p_theta_ddot: &SMatrix<f64, DOF, DOF>,
-    p_u: &SMatrix<f64, DOF, DOF>,
+    precision: &[SMatrix<f64, DOF, DOF>; super::TERMS],
 ) -> SMatrix<f64, DOF, DOF> {
+    use super::Term;
     match task {
-        super::TaskKind::Position => {
-            position_control_confidence(params, p_theta, p_theta_dot, p_theta_ddot, p_u)
-        }
-        super::TaskKind::Velocity => {
-            velocity_control_confidence(params, p_theta_dot, p_theta_ddot, p_u)
-        }
-        super::TaskKind::Acceleration => acceleration_control_confidence(params, p_theta_ddot, p_u),
+        super::TaskKind::Position => position_control_confidence(
+            params,
+            &precision[Term::Theta as usize],
+            &precision[Term::ThetaDot as usize],
+            &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::Velocity => velocity_control_confidence(
+            params,
+            &precision[Term::ThetaDot as usize],
+            &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::Acceleration => acceleration_control_confidence(
+            params,
+            &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
     }
 }
 
 /// d ln|Π^U| / dp of `task` for a tool (each task's `<task>_logdet_gradient` below), given
-/// the precisions of all four terms; a task reads only its own terms' ones.
+/// the precisions of every term by [`super::Term::index`]; a task reads only its own terms'
+/// ones.
 #[inline]
 #[must_use]
-#[allow(unused_variables)]
 pub fn task_logdet_gradient(
     task: super::TaskKind,
     params: &SVector<f64, PARAMETER_COUNT>,
-    p_theta: &SMatrix<f64, DOF, DOF>,
-    p_theta_dot: &SMatrix<f64, DOF, DOF>,
-    p_theta_ddot: &SMatrix<f64, DOF, DOF>,
-    p_u: &SMatrix<f64, DOF, DOF>,
+    precision: &[SMatrix<f64, DOF, DOF>; super::TERMS],
 ) -> SVector<f64, PARAMETER_COUNT> {
+    use super::Term;
     match task {
-        super::TaskKind::Position => {
-            position_logdet_gradient(params, p_theta, p_theta_dot, p_theta_ddot, p_u)
-        }
-        super::TaskKind::Velocity => {
-            velocity_logdet_gradient(params, p_theta_dot, p_theta_ddot, p_u)
-        }
-        super::TaskKind::Acceleration => acceleration_logdet_gradient(params, p_theta_ddot, p_u),
+        super::TaskKind::Position => position_logdet_gradient(
+            params,
+            &precision[Term::Theta as usize],
+            &precision[Term::ThetaDot as usize],
+            &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::Velocity => velocity_logdet_gradient(
+            params,
+            &precision[Term::ThetaDot as usize],
+            &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::Acceleration => acceleration_logdet_gradient(
+            params,
+            &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
     }
 }
 
@@ -20564,7 +20596,7 @@ pub fn position_sensitivity(
 /// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
-/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
 /// Cost per call: 3766 operations, weighted 4732 (1066 ADD, 138 DIV, 1777 MUL, 785 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -24692,7 +24724,7 @@ pub fn position_control_confidence(
 /// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
-/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
 /// Cost per call: 10464 operations, weighted 13950 (3064 ADD, 498 DIV, 5026 MUL, 1876 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -38539,7 +38571,7 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
 /// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
-/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
 /// Cost per call: 3411 operations, weighted 4230 (1076 ADD, 117 DIV, 1652 MUL, 566 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -42264,7 +42296,7 @@ pub fn velocity_control_confidence(
 /// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
-/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
 /// Cost per call: 9510 operations, weighted 12597 (2848 ADD, 441 DIV, 4644 MUL, 1577 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -52460,7 +52492,7 @@ pub fn acceleration_sensitivity(_params: &SVector<f64, 7>) -> SMatrix<f64, 7, 7>
 ///
 /// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
-/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
 /// Cost per call: 28 operations, weighted 28 (28 ADD).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
@@ -52616,7 +52648,7 @@ pub fn acceleration_control_confidence(
 ///
 /// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
-/// - `p_u`: precision P of the control U (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
 /// Cost per call: 0 operations, weighted 0.
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)

@@ -11,22 +11,57 @@ use core::str::FromStr;
 
 use nalgebra::SMatrix;
 
-/// A term of the free energy F (eq. free_energy): the joint angles θ, velocities θ̇,
-/// accelerations θ̈, or the control U.
+/// How many free-energy terms there are: the length of a task's goals and precisions.
+pub const TERMS: usize = 4;
+
+/// A term of the free energy F (eq. free_energy), as `derive/tasks.toml` lists them, in the
+/// order of the controller's sum (eq. U_dot_deriv). `Term::ALL[t.index()] == t`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Term {
-    /// θ, the joint angles.
+    /// "θ": the joint angles.
     Theta,
-    /// θ̇, the joint velocities.
+    /// "θ\u{307}": the joint velocities.
     ThetaDot,
-    /// θ̈, the joint accelerations.
+    /// "θ\u{308}": the joint accelerations.
     ThetaDdot,
-    /// U, the control.
+    /// "U": the control.
     U,
 }
 
+/// Where a term's value is read, for n joints: rows `block·n..(block+1)·n` of the state
+/// X = [q; q̇] or of its rate Ẋ, or the control U.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Read {
+    State { block: usize },
+    StateRate { block: usize },
+    Control,
+}
+
 impl Term {
-    /// The term's name in `derive/tasks.toml` and in task files (`theta`, `theta_dot`, ...).
+    /// Every term, in order.
+    pub const ALL: [Term; TERMS] = [Term::Theta, Term::ThetaDot, Term::ThetaDdot, Term::U];
+
+    /// The terms a goal is given for (all but the control's), by name: the keys of a task file's
+    /// `[goal]`.
+    pub const GOAL_NAMES: [&'static str; 3] = ["theta", "theta_dot", "theta_ddot"];
+
+    /// Every term by name: the keys of a task file's `[precision]`.
+    pub const NAMES: [&'static str; TERMS] = ["theta", "theta_dot", "theta_ddot", "u"];
+
+    /// The control's own term, the one [`Read::Control`] reads.
+    pub const CONTROL: Term = Term::U;
+
+    /// The order the summands of the cost J are added in (floating-point addition is not
+    /// associative; `cost_order` of `derive/tasks.toml`).
+    pub const COST_ORDER: [Term; TERMS] = [Term::ThetaDdot, Term::U, Term::ThetaDot, Term::Theta];
+
+    /// The term's position in [`Term::ALL`], and in a task's goals and precisions.
+    #[must_use]
+    pub const fn index(self) -> usize {
+        self as usize
+    }
+
+    /// The term's name in `derive/tasks.toml` and in task files (`theta`, ...).
     #[must_use]
     pub const fn name(self) -> &'static str {
         match self {
@@ -35,6 +70,109 @@ impl Term {
             Term::ThetaDdot => "theta_ddot",
             Term::U => "u",
         }
+    }
+
+    /// The name of its sensitivity ∂(term)/∂U in outputs (`d_theta_du`).
+    #[must_use]
+    pub const fn sensitivity_name(self) -> &'static str {
+        match self {
+            Term::Theta => "d_theta_du",
+            Term::ThetaDot => "d_theta_dot_du",
+            Term::ThetaDdot => "d_theta_ddot_du",
+            Term::U => "d_u_du",
+        }
+    }
+
+    /// The term's symbol in documents and plots.
+    #[must_use]
+    pub const fn symbol(self) -> &'static str {
+        match self {
+            Term::Theta => "θ",
+            Term::ThetaDot => "θ\u{307}",
+            Term::ThetaDdot => "θ\u{308}",
+            Term::U => "U",
+        }
+    }
+
+    /// What the term is, in a few words.
+    #[must_use]
+    pub const fn doc(self) -> &'static str {
+        match self {
+            Term::Theta => "the joint angles",
+            Term::ThetaDot => "the joint velocities",
+            Term::ThetaDdot => "the joint accelerations",
+            Term::U => "the control",
+        }
+    }
+
+    /// What one of its components is called, on a plot's axis.
+    #[must_use]
+    pub const fn label(self) -> &'static str {
+        match self {
+            Term::Theta => "joint angle",
+            Term::ThetaDot => "joint velocity",
+            Term::ThetaDdot => "joint acceleration",
+            Term::U => "torque",
+        }
+    }
+
+    /// The unit of each of its components.
+    #[must_use]
+    pub const fn unit(self) -> &'static str {
+        match self {
+            Term::Theta => "rad",
+            Term::ThetaDot => "rad/s",
+            Term::ThetaDdot => "rad/s²",
+            Term::U => "N m",
+        }
+    }
+
+    /// Where its value is read.
+    #[must_use]
+    pub const fn read(self) -> Read {
+        match self {
+            Term::Theta => Read::State { block: 0 },
+            Term::ThetaDot => Read::State { block: 1 },
+            Term::ThetaDdot => Read::StateRate { block: 1 },
+            Term::U => Read::Control,
+        }
+    }
+
+    /// The name of the documented range its goal must lie in; `None` for the control's term,
+    /// which has no goal (its prior mean η^U is 0, as in the paper).
+    #[must_use]
+    pub const fn goal_range(self) -> Option<&'static str> {
+        match self {
+            Term::Theta => Some("joint_angle"),
+            Term::ThetaDot => Some("joint_rate"),
+            Term::ThetaDdot => Some("joint_acceleration"),
+            Term::U => None,
+        }
+    }
+
+    /// Whether a goal is given for it ([`Term::goal_range`]).
+    #[must_use]
+    pub const fn has_goal(self) -> bool {
+        self.goal_range().is_some()
+    }
+
+    /// Whether it has a sensitivity ∂(term)/∂U (the control's term has none).
+    #[must_use]
+    pub const fn has_sensitivity(self) -> bool {
+        !matches!(self.read(), Read::Control)
+    }
+
+    /// The term named `name` exactly.
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Term> {
+        Term::ALL.into_iter().find(|t| t.name() == name)
+    }
+}
+
+/// The term's name.
+impl fmt::Display for Term {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
     }
 }
 
@@ -184,26 +322,28 @@ impl serde::Serialize for TaskKind {
     }
 }
 
-/// The sensitivities of a task's controller for one tool (eq. U_dot_deriv): ∂θ/∂U, ∂θ̇/∂U,
-/// ∂θ̈/∂U, `None` for a term the task does not use.
+/// The sensitivities ∂(term)/∂U of a task's controller for one tool (eq. U_dot_deriv), by
+/// [`Term::index`]: `None` for a term the task does not use and for the control's own term.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TaskSensitivities<const N: usize> {
-    pub d_theta_du: Option<SMatrix<f64, N, N>>,
-    pub d_theta_dot_du: Option<SMatrix<f64, N, N>>,
-    pub d_theta_ddot_du: Option<SMatrix<f64, N, N>>,
+    pub d_du: [Option<SMatrix<f64, N, N>>; TERMS],
+}
+
+impl<const N: usize> TaskSensitivities<N> {
+    /// ∂(term)/∂U, if the task uses it.
+    #[must_use]
+    pub const fn of(&self, term: Term) -> Option<SMatrix<f64, N, N>> {
+        self.d_du[term.index()]
+    }
 }
 
 /// A task's default goals and precisions for one model (the paper's "Implementation details":
-/// P = value · I): zero for a term the task does not use.
+/// P = value · I), by [`Term::index`]: zero for a term the task does not use (and the goal of the
+/// control's term).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TaskDefaults<const N: usize> {
-    pub goal_theta: [f64; N],
-    pub goal_theta_dot: [f64; N],
-    pub goal_theta_ddot: [f64; N],
-    pub precision_theta: f64,
-    pub precision_theta_dot: f64,
-    pub precision_theta_ddot: f64,
-    pub precision_u: f64,
+    pub goal: [[f64; N]; TERMS],
+    pub precision: [f64; TERMS],
 }
 
 #[cfg(test)]
@@ -212,6 +352,20 @@ mod tests {
 
     use super::*;
     use std::string::ToString;
+
+    #[test]
+    fn every_term_by_its_index_and_its_name() {
+        for (i, t) in Term::ALL.into_iter().enumerate() {
+            assert_eq!(t.index(), i);
+            assert_eq!(Term::from_name(t.name()), Some(t));
+            assert_eq!(Term::NAMES[i], t.name());
+            assert_eq!(t.has_goal(), Term::GOAL_NAMES.contains(&t.name()));
+        }
+        assert_eq!(Term::from_name(""), None);
+        let mut order = Term::COST_ORDER;
+        order.sort();
+        assert_eq!(order, Term::ALL);
+    }
 
     #[test]
     fn a_task_by_its_name_in_any_ascii_case_or_by_its_number() {

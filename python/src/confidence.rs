@@ -71,7 +71,7 @@ pub fn named(names: &[&str], values: &[f64]) -> String {
 ///
 /// Returns:
 ///     dict: ``A`` (∂f/∂X at the equilibrium), ``B`` (∂f/∂U), ``sensitivities`` (a dict of the
-///     task's ∂(task variable)/∂U: ``d_theta_du``, ``d_theta_dot_du``, ``d_theta_ddot_du``),
+///     task's ∂(term)/∂U, under the ``sensitivity`` keys of ``toolconf.terms()``),
 ///     ``pi_u`` (Π^U) and ``logdet`` (ln|Π^U|). For a 1-D ``params`` the matrices are 2-D arrays
 ///     and ``logdet`` a float; for a 2-D ``params`` every entry gains a leading axis of one row
 ///     per tool (``logdet`` a 1-D array). The numbers are the command line's

@@ -48,6 +48,7 @@ fn _toolconf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     }
     m.add_function(wrap_pyfunction!(models::models, m)?)?;
     m.add_function(wrap_pyfunction!(models::ranges, m)?)?;
+    m.add_function(wrap_pyfunction!(models::terms, m)?)?;
     m.add_function(wrap_pyfunction!(confidence::confidence, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(rank::rank, m)?)?;

@@ -32,6 +32,30 @@ pub fn models(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     Ok(out)
 }
 
+/// The free-energy terms (eq. free_energy), in order: ``[{"name", "symbol", "doc", "label", "unit",
+/// "goal_range", "sensitivity"}, ...]``. ``name`` keys a task's ``goal`` and ``precision`` (and
+/// a trajectory's arrays in ``simulate``); ``goal_range`` names the ``ranges()`` entry its goal
+/// lies in (``None``: the control's term, which has no goal); ``sensitivity`` the key of its
+/// ∂(term)/∂U in ``confidence``'s ``sensitivities`` (``None`` for the control's term).
+#[pyfunction]
+pub fn terms(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
+    toolconf::Term::ALL
+        .into_iter()
+        .map(|term| {
+            let entry = PyDict::new(py);
+            entry.set_item("name", term.name())?;
+            entry.set_item("symbol", term.symbol())?;
+            entry.set_item("doc", term.doc())?;
+            entry.set_item("label", term.label())?;
+            entry.set_item("unit", term.unit())?;
+            entry.set_item("goal_range", term.goal_range())?;
+            let sensitivity = term.has_sensitivity().then(|| term.sensitivity_name());
+            entry.set_item("sensitivity", sensitivity)?;
+            Ok(entry)
+        })
+        .collect()
+}
+
 /// Every documented valid range (``README.md``, "Bad input"): ``{name: {"low", "high",
 /// "low_open", "unit"}}``, e.g. ``ranges()["tool_parameter"]`` is ``[1e-6, 1e6]``, the range of
 /// every tool parameter, where the generated arithmetic is known to stay finite. A value outside

@@ -3,6 +3,7 @@
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use toolconf::generated::{Term, TERMS};
 use toolconf::model::Metrics;
 use toolconf::registry::{AnyTool, ModelKind};
 use toolconf::task_file::TaskSpec;
@@ -17,7 +18,8 @@ pub struct Episode {
     pub metrics: Metrics,
     pub n: usize,
     pub t: Vec<f64>,
-    pub series: [(&'static str, Vec<f64>); 4],
+    /// Every term's values by [`Term::index`], under its name.
+    pub series: [(&'static str, Vec<f64>); TERMS],
 }
 
 /// One episode of the tool `params` on `spec` bound to model `kind`, with the trajectory: the
@@ -42,12 +44,7 @@ pub fn episode_of(kind: ModelKind, spec: &TaskSpec, params: &[f64]) -> Result<Ep
     Ok(Episode {
         metrics: e.metrics,
         n: kind.dof(),
-        series: [
-            ("theta", flat(&tr.theta)),
-            ("theta_dot", flat(&tr.theta_dot)),
-            ("theta_ddot", flat(&tr.theta_ddot)),
-            ("u", flat(&tr.u)),
-        ],
+        series: Term::ALL.map(|term| (term.name(), flat(tr.of(term)))),
         t: tr.t,
     })
 }
@@ -75,9 +72,10 @@ pub fn episode_of(kind: ModelKind, spec: &TaskSpec, params: &[f64]) -> Result<Ep
 ///     dict: the metrics ``task_error`` (Σ of the task's weighted error over the grid),
 ///     ``free_energy`` (∫F dt), ``cost_j`` (∫J dt), ``logdet`` (ln|Π^U|), ``control_effort``
 ///     (∫|U|² dt), ``rhs_evals``, ``steps``, ``rejected_steps``, ``jacobian_evals``,
-///     ``factorisations``; and the trajectory on the output grid: ``t`` (shape (T,)) and
-///     ``theta``, ``theta_dot``, ``theta_ddot`` (the plant's, what the controller observes),
-///     ``u`` (each shape (T, joints)). For arm2 the metrics are ``toolconf simulate --json``'s.
+///     ``factorisations``; and the trajectory on the output grid: ``t`` (shape (T,)) and one
+///     array per free-energy term, under the name task files give it (``toolconf.terms()``;
+///     each shape (T, joints); the plant's acceleration is what the controller observes). For
+///     arm2 the metrics are ``toolconf simulate --json``'s.
 ///
 /// Raises:
 ///     ValueError: bad input (model, parameters, task or episode option), naming the value.

@@ -19,6 +19,7 @@ The runtime is Rust (the ``toolconf`` crate); this package exposes it over NumPy
 * ``toolconf.dask`` (``pip install "./python[dask]"``): ``rank`` and ``simulate_batch`` on a
   Dask cluster, with the same results.
 * ``ranges()``: the valid range of every number the package and the command line take.
+* ``terms()``: the free-energy terms, whose names key a task's goals and precisions.
 
 A task is ``"position"``, ``"velocity"`` or ``"acceleration"`` (the paper's tasks 1-3), a task
 file's path, or a dict with a task file's keys. Bad input (a value outside ``ranges()``
@@ -44,6 +45,7 @@ from ._toolconf import (
     ranges,
     simulate,
     simulate_batch,
+    terms,
 )
 
 __all__ = [
@@ -56,6 +58,7 @@ __all__ = [
     "rank",
     "simulate",
     "simulate_batch",
+    "terms",
 ]
 
 

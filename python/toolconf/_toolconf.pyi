@@ -68,6 +68,21 @@ def ranges() -> dict[str, RangeInfo]:
     A value outside its range raises ``ValueError`` before any work starts.
     """
 
+class TermInfo(TypedDict):
+    name: str
+    symbol: str
+    doc: str
+    label: str
+    unit: str
+    goal_range: Optional[str]
+    sensitivity: Optional[str]
+
+def terms() -> list[TermInfo]:
+    """The free-energy terms, in order: ``name`` keys a task's ``goal`` and ``precision`` and a
+    trajectory's arrays; ``goal_range`` names the ``ranges()`` entry of its goal (``None``: the
+    control's term, without a goal); ``sensitivity`` the key of its ∂(term)/∂U in
+    ``confidence``'s ``sensitivities``."""
+
 def confidence(model: str, params: Params, task: Task) -> dict[str, Any]:
     """The closed-form control confidence Π^U = ∂²F/∂U² of one tool or of many.
 
@@ -93,8 +108,8 @@ def simulate(
     atol: Optional[float] = ...,
 ) -> dict[str, Any]:
     """One closed-loop episode: metrics (``task_error``, ``free_energy``, ``cost_j``,
-    ``logdet``, ``control_effort``, counters) and the trajectory (``t``, ``theta``,
-    ``theta_dot``, ``theta_ddot``, ``u`` as arrays). Raises ``ValueError`` for bad input and
+    ``logdet``, ``control_effort``, counters) and the trajectory (``t`` and one array per
+    term of ``terms()``, under its name). Raises ``ValueError`` for bad input and
     ``SimulationError`` for a failed episode."""
 
 Columns = dict[str, Union[npt.NDArray[np.float64], npt.NDArray[np.int64], list[Optional[str]], list[str]]]

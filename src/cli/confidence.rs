@@ -7,7 +7,7 @@ use toolconf::rank::{Linearisation, ModelTasks};
 use toolconf::registry::ModelKind;
 use toolconf::task_file::TaskSpec;
 use toolconf::validate::finite_output;
-use toolconf::{control_confidence, Arm};
+use toolconf::{control_confidence, Arm, Term};
 
 use super::episode_args::TaskArgs;
 use super::output::{matrix_rows, print_matrix, CliError};
@@ -55,23 +55,16 @@ fn run_arm(args: &Args, arm: &Arm, spec: &TaskSpec) -> Result<(), CliError> {
     let label = format!("arm {arm}");
     finite_output(&label, "A", a.iter().copied())?;
     finite_output(&label, "B", b.iter().copied())?;
-    for m in [s.d_theta_du, s.d_theta_dot_du, s.d_theta_ddot_du]
-        .iter()
-        .flatten()
-    {
+    for m in s.d_du.iter().flatten() {
         finite_output(&label, "a sensitivity", m.iter().copied())?;
     }
     finite_output(&label, "Π^U", confidence.pi_u.iter().copied())?;
     finite_output(&label, "ln|Π^U|", [confidence.logdet])?;
     if args.json {
         let mut sens = serde_json::Map::new();
-        for (name, m) in [
-            ("d_theta_du", s.d_theta_du),
-            ("d_theta_dot_du", s.d_theta_dot_du),
-            ("d_theta_ddot_du", s.d_theta_ddot_du),
-        ] {
-            if let Some(m) = m {
-                sens.insert(name.into(), matrix_rows(&m));
+        for term in Term::ALL {
+            if let Some(m) = s.of(term) {
+                sens.insert(term.sensitivity_name().into(), matrix_rows(&m));
             }
         }
         let out = json!({
@@ -89,13 +82,9 @@ fn run_arm(args: &Args, arm: &Arm, spec: &TaskSpec) -> Result<(), CliError> {
     outln!("arm: {arm}    task: {}", spec.label());
     print_matrix("A = df/dX at the equilibrium", &a);
     print_matrix("B = df/dU at the equilibrium", &b);
-    for (name, m) in [
-        ("dtheta/dU", s.d_theta_du),
-        ("dtheta_dot/dU", s.d_theta_dot_du),
-        ("dtheta_ddot/dU", s.d_theta_ddot_du),
-    ] {
-        if let Some(m) = m {
-            print_matrix(name, &m);
+    for term in Term::ALL {
+        if let Some(m) = s.of(term) {
+            print_matrix(&sensitivity_title(term.sensitivity_name()), &m);
         }
     }
     print_matrix("Pi^U (control confidence)", &confidence.pi_u);
@@ -139,12 +128,7 @@ fn run_model(args: &Args, model: ModelKind, spec: &TaskSpec) -> Result<(), CliEr
     print_rows("A = df/dX at the equilibrium", &l.a);
     print_rows("B = df/dU at the equilibrium", &l.b);
     for (name, m) in &l.sensitivities {
-        let title = match *name {
-            "d_theta_du" => "dtheta/dU",
-            "d_theta_dot_du" => "dtheta_dot/dU",
-            _ => "dtheta_ddot/dU",
-        };
-        print_rows(title, m);
+        print_rows(&sensitivity_title(name), m);
     }
     print_rows("Pi^U (control confidence)", &l.pi_u);
     outln!("ln|Pi^U| = {:.12}", l.logdet);
@@ -168,4 +152,10 @@ fn print_rows(title: &str, m: &[Vec<f64>]) {
         let row: Vec<String> = row.iter().map(|x| format!("{x:>16.9e}")).collect();
         outln!("  [{}]", row.join(" "));
     }
+}
+
+/// `dtheta/dU` for the sensitivity named `d_theta_du` ([`Term::sensitivity_name`]).
+fn sensitivity_title(name: &str) -> String {
+    let term = name.strip_prefix("d_").and_then(|n| n.strip_suffix("_du"));
+    format!("d{}/dU", term.unwrap_or(name))
 }

@@ -196,10 +196,7 @@ macro_rules! arm_model {
                 generated::$module::task_control_confidence(
                     task.kind,
                     p,
-                    &task.precision_theta,
-                    &task.precision_theta_dot,
-                    &task.precision_theta_ddot,
-                    &task.precision_u,
+                    &task.precision,
                 )
             }
 
@@ -211,10 +208,7 @@ macro_rules! arm_model {
                 generated::$module::task_logdet_gradient(
                     task.kind,
                     p,
-                    &task.precision_theta,
-                    &task.precision_theta_dot,
-                    &task.precision_theta_ddot,
-                    &task.precision_u,
+                    &task.precision,
                 )
             }
 

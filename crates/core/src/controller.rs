@@ -4,8 +4,39 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::generated::Term;
+use crate::generated::{Read, Term, TERMS};
 use crate::{control_confidence, ArmModel, Error, TaskN, ToolN};
+
+/// The value of every free-energy term at one instant, by [`Term::index`] (θ, θ̇, θ̈ and U for
+/// the paper's terms): what the controller observes ([`observe`]).
+pub type ObservationN<const N: usize> = [SVector<f64, N>; TERMS];
+
+/// Every term read from the state X, its rate Ẋ and the control U, as [`Term::read`] says.
+#[inline]
+pub fn observe<const N: usize, const NX: usize>(
+    x: &SVector<f64, NX>,
+    x_dot: &SVector<f64, NX>,
+    u: &SVector<f64, N>,
+) -> ObservationN<N> {
+    Term::ALL.map(|term| match term.read() {
+        Read::State { block } => x.fixed_rows::<N>(block * N).into_owned(),
+        Read::StateRate { block } => x_dot.fixed_rows::<N>(block * N).into_owned(),
+        Read::Control => *u,
+    })
+}
+
+/// The control U of an observation (the value of the term [`Read::Control`] reads).
+#[inline]
+pub fn control_of<const N: usize>(observation: &ObservationN<N>) -> &SVector<f64, N> {
+    &observation[Term::CONTROL.index()]
+}
+
+/// Σ of `terms` in order, the first one as it is (no zero it is added to: −0 stays −0).
+fn sum<const R: usize, const C: usize>(
+    terms: impl Iterator<Item = SMatrix<f64, R, C>>,
+) -> SMatrix<f64, R, C> {
+    terms.reduce(|a, b| a + b).unwrap_or_else(SMatrix::zeros)
+}
 
 /// The task-based active-inference controller of one tool for one task, U̇ = −γ ∂F/∂U
 /// (eq. U_dot_deriv), with every matrix that does not change during an episode precomputed.
@@ -17,11 +48,9 @@ pub struct ActiveInferenceN<const N: usize> {
     pub task: TaskN<N>,
     /// Learning rate γ of the gradient descent (eq. AIC_gradient_des).
     pub learning_rate: f64,
-    /// Sᵀ P for each term (zero for terms the task does not use), so that
-    /// ∂F/∂U = K_θ(θ − θ^g) + K_θ̇(θ̇ − θ̇^g) + K_θ̈(θ̈ − θ̈^g) + P^U U.
-    gain_theta: SMatrix<f64, N, N>,
-    gain_theta_dot: SMatrix<f64, N, N>,
-    gain_theta_ddot: SMatrix<f64, N, N>,
+    /// K = Sᵀ P for each term, by [`Term::index`], so that ∂F/∂U = Σ K (e − e^g): zero for a
+    /// term the task does not use, P^U for the control's own term (S = ∂U/∂U = I).
+    gain: [SMatrix<f64, N, N>; TERMS],
     /// ln|Π^U|, constant for the tool and task (eq. control_conf).
     pub logdet: f64,
 }
@@ -43,141 +72,101 @@ impl<const N: usize> ActiveInferenceN<N> {
         }
         let confidence = control_confidence(tool, task)?;
         let s = tool.sensitivities(task.kind);
-        let zero = SMatrix::<f64, N, N>::zeros();
-        let gain = |s: Option<SMatrix<f64, N, N>>, p: &SMatrix<f64, N, N>| {
-            s.map_or(zero, |s| s.transpose() * p)
-        };
+        let gain = Term::ALL.map(|term| match (term.has_sensitivity(), s.of(term)) {
+            (false, _) => *task.precision(term),
+            (true, Some(s)) => s.transpose() * task.precision(term),
+            (true, None) => SMatrix::zeros(),
+        });
         Ok(Self {
             task: *task,
             learning_rate,
-            gain_theta: gain(s.d_theta_du, &task.precision_theta),
-            gain_theta_dot: gain(s.d_theta_dot_du, &task.precision_theta_dot),
-            gain_theta_ddot: gain(s.d_theta_ddot_du, &task.precision_theta_ddot),
+            gain,
             logdet: confidence.logdet,
         })
     }
 
-    /// U̇ = −γ ∂F/∂U (eq. U_dot_deriv) from the observed θ, θ̇, θ̈ and the current U (η^U = 0).
+    /// U̇ = −γ ∂F/∂U (eq. U_dot_deriv) from the observed terms (η^U = 0).
     #[inline]
-    pub fn control_rate(
-        &self,
-        theta: &SVector<f64, N>,
-        theta_dot: &SVector<f64, N>,
-        theta_ddot: &SVector<f64, N>,
-        u: &SVector<f64, N>,
-    ) -> SVector<f64, N> {
+    pub fn control_rate(&self, observed: &ObservationN<N>) -> SVector<f64, N> {
         let t = &self.task;
-        let gradient = self.gain_theta * (theta - t.goal_theta)
-            + self.gain_theta_dot * (theta_dot - t.goal_theta_dot)
-            + self.gain_theta_ddot * (theta_ddot - t.goal_theta_ddot)
-            + t.precision_u * u;
+        let gradient = sum(Term::ALL
+            .iter()
+            .map(|&term| self.gain[term.index()] * (observed[term.index()] - t.goal(term))));
         -self.learning_rate * gradient
     }
 
     /// One control period on a robot: U̇ = −γ ∂F/∂U (eq. U_dot_deriv, [`Self::control_rate`])
-    /// from the measured θ, θ̇, θ̈ and the torque U applied over the last period, then the torque
-    /// for the next one, U + period·U̇: the paper's gradient flow discretised by explicit Euler at
-    /// the control rate (first order: the torques differ from the continuous controller's by
-    /// O(period)). No allocation, a few N×N products.
+    /// from the measured terms, U among them the torque applied over the last period, then the
+    /// torque for the next one, U + period·U̇: the paper's gradient flow discretised by explicit
+    /// Euler at the control rate (first order: the torques differ from the continuous
+    /// controller's by O(period)). No allocation, a few N×N products.
     ///
-    /// The discrete loop can diverge where the continuous one settles: θ̈ follows U through the
-    /// plant's ∂θ̈/∂U, so each tick multiplies a torque error by
-    /// I − period·γ(K_θ̈ ∂θ̈/∂U + P^U); [`Self::tick_contraction`] gives that factor's size.
+    /// The discrete loop can diverge where the continuous one settles: a term read from Ẋ (θ̈)
+    /// follows U through the plant's input matrix B, so each tick multiplies a torque error by
+    /// I − period·γ(Σ K ∂(term)/∂U); [`Self::tick_contraction`] gives that factor's size.
     #[inline]
-    pub fn tick(
-        &self,
-        theta: &SVector<f64, N>,
-        theta_dot: &SVector<f64, N>,
-        theta_ddot: &SVector<f64, N>,
-        u: &SVector<f64, N>,
-        period: f64,
-    ) -> SVector<f64, N> {
-        u + self.control_rate(theta, theta_dot, theta_ddot, u) * period
+    pub fn tick(&self, observed: &ObservationN<N>, period: f64) -> SVector<f64, N> {
+        control_of(observed) + self.control_rate(observed) * period
     }
 
-    /// The spectral radius of I − period·γ(K_θ̈ ∂θ̈/∂U + P^U), with `d_theta_ddot_du` the
-    /// plant's ∂θ̈/∂U (the lower N rows of its input matrix B): how much one [`Self::tick`]
-    /// multiplies a torque error by, linearised where ∂θ̈/∂U was taken. Below 1 the ticks settle
-    /// as the continuous controller does; at 1 or above they oscillate without decaying or
-    /// diverge, and the control rate must be raised. Light distal links make ∂θ̈/∂U large
-    /// (~3/(m₂l₂²) for the paper's arm), and task 3's P^θ̈ = 10 ten times the others'.
-    pub fn tick_contraction(&self, d_theta_ddot_du: &SMatrix<f64, N, N>, period: f64) -> f64 {
+    /// The spectral radius of I − period·γ Σ K ∂(term)/∂U over the terms that follow U within
+    /// a tick: B's block for a term read from Ẋ (θ̈: the lower N rows of the plant's input matrix
+    /// `b`), I for U itself. It is how much one [`Self::tick`] multiplies a torque error by,
+    /// linearised where B was taken. Below 1 the ticks settle as the continuous controller does;
+    /// at 1 or above they oscillate without decaying or diverge, and the control rate must be
+    /// raised. Light distal links make ∂θ̈/∂U large (~3/(m₂l₂²) for the paper's arm), and task
+    /// 3's P^θ̈ = 10 ten times the others'.
+    pub fn tick_contraction<const NX: usize>(&self, b: &SMatrix<f64, NX, N>, period: f64) -> f64 {
         let g = self.learning_rate * period;
-        let step = SMatrix::<f64, N, N>::identity()
-            - (self.gain_theta_ddot * d_theta_ddot_du + self.task.precision_u) * g;
+        let instantaneous = sum(Term::ALL.iter().filter_map(|&term| {
+            let k = self.gain[term.index()];
+            match term.read() {
+                Read::State { .. } => None,
+                Read::StateRate { block } => Some(k * b.fixed_rows::<N>(block * N)),
+                Read::Control => Some(k),
+            }
+        }));
+        let step = SMatrix::<f64, N, N>::identity() - instantaneous * g;
         crate::linalg::spectral_radius(&step)
     }
 
-    /// The gains γ·(K_θ, K_θ̇, K_θ̈) and γ·P^U of U̇ = −γ ∂F/∂U, for the closed-loop Jacobian.
-    pub fn scaled_gains(&self) -> [SMatrix<f64, N, N>; 4] {
+    /// The gains γ·K of U̇ = −γ ∂F/∂U by [`Term::index`] (γ·P^U for the control's term), for
+    /// the closed-loop Jacobian.
+    pub fn scaled_gains(&self) -> [SMatrix<f64, N, N>; TERMS] {
         let g = self.learning_rate;
-        [
-            g * self.gain_theta,
-            g * self.gain_theta_dot,
-            g * self.gain_theta_ddot,
-            g * self.task.precision_u,
-        ]
+        self.gain.map(|k| g * k)
     }
 
     /// The performance and control-cost part of F, ½[Σ eᵀPe + UᵀP^U U] over the task's terms:
-    /// the optimal-control cost J of the paper (F without the confidence term).
+    /// the optimal-control cost J of the paper (F without the confidence term), summed in
+    /// [`Term::COST_ORDER`].
     #[inline]
-    pub fn cost_j(
-        &self,
-        theta: &SVector<f64, N>,
-        theta_dot: &SVector<f64, N>,
-        theta_ddot: &SVector<f64, N>,
-        u: &SVector<f64, N>,
-    ) -> f64 {
+    pub fn cost_j(&self, observed: &ObservationN<N>) -> f64 {
         let t = &self.task;
-        let q = |e: SVector<f64, N>, p: &SMatrix<f64, N, N>| e.dot(&(p * e));
-        // The terms in a fixed order (θ̈, U, θ̇, θ), each only if the task uses it.
         let mut sum = 0.0;
-        if t.kind.uses(Term::ThetaDdot) {
-            sum += q(*theta_ddot - t.goal_theta_ddot, &t.precision_theta_ddot);
-        }
-        if t.kind.uses(Term::U) {
-            sum += u.dot(&(t.precision_u * u));
-        }
-        if t.kind.uses(Term::ThetaDot) {
-            sum += q(*theta_dot - t.goal_theta_dot, &t.precision_theta_dot);
-        }
-        if t.kind.uses(Term::Theta) {
-            sum += q(*theta - t.goal_theta, &t.precision_theta);
+        for term in Term::COST_ORDER {
+            if t.kind.uses(term) {
+                let e = observed[term.index()] - t.goal(term);
+                sum += e.dot(&(t.precision(term) * e));
+            }
         }
         0.5 * sum
     }
 
     /// F = J − ½ ln|Π^U| (eq. free_energy).
     #[inline]
-    pub fn free_energy(
-        &self,
-        theta: &SVector<f64, N>,
-        theta_dot: &SVector<f64, N>,
-        theta_ddot: &SVector<f64, N>,
-        u: &SVector<f64, N>,
-    ) -> f64 {
-        self.cost_j(theta, theta_dot, theta_ddot, u) - 0.5 * self.logdet
+    pub fn free_energy(&self, observed: &ObservationN<N>) -> f64 {
+        self.cost_j(observed) - 0.5 * self.logdet
     }
 
     /// The task's own weighted error at one instant, the summand of the paper's task error:
-    /// (e − e^g)ᵀP(e − e^g) on the task's error term e ([`crate::TaskKind::error_term`]): θ in task 1,
-    /// θ̇ in task 2, θ̈ in task 3.
+    /// (e − e^g)ᵀP(e − e^g) on the task's error term e ([`crate::TaskKind::error_term`]): θ in
+    /// task 1, θ̇ in task 2, θ̈ in task 3.
     #[inline]
-    pub fn task_error(
-        &self,
-        theta: &SVector<f64, N>,
-        theta_dot: &SVector<f64, N>,
-        theta_ddot: &SVector<f64, N>,
-        u: &SVector<f64, N>,
-    ) -> f64 {
+    pub fn task_error(&self, observed: &ObservationN<N>) -> f64 {
         let t = &self.task;
-        let (e, p) = match t.kind.error_term() {
-            Term::Theta => (theta - t.goal_theta, &t.precision_theta),
-            Term::ThetaDot => (theta_dot - t.goal_theta_dot, &t.precision_theta_dot),
-            Term::ThetaDdot => (theta_ddot - t.goal_theta_ddot, &t.precision_theta_ddot),
-            Term::U => (*u, &t.precision_u),
-        };
-        e.dot(&(p * e))
+        let term = t.kind.error_term();
+        let e = observed[term.index()] - t.goal(term);
+        e.dot(&(t.precision(term) * e))
     }
 }

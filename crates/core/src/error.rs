@@ -29,18 +29,17 @@ pub enum Error {
     /// inequality of a rigid body's principal moments), by `excess` = c · p > 0.
     #[error("invalid tool: {rule} does not hold (off by {excess:.2e})")]
     ToolConstraint { rule: &'static str, excess: f64 },
-    /// A goal outside its range ([`crate::validate::JOINT_ANGLE`], `JOINT_RATE` or
-    /// `JOINT_ACCELERATION`).
-    #[error("invalid goal {name} = {}: must be a number in {range}", Short(*value))]
+    /// A goal of `term` outside its range ([`crate::validate::goal_range`]).
+    #[error("invalid goal {term}_g = {}: must be a number in {range}", Short(*value))]
     InvalidGoal {
-        name: &'static str,
+        term: crate::generated::Term,
         value: f64,
         range: Range,
     },
-    /// A precision matrix that is not in range, symmetric and positive semi-definite.
-    #[error("invalid precision {name}: {problem}")]
+    /// A precision matrix of `term` that is not in range, symmetric and positive semi-definite.
+    #[error("invalid precision P_{term}: {problem}")]
     InvalidPrecision {
-        name: &'static str,
+        term: crate::generated::Term,
         problem: PrecisionProblem,
     },
     /// A numeric option outside its domain (the learning rate γ, the control period).

@@ -48,9 +48,9 @@ pub use toolconf_generated as generated;
 
 pub use arm_model::*;
 pub use confidence::{control_confidence, logdet_of, ControlConfidenceN, ValidatedTaskN};
-pub use controller::ActiveInferenceN;
+pub use controller::{control_of, observe, ActiveInferenceN, ObservationN};
 pub use error::{Error, PrecisionKeys, PrecisionProblem};
-pub use generated::{TaskKind, Term};
+pub use generated::{Read, TaskKind, Term, TERMS};
 pub use task::TaskN;
 pub use tool::{SensitivitiesN, ToolN};
 

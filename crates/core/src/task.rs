@@ -3,24 +3,20 @@
 use nalgebra::{SMatrix, SVector};
 
 use crate::generated;
-use crate::generated::{TaskKind, Term};
+use crate::generated::{TaskKind, Term, TERMS};
 use crate::{Error, PrecisionProblem};
 
 use super::{ArmModel, ValidatedTaskN};
 
-/// A task for N joints: goals θ^g, θ̇^g, θ̈^g and prior precisions P^θ, P^θ̇, P^θ̈, P^U
-/// (eq. free_energy). A term the task's controller does not use has precision zero: task 2
-/// ignores θ, task 3 ignores θ and θ̇.
+/// A task for N joints: a goal and a prior precision for every free-energy term
+/// (eq. free_energy), indexed by [`Term::index`]: θ^g, θ̇^g, θ̈^g and P^θ, P^θ̇, P^θ̈, P^U for the
+/// paper's terms. A term the task's controller does not use has precision zero (task 2 ignores θ,
+/// task 3 θ and θ̇); the goal of the control's own term is zero (η^U = 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TaskN<const N: usize> {
     pub kind: TaskKind,
-    pub goal_theta: SVector<f64, N>,
-    pub goal_theta_dot: SVector<f64, N>,
-    pub goal_theta_ddot: SVector<f64, N>,
-    pub precision_theta: SMatrix<f64, N, N>,
-    pub precision_theta_dot: SMatrix<f64, N, N>,
-    pub precision_theta_ddot: SMatrix<f64, N, N>,
-    pub precision_u: SMatrix<f64, N, N>,
+    pub goal: [SVector<f64, N>; TERMS],
+    pub precision: [SMatrix<f64, N, N>; TERMS],
 }
 
 impl<const N: usize> TaskN<N> {
@@ -30,43 +26,51 @@ impl<const N: usize> TaskN<N> {
         Ok(ValidatedTaskN(*self))
     }
 
+    /// The goal of `term`.
+    #[inline]
+    pub fn goal(&self, term: Term) -> &SVector<f64, N> {
+        &self.goal[term.index()]
+    }
+
+    /// The precision of `term`.
+    #[inline]
+    pub fn precision(&self, term: Term) -> &SMatrix<f64, N, N> {
+        &self.precision[term.index()]
+    }
+
     /// The task with a model's generated defaults (goals; precisions P = value · I).
     pub fn from_defaults(kind: TaskKind, d: &generated::TaskDefaults<N>) -> Self {
         let eye = SMatrix::<f64, N, N>::identity();
         TaskN {
             kind,
-            goal_theta: SVector::from(d.goal_theta),
-            goal_theta_dot: SVector::from(d.goal_theta_dot),
-            goal_theta_ddot: SVector::from(d.goal_theta_ddot),
-            precision_theta: eye * d.precision_theta,
-            precision_theta_dot: eye * d.precision_theta_dot,
-            precision_theta_ddot: eye * d.precision_theta_ddot,
-            precision_u: eye * d.precision_u,
+            goal: d.goal.map(SVector::from),
+            precision: d.precision.map(|p| eye * p),
         }
     }
 
-    /// Checks goals are in their ranges ([`crate::validate::JOINT_ANGLE`], rates and
-    /// accelerations likewise) and precisions in
-    /// [`crate::validate::PRECISION_ENTRY`], symmetric and positive semi-definite, and that they
-    /// can make Π^U positive definite at all ([`Error::ConfidenceRank`]).
+    /// Checks goals are in their terms' ranges ([`crate::validate::goal_range`]; a term without
+    /// one has goal zero) and precisions in [`crate::validate::PRECISION_ENTRY`], symmetric and
+    /// positive semi-definite, and that they can make Π^U positive definite at all
+    /// ([`Error::ConfidenceRank`]).
     pub fn validate(&self) -> Result<(), Error> {
-        use crate::validate::{JOINT_ACCELERATION, JOINT_ANGLE, JOINT_RATE};
-        for (name, goal, range) in [
-            ("theta_g", &self.goal_theta, JOINT_ANGLE),
-            ("theta_dot_g", &self.goal_theta_dot, JOINT_RATE),
-            ("theta_ddot_g", &self.goal_theta_ddot, JOINT_ACCELERATION),
-        ] {
-            if let Some(&value) = goal.iter().find(|v| !range.contains(**v)) {
-                return Err(Error::InvalidGoal { name, value, range });
+        for term in Term::ALL {
+            let goal = self.goal(term);
+            let bad = match crate::validate::goal_range(term) {
+                Some(range) => goal
+                    .iter()
+                    .find(|v| !range.contains(**v))
+                    .map(|v| (*v, range)),
+                None => goal
+                    .iter()
+                    .find(|v| **v != 0.0)
+                    .map(|v| (*v, crate::validate::Range::closed(0.0, 0.0, ""))),
+            };
+            if let Some((value, range)) = bad {
+                return Err(Error::InvalidGoal { term, value, range });
             }
         }
-        for (name, p) in [
-            ("P_theta", &self.precision_theta),
-            ("P_theta_dot", &self.precision_theta_dot),
-            ("P_theta_ddot", &self.precision_theta_ddot),
-            ("P_u", &self.precision_u),
-        ] {
-            check_precision(name, p)?;
+        for term in Term::ALL {
+            check_precision(term, self.precision(term))?;
         }
         self.check_confidence_rank()
     }
@@ -75,16 +79,10 @@ impl<const N: usize> TaskN<N> {
     /// tool's sensitivities S: if the ranks of those precisions add up to fewer than N, Π^U is
     /// singular for every tool, and no tool has a control confidence ([`Error::ConfidenceRank`]).
     fn check_confidence_rank(&self) -> Result<(), Error> {
-        let used = [
-            (Term::Theta, &self.precision_theta),
-            (Term::ThetaDot, &self.precision_theta_dot),
-            (Term::ThetaDdot, &self.precision_theta_ddot),
-            (Term::U, &self.precision_u),
-        ];
-        let rank: usize = used
+        let rank: usize = Term::ALL
             .iter()
-            .filter(|(term, _)| self.kind.uses(*term))
-            .map(|(_, p)| psd_rank(p))
+            .filter(|term| self.kind.uses(**term))
+            .map(|term| psd_rank(self.precision(*term)))
             .sum();
         if rank < N {
             return Err(Error::ConfidenceRank {
@@ -140,11 +138,8 @@ fn psd_rank<const N: usize>(p: &SMatrix<f64, N, N>) -> usize {
 
 /// Finite, symmetric (to 1e-12 relative) and positive semi-definite: the smallest eigenvalue
 /// of the symmetric part is ≥ −1e-12·max|P| (for N = 2 the closed-form determinant test).
-fn check_precision<const N: usize>(
-    name: &'static str,
-    p: &SMatrix<f64, N, N>,
-) -> Result<(), Error> {
-    let invalid = |problem| Error::InvalidPrecision { name, problem };
+fn check_precision<const N: usize>(term: Term, p: &SMatrix<f64, N, N>) -> Result<(), Error> {
+    let invalid = |problem| Error::InvalidPrecision { term, problem };
     let in_range = |v: &&f64| crate::validate::PRECISION_ENTRY.contains(**v);
     if let Some(&value) = p.iter().find(|v| !in_range(v)) {
         return Err(invalid(PrecisionProblem::OutOfRange { value }));

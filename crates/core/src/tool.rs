@@ -66,7 +66,10 @@ where
         let rule = &M::TOOL_RULE;
         // A "> 0" domain within TOOL_PARAMETER first: that also refuses NaN, ±∞ and values ≤ 0,
         // so a domain the rule finds broken below is always another kind.
-        let named = M::PARAMETER_NAMES.into_iter().zip(params).zip(&rule.domains);
+        let named = M::PARAMETER_NAMES
+            .into_iter()
+            .zip(params)
+            .zip(&rule.domains);
         for ((name, value), domain) in named {
             if domain.is_positive() && !crate::validate::TOOL_PARAMETER.contains(value) {
                 return Err(Error::InvalidParameter { name, value });

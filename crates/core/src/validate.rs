@@ -105,3 +105,32 @@ pub const JOINT_RATE: Range = Range::closed(-100.0, 100.0, "rad/s");
 /// Joint accelerations, the goal θ̈_g: |θ̈| ≤ 10⁴ rad/s², enough to reach [`JOINT_RATE`]'s
 /// bound from rest in 10 ms (the shipped arms are rated at 10-40 rad/s²).
 pub const JOINT_ACCELERATION: Range = Range::closed(-1e4, 1e4, "rad/s²");
+
+/// The ranges a goal may be checked against, by the name `derive/tasks.toml` gives a term's
+/// `goal_range` (and `toolconf.ranges()` its key).
+pub const GOAL_RANGES: [(&str, Range); 3] = [
+    ("joint_angle", JOINT_ANGLE),
+    ("joint_rate", JOINT_RATE),
+    ("joint_acceleration", JOINT_ACCELERATION),
+];
+
+/// The range a goal of `term` must lie in; `None` for a term without a goal (the control's).
+pub fn goal_range(term: crate::generated::Term) -> Option<Range> {
+    let name = term.goal_range()?;
+    GOAL_RANGES
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, r)| *r)
+}
+
+#[cfg(test)]
+mod goal_range_tests {
+    use crate::generated::Term;
+
+    #[test]
+    fn every_term_with_a_goal_names_a_known_range() {
+        for term in Term::ALL {
+            assert_eq!(super::goal_range(term).is_some(), term.has_goal(), "{term}");
+        }
+    }
+}

@@ -106,14 +106,11 @@ fn run_time(input: &ReportInput) -> Vec<Block> {
     ]
 }
 
-/// The task's error term, as a symbol and an axis label.
-fn variable(kind: TaskKind) -> (&'static str, &'static str) {
-    match kind.error_term() {
-        Term::Theta => ("θ", "joint angle θ [rad]"),
-        Term::ThetaDot => ("θ̇", "joint velocity θ̇ [rad/s]"),
-        Term::ThetaDdot => ("θ̈", "joint acceleration θ̈ [rad/s²]"),
-        Term::U => ("U", "torque U [N m]"),
-    }
+/// The task's error term, as a symbol and an axis label (`joint angle θ [rad]`).
+fn variable(kind: TaskKind) -> (&'static str, String) {
+    let term = kind.error_term();
+    let axis = format!("{} {} [{}]", term.label(), term.symbol(), term.unit());
+    (term.symbol(), axis)
 }
 
 fn introduction(input: &ReportInput) -> Vec<Block> {
@@ -237,32 +234,18 @@ fn task_table(input: &ReportInput) -> Vec<Block> {
     let number = |v: Option<f64>| v.map(|v| v.to_string());
     let mut rows = vec![vec!["task kind".to_string(), spec.kind.to_string()]];
     let mut add = |name: &str, value: String| rows.push(vec![name.to_string(), value]);
-    if spec.kind.uses(Term::Theta) {
-        add("goal θ [rad]", given(vector(&spec.goal_theta), paper));
+    for term in Term::ALL.into_iter().filter(|t| spec.kind.uses(*t)) {
+        let i = term.index();
+        if term.has_goal() {
+            let name = format!("goal {} [{}]", term.symbol(), term.unit());
+            add(&name, given(vector(&spec.goal[i]), paper));
+        }
+        let name = format!("precision P^{}", term.symbol());
         add(
-            "precision P^θ",
-            given(spec.precision_theta.as_ref().map(precision), paper),
+            &name,
+            given(spec.precision[i].as_ref().map(precision), paper),
         );
     }
-    if spec.kind.uses(Term::ThetaDot) {
-        add("goal θ̇ [rad/s]", given(vector(&spec.goal_theta_dot), paper));
-        add(
-            "precision P^θ̇",
-            given(spec.precision_theta_dot.as_ref().map(precision), paper),
-        );
-    }
-    add(
-        "goal θ̈ [rad/s²]",
-        given(vector(&spec.goal_theta_ddot), paper),
-    );
-    add(
-        "precision P^θ̈",
-        given(spec.precision_theta_ddot.as_ref().map(precision), paper),
-    );
-    add(
-        "precision P^U",
-        given(spec.precision_u.as_ref().map(precision), paper),
-    );
     add(
         "integration method",
         e.method.unwrap_or_default().describe().to_string(),
@@ -502,7 +485,7 @@ fn trajectory_figure(dir: &Path, input: &ReportInput) -> Result<Vec<Block>, Repr
             Panel::Xy(XyPanel {
                 title: format!("joint {}", j + 1),
                 x_label: "time t [s]".into(),
-                y_label: axis.into(),
+                y_label: axis.as_str().into(),
                 dots: Vec::new(),
                 lines,
                 log_y: false,

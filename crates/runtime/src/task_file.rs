@@ -34,8 +34,10 @@ use serde::Deserialize;
 
 use crate::bounded_read::read_text_file;
 use crate::display::{Clip, ClipMessage, Short, ShortList, ShortRows as Rows};
+use crate::generated::TERMS;
 use crate::model::closed_loop_n::check_grid;
 use crate::model::{ArmModel, EpisodeOptionsN, TaskN};
+use crate::validate::goal_range;
 use crate::{TaskKind, Term};
 
 /// A bad task file: the file, where in it (a key or a line), and what is wrong.
@@ -105,13 +107,10 @@ pub struct TaskSpec {
     pub file: String,
     pub kind: TaskKind,
     pub description: Option<String>,
-    pub goal_theta: Option<Vec<f64>>,
-    pub goal_theta_dot: Option<Vec<f64>>,
-    pub goal_theta_ddot: Option<Vec<f64>>,
-    pub precision_theta: Option<PrecisionSpec>,
-    pub precision_theta_dot: Option<PrecisionSpec>,
-    pub precision_theta_ddot: Option<PrecisionSpec>,
-    pub precision_u: Option<PrecisionSpec>,
+    /// The goals the file gives, by [`Term::index`] (`None`: the model's paper goal).
+    pub goal: [Option<Vec<f64>>; TERMS],
+    /// The precisions the file gives, by [`Term::index`] (`None`: the model's paper precision).
+    pub precision: [Option<PrecisionSpec>; TERMS],
     pub episode: EpisodeSpec,
 }
 
@@ -121,28 +120,88 @@ struct RawTask {
     kind: String,
     description: Option<String>,
     #[serde(default)]
-    goal: RawGoal,
+    goal: TermTable<Vec<f64>, true>,
     #[serde(default)]
-    precision: RawPrecision,
+    precision: TermTable<toml::Value, false>,
     #[serde(default)]
     episode: RawEpisode,
 }
 
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct RawGoal {
-    theta: Option<Vec<f64>>,
-    theta_dot: Option<Vec<f64>>,
-    theta_ddot: Option<Vec<f64>>,
+/// A table keyed by term names ([`Term::name`]), as serde's `deny_unknown_fields` would read a
+/// struct with one optional field per term: `[goal]` (`GOALS`: the terms with a goal) or
+/// `[precision]` (every term). An unknown key is serde's own "unknown field" error, so a task
+/// file's message and place are those of any other misspelt key.
+struct TermTable<V, const GOALS: bool> {
+    values: [Option<V>; TERMS],
 }
 
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct RawPrecision {
-    theta: Option<toml::Value>,
-    theta_dot: Option<toml::Value>,
-    theta_ddot: Option<toml::Value>,
-    u: Option<toml::Value>,
+impl<V, const GOALS: bool> Default for TermTable<V, GOALS> {
+    fn default() -> Self {
+        Self {
+            values: std::array::from_fn(|_| None),
+        }
+    }
+}
+
+impl<V, const GOALS: bool> TermTable<V, GOALS> {
+    /// The keys it accepts, and the name its messages give it.
+    const NAMES: &'static [&'static str] = if GOALS {
+        &Term::GOAL_NAMES
+    } else {
+        &Term::NAMES
+    };
+    const STRUCT: &'static str = if GOALS { "RawGoal" } else { "RawPrecision" };
+}
+
+impl<'de, V: Deserialize<'de>, const GOALS: bool> Deserialize<'de> for TermTable<V, GOALS> {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Keys<V, const GOALS: bool>(std::marker::PhantomData<V>);
+        impl<'de, V: Deserialize<'de>, const GOALS: bool> serde::de::Visitor<'de> for Keys<V, GOALS> {
+            type Value = TermTable<V, GOALS>;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                write!(f, "struct {}", TermTable::<V, GOALS>::STRUCT)
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                mut map: A,
+            ) -> Result<Self::Value, A::Error> {
+                let names = TermTable::<V, GOALS>::NAMES;
+                let mut table = TermTable::default();
+                while let Some(term) = map.next_key_seed(TermKey(names))? {
+                    if table.values[term.index()].is_some() {
+                        return Err(serde::de::Error::duplicate_field(term.name()));
+                    }
+                    table.values[term.index()] = Some(map.next_value()?);
+                }
+                Ok(table)
+            }
+        }
+        let (name, names) = (Self::STRUCT, Self::NAMES);
+        deserializer.deserialize_struct(name, names, Keys::<V, GOALS>(std::marker::PhantomData))
+    }
+}
+
+/// A `[goal]`/`[precision]` key, refused while the key itself is read (as serde's derived field
+/// identifiers are), so that the file's reader points the message at the key's line, not the
+/// table's.
+struct TermKey(&'static [&'static str]);
+
+impl<'de> serde::de::DeserializeSeed<'de> for TermKey {
+    type Value = Term;
+    fn deserialize<D: serde::Deserializer<'de>>(self, deserializer: D) -> Result<Term, D::Error> {
+        deserializer.deserialize_identifier(self)
+    }
+}
+
+impl<'de> serde::de::Visitor<'de> for TermKey {
+    type Value = Term;
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("field identifier")
+    }
+    fn visit_str<E: serde::de::Error>(self, key: &str) -> Result<Term, E> {
+        let term = Term::from_name(key).filter(|t| self.0.contains(&t.name()));
+        term.ok_or_else(|| E::unknown_field(key, self.0))
+    }
 }
 
 #[derive(Deserialize, Default)]
@@ -166,13 +225,8 @@ impl TaskSpec {
             file: String::new(),
             kind,
             description: None,
-            goal_theta: None,
-            goal_theta_dot: None,
-            goal_theta_ddot: None,
-            precision_theta: None,
-            precision_theta_dot: None,
-            precision_theta_ddot: None,
-            precision_u: None,
+            goal: std::array::from_fn(|_| None),
+            precision: std::array::from_fn(|_| None),
             episode: EpisodeSpec::default(),
         }
     }
@@ -218,10 +272,13 @@ impl TaskSpec {
                 ),
             )
         })?;
-        let precision = |key: &str, v: Option<toml::Value>| {
-            v.map(|v| precision_spec(&v).map_err(|m| err(key, m)))
-                .transpose()
-        };
+        let mut precision: [Option<PrecisionSpec>; TERMS] = std::array::from_fn(|_| None);
+        for (term, v) in Term::ALL.into_iter().zip(raw.precision.values) {
+            let key = format!("precision.{term}");
+            precision[term.index()] = v
+                .map(|v| precision_spec(&v).map_err(|m| err(&key, m)))
+                .transpose()?;
+        }
         let per_joint = |key: &str, v: Option<toml::Value>| {
             v.map(|v| per_joint_spec(&v).map_err(|m| err(key, m)))
                 .transpose()
@@ -231,13 +288,8 @@ impl TaskSpec {
             file: file.into(),
             kind,
             description: raw.description,
-            goal_theta: raw.goal.theta,
-            goal_theta_dot: raw.goal.theta_dot,
-            goal_theta_ddot: raw.goal.theta_ddot,
-            precision_theta: precision("precision.theta", raw.precision.theta)?,
-            precision_theta_dot: precision("precision.theta_dot", raw.precision.theta_dot)?,
-            precision_theta_ddot: precision("precision.theta_ddot", raw.precision.theta_ddot)?,
-            precision_u: precision("precision.u", raw.precision.u)?,
+            goal: raw.goal.values,
+            precision,
             episode: EpisodeSpec {
                 t_end: e.t_end,
                 dt: e.dt,
@@ -280,31 +332,14 @@ impl TaskSpec {
     /// The checks that need no model: terms the task uses, finite numbers, precisions symmetric
     /// positive semi-definite, episode options in range. Returns (key, message).
     fn check(&self) -> Result<(), (String, String)> {
-        for (term, goal, precision) in [
-            (
-                Term::Theta,
-                self.goal_theta.is_some(),
-                self.precision_theta.is_some(),
-            ),
-            (
-                Term::ThetaDot,
-                self.goal_theta_dot.is_some(),
-                self.precision_theta_dot.is_some(),
-            ),
-            (
-                Term::ThetaDdot,
-                self.goal_theta_ddot.is_some(),
-                self.precision_theta_ddot.is_some(),
-            ),
-        ] {
+        for term in Term::ALL {
             if self.kind.uses(term) {
                 continue;
             }
-            let name = term.name();
-            let key = match (goal, precision) {
-                (true, _) => format!("goal.{name}"),
-                (false, true) => format!("precision.{name}"),
-                (false, false) => continue,
+            let key = match (&self.goal[term.index()], &self.precision[term.index()]) {
+                (Some(_), _) => format!("goal.{term}"),
+                (None, Some(_)) => format!("precision.{term}"),
+                (None, None) => continue,
             };
             let used_by: Vec<&str> = TaskKind::ALL
                 .iter()
@@ -318,24 +353,14 @@ impl TaskSpec {
             );
             return Err((key, message));
         }
-        use crate::validate::{JOINT_ACCELERATION, JOINT_ANGLE, JOINT_RATE};
-        for (key, v, range) in [
-            ("goal.theta", &self.goal_theta, JOINT_ANGLE),
-            ("goal.theta_dot", &self.goal_theta_dot, JOINT_RATE),
-            ("goal.theta_ddot", &self.goal_theta_ddot, JOINT_ACCELERATION),
-        ] {
-            if let Some(v) = v {
-                in_range(v, range).map_err(|m| (key.to_string(), m))?;
+        for term in Term::ALL {
+            if let (Some(v), Some(range)) = (&self.goal[term.index()], goal_range(term)) {
+                in_range(v, range).map_err(|m| (format!("goal.{term}"), m))?;
             }
         }
-        for (key, p) in [
-            ("precision.theta", &self.precision_theta),
-            ("precision.theta_dot", &self.precision_theta_dot),
-            ("precision.theta_ddot", &self.precision_theta_ddot),
-            ("precision.u", &self.precision_u),
-        ] {
-            if let Some(p) = p {
-                check_precision(p).map_err(|m| (key.to_string(), m))?;
+        for term in Term::ALL {
+            if let Some(p) = &self.precision[term.index()] {
+                check_precision(p).map_err(|m| (format!("precision.{term}"), m))?;
             }
         }
         self.episode.check().map_err(|(k, m)| (k.to_string(), m))
@@ -350,59 +375,32 @@ impl TaskSpec {
         M: ArmModel<N, NX, NP, NZ>,
     {
         let mut task = M::paper_task(self.kind);
-        for (key, given, goal) in [
-            ("goal.theta", &self.goal_theta, &mut task.goal_theta),
-            (
-                "goal.theta_dot",
-                &self.goal_theta_dot,
-                &mut task.goal_theta_dot,
-            ),
-            (
-                "goal.theta_ddot",
-                &self.goal_theta_ddot,
-                &mut task.goal_theta_ddot,
-            ),
-        ] {
-            if let Some(v) = given {
-                *goal = self.vector::<M, N, NX, NP, NZ>(key, v)?;
+        for term in Term::ALL {
+            if let Some(v) = &self.goal[term.index()] {
+                task.goal[term.index()] =
+                    self.vector::<M, N, NX, NP, NZ>(&format!("goal.{term}"), v)?;
             }
         }
-        for (key, given, p) in [
-            (
-                "precision.theta",
-                &self.precision_theta,
-                &mut task.precision_theta,
-            ),
-            (
-                "precision.theta_dot",
-                &self.precision_theta_dot,
-                &mut task.precision_theta_dot,
-            ),
-            (
-                "precision.theta_ddot",
-                &self.precision_theta_ddot,
-                &mut task.precision_theta_ddot,
-            ),
-            ("precision.u", &self.precision_u, &mut task.precision_u),
-        ] {
-            if let Some(given) = given {
-                *p = match given {
-                    PrecisionSpec::Scalar(s) => SMatrix::identity() * *s,
-                    PrecisionSpec::Matrix(rows) => {
-                        if rows.len() != N {
-                            return Err(self.error(
-                                key,
-                                format!(
-                                    "a {0}×{0} matrix, but model {1} has {N} joints",
-                                    rows.len(),
-                                    M::NAME
-                                ),
-                            ));
-                        }
-                        SMatrix::from_fn(|i, j| rows[i][j])
+        for term in Term::ALL {
+            let Some(given) = &self.precision[term.index()] else {
+                continue;
+            };
+            task.precision[term.index()] = match given {
+                PrecisionSpec::Scalar(s) => SMatrix::identity() * *s,
+                PrecisionSpec::Matrix(rows) => {
+                    if rows.len() != N {
+                        return Err(self.error(
+                            &format!("precision.{term}"),
+                            format!(
+                                "a {0}×{0} matrix, but model {1} has {N} joints",
+                                rows.len(),
+                                M::NAME
+                            ),
+                        ));
                     }
-                };
-            }
+                    SMatrix::from_fn(|i, j| rows[i][j])
+                }
+            };
         }
         task.validate()
             .map_err(|e| self.error("precision", e.to_string()))?;
@@ -429,8 +427,8 @@ impl TaskSpec {
             o.x0.fixed_rows_mut::<N>(0).copy_from(&theta);
         }
         if let Some(v) = &e.initial_theta_dot {
-            let theta_dot = self.vector::<M, N, NX, NP, NZ>("episode.initial_theta_dot", v)?;
-            o.x0.fixed_rows_mut::<N>(N).copy_from(&theta_dot);
+            let rate = self.vector::<M, N, NX, NP, NZ>("episode.initial_theta_dot", v)?;
+            o.x0.fixed_rows_mut::<N>(N).copy_from(&rate);
         }
         if let Some(u0) = &e.initial_torque {
             o.u0 = self.per_joint::<M, N, NX, NP, NZ>("episode.initial_torque", u0)?;
@@ -713,11 +711,17 @@ perturbation = 0.0
         let spec = TaskSpec::parse(ISSUE_EXAMPLE, "t.toml").unwrap();
         let task = spec.task::<Arm2, 2, 4, 4, 6>().unwrap();
         assert_eq!(
-            task.goal_theta,
+            *task.goal(Term::Theta),
             crate::Vector2::new(std::f64::consts::FRAC_PI_4, 0.0)
         );
-        assert_eq!(task.precision_theta, crate::Matrix2::identity() * 80.0);
-        assert_eq!(task.precision_theta_dot, crate::Matrix2::identity() * 50.0);
+        assert_eq!(
+            *task.precision(Term::Theta),
+            crate::Matrix2::identity() * 80.0
+        );
+        assert_eq!(
+            *task.precision(Term::ThetaDot),
+            crate::Matrix2::identity() * 50.0
+        );
         let o = spec.episode::<Arm2, 2, 4, 4, 6>().unwrap();
         assert_eq!((o.t_end, o.dt, o.perturbation), (5.0, 0.05, 0.0));
         assert_eq!(o.x0, Arm2::equilibrium_state());
@@ -770,6 +774,30 @@ perturbation = 0.0
         let e = TaskSpec::from_table(table, "task dict").unwrap_err();
         assert_eq!(e.place, "key precision.u");
         assert!(e.message.contains("is not symmetric"), "{e}");
+    }
+
+    /// An unknown term is refused at its own line, as serde's derived structs refuse a key.
+    #[test]
+    fn an_unknown_term_names_its_line_and_the_terms() {
+        let text = "kind = \"velocity\"\n[goal]\ntheta_dott = [1.0, 2.0]\n";
+        let e = TaskSpec::parse(text, "t.toml").unwrap_err().to_string();
+        assert!(e.contains("line 3 (theta_dott = [1.0, 2.0])"), "{e}");
+        assert!(
+            e.contains(
+                "unknown field `theta_dott`, expected one of `theta`, `theta_dot`, `theta_ddot`"
+            ),
+            "{e}"
+        );
+        let text = "kind = \"velocity\"\n[precision]\ntheta_dott = 1.0\n";
+        let e = TaskSpec::parse(text, "t.toml").unwrap_err().to_string();
+        assert!(
+            e.contains("line 3") && e.contains("`theta_ddot`, `u`"),
+            "{e}"
+        );
+        let table: toml::Table = toml::from_str(text).unwrap();
+        let e = TaskSpec::from_table(table, "task dict").unwrap_err();
+        assert_eq!(e.place, "key precision");
+        assert!(e.message.contains("unknown field `theta_dott`"), "{e}");
     }
 
     #[test]

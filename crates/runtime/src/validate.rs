@@ -35,7 +35,7 @@
 use core::fmt;
 
 pub use toolconf_core::validate::{
-    Range, JOINT_ACCELERATION, JOINT_ANGLE, JOINT_RATE, PRECISION_ENTRY, STATE_BOUND,
+    goal_range, Range, JOINT_ACCELERATION, JOINT_ANGLE, JOINT_RATE, PRECISION_ENTRY, STATE_BOUND,
     TOOL_PARAMETER,
 };
 

@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 use crate::RenderError;
 
 /// The IR schema this renderer understands (`schema` in the JSON).
-pub const IR_SCHEMA: u64 = 4;
+pub const IR_SCHEMA: u64 = 5;
 
 /// One model's IR. `R` is its report: [`ClosedFormReport`] for a model derived by SymPy,
 /// [`UrdfReport`] for a URDF arm (derived on CasADi SX).
@@ -26,6 +26,9 @@ pub struct Ir<R = Report> {
     pub schema: u64,
     pub generator: Generator,
     pub model: Model,
+    pub terms: Vec<Term>,
+    /// The order J's summands are added in (`cost_order` of `derive/tasks.toml`).
+    pub cost_order: Vec<String>,
     pub tasks: Vec<Task>,
     pub functions: Vec<Function>,
     pub test_vectors: TestVectors,
@@ -141,30 +144,44 @@ pub struct Constraint {
     pub text: String,
 }
 
-/// A free-energy term (eq. free_energy), as `derive/tasks.toml` names it.
+/// A free-energy term (eq. free_energy) of `derive/tasks.toml`'s `[[term]]` list.
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Term {
+    pub name: String,
+    pub symbol: String,
+    pub latex: String,
+    pub doc: String,
+    /// One component of it, on a plot's axis (`joint angle`).
+    pub label: String,
+    pub unit: String,
+    pub read: TermRead,
+    /// The documented range its goal lies in; none for the control's term (no goal).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub goal_range: Option<String>,
+}
+
+/// Where a term's value is read: `block` (n rows) of the state X, of its rate Ẋ, or the control.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct TermRead {
+    pub source: Source,
+    pub block: usize,
+}
+
+/// What a term is read from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
-pub enum Term {
-    Theta,
-    ThetaDot,
-    ThetaDdot,
-    U,
+pub enum Source {
+    State,
+    StateRate,
+    Control,
 }
 
 impl Term {
-    /// Every term, in the order of the runtime's `Term`.
-    pub const ALL: [Term; 4] = [Term::Theta, Term::ThetaDot, Term::ThetaDdot, Term::U];
-    /// The terms with a sensitivity ∂(term)/∂U (the control has none).
-    pub const KINEMATIC: [Term; 3] = [Term::Theta, Term::ThetaDot, Term::ThetaDdot];
-
-    /// The name in `derive/tasks.toml` (`theta_dot`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Term::Theta => "theta",
-            Term::ThetaDot => "theta_dot",
-            Term::ThetaDdot => "theta_ddot",
-            Term::U => "u",
-        }
+    /// Whether it has a sensitivity ∂(term)/∂U (the control's term has none).
+    pub fn has_sensitivity(&self) -> bool {
+        self.read.source != Source::Control
     }
 }
 
@@ -176,9 +193,9 @@ pub struct Task {
     pub index: u8,
     pub title: String,
     pub doc: String,
-    pub terms: Vec<Term>,
-    pub sensitivity_terms: Vec<Term>,
-    pub error: Term,
+    pub terms: Vec<String>,
+    pub sensitivity_terms: Vec<String>,
+    pub error: String,
     pub sensitivity_function: String,
     pub confidence_function: String,
     pub gradient_function: String,
@@ -190,7 +207,7 @@ pub struct Task {
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Goal {
-    pub term: Term,
+    pub term: String,
     pub rust: Vec<String>,
 }
 
@@ -198,7 +215,7 @@ pub struct Goal {
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Precision {
-    pub term: Term,
+    pub term: String,
     pub rust: String,
     pub value: f64,
 }
@@ -405,7 +422,7 @@ pub struct TaskReport {
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SensitivityReport {
-    pub term: Term,
+    pub term: String,
     pub what: String,
     pub formula: String,
     pub latex: String,
@@ -528,6 +545,8 @@ impl<R> Ir<R> {
             schema: self.schema,
             generator: self.generator,
             model: self.model,
+            terms: self.terms,
+            cost_order: self.cost_order,
             tasks: self.tasks,
             functions: self.functions,
             test_vectors: self.test_vectors,

@@ -6,7 +6,8 @@ use serde::Serialize;
 
 use crate::ir::{Function, Ir};
 use crate::tasks::{
-    binding_pattern, camel_case, string_literal, task_choices, task_list, TaskView,
+    binding_pattern, camel_case, cost_order, string_literal, task_choices, task_list, term_views,
+    TaskView, TermView,
 };
 use crate::tool_rule::{tool_rule_view, ToolRuleView};
 use crate::RenderError;
@@ -93,6 +94,15 @@ pub struct RegistryContext<'a> {
     pub max_parameter_count: usize,
     pub tasks: Vec<TaskView<'a>>,
     pub task_count: usize,
+    /// The free-energy terms (`derive/tasks.toml`'s `[[term]]`), the same for every model.
+    pub terms: Vec<TermView<'a>>,
+    pub term_count: usize,
+    /// The names of the terms a goal is given for, and how many.
+    pub goal_term_names: Vec<&'a str>,
+    /// `Term::ThetaDdot, Term::U, ...`: the order J's summands are added in.
+    pub cost_order: Vec<String>,
+    /// `Term::U`: the term read from the control.
+    pub control_variant: String,
     pub task_choices: String,
     pub package: PackageView,
 }
@@ -106,12 +116,28 @@ pub fn registry_context<'a>(
         .map(registry_model)
         .collect::<Result<Vec<_>, _>>()?;
     let tasks = task_list(irs)?;
+    let terms = irs
+        .first()
+        .map_or(Ok(Vec::new()), |ir| term_views(&ir.terms))?;
+    let cost_order = irs.first().map_or(Ok(Vec::new()), cost_order)?;
     let list = |items: Vec<&str>| items.join(", ");
     Ok(RegistryContext {
         model_count: models.len(),
         max_parameter_count: models.iter().map(|m| m.parameter_count).max().unwrap_or(0),
         task_count: tasks.len(),
         task_choices: task_choices(&tasks),
+        term_count: terms.len(),
+        goal_term_names: terms
+            .iter()
+            .filter(|t| t.goal_range != "None")
+            .map(|t| t.name)
+            .collect(),
+        cost_order,
+        control_variant: terms
+            .iter()
+            .find(|t| !t.has_sensitivity)
+            .map_or(String::new(), |t| format!("Term::{}", t.variant)),
+        terms,
         package: PackageView {
             name: package.name.clone(),
             lib: package.name.replace('-', "_"),

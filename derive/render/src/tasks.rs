@@ -8,7 +8,7 @@
 
 use serde::Serialize;
 
-use crate::ir::{Ir, Task, Term};
+use crate::ir::{Ir, Source, Task, Term};
 use crate::RenderError;
 
 /// `arm2_exact` → `Arm2Exact`, `position` → `Position`.
@@ -28,51 +28,104 @@ pub fn string_literal(text: &str) -> String {
     format!("{text:?}")
 }
 
-impl Term {
-    /// The runtime's `Term` variant (`Term::ThetaDot`).
-    fn variant(self) -> String {
-        format!("Term::{}", camel_case(self.name()))
-    }
-
-    /// The field of `TaskSensitivities` that holds ∂(term)/∂U, and the sensitivity function's
-    /// output of that name.
-    fn sensitivity(self) -> String {
-        format!("d_{}_du", self.name())
-    }
-
-    /// The name of the model's constant of a task's default goal for this term.
-    fn goal_constant(self) -> String {
-        format!("GOAL_{}", self.name().to_uppercase())
-    }
-
-    /// The name of the model's constant of a task's default precision for this term.
-    fn precision_constant(self) -> String {
-        format!("PRECISION_{}", self.name().to_uppercase())
-    }
+/// The runtime's `Term` variant of a term named `name` (`Term::ThetaDot`).
+fn variant(name: &str) -> String {
+    format!("Term::{}", camel_case(name))
 }
 
-/// `field: value,` of a struct literal.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
-pub struct FieldValue {
-    pub field: String,
-    pub value: String,
+/// The name of the model's constant of a task's default goal for a term.
+fn goal_constant(name: &str) -> String {
+    format!("GOAL_{}", name.to_uppercase())
 }
 
-/// `pub const GOAL_THETA: [f64; count] = [values];` of a task's module.
+/// The name of the model's constant of a task's default precision for a term.
+fn precision_constant(name: &str) -> String {
+    format!("PRECISION_{}", name.to_uppercase())
+}
+
+/// The sensitivity function's output, and the local, that holds ∂(term)/∂U.
+fn sensitivity(name: &str) -> String {
+    format!("d_{name}_du")
+}
+
+/// What the templates render of one term of the free energy.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct GoalView<'a> {
-    pub term: &'static str,
-    pub constant: String,
-    pub count: usize,
-    pub values: &'a [String],
+pub struct TermView<'a> {
+    pub name: &'a str,
+    /// `Term`'s variant, without the `Term::` path (`ThetaDot`).
+    pub variant: String,
+    pub index: usize,
+    pub symbol_literal: String,
+    pub doc: &'a str,
+    pub doc_literal: String,
+    pub label_literal: String,
+    pub unit_literal: String,
+    /// `Read::State { block: 0 }`.
+    pub read: String,
+    /// `Some("joint_angle")` or `None`.
+    pub goal_range: String,
+    pub has_sensitivity: bool,
 }
 
-/// `pub const PRECISION_THETA: f64 = rust;` of a task's module.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct PrecisionView<'a> {
-    pub term: &'static str,
-    pub constant: String,
-    pub rust: &'a str,
+/// The term list's view; an error for a repeated name, a term nothing can read, or a list
+/// without exactly one control term.
+pub fn term_views(terms: &[Term]) -> Result<Vec<TermView<'_>>, RenderError> {
+    let bad = |what: String| RenderError::Task(format!("terms: {what}"));
+    for (i, t) in terms.iter().enumerate() {
+        if terms[..i]
+            .iter()
+            .any(|o| o.name == t.name || o.read == t.read)
+        {
+            return Err(bad(format!(
+                "'{}' repeats an earlier term's name or reading",
+                t.name
+            )));
+        }
+    }
+    if terms.iter().filter(|t| !t.has_sensitivity()).count() != 1 {
+        return Err(bad("exactly one term must be read from the control".into()));
+    }
+    Ok(terms.iter().enumerate().map(term_view).collect())
+}
+
+fn term_view((index, t): (usize, &Term)) -> TermView<'_> {
+    let read = match t.read.source {
+        Source::State => format!("Read::State {{ block: {} }}", t.read.block),
+        Source::StateRate => format!("Read::StateRate {{ block: {} }}", t.read.block),
+        Source::Control => "Read::Control".to_string(),
+    };
+    TermView {
+        name: &t.name,
+        variant: camel_case(&t.name),
+        index,
+        symbol_literal: string_literal(&t.symbol),
+        doc: &t.doc,
+        doc_literal: string_literal(&t.doc),
+        label_literal: string_literal(&t.label),
+        unit_literal: string_literal(&t.unit),
+        read,
+        goal_range: t
+            .goal_range
+            .as_deref()
+            .map_or("None".into(), |r| format!("Some({})", string_literal(r))),
+        has_sensitivity: t.has_sensitivity(),
+    }
+}
+
+/// `Term::ThetaDdot, ...`: the IR's `cost_order`, which must name every term once.
+pub fn cost_order(ir: &Ir) -> Result<Vec<String>, RenderError> {
+    let mut named: Vec<&str> = ir.cost_order.iter().map(String::as_str).collect();
+    let mut all: Vec<&str> = ir.terms.iter().map(|t| t.name.as_str()).collect();
+    named.sort_unstable();
+    all.sort_unstable();
+    if named != all {
+        return Err(RenderError::Task(format!(
+            "cost_order {:?} must name every term once ({})",
+            ir.cost_order,
+            all.join(", ")
+        )));
+    }
+    Ok(ir.cost_order.iter().map(|t| variant(t)).collect())
 }
 
 /// What the templates render of one task.
@@ -83,7 +136,7 @@ pub struct TaskView<'a> {
     pub title: &'a str,
     pub doc: &'a str,
     /// The task's terms' names, and how many.
-    pub terms: Vec<&'static str>,
+    pub terms: Vec<&'a str>,
     pub term_count: usize,
     pub goals: Vec<GoalView<'a>>,
     pub precisions: Vec<PrecisionView<'a>>,
@@ -93,37 +146,80 @@ pub struct TaskView<'a> {
     pub variant: String,
     /// `let <outputs> = <task>_sensitivity(params);`
     pub sensitivity_binding: String,
-    /// `TaskSensitivities`' fields: `Some(d_theta_du)` or `None` per kinematic term.
-    pub sensitivity_fields: Vec<FieldValue>,
-    /// The precisions the task's confidence functions take: `p_theta, p_u`.
+    /// `TaskSensitivities::d_du`, one per term: `Some(d_theta_du)` or `None`.
+    pub sensitivity_values: Vec<String>,
+    /// The precisions the task's confidence functions take: `&precision[Term::Theta as usize], ...`.
     pub confidence_args: String,
-    /// `TaskDefaults`' fields: the task module's constant, or zero for a term it does not use.
-    pub default_fields: Vec<FieldValue>,
+    /// `TaskDefaults::goal` and `::precision`, one per term: the task module's constant, or
+    /// zero for a term it does not use.
+    pub default_goals: Vec<String>,
+    pub default_precisions: Vec<String>,
     pub term_variants: Vec<String>,
     pub error_variant: String,
     pub title_literal: String,
     pub doc_literal: String,
 }
 
-/// The task's view; an error for a sensitivity of a term that has none or a goal or precision
-/// of a term the task does not use.
-pub fn task_view(task: &Task) -> Result<TaskView<'_>, RenderError> {
-    let name = task.name.as_str();
-    let bad = |what: String| RenderError::Task(format!("task '{name}': {what}"));
+/// `pub const GOAL_THETA: [f64; count] = [values];` of a task's module.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GoalView<'a> {
+    pub term: &'a str,
+    pub constant: String,
+    pub count: usize,
+    pub values: &'a [String],
+}
+
+/// `pub const PRECISION_THETA: f64 = rust;` of a task's module.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PrecisionView<'a> {
+    pub term: &'a str,
+    pub constant: String,
+    pub rust: &'a str,
+}
+
+/// Checks a task's terms against the term list: known names, sensitivities only of terms that
+/// have one and the task uses, goals only of those, precisions only of the task's terms.
+fn check_task(task: &Task, terms: &[Term]) -> Result<(), RenderError> {
+    let bad = |what: String| RenderError::Task(format!("task '{}': {what}", task.name));
+    let find = |name: &str| terms.iter().find(|t| t.name == name);
+    let named = task
+        .terms
+        .iter()
+        .chain(&task.sensitivity_terms)
+        .chain(std::iter::once(&task.error))
+        .chain(task.goals.iter().map(|g| &g.term))
+        .chain(task.precisions.iter().map(|p| &p.term));
+    for name in named {
+        if find(name).is_none() {
+            let known: Vec<&str> = terms.iter().map(|t| t.name.as_str()).collect();
+            return Err(bad(format!(
+                "unknown term '{name}' (terms: {})",
+                known.join(", ")
+            )));
+        }
+    }
     let used = &task.sensitivity_terms;
-    if let Some(t) = used.iter().find(|t| !Term::KINEMATIC.contains(t)) {
-        return Err(bad(format!("'{}' has no sensitivity ∂/∂U", t.name())));
+    if let Some(t) = used
+        .iter()
+        .find(|t| !find(t).is_some_and(Term::has_sensitivity))
+    {
+        return Err(bad(format!("'{t}' has no sensitivity ∂/∂U")));
     }
     if let Some(t) = used.iter().find(|t| !task.terms.contains(t)) {
         return Err(bad(format!(
-            "a sensitivity of '{}', which is not among its terms",
-            t.name()
+            "a sensitivity of '{t}', which is not among its terms"
+        )));
+    }
+    if !used.contains(&task.error) {
+        return Err(bad(format!(
+            "its error term '{}' has no sensitivity in it",
+            task.error
         )));
     }
     if let Some(g) = task.goals.iter().find(|g| !used.contains(&g.term)) {
         return Err(bad(format!(
             "a goal for '{}', which has no sensitivity",
-            g.term.name()
+            g.term
         )));
     }
     if let Some(p) = task
@@ -133,50 +229,38 @@ pub fn task_view(task: &Task) -> Result<TaskView<'_>, RenderError> {
     {
         return Err(bad(format!(
             "a precision for '{}', which is not among its terms",
-            p.term.name()
+            p.term
         )));
     }
-    let outputs: Vec<String> = used.iter().map(|t| t.sensitivity()).collect();
-    let sensitivity_fields = Term::KINEMATIC
+    Ok(())
+}
+
+/// The task's view (after [`check_task`]); `terms` is the IR's term list.
+pub fn task_view<'a>(task: &'a Task, terms: &'a [Term]) -> Result<TaskView<'a>, RenderError> {
+    check_task(task, terms)?;
+    let name = task.name.as_str();
+    let used = &task.sensitivity_terms;
+    let uses = |t: &Term| task.terms.contains(&t.name);
+    let senses = |t: &Term| used.contains(&t.name);
+    let outputs: Vec<String> = used.iter().map(|t| sensitivity(t)).collect();
+    let control = terms.iter().find(|t| !t.has_sensitivity());
+    let confidence_terms = used
         .iter()
-        .map(|t| FieldValue {
-            field: t.sensitivity(),
-            value: if used.contains(t) {
-                format!("Some({})", t.sensitivity())
-            } else {
-                "None".to_string()
-            },
-        })
-        .collect();
-    let goals = Term::KINEMATIC.iter().map(|t| FieldValue {
-        field: format!("goal_{}", t.name()),
-        value: if used.contains(t) {
-            format!("{name}::{}", t.goal_constant())
-        } else {
-            "[0.0; DOF]".to_string()
-        },
-    });
-    let precisions = Term::ALL.iter().map(|t| FieldValue {
-        field: format!("precision_{}", t.name()),
-        value: if task.terms.contains(t) {
-            format!("{name}::{}", t.precision_constant())
-        } else {
-            "0.0".to_string()
-        },
-    });
+        .map(String::as_str)
+        .chain(control.map(|t| t.name.as_str()));
     Ok(TaskView {
         name,
         index: task.index,
         title: &task.title,
         doc: &task.doc,
-        terms: task.terms.iter().map(|t| t.name()).collect(),
+        terms: task.terms.iter().map(String::as_str).collect(),
         term_count: task.terms.len(),
         goals: task
             .goals
             .iter()
             .map(|g| GoalView {
-                term: g.term.name(),
-                constant: g.term.goal_constant(),
+                term: &g.term,
+                constant: goal_constant(&g.term),
                 count: g.rust.len(),
                 values: &g.rust,
             })
@@ -185,8 +269,8 @@ pub fn task_view(task: &Task) -> Result<TaskView<'_>, RenderError> {
             .precisions
             .iter()
             .map(|p| PrecisionView {
-                term: p.term.name(),
-                constant: p.term.precision_constant(),
+                term: &p.term,
+                constant: precision_constant(&p.term),
                 rust: &p.rust,
             })
             .collect(),
@@ -198,16 +282,33 @@ pub fn task_view(task: &Task) -> Result<TaskView<'_>, RenderError> {
             binding_pattern(&outputs),
             task.sensitivity_function
         ),
-        sensitivity_fields,
-        confidence_args: task
-            .terms
+        sensitivity_values: terms
             .iter()
-            .map(|t| format!("p_{}", t.name()))
+            .map(|t| match senses(t) {
+                true => format!("Some({})", sensitivity(&t.name)),
+                false => "None".to_string(),
+            })
+            .collect(),
+        confidence_args: confidence_terms
+            .map(|t| format!("&precision[{} as usize]", variant(t)))
             .collect::<Vec<_>>()
             .join(", "),
-        default_fields: goals.chain(precisions).collect(),
-        term_variants: task.terms.iter().map(|t| t.variant()).collect(),
-        error_variant: task.error.variant(),
+        default_goals: terms
+            .iter()
+            .map(|t| match senses(t) {
+                true => format!("{name}::{}", goal_constant(&t.name)),
+                false => "[0.0; DOF]".to_string(),
+            })
+            .collect(),
+        default_precisions: terms
+            .iter()
+            .map(|t| match uses(t) {
+                true => format!("{name}::{}", precision_constant(&t.name)),
+                false => "0.0".to_string(),
+            })
+            .collect(),
+        term_variants: task.terms.iter().map(|t| variant(t)).collect(),
+        error_variant: variant(&task.error),
         title_literal: string_literal(&task.title),
         doc_literal: string_literal(&task.doc),
     })
@@ -224,7 +325,8 @@ pub fn binding_pattern(outputs: &[String]) -> String {
 
 /// The IR's tasks, each [`task_view`].
 pub fn task_views(ir: &Ir) -> Result<Vec<TaskView<'_>>, RenderError> {
-    ir.tasks.iter().map(task_view).collect()
+    term_views(&ir.terms)?;
+    ir.tasks.iter().map(|t| task_view(t, &ir.terms)).collect()
 }
 
 /// The tasks every model shares (from `derive/tasks.toml`), for the registry: an error names the
@@ -236,6 +338,12 @@ pub fn task_list(irs: &[Ir]) -> Result<Vec<TaskView<'_>>, RenderError> {
     let names = |ir: &Ir| -> Vec<String> { ir.tasks.iter().map(|t| t.name.clone()).collect() };
     let expected = names(first);
     for ir in &irs[1..] {
+        if ir.terms != first.terms || ir.cost_order != first.cost_order {
+            return Err(RenderError::Task(format!(
+                "model {:?} has other terms than the first model, {:?}: every model is derived with the same derive/tasks.toml",
+                ir.model.name, first.model.name
+            )));
+        }
         if names(ir) != expected {
             return Err(RenderError::Task(format!(
                 "model {:?} has tasks {:?}, the first model has {:?}: every model is derived with the same derive/tasks.toml",
@@ -265,6 +373,24 @@ pub fn task_choices(tasks: &[TaskView]) -> String {
 mod tests {
     use super::*;
 
+    /// The paper's four terms, as tasks.toml lists them.
+    fn terms() -> Vec<Term> {
+        let term = |name: &str, source: &str, block: usize, range: Option<&str>| {
+            let range = range.map_or(String::new(), |r| format!(r#", "goal_range": "{r}""#));
+            let text = format!(
+                r#"{{"name": "{name}", "symbol": "s", "latex": "l", "doc": "d", "label": "a", "unit": "u",
+                    "read": {{"source": "{source}", "block": {block}}}{range}}}"#
+            );
+            serde_json::from_str::<Term>(&text).unwrap_or_else(|e| panic!("{e}: {text}"))
+        };
+        vec![
+            term("theta", "state", 0, Some("joint_angle")),
+            term("theta_dot", "state", 1, Some("joint_rate")),
+            term("theta_ddot", "state_rate", 1, Some("joint_acceleration")),
+            term("u", "control", 0, None),
+        ]
+    }
+
     fn task(name: &str, terms: &[&str], error: &str) -> Task {
         let used: Vec<&str> = ["theta", "theta_dot", "theta_ddot"]
             .into_iter()
@@ -290,41 +416,62 @@ mod tests {
 
     #[test]
     fn one_output_binds_the_matrix_and_unused_terms_are_none_or_zero() {
-        let task = task("hold", &["theta_ddot", "u"], "theta_ddot");
-        let t = task_view(&task).unwrap();
+        let (task, terms) = (task("hold", &["theta_ddot", "u"], "theta_ddot"), terms());
+        let t = task_view(&task, &terms).unwrap();
         assert_eq!(
             t.sensitivity_binding,
             "let d_theta_ddot_du = hold_sensitivity(params);"
         );
-        assert_eq!(t.sensitivity_fields[0].value, "None");
-        assert_eq!(t.sensitivity_fields[2].value, "Some(d_theta_ddot_du)");
-        assert_eq!(t.default_fields[0].value, "[0.0; DOF]");
-        assert_eq!(t.default_fields[2].value, "hold::GOAL_THETA_DDOT");
-        assert_eq!(t.default_fields[3].value, "0.0");
-        assert_eq!(t.default_fields[6].value, "hold::PRECISION_U");
-        assert_eq!(t.confidence_args, "p_theta_ddot, p_u");
+        assert_eq!(
+            t.sensitivity_values,
+            ["None", "None", "Some(d_theta_ddot_du)", "None"]
+        );
+        assert_eq!(t.default_goals[0], "[0.0; DOF]");
+        assert_eq!(t.default_goals[2], "hold::GOAL_THETA_DDOT");
+        assert_eq!(t.default_goals[3], "[0.0; DOF]");
+        assert_eq!(t.default_precisions[0], "0.0");
+        assert_eq!(t.default_precisions[3], "hold::PRECISION_U");
+        assert_eq!(
+            t.confidence_args,
+            "&precision[Term::ThetaDdot as usize], &precision[Term::U as usize]"
+        );
         assert_eq!(t.variant, "Hold");
         assert_eq!(t.error_variant, "Term::ThetaDdot");
     }
 
     #[test]
     fn several_outputs_bind_a_tuple_in_term_order() {
-        let task = task("reach", &["theta", "theta_dot", "u"], "theta");
-        let t = task_view(&task).unwrap();
+        let (task, terms) = (
+            task("reach", &["theta", "theta_dot", "u"], "theta"),
+            terms(),
+        );
+        let t = task_view(&task, &terms).unwrap();
         assert_eq!(
             t.sensitivity_binding,
             "let (d_theta_du, d_theta_dot_du) = reach_sensitivity(params);"
         );
-        assert_eq!(t.sensitivity_fields[2].value, "None");
+        assert_eq!(t.sensitivity_values[2], "None");
     }
 
     #[test]
     fn an_unknown_term_is_an_error_naming_it() {
-        let text = r#"{"name": "x", "index": 1, "title": "T", "doc": "D", "terms": ["theta", "jerk"],
-            "sensitivity_terms": [], "error": "theta", "sensitivity_function": "s",
-            "confidence_function": "c", "gradient_function": "g", "goals": [], "precisions": []}"#;
-        let e = serde_json::from_str::<Task>(text).unwrap_err().to_string();
-        assert!(e.contains("unknown variant `jerk`"), "{e}");
+        let t = task("x", &["theta", "jerk"], "theta");
+        let e = task_view(&t, &terms()).unwrap_err().to_string();
+        assert!(e.contains("unknown term 'jerk'"), "{e}");
+    }
+
+    #[test]
+    fn a_term_list_needs_one_control_term_and_distinct_readings() {
+        let mut list = terms();
+        assert_eq!(
+            term_views(&list).unwrap()[2].read,
+            "Read::StateRate { block: 1 }"
+        );
+        list[1].read = list[0].read;
+        let e = term_views(&list).unwrap_err().to_string();
+        assert!(e.contains("'theta_dot' repeats"), "{e}");
+        let e = term_views(&terms()[..3]).unwrap_err().to_string();
+        assert!(e.contains("exactly one term"), "{e}");
     }
 
     #[test]
@@ -342,8 +489,8 @@ mod tests {
     #[test]
     fn a_sensitivity_of_the_control_is_an_error() {
         let mut t = task("x", &["theta", "u"], "theta");
-        t.sensitivity_terms.push(Term::U);
-        let e = task_view(&t).unwrap_err().to_string();
+        t.sensitivity_terms.push("u".into());
+        let e = task_view(&t, &terms()).unwrap_err().to_string();
         assert!(e.contains("'u' has no sensitivity"), "{e}");
     }
 }

@@ -143,8 +143,7 @@ where
         let controller = ActiveInferenceN::new(tool, task, learning_rate)?;
         let period = 1.0 / rate_hz;
         let b = M::input_matrix(&tool.params());
-        let contraction =
-            controller.tick_contraction(&b.fixed_view::<N, N>(N, 0).into_owned(), period);
+        let contraction = controller.tick_contraction(&b, period);
         if !(contraction.is_finite() && contraction < 1.0) {
             return Err(Error::InvalidOption {
                 name: "control rate [Hz] (too low for this tool and task: each tick would not shrink a torque error; raise it)",
@@ -173,7 +172,7 @@ where
     pub fn tick(&mut self, state: &[f64; NX]) -> Result<Command<N>, Error> {
         let x = measured(state)?;
         let x_dot = M::dynamics_with(&x, &self.torque, &self.dynamics);
-        self.step(&x, &x_dot.fixed_rows::<N>(N).into_owned())
+        self.step(&x, &x_dot)
     }
 
     /// One tick with θ̈ measured too (by a robot with accelerometers): the controller then
@@ -182,24 +181,21 @@ where
     pub fn tick_with_acceleration(
         &mut self,
         state: &[f64; NX],
-        theta_ddot: &[f64; N],
+        acceleration: &[f64; N],
     ) -> Result<Command<N>, Error> {
         let x = measured(state)?;
-        let theta_ddot = measured(theta_ddot)?;
-        self.step(&x, &theta_ddot)
+        let acceleration = measured(acceleration)?;
+        // Ẋ = [q̇; q̈]: the measured velocity and acceleration.
+        let mut x_dot = SVector::<f64, NX>::zeros();
+        x_dot.fixed_rows_mut::<N>(0).copy_from(&x.fixed_rows::<N>(N));
+        x_dot.fixed_rows_mut::<N>(N).copy_from(&acceleration);
+        self.step(&x, &x_dot)
     }
 
     #[inline]
-    fn step(
-        &mut self,
-        x: &SVector<f64, NX>,
-        theta_ddot: &SVector<f64, N>,
-    ) -> Result<Command<N>, Error> {
-        let theta = x.fixed_rows::<N>(0).into_owned();
-        let theta_dot = x.fixed_rows::<N>(N).into_owned();
-        let next = self
-            .controller
-            .tick(&theta, &theta_dot, theta_ddot, &self.torque, self.period);
+    fn step(&mut self, x: &SVector<f64, NX>, x_dot: &SVector<f64, NX>) -> Result<Command<N>, Error> {
+        let observed = toolconf_core::observe(x, x_dot, &self.torque);
+        let next = self.controller.tick(&observed, self.period);
         if let Some(&value) = next.iter().find(|v| !v.is_finite()) {
             return Err(Error::InvalidOption {
                 name: "torque (the measurement drives it out of range)",

@@ -7,7 +7,7 @@
 mod reference;
 
 use reference::{Reference, REFERENCES};
-use toolconf_core::{ActiveInferenceN, ArmModel, Error, TaskN};
+use toolconf_core::{ActiveInferenceN, ArmModel, Error, TaskN, Term};
 use toolconf_on_robot::{Arm2, Arm2Controller, Arm2Tool, Arm3Controller, Arm3Tool, TaskKind};
 
 /// Runge–Kutta steps per tick for the plant.
@@ -63,10 +63,10 @@ fn episode(p: [f64; 4], kind: TaskKind, rate_hz: f64) -> Run {
 /// (e − e^g)ᵀP(e − e^g) on the task's error term (θ for task 1, θ̇ for task 2).
 fn weighted_error(task: &TaskN<2>, x: &nalgebra::Vector4<f64>) -> f64 {
     let (e, p) = match task.kind {
-        TaskKind::Position => (x.fixed_rows::<2>(0) - task.goal_theta, task.precision_theta),
+        TaskKind::Position => (x.fixed_rows::<2>(0) - task.goal[Term::Theta.index()], task.precision[Term::Theta.index()]),
         TaskKind::Velocity => (
-            x.fixed_rows::<2>(2) - task.goal_theta_dot,
-            task.precision_theta_dot,
+            x.fixed_rows::<2>(2) - task.goal[Term::ThetaDot.index()],
+            task.precision[Term::ThetaDot.index()],
         ),
         other => panic!("{other} is not compared here"),
     };
@@ -138,17 +138,7 @@ fn task3_ticks_stay_bounded(p: [f64; 4], rate_hz: f64) -> bool {
     let (mut x, mut u) = (Arm2::equilibrium_state(), nalgebra::Vector2::repeat(0.1));
     for _ in 0..(0.5 * rate_hz) as usize {
         let f = Arm2::dynamics_with(&x, &u, &plant);
-        let (theta, theta_dot) = (
-            x.fixed_rows::<2>(0).into_owned(),
-            x.fixed_rows::<2>(2).into_owned(),
-        );
-        u = controller.tick(
-            &theta,
-            &theta_dot,
-            &f.fixed_rows::<2>(2).into_owned(),
-            &u,
-            h,
-        );
+        u = controller.tick(&toolconf_core::observe(&x, &f, &u), h);
         x += Arm2::dynamics_with(&x, &u, &plant) * h;
         if !(u.amax().is_finite() && u.amax() < 1e3) {
             return false;
@@ -240,7 +230,7 @@ fn the_confidence_is_the_closed_form_and_arm3_ticks_too() {
         last = u.into();
     }
     // Task 1 of arm3 drives the joints toward θ^g = [π/3, π/3, π/6] with bounded torques.
-    let goal = toolconf_core::Arm3::paper_task(TaskKind::Position).goal_theta;
+    let goal = toolconf_core::Arm3::paper_task(TaskKind::Position).goal[Term::Theta.index()];
     let start = (toolconf_core::Arm3::equilibrium_state().fixed_rows::<3>(0) - goal).norm();
     assert!((x.fixed_rows::<3>(0) - goal).norm() < 0.5 * start, "{x}");
     assert!(last.iter().all(|u| u.is_finite() && u.abs() < 50.0));

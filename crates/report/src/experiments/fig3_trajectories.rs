@@ -7,7 +7,7 @@
 use crate::closed_loop::{Metrics, Trajectory};
 use crate::confidence::control_confidence;
 use crate::select::draw_tools;
-use crate::{Arm, Task, TaskKind};
+use crate::{Arm, Task, TaskKind, Term};
 
 use super::batch::map_ordered;
 use super::csv::{Cell, CsvWriter};
@@ -55,8 +55,11 @@ fn traj(r: &Run) -> Option<&Trajectory> {
 
 /// Time from which |θ2 − goal| stays within the band for the rest of the episode.
 fn settling_time(tr: &Trajectory, goal: f64) -> Option<f64> {
-    let band = BAND * (tr.theta.first()?[1] - goal).abs();
-    let last_outside = tr.theta.iter().rposition(|th| (th[1] - goal).abs() > band);
+    let band = BAND * (tr.of(Term::Theta).first()?[1] - goal).abs();
+    let last_outside = tr
+        .of(Term::Theta)
+        .iter()
+        .rposition(|th| (th[1] - goal).abs() > band);
     match last_outside {
         None => tr.t.first().copied(),
         Some(k) if k + 1 < tr.t.len() => Some(tr.t[k + 1]),
@@ -84,7 +87,7 @@ impl Experiment for Fig3 {
     fn run(&self, ctx: &Context) -> Result<Section, ReproduceError> {
         let plan = ctx.plan;
         let task = Task::paper(TaskKind::Position);
-        let goal = task.goal_theta[1];
+        let goal = task.goal(Term::Theta)[1];
         let tools = draw_tools(plan.fig3_sample, ctx.seed_for(self, "tools"));
         let logdets: Vec<Option<f64>> = tools
             .iter()
@@ -258,12 +261,12 @@ fn write_run(csv: &mut CsvWriter, run: &Run) -> Result<(), ReproduceError> {
                 row.extend(
                     [
                         tr.t[k],
-                        tr.theta[k][0],
-                        tr.theta[k][1],
-                        tr.theta_dot[k][0],
-                        tr.theta_dot[k][1],
-                        tr.u[k][0],
-                        tr.u[k][1],
+                        tr.of(Term::Theta)[k][0],
+                        tr.of(Term::Theta)[k][1],
+                        tr.of(Term::ThetaDot)[k][0],
+                        tr.of(Term::ThetaDot)[k][1],
+                        tr.of(Term::U)[k][0],
+                        tr.of(Term::U)[k][1],
                     ]
                     .map(Cell::from),
                 );
@@ -308,7 +311,11 @@ impl Runs {
     }
 
     fn final_error(&self, r: &Run) -> Option<f64> {
-        traj(r).and_then(|tr| tr.theta.last().map(|th| (th[1] - self.goal).abs()))
+        traj(r).and_then(|tr| {
+            tr.of(Term::Theta)
+                .last()
+                .map(|th| (th[1] - self.goal).abs())
+        })
     }
 
     /// The largest |θ2 − θ2 of the same tool without perturbation|.
@@ -316,9 +323,9 @@ impl Runs {
         let base = traj(self.find(r.role, 0.0))?;
         let tr = traj(r)?;
         Some(
-            tr.theta
+            tr.of(Term::Theta)
                 .iter()
-                .zip(&base.theta)
+                .zip(base.of(Term::Theta))
                 .map(|(a, b)| (a[1] - b[1]).abs())
                 .fold(0.0, f64::max),
         )
@@ -382,7 +389,7 @@ impl Runs {
                     ),
                     colour(r.role, r.perturbation),
                     tr.t.iter()
-                        .zip(&tr.theta)
+                        .zip(tr.of(Term::Theta))
                         .map(|(t, th)| (*t, th[1]))
                         .collect(),
                 );
@@ -503,18 +510,18 @@ mod tests {
     #[test]
     fn settling_time_is_when_the_band_is_entered_for_good() {
         let theta = |v: f64| toolconf::Vector2::new(0.0, v);
-        let tr = Trajectory {
+        let mut tr = Trajectory {
             t: vec![0.0, 1.0, 2.0, 3.0],
-            theta: vec![theta(-1.0), theta(0.01), theta(0.2), theta(0.02)],
             ..Trajectory::default()
         };
+        tr.terms[Term::Theta.index()] = vec![theta(-1.0), theta(0.01), theta(0.2), theta(0.02)];
         // Band: 5 % of 1.0 around 0.
         assert_eq!(settling_time(&tr, 0.0), Some(3.0));
-        let never = Trajectory {
+        let mut never = Trajectory {
             t: vec![0.0, 1.0],
-            theta: vec![theta(-1.0), theta(-0.5)],
             ..Trajectory::default()
         };
+        never.terms[Term::Theta.index()] = vec![theta(-1.0), theta(-0.5)];
         assert_eq!(settling_time(&never, 0.0), None);
     }
 }

@@ -5,11 +5,12 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::{ActiveInferenceN, ArmModel, TaskN, ToolN};
-use crate::generated::Term;
+use crate::generated::{Read, Term, TERMS};
 use crate::integrate::{
     solve_grid_with_jacobian, uniform_grid, IntegrationError, Method, Options as IntegratorOptions,
 };
 use crate::Error;
+use toolconf_core::{observe, ObservationN};
 
 /// A grid state whose magnitude passes this is a diverging simulation, not a result.
 pub(crate) const DIVERGENCE_BOUND: f64 = crate::validate::STATE_BOUND;
@@ -86,55 +87,67 @@ where
         })
     }
 
-    /// Ż and the plant's θ̈ (what the controller observes).
+    /// Ż and the terms the controller observes (the plant's θ̈ among them).
     #[inline]
-    pub fn rhs_and_acceleration(
-        &self,
-        z: &SVector<f64, NZ>,
-    ) -> (SVector<f64, NZ>, SVector<f64, N>) {
+    pub fn rhs_and_observation(&self, z: &SVector<f64, NZ>) -> (SVector<f64, NZ>, ObservationN<N>) {
         let x = z.fixed_rows::<NX>(0).into_owned();
         let u = z.fixed_rows::<N>(NX).into_owned();
         let x_dot = P::dynamics_with(&x, &(u + self.perturbation), &self.dynamics);
-        let theta = x.fixed_rows::<N>(0).into_owned();
-        let theta_dot = x.fixed_rows::<N>(N).into_owned();
-        let theta_ddot = x_dot.fixed_rows::<N>(N).into_owned();
-        let u_dot = self
-            .controller
-            .control_rate(&theta, &theta_dot, &theta_ddot, &u);
+        let observed = observe(&x, &x_dot, &u);
+        let u_dot = self.controller.control_rate(&observed);
         let mut z_dot = SVector::<f64, NZ>::zeros();
         z_dot.fixed_rows_mut::<NX>(0).copy_from(&x_dot);
         z_dot.fixed_rows_mut::<N>(NX).copy_from(&u_dot);
-        (z_dot, theta_ddot)
+        (z_dot, observed)
     }
 
     /// Ż.
     #[inline]
     pub fn rhs(&self, z: &SVector<f64, NZ>) -> SVector<f64, NZ> {
-        self.rhs_and_acceleration(z).0
+        self.rhs_and_observation(z).0
     }
 
     /// ∂Ż/∂Z, from the generated Jacobian of the plant (∂f/∂X, ∂f/∂U) and the controller's
-    /// constant gains: with θ̈ = f_θ̈(X, U + ΔT),
-    /// ∂U̇/∂X = −γ(K_θ[I O] + K_θ̇[O I] + K_θ̈ ∂f_θ̈/∂X) and ∂U̇/∂U = −γ(K_θ̈ ∂f_θ̈/∂U + P^U).
+    /// constant gains γK: U̇ = −γ Σ K (term − goal), where a term read from X has ∂/∂X its
+    /// selection ([I O] for θ), one read from Ẋ = f(X, U + ΔT) the rows of ∂f/∂X and ∂f/∂U
+    /// (θ̈), and U itself ∂/∂U = I.
     #[inline]
     pub fn jacobian(&self, z: &SVector<f64, NZ>) -> SMatrix<f64, NZ, NZ> {
         let x = z.fixed_rows::<NX>(0).into_owned();
         let u = z.fixed_rows::<N>(NX).into_owned();
         let (f_x, f_u) = P::dynamics_jacobian_with(&x, &(u + self.perturbation), &self.jacobian);
-        let [k_theta, k_theta_dot, k_theta_ddot, p_u] = self.controller.scaled_gains();
-        let accel_x = f_x.fixed_view::<N, NX>(N, 0);
-        let accel_u = f_u.fixed_view::<N, N>(N, 0);
+        let gains = self.controller.scaled_gains();
         let mut j = SMatrix::<f64, NZ, NZ>::zeros();
         j.fixed_view_mut::<NX, NX>(0, 0).copy_from(&f_x);
         j.fixed_view_mut::<NX, N>(0, NX).copy_from(&f_u);
-        let mut du_dx = -(k_theta_ddot * accel_x);
-        let mut block = du_dx.fixed_view_mut::<N, N>(0, 0);
-        block -= k_theta;
-        let mut block = du_dx.fixed_view_mut::<N, N>(0, N);
-        block -= k_theta_dot;
+        // Terms read from Ẋ first, each negated as it is added (no zero to subtract from).
+        let (mut du_dx, mut du_du) = (None::<SMatrix<f64, N, NX>>, None::<SMatrix<f64, N, N>>);
+        for term in Term::ALL {
+            if let Read::StateRate { block } = term.read() {
+                let k = gains[term.index()];
+                let (kx, ku) = (
+                    k * f_x.fixed_rows::<N>(block * N),
+                    k * f_u.fixed_rows::<N>(block * N),
+                );
+                du_dx = Some(du_dx.map_or(-kx, |a| a - kx));
+                du_du = Some(du_du.map_or(-ku, |a| a - ku));
+            }
+        }
+        let mut du_dx = du_dx.unwrap_or_else(SMatrix::zeros);
+        let mut du_du = du_du.unwrap_or_else(SMatrix::zeros);
+        for term in Term::ALL {
+            let k = gains[term.index()];
+            match term.read() {
+                Read::State { block } => {
+                    let mut columns = du_dx.fixed_view_mut::<N, N>(0, block * N);
+                    columns -= k;
+                }
+                Read::Control => du_du -= k,
+                Read::StateRate { .. } => {}
+            }
+        }
         j.fixed_view_mut::<N, NX>(NX, 0).copy_from(&du_dx);
-        j.fixed_view_mut::<N, N>(NX, NX)
-            .copy_from(&(-(k_theta_ddot * accel_u) - p_u));
+        j.fixed_view_mut::<N, N>(NX, NX).copy_from(&du_du);
         j
     }
 }
@@ -231,15 +244,36 @@ impl Metrics {
     }
 }
 
-/// The trajectory on the output grid.
-#[derive(Debug, Clone, Default, PartialEq)]
+/// The trajectory on the output grid: every term the controller observes at each time, by
+/// [`Term::index`] (θ̈ is the plant's, f(X, U + ΔT)).
+#[derive(Debug, Clone, PartialEq)]
 pub struct TrajectoryN<const N: usize> {
     pub t: Vec<f64>,
-    pub theta: Vec<SVector<f64, N>>,
-    pub theta_dot: Vec<SVector<f64, N>>,
-    /// The plant's θ̈ = f(X, U + ΔT), what the controller observes.
-    pub theta_ddot: Vec<SVector<f64, N>>,
-    pub u: Vec<SVector<f64, N>>,
+    pub terms: [Vec<SVector<f64, N>>; TERMS],
+}
+
+impl<const N: usize> Default for TrajectoryN<N> {
+    fn default() -> Self {
+        Self {
+            t: Vec::new(),
+            terms: core::array::from_fn(|_| Vec::new()),
+        }
+    }
+}
+
+impl<const N: usize> TrajectoryN<N> {
+    /// The values of `term` on the grid.
+    pub fn of(&self, term: Term) -> &[SVector<f64, N>] {
+        &self.terms[term.index()]
+    }
+
+    /// Appends the observation at time `t`.
+    pub fn push(&mut self, t: f64, observed: ObservationN<N>) {
+        self.t.push(t);
+        for (series, value) in self.terms.iter_mut().zip(observed) {
+            series.push(value);
+        }
+    }
 }
 
 /// One episode's metrics and, if [`EpisodeOptionsN::record_trajectory`], its trajectory.
@@ -410,7 +444,9 @@ where
     let mut integrator = options.integrator;
     // Auto switches only on acceleration-control tasks (θ̈ feedback makes them stiff); elsewhere
     // it stays DP5 so the paper's ode45 runs keep their numbers (see EpisodeOptions::integrator).
-    if integrator.method == Method::Auto && task.kind.error_term() != Term::ThetaDdot {
+    let fed_back_through_the_plant =
+        matches!(task.kind.error_term().read(), Read::StateRate { .. });
+    if integrator.method == Method::Auto && !fed_back_through_the_plant {
         integrator.method = Method::Explicit;
     }
     let cap = integrator.max_steps;
@@ -421,16 +457,14 @@ where
         cap,
     );
     let stats = solve_grid_with_jacobian(rhs, jacobian, &z0, &grid, &integrator, |_, t, z| {
-        let (_, theta_ddot) = system.rhs_and_acceleration(z);
-        let theta = z.fixed_rows::<N>(0).into_owned();
-        let theta_dot = z.fixed_rows::<N>(N).into_owned();
+        let (_, observed) = system.rhs_and_observation(z);
         let u = z.fixed_rows::<N>(NX).into_owned();
         let magnitude = z.amax();
         if divergence.is_none() && magnitude > DIVERGENCE_BOUND {
             divergence = Some((t, magnitude));
         }
-        task_error += controller.task_error(&theta, &theta_dot, &theta_ddot, &u);
-        let j = controller.cost_j(&theta, &theta_dot, &theta_ddot, &u);
+        task_error += controller.task_error(&observed);
+        let j = controller.cost_j(&observed);
         let f = j - 0.5 * controller.logdet;
         let e = u.norm_squared();
         if let Some((t_prev, f_prev, j_prev, e_prev)) = previous {
@@ -441,11 +475,7 @@ where
         }
         previous = Some((t, f, j, e));
         if let Some(tr) = trajectory.as_mut() {
-            tr.t.push(t);
-            tr.theta.push(theta);
-            tr.theta_dot.push(theta_dot);
-            tr.theta_ddot.push(theta_ddot);
-            tr.u.push(u);
+            tr.push(t, observed);
         }
     })
     .map_err(|e| EpisodeFailure::Integration(out_of_work::<N>(e, cap, options.dt)))?;

@@ -228,13 +228,10 @@ where
     let (mut task_error, mut int_j, mut effort) = (0.0, 0.0, 0.0);
     let mut previous: Option<(f64, f64, f64)> = None;
     let mut sample = |t: f64, x: &SVector<f64, NX>, u: &SVector<f64, N>| {
-        let theta_ddot = P::dynamics_with(x, &(u + perturbation), &plant)
-            .fixed_rows::<N>(N)
-            .into_owned();
-        let theta = x.fixed_rows::<N>(0).into_owned();
-        let theta_dot = x.fixed_rows::<N>(N).into_owned();
-        task_error += metrics_of.task_error(&theta, &theta_dot, &theta_ddot, u);
-        let j = metrics_of.cost_j(&theta, &theta_dot, &theta_ddot, u);
+        let x_dot = P::dynamics_with(x, &(u + perturbation), &plant);
+        let observed = toolconf_core::observe(x, &x_dot, u);
+        task_error += metrics_of.task_error(&observed);
+        let j = metrics_of.cost_j(&observed);
         let e = u.norm_squared();
         if let Some((t0, j0, e0)) = previous {
             int_j += 0.5 * (t - t0) * (j + j0);
@@ -242,11 +239,7 @@ where
         }
         previous = Some((t, j, e));
         if let Some(tr) = trajectory.as_mut() {
-            tr.t.push(t);
-            tr.theta.push(theta);
-            tr.theta_dot.push(theta_dot);
-            tr.theta_ddot.push(theta_ddot);
-            tr.u.push(*u);
+            tr.push(t, observed);
         }
     };
 

@@ -16,6 +16,7 @@ use clarabel::solver::{
 use nalgebra::{SMatrix, SVector};
 
 use super::discretise::Discretised;
+use crate::generated::{Read, Term};
 use crate::model::TaskN;
 // The 2-link names the unit tests below use (through `use super::*`).
 #[cfg(test)]
@@ -47,26 +48,34 @@ impl<const N: usize, const NX: usize, const NZ: usize> StageCost<N, NX, NZ> {
     ) -> Self {
         let mut m = SMatrix::<f64, NZ, NZ>::zeros();
         m.fixed_view_mut::<NX, NX>(0, 0).fill_with_identity();
-        m.fixed_view_mut::<N, NX>(NX, 0)
-            .copy_from(&a.fixed_view::<N, NX>(N, 0));
-        m.fixed_view_mut::<N, N>(NX, NX)
-            .copy_from(&b.fixed_view::<N, N>(N, 0));
         let mut r = SVector::<f64, NZ>::zeros();
-        r.fixed_rows_mut::<N>(0).copy_from(&task.goal_theta);
-        r.fixed_rows_mut::<N>(N).copy_from(&task.goal_theta_dot);
-        r.fixed_rows_mut::<N>(NX)
-            .copy_from(&(task.goal_theta_ddot - c.fixed_rows::<N>(N)));
         let mut w = SMatrix::<f64, NZ, NZ>::zeros();
-        w.fixed_view_mut::<N, N>(0, 0)
-            .copy_from(&task.precision_theta);
-        w.fixed_view_mut::<N, N>(N, N)
-            .copy_from(&task.precision_theta_dot);
-        w.fixed_view_mut::<N, N>(NX, NX)
-            .copy_from(&task.precision_theta_ddot);
+        // Residual rows: X's own (the terms read from X), then N rows for the one term read
+        // from Ẋ (θ̈), whose row of the affine model is [a b] there.
+        for term in Term::ALL {
+            let (goal, p) = (task.goal(term), task.precision(term));
+            let rows = match term.read() {
+                Read::State { block } => {
+                    r.fixed_rows_mut::<N>(block * N).copy_from(goal);
+                    block * N
+                }
+                Read::StateRate { block } => {
+                    m.fixed_view_mut::<N, NX>(NX, 0)
+                        .copy_from(&a.fixed_view::<N, NX>(block * N, 0));
+                    m.fixed_view_mut::<N, N>(NX, NX)
+                        .copy_from(&b.fixed_view::<N, N>(block * N, 0));
+                    r.fixed_rows_mut::<N>(NX)
+                        .copy_from(&(goal - c.fixed_rows::<N>(block * N)));
+                    NX
+                }
+                Read::Control => continue,
+            };
+            w.fixed_view_mut::<N, N>(rows, rows).copy_from(p);
+        }
 
         let mut hessian = m.transpose() * w * m;
         let mut uu = hessian.fixed_view_mut::<N, N>(NX, NX);
-        uu += task.precision_u;
+        uu += task.precision(Term::CONTROL);
         // Clarabel reads only the upper triangle, the Riccati reference the whole matrix:
         // make them the same matrix.
         let hessian = (hessian + hessian.transpose()) * (0.5 * period);
@@ -426,13 +435,15 @@ mod tests {
         let quad = |e: Vector2, p: &crate::Matrix2| (e.transpose() * p * e)[0];
         0.5 * period
             * (quad(
-                x.fixed_rows::<2>(0) - task.goal_theta,
-                &task.precision_theta,
+                x.fixed_rows::<2>(0) - task.goal(Term::Theta),
+                task.precision(Term::Theta),
             ) + quad(
-                x.fixed_rows::<2>(2) - task.goal_theta_dot,
-                &task.precision_theta_dot,
-            ) + quad(accel - task.goal_theta_ddot, &task.precision_theta_ddot)
-                + quad(*u, &task.precision_u))
+                x.fixed_rows::<2>(2) - task.goal(Term::ThetaDot),
+                task.precision(Term::ThetaDot),
+            ) + quad(
+                accel - task.goal(Term::ThetaDdot),
+                task.precision(Term::ThetaDdot),
+            ) + quad(*u, task.precision(Term::U)))
     }
 
     /// A QP on the equilibrium model, and the data of the local model at a state far from it

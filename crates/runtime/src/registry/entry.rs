@@ -14,6 +14,7 @@ use super::{
 };
 use crate::closed_loop::EpisodeOptions;
 use crate::generated;
+use crate::generated::TERMS;
 use crate::model::{
     control_confidence, episode, simulate, ArmModel, EpisodeOptionsN, Metrics,
     ModelSimulationError, TaskN, ToolN, ValidatedTaskN,
@@ -239,14 +240,10 @@ where
         let tool = tool::<M, N, NX, NP, NZ>(params)?;
         let c = self.validated()?.control_confidence(&tool)?;
         let s = tool.sensitivities(self.kind);
-        let sensitivities = [
-            ("d_theta_du", s.d_theta_du),
-            ("d_theta_dot_du", s.d_theta_dot_du),
-            ("d_theta_ddot_du", s.d_theta_ddot_du),
-        ]
-        .into_iter()
-        .filter_map(|(name, m)| m.map(|m| (name, rows(&m))))
-        .collect();
+        let sensitivities = Term::ALL
+            .into_iter()
+            .filter_map(|term| s.of(term).map(|m| (term.sensitivity_name(), rows(&m))))
+            .collect();
         Ok(Linearisation {
             a: rows(&tool.state_matrix()),
             b: rows(&tool.input_matrix()),
@@ -286,12 +283,8 @@ where
         let tr = episode(&tool, task, &self.recorded()?)?
             .trajectory
             .expect("a recorded episode has a trajectory");
-        let (series, goal) = match self.kind.error_term() {
-            Term::Theta => (&tr.theta, task.goal_theta),
-            Term::ThetaDot => (&tr.theta_dot, task.goal_theta_dot),
-            Term::ThetaDdot => (&tr.theta_ddot, task.goal_theta_ddot),
-            Term::U => (&tr.u, SVector::zeros()),
-        };
+        let term = self.kind.error_term();
+        let (series, goal) = (tr.of(term), task.goal(term));
         Ok(TaskTrace {
             t: tr.t.clone(),
             value: per_joint(series),
@@ -320,7 +313,7 @@ impl<const N: usize, const NX: usize> One<N, NX> {
         M: ArmModel<N, NX, NP, NZ>,
     {
         let s = &self.sensitivities;
-        let sensitivities = [s.d_theta_du, s.d_theta_dot_du, s.d_theta_ddot_du];
+        let sensitivities = s.d_du;
         let finite = |m: &[f64]| m.iter().all(|v| v.is_finite());
         if finite(self.a.as_slice())
             && finite(self.b.as_slice())
@@ -359,7 +352,7 @@ where
         tool::<M, N, NX, NP, NZ>(p).map_err(|e| BatchError::Tool(i, e))?;
     }
     // A term the task does not use has no sensitivity (the command line leaves it out too).
-    let used = [Term::Theta, Term::ThetaDot, Term::ThetaDdot].map(|t| kind.uses(t));
+    let used = Term::ALL.map(|t| t.has_sensitivity() && kind.uses(t));
     let mut out = allocate(k, N, NX, used)?;
     let chunk = (CHUNK_BYTES / std::mem::size_of::<Result<One<N, NX>, Error>>()).max(1);
     for (c, tools) in params.chunks(chunk * NP).enumerate() {
@@ -393,16 +386,15 @@ where
 const CHUNK_BYTES: usize = 8 << 20;
 
 /// Room for k tools' results (the sensitivities of the `used` terms only).
-fn allocate(k: usize, n: usize, nx: usize, used: [bool; 3]) -> Result<Confidences, BatchError> {
+fn allocate(k: usize, n: usize, nx: usize, used: [bool; TERMS]) -> Result<Confidences, BatchError> {
     // The error says what all the arrays need, not the one that failed.
     let per_tool = nx * nx + nx * n + (used.iter().filter(|u| **u).count() + 1) * n * n + 1;
     let total = k.saturating_mul(per_tool);
     let part = |per_tool: usize| room(k.saturating_mul(per_tool), total);
-    let names = ["d_theta_du", "d_theta_dot_du", "d_theta_ddot_du"];
     let mut sensitivities = Vec::new();
-    for (name, used) in names.into_iter().zip(used) {
+    for (term, used) in Term::ALL.into_iter().zip(used) {
         if used {
-            sensitivities.push((name, part(n * n)?));
+            sensitivities.push((term.sensitivity_name(), part(n * n)?));
         }
     }
     Ok(Confidences {
@@ -424,9 +416,7 @@ fn push<const N: usize, const NX: usize>(out: &mut Confidences, one: &One<N, NX>
     push_c_order(&mut out.pi_u, &one.pi_u);
     out.logdet.push(one.logdet);
     let s = &one.sensitivities;
-    let present = [s.d_theta_du, s.d_theta_dot_du, s.d_theta_ddot_du]
-        .into_iter()
-        .flatten();
+    let present = s.d_du.into_iter().flatten();
     for ((_, all), m) in out.sensitivities.iter_mut().zip(present) {
         push_c_order(all, &m);
     }

@@ -3,6 +3,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
+use crate::generated::{Term, TERMS};
 use crate::model::{Metrics, TrajectoryN};
 use crate::Error;
 
@@ -53,15 +54,12 @@ pub struct AnyEpisode {
     pub trajectory: Option<TrajectoryTable>,
 }
 
-/// A trajectory on the output grid with the joint count known only at run time:
-/// `theta[j][i]` is joint j at `t[i]`, and likewise θ̇, θ̈ (the plant's) and U.
+/// A trajectory on the output grid with the joint count known only at run time: for each
+/// term by [`Term::index`] (θ, θ̇, θ̈ (the plant's) and U), `terms[k][j][i]` is joint j at `t[i]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrajectoryTable {
     pub t: Vec<f64>,
-    pub theta: Vec<Vec<f64>>,
-    pub theta_dot: Vec<Vec<f64>>,
-    pub theta_ddot: Vec<Vec<f64>>,
-    pub u: Vec<Vec<f64>>,
+    pub terms: [Vec<Vec<f64>>; TERMS],
 }
 
 impl TrajectoryTable {
@@ -69,30 +67,34 @@ impl TrajectoryTable {
     pub fn from_trajectory<const N: usize>(tr: &TrajectoryN<N>) -> Self {
         TrajectoryTable {
             t: tr.t.clone(),
-            theta: per_joint(&tr.theta),
-            theta_dot: per_joint(&tr.theta_dot),
-            theta_ddot: per_joint(&tr.theta_ddot),
-            u: per_joint(&tr.u),
+            terms: Term::ALL.map(|term| per_joint(tr.of(term))),
         }
     }
 
-    /// As CSV: `t`, then θ, θ̇, θ̈ and U of each joint (`theta1, …, u<n>`), one row per time.
+    /// The values of `term`, per joint.
+    pub fn of(&self, term: Term) -> &[Vec<f64>] {
+        &self.terms[term.index()]
+    }
+
+    /// As CSV: `t`, then every term of each joint (`theta1, …, theta1_dot, …, u<n>`: the joint's
+    /// number after the name's first word), one row per time.
     pub fn to_csv(&self) -> String {
-        // (prefix, suffix, values): the columns theta1, …, theta1_dot, …, u<n>.
-        let blocks = [
-            ("theta", "", &self.theta),
-            ("theta", "_dot", &self.theta_dot),
-            ("theta", "_ddot", &self.theta_ddot),
-            ("u", "", &self.u),
-        ];
+        let column = |term: Term, j: usize| match term.name().split_once('_') {
+            Some((first, rest)) => format!("{first}{j}_{rest}"),
+            None => format!("{}{j}", term.name()),
+        };
+        let blocks: Vec<(Term, &Vec<Vec<f64>>)> = Term::ALL
+            .iter()
+            .map(|&t| (t, &self.terms[t.index()]))
+            .collect();
         let mut header = vec!["t".to_string()];
-        for (prefix, suffix, block) in blocks {
-            header.extend((1..=block.len()).map(|j| format!("{prefix}{j}{suffix}")));
+        for &(term, block) in &blocks {
+            header.extend((1..=block.len()).map(|j| column(term, j)));
         }
         let mut out = header.join(",") + "\n";
         for i in 0..self.t.len() {
             let mut row = vec![self.t[i].to_string()];
-            for (_, _, block) in blocks {
+            for (_, block) in &blocks {
                 row.extend(block.iter().map(|joint| joint[i].to_string()));
             }
             out += &(row.join(",") + "\n");
