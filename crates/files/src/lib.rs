@@ -4,6 +4,9 @@
 //! and only over a new path or a regular file ([`file`]); no output that is an input or another
 //! output of the same run ([`run_files`]); an interrupted run keeps the old files
 //! ([`partial`]).
+//!
+//! The lowest layer for file output, on no other toolconf crate: the runtime re-exports it as
+//! `toolconf::output`.
 
 pub mod csv;
 pub mod file;
