@@ -421,6 +421,7 @@ impl CrateFolder {
     /// As [`Self::install_staged`], for a folder made elsewhere beside OUT; on failure it stays
     /// where it is, for its maker to remove.
     pub fn install(&self, staging: &Path) -> Result<(), FolderError> {
+        self.check_staging(staging)?;
         let previous = self.check()?;
         self.write_manifest(staging)?;
         user_permissions(staging)?;
@@ -429,6 +430,21 @@ impl CrateFolder {
             Previous::Nothing => fs::rename(staging, &self.out).map_err(write_error(&self.out)),
             Previous::Empty | Previous::Ours(_) => self.replace(staging),
         }
+    }
+
+    /// `staging` is a folder (not a link to one) beside OUT: renamed, it becomes OUT whole.
+    fn check_staging(&self, staging: &Path) -> Result<(), FolderError> {
+        let folder = fs::symlink_metadata(staging).is_ok_and(|m| m.is_dir());
+        let beside = resolved(crate::file::parent(staging)) == crate::file::parent(&self.out);
+        let real = resolved(staging);
+        let holds_input = self.inputs.iter().any(|(_, i)| inside(&resolved(i), &real));
+        if folder && beside && real != self.out && !holds_input {
+            return Ok(());
+        }
+        Err(self.says(format_args!(
+            "{} is not a folder beside it to make the crate in",
+            staging.display()
+        )))
     }
 
     /// Lists every file under `staging` (the new folder, before it is moved into place).
@@ -808,6 +824,14 @@ mod tests {
         fs::write(out.join("x"), "").unwrap();
         assert!(refusal(r.install_staged(staging)).contains("other files"));
         assert_eq!(names(base.path()), ["file", "late", "models"]);
+        // Only a folder beside OUT, holding no input, is moved there.
+        fs::create_dir(base.path().join("sub")).unwrap();
+        let not_beside = "models is not a folder beside it to make the crate in";
+        let e = refusal(rule(&base.path().join("sub/new"), &models).install(&models));
+        assert!(e.ends_with(not_beside), "{e}");
+        let e = refusal(rule(&base.path().join("new"), &models).install(&models));
+        assert!(e.ends_with(not_beside), "{e}");
+        assert!(models.join("m.toml").is_file());
     }
 
     #[cfg(unix)]
