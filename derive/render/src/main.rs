@@ -18,14 +18,15 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use toolconf_files::folder::{CrateFolder, FolderError};
-use toolconf_files::{file, write_atomically, WriteError};
+use toolconf_files::file::create_folder;
+use toolconf_files::{write_atomically, WriteError};
 use toolconf_render::{check_crate, crate_irs, render_crate, CrateFile, Package, RenderError};
 
 /// Writes one rendered file whole, or leaves what was there (toolconf_files' rule).
 fn write(out: &Path, file: &CrateFile) -> Result<(), RenderError> {
     let target = out.join(&file.path);
     let folder = target.parent().unwrap_or(out);
-    file::create_folder(folder).map_err(WriteError::at(folder))?;
+    create_folder(folder).map_err(WriteError::at(folder))?;
     write_atomically(&target, &file.contents)?;
     println!("render: {} -> {}", file.source.display(), target.display());
     Ok(())
@@ -210,5 +211,30 @@ fn main() -> ExitCode {
             eprintln!("toolconf-render: {e}");
             ExitCode::FAILURE
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args(words: &[&str]) -> Result<Args, String> {
+        parse(&words.iter().map(|w| w.to_string()).collect::<Vec<_>>())
+    }
+
+    #[test]
+    fn the_folder_rules_flags_need_their_values() {
+        let a = args(&["--check-crate-out", "/o", "--input", "TASKS=t", "/t"]).unwrap();
+        assert!(matches!(&a.crate_rule, Some(CrateRule::Check(out)) if out == Path::new("/o")));
+        assert_eq!(a.inputs, [("TASKS=t".to_string(), PathBuf::from("/t"))]);
+        assert!(a.irs.is_empty());
+        let e = args(&["--check-crate-out", "/o", "--input", "TASKS=t"]).err();
+        assert_eq!(e.as_deref(), Some("--input LABEL needs a value"));
+        let e = args(&["--repository"]).err();
+        assert_eq!(e.as_deref(), Some("--repository needs a value"));
+        // Without --out, the install would aim at generated/: refused.
+        let e = args(&["--install-crate", "/s"]).err();
+        assert_eq!(e.as_deref(), Some("--install-crate needs --out OUT"));
+        assert!(args(&["--install-crate", "/s", "--out", "/o"]).is_ok());
     }
 }
