@@ -474,11 +474,8 @@ impl CrateFolder {
         fs::rename(out, &old).map_err(write_error(out))?;
         if let Err(e) = fs::rename(staging, out) {
             if let Err(back) = fs::rename(&old, out) {
-                let kept = aside.keep();
-                return Err(self.says(format_args!(
-                    "cannot be replaced ({e}) nor restored ({back}); the old folder is {}",
-                    kept.join("crate").display()
-                )));
+                let why = format!("{e}, and the old folder could not be put back ({back})");
+                return Err(kept_aside(out, aside, &why));
             }
             return Err(write_error(out)(e));
         }
@@ -487,16 +484,21 @@ impl CrateFolder {
             if fs::symlink_metadata(&from).is_ok() {
                 if let Err(e) = fs::rename(&from, out.join(product)) {
                     // The new folder is in place; the old one stays, with what it still holds.
-                    let kept = aside.keep();
-                    return Err(self.says(format_args!(
-                        "{product} could not be kept ({e}); it is in {}",
-                        kept.join("crate").display()
-                    )));
+                    let why = format!("{product} could not be moved into it ({e})");
+                    return Err(kept_aside(out, aside, &why));
                 }
             }
         }
         aside.close().map_err(write_error(out))
     }
+}
+
+/// The failure of a swap that could not be undone: the folder moved aside is kept, not removed
+/// (it holds what the run did not create), and named.
+fn kept_aside(out: &Path, aside: tempfile::TempDir, why: &str) -> FolderError {
+    let kept = aside.keep().join("crate");
+    let message = format!("{why}; the old folder is kept as {}", kept.display());
+    WriteError::at(out)(io::Error::other(message)).into()
 }
 
 /// The regular files under `dir`, links not followed.
@@ -683,6 +685,35 @@ mod tests {
         fs::create_dir(&empty).unwrap();
         make(&rule(&empty, &models), &CRATE).unwrap();
         assert!(empty.join("src/lib.rs").is_file());
+    }
+
+    #[test]
+    fn cargos_products_that_cannot_be_moved_stay_in_the_old_folder_which_is_named() {
+        let (base, models) = scratch();
+        let out = base.path().join("mine");
+        make(&rule(&out, &models), &CRATE).unwrap();
+        fs::create_dir_all(out.join("target/debug")).unwrap();
+        fs::write(out.join("target/debug/build"), "built").unwrap();
+        // A new crate with a target/ of its own, which the old one's cannot replace.
+        let e = make(&rule(&out, &models), &[("target/own", "")]).unwrap_err();
+        let FolderError::Write(e) = e else {
+            panic!("{e}")
+        };
+        assert_eq!(e.path, out);
+        let message = e.to_string();
+        let kept = message
+            .rsplit_once("kept as ")
+            .map(|(_, k)| PathBuf::from(k));
+        let kept = kept.unwrap_or_else(|| panic!("{message}"));
+        assert!(
+            message.contains("target could not be moved into it"),
+            "{message}"
+        );
+        assert_eq!(
+            fs::read_to_string(kept.join("target/debug/build")).unwrap(),
+            "built"
+        );
+        assert!(out.join("target/own").is_file());
     }
 
     #[test]
