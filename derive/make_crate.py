@@ -129,8 +129,9 @@ def derive_all(found: list[Path], tasks: Path, folder: Path) -> int:
     """derive.py for every description into `folder`, largest first, as many at once as there
     are cores; its one-line errors are passed on. The worst status, 0 if all succeeded."""
     def derive(path: Path):
-        cmd = [sys.executable, str(ROOT / "derive" / "derive.py"), str(path), "--tasks", str(tasks),
-               "--out-dir", str(folder), "--command", COMMAND]
+        # derive.py runs in the repository: a path relative to where make crate was run is made whole.
+        cmd = [sys.executable, str(ROOT / "derive" / "derive.py"), str(Path.cwd() / path), "--tasks",
+               str(Path.cwd() / tasks), "--out-dir", str(folder), "--command", COMMAND]
         return subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
 
     jobs = sorted(found, key=lambda p: -_dof(p))
