@@ -17,8 +17,8 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use toolconf_files::folder::{CrateFolder, FolderError};
 use toolconf_files::file::create_folder;
+use toolconf_files::folder::{CrateFolder, FolderError};
 use toolconf_files::{write_atomically, WriteError};
 use toolconf_render::{check_crate, crate_irs, render_crate, CrateFile, Package, RenderError};
 
