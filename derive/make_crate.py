@@ -16,20 +16,22 @@ unless NAME is given.
 
 Everything is written into a temporary folder beside OUT and renamed into place at the end, so a
 failure or an interrupt (Ctrl-C, SIGTERM, SIGHUP) leaves nothing behind and keeps the crate that
-was there. The crate holds an ownership manifest, .toolconf-crate, listing every file this command
-wrote with its SHA-256; OUT must not exist, be an empty folder, or be a crate this command made
-whose files are all still as listed, with nothing else in it but cargo's Cargo.lock and target/
-(which the new crate keeps): only then is it replaced. OUT may not be a symbolic link, lie inside
-the repository, or hold the descriptions, their URDFs or the task file, and the crate gets the
-permissions of any folder the user makes (0777 less the umask). Nothing in the repository changes
-(the derivation runs in place, the renderer builds into target/). Bad input is one line naming
-the file, key or value, status 2.
+was there. What may happen to OUT is the one output-file rule of the command line and the reports,
+in Rust (crates/files/src/folder.rs), which this script asks through the renderer before deriving
+anything (toolconf-render --check-crate-out) and again to move the crate into place
+(--install-crate). The crate holds an ownership manifest, .toolconf-crate, listing every file this
+command wrote with its SHA-256; OUT must not exist, be an empty folder, or be a crate this command
+made whose files are all still as listed, with nothing else in it but cargo's Cargo.lock and
+target/ (which the new crate keeps): only then is it replaced. OUT may not be a symbolic link, lie
+inside the repository, or hold the descriptions, their URDFs or the task file, and the crate gets
+the permissions of any folder the user makes (0777 less the umask). Nothing in the repository
+changes (the derivation runs in place, the renderer builds into target/). Bad input is one line
+naming the file, key or value, status 2.
 """
 
 from __future__ import annotations
 
 import argparse
-import hashlib
 import os
 import re
 import shutil
@@ -47,12 +49,6 @@ from toolconf_derive.files import read_toml
 ROOT = Path(__file__).resolve().parent.parent
 TASKS = ROOT / "derive" / "tasks.toml"
 COMMAND = "make crate"
-# The ownership manifest in every crate this command makes: its first line, then one line per
-# file it wrote, "<sha256 hex>  <path relative to the crate>" (as sha256sum writes them).
-OWNERSHIP = ".toolconf-crate"
-OWNERSHIP_HEADER = f"# files written by `{COMMAND}`; the crate is replaced only while they are as listed"
-# What cargo makes in a crate it builds or tests: kept across a replacement, never deleted.
-CARGO_PRODUCTS = ("Cargo.lock", "target")
 # Crates the generated crate names in its code: Rust's own, and the dependencies of
 # templates/registry/Cargo.toml.tera (a test keeps this list and the template in step).
 TAKEN_CRATE_NAMES = ("std", "core", "alloc", "proc_macro", "test", "nalgebra", "libm", "serde", "serde_json")
@@ -60,6 +56,10 @@ TAKEN_CRATE_NAMES = ("std", "core", "alloc", "proc_macro", "test", "nalgebra", "
 
 class Refused(Exception):
     """Bad input: the message (one line) and status 2."""
+
+
+class Failed(Exception):
+    """A failure to write OUT once the input was good: the message (one line) and status 1."""
 
 
 def crate_name(out: Path, name: str | None) -> str:
@@ -103,82 +103,11 @@ def duplicate_model_names(found: list[Path]) -> None:
             seen[name] = path
 
 
-def sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with path.open("rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
-
-
-def write_ownership(folder: Path) -> None:
-    """Lists every file under `folder` (the new crate, before it is moved into place)."""
-    files = sorted(p for p in folder.rglob("*") if p.is_file() and not p.is_symlink())
-    lines = [OWNERSHIP_HEADER] + [f"{sha256(p)}  {p.relative_to(folder).as_posix()}" for p in files]
-    (folder / OWNERSHIP).write_text("\n".join(lines) + "\n")
-
-
-def owned_files(out: Path) -> dict[str, str] | None:
-    """The files OUT's manifest lists, with their hashes; None without a manifest of ours."""
-    manifest = out / OWNERSHIP
-    if manifest.is_symlink() or not manifest.is_file():
-        return None
-    try:
-        lines = manifest.read_text(encoding="utf-8").splitlines()
-    except (OSError, UnicodeDecodeError):
-        return None
-    if not lines or lines[0] != OWNERSHIP_HEADER:
-        return None
-    files = {}
-    for line in lines[1:]:
-        digest, sep, name = line.partition("  ")
-        if not sep or not re.fullmatch(r"[0-9a-f]{64}", digest) or name.startswith("/") or ".." in name.split("/"):
-            return None
-        files[name] = digest
-    return files
-
-
-def previous_crate(out: Path) -> bool:
-    """Whether OUT is there to be replaced: an empty folder, or a crate made by this command
-    that still holds only what it wrote (and cargo's products); anything else is refused."""
-    if out.is_symlink():
-        raise Refused(f"OUT={out}: a symbolic link (to {os.readlink(out)}); give the folder itself")
-    if not out.exists():
-        return False
-    if not out.is_dir():
-        raise Refused(f"OUT={out}: exists and is not a folder")
-    if not any(out.iterdir()):
-        return True
-    owned = owned_files(out)
-    if owned is None:
-        raise Refused(f"OUT={out}: a folder with other files in it and no {OWNERSHIP} of `{COMMAND}`; "
-                      "give a new or empty folder")
-    for folder, dirs, files in os.walk(out):
-        here = Path(folder)
-        if here == out:
-            # cargo's products are not walked (target/ can hold thousands of files).
-            dirs[:] = [d for d in dirs if d not in CARGO_PRODUCTS]
-            files = [f for f in files if f not in CARGO_PRODUCTS and f != OWNERSHIP]
-        for name in sorted(dirs) + sorted(files):
-            path = here / name
-            rel = path.relative_to(out).as_posix()
-            if path.is_symlink() or not (path.is_dir() or path.is_file()):
-                listed = False
-            elif path.is_dir():
-                listed = any(f.startswith(rel + "/") for f in owned)
-            else:
-                listed = rel in owned
-            if not listed:
-                raise Refused(f"OUT={out}: {path} was not written by `{COMMAND}`; move it out first")
-            if path.is_file() and sha256(path) != owned[rel]:
-                raise Refused(f"OUT={out}: {path} was changed since `{COMMAND}` wrote it; move it out first")
-    return True
-
-
-def inputs(found: list[Path], tasks: Path) -> list[tuple[str, Path]]:
-    """Every file the run reads, named as in its error: the descriptions, the URDFs they name
-    (resolved as the derivation resolves them) and the task file."""
-    files = [(f"description {p}", p) for p in found] + [(f"TASKS={tasks}", tasks)]
+def inputs(models: Path, found: list[Path], tasks: Path) -> list[tuple[str, Path]]:
+    """Every file the run reads, named as in its error: the descriptions' folder, the
+    descriptions, the URDFs they name (resolved as the derivation resolves them) and the task
+    file."""
+    files = [(f"MODELS={models}", models)] + [(f"description {p}", p) for p in found] + [(f"TASKS={tasks}", tasks)]
     for path in found:
         try:
             urdf = read_toml(path).get("urdf", {})
@@ -187,37 +116,6 @@ def inputs(found: list[Path], tasks: Path) -> list[tuple[str, Path]]:
         if isinstance(urdf, dict) and isinstance(urdf.get("file"), str):
             files.append((f"the URDF of {path}", Path(os.path.normpath(path.parent / urdf["file"]))))
     return files
-
-
-def inside(path: Path, folder: Path) -> bool:
-    return path == folder or folder in path.parents
-
-
-def check_out(out: Path, models: Path, found: list[Path], tasks: Path) -> None:
-    """OUT is no input, holds none and is outside the repository, whose files `make derive` owns."""
-    if inside(out, ROOT) or inside(ROOT, out):
-        raise Refused(f"OUT={out}: inside the repository {ROOT}; give a folder outside it")
-    real_models = models.resolve()
-    if inside(real_models, out) or inside(out, real_models):
-        raise Refused(f"OUT={out}: MODELS={models} is inside it or it is inside MODELS; "
-                      "the crate would replace the descriptions")
-    for label, path in inputs(found, tasks):
-        if inside(path.resolve(), out):
-            raise Refused(f"OUT={out}: {label} is inside it; the crate would replace it")
-
-
-def out_path(out: Path) -> Path:
-    """OUT made absolute with its folder's links resolved but not its own: a link is refused
-    (previous_crate), and the crate is named after the name given."""
-    out = Path(os.path.abspath(out))
-    return out.parent.resolve() / out.name
-
-
-def user_permissions(folder: Path) -> None:
-    """mkdtemp makes 0700; a folder the user makes gets 0777 less the umask."""
-    mask = os.umask(0)
-    os.umask(mask)
-    folder.chmod(0o777 & ~mask)
 
 
 def _dof(path: Path) -> int:
@@ -231,8 +129,9 @@ def derive_all(found: list[Path], tasks: Path, folder: Path) -> int:
     """derive.py for every description into `folder`, largest first, as many at once as there
     are cores; its one-line errors are passed on. The worst status, 0 if all succeeded."""
     def derive(path: Path):
-        cmd = [sys.executable, str(ROOT / "derive" / "derive.py"), str(path), "--tasks", str(tasks),
-               "--out-dir", str(folder), "--command", COMMAND]
+        # derive.py runs in the repository: a path relative to where make crate was run is made whole.
+        cmd = [sys.executable, str(ROOT / "derive" / "derive.py"), str(Path.cwd() / path), "--tasks",
+               str(Path.cwd() / tasks), "--out-dir", str(folder), "--command", COMMAND]
         return subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
 
     jobs = sorted(found, key=lambda p: -_dof(p))
@@ -244,38 +143,52 @@ def derive_all(found: list[Path], tasks: Path, folder: Path) -> int:
     return max(r.returncode for r in results)
 
 
+def renderer(*args: str, **run) -> subprocess.CompletedProcess:
+    """The renderer, toolconf-render, built into the repository's target/ when it is not."""
+    return subprocess.run(["cargo", "run", "--quiet", "-p", "toolconf-render", "--", *args], cwd=ROOT, **run)
+
+
 def render(folder: Path, name: str) -> int:
     irs = sorted(p for p in folder.glob("*.json") if not p.name.endswith(".vectors.json"))
-    cmd = ["cargo", "run", "--quiet", "-p", "toolconf-render", "--", *map(str, irs),
-           "--templates", str(ROOT / "templates"), "--out", str(folder), "--crate-name", name, "--standalone"]
-    return subprocess.run(cmd, cwd=ROOT, stdout=subprocess.DEVNULL).returncode
+    return renderer(*map(str, irs), "--templates", str(ROOT / "templates"), "--out", str(folder),
+                    "--crate-name", name, "--standalone", stdout=subprocess.DEVNULL).returncode
 
 
-INTERRUPTS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+def folder_rule(args: list[str], files: list[tuple[str, Path]]) -> None:
+    """The rule for OUT (crates/files/src/folder.rs, through the renderer), with every input of
+    the run; its refusal is raised as Refused, its failure to write as Failed. Paths go absolute
+    but unresolved: the renderer runs in the repository and resolves them as the rule says."""
+    args = [*args, "--repository", str(ROOT)]
+    for label, path in files:
+        args += ["--input", label, str(Path.cwd() / path)]
+    r = renderer(*args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, errors="replace")
+    if r.returncode == 0:
+        return
+    last = (r.stderr.strip().splitlines() or [""])[-1]
+    # Its own line is the last; anything before it is cargo's, building the renderer.
+    if r.returncode in (1, 2) and last.startswith("toolconf-render: "):
+        message = last.removeprefix("toolconf-render: ")
+        raise Refused(message) if r.returncode == 2 else Failed(message)
+    sys.stderr.write(r.stderr)
+    raise Failed(f"the rule for OUT did not run: toolconf-render {args[0]} ended with status {r.returncode}")
 
 
-def install(tmp: Path, out: Path, replace: bool) -> None:
-    """Moves the finished crate into place (a rename on one file system), replacing a previous
-    one, whose cargo products the new crate keeps. The signals wait until it is done, so an
-    interrupt finds the old crate or the new one in place, never neither."""
-    signal.pthread_sigmask(signal.SIG_BLOCK, INTERRUPTS)
+INTERRUPTS = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
+
+
+def install(tmp: Path, out: Path, files: list[tuple[str, Path]]) -> None:
+    """Moves the finished crate into place by the rule, which checks OUT again, writes the
+    ownership manifest and swaps the crates with the interrupts blocked. They wait here too until
+    it is done: this process ending would end the renderer half-way."""
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, INTERRUPTS)
     try:
-        if not replace:
-            os.rename(tmp, out)
-            return
-        for name in CARGO_PRODUCTS:
-            if (out / name).exists() or (out / name).is_symlink():
-                os.rename(out / name, tmp / name)
-        old = Path(tempfile.mkdtemp(prefix=f".{out.name}-old-", dir=out.parent))
-        os.rename(out, old / "crate")
-        os.rename(tmp, out)
-        shutil.rmtree(old)
+        folder_rule(["--install-crate", str(tmp), "--out", str(out)], files)
     finally:
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, INTERRUPTS)
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
 
 
 def make_crate(models: Path, out: Path, tasks: Path, name: str | None) -> int:
-    out = out_path(out)
+    out = Path(os.path.abspath(out))  # the crate is named after the name given, links and all
     package = crate_name(out, name)
     found = descriptions(models)
     duplicate_model_names(found)
@@ -283,13 +196,10 @@ def make_crate(models: Path, out: Path, tasks: Path, name: str | None) -> int:
         load_tasks(tasks)  # read as derive.py reads it: a FIFO, a device or bad TOML is one line now
     except DescriptionError as err:
         raise Refused(f"TASKS={err}") from err
-    check_out(out, models, found, tasks)
-    if not out.parent.is_dir():
-        raise Refused(f"OUT={out}: the folder {out.parent} does not exist")
-    replace = previous_crate(out)
+    files = inputs(models, found, tasks)
+    folder_rule(["--check-crate-out", str(out)], files)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}-partial-", dir=out.parent))
     try:
-        user_permissions(tmp)
         status = derive_all(found, tasks, tmp)
         if status:
             return status
@@ -297,8 +207,7 @@ def make_crate(models: Path, out: Path, tasks: Path, name: str | None) -> int:
             print("make crate: rendering failed", file=sys.stderr)
             return 1
         made = sorted(p.stem for p in tmp.glob("*.json") if not p.name.endswith(".vectors.json"))
-        write_ownership(tmp)
-        install(tmp, out, replace)
+        install(tmp, out, files)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     print(f"make crate: {out}: crate {package} with the models {', '.join(made)}; "
@@ -322,6 +231,9 @@ def main() -> int:
     except Refused as err:
         print(f"make crate: {err}", file=sys.stderr)
         return 2
+    except Failed as err:
+        print(f"make crate: {err}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print("make crate: interrupted; nothing changed", file=sys.stderr)
         return 130

@@ -90,7 +90,7 @@ fn what_a_robot_links_has_nothing_heavy() {
     // All edges, dev and build included: the crate's whole tree.
     let all = tree("examples/on_robot/Cargo.toml", &[]);
     assert!(all.contains("toolconf-core") && all.contains("toolconf-generated"));
-    for heavy in HEAVY.iter().chain(&["toolconf"]) {
+    for heavy in HEAVY.iter().chain(&["toolconf", "toolconf-files"]) {
         assert!(
             !all.contains(*heavy),
             "{heavy} in the on-robot tree {all:?}"
@@ -117,6 +117,22 @@ fn the_runtime_and_the_python_package_have_no_command_line_plots_or_progress_bar
         &["-e", "normal", "--depth", "1"],
     );
     assert!(runtime.contains("toolconf-core") && runtime.contains("toolconf-generated"));
+}
+
+#[test]
+fn the_files_crate_is_a_leaf_that_the_runtime_and_the_renderer_share() {
+    let all = tree("crates/files/Cargo.toml", &["-e", "normal"]);
+    let ours: Vec<&String> = all.iter().filter(|p| p.starts_with("toolconf")).collect();
+    assert_eq!(ours, ["toolconf-files"], "{all:?}");
+    for heavy in HEAVY {
+        assert!(!all.contains(heavy), "{heavy} in the files crate's tree");
+    }
+    // One output-file rule: the command line and the reports reach it through the runtime,
+    // make crate through the renderer.
+    for manifest in ["crates/runtime/Cargo.toml", "derive/render/Cargo.toml"] {
+        let direct = tree(manifest, &["-e", "normal", "--depth", "1"]);
+        assert!(direct.contains("toolconf-files"), "{manifest}: {direct:?}");
+    }
 }
 
 /// What a robot links builds for a microcontroller without std or an allocator (a Cortex-M4F),

@@ -13,6 +13,7 @@
 //! ```text
 //! generated/       toolconf-generated  no_std   the derived code: models, tasks, registry
 //! crates/core/     toolconf-core       no_std   models, tools, tasks, Π^U, the controller's tick
+//! crates/files/    toolconf-files      std      the one rule for output files (below it, beside core)
 //! crates/runtime/  toolconf            std      this crate
 //! crates/report/   toolconf-report     std      the paper's experiments, figures, reports
 //! toolconf-cli (the `toolconf` command), toolconf-python (`import toolconf`)
@@ -38,7 +39,9 @@ pub use toolconf_generated::for_each_model;
 pub mod integrate;
 pub mod model;
 pub mod mpc;
-pub mod output;
+/// Result files, by the one rule the command line, the reports and `make crate` share: the crate
+/// toolconf-files (`crates/files`), below the runtime so that the renderer can use it too.
+pub use toolconf_files as output;
 pub mod rank;
 pub mod registry;
 pub mod select;

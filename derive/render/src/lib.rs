@@ -43,6 +43,8 @@ pub enum RenderError {
         path: PathBuf,
         source: std::io::Error,
     },
+    #[error(transparent)]
+    Write(#[from] toolconf_files::WriteError),
     #[error("{path} is not an IR this renderer reads: {source}")]
     Json {
         path: PathBuf,

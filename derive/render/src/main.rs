@@ -7,49 +7,76 @@
 //! vectors) back into it: `make render`, after a change to the templates or the renderer, with no
 //! derivation. `--check` writes nothing: it compares what it would write with the folder, byte for
 //! byte, names each file that differs and its first differing line, and fails (status 1).
+//!
+//! `make crate`'s folder rule ([`toolconf_files::folder`]), with no rendering:
+//! `--check-crate-out OUT --repository DIR [--input LABEL PATH]...` checks, before anything is
+//! derived, that OUT may become the crate; `--install-crate STAGING --out OUT --repository DIR
+//! [--input LABEL PATH]...` checks again, writes the ownership manifest into the crate made in
+//! STAGING and moves it into place. A refusal is one line, status 2; a failure to write, status 1.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use toolconf_files::file::create_folder;
+use toolconf_files::folder::{CrateFolder, FolderError};
+use toolconf_files::{write_atomically, WriteError};
 use toolconf_render::{check_crate, crate_irs, render_crate, CrateFile, Package, RenderError};
 
+/// Writes one rendered file whole, or leaves what was there (toolconf_files' rule).
 fn write(out: &Path, file: &CrateFile) -> Result<(), RenderError> {
     let target = out.join(&file.path);
-    let io = |source| RenderError::Io {
-        path: target.clone(),
-        source,
-    };
-    if let Some(parent) = target.parent() {
-        std::fs::create_dir_all(parent).map_err(io)?;
-    }
-    std::fs::write(&target, &file.contents).map_err(io)?;
+    let folder = target.parent().unwrap_or(out);
+    create_folder(folder).map_err(WriteError::at(folder))?;
+    write_atomically(&target, &file.contents)?;
     println!("render: {} -> {}", file.source.display(), target.display());
     Ok(())
+}
+
+/// `make crate`'s folder rule, asked for instead of a render.
+enum CrateRule {
+    Check(PathBuf),
+    Install(PathBuf),
 }
 
 struct Args {
     irs: Vec<PathBuf>,
     templates: PathBuf,
     out: PathBuf,
+    out_given: bool,
     package: Package,
     from_crate: bool,
     check: bool,
+    crate_rule: Option<CrateRule>,
+    repository: Option<PathBuf>,
+    inputs: Vec<(String, PathBuf)>,
 }
 
-fn parse(args: &[String]) -> Args {
+/// The value after `flag`, which the folder rule cannot do without.
+fn value<'a>(it: &mut impl Iterator<Item = &'a String>, flag: &str) -> Result<&'a String, String> {
+    it.next().ok_or_else(|| format!("{flag} needs a value"))
+}
+
+fn parse(args: &[String]) -> Result<Args, String> {
     let mut a = Args {
         irs: Vec::new(),
         templates: PathBuf::from("templates"),
         out: PathBuf::from("generated"),
+        out_given: false,
         package: Package::in_repository(),
         from_crate: false,
         check: false,
+        crate_rule: None,
+        repository: None,
+        inputs: Vec::new(),
     };
     let mut it = args.iter();
     while let Some(arg) = it.next() {
         match arg.as_str() {
             "--templates" => a.templates = it.next().map(PathBuf::from).unwrap_or(a.templates),
-            "--out" => a.out = it.next().map(PathBuf::from).unwrap_or(a.out),
+            "--out" => {
+                a.out = it.next().map(PathBuf::from).unwrap_or(a.out);
+                a.out_given = true;
+            }
             "--crate" => {
                 a.out = it.next().map(PathBuf::from).unwrap_or(a.out);
                 a.from_crate = true;
@@ -57,10 +84,44 @@ fn parse(args: &[String]) -> Args {
             "--crate-name" => a.package.name = it.next().cloned().unwrap_or(a.package.name),
             "--standalone" => a.package.standalone = true,
             "--check" => a.check = true,
+            "--check-crate-out" => {
+                a.crate_rule = Some(CrateRule::Check(value(&mut it, arg)?.into()));
+            }
+            "--install-crate" => {
+                a.crate_rule = Some(CrateRule::Install(value(&mut it, arg)?.into()));
+            }
+            "--repository" => a.repository = Some(value(&mut it, arg)?.into()),
+            "--input" => {
+                let label = value(&mut it, arg)?.clone();
+                let path = value(&mut it, "--input LABEL")?.into();
+                a.inputs.push((label, path));
+            }
             _ => a.irs.push(PathBuf::from(arg)),
         }
     }
-    a
+    if matches!(a.crate_rule, Some(CrateRule::Install(_))) && !a.out_given {
+        return Err("--install-crate needs --out OUT".into());
+    }
+    Ok(a)
+}
+
+/// Checks OUT, or installs the staged crate there, by `make crate`'s folder rule.
+fn crate_folder(a: &Args, rule: &CrateRule) -> Result<(), FolderError> {
+    let out = match rule {
+        CrateRule::Check(out) => out,
+        CrateRule::Install(_) => &a.out,
+    };
+    let mut folder = CrateFolder::new("OUT", out, "make crate")?;
+    if let Some(repository) = &a.repository {
+        folder.repository(repository);
+    }
+    for (label, path) in &a.inputs {
+        folder.input(label, path);
+    }
+    match rule {
+        CrateRule::Check(_) => folder.check().map(drop),
+        CrateRule::Install(staging) => folder.install(staging),
+    }
 }
 
 /// Renders; with `--check`, the differences found (none when the folder is up to date).
@@ -80,15 +141,47 @@ fn run(a: &Args) -> Result<Vec<String>, RenderError> {
     Ok(Vec::new())
 }
 
+/// `make crate`'s folder rule: a refusal is status 2, a failure to write status 1.
+fn run_crate_rule(a: &Args, rule: &CrateRule) -> ExitCode {
+    match crate_folder(a, rule) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("toolconf-render: {e}");
+            let refused = matches!(e, FolderError::Refused(_));
+            ExitCode::from(if refused { 2 } else { 1 })
+        }
+    }
+}
+
+/// The arguments, each of which must be UTF-8 (a path that is not cannot be told apart here).
+fn arguments() -> Result<Vec<String>, String> {
+    std::env::args_os()
+        .skip(1)
+        .map(|a| {
+            a.into_string()
+                .map_err(|a| format!("{}: not UTF-8", a.to_string_lossy()))
+        })
+        .collect()
+}
+
 fn main() -> ExitCode {
-    let args: Vec<String> = std::env::args().skip(1).collect();
+    let parsed = arguments().and_then(|args| parse(&args).map(|a| (args, a)));
+    let (args, a) = match parsed {
+        Ok(parsed) => parsed,
+        Err(message) => {
+            eprintln!("toolconf-render: {message}");
+            return ExitCode::from(2);
+        }
+    };
     if args.is_empty() || args.iter().any(|a| a == "--help" || a == "-h") {
         eprintln!(
-            "usage: toolconf-render [IR.json...] [--crate DIR] [--templates DIR] [--out DIR] [--crate-name NAME] [--standalone] [--check]"
+            "usage: toolconf-render [IR.json...] [--crate DIR] [--templates DIR] [--out DIR] [--crate-name NAME] [--standalone] [--check]\n       toolconf-render --check-crate-out OUT --repository DIR [--input LABEL PATH]...\n       toolconf-render --install-crate STAGING --out OUT --repository DIR [--input LABEL PATH]..."
         );
         return ExitCode::from(2);
     }
-    let a = parse(&args);
+    if let Some(rule) = &a.crate_rule {
+        return run_crate_rule(&a, rule);
+    }
     match run(&a) {
         Ok(problems) if problems.is_empty() => {
             if a.check {
@@ -118,5 +211,30 @@ fn main() -> ExitCode {
             eprintln!("toolconf-render: {e}");
             ExitCode::FAILURE
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args(words: &[&str]) -> Result<Args, String> {
+        parse(&words.iter().map(|w| w.to_string()).collect::<Vec<_>>())
+    }
+
+    #[test]
+    fn the_folder_rules_flags_need_their_values() {
+        let a = args(&["--check-crate-out", "/o", "--input", "TASKS=t", "/t"]).unwrap();
+        assert!(matches!(&a.crate_rule, Some(CrateRule::Check(out)) if out == Path::new("/o")));
+        assert_eq!(a.inputs, [("TASKS=t".to_string(), PathBuf::from("/t"))]);
+        assert!(a.irs.is_empty());
+        let e = args(&["--check-crate-out", "/o", "--input", "TASKS=t"]).err();
+        assert_eq!(e.as_deref(), Some("--input LABEL needs a value"));
+        let e = args(&["--repository"]).err();
+        assert_eq!(e.as_deref(), Some("--repository needs a value"));
+        // Without --out, the install would aim at generated/: refused.
+        let e = args(&["--install-crate", "/s"]).err();
+        assert_eq!(e.as_deref(), Some("--install-crate needs --out OUT"));
+        assert!(args(&["--install-crate", "/s", "--out", "/o"]).is_ok());
     }
 }

@@ -14,17 +14,17 @@
 //! * a folder: refused, as "is a folder, not a file".
 //!
 //! The temporary file is removed on every failure path, and on SIGINT, SIGTERM or SIGHUP where
-//! the command line asked for it ([`super::partial::remove_on_interrupt`]); only a process
+//! the command line asked for it ([`crate::partial::remove_on_interrupt`]); only a process
 //! killed outright (SIGKILL) can leave one, named `.NAME.*.partial` beside the target.
 //! [`check_file`] and [`check_folder`] tell the command line, before any work, whether a path can
 //! be written at all, so that a bad path is bad input (status 2), not a failed run; which outputs
-//! clash with each other or with an input is [`super::run_files`]'s.
+//! clash with each other or with an input is [`crate::run_files`]'s.
 
 use std::fs::{self, File, OpenOptions, Permissions};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
-use super::partial::Partial;
+use crate::partial::Partial;
 
 /// How a path is to be written.
 #[derive(Debug)]

@@ -10,7 +10,7 @@
 use std::fs;
 use std::path::{Component, Path, PathBuf};
 
-use super::file::{check_file, check_folder, names_a_descriptor};
+use crate::file::{check_file, check_folder, names_a_descriptor};
 
 /// What tells two paths apart.
 #[derive(Debug, PartialEq, Eq)]
@@ -35,7 +35,7 @@ fn inode(_: &fs::Metadata) -> Identity {
 }
 
 /// `path` with its longest existing ancestor canonicalised and the rest appended.
-fn resolved(path: &Path) -> PathBuf {
+pub(crate) fn resolved(path: &Path) -> PathBuf {
     let mut rest = Vec::new();
     let mut head = path;
     loop {

@@ -50,7 +50,7 @@ impl Partial {
             use std::os::unix::fs::PermissionsExt;
             builder.permissions(Permissions::from_mode(0o666));
         }
-        let folder = super::file::parent(target);
+        let folder = crate::file::parent(target);
         // Listed before the lock is let go, so that no signal can come between.
         let mut live = live();
         let file = builder.tempfile_in(folder)?;

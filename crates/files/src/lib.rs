@@ -1,12 +1,17 @@
-//! Result files, one rule for the command line, the experiments and the reports: whole files
-//! written atomically ([`write_atomically`]) and CSV rows appended as they are computed
-//! ([`csv::CsvWriter`]), both through a temporary file renamed over the target only when whole,
-//! and only over a new path or a regular file ([`file`]); no output that is an input or another
-//! output of the same run ([`run_files`]); an interrupted run keeps the old files
-//! ([`partial`]).
+//! Result files, one rule for the command line, the experiments, the reports and `make crate`:
+//! whole files written atomically ([`write_atomically`]) and CSV rows appended as they are
+//! computed ([`csv::CsvWriter`]), both through a temporary file renamed over the target only when
+//! whole, and only over a new path or a regular file ([`file`]); no output that is an input or
+//! another output of the same run ([`run_files`]); an interrupted run keeps the old files
+//! ([`partial`]); a generated folder replaced only while it holds only what was written into it
+//! ([`folder`]).
+//!
+//! The lowest layer for file output, on no other toolconf crate: the runtime re-exports it as
+//! `toolconf::output`, and the renderer (`derive/render`, which `make crate` runs) uses it too.
 
 pub mod csv;
 pub mod file;
+pub mod folder;
 pub mod partial;
 pub mod run_files;
 

@@ -1,5 +1,5 @@
 //! CSV rows written as they are computed: the header and each row are one `write_all` on an
-//! unbuffered file, the temporary beside the target ([`super::file::create_streaming`]), renamed
+//! unbuffered file, the temporary beside the target ([`crate::file::create_streaming`]), renamed
 //! over it at [`CsvWriter::finish`]: an interrupted or failed run keeps the file that was there.
 //!
 //! Numbers are written exactly (Rust's shortest round-trip form, in exponent notation outside
@@ -10,8 +10,8 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use super::file::Streaming;
-use super::WriteError;
+use crate::file::Streaming;
+use crate::WriteError;
 
 /// One cell of a row.
 #[derive(Debug, Clone, PartialEq)]
@@ -108,7 +108,7 @@ pub struct CsvWriter {
 impl CsvWriter {
     /// Starts the file at `path` (its temporary, for a new or regular file) with the header.
     pub fn create(path: &Path, header: &[&str]) -> Result<Self, WriteError> {
-        let file = super::file::create_streaming(path).map_err(WriteError::at(path))?;
+        let file = crate::file::create_streaming(path).map_err(WriteError::at(path))?;
         let mut writer = Self {
             file,
             path: path.to_path_buf(),
