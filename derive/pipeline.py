@@ -22,15 +22,23 @@ import os
 import subprocess
 import sys
 import tempfile
+import time
 import tomllib
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "derive"))
+from toolconf_derive.description import load_model, load_tasks  # noqa: E402
+from toolconf_derive.errors import DescriptionError  # noqa: E402
+from toolconf_derive.reference import description_reference  # noqa: E402
+
 MODELS = ROOT / "derive" / "models"
 GENERATED = ROOT / "generated"
 FIXTURES = ROOT / "tests" / "fixtures"
+# The description file's reference, written from the reader's key tables (reference.py).
+REFERENCE = ROOT / "docs" / "description.md"
 # The renderer's fixture: a small model with few vectors, pinned by tests/render_snapshot.rs.
 FIXTURE_MODELS = [("pendulum", 3)]
 # glibc's x86 features whose ifunc variants (libm's sin, cos, exp, log, pow...) depend on them.
@@ -83,10 +91,36 @@ def _cost(model: Path) -> int:
         return int(tomllib.load(f).get("model", {}).get("dof", 1))
 
 
+def validate_all(runs: list[Run]) -> None:
+    """Reads and checks every description and the task file before anything is derived, so a
+    mistake in one is reported at once, with every other mistake, not after the others' minutes
+    of derivation (the checks of description.py; what only the derivation can find, such as an
+    equilibrium residual, is reported as soon as that model's derivation stops)."""
+    problems = []
+    try:
+        load_tasks(ROOT / "derive" / "tasks.toml")
+    except DescriptionError as err:
+        problems.append(str(err))
+    for model in sorted({job[0] for run in runs for job in run.jobs()}):
+        try:
+            load_model(model)
+        except DescriptionError as err:
+            problems.append(str(err))
+    for p in problems:
+        print(f"error: {p}", file=sys.stderr)
+    if problems:
+        print(f"pipeline: {len(problems)} description(s) refused; nothing was derived", file=sys.stderr)
+        raise SystemExit(2)
+
+
 def derive_all(runs: list[Run]) -> None:
     """Runs derive.py for every model of every run (as many at once as there are cores, largest
-    models first), then the renderer for each run's generated/."""
+    models first), then the renderer for each run's generated/. Each model is reported as it
+    finishes; the first failure is shown at once and the derivations not yet started are
+    cancelled."""
+    validate_all(runs)
     jobs = sorted(((run, *job) for run in runs for job in run.jobs()), key=lambda j: -_cost(j[1]))
+    start = time.monotonic()
 
     def derive(job):
         run, model, out, vectors = job
@@ -94,12 +128,25 @@ def derive_all(runs: list[Run]) -> None:
                "--out", str(out), "--vectors", str(vectors)]
         return subprocess.run(cmd, cwd=ROOT, env=run.env, capture_output=True, text=True)
 
+    failed = False
     with ThreadPoolExecutor(max_workers=max(1, min(len(jobs), os.cpu_count() or 1))) as pool:
-        results = list(pool.map(derive, jobs))
-    for r in results:
-        sys.stdout.write(r.stdout)
-        sys.stderr.write(r.stderr)
-    if any(r.returncode for r in results):
+        futures = {pool.submit(derive, job): job for job in jobs}
+        done = 0
+        for future in as_completed(futures):
+            if future.cancelled():
+                continue
+            done += 1
+            r, model = future.result(), futures[future][1]
+            sys.stdout.write(r.stdout)
+            sys.stderr.write(r.stderr)
+            state = "failed" if r.returncode else "derived"
+            print(f"pipeline: {state} {model.stem} ({done}/{len(jobs)}, {time.monotonic() - start:.0f} s)",
+                  file=sys.stderr, flush=True)
+            if r.returncode and not failed:
+                failed = True
+                for f in futures:
+                    f.cancel()
+    if failed:
         raise SystemExit(1)
     for run in runs:
         irs = [str(out) for _, out, _ in run.model_jobs()]
@@ -150,8 +197,11 @@ def main() -> int:
     args = ap.parse_args()
     env = dict(os.environ)
     env.setdefault("PYTHONHASHSEED", "0")
+    reference = description_reference().encode()
     if not args.check:
         derive_all([Run(env, GENERATED, FIXTURES)])
+        if not REFERENCE.exists() or REFERENCE.read_bytes() != reference:
+            REFERENCE.write_bytes(reference)
         return 0
     checks = [("drift check", env)]
     if args.portability:
@@ -167,6 +217,10 @@ def main() -> int:
         failed = False
         for (what, _), run in zip(checks, runs):
             problems = compare(run.generated, GENERATED, True) + compare(run.fixtures, FIXTURES, False)
+            if not REFERENCE.exists():
+                problems.append(f"{REFERENCE.relative_to(ROOT)}: missing")
+            elif REFERENCE.read_bytes() != reference:
+                problems.append(f"{REFERENCE.relative_to(ROOT)}: {first_difference(REFERENCE.read_bytes(), reference)}")
             if problems:
                 failed = True
                 print(f"{what}: the committed generated files are not what make derive produces:", file=sys.stderr)

@@ -21,7 +21,7 @@ LEAVES = ("errors", "expression", "quantities")
 # the rows below its own.
 LAYERS = (
     ("urdf_functions",),
-    ("ir", "report", "urdf_model"),
+    ("ir", "report", "urdf_model", "reference"),
     ("functions", "hoist", "sequence"),
     ("symbolic", "numeric", "rigid_body"),
     ("description",),

@@ -104,3 +104,37 @@ class DeriveCommandLine(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class ValidateFirst(unittest.TestCase):
+    """make derive reads every description before it derives any: two broken descriptions are both
+    named, with status 2, and no derivation is started."""
+
+    def test_every_refused_description_is_named_before_any_derivation(self):
+        import contextlib
+        import io
+        with tempfile.TemporaryDirectory() as tmp:
+            models = Path(tmp)
+            good = (ROOT / "derive" / "models" / "arm2.toml").read_text()
+            (models / "a.toml").write_text(good.replace("dof = 2", 'dof = "two"'))
+            (models / "b.toml").write_text(good.replace("[equilibrium]", "[equilibrium]\nspeed = 1"))
+            (models / "c.toml").write_text(good)
+            saved, pipeline.MODELS = pipeline.MODELS, models
+            self.addCleanup(setattr, pipeline, "MODELS", saved)
+            started = []
+            run = pipeline.Run({}, models / "generated", models / "fixtures")
+            err = io.StringIO()
+            with contextlib.redirect_stderr(err), self.assertRaises(SystemExit) as caught:
+                original = pipeline.subprocess.run
+                pipeline.subprocess.run = lambda *a, **k: started.append(a)
+                try:
+                    pipeline.derive_all([run])
+                finally:
+                    pipeline.subprocess.run = original
+        self.assertEqual(caught.exception.code, 2)
+        self.assertEqual(started, [])
+        text = err.getvalue()
+        self.assertIn("a.toml: model.dof", text)
+        self.assertIn("b.toml: equilibrium", text)
+        self.assertNotIn("c.toml", text)
+        self.assertIn("2 description(s) refused; nothing was derived", text)

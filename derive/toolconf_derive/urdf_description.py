@@ -45,7 +45,12 @@ def urdf_names(path: Path, top: Table):
     for i, g in enumerate(urdf.get("gravity")):
         if abs(g) > MAX_GRAVITY:
             raise DescriptionError(path, f"urdf.gravity[{i}]", f"{g!r} is outside [-{MAX_GRAVITY:g}, {MAX_GRAVITY:g}] m/s^2")
-    chain = read_chain(Path(os.path.normpath(path.parent / urdf.get("file"))), urdf.get("base"), urdf.get("flange"))
+    file = Path(os.path.normpath(path.parent / urdf.get("file")))
+    if not os.path.lexists(file):
+        # The reader would name only the URDF; the user needs the key and the rule for its path.
+        raise DescriptionError(path, "urdf.file", f"{urdf.get('file')!r}: no such file {str(file)!r} (urdf.file is "
+                                                  "relative to the folder of the description)")
+    chain = read_chain(file, urdf.get("base"), urdf.get("flange"))
     dof = top.raw["model"]["dof"]
     if dof != chain.dof:
         raise DescriptionError(path, "model.dof", f"is {dof}, the chain from '{chain.base}' to '{chain.flange}' "

@@ -1,0 +1,153 @@
+"""docs/description.md, the reference of the model description file, written from the key tables
+the reader enforces (description.py's TOP_KEYS and MODEL_KEYS, urdf_description.py's URDF_KEYS):
+which keys each table has, their type and whether they are required come from the same tuples that
+refuse a misspelt key, so the reference cannot list a key the reader does not know, or miss one.
+What a key means and its default are written here, once; `undocumented` names a key the tables
+have and MEANING lacks, and the test (derive/tests/test_reference.py) fails on it and on a stale
+docs/description.md. `make derive` rewrites the file.
+"""
+
+from __future__ import annotations
+
+from .description import MODEL_KEYS, NAMED, TOP_KEYS
+from .urdf_description import COM_BOUND, SAMPLE, URDF_KEYS
+
+_NAMED = {
+    "name": (None, "identifier (letters, digits, `_`; not a Rust or Python keyword): the tools-file column, "
+                   "the Python dict key, the name in every message"),
+    "latex": ("the name", "how the report typesets it"),
+    "unit": ('""', "SI unit, shown in reports and docs"),
+    "doc": ('""', "one line, in the generated docs"),
+}
+
+# (table as the reader names it, its keys, where it applies, what it is).
+SECTIONS = (
+    ("(top level)", TOP_KEYS, "every model", "The tables of a description file."),
+    ("model", MODEL_KEYS["model"], "every model", "The model's identity."),
+    ("parameters", NAMED, "kinds `explicit`, `planar_chain`",
+     "`[[parameters]]`, one table per tool parameter, in the order the runtime passes them (a tools "
+     "file's columns). Every parameter's domain is > 0. A `urdf` model has none: its tool's parameters "
+     "are fixed (`tool_mass`, `tool_com_x`, `tool_com_y`, `tool_com_z`, `tool_ixx`, `tool_iyy`, "
+     "`tool_izz`)."),
+    ("constants.NAME", MODEL_KEYS["constant"], "kinds `explicit`, `planar_chain`",
+     "`[constants]` holds one table per constant, e.g. `g = { value = 9.81, unit = \"m/s^2\" }`; the "
+     "expressions may use its name."),
+    ("coordinates", MODEL_KEYS["coordinates"], "kinds `explicit`, `planar_chain`",
+     "The generalised coordinates q, their rates and the controls, each a list of `model.dof` tables "
+     "with the keys of `coordinates.q[i]`. A `urdf` model takes them from the URDF's joint names "
+     "(`<joint>`, `<joint>_dot`, `<joint>_torque`)."),
+    ("coordinates.q[i]", NAMED, "each entry of `q`, `q_dot` and `u`", "One coordinate."),
+    ("dynamics", MODEL_KEYS["dynamics"], "every model", "The equations of motion."),
+    ("dynamics.links[i]", MODEL_KEYS["link"], "kind `planar_chain`", "One uniform rod of the chain."),
+    ("equilibrium", MODEL_KEYS["equilibrium"], "every model",
+     "The equilibrium (X^e, U^e) the model is linearised about (eq. LTI), checked before anything is "
+     "derived: f(X^e, U^e) = 0 (exactly for the symbolic kinds, to the rounding of the graphs' constants "
+     "for `urdf`). Each entry is an expression (`pi`, `sqrt`, numbers)."),
+    ("printed", MODEL_KEYS["printed"], "optional",
+     "A paper's printed A and B (expressions over the parameters), compared entry by entry with the "
+     "derived ones in the model's report."),
+    ("urdf", URDF_KEYS["urdf"], "kind `urdf` (required)", "The robot and its chain."),
+    ("impedance", URDF_KEYS["impedance"], "kind `urdf` (required)",
+     "The joint impedance of the plant tau = U + K (q^e - q) - D q_dot + g(q^e) (docs/urdf.md): K and "
+     "D per joint, each in [0, 1e6]. Every confidence depends on them; docs/urdf.md says how to choose "
+     "them."),
+    ("tool", URDF_KEYS["tool"], "kind `urdf`", "Which tools are valid, and where random tools come from."),
+)
+
+_SAMPLE = ", ".join(f"`{k}` [{lo:g}, {hi:g}]" for k, (lo, hi) in SAMPLE.items())
+
+# (table, key) -> (default or None for required, meaning). Types and requiredness are the tables'.
+MEANING = {
+    ("(top level)", "model"): (None, "`[model]`"),
+    ("(top level)", "parameters"): ("none", "`[[parameters]]`: required for kinds `explicit`, `planar_chain`; "
+                                            "refused for `urdf`"),
+    ("(top level)", "constants"): ("none", "`[constants]`"),
+    ("(top level)", "coordinates"): ("none", "`[coordinates]`: required for kinds `explicit`, `planar_chain`; "
+                                             "refused for `urdf`"),
+    ("(top level)", "dynamics"): (None, "`[dynamics]`"),
+    ("(top level)", "equilibrium"): (None, "`[equilibrium]`"),
+    ("(top level)", "goals"): ("zero goals", "`[goals.<task>]`, one table per task of derive/tasks.toml "
+                                             "(`position`, `velocity`, `acceleration`), each key a term "
+                                             "(`theta`, `theta_dot`, `theta_ddot`) with `model.dof` "
+                                             "expressions: the default goal of that task; a term it omits "
+                                             "has goal 0"),
+    ("(top level)", "printed"): ("none", "`[printed]`"),
+    ("(top level)", "urdf"): ("none", "`[urdf]`: required for kind `urdf`, refused otherwise"),
+    ("(top level)", "impedance"): ("none", "`[impedance]`: required for kind `urdf`, refused otherwise"),
+    ("(top level)", "tool"): ("the defaults below", "`[tool]`: kind `urdf` only"),
+    ("model", "name"): (None, "identifier of the model: `--model NAME`, the generated module and file names"),
+    ("model", "title"): ('""', "one line for reports and `toolconf models`"),
+    ("model", "source"): ('""', "where the equations come from"),
+    ("model", "dof"): (None, "number of joints n (for `urdf`, checked against the chain)"),
+    **{("parameters", k): v for k, v in _NAMED.items()},
+    **{("coordinates.q[i]", k): v for k, v in _NAMED.items()},
+    ("constants.NAME", "value"): (None, "the number"),
+    ("constants.NAME", "latex"): ("the name", "how the report typesets it"),
+    ("constants.NAME", "unit"): ('""', "SI unit"),
+    ("constants.NAME", "doc"): ('""', "one line"),
+    ("coordinates", "q"): (None, "the joint coordinates"),
+    ("coordinates", "q_dot"): (None, "their rates, in the same order"),
+    ("coordinates", "u"): (None, "the joint torques (or forces)"),
+    ("dynamics", "kind"): (None, "`explicit` (q_ddot written out), `planar_chain` (derived by Lagrange from "
+                                 "`links`) or `urdf` (derived from `[urdf]` by RNEA/CRBA)"),
+    ("dynamics", "equations"): ("[]", "the equations' names in their source, for the docs"),
+    ("dynamics", "q_ddot"): ("none", "kind `explicit`: `model.dof` expressions of q, q_dot, u, the parameters "
+                                     "and constants (`sin`, `cos`, `sqrt`, `pi`); parsed, never evaluated"),
+    ("dynamics", "links"): ("none", "kind `planar_chain`: `model.dof` tables `{ mass, length }`"),
+    ("dynamics", "gravity"): ('"g"', "kind `planar_chain`: the constant that is the gravitational acceleration"),
+    ("dynamics", "payload"): ("none", "kind `planar_chain`: a parameter that is a point mass held at the tip"),
+    ("dynamics.links[i]", "mass"): (None, "the parameter that is the rod's mass"),
+    ("dynamics.links[i]", "length"): (None, "the parameter that is the rod's length"),
+    ("equilibrium", "q"): (None, "q^e, `model.dof` expressions; for `urdf`, within each joint's URDF limits"),
+    ("equilibrium", "q_dot"): (None, "q_dot^e, `model.dof` expressions (zero at a rest equilibrium)"),
+    ("equilibrium", "u"): (None, "U^e, `model.dof` expressions (zero for `urdf`: gravity is fed forward)"),
+    ("printed", "where"): ('""', "where in the paper they are printed"),
+    ("printed", "A"): ("none", "2n x 2n expressions"),
+    ("printed", "B"): ("none", "2n x n expressions"),
+    ("urdf", "file"): (None, "the URDF, **relative to the folder of this description file** (the one rule: "
+                             "`make derive`, `make crate` and derive/derive.py resolve it the same way); read "
+                             "as docs/urdf.md, \"How a URDF is read\", says"),
+    ("urdf", "base"): (None, "the link the chain starts from (fixed to the world)"),
+    ("urdf", "flange"): (None, "the link the tool is fixed to; links beyond it are not read"),
+    ("urdf", "gravity"): (None, "3 numbers, m/s^2 in the base frame, each within +-1e3"),
+    ("urdf", "source"): ('""', "where the URDF comes from"),
+    ("impedance", "stiffness"): (None, "K, one per joint, N m/rad (N/m for a prismatic joint)"),
+    ("impedance", "damping"): (None, "D, one per joint, N m s/rad"),
+    ("impedance", "source"): ('""', "where the gains come from"),
+    ("tool", "com_bound"): (f"{COM_BOUND:g}", "m: a valid tool's centre of mass lies within it of the flange "
+                                              "along each flange axis; in (0, 1e6]"),
+    ("tool", "sample"): (_SAMPLE, "`[tool.sample]`: per tool parameter, the box `[lo, hi]` random tools are drawn "
+                                  "from (`select --models`, design's random baseline); within the parameter's "
+                                  "domain, its centre a valid tool"),
+    ("tool", "source"): ('""', "where the tool rule comes from (a datasheet's payload)"),
+}
+
+
+def undocumented() -> list[str]:
+    """Keys the reader knows that MEANING lacks, and MEANING's keys the reader does not know."""
+    known = {(table, key) for table, keys, _, _ in SECTIONS for key, _, _ in keys}
+    return ([f"{t}.{k}: not documented" for t, k in sorted(known - MEANING.keys())]
+            + [f"{t}.{k}: documented, but not a key" for t, k in sorted(MEANING.keys() - known)])
+
+
+def description_reference() -> str:
+    lines = ["# The model description file: reference",
+             "",
+             "<!-- Written by derive/toolconf_derive/reference.py from the tables the reader enforces; "
+             "`make derive` rewrites it, derive/tests/test_reference.py fails when it is stale. -->",
+             "",
+             "A model is one TOML file (`derive/models/*.toml`; `make crate MODELS=<folder>` for your own). "
+             "Every table refuses a key it does not list here, naming the file and the key; every "
+             "expression is parsed (numbers, names, `+ - * / **`, `sin`, `cos`, `sqrt`, `pi`), never "
+             "evaluated. \"required\" means the file is refused without it.",
+             ""]
+    for table, keys, applies, what in SECTIONS:
+        lines += [f"## `{table}`" if table != "(top level)" else "## Top level", "",
+                  f"{what} Applies to: {applies}.", "",
+                  "| key | type | required / default | meaning |", "|---|---|---|---|"]
+        for key, kind, required in keys:
+            default, meaning = MEANING[(table, key)]
+            need = "required" if required else f"default: {default}"
+            lines.append(f"| `{key}` | {kind} | {need} | {meaning} |")
+        lines.append("")
+    return "\n".join(lines)
