@@ -137,6 +137,11 @@ def run() -> int:
     except OSError as err:
         print(f"derive: cannot write {err.filename}: {err.strerror}", file=sys.stderr)
         return 1
+    if model.dynamics_kind == "urdf" and model.chain.ignored_dynamics:
+        # urdf.py's rule: the plant's joint damping is the description's [impedance].
+        print(f"derive: {model.chain.path}: note: <dynamics> damping/friction of joints "
+              f"{', '.join(model.chain.ignored_dynamics)} ignored: the plant's joint damping is the "
+              "description's [impedance]", file=sys.stderr)
     checked = sum(len(f["vectors"]) for f in vectors["functions"])
     print(f"derive: {model.name}: {len(ir.functions)} functions, {checked} points checked SymPy = CasADi "
           f"-> {out}, {vectors_out}")

@@ -9,6 +9,11 @@ three independent sources.
   tensors, a tool) built from the raw URDF numbers, not from urdf.py, agrees to 1e-10.
 - (c) Pinocchio's crba, rnea and aba agree on the Panda and the UR5 with random tools at 100
   random states each, and so does the generated plant `dynamics` (aba with the impedance torque).
+- (d) How a URDF is read (urdf.py's rule): an xArm7-style chain (its quarter turns written
+  1.5708) derives and matches Pinocchio on the literal file; Kinova-style 1.57079632679 are exact
+  quarter turns; a rotation that is not orthonormal, an equilibrium outside the joint limits and a
+  moving side branch are refused naming the file, the joint and the value; <dynamics> is noted
+  as ignored; an equilibrium failure names the joints and the likely cause.
 
     derive/.venv/bin/python -m unittest discover -s derive/tests      (part of make test)
 """
@@ -16,6 +21,7 @@ three independent sources.
 from __future__ import annotations
 
 import math
+import re
 import subprocess
 import sys
 import tempfile
@@ -125,7 +131,13 @@ class Refusals(unittest.TestCase):
 
     def test_branch(self):
         urdf = _robot(*GOOD, _link("side", _inertial(0.2)), _joint("jside", "revolute", "a", "side"))
-        self.stops(urdf, "joint 'jside'", "branches off the chain at link 'a'")
+        self.stops(urdf, "joint 'jside'", "(revolute) is a moving side branch at link 'a'")
+        # Off the base too: it would be a degree of freedom the chain does not have.
+        urdf = _robot(*GOOD, _link("side", _inertial(0.2)), _joint("jside", "prismatic", "base", "side"))
+        self.stops(urdf, "joint 'jside'", "(prismatic) is a moving side branch at link 'base'")
+        # Beyond the flange everything is dropped, moving or not (the tool replaces the hand).
+        beyond = _robot(*GOOD, _link("finger", _inertial(0.2)), _joint("jf", "revolute", "flange", "finger"))
+        self.assertEqual(self.chain(beyond).dof, 2)
 
     def test_fixed_side_links_merge_but_a_fixed_side_link_with_a_moving_child_is_a_branch(self):
         merged = _robot(*GOOD, _link("cam", _inertial(0.2, (0.05, 0.0, 0.0))), _joint("jcam", "fixed", "a", "cam"))
@@ -133,7 +145,7 @@ class Refusals(unittest.TestCase):
         self.assertAlmostEqual(chain.bodies[0].mass, 1.2)
         deeper = _robot(*GOOD, _link("cam"), _joint("jcam", "fixed", "a", "cam"), _link("lens", _inertial(0.1)),
                         _joint("jlens", "prismatic", "cam", "lens"))
-        self.stops(deeper, "joint 'jlens'", "branches off the chain at link 'cam'")
+        self.stops(deeper, "joint 'jlens'", "is a moving side branch at link 'cam'")
 
     def chain(self, urdf: str):
         tmp = Path(self.enterContext(tempfile.TemporaryDirectory()))
@@ -391,9 +403,9 @@ def _quarter_turn(angle: float) -> float:
     return k * (math.pi / 2) if abs(angle - k * (math.pi / 2)) < 1e-9 else angle
 
 
-class Pinocchio(unittest.TestCase):
-    """(c) Pinocchio (pin, derive/requirements.txt) on the same URDF cut at the flange, the tool
-    added as a fixed link."""
+class PinocchioCheck:
+    """Pinocchio (pin, derive/requirements.txt) on a model's URDF cut at the flange, the tool
+    added as a fixed link: crba, rnea, aba and the generated plant at random tools and states."""
 
     def pinocchio_model(self, model, tool):
         import pinocchio as pin
@@ -404,9 +416,9 @@ class Pinocchio(unittest.TestCase):
                 name = e.get("name") if tag == "link" else e.find("child").get("link")
                 if name not in keep:
                     root.remove(e)
-        # The reader takes rotation entries within 1e-9 of 0 or +-1 as exact (urdf.py): give
-        # Pinocchio the same angles, each within 1e-9 of a multiple of pi/2 written as the double
-        # nearest it (UR5's 1.57079632679 otherwise makes a robot 5e-12 rad away, 8e-11 apart).
+        # The reader takes rpy angles within 1e-9 of a multiple of pi/2 as that multiple (urdf.py):
+        # give Pinocchio the same angles, written as the double nearest it (UR5's 1.57079632679
+        # otherwise makes a robot 5e-12 rad away, 8e-11 apart); other angles stay literal.
         for origin in root.iter("origin"):
             if origin.get("rpy"):
                 origin.set("rpy", " ".join(repr(_quarter_turn(float(v))) for v in origin.get("rpy").split()))
@@ -429,7 +441,7 @@ class Pinocchio(unittest.TestCase):
             stack += children.get(link, [])
         return {l.get("name") for l in root.findall("link")} - below
 
-    def check_robot(self, path: Path):
+    def check_robot(self, path: Path, states: int = 100) -> dict:
         import pinocchio as pin
         model = load_model(path)
         dv = UrdfDerivation(model, model.chain, load_tasks(ROOT / "derive" / "tasks.toml"))
@@ -438,7 +450,7 @@ class Pinocchio(unittest.TestCase):
         plant = ca.Function("f", [dv.x, dv.u, dv.p], [dv.dynamics_with(dv.x, dv.u, dv.coefficients(dv.p))])
         rng = np.random.default_rng(7)
         worst = dict.fromkeys(("crba", "rnea", "aba", "plant"), 0.0)
-        for k in range(100):
+        for k in range(states):
             tool = _sample_tool(rng).ravel()
             pm, data = self.pinocchio_model(model, tool)
             self.assertEqual(pm.nq, n)
@@ -462,8 +474,14 @@ class Pinocchio(unittest.TestCase):
             worst["plant"] = max(worst["plant"], rel(np.array(plant(np.concatenate([q, qd]), u, tool)).ravel(), want))
         for what, err in worst.items():
             self.assertLess(err, TOLERANCE, f"{path.stem} {what}: worst normwise relative difference {err:.2e}")
+        return worst
 
-    # urdfdom (Pinocchio's parser) wants limits on revolute and prismatic joints; toolconf ignores them.
+
+class Pinocchio(PinocchioCheck, unittest.TestCase):
+    """(c) Pinocchio (pin, derive/requirements.txt) on the same URDF cut at the flange, the tool
+    added as a fixed link."""
+
+    # urdfdom (Pinocchio's parser) wants limits on revolute and prismatic joints; toolconf checks q^e against them.
     def test_a_prismatic_joint_and_a_continuous_one(self):
         """A chain the arms do not have: a prismatic joint along a tilted axis between a
         continuous and a revolute joint, with a tool, against crba, rnea and aba."""
@@ -503,6 +521,238 @@ class Pinocchio(unittest.TestCase):
 
     def test_ur5(self):
         self.check_robot(UR5)
+
+
+# UFactory's xArm7 (xarm7.urdf, example-robot-data 6.0.0), its first four joints: origins, axes,
+# limits, <dynamics>, masses, centres of mass and inertias as the file writes them, its quarter
+# turns 1.5708 (3.7e-6 rad from pi/2: a different angle, which Pinocchio and the reader use as
+# written). (joint, origin xyz, rpy, lower, upper, damping, link mass, com, (ixx iyy izz), (ixy ixz iyz)).
+XARM = [
+    ("joint1", "0 0 0.267", "0 0 0", -6.283185307179586, 6.283185307179586, 10, 2.382, (-0.0002, 0.02905, -0.01233),
+     (0.0056905, 0.0049566, 0.003316654), (-1.579e-05, 5.125e-06, -0.000873378)),
+    ("joint2", "0 0 0", "-1.5708 0 0", -2.059, 2.0944, 10, 1.869, (0.00022, -0.12856, 0.01735),
+     (0.0095989, 0.00382472, 0.007565669), (1.541e-06, 5.56e-06, -0.00317156)),
+    ("joint3", "0 -0.293 0", "1.5708 0 0", -6.283185307179586, 6.283185307179586, 5, 1.6383, (0.0466, -0.02463, -0.00768),
+     (0.00310955, 0.00264483, 0.0026624), (0.00030837, -0.00058453, 0.000338893)),
+    ("joint4", "0.0525 0 0", "1.5708 0 0", -0.19198, 3.927, 5, 1.7269, (0.07047, -0.11575, 0.012),
+     (0.005889, 0.00359703, 0.00543244), (0.00137112, 0.00088143, -0.001762155)),
+]
+XARM_MODEL = """
+[model]
+name = "xarm"
+dof = 4
+[dynamics]
+kind = "urdf"
+[urdf]
+file = "xarm.urdf"
+base = "link_base"
+flange = "link_eef"
+gravity = [0.0, 0.0, -9.81]
+[impedance]
+stiffness = [50.0, 50.0, 50.0, 50.0]
+damping = [5.0, 5.0, 5.0, 5.0]
+[equilibrium]
+q = ["0", "{q2}", "0", "1.0"]
+q_dot = ["0", "0", "0", "0"]
+u = ["0", "0", "0", "0"]
+"""
+
+
+def _xarm_urdf() -> str:
+    parts = [_link("link_base", _inertial(0.88556, (-0.021131, -0.0016302, 0.056488), (0.0030595, 0.0037783, 0.0020125),
+                                           products=(0.00012259, -0.00062705, 0.00027023)))]
+    parent = "link_base"
+    for i, (name, xyz, rpy, lower, upper, damping, m, com, moments, products) in enumerate(XARM):
+        child = f"link{i + 1}"
+        parts.append(_link(child, _inertial(m, com, moments, products=products)))
+        parts.append(_joint(name, "revolute", parent, child, xyz, rpy, extra=(
+            f'<limit effort="50" lower="{lower!r}" upper="{upper!r}" velocity="3.14"/>'
+            f'<dynamics damping="{damping}" friction="1"/>')))
+        parent = child
+    parts += [_link("link_eef"), _joint("joint_eef", "fixed", parent, "link_eef", "0.0775 -0.3425 0", "1.5708 0 0")]
+    return _robot(*parts)
+
+
+# The Kinova Gen2 (kinova.urdf, example-robot-data 6.0.0) writes pi/2 and pi as 1.57079632679 and
+# 3.14159265359 (5e-12 and 3.6e-12 off: quarter turns), alone, together, and beside a generic
+# angle (its fingers: -1.570796327, 2e-10 off); the fingers hang beside the flange.
+KINOVA = [
+    ("j1", "0 0 0.15675", "0 3.14159265359 0"),
+    ("j2", "0 0.0016 -0.11875", "-1.57079632679 0 3.14159265359"),
+    ("j3", "0 -0.410 0", "1.57079632679 0.649262481663582 0.3"),
+]
+KINOVA_FINGER = "-1.570796327 .649262481663582 1.57079632679490"
+
+
+def _kinova_urdf(finger: str = "fixed") -> str:
+    parts = [_link("base")]
+    parent = "base"
+    for i, (name, xyz, rpy) in enumerate(KINOVA):
+        child = f"l{i + 1}"
+        parts.append(_link(child, _inertial(0.6 + 0.1 * i, (0.01, -0.02 * i, 0.05), (0.004, 0.003 + 0.001 * i, 0.002),
+                                            rpy="0 1.57079632679 0", products=(0.0001, 0.0, -0.0002))))
+        parts.append(_joint(name, "revolute", parent, child, xyz, rpy, axis="0 0 1", extra=LIMIT))
+        parent = child
+    parts += [_link("flange"), _joint("end_effector", "fixed", parent, "flange", "0 0 -0.16",
+                                      "3.14159265359 1.57079632679 0"),
+              _link("finger_1", _inertial(0.01, (0.022, 0.0, 0.0), (1e-6, 1e-6, 1e-6))),
+              _joint("finger_joint_1", finger, parent, "finger_1", "-0.0025 0.03095 -0.11482", KINOVA_FINGER,
+                     extra=LIMIT)]
+    return _robot(*parts)
+
+
+def _entry_snapped_rotation(rpy):
+    """The reader's former rule (the bug): each rotation entry within 1e-9 of 0 or +-1 snapped."""
+    import mpmath
+    r, p, y = rpy
+    cr, sr, cp, sp, cy, sy = (mpmath.cos(r), mpmath.sin(r), mpmath.cos(p), mpmath.sin(p), mpmath.cos(y), mpmath.sin(y))
+    m = mpmath.matrix([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+                       [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr], [-sp, cp * sr, cp * cr]])
+
+    def snap(x):
+        return next((mpmath.mpf(t) for t in (0, 1, -1) if abs(x - t) < mpmath.mpf("1e-9")), x)
+    return mpmath.matrix([[snap(m[i, j]) for j in range(3)] for i in range(3)])
+
+
+def _orthonormality(rotation) -> float:
+    r = np.array(rotation, dtype=float)
+    return float(np.max(np.abs(r.T @ r - np.eye(3))))
+
+
+class HowAUrdfIsRead(PinocchioCheck, unittest.TestCase):
+    """(d) urdf.py's rule ("How a URDF is read", docs/urdf.md): angles snapped to quarter turns
+    within 1e-9 rad and otherwise literal, as Pinocchio reads them; joint limits, <dynamics> and
+    side branches."""
+
+    def files(self, urdf: str, name: str, model: str | None = None) -> tuple[Path, Path | None]:
+        tmp = Path(self.enterContext(tempfile.TemporaryDirectory()))
+        (tmp / name).write_text(urdf)
+        if model is not None:
+            (tmp / "xarm.toml").write_text(model)
+        return tmp / name, (tmp / "xarm.toml" if model is not None else None)
+
+    def derive(self, model: Path) -> subprocess.CompletedProcess:
+        return subprocess.run([sys.executable, str(DERIVE), str(model), "--out", str(model.with_suffix(".json")),
+                               "--vectors", "1"], capture_output=True, text=True)
+
+    def test_xarm7_style_angles_are_literal_and_match_pinocchio_on_the_file(self):
+        import pinocchio as pin
+        urdf, _ = self.files(_xarm_urdf(), "xarm.urdf")
+        chain = read_chain(urdf, "link_base", "link_eef")
+        # 1.5708 is no quarter turn: its cosine is kept, and the rotation stays one.
+        c, s = math.cos(1.5708), math.sin(1.5708)
+        self.assertEqual(chain.bodies[2].rotation, ((1.0, 0.0, 0.0), (0.0, c, -s), (0.0, s, c)))
+        for b in chain.bodies:
+            self.assertLess(_orthonormality(b.rotation), 1e-15, b.joint)
+        fd, crba, bias = _raw_dynamics(ChainDynamics(chain, [0.0, 0.0, -9.81]))
+        pm = pin.buildModelFromUrdf(str(urdf))      # the literal file
+        data = pm.createData()
+        self.assertEqual(pm.nq, 4)
+        rng = np.random.default_rng(31)
+        worst = 0.0
+        for _ in range(100):
+            q, qd, tau = rng.uniform(-math.pi, math.pi, 4), rng.uniform(-3, 3, 4), rng.uniform(-20, 20, 4)
+            m_pin = pin.crba(pm, data, q)
+            m_pin = np.triu(m_pin) + np.triu(m_pin, 1).T
+            zero = np.zeros(7)
+            for got, want in ((crba(q, zero), m_pin), (bias(q, qd, zero), pin.rnea(pm, data, q, qd, np.zeros(4))),
+                              (fd(q, qd, tau, zero), pin.aba(pm, data, q, qd, tau))):
+                got = np.array(got, dtype=float).reshape(np.shape(want))
+                worst = max(worst, float(np.max(np.abs(got - want)) / np.max(np.abs(want))))
+        self.assertLess(worst, TOLERANCE, f"worst normwise relative difference {worst:.2e}")
+
+    def test_xarm7_style_chain_derives_and_its_plant_matches_pinocchio(self):
+        urdf, model = self.files(_xarm_urdf(), "xarm.urdf", XARM_MODEL.format(q2="0.3"))
+        r = self.derive(model)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        # The URDF's <dynamics> are not the plant's damping: said once, on stderr.
+        self.assertEqual(r.stderr.splitlines(), [
+            f"derive: {urdf}: note: <dynamics> damping/friction of joints joint1, joint2, joint3, joint4 ignored: "
+            "the plant's joint damping is the description's [impedance]"])
+        self.check_robot(model, states=20)
+
+    def test_kinova_style_quarter_turns_are_exact(self):
+        import pinocchio as pin
+        urdf, _ = self.files(_kinova_urdf(), "kinova.urdf")
+        chain = read_chain(urdf, "base", "flange")
+        # All quarter turns: entries exactly 0 and +-1 (no 1e-12 residues in the generated code).
+        self.assertEqual(chain.bodies[0].rotation, ((-1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, -1.0)))
+        self.assertEqual(chain.bodies[1].rotation, ((-1.0, 0.0, 0.0), (0.0, 0.0, -1.0), (0.0, -1.0, 0.0)))
+        self.assertEqual(chain.flange_rotation, ((0.0, 0.0, -1.0), (0.0, -1.0, 0.0), (-1.0, 0.0, 0.0)))
+        # A quarter turn beside generic angles: still a rotation to the last bit.
+        self.assertLess(_orthonormality(chain.bodies[2].rotation), 1e-15)
+        self.assertEqual(chain.bodies[2].rotation[2][2], 0.0)
+        # The fixed fingers are merged into the last body.
+        self.assertAlmostEqual(chain.bodies[2].mass, 0.81, places=15)
+        root = ET.fromstring(_kinova_urdf())
+        for origin in root.iter("origin"):
+            origin.set("rpy", " ".join(repr(_quarter_turn(float(v))) for v in origin.get("rpy").split()))
+        fd, _, _ = _raw_dynamics(ChainDynamics(chain, [0.0, 0.0, -9.81]))
+        worst = 0.0
+        literal = pin.buildModelFromUrdf(str(urdf))
+        for pm in (pin.buildModelFromXML(ET.tostring(root, encoding="unicode")), literal):
+            data = pm.createData()
+            rng = np.random.default_rng(37)
+            for _ in range(100):
+                q, qd, tau = rng.uniform(-math.pi, math.pi, 3), rng.uniform(-3, 3, 3), rng.uniform(-5, 5, 3)
+                want = pin.aba(pm, data, q, qd, tau)
+                got = np.array(fd(q, qd, tau, np.zeros(7)), dtype=float).ravel()
+                worst = max(worst, float(np.max(np.abs(got - want)) / np.max(np.abs(want))))
+        self.assertLess(worst, TOLERANCE, f"worst normwise relative difference {worst:.2e}")
+
+    def test_a_moving_finger_beside_the_flange_is_refused(self):
+        urdf, _ = self.files(_kinova_urdf("revolute"), "kinova.urdf")
+        with self.assertRaises(DescriptionError) as caught:
+            read_chain(urdf, "base", "flange")
+        self.assertEqual(str(caught.exception).splitlines(), [
+            f"{urdf}: joint 'finger_joint_1': (revolute) is a moving side branch at link 'l3': the branch moves "
+            "and does not hold the flange 'flange'; only fixed side branches are merged into the chain"])
+
+    def test_a_rotation_that_is_not_orthonormal_is_refused(self):
+        # The former entry snapping of 1.5708 (sin -> 1, cos kept at -3.7e-6) is no rotation.
+        from unittest import mock
+        import toolconf_derive.urdf as urdf_module
+        urdf, _ = self.files(_xarm_urdf(), "xarm.urdf")
+        with mock.patch.object(urdf_module, "rpy_rotation", _entry_snapped_rotation):
+            with self.assertRaises(DescriptionError) as caught:
+                read_chain(urdf, "link_base", "link_eef")
+        self.assertEqual(str(caught.exception), f"{urdf}: joint 'joint2' origin rpy: rotation is not orthonormal: "
+                                                "max |R^T R - I| = 1.35e-11 > 1.0e-12")
+
+    def test_an_equilibrium_outside_the_joint_limits_is_refused(self):
+        urdf, model = self.files(_xarm_urdf(), "xarm.urdf", XARM_MODEL.format(q2="2.5"))
+        r = self.derive(model)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertEqual(r.stderr.splitlines(), [
+            f"derive: {model}: equilibrium.q[1]: '2.5' = 2.5 is outside joint 'joint2''s limits [-2.059, 2.0944] "
+            f"({urdf} <limit lower upper>)"])
+        # A continuous joint has no limits; a limit's absent side is no bound.
+        text = _xarm_urdf().replace('lower="-2.059" ', "")
+        urdf, model = self.files(text, "xarm.urdf", XARM_MODEL.format(q2="-2.5"))
+        self.assertEqual(load_model(model).chain.limits[1], (None, 2.0944))
+
+    def test_an_equilibrium_failure_names_the_joints_and_the_cause(self):
+        # With the former entry snapping let through, gravity fed forward by the code (RNEA) and
+        # by the reference (the potential's gradient) disagree at q^e: derivation stops there.
+        from unittest import mock
+        import mpmath
+        import toolconf_derive.urdf as urdf_module
+        from toolconf_derive import ir_types as irt
+        from toolconf_derive.ir import IR_SCHEMA
+        from toolconf_derive.urdf_functions import urdf_documents
+        urdf, model_path = self.files(_xarm_urdf(), "xarm.urdf", XARM_MODEL.format(q2="0.3"))
+        with mock.patch.object(urdf_module, "rpy_rotation", _entry_snapped_rotation), \
+                mock.patch.object(urdf_module, "ORTHONORMAL", mpmath.mpf(1)):
+            model = load_model(model_path)
+        generator = irt.Generator(command="", model="", tasks="", ir="", vectors="", derive="", render="")
+        with self.assertRaises(DescriptionError) as caught:
+            urdf_documents(model, load_tasks(ROOT / "derive" / "tasks.toml"), generator, 1, IR_SCHEMA)
+        message = str(caught.exception)
+        self.assertNotIn("characters)", message)
+        self.assertRegex(message, rf"^{re.escape(str(model_path))}: equilibrium: not an equilibrium: "
+                                  r"\|f\(X\^e, U\^e\)\| = \d\.\d\de-10 > 1e-12, largest at joint 'joint2' \d\.\d\de-10 rad/s\^2, ")
+        self.assertTrue(message.endswith("likely cause: the rotation of joint 'joint2' origin is not orthonormal "
+                                         f"(|R^T R - I| = 1.35e-11) in {urdf.name}"), message)
 
 
 if __name__ == "__main__":

@@ -529,6 +529,8 @@ def _validate_expressions(m: Model) -> None:
                 raise DescriptionError(m.path, f"equilibrium.{label}[{i}]",
                                        f"'{text}' is not 0: a URDF arm's equilibrium is at rest (q_dot = 0) with "
                                        "U = 0, the impedance and gravity feed-forward holding it")
+            if m.dynamics_kind == "urdf" and label == "q":
+                _within_limits(m, i, text, v)
     for task, terms in m.goals.items():
         for term, values in terms.items():
             for i, text in enumerate(values):
@@ -538,6 +540,20 @@ def _validate_expressions(m: Model) -> None:
         for i, row in enumerate(matrix or []):
             for j, text in enumerate(row):
                 expression(m.path, f"printed.{label}[{i}][{j}]", text, printed_names)
+
+
+def _within_limits(m: Model, i: int, text: str, v: float) -> None:
+    """A URDF arm's q^e[i] (the double `v`) inside its joint's <limit lower upper> (urdf.py's
+    rule: revolute and prismatic joints; an absent side is no bound), else refused."""
+    chain = m.chain
+    if chain is None or i >= len(chain.limits):
+        return
+    lower, upper = chain.limits[i]
+    if (lower is not None and v < lower) or (upper is not None and v > upper):
+        shown = lambda b, inf: inf if b is None else repr(b)  # noqa: E731
+        raise DescriptionError(m.path, f"equilibrium.q[{i}]",
+                               f"'{text}' = {v!r} is outside joint '{chain.joint_names[i]}''s limits "
+                               f"[{shown(lower, '-inf')}, {shown(upper, 'inf')}] ({chain.path} <limit lower upper>)")
 
 
 def _validate_task_expressions(path: Path, t: Task) -> None:

@@ -146,8 +146,12 @@ def derive(model: Model, tasks: list[Task]) -> Derivation:
     if any(r.has(sp.zoo, sp.nan, sp.oo, -sp.oo) for r in residual):
         raise DescriptionError(model.path, "equilibrium", f"f(X^e, U^e) = {list(residual)} is not finite there")
     if any(r != 0 for r in residual):
+        names = [c.name for c in model.q_dot] + [f"{c.name}_ddot" for c in model.q]
+        nonzero = ", ".join(f"{names[i]} = {r}" for i, r in enumerate(residual) if r != 0)
         raise DescriptionError(model.path, "equilibrium",
-                               f"not an equilibrium: f(X^e, U^e) = {list(residual)} is not zero")
+                               f"not an equilibrium: f(X^e, U^e) = {list(residual)} is not zero ({nonzero}): "
+                               "the forces (gravity among them) are not balanced at q^e with U^e; choose q^e where "
+                               "they are, or U^e that feeds them forward")
 
     a = tidy_matrix(f_x.subs(at_e))
     b = tidy_matrix(f_u.subs(at_e))

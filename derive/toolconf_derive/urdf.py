@@ -4,24 +4,48 @@ merged in), and the flange's pose in the last body's frame.
 
 Only the kinematic and inertial data are read (xml.etree through defusedxml: URDF is small and
 plain XML, and entity declarations, which no URDF needs, are refused).
-Everything beyond the flange is dropped (the tool replaces the hand). Refused, each with one line
-naming the file, the joint or link and the reason (a DescriptionError, status 2 from derive.py):
-floating, planar and mimic joints (and any unknown type) between the base and the flange; a
-moving joint that leaves the chain (a branch); a link with two parents (a loop); a body carried
-by a moving joint without an <inertial>, or with mass <= 0; an inertia that is not positive
-definite or whose principal moments violate the triangle inequality; a number outside its
-physical range (MAX_MASS, MAX_INERTIA, MAX_LENGTH, MAX_ANGLE) or more than MAX_LINKS links.
+Refused, each with one line naming the file, the joint or link and the reason (a
+DescriptionError, status 2 from derive.py): floating, planar and mimic joints (and any unknown
+type) between the base and the flange; a moving side branch (below); a link with two parents (a
+loop); a body carried by a moving joint without an <inertial>, or with mass <= 0; an inertia that
+is not positive definite or whose principal moments violate the triangle inequality; a rotation
+that is not orthonormal (below); a number outside its physical range (MAX_MASS, MAX_INERTIA,
+MAX_LENGTH, MAX_ANGLE) or more than MAX_LINKS links.
+
+How a URDF is read (one rule; docs/urdf.md, "How a URDF is read"):
+
+- Angles, as Pinocchio reads them. Each rpy angle within SNAP (1e-9 rad) of a multiple k pi/2 is
+  taken as exactly k pi/2, so its sine and cosine are exactly 0 or +-1; any other angle is used
+  literally, as Pinocchio uses it. URDFs write pi/2 rounded: UR5 and Kinova 1.57079632679
+  (5e-12 off, snapped: the exact zeros keep the generated code from multiplying by 1e-12 residues
+  and move a link by under 1e-9 of its offset), UFactory's xArm7 1.5708 (3.7e-6 off: a different
+  angle, used as written). Angles are snapped, never the matrix entries: snapping each entry on
+  its own (as this reader once did) took sin(1.5708) as 1 but kept cos(1.5708) = -3.7e-6, a
+  matrix that is no rotation, and the derivation then failed far from the cause (an equilibrium
+  residual of 1e-9). Every rotation built from the file is checked orthonormal to
+  ORTHONORMAL (1e-12) and refused otherwise, naming the joint or link and the deviation.
+- Joint limits: the <limit lower upper> of each revolute or prismatic joint of the chain is kept
+  (`UrdfChain.limits`; an absent attribute is no bound, continuous joints have none), and an
+  equilibrium q^e outside it is refused by description.py, naming equilibrium.q[i], the joint,
+  the value and the limits. Effort and velocity limits are not read.
+- <dynamics damping friction>: not read into the plant, whose joint damping is the description's
+  [impedance]; the chain's joints with a non-zero value are listed (`UrdfChain.ignored_dynamics`)
+  and derive.py says on stderr, once per derivation, that they are ignored.
+- Branches: a fixed side branch (a fixed joint whose subtree does not hold the flange: a camera,
+  UR5's ee_link) is merged into the body it hangs from, fixed links in it included; a moving side
+  branch (a moving joint anywhere off the base-to-flange chain, e.g. fingers hanging beside the
+  flange) is refused, naming the joint: the chain the derivation builds cannot move it.
+  Everything below the flange is dropped (the tool replaces the hand), moving or not, and so is
+  everything above the base.
 
 Numbers: the file's decimals are read as doubles (correctly rounded, the same on every machine);
 rotations (URDF rpy) and the merging of fixed links are done in 50-digit mpmath and rounded once,
-never in libm. Rotation entries within SNAP of 0 or +-1 are taken as exactly 0 or +-1: URDFs
-write pi/2 rounded (UR5: 1.57079632679, whose cosine is 4.9e-12), and the exact zero keeps the
-generated code from multiplying by 1e-12 residues. That moves a link by less than 1e-9 of its
-offset; the check against Pinocchio, which uses the literal angles, passes at 1e-10 relative.
+never in libm.
 """
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 
 import defusedxml.ElementTree as SafeET
@@ -35,7 +59,10 @@ from .errors import DescriptionError
 from .files import read_text
 
 DIGITS = 50
+# An rpy angle within SNAP (rad) of a multiple of pi/2 is that multiple (the module docs).
 SNAP = mpmath.mpf("1e-9")
+# A rotation built from the file whose R^T R is further than this from I is refused.
+ORTHONORMAL = mpmath.mpf("1e-12")
 SUPPORTED = ("revolute", "continuous", "prismatic", "fixed")
 # Bounds on what is read: the Panda's URDF is 15 KB; the derivation's graphs grow as n^2 (M) to
 # n^3 (the Jacobian's solves) and a 7-joint arm already emits 2 MB of Rust.
@@ -80,6 +107,10 @@ class UrdfChain:
     # The flange frame in the last body's frame.
     flange_rotation: tuple
     flange_translation: tuple
+    # Per body, its joint's <limit> (lower, upper) as doubles, None for a side without a bound.
+    limits: tuple = ()
+    # The chain's joints whose <dynamics> give a non-zero damping or friction (not read).
+    ignored_dynamics: tuple = ()
 
     @property
     def dof(self) -> int:
@@ -120,24 +151,40 @@ def _number(path: Path, where: str, element, attribute: str, bound: float, unit:
     return _floats(path, f"{where} {attribute}", text, 1, "", bound, unit)[0]
 
 
-def _snap(x: mpmath.mpf) -> mpmath.mpf:
-    for target in (0, 1, -1):
-        if abs(x - target) < SNAP:
-            return mpmath.mpf(target)
-    return x
+def _sin_cos(angle: mpmath.mpf) -> tuple[mpmath.mpf, mpmath.mpf]:
+    """(sin, cos) of an rpy angle: exactly 0 and +-1 for an angle within SNAP of k pi/2 (taken as
+    k pi/2), the literal angle's otherwise."""
+    k = int(mpmath.nint(angle / (mpmath.pi / 2)))
+    if abs(angle - k * mpmath.pi / 2) < SNAP:
+        return [(mpmath.mpf(0), mpmath.mpf(1)), (mpmath.mpf(1), mpmath.mpf(0)),
+                (mpmath.mpf(0), mpmath.mpf(-1)), (mpmath.mpf(-1), mpmath.mpf(0))][k % 4]
+    return mpmath.sin(angle), mpmath.cos(angle)
 
 
 def rpy_rotation(rpy: list[mpmath.mpf]) -> mpmath.matrix:
-    """URDF's fixed-axis roll, pitch, yaw: R = Rz(yaw) Ry(pitch) Rx(roll), snapped."""
-    r, p, y = rpy
-    cr, sr, cp, sp, cy, sy = (mpmath.cos(r), mpmath.sin(r), mpmath.cos(p), mpmath.sin(p),
-                              mpmath.cos(y), mpmath.sin(y))
-    m = mpmath.matrix([
+    """URDF's fixed-axis roll, pitch, yaw: R = Rz(yaw) Ry(pitch) Rx(roll), each angle snapped to a
+    quarter turn within SNAP (never the entries: R stays a rotation)."""
+    (sr, cr), (sp, cp), (sy, cy) = (_sin_cos(a) for a in rpy)
+    return mpmath.matrix([
         [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
         [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
         [-sp, cp * sr, cp * cr],
     ])
-    return mpmath.matrix([[_snap(m[i, j]) for j in range(3)] for i in range(3)])
+
+
+def orthonormal_deviation(rotation: mpmath.matrix) -> mpmath.mpf:
+    """max |R^T R - I|: 0 for a rotation (to the working precision)."""
+    gram = rotation.T * rotation - mpmath.eye(3)
+    return max(abs(gram[i, j]) for i in range(3) for j in range(3))
+
+
+def check_rotation(path: Path, where: str, rotation: mpmath.matrix) -> mpmath.matrix:
+    """`rotation` if it is orthonormal to ORTHONORMAL, else refused naming `where`."""
+    deviation = orthonormal_deviation(rotation)
+    if not deviation <= ORTHONORMAL:
+        raise DescriptionError(path, where, f"rotation is not orthonormal: max |R^T R - I| = "
+                                            f"{mpmath.nstr(deviation, 3)} > {mpmath.nstr(ORTHONORMAL, 1)}")
+    return rotation
 
 
 def _origin(path: Path, where: str, element) -> tuple[mpmath.matrix, mpmath.matrix]:
@@ -146,7 +193,7 @@ def _origin(path: Path, where: str, element) -> tuple[mpmath.matrix, mpmath.matr
                   MAX_LENGTH, "m")
     rpy = _floats(path, f"{where} origin rpy", origin.get("rpy") if origin is not None else None, 3, "0 0 0",
                   MAX_ANGLE, "rad")
-    return rpy_rotation(rpy), mpmath.matrix(xyz)
+    return check_rotation(path, f"{where} origin rpy", rpy_rotation(rpy)), mpmath.matrix(xyz)
 
 
 def _check_inertia(path: Path, where: str, inertia: mpmath.matrix, massless: bool) -> None:
@@ -293,9 +340,21 @@ def _joint_kind(path: Path, joint) -> str:
     return kind
 
 
+def _side_joint(tree: _Tree, joint, link: str, flange: str) -> None:
+    """A joint off the chain at `link`: a fixed one is merged by the caller; a moving one is a
+    moving side branch, refused; any other type as _joint_kind refuses it."""
+    kind = joint.get("type")
+    if kind in MOVING or kind in ("floating", "planar"):
+        raise DescriptionError(tree.path, f"joint '{joint.get('name')}'",
+                               f"({kind}) is a moving side branch at link '{link}': the branch moves and does "
+                               f"not hold the flange '{flange}'; only fixed side branches are merged into the chain")
+    _joint_kind(tree.path, joint)
+
+
 def _fixed_subtree(tree: _Tree, link: str, on_path: set[str], flange: str) -> _Inertial:
     """The inertia of `link` and of every link fixed below it off the chain, in `link`'s frame;
-    a moving joint off the chain is a branch, refused. Nothing below the flange is read."""
+    a moving joint off the chain is a moving side branch, refused. Nothing below the flange is
+    read."""
     total = _inertial(tree.path, tree.links[link], link in on_path and tree.parent_joint.get(link) is not None
                       and tree.parent_joint[link].get("type") in MOVING)
     if link == flange:
@@ -304,14 +363,57 @@ def _fixed_subtree(tree: _Tree, link: str, on_path: set[str], flange: str) -> _I
         child = joint.find("child").get("link")
         if child in on_path:
             continue
-        kind = _joint_kind(tree.path, joint)
-        if kind != "fixed":
-            raise DescriptionError(tree.path, f"joint '{joint.get('name')}'",
-                                   f"({kind}) branches off the chain at link '{link}': only a serial chain from "
-                                   "the base to the flange is supported")
+        _side_joint(tree, joint, link, flange)
         rotation, translation = _origin(tree.path, f"joint '{joint.get('name')}'", joint)
         total = _merged(total, _moved(_fixed_subtree(tree, child, on_path, flange), rotation, translation))
     return total
+
+
+def _base_side_branches(tree: _Tree, link: str, on_path: set[str], flange: str) -> None:
+    """Off the chain at the base: fixed links do not move with the arm and are not read, but a
+    moving joint among them is a moving side branch like any other, refused."""
+    for joint in tree.child_joints[link]:
+        child = joint.find("child").get("link")
+        if child in on_path:
+            continue
+        _side_joint(tree, joint, link, flange)
+        _base_side_branches(tree, child, on_path, flange)
+
+
+def _limits(path: Path, joint) -> tuple:
+    """A revolute or prismatic joint's <limit> (lower, upper) as doubles, None for an absent one
+    (a continuous joint has none)."""
+    element = joint.find("limit")
+    if joint.get("type") not in ("revolute", "prismatic") or element is None:
+        return (None, None)
+    out = []
+    for side in ("lower", "upper"):
+        text = element.get(side)
+        if text is None:
+            out.append(None)
+            continue
+        try:
+            v = float(text)
+        except ValueError:
+            v = math.nan
+        if math.isnan(v):
+            raise DescriptionError(path, f"joint '{joint.get('name')}' limit {side}", f"'{text}' is not a number")
+        out.append(v if math.isfinite(v) else None)
+    return tuple(out)
+
+
+def _dynamics_given(joint) -> bool:
+    """The joint's <dynamics> gives a non-zero damping or friction (which the plant ignores)."""
+    element = joint.find("dynamics")
+    if element is None:
+        return False
+    for attribute in ("damping", "friction"):
+        try:
+            if float(element.get(attribute, "0")) != 0:
+                return True
+        except ValueError:
+            return True
+    return False
 
 
 def read_chain(path: Path, base: str, flange: str) -> UrdfChain:
@@ -336,6 +438,7 @@ def _chain(tree: _Tree, base: str, flange: str) -> UrdfChain:
     on_path = {j.find("child").get("link") for j in joints} | {base}
     for j in joints:
         _joint_kind(path, j)
+    _base_side_branches(tree, base, on_path, flange)
     moving = [j for j in joints if j.get("type") in MOVING]
     if not moving:
         raise DescriptionError(path, f"link '{flange}'", f"no moving joint between the base '{base}' and the flange")
@@ -365,7 +468,9 @@ def _chain(tree: _Tree, base: str, flange: str) -> UrdfChain:
     bodies.append(_body(joint_of_body, current))
     return UrdfChain(path, tree.robot, base, flange, bodies,
                      tuple(tuple(float(pending_r[i, k]) for k in range(3)) for i in range(3)),
-                     tuple(float(pending_t[i]) for i in range(3)))
+                     tuple(float(pending_t[i]) for i in range(3)),
+                     limits=tuple(_limits(path, j) for j in moving),
+                     ignored_dynamics=tuple(j.get("name") for j in moving if _dynamics_given(j)))
 
 
 def _body(joint_data, inertial: _Inertial) -> Body:

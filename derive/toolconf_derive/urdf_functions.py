@@ -331,13 +331,44 @@ def report_data(dv: UrdfDerivation, functions: list[SeqFunction]) -> irt.UrdfRep
     )
 
 
+def not_an_equilibrium(chain, residual) -> str:
+    """Why f(X^e, U^e) is not zero, in one line: the joints with the largest residual q_ddot, and
+    the likely cause. The plant feeds the gravity at q^e forward (tau = ... + g(q^e)) and q_dot^e
+    = U^e = 0 are checked, so a residual means the code's g(q^e) (RNEA) and the reference's (the
+    gradient of the potential) disagree: a rotation of the chain that is not orthonormal makes
+    them differ (urdf.py refuses one, this names it should one get through), otherwise numbers
+    so far apart that their rounding shows."""
+    import mpmath
+    from .urdf import orthonormal_deviation
+    n = chain.dof
+    acc = [abs(float(v)) for v in residual[n:2 * n]]
+    top = max(acc)
+    worst = sorted((i for i in range(n) if acc[i] >= top / 10), key=lambda i: -acc[i])[:3]
+    unit = ["rad/s^2" if b.kind == "revolute" else "m/s^2" for b in chain.bodies]
+    joints = ", ".join(f"'{chain.joint_names[i]}' {acc[i]:.2e} {unit[i]}" for i in worst)
+    with mpmath.workdps(50):
+        rotations = [(f"joint '{b.joint}' origin", b.rotation) for b in chain.bodies]
+        rotations.append((f"flange '{chain.flange}'", chain.flange_rotation))
+        where, deviation = max(((w, orthonormal_deviation(mpmath.matrix([list(r) for r in rot])))
+                                for w, rot in rotations), key=lambda t: t[1])
+        shown = mpmath.nstr(deviation, 3)
+    if deviation > 1e-12:
+        cause = (f"likely cause: the rotation of {where} is not orthonormal (|R^T R - I| = {shown}) in "
+                 f"{chain.path.name}")
+    else:
+        cause = (f"rotations orthonormal (|R^T R - I| <= {shown}), gravity fed forward: the code's g(q^e) (RNEA) "
+                 f"and the reference's disagree; look for numbers far off an arm's scale in {chain.path.name}")
+    return (f"not an equilibrium: |f(X^e, U^e)| = {top:.2e} > {EQUILIBRIUM_RESIDUAL:g}, largest at joint {joints}; "
+            f"{cause}")
+
+
 def urdf_documents(model: Model, tasks, generator: irt.Generator, vectors: int, schema: int) -> tuple[irt.Ir, dict]:
     """The IR and the test vectors of a URDF model."""
     dv = UrdfDerivation(model, model.chain, tasks)
     residual = dv.reference_dynamics(dv.x_e, dv.u_e, report_tool(*REPORT_TOOLS[1][1:]))[0].to_numpy()
     # Not exactly zero: the graphs' constants were folded in double while they were built.
     if not float(np.max(np.abs(residual))) <= EQUILIBRIUM_RESIDUAL:
-        raise DescriptionError(model.path, "equilibrium", f"not an equilibrium: f(X^e, U^e) = {residual.ravel()}")
+        raise DescriptionError(model.path, "equilibrium", not_an_equilibrium(model.chain, residual.ravel()))
     for name, mass, com, sides in REPORT_TOOLS:
         singular_joints(dv, report_tool(mass, com, sides), name)
     functions = build_functions(dv)
