@@ -11,6 +11,7 @@ from __future__ import annotations
 import time
 
 import casadi as ca
+import mpmath
 import numpy as np
 
 from . import ir_types as irt
@@ -22,6 +23,7 @@ from .ir import _rust_type, _struct_name, model_document
 from .rigid_body import ldl_logdet
 from .rust_printer import float_literal
 from .sequence import as_lets, instruction_count, instructions
+from .urdf import orthonormal_deviation
 from .urdf_model import AGREEMENT, SeqArg, SeqFunction, SeqOutput, UrdfDerivation, UrdfMismatch, _sample_tool
 
 
@@ -338,8 +340,6 @@ def not_an_equilibrium(chain, residual) -> str:
     gradient of the potential) disagree: a rotation of the chain that is not orthonormal makes
     them differ (urdf.py refuses one, this names it should one get through), otherwise numbers
     so far apart that their rounding shows."""
-    import mpmath
-    from .urdf import orthonormal_deviation
     n = chain.dof
     acc = [abs(float(v)) for v in residual[n:2 * n]]
     top = max(acc)
