@@ -189,6 +189,18 @@ def compare(derived: Path, committed: Path, whole_folder: bool) -> list[str]:
     return problems
 
 
+def write_replacing(path: Path, data: bytes) -> None:
+    """`data` into `path` through a temporary file beside it: an interrupted write keeps the old
+    file, and leaves no temporary file."""
+    with tempfile.NamedTemporaryFile(dir=path.parent, prefix=f".{path.name}.", delete=False) as f:
+        f.write(data)
+    try:
+        os.replace(f.name, path)
+    finally:
+        if os.path.exists(f.name):
+            os.unlink(f.name)
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--check", action="store_true", help="derive into a temporary folder and compare")
@@ -201,7 +213,7 @@ def main() -> int:
     if not args.check:
         derive_all([Run(env, GENERATED, FIXTURES)])
         if not REFERENCE.exists() or REFERENCE.read_bytes() != reference:
-            REFERENCE.write_bytes(reference)
+            write_replacing(REFERENCE, reference)
         return 0
     checks = [("drift check", env)]
     if args.portability:

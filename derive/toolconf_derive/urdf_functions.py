@@ -23,7 +23,7 @@ from .ir import _rust_type, _struct_name, model_document
 from .rigid_body import ldl_logdet
 from .rust_printer import float_literal
 from .sequence import as_lets, instruction_count, instructions
-from .urdf import orthonormal_deviation
+from .urdf import DIGITS, ORTHONORMAL, orthonormal_deviation
 from .urdf_model import AGREEMENT, SeqArg, SeqFunction, SeqOutput, UrdfDerivation, UrdfMismatch, _sample_tool
 
 
@@ -346,13 +346,13 @@ def not_an_equilibrium(chain, residual) -> str:
     worst = sorted((i for i in range(n) if acc[i] >= top / 10), key=lambda i: -acc[i])[:3]
     unit = ["rad/s^2" if b.kind == "revolute" else "m/s^2" for b in chain.bodies]
     joints = ", ".join(f"'{chain.joint_names[i]}' {acc[i]:.2e} {unit[i]}" for i in worst)
-    with mpmath.workdps(50):
+    with mpmath.workdps(DIGITS):
         rotations = [(f"joint '{b.joint}' origin", b.rotation) for b in chain.bodies]
         rotations.append((f"flange '{chain.flange}'", chain.flange_rotation))
         where, deviation = max(((w, orthonormal_deviation(mpmath.matrix([list(r) for r in rot])))
                                 for w, rot in rotations), key=lambda t: t[1])
         shown = mpmath.nstr(deviation, 3)
-    if deviation > 1e-12:
+    if deviation > ORTHONORMAL:
         cause = (f"likely cause: the rotation of {where} is not orthonormal (|R^T R - I| = {shown}) in "
                  f"{chain.path.name}")
     else:
