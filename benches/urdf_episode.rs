@@ -28,7 +28,7 @@ fn tools(n: usize, seed: u64) -> Vec<AnyTool> {
 }
 
 fn panda(tool: &AnyTool) -> PandaTool {
-    tool.downcast::<Panda, 7, 14, 7, 21>()
+    tool.downcast::<Panda, 7, 14, 13, 21>()
         .expect("the sampler draws Panda tools only")
 }
 
@@ -54,7 +54,7 @@ fn closed_loop_rhs(c: &mut Criterion) {
     let mut group = c.benchmark_group("panda_closed_loop_rhs");
     for kind in TaskKind::ALL {
         let task = <Panda as toolconf::model::ArmModel<7, 14, 7, 21>>::paper_task(kind);
-        let system = ClosedLoopN::<Panda, 7, 14, 7, 21>::new(&tool, &task, 1.0, 0.0).unwrap();
+        let system = ClosedLoopN::<Panda, 7, 14, 13, 21>::new(&tool, &task, 1.0, 0.0).unwrap();
         group.bench_function(kind.name(), |b| b.iter(|| system.rhs(black_box(&z))));
     }
     group.finish();

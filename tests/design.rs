@@ -25,13 +25,17 @@ fn spec(text: &str, model: ModelKind) -> DesignSpec {
 }
 
 /// Central difference of ln|Π^U| in parameter j (step 1e-5 relative, or 1e-5 of the sampling
-/// box where the parameter is 0): O(h²) ≈ 1e-10 truncation.
+/// box where the parameter is 0): O(h²) ≈ 1e-10 truncation. A product of inertia steps by 1e-5
+/// of the tensor's trace, its physical scale: products are often orders of magnitude below the
+/// moments, and a step relative to them would leave only rounding (ε·|ln|Π^U||/h ~ 1e-5).
 fn central_difference(tasks: &ModelTasks, model: ModelKind, p: &[f64], j: usize) -> f64 {
     let (lo, hi) = model.sample_box()[j];
-    let h = if p[j] != 0.0 {
-        1e-5 * p[j]
-    } else {
-        1e-5 * (hi - lo)
+    let h = match model.info().inertia {
+        Some(rule) if rule.products.contains(&j) => {
+            1e-5 * rule.moments.iter().map(|&m| p[m]).sum::<f64>()
+        }
+        _ if p[j] != 0.0 => 1e-5 * p[j],
+        _ => 1e-5 * (hi - lo),
     };
     let at = |d: f64| {
         let mut q = p.to_vec();

@@ -17,20 +17,31 @@ use toolconf::validate::{STATE_BOUND, TOOL_PARAMETER};
 use toolconf::{TaskKind, Term};
 
 /// The corners of the box `boxes` (one interval per parameter) that the model's rule admits
-/// (a URDF tool's principal moments obey the triangle inequality), and its centre: in ln p for a
-/// "> 0" parameter, the midpoint for a signed one (a centre of mass).
+/// (a URDF tool's inertia tensor a rigid body's), and its centre: in ln p for a "> 0" parameter,
+/// the midpoint for a signed one (a centre of mass). The parameters a tool may leave out (a URDF
+/// tool's products of inertia and tip) move together, to both ends of their intervals at once:
+/// each corner of the others is taken with them at their lower ends and at their upper ends
+/// (2^13 corners of every parameter apart would take minutes, and the products are bounded by
+/// the moments, not by a box of their own).
 fn points<const NP: usize>(rule: &ToolRule<NP>, boxes: [(f64, f64); NP]) -> Vec<[f64; NP]> {
-    let mut points: Vec<[f64; NP]> = (0..1usize << NP)
-        .map(|bits| {
-            std::array::from_fn(|j| {
-                if bits >> j & 1 == 0 {
-                    boxes[j].0
-                } else {
+    let linked: Vec<usize> = (0..NP).filter(|&j| rule.defaults[j].is_some()).collect();
+    let free: Vec<usize> = (0..NP).filter(|j| !linked.contains(j)).collect();
+    let mut points = Vec::new();
+    for bits in 0..1usize << free.len() {
+        for upper in [false, true] {
+            points.push(std::array::from_fn(|j| {
+                let high = match free.iter().position(|&f| f == j) {
+                    Some(k) => bits >> k & 1 == 1,
+                    None => upper,
+                };
+                if high {
                     boxes[j].1
+                } else {
+                    boxes[j].0
                 }
-            })
-        })
-        .collect();
+            }));
+        }
+    }
     points.push(std::array::from_fn(|j| {
         let (lo, hi) = boxes[j];
         if rule.domains[j].is_positive() {
@@ -43,12 +54,16 @@ fn points<const NP: usize>(rule: &ToolRule<NP>, boxes: [(f64, f64); NP]) -> Vec<
     points
 }
 
-/// Per parameter: `positive` for a "> 0" domain, else the domain itself within ±1e6.
+/// Per parameter: `positive` for a "> 0" domain, a quarter of its lower end either way for a
+/// product of inertia (a tensor whose moments are all at least that stays a rigid body's for
+/// most corners), else the domain itself within ±1e6.
 fn boxes<const NP: usize>(rule: &ToolRule<NP>, positive: (f64, f64)) -> [(f64, f64); NP] {
     std::array::from_fn(|j| {
         let d = &rule.domains[j];
         if d.is_positive() {
             positive
+        } else if rule.inertia.is_some_and(|i| i.products.contains(&j)) {
+            (-0.25 * positive.0, 0.25 * positive.0)
         } else {
             (d.lo.max(-TOOL_PARAMETER.hi), d.hi.min(TOOL_PARAMETER.hi))
         }

@@ -4,7 +4,7 @@ write, and the independent reference of python/tests/test_dynamics.py.
 
 The URDF is cut at the description's flange (every link below it dropped, as toolconf's reader
 drops the hand) and the tool added as a fixed link: mass, centre of mass in the flange frame,
-principal moments along the flange axes. Rotations within 1e-9 of a multiple of pi/2 are given
+its inertia tensor about it in flange axes, and its tip as a frame "tool_tip". Rotations within 1e-9 of a multiple of pi/2 are given
 as that multiple, as toolconf's reader takes them (UR5 prints pi/2 as 1.57079632679).
 
 Needs numpy and pin (Pinocchio) only.
@@ -53,8 +53,9 @@ def quarter_turn(angle: float) -> float:
 
 
 def model_with_tool(name: str, tool) -> tuple[pin.Model, pin.Data]:
-    """Pinocchio's model of robot `name` with `tool` = (mass, com_x, com_y, com_z, ixx, iyy, izz)
-    fixed at its flange."""
+    """Pinocchio's model of robot `name` with `tool` = (mass, com_x, com_y, com_z, ixx, iyy, izz,
+    [ixy, ixz, iyz, [tip_x, tip_y, tip_z]]) fixed at its flange (the products and the tip zero
+    where not given), its tip the frame "tool_tip"."""
     d = description(name)
     root = ET.parse(d.urdf).getroot()
     children: dict[str, list[str]] = {}
@@ -74,10 +75,17 @@ def model_with_tool(name: str, tool) -> tuple[pin.Model, pin.Data]:
     for origin in root.iter("origin"):
         if origin.get("rpy"):
             origin.set("rpy", " ".join(repr(quarter_turn(float(v))) for v in origin.get("rpy").split()))
-    m, cx, cy, cz, ixx, iyy, izz = (float(v) for v in tool)
+    values = [float(v) for v in tool] + [0.0] * (13 - len(tool))
+    m, cx, cy, cz, ixx, iyy, izz, ixy, ixz, iyz, tx, ty, tz = values
     root.append(ET.fromstring(
         f'<link name="tool"><inertial><origin xyz="{cx!r} {cy!r} {cz!r}" rpy="0 0 0"/><mass value="{m!r}"/>'
-        f'<inertia ixx="{ixx!r}" ixy="0" ixz="0" iyy="{iyy!r}" iyz="0" izz="{izz!r}"/></inertial></link>'))
+        f'<inertia ixx="{ixx!r}" ixy="{ixy!r}" ixz="{ixz!r}" iyy="{iyy!r}" iyz="{iyz!r}" izz="{izz!r}"/>'
+        '</inertial></link>'))
+    # The tip: a massless link (Pinocchio makes it a frame, "tool_tip") at the tool's tip offset.
+    root.append(ET.fromstring('<link name="tool_tip"/>'))
+    root.append(ET.fromstring(
+        f'<joint name="tool_tip_joint" type="fixed"><parent link="tool"/><child link="tool_tip"/>'
+        f'<origin xyz="{tx!r} {ty!r} {tz!r}" rpy="0 0 0"/></joint>'))
     root.append(ET.fromstring(
         f'<joint name="tool_joint" type="fixed"><parent link="{d.flange}"/><child link="tool"/>'
         '<origin xyz="0 0 0" rpy="0 0 0"/></joint>'))

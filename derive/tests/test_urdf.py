@@ -227,8 +227,8 @@ def _raw_dynamics(dyn: ChainDynamics, tool=None):
     CRBA + RNEA + LDL^T, the code's route."""
     n = dyn.n
     q, qd, tau = ca.SX.sym("q", n), ca.SX.sym("qd", n), ca.SX.sym("tau", n)
-    p = ca.SX.sym("p", 7)
-    last = dyn.tool_parameters([p[i] for i in range(7)]) if tool else dyn.link_parameters(n - 1)
+    p = ca.SX.sym("p", 10)
+    last = dyn.tool_parameters([p[i] for i in range(10)]) if tool else dyn.link_parameters(n - 1)
     qs, qds = [q[i] for i in range(n)], [qd[i] for i in range(n)]
     trig = [(ca.sin(q[i]), ca.cos(q[i])) for i in range(n)]
     mass = dyn.mass_matrix(qs, trig, last)
@@ -236,9 +236,15 @@ def _raw_dynamics(dyn: ChainDynamics, tool=None):
     acc = ldl_apply(ldl_factor(mass), [tau[i] - bias[i] for i in range(n)])
     mass_sx = ca.vertcat(*[ca.horzcat(*row) for row in mass])
     inverse = dyn.rnea(qs, trig, qds, [0.0] * n, last)
-    return (ca.Function("fd", [q, qd, tau, p], [ca.vertcat(*acc)]),
-            ca.Function("crba", [q, p], [mass_sx]),
-            ca.Function("bias", [q, qd, p], [ca.vertcat(*inverse)]))
+    fns = (ca.Function("fd", [q, qd, tau, p], [ca.vertcat(*acc)]), ca.Function("crba", [q, p], [mass_sx]),
+           ca.Function("bias", [q, qd, p], [ca.vertcat(*inverse)]))
+
+    def inertial(tool):
+        """A tool's ten inertial numbers: a 7-number tool's products are zero, a 13-number tool's
+        tip is dropped (it does not move the dynamics)."""
+        t = [float(v) for v in np.asarray(tool).ravel()]
+        return (t + [0.0] * 3)[:10] if len(t) == 7 else t[:10]
+    return tuple((lambda *a, f=f: f(*a[:-1], inertial(a[-1]))) for f in fns)
 
 
 class PlanarRods(unittest.TestCase):
@@ -422,8 +428,9 @@ class PinocchioCheck:
         for origin in root.iter("origin"):
             if origin.get("rpy"):
                 origin.set("rpy", " ".join(repr(_quarter_turn(float(v))) for v in origin.get("rpy").split()))
-        m, cx, cy, cz, ixx, iyy, izz = (float(v) for v in tool)
-        root.append(ET.fromstring(_link("tool", _inertial(m, (cx, cy, cz), (ixx, iyy, izz)))))
+        m, cx, cy, cz, ixx, iyy, izz, ixy, ixz, iyz = (float(v) for v in tool[:10])
+        root.append(ET.fromstring(_link("tool", _inertial(m, (cx, cy, cz), (ixx, iyy, izz),
+                                                          products=(ixy, ixz, iyz)))))
         root.append(ET.fromstring(_joint("tool_joint", "fixed", model.chain.flange, "tool")))
         built = pin.buildModelFromXML(ET.tostring(root, encoding="unicode"))
         return built, built.createData()

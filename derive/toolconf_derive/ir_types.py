@@ -94,18 +94,33 @@ class Constraint:
 
 
 @dataclass
+class Inertia:
+    """The parameters that are a rigid body's inertia tensor about its centre of mass (their
+    indices: the moments xx, yy, zz and the products xy, xz, yz), which must be positive definite
+    with eigenvalues obeying the triangle inequality, to a relative `slack`."""
+    moments: list[int]
+    products: list[int]
+    slack: float
+
+
+@dataclass
 class ToolRule:
     domains: list[Domain]
     constraints: list[Constraint]
     sample: list[list[float]]
+    # Per parameter, what a tools file that leaves its column out means (None: required).
+    defaults: list[float | None]
+    inertia: Inertia | None
     source: str
 
     @classmethod
     def of(cls, rule: dict) -> "ToolRule":
         """The rule urdf_description.tool_rule gives as a dict."""
+        inertia = rule.get("inertia")
         return cls(domains=[Domain(**d) for d in rule["domains"]],
                    constraints=[Constraint(**c) for c in rule["constraints"]],
-                   sample=rule["sample"], source=rule["source"])
+                   sample=rule["sample"], defaults=rule["defaults"],
+                   inertia=None if inertia is None else Inertia(**inertia), source=rule["source"])
 
 
 @dataclass

@@ -112,8 +112,8 @@ MEANING = {
     ("impedance", "stiffness"): (None, "K, one per joint, N m/rad (N/m for a prismatic joint)"),
     ("impedance", "damping"): (None, "D, one per joint, N m s/rad"),
     ("impedance", "source"): ('""', "where the gains come from"),
-    ("tool", "com_bound"): (f"{COM_BOUND:g}", "m: a valid tool's centre of mass lies within it of the flange "
-                                              "along each flange axis; in (0, 1e6]"),
+    ("tool", "com_bound"): (f"{COM_BOUND:g}", "m: a valid tool's centre of mass and tip lie within it of the "
+                                              "flange along each flange axis; in (0, 1e6]"),
     ("tool", "sample"): (_SAMPLE, "`[tool.sample]`: per tool parameter, the box `[lo, hi]` random tools are drawn "
                                   "from (`select --models`, design's random baseline); within the parameter's "
                                   "domain, its centre a valid tool"),

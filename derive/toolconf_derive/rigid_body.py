@@ -167,14 +167,17 @@ class ChainDynamics:
 
     def tool_parameters(self, tool) -> list:
         """The last body's 10 numbers with a tool fixed at the flange: tool = [mass, com_x,
-        com_y, com_z (flange frame), ixx, iyy, izz (principal, about the CoM, flange axes)]."""
-        m, cx, cy, cz, ixx, iyy, izz = tool
+        com_y, com_z (flange frame), ixx, iyy, izz, ixy, ixz, iyz (the inertia tensor about the
+        CoM in flange axes, URDF's convention: the products are its off-diagonal entries)]."""
+        m, cx, cy, cz, ixx, iyy, izz, ixy, ixz, iyz = tool
         rf = [list(r) for r in self.chain.flange_rotation]
         pf = list(self.chain.flange_translation)
         c = _add(_matvec(rf, [cx, cy, cz]), pf)
-        # R diag(I) R^T about the CoM, then the parallel-axis shift to the body origin.
-        principal = [ixx, iyy, izz]
-        about_com = [[_dot([rf[i][k] * rf[j][k] for k in range(3)], principal) for j in range(3)] for i in range(3)]
+        # R I R^T about the CoM (a structural zero product adds nothing), then the parallel-axis
+        # shift to the body origin.
+        tensor = [[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]
+        rotated = [[_dot(rf[i], [tensor[k][l] for k in range(3)]) for l in range(3)] for i in range(3)]
+        about_com = [[_dot(rotated[i], rf[j]) for j in range(3)] for i in range(3)]
         cc = _dot(c, c)
         about_origin = [[_add([about_com[i][j]], [_product(m, _difference(cc if i == j else 0.0, _product(c[i], c[j])))])[0]
                          for j in range(3)] for i in range(3)]

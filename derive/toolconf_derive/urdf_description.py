@@ -84,19 +84,36 @@ TOOL_PARAMETERS = [
     Named("tool_ixx", "I_{xx}", "kg m^2", "tool's principal moment about its centre of mass, flange x axis"),
     Named("tool_iyy", "I_{yy}", "kg m^2", "tool's principal moment about its centre of mass, flange y axis"),
     Named("tool_izz", "I_{zz}", "kg m^2", "tool's principal moment about its centre of mass, flange z axis"),
+    Named("tool_ixy", "I_{xy}", "kg m^2", "tool's product of inertia about its centre of mass, flange axes (URDF's ixy)"),
+    Named("tool_ixz", "I_{xz}", "kg m^2", "tool's product of inertia about its centre of mass, flange axes (URDF's ixz)"),
+    Named("tool_iyz", "I_{yz}", "kg m^2", "tool's product of inertia about its centre of mass, flange axes (URDF's iyz)"),
+    Named("tool_tip_x", "t_x", "m", "tool's tip (tool-centre point), x in the flange frame"),
+    Named("tool_tip_y", "t_y", "m", "tool's tip (tool-centre point), y in the flange frame"),
+    Named("tool_tip_z", "t_z", "m", "tool's tip (tool-centre point), z in the flange frame"),
 ]
+# What a tools file that leaves a column out means: a tool whose inertia tensor is diagonal in
+# flange axes (files written before the products were parameters), and a tip at the flange.
+PARAMETER_DEFAULTS = {"tool_ixy": 0.0, "tool_ixz": 0.0, "tool_iyz": 0.0,
+                      "tool_tip_x": 0.0, "tool_tip_y": 0.0, "tool_tip_z": 0.0}
 # Which tools are valid (generated/src/validity.rs; toolconf-core's ToolN::new refuses the rest)
 # and the box random tools are drawn from (the mixed sampler, the design tests). A rigid body:
-# mass > 0, principal moments > 0 obeying the triangle inequality (the largest at most the sum of
-# the other two, with urdf.py's relative slack for printed decimals), and its centre of mass
-# within `com_bound` of the flange along each axis (a description's `[tool] com_bound`).
+# mass > 0; an inertia tensor I (moments and products) that is positive definite with eigenvalues
+# obeying the triangle inequality, i.e. 1/2 tr(I) 1 - I (the body's second moment of mass) positive
+# semi-definite (the linear rule on the diagonal moments is the part of it a design can use, the
+# `inertia` rule the whole); its centre of mass and its tip within `com_bound` of the flange along
+# each axis (a description's `[tool] com_bound`). Slack: urdf.py's relative 1e-9 for printed decimals.
 COM_BOUND = 1.0
 TRIANGLE_SLACK = 1e-9
 # A tool of 0.05-3 kg with its centre of mass within 5 cm of the flange axis and up to 25 cm out,
 # moments of a body a few centimetres to 30 cm across (a description's `[tool.sample]`).
+# Products within 1e-4 kg m^2 (a body a little off its flange axes), tips 5-35 cm out along the
+# flange's z axis and within 5 cm of it.
 SAMPLE = {"tool_mass": (0.05, 3.0), "tool_com_x": (-0.05, 0.05), "tool_com_y": (-0.05, 0.05),
-          "tool_com_z": (0.0, 0.25), "tool_ixx": (1e-4, 0.02), "tool_iyy": (1e-4, 0.02), "tool_izz": (1e-4, 0.02)}
+          "tool_com_z": (0.0, 0.25), "tool_ixx": (1e-4, 0.02), "tool_iyy": (1e-4, 0.02), "tool_izz": (1e-4, 0.02),
+          "tool_ixy": (-1e-4, 1e-4), "tool_ixz": (-1e-4, 1e-4), "tool_iyz": (-1e-4, 1e-4),
+          "tool_tip_x": (-0.05, 0.05), "tool_tip_y": (-0.05, 0.05), "tool_tip_z": (0.05, 0.35)}
 _MOMENTS = ("tool_ixx", "tool_iyy", "tool_izz")
+_PRODUCTS = ("tool_ixy", "tool_ixz", "tool_iyz")
 
 
 def tool_rule(path, table) -> dict:
@@ -109,9 +126,7 @@ def tool_rule(path, table) -> dict:
     if not (isinstance(bound, (int, float)) and math.isfinite(bound) and 0 < bound <= 1e6):
         raise DescriptionError(path, "tool.com_bound", f"{bound!r} must be a number in (0, 1e6] (m)")
     names = [p.name for p in TOOL_PARAMETERS]
-    domains = [{"lo": -float(bound), "hi": float(bound), "lo_open": False, "hi_open": False}
-               if n.startswith("tool_com_") else {"lo": 0.0, "hi": None, "lo_open": True, "hi_open": True}
-               for n in names]
+    domains = [_domain(n, float(bound)) for n in names]
     raw = table.get("sample", {})
     for key in raw:
         if key not in names:
@@ -145,7 +160,18 @@ def tool_rule(path, table) -> dict:
             raise DescriptionError(path, "tool.sample", f"the sampling box's centre violates {c['text']}: random "
                                                         "tools could not be drawn from it")
     return {"domains": domains, "constraints": constraints, "sample": sample,
+            "inertia": {"moments": [names.index(m) for m in _MOMENTS],
+                        "products": [names.index(m) for m in _PRODUCTS], "slack": TRIANGLE_SLACK},
+            "defaults": [PARAMETER_DEFAULTS.get(n) for n in names],
             "source": table.get("source", "")}
+
+
+def _domain(name: str, bound: float) -> dict:
+    if name.startswith(("tool_com_", "tool_tip_")):
+        return {"lo": -bound, "hi": bound, "lo_open": False, "hi_open": False}
+    if name in _PRODUCTS:
+        return {"lo": None, "hi": None, "lo_open": True, "hi_open": True}
+    return {"lo": 0.0, "hi": None, "lo_open": True, "hi_open": True}
 
 
 def _inside(value: float, domain: dict) -> bool:

@@ -35,7 +35,8 @@ def build_functions(dv: UrdfDerivation) -> list[SeqFunction]:
     m, n = dv.model, dv.n
     x = SeqArg("x", _state_doc(m), 2 * n, 1, False, _sample_state(n))
     u = SeqArg("u", f"control U = [{' '.join(s.name for s in m.u)}]", n, 1, False, _sample_control(n))
-    p = SeqArg("params", f"tool parameters [{' '.join(s.name for s in m.parameters)}]", 7, 1, False, _sample_tool)
+    np_ = len(m.parameters)
+    p = SeqArg("params", f"tool parameters [{' '.join(s.name for s in m.parameters)}]", np_, 1, False, _sample_tool)
     eqs = ", ".join(m.equations)
     xs, us, ps = dv.x, dv.u, dv.p
     k = dv.coefficients(ps)
@@ -85,6 +86,18 @@ def build_functions(dv: UrdfDerivation) -> list[SeqFunction]:
         lambda v: dv.reference_rigid_body.checked(v["x"], v["u"], v["params"]),
         coefficients=dv.rigid_coefficients, code_with=dv.rigid_with, unhoisted=dv.rigid_inline,
     ))
+    q = SeqArg("q", f"joint positions q = [{' '.join(s.name for s in m.state[:n])}]", n, 1, False,
+               lambda rng: _sample_state(n)(rng)[:n])
+    fns.append(SeqFunction(
+        "tip",
+        f"The tool's tip (tool-centre point) y(q; p) in the base frame '{dv.chain.base}', and its "
+        "Jacobian J = dy/dq (geometric: z_i x (y - o_i) per revolute joint, z_i per prismatic one), "
+        "what Pinocchio's frame placement and computeFrameJacobian (LOCAL_WORLD_ALIGNED, linear "
+        "rows) give for a frame at the tip.",
+        "forward kinematics of the URDF chain to the flange, then the tip offset (tool_tip_x/y/z)",
+        [q, p], [SeqOutput("position", "y (m, base frame)", 3, 1), SeqOutput("jacobian", "J = dy/dq", 3, n)],
+        dv.tip, lambda v: dv.reference_tip.checked(v["q"], v["params"]),
+    ))
     return fns
 
 
@@ -130,7 +143,7 @@ def _task_functions(dv: UrdfDerivation, task, ns, p_arg) -> list[SeqFunction]:
         "tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (by reverse-mode AD of "
         "sum ln D_ii, Pi^U = L D L^T), what a tool design search climbs.",
         "eq. (control_conf) differentiated in the tool parameters", [p_arg] + prec_args,
-        [SeqOutput("gradient", "d ln|Pi^U| / dp, one entry per tool parameter", 7, 1)],
+        [SeqOutput("gradient", "d ln|Pi^U| / dp, one entry per tool parameter", len(dv.model.parameters), 1)],
         ca.Function(task.gradient_function, [ps] + symbols, [ca.cse(gradient)]),
         lambda v, task=task: [dv.reference_gradient(task, v["params"], precisions(v))],
     ))
@@ -197,7 +210,8 @@ def function_ir(fn: SeqFunction) -> irt.Function:
         call = [a for a in fn.args if a.name != "params"]
         body = instructions(fn.code_with, [{"name": a.name, "rows": a.rows, "cols": a.cols} for a in call] + [k_arg],
                             [o.name for o in fn.outputs])
-        made = instructions(fn.coefficients, [{"name": "params", "rows": 7, "cols": 1}], ["k"], prefix="s")
+        made = instructions(fn.coefficients, [{"name": "params", "rows": fn.coefficients.size1_in(0), "cols": 1}],
+                            ["k"], prefix="s")
         # A few hundred operations: one `let` each, the coefficient struct's form.
         temporaries, writes = as_lets(made, prefix="s")
         values = ["0.0"] * k_count
@@ -265,7 +279,8 @@ def report_tool(mass: float, com, sides) -> np.ndarray:
     m = Fraction(mass)
     a, b, c = (Fraction(s) for s in sides)
     moments = [m * (b * b + c * c) / 12, m * (a * a + c * c) / 12, m * (a * a + b * b) / 12]
-    return np.array([mass, *com, *(float(x) for x in moments)])
+    # A box in flange axes (no products), its tip at the far end of its z side.
+    return np.array([mass, *com, *(float(x) for x in moments), 0.0, 0.0, 0.0, 0.0, 0.0, float(c)])
 
 
 def singular_joints(dv: UrdfDerivation, p: np.ndarray, name: str) -> None:

@@ -47,6 +47,9 @@ from .urdf import UrdfChain
 # Code and reference graphs, both evaluated exactly, agree to this (normwise relative per output);
 # they differ only by the double rounding of constants folded while the graphs were built.
 AGREEMENT = 1e-10
+# The tool's parameters: its ten inertial numbers (mass, centre of mass, moments, products), then its
+# tip (urdf_description.TOOL_PARAMETERS).
+INERTIAL = 10
 # Forward-difference step of the 50-digit reference gradient (truncation ~h, far below 1e-12).
 GRADIENT_STEP = mpmath.mpf("1e-20")
 
@@ -98,13 +101,28 @@ class SeqFunction:
 
 def _sample_tool(rng: np.random.Generator) -> np.ndarray:
     """A physical tool, exactly: mass on a 2^-16 grid in [0.05, 3] kg, centre of mass within 5 cm
-    of the flange axis and up to 25 cm out, principal moments of a solid box whose sides lie on the
-    grid in [1, 30] cm (so the triangle inequality holds), each rounded once from exact rationals."""
+    of the flange axis and up to 25 cm out, the inertia tensor of a solid box whose sides lie on
+    the grid in [1, 30] cm, turned by a rational rotation (so it is a rigid body's), its tip within
+    5 cm of the flange axis and 5-35 cm out; each number rounded once from exact rationals."""
     mass = Fraction(float(_grid_uniform(rng, 0.05, 3.0, 1)[0]))
     com = [float(v) for v in _grid_uniform(rng, -0.05, 0.05, 2)] + [float(_grid_uniform(rng, 0.0, 0.25, 1)[0])]
     a, b, c = (Fraction(float(v)) for v in _grid_uniform(rng, 0.01, 0.30, 3))
     moments = [mass * (b * b + c * c) / 12, mass * (a * a + c * c) / 12, mass * (a * a + b * b) / 12]
-    return np.array([float(mass), *com, *(float(m) for m in moments)]).reshape(7, 1)
+    r = _rational_rotation([Fraction(int(k), 8) for k in rng.integers(-4, 4, size=3, endpoint=True)])
+    tensor = [[sum(r[i][k] * moments[k] * r[j][k] for k in range(3)) for j in range(3)] for i in range(3)]
+    tip = [float(v) for v in _grid_uniform(rng, -0.05, 0.05, 2)] + [float(_grid_uniform(rng, 0.05, 0.35, 1)[0])]
+    inertia = [tensor[0][0], tensor[1][1], tensor[2][2], tensor[0][1], tensor[0][2], tensor[1][2]]
+    return np.array([float(mass), *com, *(float(m) for m in inertia), *tip]).reshape(INERTIAL + 3, 1)
+
+
+def _rational_rotation(w: list[Fraction]) -> list[list[Fraction]]:
+    """The Cayley transform (I - W)^-1 (I + W) of the skew matrix of w: a rotation with rational
+    entries, exactly."""
+    x, y, z = w
+    d = 1 + x * x + y * y + z * z
+    return [[(1 + x * x - y * y - z * z) / d, 2 * (x * y - z) / d, 2 * (x * z + y) / d],
+            [2 * (x * y + z) / d, (1 - x * x + y * y - z * z) / d, 2 * (y * z - x) / d],
+            [2 * (x * z - y) / d, 2 * (y * z + x) / d, (1 - x * x - y * y + z * z) / d]]
 
 
 def _exact_sin_cos(values: list[float]) -> list[tuple[float, float]]:
@@ -126,6 +144,18 @@ def _column(v):
     return _sx([[x] for x in v])
 
 
+def _matvec_list(m, v):
+    """m v for a 3 x 3 of floats and a list (skipping exact zeros)."""
+    out = []
+    for row in m:
+        total = 0.0
+        for a, b in zip(row, v):
+            if a != 0.0:
+                total = a * b if isinstance(total, float) and total == 0.0 else total + a * b
+        out.append(total)
+    return out
+
+
 class UrdfDerivation:
     """The code and reference graphs of one URDF model (see the module docs)."""
 
@@ -141,7 +171,7 @@ class UrdfDerivation:
         self.u_e = np.zeros(n)
         self.x = ca.SX.sym("x", 2 * n)
         self.u = ca.SX.sym("u", n)
-        self.p = ca.SX.sym("params", 7)
+        self.p = ca.SX.sym("params", len(model.parameters))
         self.k = ca.SX.sym("coefficients", 10 + n)
         self.revolute = [b.kind == "revolute" for b in chain.bodies]
         self._build_code()
@@ -153,7 +183,10 @@ class UrdfDerivation:
         return [(ca.sin(q[i]), ca.cos(q[i])) if self.revolute[i] else None for i in range(self.n)]
 
     def _last(self, p):
-        return self.dyn.tool_parameters([p[i] for i in range(7)])
+        return self.dyn.tool_parameters([p[i] for i in range(INERTIAL)])
+
+    def _tip_offset(self, p):
+        return [p[i] for i in range(INERTIAL, INERTIAL + 3)]
 
     def _gravity_at_equilibrium(self, last):
         return self.dyn.rnea(self.q_e, self.trig_e, [0.0] * self.n, [0.0] * self.n, last)
@@ -212,6 +245,44 @@ class UrdfDerivation:
                                            [ca.cse(e) for e in self.jacobian_with(x, u, inline)])
         self._build_rigid_body()
         self._build_linearisation()
+        self._build_tip()
+
+    def tip_with(self, q, trig, p):
+        """The tip y(q; p) in the base frame and its Jacobian J = dy/dq (3 x n): the joint frames
+        composed from the base outwards, then the flange and the tool's tip offset; J's columns are
+        geometric, z_i x (y - o_i) for a revolute joint about the axis z_i through o_i, z_i for a
+        prismatic one (both in the base frame)."""
+        rot, pos = ca.SX.eye(3), ca.SX.zeros(3, 1)
+        axes, origins = [], []
+        for b, j in zip(self.chain.bodies, self.dyn.joints(q, trig)):
+            pos = pos + rot @ _column(j.p)
+            r0 = _sx([list(r) for r in b.rotation])
+            axes.append(rot @ r0 @ _column(list(b.axis)))
+            origins.append(pos)
+            cols = [j.to_parent([1.0 if r == k else 0.0 for r in range(3)]) for k in range(3)]
+            rot = rot @ ca.horzcat(*[_column(col) for col in cols])
+        flange = pos + rot @ _column(list(self.chain.flange_translation))
+        y = flange + rot @ _sx([list(r) for r in self.chain.flange_rotation]) @ _column(self._tip_offset(p))
+        columns = [ca.cross(z, y - o) if kind else z for z, o, kind in zip(axes, origins, self.revolute)]
+        return y, ca.horzcat(*columns)
+
+    def _reference_tip(self, q, trig, p):
+        """The same tip by the other composition order: the offset carried from the flange inwards,
+        one parent frame at a time, and J by AD of that graph (not the geometric formula)."""
+        v = [a + b for a, b in zip(_matvec_list(self.chain.flange_rotation, self._tip_offset(p)),
+                                   self.chain.flange_translation)]
+        for j in reversed(self.dyn.joints(q, trig)):
+            v = [a + b for a, b in zip(j.to_parent(v), j.p)]
+        return ca.vertcat(*v)
+
+    def _build_tip(self):
+        n, p = self.n, self.p
+        q = ca.SX.sym("q", n)
+        qs = [q[i] for i in range(n)]
+        y, jac = self.tip_with(qs, self._symbolic_trig(qs), p)
+        self.tip = ca.Function("tip", [q, p], [ca.cse(y), ca.cse(jac)])
+        y_ref = self._reference_tip(qs, self._symbolic_trig(qs), p)
+        self.reference_tip = ExactFunction(ca.Function("tip_ref", [q, p], [y_ref, ca.jacobian(y_ref, q)]))
 
     def _build_rigid_body(self):
         """The robot's own rigid-body dynamics, U the joint torques and no impedance:

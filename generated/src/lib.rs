@@ -61,6 +61,91 @@ pub mod rigid_body {
     pub use crate::ur5::rigid_body_dynamics as ur5;
 }
 
+/// Each model's tool tip y(q; p) (base frame, m) and its Jacobian J = ∂y/∂q (3 × DOF):
+/// `tip::<model>(q, params)`, `None` for a model whose description gives no tip.
+pub mod tip {
+    #[allow(unused_imports)]
+    use nalgebra::{SMatrix, SVector};
+
+    /// `arm2`'s tip.
+    #[inline]
+    #[must_use]
+    pub fn arm2(
+        q: &SVector<f64, { crate::arm2::DOF }>,
+        params: &SVector<f64, { crate::arm2::PARAMETER_COUNT }>,
+    ) -> Option<(SVector<f64, 3>, SMatrix<f64, 3, { crate::arm2::DOF }>)> {
+        let _ = (q, params);
+        None
+    }
+
+    /// `arm2_exact`'s tip.
+    #[inline]
+    #[must_use]
+    pub fn arm2_exact(
+        q: &SVector<f64, { crate::arm2_exact::DOF }>,
+        params: &SVector<f64, { crate::arm2_exact::PARAMETER_COUNT }>,
+    ) -> Option<(SVector<f64, 3>, SMatrix<f64, 3, { crate::arm2_exact::DOF }>)> {
+        let _ = (q, params);
+        None
+    }
+
+    /// `arm2_payload`'s tip.
+    #[inline]
+    #[must_use]
+    pub fn arm2_payload(
+        q: &SVector<f64, { crate::arm2_payload::DOF }>,
+        params: &SVector<f64, { crate::arm2_payload::PARAMETER_COUNT }>,
+    ) -> Option<(
+        SVector<f64, 3>,
+        SMatrix<f64, 3, { crate::arm2_payload::DOF }>,
+    )> {
+        let _ = (q, params);
+        None
+    }
+
+    /// `arm3`'s tip.
+    #[inline]
+    #[must_use]
+    pub fn arm3(
+        q: &SVector<f64, { crate::arm3::DOF }>,
+        params: &SVector<f64, { crate::arm3::PARAMETER_COUNT }>,
+    ) -> Option<(SVector<f64, 3>, SMatrix<f64, 3, { crate::arm3::DOF }>)> {
+        let _ = (q, params);
+        None
+    }
+
+    /// `msd`'s tip.
+    #[inline]
+    #[must_use]
+    pub fn msd(
+        q: &SVector<f64, { crate::msd::DOF }>,
+        params: &SVector<f64, { crate::msd::PARAMETER_COUNT }>,
+    ) -> Option<(SVector<f64, 3>, SMatrix<f64, 3, { crate::msd::DOF }>)> {
+        let _ = (q, params);
+        None
+    }
+
+    /// `panda`'s tip.
+    #[inline]
+    #[must_use]
+    pub fn panda(
+        q: &SVector<f64, { crate::panda::DOF }>,
+        params: &SVector<f64, { crate::panda::PARAMETER_COUNT }>,
+    ) -> Option<(SVector<f64, 3>, SMatrix<f64, 3, { crate::panda::DOF }>)> {
+        Some(crate::panda::tip(q, params))
+    }
+
+    /// `ur5`'s tip.
+    #[inline]
+    #[must_use]
+    pub fn ur5(
+        q: &SVector<f64, { crate::ur5::DOF }>,
+        params: &SVector<f64, { crate::ur5::PARAMETER_COUNT }>,
+    ) -> Option<(SVector<f64, 3>, SMatrix<f64, 3, { crate::ur5::DOF }>)> {
+        Some(crate::ur5::tip(q, params))
+    }
+}
+
 /// The names of the generated models, in registry order.
 pub const MODEL_NAMES: [&str; 7] = [
     "arm2",
@@ -73,7 +158,7 @@ pub const MODEL_NAMES: [&str; 7] = [
 ];
 
 /// The most tool parameters of any model: a tool of any model fits in this many.
-pub const MAX_PARAMETER_COUNT: usize = 7;
+pub const MAX_PARAMETER_COUNT: usize = 13;
 
 /// A constraint c · p ≤ 0 across a model's tool parameters, with its length known only at run
 /// time (the typed one is `validity::<model>::RULE`'s).
@@ -123,6 +208,12 @@ pub struct ModelInfo {
     pub constraints: &'static [Constraint],
     /// The box random tools are drawn from, (lo, hi) per parameter.
     pub sample: &'static [(f64, f64)],
+    /// Per parameter, what a tools file that leaves its column out means (`None`: required).
+    pub defaults: &'static [Option<f64>],
+    /// The rule the inertia tensor among the parameters obeys, if there is one.
+    pub inertia: Option<validity::InertiaRule>,
+    /// Whether the model's tools have a tip (`tip::<name>` gives `Some`).
+    pub has_tip: bool,
     /// The equilibrium X^e = [q^e; q̇^e] the model is linearised at.
     pub equilibrium_state: &'static [f64],
     /// The equilibrium torque U^e.
@@ -146,6 +237,9 @@ pub static MODELS: [ModelInfo; 7] = [
         domains: &validity::arm2::RULE.domains,
         constraints: &[],
         sample: &validity::arm2::RULE.sample,
+        defaults: &validity::arm2::RULE.defaults,
+        inertia: validity::arm2::RULE.inertia,
+        has_tip: false,
         equilibrium_state: &arm2::EQUILIBRIUM_STATE,
         equilibrium_control: &arm2::EQUILIBRIUM_CONTROL,
         tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
@@ -163,6 +257,9 @@ pub static MODELS: [ModelInfo; 7] = [
         domains: &validity::arm2_exact::RULE.domains,
         constraints: &[],
         sample: &validity::arm2_exact::RULE.sample,
+        defaults: &validity::arm2_exact::RULE.defaults,
+        inertia: validity::arm2_exact::RULE.inertia,
+        has_tip: false,
         equilibrium_state: &arm2_exact::EQUILIBRIUM_STATE,
         equilibrium_control: &arm2_exact::EQUILIBRIUM_CONTROL,
         tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
@@ -180,6 +277,9 @@ pub static MODELS: [ModelInfo; 7] = [
         domains: &validity::arm2_payload::RULE.domains,
         constraints: &[],
         sample: &validity::arm2_payload::RULE.sample,
+        defaults: &validity::arm2_payload::RULE.defaults,
+        inertia: validity::arm2_payload::RULE.inertia,
+        has_tip: false,
         equilibrium_state: &arm2_payload::EQUILIBRIUM_STATE,
         equilibrium_control: &arm2_payload::EQUILIBRIUM_CONTROL,
         tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
@@ -197,6 +297,9 @@ pub static MODELS: [ModelInfo; 7] = [
         domains: &validity::arm3::RULE.domains,
         constraints: &[],
         sample: &validity::arm3::RULE.sample,
+        defaults: &validity::arm3::RULE.defaults,
+        inertia: validity::arm3::RULE.inertia,
+        has_tip: false,
         equilibrium_state: &arm3::EQUILIBRIUM_STATE,
         equilibrium_control: &arm3::EQUILIBRIUM_CONTROL,
         tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
@@ -214,6 +317,9 @@ pub static MODELS: [ModelInfo; 7] = [
         domains: &validity::msd::RULE.domains,
         constraints: &[],
         sample: &validity::msd::RULE.sample,
+        defaults: &validity::msd::RULE.defaults,
+        inertia: validity::msd::RULE.inertia,
+        has_tip: false,
         equilibrium_state: &msd::EQUILIBRIUM_STATE,
         equilibrium_control: &msd::EQUILIBRIUM_CONTROL,
         tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
@@ -235,6 +341,9 @@ pub static MODELS: [ModelInfo; 7] = [
             Constraint::of(&validity::panda::RULE, 2),
         ],
         sample: &validity::panda::RULE.sample,
+        defaults: &validity::panda::RULE.defaults,
+        inertia: validity::panda::RULE.inertia,
+        has_tip: true,
         equilibrium_state: &panda::EQUILIBRIUM_STATE,
         equilibrium_control: &panda::EQUILIBRIUM_CONTROL,
         tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
@@ -256,6 +365,9 @@ pub static MODELS: [ModelInfo; 7] = [
             Constraint::of(&validity::ur5::RULE, 2),
         ],
         sample: &validity::ur5::RULE.sample,
+        defaults: &validity::ur5::RULE.defaults,
+        inertia: validity::ur5::RULE.inertia,
+        has_tip: true,
         equilibrium_state: &ur5::EQUILIBRIUM_STATE,
         equilibrium_control: &ur5::EQUILIBRIUM_CONTROL,
         tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],

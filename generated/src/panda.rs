@@ -23,9 +23,9 @@ pub const DOF: usize = 7;
 /// Dimension of the state X = [q; q_dot].
 pub const STATE_DIM: usize = 14;
 /// Number of tool parameters.
-pub const PARAMETER_COUNT: usize = 7;
+pub const PARAMETER_COUNT: usize = 13;
 /// Tool parameters, in the order every function takes them.
-pub const PARAMETER_NAMES: [&str; 7] = [
+pub const PARAMETER_NAMES: [&str; 13] = [
     "tool_mass",
     "tool_com_x",
     "tool_com_y",
@@ -33,9 +33,17 @@ pub const PARAMETER_NAMES: [&str; 7] = [
     "tool_ixx",
     "tool_iyy",
     "tool_izz",
+    "tool_ixy",
+    "tool_ixz",
+    "tool_iyz",
+    "tool_tip_x",
+    "tool_tip_y",
+    "tool_tip_z",
 ];
 /// Units of the tool parameters.
-pub const PARAMETER_UNITS: [&str; 7] = ["kg", "m", "m", "m", "kg m^2", "kg m^2", "kg m^2"];
+pub const PARAMETER_UNITS: [&str; 13] = [
+    "kg", "m", "m", "m", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "kg m^2", "m", "m", "m",
+];
 /// State names, X = [q; q_dot].
 pub const STATE_NAMES: [&str; 14] = [
     "panda_joint1",
@@ -311,12 +319,12 @@ pub struct DynamicsCoefficients {
 }
 
 impl DynamicsCoefficients {
-    /// - `params`: tool parameters `[tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]`
+    /// - `params`: tool parameters `[tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]`
     ///
-    /// Cost, once per tool: 131 operations, weighted 131 (43 ADD, 59 MUL, 1 NEG, 28 SUB) (derive/toolconf_derive/cost.py).
+    /// Cost, once per tool: 134 operations, weighted 134 (46 ADD, 59 MUL, 1 NEG, 28 SUB) (derive/toolconf_derive/cost.py).
     #[inline]
     #[must_use]
-    pub fn new(params: &SVector<f64, 7>) -> Self {
+    pub fn new(params: &SVector<f64, 13>) -> Self {
         let params_0 = params[0];
         let params_1 = params[1];
         let params_2 = params[2];
@@ -324,6 +332,9 @@ impl DynamicsCoefficients {
         let params_4 = params[4];
         let params_5 = params[5];
         let params_6 = params[6];
+        let params_7 = params[7];
+        let params_8 = params[8];
+        let params_9 = params[9];
         let s2_0 = 0.735522 + params_0;
         let s4_1 = params_0 * params_1;
         let s4_2 = 0.007735484874 + s4_1;
@@ -350,115 +361,118 @@ impl DynamicsCoefficients {
         let s12_23 = params_0 * s12_10;
         let s11_24 = params_6 + s12_23;
         let s10_25 = 0.004909651967360946 + s11_24;
-        let s11_26 = params_1 * params_2;
-        let s11_27 = params_0 * s11_26;
-        let s10_28 = (-0.000395108718315752) - s11_27;
-        let s11_29 = params_1 * s9_5;
-        let s11_30 = params_0 * s11_29;
-        let s10_31 = (-0.001672482661783778) - s11_30;
-        let s9_32 = params_2 * s9_5;
-        let s9_33 = params_0 * s9_32;
-        let s10_34 = (-0.000548359106408232) - s9_33;
-        let s5_35 = params_0 * params_2;
-        let s4_36 = (-0.0031274395439999996) + s5_35;
-        let s5_37 = (-9.81) * s4_36;
-        let s7_38 = params_3 + 0.107;
-        let s7_39 = params_0 * s7_38;
-        let s6_40 = 0.045305948634 + s7_39;
-        let s7_41 = 4.2475144558350945e-16 * s6_40;
-        let s5_42 = s5_37 - s7_41;
-        let s7_43 = 0.7071067811865476 * s5_42;
-        let s6_44 = (-4.247514455835095e-16) * s6_40;
-        let s3_45 = params_0 * params_1;
-        let s2_46 = 0.007735484874 + s3_45;
-        let s3_47 = (-9.81) * s2_46;
-        let s6_48 = s6_44 - s3_47;
-        let s3_49 = 0.7071067811865475 * s6_48;
-        let s7_50 = s7_43 - s3_49;
-        let s13_51 = 0.17194142915235003 + s7_50;
-        let s7_52 = 6.123233995736766e-17 * s13_51;
-        let s16_53 = 4.2475144558350945e-16 * s2_46;
-        let s17_54 = (-4.247514455835095e-16) * s4_36;
-        let s16_55 = s16_53 - s17_54;
-        let s3_56 = 1.0528376042612343e-17 - s16_55;
-        let s0_57 = 0.735522 + params_0;
-        let s4_58 = (-3.003446274908884e-16) * s0_57;
-        let s1_59 = 3.003446274908884e-16 * s0_57;
-        let s4_60 = s4_58 + s1_59;
-        let s17_61 = 0.088 * s4_60;
-        let s3_62 = s3_56 - s17_61;
-        let s7_63 = s7_52 - s3_62;
-        let s1_64 = 0.384 * s4_60;
-        let s7_65 = s7_63 + s1_64;
-        let s1_66 = (-0.7071067811865475) * s7_65;
-        let s3_67 = 6.123233995736766e-17 * s3_62;
-        let s13_68 = s13_51 + s3_67;
-        let s19_69 = 0.4938694651269 + s13_68;
-        let s18_70 = (-0.9663053001273) + s19_69;
-        let s3_71 = (-0.0825) * s4_60;
-        let s18_72 = s18_70 - s3_71;
-        let s3_73 = (-0.7071067811865476) * s18_72;
-        let s1_74 = s1_66 - s3_73;
-        let s11_75 = 0.879084414092543 + s1_74;
-        let s9_76 = 0.015683962507388537 + s11_75;
-        let s1_77 = (-0.316) * s4_60;
-        let s9_78 = s9_76 - s1_77;
-        let s9_79 = (-0.7071067811865475) * s9_78;
-        let s7_80 = (-0.7071067811865476) * s7_65;
-        let s18_81 = (-0.7071067811865475) * s18_72;
-        let s7_82 = s7_80 + s18_81;
-        let s3_83 = (-0.8790844140925428) + s7_82;
-        let s4_84 = 0.0825 * s4_60;
-        let s3_85 = s3_83 - s4_84;
-        let s1_86 = 0.015683962507388533 - s3_85;
-        let s1_87 = 0.7071067811865476 * s1_86;
-        let s9_88 = s9_79 + s1_87;
-        let s9_89 = -s9_88;
-        let s8_90 = 0.7071067811865475 * s5_42;
-        let s14_91 = 0.7071067811865476 * s6_48;
-        let s8_92 = s8_90 + s14_91;
-        let s21_93 = 0.9833702597779501 + s8_92;
-        let s8_94 = (-0.86328) * s0_57;
-        let s21_95 = s21_93 - s8_94;
-        let s20_96 = 0.46226374360362 - s21_95;
-        let s18_97 = 3.67526164252905 - s20_96;
-        let s8_98 = (-3.0034462749088843e-16) * s0_57;
-        let s14_99 = 3.0034462749088833e-16 * s0_57;
-        let s8_100 = s8_98 - s14_99;
-        let s20_101 = (-1.001081681336155e-15) + s8_100;
-        let s15_102 = (-9.81) * s0_57;
-        let s8_103 = 16.34890455 - s15_102;
-        let s15_104 = 6.123233995736766e-17 * s8_103;
-        let s15_105 = s20_101 + s15_104;
-        let s13_106 = (-0.0825) * s15_105;
-        let s12_107 = 6.123233995736766e-17 * s20_101;
-        let s12_108 = s12_107 - s8_103;
-        let s0_109 = (-12.026530260000001) + s12_108;
-        let s17_110 = 0.384 * s0_109;
-        let s13_111 = s13_106 - s17_110;
-        let s18_112 = s18_97 + s13_111;
-        let s4_113 = (-2.1056638289254273) - s18_112;
-        let s13_114 = (-35.19724995) + s0_109;
-        let s0_115 = (-0.7071067811865476) * s13_114;
-        let s17_116 = (-0.7071067811865475) * s15_105;
-        let s0_117 = s0_115 + s17_116;
-        let s7_118 = 0.0825 * s0_117;
-        let s4_119 = s4_113 - s7_118;
-        let s1_120 = 0.1429776049922478 + s4_119;
-        let s10_121 = (-0.7071067811865475) * s13_114;
-        let s2_122 = (-0.7071067811865476) * s15_105;
-        let s10_123 = s10_121 - s2_122;
-        let s4_124 = 22.395913943048576 + s10_123;
-        let s11_125 = (-0.316) * s4_124;
-        let s1_126 = s1_120 - s11_125;
-        let s9_127 = (-471.23889803846896) + s1_126;
-        let s3_128 = (-1413.7166941154069) + s18_112;
-        let s19_129 = 235.61944901923448 + s21_95;
-        let s19_130 = 39.269908169872416 + s16_55;
+        let s12_26 = params_1 * params_2;
+        let s12_27 = params_0 * s12_26;
+        let s11_28 = params_7 - s12_27;
+        let s10_29 = (-0.000395108718315752) + s11_28;
+        let s12_30 = params_1 * s9_5;
+        let s12_31 = params_0 * s12_30;
+        let s11_32 = params_8 - s12_31;
+        let s10_33 = (-0.001672482661783778) + s11_32;
+        let s9_34 = params_2 * s9_5;
+        let s9_35 = params_0 * s9_34;
+        let s11_36 = params_9 - s9_35;
+        let s10_37 = (-0.000548359106408232) + s11_36;
+        let s5_38 = params_0 * params_2;
+        let s4_39 = (-0.0031274395439999996) + s5_38;
+        let s5_40 = (-9.81) * s4_39;
+        let s7_41 = params_3 + 0.107;
+        let s7_42 = params_0 * s7_41;
+        let s6_43 = 0.045305948634 + s7_42;
+        let s7_44 = 4.2475144558350945e-16 * s6_43;
+        let s5_45 = s5_40 - s7_44;
+        let s7_46 = 0.7071067811865476 * s5_45;
+        let s6_47 = (-4.247514455835095e-16) * s6_43;
+        let s3_48 = params_0 * params_1;
+        let s2_49 = 0.007735484874 + s3_48;
+        let s3_50 = (-9.81) * s2_49;
+        let s6_51 = s6_47 - s3_50;
+        let s3_52 = 0.7071067811865475 * s6_51;
+        let s7_53 = s7_46 - s3_52;
+        let s13_54 = 0.17194142915235003 + s7_53;
+        let s7_55 = 6.123233995736766e-17 * s13_54;
+        let s16_56 = 4.2475144558350945e-16 * s2_49;
+        let s17_57 = (-4.247514455835095e-16) * s4_39;
+        let s16_58 = s16_56 - s17_57;
+        let s3_59 = 1.0528376042612343e-17 - s16_58;
+        let s0_60 = 0.735522 + params_0;
+        let s4_61 = (-3.003446274908884e-16) * s0_60;
+        let s1_62 = 3.003446274908884e-16 * s0_60;
+        let s4_63 = s4_61 + s1_62;
+        let s17_64 = 0.088 * s4_63;
+        let s3_65 = s3_59 - s17_64;
+        let s7_66 = s7_55 - s3_65;
+        let s1_67 = 0.384 * s4_63;
+        let s7_68 = s7_66 + s1_67;
+        let s1_69 = (-0.7071067811865475) * s7_68;
+        let s3_70 = 6.123233995736766e-17 * s3_65;
+        let s13_71 = s13_54 + s3_70;
+        let s19_72 = 0.4938694651269 + s13_71;
+        let s18_73 = (-0.9663053001273) + s19_72;
+        let s3_74 = (-0.0825) * s4_63;
+        let s18_75 = s18_73 - s3_74;
+        let s3_76 = (-0.7071067811865476) * s18_75;
+        let s1_77 = s1_69 - s3_76;
+        let s9_78 = 0.879084414092543 + s1_77;
+        let s11_79 = 0.015683962507388537 + s9_78;
+        let s1_80 = (-0.316) * s4_63;
+        let s11_81 = s11_79 - s1_80;
+        let s11_82 = (-0.7071067811865475) * s11_81;
+        let s7_83 = (-0.7071067811865476) * s7_68;
+        let s18_84 = (-0.7071067811865475) * s18_75;
+        let s7_85 = s7_83 + s18_84;
+        let s3_86 = (-0.8790844140925428) + s7_85;
+        let s4_87 = 0.0825 * s4_63;
+        let s3_88 = s3_86 - s4_87;
+        let s1_89 = 0.015683962507388533 - s3_88;
+        let s1_90 = 0.7071067811865476 * s1_89;
+        let s11_91 = s11_82 + s1_90;
+        let s11_92 = -s11_91;
+        let s8_93 = 0.7071067811865475 * s5_45;
+        let s14_94 = 0.7071067811865476 * s6_51;
+        let s8_95 = s8_93 + s14_94;
+        let s21_96 = 0.9833702597779501 + s8_95;
+        let s8_97 = (-0.86328) * s0_60;
+        let s21_98 = s21_96 - s8_97;
+        let s20_99 = 0.46226374360362 - s21_98;
+        let s18_100 = 3.67526164252905 - s20_99;
+        let s8_101 = (-3.0034462749088843e-16) * s0_60;
+        let s14_102 = 3.0034462749088833e-16 * s0_60;
+        let s8_103 = s8_101 - s14_102;
+        let s20_104 = (-1.001081681336155e-15) + s8_103;
+        let s15_105 = (-9.81) * s0_60;
+        let s8_106 = 16.34890455 - s15_105;
+        let s15_107 = 6.123233995736766e-17 * s8_106;
+        let s15_108 = s20_104 + s15_107;
+        let s13_109 = (-0.0825) * s15_108;
+        let s12_110 = 6.123233995736766e-17 * s20_104;
+        let s12_111 = s12_110 - s8_106;
+        let s0_112 = (-12.026530260000001) + s12_111;
+        let s17_113 = 0.384 * s0_112;
+        let s13_114 = s13_109 - s17_113;
+        let s18_115 = s18_100 + s13_114;
+        let s4_116 = (-2.1056638289254273) - s18_115;
+        let s13_117 = (-35.19724995) + s0_112;
+        let s0_118 = (-0.7071067811865476) * s13_117;
+        let s17_119 = (-0.7071067811865475) * s15_108;
+        let s0_120 = s0_118 + s17_119;
+        let s7_121 = 0.0825 * s0_120;
+        let s4_122 = s4_116 - s7_121;
+        let s1_123 = 0.1429776049922478 + s4_122;
+        let s10_124 = (-0.7071067811865475) * s13_117;
+        let s2_125 = (-0.7071067811865476) * s15_108;
+        let s10_126 = s10_124 - s2_125;
+        let s4_127 = 22.395913943048576 + s10_126;
+        let s9_128 = (-0.316) * s4_127;
+        let s1_129 = s1_123 - s9_128;
+        let s11_130 = (-471.23889803846896) + s1_129;
+        let s3_131 = (-1413.7166941154069) + s18_115;
+        let s19_132 = 235.61944901923448 + s21_98;
+        let s19_133 = 39.269908169872416 + s16_58;
         Self {
             k: [
-                s2_0, s4_2, s6_4, s10_7, s10_17, s10_22, s10_25, s10_28, s10_31, s10_34, s9_89,
-                s9_127, s3_85, s3_128, s19_69, s19_129, s19_130,
+                s2_0, s4_2, s6_4, s10_7, s10_17, s10_22, s10_25, s10_29, s10_33, s10_37, s11_92,
+                s11_130, s3_88, s3_131, s19_72, s19_132, s19_133,
             ],
         }
     }
@@ -470,17 +484,17 @@ impl DynamicsCoefficients {
 ///
 /// - `x`: state X = [panda_joint1 panda_joint2 panda_joint3 panda_joint4 panda_joint5 panda_joint6 panda_joint7 panda_joint1_dot panda_joint2_dot panda_joint3_dot panda_joint4_dot panda_joint5_dot panda_joint6_dot panda_joint7_dot]
 /// - `u`: control U = [panda_joint1_torque panda_joint2_torque panda_joint3_torque panda_joint4_torque panda_joint5_torque panda_joint6_torque panda_joint7_torque]
-/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
 ///
-/// Cost per call: 1672 operations, weighted 1868, plus 6 `sin_cos`: [`DynamicsCoefficients::new`] (131, weighted 131), then [`dynamics_with`] (1541, weighted 1737). Build the coefficients once per tool and call [`dynamics_with`] where it is called often.
-/// The same closed form with the parameters inline (not hoisted) would take 1661 operations, weighted 1857 (434 ADD, 28 DIV, 867 MUL, 332 SUB), plus 6 `sin_cos`.
+/// Cost per call: 1675 operations, weighted 1871, plus 6 `sin_cos`: [`DynamicsCoefficients::new`] (134, weighted 134), then [`dynamics_with`] (1541, weighted 1737). Build the coefficients once per tool and call [`dynamics_with`] where it is called often.
+/// The same closed form with the parameters inline (not hoisted) would take 1664 operations, weighted 1860 (437 ADD, 28 DIV, 867 MUL, 332 SUB), plus 6 `sin_cos`.
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
 pub fn dynamics(
     x: &SVector<f64, 14>,
     u: &SVector<f64, 7>,
-    params: &SVector<f64, 7>,
+    params: &SVector<f64, 13>,
 ) -> SVector<f64, 14> {
     dynamics_with(x, u, &DynamicsCoefficients::new(params))
 }
@@ -2259,17 +2273,17 @@ pub type DynamicsJacobianCoefficients = DynamicsCoefficients;
 ///
 /// - `x`: state X = [panda_joint1 panda_joint2 panda_joint3 panda_joint4 panda_joint5 panda_joint6 panda_joint7 panda_joint1_dot panda_joint2_dot panda_joint3_dot panda_joint4_dot panda_joint5_dot panda_joint6_dot panda_joint7_dot]
 /// - `u`: control U = [panda_joint1_torque panda_joint2_torque panda_joint3_torque panda_joint4_torque panda_joint5_torque panda_joint6_torque panda_joint7_torque]
-/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
 ///
-/// Cost per call: 11403 operations, weighted 12663, plus 6 `sin_cos`: [`DynamicsCoefficients::new`] (131, weighted 131), then [`dynamics_jacobian_with`] (11272, weighted 12532). Build the coefficients once per tool and call [`dynamics_jacobian_with`] where it is called often.
-/// The same closed form with the parameters inline (not hoisted) would take 11430 operations, weighted 12690 (2771 ADD, 180 DIV, 6037 MUL, 91 NEG, 2351 SUB), plus 6 `sin_cos`.
+/// Cost per call: 11406 operations, weighted 12666, plus 6 `sin_cos`: [`DynamicsCoefficients::new`] (134, weighted 134), then [`dynamics_jacobian_with`] (11272, weighted 12532). Build the coefficients once per tool and call [`dynamics_jacobian_with`] where it is called often.
+/// The same closed form with the parameters inline (not hoisted) would take 11433 operations, weighted 12693 (2774 ADD, 180 DIV, 6037 MUL, 91 NEG, 2351 SUB), plus 6 `sin_cos`.
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
 pub fn dynamics_jacobian(
     x: &SVector<f64, 14>,
     u: &SVector<f64, 7>,
-    params: &SVector<f64, 7>,
+    params: &SVector<f64, 13>,
 ) -> (SMatrix<f64, 14, 14>, SMatrix<f64, 14, 7>) {
     dynamics_jacobian_with(x, u, &DynamicsCoefficients::new(params))
 }
@@ -14149,19 +14163,22 @@ pub fn dynamics_jacobian_with(
 ///
 /// From eq. (LTI) for the arm under joint impedance.
 ///
-/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
 ///
-/// Cost per call: 2264 operations, weighted 2950 (493 ADD, 98 DIV, 1032 MUL, 71 NEG, 570 SUB).
+/// Cost per call: 2267 operations, weighted 2953 (496 ADD, 98 DIV, 1032 MUL, 71 NEG, 570 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
-pub fn state_matrix(params: &SVector<f64, 7>) -> SMatrix<f64, 14, 14> {
+pub fn state_matrix(params: &SVector<f64, 13>) -> SMatrix<f64, 14, 14> {
     let params_4 = params[4];
     let params_0 = params[0];
     let params_1 = params[1];
     let params_2 = params[2];
     let params_3 = params[3];
+    let params_7 = params[7];
     let params_5 = params[5];
+    let params_9 = params[9];
+    let params_8 = params[8];
     let params_6 = params[6];
     // A
     let mut a = <SMatrix<f64, 14, 14>>::zeros();
@@ -14289,9 +14306,10 @@ pub fn state_matrix(params: &SVector<f64, 7>) -> SMatrix<f64, 14, 14> {
     w11 = params_4 + w14;
     w10 = 0.015320008390949585 + w11;
     w11 = 0.7071067811865476 * w10;
-    w21 = params_1 * params_2;
-    w21 = params_0 * w21;
-    w20 = (-0.000395108718315752) - w21;
+    w22 = params_1 * params_2;
+    w22 = params_0 * w22;
+    w21 = params_7 - w22;
+    w20 = (-0.000395108718315752) + w21;
     w21 = 0.7071067811865475 * w20;
     w11 = w11 - w21;
     w11 = 0.7071067811865476 * w11;
@@ -14306,13 +14324,15 @@ pub fn state_matrix(params: &SVector<f64, 7>) -> SMatrix<f64, 14, 14> {
     w11 = w11 - w23;
     w8 = 0.00248046035817079 + w11;
     w11 = 6.123233995736766e-17 * w8;
-    w16 = params_2 * w18;
-    w16 = params_0 * w16;
-    w19 = (-0.000548359106408232) - w16;
+    w24 = params_2 * w18;
+    w24 = params_0 * w24;
+    w16 = params_9 - w24;
+    w19 = (-0.000548359106408232) + w16;
     w16 = 0.7071067811865475 * w19;
-    w25 = params_1 * w18;
-    w25 = params_0 * w25;
-    w24 = (-0.001672482661783778) - w25;
+    w26 = params_1 * w18;
+    w26 = params_0 * w26;
+    w25 = params_8 - w26;
+    w24 = (-0.001672482661783778) + w25;
     w25 = 0.7071067811865476 * w24;
     w26 = w16 - w25;
     w18 = params_0 * w18;
@@ -16654,19 +16674,22 @@ pub fn state_matrix(params: &SVector<f64, 7>) -> SMatrix<f64, 14, 14> {
 ///
 /// From eq. (LTI) for the arm under joint impedance.
 ///
-/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
 ///
-/// Cost per call: 905 operations, weighted 1283 (218 ADD, 54 DIV, 398 MUL, 35 NEG, 200 SUB).
+/// Cost per call: 908 operations, weighted 1286 (221 ADD, 54 DIV, 398 MUL, 35 NEG, 200 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
-pub fn input_matrix(params: &SVector<f64, 7>) -> SMatrix<f64, 14, 7> {
+pub fn input_matrix(params: &SVector<f64, 13>) -> SMatrix<f64, 14, 7> {
     let params_4 = params[4];
     let params_0 = params[0];
     let params_1 = params[1];
     let params_2 = params[2];
     let params_3 = params[3];
+    let params_7 = params[7];
     let params_5 = params[5];
+    let params_9 = params[9];
+    let params_8 = params[8];
     let params_6 = params[6];
     // B
     let mut b = <SMatrix<f64, 14, 7>>::zeros();
@@ -16740,9 +16763,10 @@ pub fn input_matrix(params: &SVector<f64, 7>) -> SMatrix<f64, 14, 7> {
     w10 = params_4 + w13;
     w9 = 0.015320008390949585 + w10;
     w10 = 0.7071067811865476 * w9;
-    w20 = params_1 * params_2;
-    w20 = params_0 * w20;
-    w19 = (-0.000395108718315752) - w20;
+    w21 = params_1 * params_2;
+    w21 = params_0 * w21;
+    w20 = params_7 - w21;
+    w19 = (-0.000395108718315752) + w20;
     w20 = 0.7071067811865475 * w19;
     w10 = w10 - w20;
     w10 = 0.7071067811865476 * w10;
@@ -16757,13 +16781,15 @@ pub fn input_matrix(params: &SVector<f64, 7>) -> SMatrix<f64, 14, 7> {
     w10 = w10 - w22;
     w7 = 0.00248046035817079 + w10;
     w10 = 6.123233995736766e-17 * w7;
-    w15 = params_2 * w17;
-    w15 = params_0 * w15;
-    w18 = (-0.000548359106408232) - w15;
+    w23 = params_2 * w17;
+    w23 = params_0 * w23;
+    w15 = params_9 - w23;
+    w18 = (-0.000548359106408232) + w15;
     w15 = 0.7071067811865475 * w18;
-    w24 = params_1 * w17;
-    w24 = params_0 * w24;
-    w23 = (-0.001672482661783778) - w24;
+    w25 = params_1 * w17;
+    w25 = params_0 * w25;
+    w24 = params_8 - w25;
+    w23 = (-0.001672482661783778) + w24;
     w24 = 0.7071067811865476 * w23;
     w25 = w15 - w24;
     w17 = params_0 * w17;
@@ -17690,21 +17716,24 @@ pub fn input_matrix(params: &SVector<f64, 7>) -> SMatrix<f64, 14, 7> {
 ///
 /// From appendix "Task specific controllers".
 ///
-/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
 ///
-/// Cost per call: 2691 operations, weighted 3657 (635 ADD, 138 DIV, 1238 MUL, 10 NEG, 670 SUB).
+/// Cost per call: 2694 operations, weighted 3660 (638 ADD, 138 DIV, 1238 MUL, 10 NEG, 670 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
 pub fn position_sensitivity(
-    params: &SVector<f64, 7>,
+    params: &SVector<f64, 13>,
 ) -> (SMatrix<f64, 7, 7>, SMatrix<f64, 7, 7>, SMatrix<f64, 7, 7>) {
     let params_4 = params[4];
     let params_0 = params[0];
     let params_1 = params[1];
     let params_2 = params[2];
     let params_3 = params[3];
+    let params_7 = params[7];
     let params_5 = params[5];
+    let params_9 = params[9];
+    let params_8 = params[8];
     let params_6 = params[6];
     // dtheta/dU = IO @ inv(A) @ (E - B)
     let mut d_theta_du = <SMatrix<f64, 7, 7>>::zeros();
@@ -17848,9 +17877,10 @@ pub fn position_sensitivity(
     w12 = params_4 + w15;
     w11 = 0.015320008390949585 + w12;
     w12 = 0.7071067811865476 * w11;
-    w22 = params_1 * params_2;
-    w22 = params_0 * w22;
-    w21 = (-0.000395108718315752) - w22;
+    w23 = params_1 * params_2;
+    w23 = params_0 * w23;
+    w22 = params_7 - w23;
+    w21 = (-0.000395108718315752) + w22;
     w22 = 0.7071067811865475 * w21;
     w12 = w12 - w22;
     w12 = 0.7071067811865476 * w12;
@@ -17865,13 +17895,15 @@ pub fn position_sensitivity(
     w12 = w12 - w24;
     w9 = 0.00248046035817079 + w12;
     w12 = 6.123233995736766e-17 * w9;
-    w17 = params_2 * w19;
-    w17 = params_0 * w17;
-    w20 = (-0.000548359106408232) - w17;
+    w25 = params_2 * w19;
+    w25 = params_0 * w25;
+    w17 = params_9 - w25;
+    w20 = (-0.000548359106408232) + w17;
     w17 = 0.7071067811865475 * w20;
-    w26 = params_1 * w19;
-    w26 = params_0 * w26;
-    w25 = (-0.001672482661783778) - w26;
+    w27 = params_1 * w19;
+    w27 = params_0 * w27;
+    w26 = params_8 - w27;
+    w25 = (-0.001672482661783778) + w26;
     w26 = 0.7071067811865476 * w25;
     w27 = w17 - w26;
     w19 = params_0 * w19;
@@ -20598,18 +20630,18 @@ pub fn position_sensitivity(
 ///
 /// From eq. (control_conf) and the closed forms after it.
 ///
-/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
 /// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
-/// Cost per call: 3766 operations, weighted 4732 (1066 ADD, 138 DIV, 1777 MUL, 785 SUB).
+/// Cost per call: 3769 operations, weighted 4735 (1069 ADD, 138 DIV, 1777 MUL, 785 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
 pub fn position_control_confidence(
-    params: &SVector<f64, 7>,
+    params: &SVector<f64, 13>,
     p_theta: &SMatrix<f64, 7, 7>,
     p_theta_dot: &SMatrix<f64, 7, 7>,
     p_theta_ddot: &SMatrix<f64, 7, 7>,
@@ -20621,7 +20653,10 @@ pub fn position_control_confidence(
     let params_1 = params[1];
     let params_2 = params[2];
     let params_3 = params[3];
+    let params_7 = params[7];
     let params_5 = params[5];
+    let params_9 = params[9];
+    let params_8 = params[8];
     let params_6 = params[6];
     let p_theta_0_0 = p_theta[(0, 0)];
     let p_theta_0_1 = p_theta[(0, 1)];
@@ -20915,9 +20950,10 @@ pub fn position_control_confidence(
     w13 = params_4 + w16;
     w12 = 0.015320008390949585 + w13;
     w13 = 0.7071067811865476 * w12;
-    w23 = params_1 * params_2;
-    w23 = params_0 * w23;
-    w22 = (-0.000395108718315752) - w23;
+    w24 = params_1 * params_2;
+    w24 = params_0 * w24;
+    w23 = params_7 - w24;
+    w22 = (-0.000395108718315752) + w23;
     w23 = 0.7071067811865475 * w22;
     w13 = w13 - w23;
     w13 = 0.7071067811865476 * w13;
@@ -20932,13 +20968,15 @@ pub fn position_control_confidence(
     w13 = w13 - w25;
     w10 = 0.00248046035817079 + w13;
     w13 = 6.123233995736766e-17 * w10;
-    w18 = params_2 * w20;
-    w18 = params_0 * w18;
-    w21 = (-0.000548359106408232) - w18;
+    w26 = params_2 * w20;
+    w26 = params_0 * w26;
+    w18 = params_9 - w26;
+    w21 = (-0.000548359106408232) + w18;
     w18 = 0.7071067811865475 * w21;
-    w27 = params_1 * w20;
-    w27 = params_0 * w27;
-    w26 = (-0.001672482661783778) - w27;
+    w28 = params_1 * w20;
+    w28 = params_0 * w28;
+    w27 = params_8 - w28;
+    w26 = (-0.001672482661783778) + w27;
     w27 = 0.7071067811865476 * w26;
     w28 = w18 - w27;
     w20 = params_0 * w20;
@@ -24726,29 +24764,32 @@ pub fn position_control_confidence(
 ///
 /// From eq. (control_conf) differentiated in the tool parameters.
 ///
-/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
 /// - `p_theta`: precision P of the joint angles theta (symmetric; the upper triangle is read)
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
-/// Cost per call: 10464 operations, weighted 13950 (3064 ADD, 498 DIV, 5026 MUL, 1876 SUB).
+/// Cost per call: 10467 operations, weighted 13953 (3067 ADD, 498 DIV, 5026 MUL, 1876 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
 pub fn position_logdet_gradient(
-    params: &SVector<f64, 7>,
+    params: &SVector<f64, 13>,
     p_theta: &SMatrix<f64, 7, 7>,
     p_theta_dot: &SMatrix<f64, 7, 7>,
     p_theta_ddot: &SMatrix<f64, 7, 7>,
     p_u: &SMatrix<f64, 7, 7>,
-) -> SVector<f64, 7> {
+) -> SVector<f64, 13> {
     let params_0 = params[0];
     let params_2 = params[2];
     let params_3 = params[3];
     let params_1 = params[1];
+    let params_8 = params[8];
+    let params_9 = params[9];
     let params_6 = params[6];
     let params_4 = params[4];
+    let params_7 = params[7];
     let params_5 = params[5];
     let p_theta_0_3 = p_theta[(0, 3)];
     let p_theta_1_3 = p_theta[(1, 3)];
@@ -24863,7 +24904,7 @@ pub fn position_logdet_gradient(
     let p_theta_dot_6_6 = p_theta_dot[(6, 6)];
     let p_theta_ddot_6_6 = p_theta_ddot[(6, 6)];
     // d ln|Pi^U| / dp, one entry per tool parameter
-    let mut gradient = <SVector<f64, 7>>::zeros();
+    let mut gradient = <SVector<f64, 13>>::zeros();
     let mut w0: f64;
     let mut w1: f64;
     let mut w2: f64;
@@ -25737,15 +25778,17 @@ pub fn position_logdet_gradient(
     w18 = w18 - w43;
     w43 = (-50.0) / w18;
     w19 = w43 / w18;
-    w12 = params_1 * w30;
-    w73 = params_0 * w12;
-    w6 = (-0.001672482661783778) - w73;
-    w73 = 0.7071067811865476 * w6;
-    w77 = params_2 * w30;
-    w78 = params_0 * w77;
-    w75 = (-0.000548359106408232) - w78;
-    w78 = 0.7071067811865475 * w75;
-    w79 = w73 - w78;
+    w73 = params_1 * w30;
+    w75 = params_0 * w73;
+    w12 = params_8 - w75;
+    w6 = (-0.001672482661783778) + w12;
+    w12 = 0.7071067811865476 * w6;
+    w78 = params_2 * w30;
+    w79 = params_0 * w78;
+    w77 = params_9 - w79;
+    w75 = (-0.000548359106408232) + w77;
+    w77 = 0.7071067811865475 * w75;
+    w79 = w12 - w77;
     w80 = 6.123233995736766e-17 * w79;
     w83 = params_1 * params_1;
     w84 = params_2 * params_2;
@@ -25786,11 +25829,12 @@ pub fn position_logdet_gradient(
     w96 = params_4 + w98;
     w95 = 0.015320008390949585 + w96;
     w96 = 0.7071067811865476 * w95;
-    w99 = params_1 * params_2;
-    w100 = params_0 * w99;
-    w98 = (-0.000395108718315752) - w100;
-    w100 = 0.7071067811865475 * w98;
-    w96 = w96 - w100;
+    w100 = params_1 * params_2;
+    w101 = params_0 * w100;
+    w99 = params_7 - w101;
+    w98 = (-0.000395108718315752) + w99;
+    w99 = 0.7071067811865475 * w98;
+    w96 = w96 - w99;
     w96 = 0.7071067811865476 * w96;
     w98 = 0.7071067811865476 * w98;
     w97 = w97 - w84;
@@ -25803,31 +25847,31 @@ pub fn position_logdet_gradient(
     w96 = w96 - w102;
     w94 = 0.00248046035817079 + w96;
     w96 = 6.123233995736766e-17 * w94;
-    w78 = w78 - w73;
+    w77 = w77 - w12;
     w84 = (-0.088) * w29;
-    w84 = w78 - w84;
+    w84 = w77 - w84;
     w84 = 0.001524110902883315 + w84;
     w96 = w96 - w84;
     w96 = 6.123233995736766e-17 * w96;
     w103 = 0.088 * w29;
-    w78 = w78 + w103;
-    w102 = 0.001524110902883315 + w78;
-    w78 = 6.123233995736766e-17 * w102;
+    w77 = w77 + w103;
+    w102 = 0.001524110902883315 + w77;
+    w77 = 6.123233995736766e-17 * w102;
     w104 = (-0.088) * w82;
     w86 = w86 - w104;
     w105 = 0.007743999999999999 * w8;
     w86 = w86 + w105;
     w105 = w81 + w86;
     w103 = 0.01056776613310695 + w105;
-    w78 = w78 - w103;
-    w96 = w96 - w78;
+    w77 = w77 - w103;
+    w96 = w96 - w77;
     w93 = 0.03942757095803552 + w96;
-    w78 = 0.10024161669500001 + w82;
+    w77 = 0.10024161669500001 + w82;
     w82 = 0.088 * w8;
-    w78 = w78 + w82;
+    w77 = w77 + w82;
     w82 = (-0.023526756935) - w29;
     w105 = 6.123233995736766e-17 * w82;
-    w106 = w78 + w105;
+    w106 = w77 + w105;
     w96 = (-0.047121686402) + w106;
     w106 = 0.384 * w96;
     w108 = (-0.384) * w96;
@@ -25846,7 +25890,7 @@ pub fn position_logdet_gradient(
     w102 = w102 + w103;
     w84 = w84 - w102;
     w112 = (-0.004600245517563105) + w84;
-    w103 = 6.123233995736766e-17 * w78;
+    w103 = 6.123233995736766e-17 * w77;
     w103 = w103 - w82;
     w84 = (-0.014653732538) + w103;
     w82 = (-0.384) * w84;
@@ -25950,8 +25994,8 @@ pub fn position_logdet_gradient(
     w95 = w95 + w98;
     w98 = 0.7071067811865476 * w95;
     w101 = 0.7071067811865476 * w101;
-    w100 = w100 + w101;
-    w101 = 0.7071067811865475 * w100;
+    w99 = w99 + w101;
+    w101 = 0.7071067811865475 * w99;
     w98 = w98 - w101;
     w101 = 0.7071067811865475 * w36;
     w128 = 0.7071067811865476 * w25;
@@ -26025,8 +26069,8 @@ pub fn position_logdet_gradient(
     w128 = w129 * w91;
     w128 = w101 - w128;
     w95 = 0.7071067811865475 * w95;
-    w100 = 0.7071067811865476 * w100;
-    w95 = w95 + w100;
+    w99 = 0.7071067811865476 * w99;
+    w95 = w95 + w99;
     w95 = w95 + w86;
     w142 = 0.01179456023023895 + w95;
     w141 = 0.03146037232526039 + w142;
@@ -26087,20 +26131,20 @@ pub fn position_logdet_gradient(
     w92 = w92 + w108;
     w108 = w109 * w126;
     w86 = w120 / w139;
-    w100 = w86 * w122;
-    w108 = w108 + w100;
+    w99 = w86 * w122;
+    w108 = w108 + w99;
     w108 = w136 - w108;
-    w100 = w106 * w108;
-    w92 = w92 + w100;
+    w99 = w106 * w108;
+    w92 = w92 + w99;
     w92 = w98 - w92;
-    w100 = w134 * w109;
+    w99 = w134 * w109;
     w143 = w120 * w86;
-    w100 = w100 + w143;
+    w99 = w99 + w143;
     w143 = w108 / w141;
     w144 = w108 * w143;
-    w100 = w100 + w144;
-    w100 = w140 - w100;
-    w144 = w92 / w100;
+    w99 = w99 + w144;
+    w99 = w140 - w99;
+    w144 = w92 / w99;
     w145 = w92 * w144;
     w118 = w118 + w145;
     w112 = w112 - w116;
@@ -26149,7 +26193,7 @@ pub fn position_logdet_gradient(
     w151 = w151 + w152;
     w152 = w147 * w150;
     w151 = w151 + w152;
-    w152 = w149 / w100;
+    w152 = w149 / w99;
     w153 = w149 * w152;
     w151 = w151 + w153;
     w151 = w117 - w151;
@@ -26168,11 +26212,11 @@ pub fn position_logdet_gradient(
     w154 = 0.7071067811865476 * w130;
     w131 = w131 - w154;
     w154 = w129 * w131;
-    w105 = w105 + w78;
-    w78 = (-0.7071067811865475) * w105;
+    w105 = w105 + w77;
+    w77 = (-0.7071067811865475) * w105;
     w155 = (-0.7071067811865476) * w103;
-    w78 = w78 + w155;
-    w78 = (-0.316) * w78;
+    w77 = w77 + w155;
+    w77 = (-0.316) * w77;
     w155 = (-0.0825) * w103;
     w156 = 0.384 * w105;
     w155 = w155 + w156;
@@ -26182,10 +26226,10 @@ pub fn position_logdet_gradient(
     w103 = w103 - w105;
     w103 = 0.0825 * w103;
     w103 = w155 + w103;
-    w78 = w78 - w103;
+    w77 = w77 - w103;
     w103 = w131 / w89;
     w105 = w103 * w91;
-    w105 = w78 - w105;
+    w105 = w77 - w105;
     w156 = w123 * w105;
     w154 = w154 + w156;
     w156 = w103 * w126;
@@ -26209,7 +26253,7 @@ pub fn position_logdet_gradient(
     w160 = w160 + w161;
     w161 = w159 * w147;
     w160 = w160 + w161;
-    w161 = w158 / w100;
+    w161 = w158 / w99;
     w162 = w161 * w149;
     w160 = w160 + w162;
     w160 = w75 - w160;
@@ -26547,7 +26591,7 @@ pub fn position_logdet_gradient(
     w215 = w215 - w216;
     w216 = w52 * w214;
     w215 = w215 + w216;
-    w215 = w78 + w215;
+    w215 = w77 + w215;
     w216 = w29 * w215;
     w212 = w212 - w216;
     w212 = w101 + w212;
@@ -26858,21 +26902,21 @@ pub fn position_logdet_gradient(
     w275 = w265 + w275;
     w276 = w275 * w170;
     w224 = w224 + w276;
-    w276 = w78 / w54;
-    w277 = w3 * w78;
+    w276 = w77 / w54;
+    w277 = w3 * w77;
     w277 = w277 - w130;
     w130 = w277 / w31;
     w278 = w191 * w277;
-    w279 = w185 * w78;
+    w279 = w185 * w77;
     w278 = w278 - w279;
-    w279 = w65 * w78;
+    w279 = w65 * w77;
     w280 = w64 * w277;
     w279 = w279 + w280;
     w279 = w279 - w155;
     w155 = w193 * w279;
     w278 = w278 + w155;
     w155 = w68 * w277;
-    w280 = w196 * w78;
+    w280 = w196 * w77;
     w155 = w155 - w280;
     w280 = w192 * w279;
     w155 = w155 + w280;
@@ -26880,7 +26924,7 @@ pub fn position_logdet_gradient(
     w155 = w195 * w75;
     w278 = w278 - w155;
     w155 = w22 * w279;
-    w280 = w60 * w78;
+    w280 = w60 * w77;
     w281 = w49 * w277;
     w280 = w280 + w281;
     w155 = w155 - w280;
@@ -27200,7 +27244,7 @@ pub fn position_logdet_gradient(
     w329 = w329 + w330;
     w331 = w329 * p_theta_0_6;
     w312 = w312 - w331;
-    w331 = 1.0 / w100;
+    w331 = 1.0 / w99;
     w332 = w153 * w152;
     w332 = w144 - w332;
     w333 = w163 * w152;
@@ -27526,7 +27570,7 @@ pub fn position_logdet_gradient(
     w388 = w157 * w386;
     w389 = w382 / w141;
     w390 = w159 * w386;
-    w391 = w383 / w100;
+    w391 = w383 / w99;
     w392 = w161 * w386;
     w393 = w384 / w151;
     w394 = w163 * w386;
@@ -27923,7 +27967,7 @@ pub fn position_logdet_gradient(
     w428 = w426 / w162;
     w427 = w427 - w428;
     w429 = w159 * w427;
-    w430 = w424 / w100;
+    w430 = w424 / w99;
     w431 = w161 * w427;
     w432 = w425 / w151;
     w433 = w163 * w427;
@@ -28313,7 +28357,7 @@ pub fn position_logdet_gradient(
     w477 = w475 / w162;
     w476 = w476 - w477;
     w478 = w159 * w476;
-    w479 = w143 / w100;
+    w479 = w143 / w99;
     w480 = w161 * w476;
     w481 = w474 / w151;
     w482 = w163 * w476;
@@ -32884,7 +32928,7 @@ pub fn position_logdet_gradient(
     w406 = w406 + w453;
     w360 = w360 / w31;
     w406 = w406 + w360;
-    w360 = w78 * w406;
+    w360 = w77 * w406;
     w62 = w62 + w360;
     w360 = w272 * w407;
     w62 = w62 + w360;
@@ -32984,7 +33028,7 @@ pub fn position_logdet_gradient(
     w8 = w8 + w489;
     w489 = w280 * w346;
     w8 = w8 + w489;
-    w489 = w78 * w199;
+    w489 = w77 * w199;
     w8 = w8 + w489;
     w489 = w270 * w407;
     w8 = w8 + w489;
@@ -33045,7 +33089,7 @@ pub fn position_logdet_gradient(
     w71 = w71 + w366;
     w366 = w278 * w346;
     w71 = w71 + w366;
-    w366 = w78 * w370;
+    w366 = w77 * w370;
     w71 = w71 + w366;
     w366 = w267 * w407;
     w71 = w71 + w366;
@@ -33105,7 +33149,7 @@ pub fn position_logdet_gradient(
     w59 = w59 + w497;
     w497 = w284 * w346;
     w59 = w59 + w497;
-    w497 = w78 * w206;
+    w497 = w77 * w206;
     w59 = w59 + w497;
     w497 = w274 * w407;
     w59 = w59 + w497;
@@ -33179,10 +33223,10 @@ pub fn position_logdet_gradient(
     w552 = w552 - w101;
     w101 = w6 * w346;
     w552 = w552 - w101;
-    w78 = w78 * w377;
-    w552 = w552 - w78;
-    w78 = w79 * w407;
-    w552 = w552 - w78;
+    w77 = w77 * w377;
+    w552 = w552 - w77;
+    w77 = w79 * w407;
+    w552 = w552 - w77;
     w84 = w84 * w570;
     w552 = w552 - w84;
     w84 = w98 * w462;
@@ -34509,7 +34553,7 @@ pub fn position_logdet_gradient(
     w15 = w15 - w164;
     w164 = w149 * w15;
     w385 = w385 - w164;
-    w164 = w385 / w100;
+    w164 = w385 / w99;
     w162 = w161 * w540;
     w164 = w164 - w162;
     w162 = w144 * w180;
@@ -34712,7 +34756,7 @@ pub fn position_logdet_gradient(
     w160 = w160 - w163;
     w163 = w149 * w537;
     w160 = w160 + w163;
-    w163 = w160 / w100;
+    w163 = w160 / w99;
     w393 = w393 + w163;
     w267 = w267 / w151;
     w153 = w153 * w297;
@@ -34766,7 +34810,7 @@ pub fn position_logdet_gradient(
     w163 = w163 - w581;
     w581 = w431 * w468;
     w163 = w163 + w581;
-    w581 = w585 / w100;
+    w581 = w585 / w99;
     w589 = w161 * w477;
     w581 = w581 + w589;
     w589 = w152 * w521;
@@ -34776,7 +34820,7 @@ pub fn position_logdet_gradient(
     w163 = w163 + w581;
     w589 = w392 * w405;
     w163 = w163 + w589;
-    w589 = w399 / w100;
+    w589 = w399 / w99;
     w384 = w161 * w428;
     w589 = w589 + w384;
     w384 = w152 * w205;
@@ -34785,24 +34829,24 @@ pub fn position_logdet_gradient(
     w589 = w589 - w384;
     w384 = w115 * w589;
     w163 = w163 + w384;
-    w331 = w331 / w100;
+    w331 = w331 / w99;
     w331 = w331 * w579;
-    w479 = w479 / w100;
+    w479 = w479 / w99;
     w479 = w479 * w596;
     w331 = w331 + w479;
-    w430 = w430 / w100;
+    w430 = w430 / w99;
     w430 = w430 * w585;
     w331 = w331 + w430;
-    w391 = w391 / w100;
+    w391 = w391 / w99;
     w391 = w391 * w399;
     w331 = w331 + w391;
-    w391 = w161 / w100;
+    w391 = w161 / w99;
     w391 = w391 * w385;
     w331 = w331 + w391;
-    w391 = w152 / w100;
+    w391 = w152 / w99;
     w391 = w391 * w160;
     w331 = w331 + w391;
-    w391 = w144 / w100;
+    w391 = w144 / w99;
     w255 = w255 / w118;
     w324 = w169 * w324;
     w255 = w255 - w324;
@@ -34847,7 +34891,7 @@ pub fn position_logdet_gradient(
     w158 = w158 - w149;
     w149 = w480 * w599;
     w158 = w158 + w149;
-    w596 = w596 / w100;
+    w596 = w596 / w99;
     w158 = w158 + w596;
     w161 = w161 * w335;
     w158 = w158 + w161;
@@ -34867,7 +34911,7 @@ pub fn position_logdet_gradient(
     w158 = w158 + w152;
     w152 = w158 / w141;
     w391 = w391 + w152;
-    w255 = w255 / w100;
+    w255 = w255 / w99;
     w144 = w144 * w297;
     w255 = w255 - w144;
     w144 = w106 * w255;
@@ -34878,16 +34922,16 @@ pub fn position_logdet_gradient(
     w435 = w435 + w359;
     w359 = w111 / w139;
     w144 = w478 * w515;
-    w100 = w172 * w216;
+    w99 = w172 * w216;
     w152 = w306 * w580;
-    w100 = w100 + w152;
+    w99 = w99 + w152;
     w152 = w543 * w582;
-    w100 = w100 + w152;
+    w99 = w99 + w152;
     w152 = w340 * w303;
-    w100 = w100 + w152;
-    w144 = w144 - w100;
-    w100 = w429 * w468;
-    w144 = w144 + w100;
+    w99 = w99 + w152;
+    w144 = w144 - w99;
+    w99 = w429 * w468;
+    w144 = w144 + w99;
     w477 = w159 * w477;
     w144 = w144 + w477;
     w521 = w150 * w521;
@@ -35854,10 +35898,10 @@ pub fn position_logdet_gradient(
     w394 = w394 + w153;
     w153 = 6.123233995736766e-17 * w394;
     w153 = w153 - w113;
-    w73 = (-0.088) * w153;
-    w48 = w48 - w73;
-    w73 = w30 * w48;
-    w0 = w0 + w73;
+    w12 = (-0.088) * w153;
+    w48 = w48 - w12;
+    w12 = w30 * w48;
+    w0 = w0 + w12;
     w144 = 6.123233995736766e-17 * w144;
     w442 = w442 + w144;
     w144 = 0.7071067811865476 * w442;
@@ -35876,8 +35920,8 @@ pub fn position_logdet_gradient(
     w114 = w114 + w153;
     w153 = 0.7071067811865476 * w114;
     w144 = w144 - w153;
-    w12 = w12 * w144;
-    w0 = w0 - w12;
+    w73 = w73 * w144;
+    w0 = w0 - w73;
     w377 = 0.7071067811865476 * w377;
     w442 = 0.7071067811865475 * w442;
     w377 = w377 - w442;
@@ -35885,31 +35929,31 @@ pub fn position_logdet_gradient(
     w377 = w377 - w15;
     w114 = 0.7071067811865475 * w114;
     w377 = w377 + w114;
-    w77 = w77 * w377;
-    w0 = w0 - w77;
-    w77 = 0.7071067811865476 * w387;
+    w78 = w78 * w377;
+    w0 = w0 - w78;
+    w78 = 0.7071067811865476 * w387;
     w14 = 6.123233995736766e-17 * w173;
     w615 = w615 - w14;
     w14 = 0.7071067811865475 * w615;
-    w77 = w77 - w14;
-    w14 = 0.7071067811865476 * w77;
+    w78 = w78 - w14;
+    w14 = 0.7071067811865476 * w78;
     w173 = 3.749399456654644e-33 * w396;
     w394 = w394 + w173;
     w482 = 0.4999999999999999 * w394;
     w14 = w14 + w482;
     w97 = w97 * w14;
     w0 = w0 + w97;
-    w77 = 0.7071067811865475 * w77;
+    w78 = 0.7071067811865475 * w78;
     w387 = 0.7071067811865475 * w387;
     w615 = 0.7071067811865476 * w615;
     w387 = w387 + w615;
     w33 = 0.7071067811865476 * w387;
-    w77 = w77 + w33;
+    w78 = w78 + w33;
     w433 = 0.5 * w394;
-    w77 = w77 - w433;
-    w77 = w77 - w433;
-    w99 = w99 * w77;
-    w0 = w0 - w99;
+    w78 = w78 - w433;
+    w78 = w78 - w433;
+    w100 = w100 * w78;
+    w0 = w0 - w100;
     w24 = 0.7071067811865475 * w387;
     w462 = 0.5000000000000001 * w394;
     w24 = w24 + w462;
@@ -35917,47 +35961,53 @@ pub fn position_logdet_gradient(
     w0 = w0 + w83;
     gradient[0] = w0;
     w189 = params_0 * w189;
-    w144 = params_0 * w144;
-    w0 = w30 * w144;
-    w189 = w189 - w0;
-    w77 = params_0 * w77;
-    w0 = params_2 * w77;
-    w189 = w189 - w0;
-    w0 = 2.0 * params_1;
-    w83 = params_0 * w24;
-    w462 = w0 * w83;
+    w0 = params_0 * w144;
+    w83 = w30 * w0;
+    w189 = w189 - w83;
+    w83 = params_0 * w78;
+    w462 = params_2 * w83;
     w189 = w189 - w462;
-    w462 = params_0 * w349;
-    w394 = params_0 * w14;
-    w83 = w394 + w83;
-    w462 = w462 + w83;
-    w0 = w0 * w462;
-    w189 = w189 + w0;
+    w462 = 2.0 * params_1;
+    w394 = params_0 * w24;
+    w387 = w462 * w394;
+    w189 = w189 - w387;
+    w387 = params_0 * w349;
+    w100 = params_0 * w14;
+    w394 = w100 + w394;
+    w387 = w387 + w394;
+    w462 = w462 * w387;
+    w189 = w189 + w462;
     gradient[1] = w189;
     w104 = params_0 * w104;
-    w377 = params_0 * w377;
-    w189 = w30 * w377;
-    w104 = w104 - w189;
-    w189 = 2.0 * params_2;
-    w394 = w189 * w394;
-    w104 = w104 - w394;
-    w77 = params_1 * w77;
-    w104 = w104 - w77;
-    w189 = w189 * w462;
-    w104 = w104 + w189;
+    w189 = params_0 * w377;
+    w462 = w30 * w189;
+    w104 = w104 - w462;
+    w462 = 2.0 * params_2;
+    w100 = w462 * w100;
+    w104 = w104 - w100;
+    w83 = params_1 * w83;
+    w104 = w104 - w83;
+    w462 = w462 * w387;
+    w104 = w104 + w462;
     gradient[2] = w104;
     w9 = params_0 * w48;
-    w37 = params_1 * w144;
+    w37 = params_1 * w0;
     w9 = w9 - w37;
-    w26 = params_2 * w377;
+    w26 = params_2 * w189;
     w9 = w9 - w26;
     w30 = 2.0 * w30;
-    w30 = w30 * w83;
+    w30 = w30 * w394;
     w9 = w9 + w30;
     gradient[3] = w9;
     gradient[4] = w24;
     gradient[5] = w14;
     gradient[6] = w349;
+    gradient[7] = w78;
+    gradient[8] = w144;
+    gradient[9] = w377;
+    gradient[10] = 0.0;
+    gradient[11] = 0.0;
+    gradient[12] = 0.0;
     gradient
 }
 
@@ -35965,19 +36015,22 @@ pub fn position_logdet_gradient(
 ///
 /// From appendix "Task specific controllers".
 ///
-/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
 ///
-/// Cost per call: 2403 operations, weighted 3222 (558 ADD, 117 DIV, 1113 MUL, 49 NEG, 566 SUB).
+/// Cost per call: 2406 operations, weighted 3225 (561 ADD, 117 DIV, 1113 MUL, 49 NEG, 566 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
-pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SMatrix<f64, 7, 7>) {
+pub fn velocity_sensitivity(params: &SVector<f64, 13>) -> (SMatrix<f64, 7, 7>, SMatrix<f64, 7, 7>) {
     let params_4 = params[4];
     let params_0 = params[0];
     let params_1 = params[1];
     let params_2 = params[2];
     let params_3 = params[3];
+    let params_7 = params[7];
     let params_5 = params[5];
+    let params_8 = params[8];
+    let params_9 = params[9];
     let params_6 = params[6];
     // dtheta_dot/dU = -IO @ inv(A) @ B
     let mut d_theta_dot_du = <SMatrix<f64, 7, 7>>::zeros();
@@ -36119,9 +36172,10 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w11 = params_4 + w14;
     w10 = 0.015320008390949585 + w11;
     w11 = 0.7071067811865475 * w10;
-    w20 = params_1 * params_2;
-    w20 = params_0 * w20;
-    w14 = (-0.000395108718315752) - w20;
+    w21 = params_1 * params_2;
+    w21 = params_0 * w21;
+    w20 = params_7 - w21;
+    w14 = (-0.000395108718315752) + w20;
     w20 = 0.7071067811865476 * w14;
     w11 = w11 + w20;
     w21 = 0.7071067811865476 * w11;
@@ -36146,17 +36200,19 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w28 = (-0.0001037589172186849) + w28;
     w13 = params_1 * w18;
     w13 = params_0 * w13;
-    w31 = (-0.001672482661783778) - w13;
-    w13 = 0.7071067811865475 * w31;
+    w32 = params_8 - w13;
+    w31 = (-0.001672482661783778) + w32;
+    w32 = 0.7071067811865475 * w31;
     w15 = params_2 * w18;
     w15 = params_0 * w15;
-    w32 = (-0.000548359106408232) - w15;
-    w15 = 0.7071067811865476 * w32;
-    w13 = w13 + w15;
-    w30 = 9.3569097314605e-05 - w13;
-    w15 = 6.123233995736766e-17 * w30;
-    w15 = w28 + w15;
-    w6 = 0.0021640520520981297 - w15;
+    w33 = params_9 - w15;
+    w13 = (-0.000548359106408232) + w33;
+    w33 = 0.7071067811865476 * w13;
+    w32 = w32 + w33;
+    w30 = 9.3569097314605e-05 - w32;
+    w33 = 6.123233995736766e-17 * w30;
+    w33 = w28 + w33;
+    w6 = 0.0021640520520981297 - w33;
     w35 = (-0.017527158935000002) + w27;
     w34 = 0.05034347249 - w35;
     w35 = (-0.384) * w34;
@@ -36206,9 +36262,9 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w10 = w10 - w20;
     w45 = 0.00248046035817079 + w10;
     w10 = 6.123233995736766e-17 * w45;
-    w32 = 0.7071067811865475 * w32;
+    w13 = 0.7071067811865475 * w13;
     w31 = 0.7071067811865476 * w31;
-    w22 = w32 - w31;
+    w22 = w13 - w31;
     w18 = params_0 * w18;
     w14 = 0.045305948634 + w18;
     w18 = (-0.088) * w14;
@@ -36264,14 +36320,14 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w46 = 6.123233995736766e-17 * w22;
     w46 = w46 - w49;
     w18 = (-0.014653732538) + w46;
-    w33 = (-0.384) * w18;
+    w15 = (-0.384) * w18;
     w49 = 0.0825 * w10;
-    w33 = w33 + w49;
+    w15 = w15 + w49;
     w49 = 0.03168 * w55;
-    w33 = w33 + w49;
-    w33 = w54 + w33;
-    w33 = 0.02771584317362585 + w33;
-    w56 = (-0.7071067811865476) * w33;
+    w15 = w15 + w49;
+    w15 = w54 + w15;
+    w15 = 0.02771584317362585 + w15;
+    w56 = (-0.7071067811865476) * w15;
     w44 = w44 - w56;
     w44 = (-0.7071067811865475) * w44;
     w56 = (-0.0825) * w10;
@@ -36324,16 +36380,16 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w49 = w49 + w62;
     w44 = 0.316 * w49;
     w43 = (-0.7071067811865476) * w43;
-    w33 = (-0.7071067811865475) * w33;
-    w43 = w43 + w33;
-    w33 = (-0.7071067811865475) * w43;
+    w15 = (-0.7071067811865475) * w15;
+    w43 = w43 + w15;
+    w15 = (-0.7071067811865475) * w43;
     w53 = (-0.7071067811865476) * w53;
     w56 = (-0.7071067811865475) * w56;
     w53 = w53 + w56;
     w56 = (-0.7071067811865476) * w53;
-    w33 = w33 - w56;
+    w15 = w15 - w56;
     w56 = 0.0825 * w63;
-    w56 = w33 - w56;
+    w56 = w15 - w56;
     w56 = (-0.005487648106562256) + w56;
     w44 = w44 - w56;
     w44 = (-0.00398335888393552) + w44;
@@ -36399,11 +36455,11 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w28 = 6.123233995736766e-17 * w28;
     w28 = w28 - w30;
     w30 = (-0.7071067811865475) * w28;
-    w46 = (-0.7071067811865476) * w15;
+    w46 = (-0.7071067811865476) * w33;
     w30 = w30 - w46;
     w30 = (-0.7071067811865475) * w30;
     w28 = (-0.7071067811865476) * w28;
-    w46 = (-0.7071067811865475) * w15;
+    w46 = (-0.7071067811865475) * w33;
     w28 = w28 + w46;
     w46 = 0.7071067811865476 * w28;
     w30 = w30 - w46;
@@ -36411,13 +36467,13 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w12 = w46 * w2;
     w12 = w22 - w12;
     w60 = w12 / w56;
-    w31 = w31 - w32;
-    w32 = 6.123233995736766e-17 * w31;
+    w31 = w31 - w13;
+    w13 = 6.123233995736766e-17 * w31;
     w17 = w47 + w17;
-    w32 = w32 + w17;
+    w13 = w13 + w17;
     w11 = 0.384 * w48;
-    w32 = w32 + w11;
-    w11 = (-0.7071067811865475) * w32;
+    w13 = w13 + w11;
+    w11 = (-0.7071067811865475) * w13;
     w17 = 6.123233995736766e-17 * w17;
     w31 = w31 - w17;
     w17 = (-0.0825) * w48;
@@ -36427,12 +36483,12 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w51 = (-0.316) * w48;
     w11 = w11 - w51;
     w11 = (-0.7071067811865475) * w11;
-    w32 = (-0.7071067811865476) * w32;
+    w13 = (-0.7071067811865476) * w13;
     w17 = (-0.7071067811865475) * w17;
-    w32 = w32 + w17;
+    w13 = w13 + w17;
     w48 = 0.0825 * w48;
-    w32 = w32 - w48;
-    w48 = 0.7071067811865476 * w32;
+    w13 = w13 - w48;
+    w48 = 0.7071067811865476 * w13;
     w11 = w11 - w48;
     w48 = w11 / w41;
     w17 = w48 * w30;
@@ -36444,7 +36500,7 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w24 = 2.3513218543629182e-17 * w26;
     w52 = (-0.0825) * w26;
     w24 = w24 - w52;
-    w24 = w13 + w24;
+    w24 = w32 + w24;
     w51 = w51 - w24;
     w52 = (-0.7071067811865476) * w26;
     w55 = (-4.329780281177466e-17) * w26;
@@ -36457,20 +36513,20 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w26 = w55 * w12;
     w17 = w17 + w26;
     w63 = (-0.0825) * w63;
-    w33 = w33 + w63;
-    w62 = (-0.005487648106562256) + w33;
+    w15 = w15 + w63;
+    w62 = (-0.005487648106562256) + w15;
     w62 = w62 + w49;
     w62 = (-0.7071067811865475) * w62;
     w49 = 0.7071067811865476 * w44;
     w62 = w62 - w49;
     w49 = w48 * w62;
-    w33 = w62 / w41;
-    w63 = w33 * w2;
+    w15 = w62 / w41;
+    w63 = w15 * w2;
     w63 = w35 - w63;
     w26 = w55 * w63;
     w49 = w49 + w26;
-    w49 = w32 - w49;
-    w26 = w62 * w33;
+    w49 = w13 - w49;
+    w26 = w62 * w15;
     w19 = w63 / w56;
     w23 = w63 * w19;
     w26 = w26 + w23;
@@ -36582,10 +36638,10 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w74 = w72 / w69;
     w63 = w74 * w63;
     w78 = w78 + w63;
-    w78 = w15 - w78;
+    w78 = w33 - w78;
     w63 = w77 * w78;
     w17 = w17 + w63;
-    w17 = w13 - w17;
+    w17 = w32 - w17;
     w63 = w30 * w46;
     w12 = w12 * w60;
     w63 = w63 + w12;
@@ -36601,7 +36657,7 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w65 = w55 * w38;
     w65 = w65 - w48;
     w12 = w19 * w38;
-    w12 = w12 - w33;
+    w12 = w12 - w15;
     w34 = w23 * w12;
     w65 = w65 - w34;
     w34 = w68 * w38;
@@ -36678,7 +36734,7 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w80 = w3 * w64;
     w20 = 0.0016666666666666668 * w41;
     w41 = 1.0 / w41;
-    w5 = w33 * w12;
+    w5 = w15 * w12;
     w49 = w38 * w64;
     w5 = w5 - w49;
     w49 = w53 * w34;
@@ -37254,7 +37310,7 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w84 = w28 + w84;
     w35 = w8 * w84;
     w57 = w57 - w35;
-    w57 = w32 + w57;
+    w57 = w13 + w57;
     w57 = w57 / w89;
     w35 = w8 * w57;
     w84 = w84 / w29;
@@ -37387,7 +37443,7 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w27 = w27 - w45;
     w45 = w1 * w58;
     w27 = w27 + w45;
-    w27 = w15 + w27;
+    w27 = w33 + w27;
     w45 = w8 * w27;
     w96 = w96 - w45;
     w96 = w31 + w96;
@@ -37445,20 +37501,20 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w59 = w59 - w117;
     w117 = w107 * w108;
     w59 = w59 + w117;
-    w15 = w15 + w59;
-    w59 = w21 * w15;
+    w33 = w33 + w59;
+    w59 = w21 * w33;
     w50 = w50 - w59;
     w59 = w123 * w108;
     w22 = w100 * w22;
     w110 = w4 * w110;
     w22 = w22 + w110;
     w59 = w59 - w22;
-    w22 = w1 * w15;
+    w22 = w1 * w33;
     w59 = w59 + w22;
     w66 = w66 + w59;
     w59 = w8 * w66;
     w50 = w50 - w59;
-    w50 = w13 + w50;
+    w50 = w32 + w50;
     w50 = w50 / w89;
     w59 = w8 * w50;
     w66 = w66 / w29;
@@ -37466,9 +37522,9 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w66 = w1 * w59;
     w22 = w21 * w50;
     w66 = w66 + w22;
-    w15 = w15 / w93;
-    w66 = w66 - w15;
-    w15 = w94 * w66;
+    w33 = w33 / w93;
+    w66 = w66 - w33;
+    w33 = w94 * w66;
     w108 = w108 / w83;
     w22 = w107 * w66;
     w110 = w123 * w59;
@@ -37477,60 +37533,60 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w22 = w22 - w110;
     w108 = w108 - w22;
     w22 = w37 * w108;
-    w15 = w15 - w22;
+    w33 = w33 - w22;
     w22 = w4 * w59;
-    w15 = w15 - w22;
+    w33 = w33 - w22;
     w22 = w101 * w50;
-    w15 = w15 - w22;
-    w28 = w28 - w15;
-    w15 = w103 * w28;
+    w33 = w33 - w22;
+    w28 = w28 - w33;
+    w33 = w103 * w28;
     w22 = w85 * w108;
-    w15 = w15 + w22;
+    w33 = w33 + w22;
     w22 = w91 * w66;
-    w15 = w15 + w22;
+    w33 = w33 + w22;
     w22 = w100 * w59;
-    w15 = w15 + w22;
+    w33 = w33 + w22;
     w22 = w40 * w50;
-    w15 = w15 - w22;
-    w58 = w58 + w15;
-    w15 = w58 * w17;
-    w119 = w119 - w15;
+    w33 = w33 - w22;
+    w58 = w58 + w33;
+    w33 = w58 * w17;
+    w119 = w119 - w33;
     w80 = w51 / w80;
-    w15 = w103 * w51;
-    w15 = w15 - w32;
-    w116 = w15 / w116;
-    w32 = w101 * w15;
+    w33 = w103 * w51;
+    w33 = w33 - w13;
+    w116 = w33 / w116;
+    w13 = w101 * w33;
     w22 = w40 * w51;
-    w32 = w32 - w22;
+    w13 = w13 - w22;
     w22 = w85 * w51;
-    w110 = w37 * w15;
+    w110 = w37 * w33;
     w22 = w22 + w110;
     w22 = w22 - w24;
     w24 = w109 * w22;
-    w32 = w32 + w24;
-    w24 = w94 * w15;
+    w13 = w13 + w24;
+    w24 = w94 * w33;
     w110 = w91 * w51;
     w24 = w24 - w110;
     w110 = w107 * w22;
     w24 = w24 + w110;
     w31 = w31 + w24;
     w24 = w21 * w31;
-    w32 = w32 - w24;
+    w13 = w13 - w24;
     w24 = w123 * w22;
     w51 = w100 * w51;
-    w15 = w4 * w15;
-    w51 = w51 + w15;
+    w33 = w4 * w33;
+    w51 = w51 + w33;
     w24 = w24 - w51;
     w51 = w1 * w31;
     w24 = w24 + w51;
-    w13 = w13 + w24;
-    w24 = w8 * w13;
-    w32 = w32 - w24;
-    w47 = w47 + w32;
+    w32 = w32 + w24;
+    w24 = w8 * w32;
+    w13 = w13 - w24;
+    w47 = w47 + w13;
     w47 = w47 / w89;
     w8 = w8 * w47;
-    w13 = w13 / w29;
-    w8 = w8 - w13;
+    w32 = w32 / w29;
+    w8 = w8 - w32;
     w1 = w1 * w8;
     w21 = w21 * w47;
     w1 = w1 + w21;
@@ -37685,7 +37741,7 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w64 = w23 * w65;
     w34 = w34 - w64;
     w41 = w41 + w34;
-    w34 = w33 * w41;
+    w34 = w15 * w41;
     w56 = 1.0 / w56;
     w64 = w60 * w12;
     w119 = w19 * w41;
@@ -37859,7 +37915,7 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w34 = w55 * w41;
     w12 = w12 - w34;
     w34 = w38 * w12;
-    w56 = w33 * w26;
+    w56 = w15 * w26;
     w34 = w34 - w56;
     w56 = w53 * w17;
     w34 = w34 + w56;
@@ -38013,7 +38069,7 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w26 = w55 * w12;
     w41 = w41 - w26;
     w26 = w38 * w41;
-    w34 = w33 * w17;
+    w34 = w15 * w17;
     w26 = w26 + w34;
     w34 = w53 * w69;
     w26 = w26 - w34;
@@ -38161,7 +38217,7 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w17 = w55 * w41;
     w79 = w79 - w17;
     w17 = w38 * w79;
-    w26 = w33 * w65;
+    w26 = w15 * w65;
     w17 = w17 + w26;
     w26 = w53 * w69;
     w17 = w17 + w26;
@@ -38305,7 +38361,7 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w69 = w55 * w79;
     w78 = w78 - w69;
     w69 = w38 * w78;
-    w65 = w33 * w41;
+    w65 = w15 * w41;
     w69 = w69 + w65;
     w65 = w53 * w12;
     w69 = w69 + w65;
@@ -38445,8 +38501,8 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
     w19 = w19 + w60;
     w55 = w55 - w19;
     w38 = w38 * w55;
-    w33 = w33 * w23;
-    w38 = w38 + w33;
+    w15 = w15 * w23;
+    w38 = w38 + w15;
     w53 = w53 * w71;
     w38 = w38 + w53;
     w18 = w18 * w77;
@@ -38574,17 +38630,17 @@ pub fn velocity_sensitivity(params: &SVector<f64, 7>) -> (SMatrix<f64, 7, 7>, SM
 ///
 /// From eq. (control_conf) and the closed forms after it.
 ///
-/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
-/// Cost per call: 3411 operations, weighted 4230 (1076 ADD, 117 DIV, 1652 MUL, 566 SUB).
+/// Cost per call: 3414 operations, weighted 4233 (1079 ADD, 117 DIV, 1652 MUL, 566 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
 pub fn velocity_control_confidence(
-    params: &SVector<f64, 7>,
+    params: &SVector<f64, 13>,
     p_theta_dot: &SMatrix<f64, 7, 7>,
     p_theta_ddot: &SMatrix<f64, 7, 7>,
     p_u: &SMatrix<f64, 7, 7>,
@@ -38595,7 +38651,10 @@ pub fn velocity_control_confidence(
     let params_1 = params[1];
     let params_2 = params[2];
     let params_3 = params[3];
+    let params_7 = params[7];
     let params_5 = params[5];
+    let params_8 = params[8];
+    let params_9 = params[9];
     let params_6 = params[6];
     let p_theta_dot_0_0 = p_theta_dot[(0, 0)];
     let p_theta_dot_0_1 = p_theta_dot[(0, 1)];
@@ -38843,9 +38902,10 @@ pub fn velocity_control_confidence(
     w12 = params_4 + w15;
     w11 = 0.015320008390949585 + w12;
     w12 = 0.7071067811865475 * w11;
-    w21 = params_1 * params_2;
-    w21 = params_0 * w21;
-    w15 = (-0.000395108718315752) - w21;
+    w22 = params_1 * params_2;
+    w22 = params_0 * w22;
+    w21 = params_7 - w22;
+    w15 = (-0.000395108718315752) + w21;
     w21 = 0.7071067811865476 * w15;
     w12 = w12 + w21;
     w22 = 0.7071067811865476 * w12;
@@ -38870,17 +38930,19 @@ pub fn velocity_control_confidence(
     w29 = (-0.0001037589172186849) + w29;
     w14 = params_1 * w19;
     w14 = params_0 * w14;
-    w32 = (-0.001672482661783778) - w14;
-    w14 = 0.7071067811865475 * w32;
+    w33 = params_8 - w14;
+    w32 = (-0.001672482661783778) + w33;
+    w33 = 0.7071067811865475 * w32;
     w16 = params_2 * w19;
     w16 = params_0 * w16;
-    w33 = (-0.000548359106408232) - w16;
-    w16 = 0.7071067811865476 * w33;
-    w14 = w14 + w16;
-    w31 = 9.3569097314605e-05 - w14;
-    w16 = 6.123233995736766e-17 * w31;
-    w16 = w29 + w16;
-    w7 = 0.0021640520520981297 - w16;
+    w34 = params_9 - w16;
+    w14 = (-0.000548359106408232) + w34;
+    w34 = 0.7071067811865476 * w14;
+    w33 = w33 + w34;
+    w31 = 9.3569097314605e-05 - w33;
+    w34 = 6.123233995736766e-17 * w31;
+    w34 = w29 + w34;
+    w7 = 0.0021640520520981297 - w34;
     w36 = (-0.017527158935000002) + w28;
     w35 = 0.05034347249 - w36;
     w36 = (-0.384) * w35;
@@ -38930,9 +38992,9 @@ pub fn velocity_control_confidence(
     w11 = w11 - w21;
     w46 = 0.00248046035817079 + w11;
     w11 = 6.123233995736766e-17 * w46;
-    w33 = 0.7071067811865475 * w33;
+    w14 = 0.7071067811865475 * w14;
     w32 = 0.7071067811865476 * w32;
-    w23 = w33 - w32;
+    w23 = w14 - w32;
     w19 = params_0 * w19;
     w15 = 0.045305948634 + w19;
     w19 = (-0.088) * w15;
@@ -38988,14 +39050,14 @@ pub fn velocity_control_confidence(
     w47 = 6.123233995736766e-17 * w23;
     w47 = w47 - w50;
     w19 = (-0.014653732538) + w47;
-    w34 = (-0.384) * w19;
+    w16 = (-0.384) * w19;
     w50 = 0.0825 * w11;
-    w34 = w34 + w50;
+    w16 = w16 + w50;
     w50 = 0.03168 * w56;
-    w34 = w34 + w50;
-    w34 = w55 + w34;
-    w34 = 0.02771584317362585 + w34;
-    w57 = (-0.7071067811865476) * w34;
+    w16 = w16 + w50;
+    w16 = w55 + w16;
+    w16 = 0.02771584317362585 + w16;
+    w57 = (-0.7071067811865476) * w16;
     w45 = w45 - w57;
     w45 = (-0.7071067811865475) * w45;
     w57 = (-0.0825) * w11;
@@ -39048,16 +39110,16 @@ pub fn velocity_control_confidence(
     w50 = w50 + w63;
     w45 = 0.316 * w50;
     w44 = (-0.7071067811865476) * w44;
-    w34 = (-0.7071067811865475) * w34;
-    w44 = w44 + w34;
-    w34 = (-0.7071067811865475) * w44;
+    w16 = (-0.7071067811865475) * w16;
+    w44 = w44 + w16;
+    w16 = (-0.7071067811865475) * w44;
     w54 = (-0.7071067811865476) * w54;
     w57 = (-0.7071067811865475) * w57;
     w54 = w54 + w57;
     w57 = (-0.7071067811865476) * w54;
-    w34 = w34 - w57;
+    w16 = w16 - w57;
     w57 = 0.0825 * w64;
-    w57 = w34 - w57;
+    w57 = w16 - w57;
     w57 = (-0.005487648106562256) + w57;
     w45 = w45 - w57;
     w45 = (-0.00398335888393552) + w45;
@@ -39123,11 +39185,11 @@ pub fn velocity_control_confidence(
     w29 = 6.123233995736766e-17 * w29;
     w29 = w29 - w31;
     w31 = (-0.7071067811865475) * w29;
-    w47 = (-0.7071067811865476) * w16;
+    w47 = (-0.7071067811865476) * w34;
     w31 = w31 - w47;
     w31 = (-0.7071067811865475) * w31;
     w29 = (-0.7071067811865476) * w29;
-    w47 = (-0.7071067811865475) * w16;
+    w47 = (-0.7071067811865475) * w34;
     w29 = w29 + w47;
     w47 = 0.7071067811865476 * w29;
     w31 = w31 - w47;
@@ -39135,13 +39197,13 @@ pub fn velocity_control_confidence(
     w13 = w47 * w3;
     w13 = w23 - w13;
     w61 = w13 / w57;
-    w32 = w32 - w33;
-    w33 = 6.123233995736766e-17 * w32;
+    w32 = w32 - w14;
+    w14 = 6.123233995736766e-17 * w32;
     w18 = w48 + w18;
-    w33 = w33 + w18;
+    w14 = w14 + w18;
     w12 = 0.384 * w49;
-    w33 = w33 + w12;
-    w12 = (-0.7071067811865475) * w33;
+    w14 = w14 + w12;
+    w12 = (-0.7071067811865475) * w14;
     w18 = 6.123233995736766e-17 * w18;
     w32 = w32 - w18;
     w18 = (-0.0825) * w49;
@@ -39151,12 +39213,12 @@ pub fn velocity_control_confidence(
     w52 = (-0.316) * w49;
     w12 = w12 - w52;
     w12 = (-0.7071067811865475) * w12;
-    w33 = (-0.7071067811865476) * w33;
+    w14 = (-0.7071067811865476) * w14;
     w18 = (-0.7071067811865475) * w18;
-    w33 = w33 + w18;
+    w14 = w14 + w18;
     w49 = 0.0825 * w49;
-    w33 = w33 - w49;
-    w49 = 0.7071067811865476 * w33;
+    w14 = w14 - w49;
+    w49 = 0.7071067811865476 * w14;
     w12 = w12 - w49;
     w49 = w12 / w42;
     w18 = w49 * w31;
@@ -39168,7 +39230,7 @@ pub fn velocity_control_confidence(
     w25 = 2.3513218543629182e-17 * w27;
     w53 = (-0.0825) * w27;
     w25 = w25 - w53;
-    w25 = w14 + w25;
+    w25 = w33 + w25;
     w52 = w52 - w25;
     w53 = (-0.7071067811865476) * w27;
     w56 = (-4.329780281177466e-17) * w27;
@@ -39181,20 +39243,20 @@ pub fn velocity_control_confidence(
     w27 = w56 * w13;
     w18 = w18 + w27;
     w64 = (-0.0825) * w64;
-    w34 = w34 + w64;
-    w63 = (-0.005487648106562256) + w34;
+    w16 = w16 + w64;
+    w63 = (-0.005487648106562256) + w16;
     w63 = w63 + w50;
     w63 = (-0.7071067811865475) * w63;
     w50 = 0.7071067811865476 * w45;
     w63 = w63 - w50;
     w50 = w49 * w63;
-    w34 = w63 / w42;
-    w64 = w34 * w3;
+    w16 = w63 / w42;
+    w64 = w16 * w3;
     w64 = w36 - w64;
     w27 = w56 * w64;
     w50 = w50 + w27;
-    w50 = w33 - w50;
-    w27 = w63 * w34;
+    w50 = w14 - w50;
+    w27 = w63 * w16;
     w20 = w64 / w57;
     w24 = w64 * w20;
     w27 = w27 + w24;
@@ -39306,10 +39368,10 @@ pub fn velocity_control_confidence(
     w75 = w73 / w70;
     w64 = w75 * w64;
     w79 = w79 + w64;
-    w79 = w16 - w79;
+    w79 = w34 - w79;
     w64 = w78 * w79;
     w18 = w18 + w64;
-    w18 = w14 - w18;
+    w18 = w33 - w18;
     w64 = w31 * w47;
     w13 = w13 * w61;
     w64 = w64 + w13;
@@ -39325,7 +39387,7 @@ pub fn velocity_control_confidence(
     w66 = w56 * w39;
     w66 = w66 - w49;
     w13 = w20 * w39;
-    w13 = w13 - w34;
+    w13 = w13 - w16;
     w35 = w24 * w13;
     w66 = w66 - w35;
     w35 = w69 * w39;
@@ -39402,7 +39464,7 @@ pub fn velocity_control_confidence(
     w81 = w4 * w65;
     w21 = 0.0016666666666666668 * w42;
     w42 = 1.0 / w42;
-    w6 = w34 * w13;
+    w6 = w16 * w13;
     w50 = w39 * w65;
     w6 = w6 - w50;
     w50 = w54 * w35;
@@ -39977,7 +40039,7 @@ pub fn velocity_control_confidence(
     w88 = w29 + w88;
     w36 = w9 * w88;
     w58 = w58 - w36;
-    w58 = w33 + w58;
+    w58 = w14 + w58;
     w58 = w58 / w93;
     w36 = w9 * w58;
     w88 = w88 / w30;
@@ -40110,7 +40172,7 @@ pub fn velocity_control_confidence(
     w28 = w28 - w46;
     w46 = w2 * w59;
     w28 = w28 + w46;
-    w28 = w16 + w28;
+    w28 = w34 + w28;
     w46 = w9 * w28;
     w100 = w100 - w46;
     w100 = w32 + w100;
@@ -40168,20 +40230,20 @@ pub fn velocity_control_confidence(
     w60 = w60 - w121;
     w121 = w111 * w112;
     w60 = w60 + w121;
-    w16 = w16 + w60;
-    w60 = w22 * w16;
+    w34 = w34 + w60;
+    w60 = w22 * w34;
     w51 = w51 - w60;
     w60 = w127 * w112;
     w23 = w104 * w23;
     w114 = w5 * w114;
     w23 = w23 + w114;
     w60 = w60 - w23;
-    w23 = w2 * w16;
+    w23 = w2 * w34;
     w60 = w60 + w23;
     w67 = w67 + w60;
     w60 = w9 * w67;
     w51 = w51 - w60;
-    w51 = w14 + w51;
+    w51 = w33 + w51;
     w51 = w51 / w93;
     w60 = w9 * w51;
     w67 = w67 / w30;
@@ -40189,9 +40251,9 @@ pub fn velocity_control_confidence(
     w67 = w2 * w60;
     w23 = w22 * w51;
     w67 = w67 + w23;
-    w16 = w16 / w97;
-    w67 = w67 - w16;
-    w16 = w98 * w67;
+    w34 = w34 / w97;
+    w67 = w67 - w34;
+    w34 = w98 * w67;
     w112 = w112 / w87;
     w23 = w111 * w67;
     w114 = w127 * w60;
@@ -40200,60 +40262,60 @@ pub fn velocity_control_confidence(
     w23 = w23 - w114;
     w112 = w112 - w23;
     w23 = w38 * w112;
-    w16 = w16 - w23;
+    w34 = w34 - w23;
     w23 = w5 * w60;
-    w16 = w16 - w23;
+    w34 = w34 - w23;
     w23 = w105 * w51;
-    w16 = w16 - w23;
-    w29 = w29 - w16;
-    w16 = w107 * w29;
+    w34 = w34 - w23;
+    w29 = w29 - w34;
+    w34 = w107 * w29;
     w23 = w89 * w112;
-    w16 = w16 + w23;
+    w34 = w34 + w23;
     w23 = w95 * w67;
-    w16 = w16 + w23;
+    w34 = w34 + w23;
     w23 = w104 * w60;
-    w16 = w16 + w23;
+    w34 = w34 + w23;
     w23 = w41 * w51;
-    w16 = w16 - w23;
-    w59 = w59 + w16;
-    w16 = w59 * w18;
-    w123 = w123 - w16;
+    w34 = w34 - w23;
+    w59 = w59 + w34;
+    w34 = w59 * w18;
+    w123 = w123 - w34;
     w86 = w52 / w86;
-    w16 = w107 * w52;
-    w16 = w16 - w33;
-    w120 = w16 / w120;
-    w33 = w105 * w16;
+    w34 = w107 * w52;
+    w34 = w34 - w14;
+    w120 = w34 / w120;
+    w14 = w105 * w34;
     w23 = w41 * w52;
-    w33 = w33 - w23;
+    w14 = w14 - w23;
     w23 = w89 * w52;
-    w114 = w38 * w16;
+    w114 = w38 * w34;
     w23 = w23 + w114;
     w23 = w23 - w25;
     w25 = w113 * w23;
-    w33 = w33 + w25;
-    w25 = w98 * w16;
+    w14 = w14 + w25;
+    w25 = w98 * w34;
     w114 = w95 * w52;
     w25 = w25 - w114;
     w114 = w111 * w23;
     w25 = w25 + w114;
     w32 = w32 + w25;
     w25 = w22 * w32;
-    w33 = w33 - w25;
+    w14 = w14 - w25;
     w25 = w127 * w23;
     w52 = w104 * w52;
-    w16 = w5 * w16;
-    w52 = w52 + w16;
+    w34 = w5 * w34;
+    w52 = w52 + w34;
     w25 = w25 - w52;
     w52 = w2 * w32;
     w25 = w25 + w52;
-    w14 = w14 + w25;
-    w25 = w9 * w14;
-    w33 = w33 - w25;
-    w48 = w48 + w33;
+    w33 = w33 + w25;
+    w25 = w9 * w33;
+    w14 = w14 - w25;
+    w48 = w48 + w14;
     w48 = w48 / w93;
     w9 = w9 * w48;
-    w14 = w14 / w30;
-    w9 = w9 - w14;
+    w33 = w33 / w30;
+    w9 = w9 - w33;
     w2 = w2 * w9;
     w22 = w22 * w48;
     w2 = w2 + w22;
@@ -40386,8 +40448,8 @@ pub fn velocity_control_confidence(
     w87 = w87 + w97;
     w22 = w95 * p_theta_dot_2_3;
     w87 = w87 + w22;
-    w14 = w98 * p_theta_dot_2_4;
-    w87 = w87 + w14;
+    w33 = w98 * p_theta_dot_2_4;
+    w87 = w87 + w33;
     w30 = w5 * p_theta_dot_2_5;
     w87 = w87 + w30;
     w93 = w42 * p_theta_dot_2_6;
@@ -40395,16 +40457,16 @@ pub fn velocity_control_confidence(
     w93 = w87 * w41;
     w18 = w18 + w93;
     w93 = w81 * p_theta_dot_0_3;
-    w33 = w123 * p_theta_dot_1_3;
-    w93 = w93 + w33;
-    w33 = w41 * p_theta_dot_2_3;
-    w93 = w93 + w33;
+    w14 = w123 * p_theta_dot_1_3;
+    w93 = w93 + w14;
+    w14 = w41 * p_theta_dot_2_3;
+    w93 = w93 + w14;
     w25 = w95 * p_theta_dot_3_3;
     w93 = w93 + w25;
     w52 = w98 * p_theta_dot_3_4;
     w93 = w93 + w52;
-    w16 = w5 * p_theta_dot_3_5;
-    w93 = w93 + w16;
+    w34 = w5 * p_theta_dot_3_5;
+    w93 = w93 + w34;
     w114 = w42 * p_theta_dot_3_6;
     w93 = w93 + w114;
     w114 = w93 * w95;
@@ -40502,7 +40564,7 @@ pub fn velocity_control_confidence(
     w117 = w24 * w42;
     w41 = w41 - w117;
     w18 = w18 + w41;
-    w41 = w34 * w18;
+    w41 = w16 * w18;
     w57 = 1.0 / w57;
     w117 = w61 * w123;
     w115 = w20 * w18;
@@ -40785,7 +40847,7 @@ pub fn velocity_control_confidence(
     w109 = w56 * w42;
     w125 = w125 - w109;
     w109 = w39 * w125;
-    w110 = w34 * w27;
+    w110 = w16 * w27;
     w109 = w109 - w110;
     w110 = w54 * w102;
     w109 = w109 + w110;
@@ -41064,7 +41126,7 @@ pub fn velocity_control_confidence(
     w91 = w56 * w42;
     w125 = w125 - w91;
     w91 = w39 * w125;
-    w122 = w34 * w128;
+    w122 = w16 * w128;
     w91 = w91 + w122;
     w122 = w54 * w70;
     w91 = w91 - w122;
@@ -41353,7 +41415,7 @@ pub fn velocity_control_confidence(
     w133 = w56 * w42;
     w136 = w136 - w133;
     w133 = w39 * w136;
-    w132 = w34 * w135;
+    w132 = w16 * w135;
     w133 = w133 + w132;
     w132 = w54 * w134;
     w133 = w133 + w132;
@@ -41654,7 +41716,7 @@ pub fn velocity_control_confidence(
     w140 = w56 * w42;
     w79 = w79 - w140;
     w140 = w39 * w79;
-    w139 = w34 * w136;
+    w139 = w16 * w136;
     w140 = w140 + w139;
     w139 = w54 * w142;
     w140 = w140 + w139;
@@ -41967,8 +42029,8 @@ pub fn velocity_control_confidence(
     w20 = w20 + w61;
     w56 = w56 - w20;
     w39 = w39 * w56;
-    w34 = w34 * w24;
-    w39 = w39 + w34;
+    w16 = w16 * w24;
+    w39 = w39 + w16;
     w54 = w54 * w72;
     w39 = w39 + w54;
     w19 = w19 * w78;
@@ -42213,14 +42275,14 @@ pub fn velocity_control_confidence(
     w89 = w89 + w65;
     w97 = w120 * p_theta_dot_2_3;
     w89 = w89 + w97;
-    w33 = w23 * p_theta_dot_3_3;
-    w89 = w89 + w33;
-    w33 = w2 * p_theta_dot_3_4;
-    w89 = w89 + w33;
-    w33 = w9 * p_theta_dot_3_5;
-    w89 = w89 + w33;
-    w33 = w116 * p_theta_dot_3_6;
-    w89 = w89 + w33;
+    w14 = w23 * p_theta_dot_3_3;
+    w89 = w89 + w14;
+    w14 = w2 * p_theta_dot_3_4;
+    w89 = w89 + w14;
+    w14 = w9 * p_theta_dot_3_5;
+    w89 = w89 + w14;
+    w14 = w116 * p_theta_dot_3_6;
+    w89 = w89 + w14;
     w89 = w89 * w23;
     w84 = w84 + w89;
     w105 = w21 * p_theta_dot_0_4;
@@ -42241,8 +42303,8 @@ pub fn velocity_control_confidence(
     w38 = w21 * p_theta_dot_0_5;
     w113 = w118 * p_theta_dot_1_5;
     w38 = w38 + w113;
-    w14 = w120 * p_theta_dot_2_5;
-    w38 = w38 + w14;
+    w33 = w120 * p_theta_dot_2_5;
+    w38 = w38 + w33;
     w52 = w23 * p_theta_dot_3_5;
     w38 = w38 + w52;
     w119 = w2 * p_theta_dot_4_5;
@@ -42299,28 +42361,31 @@ pub fn velocity_control_confidence(
 ///
 /// From eq. (control_conf) differentiated in the tool parameters.
 ///
-/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
 /// - `p_theta_dot`: precision P of the joint velocities theta_dot (symmetric; the upper triangle is read)
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
-/// Cost per call: 9510 operations, weighted 12597 (2848 ADD, 441 DIV, 4644 MUL, 1577 SUB).
+/// Cost per call: 9513 operations, weighted 12600 (2851 ADD, 441 DIV, 4644 MUL, 1577 SUB).
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
 pub fn velocity_logdet_gradient(
-    params: &SVector<f64, 7>,
+    params: &SVector<f64, 13>,
     p_theta_dot: &SMatrix<f64, 7, 7>,
     p_theta_ddot: &SMatrix<f64, 7, 7>,
     p_u: &SMatrix<f64, 7, 7>,
-) -> SVector<f64, 7> {
+) -> SVector<f64, 13> {
     let params_0 = params[0];
     let params_2 = params[2];
     let params_3 = params[3];
     let params_1 = params[1];
     let params_6 = params[6];
+    let params_8 = params[8];
+    let params_9 = params[9];
     let p_theta_dot_4_6 = p_theta_dot[(4, 6)];
     let params_4 = params[4];
+    let params_7 = params[7];
     let params_5 = params[5];
     let p_u_4_5 = p_u[(4, 5)];
     let p_theta_dot_0_0 = p_theta_dot[(0, 0)];
@@ -42406,7 +42471,7 @@ pub fn velocity_logdet_gradient(
     let p_u_6_6 = p_u[(6, 6)];
     let p_theta_ddot_6_6 = p_theta_ddot[(6, 6)];
     // d ln|Pi^U| / dp, one entry per tool parameter
-    let mut gradient = <SVector<f64, 7>>::zeros();
+    let mut gradient = <SVector<f64, 13>>::zeros();
     let mut w0: f64;
     let w1: f64;
     let mut w2: f64;
@@ -43335,19 +43400,21 @@ pub fn velocity_logdet_gradient(
     w82 = (-0.7071067811865475) * w80;
     w81 = w81 + w82;
     w81 = 0.0825 * w81;
-    w83 = params_1 * w12;
-    w84 = params_0 * w83;
-    w82 = (-0.001672482661783778) - w84;
-    w84 = 0.7071067811865475 * w82;
-    w86 = params_2 * w12;
-    w87 = params_0 * w86;
-    w85 = (-0.000548359106408232) - w87;
-    w87 = 0.7071067811865476 * w85;
-    w84 = w84 + w87;
+    w84 = params_1 * w12;
+    w85 = params_0 * w84;
+    w83 = params_8 - w85;
+    w82 = (-0.001672482661783778) + w83;
+    w83 = 0.7071067811865475 * w82;
+    w87 = params_2 * w12;
+    w88 = params_0 * w87;
+    w86 = params_9 - w88;
+    w85 = (-0.000548359106408232) + w86;
+    w86 = 0.7071067811865476 * w85;
+    w83 = w83 + w86;
     w88 = 2.3513218543629182e-17 * w80;
     w89 = (-0.0825) * w80;
     w88 = w88 - w89;
-    w88 = w84 + w88;
+    w88 = w83 + w88;
     w81 = w81 - w88;
     w89 = (-0.7071067811865476) * w80;
     w80 = (-4.329780281177466e-17) * w80;
@@ -43401,7 +43468,7 @@ pub fn velocity_logdet_gradient(
     w99 = w99 - w100;
     w100 = w33 * w98;
     w99 = w99 + w100;
-    w99 = w84 + w99;
+    w99 = w83 + w99;
     w100 = w74 * w99;
     w96 = w96 - w100;
     w96 = w43 + w96;
@@ -43430,11 +43497,12 @@ pub fn velocity_logdet_gradient(
     w110 = params_4 + w112;
     w109 = 0.015320008390949585 + w110;
     w110 = 0.7071067811865475 * w109;
-    w113 = params_1 * params_2;
-    w114 = params_0 * w113;
-    w112 = (-0.000395108718315752) - w114;
-    w114 = 0.7071067811865476 * w112;
-    w110 = w110 + w114;
+    w114 = params_1 * params_2;
+    w115 = params_0 * w114;
+    w113 = params_7 - w115;
+    w112 = (-0.000395108718315752) + w113;
+    w113 = 0.7071067811865476 * w112;
+    w110 = w110 + w113;
     w115 = 0.7071067811865475 * w110;
     w112 = 0.7071067811865475 * w112;
     w111 = w111 - w13;
@@ -43505,7 +43573,7 @@ pub fn velocity_logdet_gradient(
     w105 = w105 + w138;
     w104 = 0.026534991901690206 + w105;
     w105 = w68 * w104;
-    w142 = 9.3569097314605e-05 - w84;
+    w142 = 9.3569097314605e-05 - w83;
     w110 = 0.7071067811865476 * w110;
     w117 = 0.7071067811865475 * w117;
     w110 = w110 - w117;
@@ -43595,17 +43663,17 @@ pub fn velocity_logdet_gradient(
     w109 = w109 - w112;
     w109 = 0.7071067811865476 * w109;
     w116 = 0.7071067811865475 * w116;
-    w114 = w114 - w116;
-    w114 = 0.7071067811865475 * w114;
-    w109 = w109 - w114;
+    w113 = w113 - w116;
+    w113 = 0.7071067811865475 * w113;
+    w109 = w109 - w113;
     w154 = 0.00248046035817079 + w109;
     w85 = w85 - w82;
     w82 = (-0.088) * w11;
     w82 = w85 - w82;
     w82 = 0.001524110902883315 + w82;
-    w114 = 6.123233995736766e-17 * w82;
-    w114 = w154 + w114;
-    w116 = 6.123233995736766e-17 * w114;
+    w113 = 6.123233995736766e-17 * w82;
+    w113 = w154 + w113;
+    w116 = 6.123233995736766e-17 * w113;
     w11 = 0.088 * w11;
     w85 = w85 + w11;
     w109 = 0.001524110902883315 + w85;
@@ -43619,20 +43687,20 @@ pub fn velocity_logdet_gradient(
     w11 = w123 - w116;
     w112 = (-0.7071067811865475) * w11;
     w93 = 6.123233995736766e-17 * w93;
-    w114 = w114 + w93;
-    w155 = 0.010869510762828563 + w114;
-    w114 = w155 + w130;
-    w93 = (-0.7071067811865476) * w114;
+    w113 = w113 + w93;
+    w155 = 0.010869510762828563 + w113;
+    w113 = w155 + w130;
+    w93 = (-0.7071067811865476) * w113;
     w112 = w112 - w93;
     w93 = (-0.316) * w121;
     w112 = w112 + w93;
     w112 = (-0.7071067811865475) * w112;
     w11 = (-0.7071067811865476) * w11;
-    w114 = (-0.7071067811865475) * w114;
-    w11 = w11 + w114;
+    w113 = (-0.7071067811865475) * w113;
+    w11 = w11 + w113;
     w11 = w11 + w124;
-    w114 = 0.7071067811865476 * w11;
-    w112 = w112 - w114;
+    w113 = 0.7071067811865476 * w11;
+    w112 = w112 - w113;
     w154 = 6.123233995736766e-17 * w154;
     w154 = w154 - w82;
     w154 = 6.123233995736766e-17 * w154;
@@ -43710,8 +43778,8 @@ pub fn velocity_logdet_gradient(
     w156 = w156 + w109;
     w156 = 0.7071067811865476 * w156;
     w93 = w93 + w156;
-    w114 = 0.009213163777211224 + w93;
-    w93 = w112 / w114;
+    w113 = 0.009213163777211224 + w93;
+    w93 = w112 / w113;
     w157 = (-0.384) * w78;
     w147 = w147 + w157;
     w145 = (-0.0016444875773692703) - w147;
@@ -43731,7 +43799,7 @@ pub fn velocity_logdet_gradient(
     w156 = w156 + w109;
     w109 = w93 * w156;
     w109 = w107 - w109;
-    w145 = w156 / w114;
+    w145 = w156 / w113;
     w149 = w156 * w145;
     w149 = w104 - w149;
     w140 = w109 / w149;
@@ -43746,7 +43814,7 @@ pub fn velocity_logdet_gradient(
     w138 = 0.7071067811865476 * w134;
     w120 = w120 - w138;
     w138 = w93 * w120;
-    w121 = w120 / w114;
+    w121 = w120 / w113;
     w137 = w121 * w156;
     w137 = w139 - w137;
     w141 = w140 * w137;
@@ -43767,7 +43835,7 @@ pub fn velocity_logdet_gradient(
     w79 = 0.7071067811865476 * w144;
     w117 = w117 - w79;
     w79 = w93 * w117;
-    w132 = w117 / w114;
+    w132 = w117 / w113;
     w126 = w132 * w156;
     w126 = w127 - w126;
     w158 = w140 * w126;
@@ -43803,7 +43871,7 @@ pub fn velocity_logdet_gradient(
     w143 = w143 + w116;
     w116 = 0.7071067811865476 * w143;
     w142 = w142 - w116;
-    w116 = w142 / w114;
+    w116 = w142 / w113;
     w85 = w116 * w112;
     w82 = w116 * w156;
     w82 = w122 - w82;
@@ -43836,7 +43904,7 @@ pub fn velocity_logdet_gradient(
     w91 = (-0.7071067811865475) * w91;
     w92 = 0.7071067811865476 * w95;
     w91 = w91 - w92;
-    w92 = w91 / w114;
+    w92 = w91 / w113;
     w94 = w92 * w142;
     w165 = w92 * w156;
     w165 = w81 - w165;
@@ -43870,7 +43938,7 @@ pub fn velocity_logdet_gradient(
     w172 = w171 / w78;
     w173 = w172 * w85;
     w94 = w94 + w173;
-    w94 = w84 - w94;
+    w94 = w83 - w94;
     w173 = w142 * w116;
     w174 = w82 * w159;
     w173 = w173 + w174;
@@ -44098,13 +44166,13 @@ pub fn velocity_logdet_gradient(
     w108 = w108 + w153;
     w153 = w74 * w108;
     w143 = w143 - w153;
-    w84 = w84 + w143;
-    w84 = w84 / w6;
-    w143 = w84 * w176;
+    w83 = w83 + w143;
+    w83 = w83 / w6;
+    w143 = w83 * w176;
     w182 = w182 - w143;
     w143 = w96 * w175;
     w182 = w182 + w143;
-    w197 = 0.0016666666666666668 * w114;
+    w197 = 0.0016666666666666668 * w113;
     w198 = 1.0 / w173;
     w199 = w174 / w43;
     w200 = w174 * w199;
@@ -44350,11 +44418,11 @@ pub fn velocity_logdet_gradient(
     w225 = w225 + w266;
     w266 = w122 / w51;
     w267 = w11 / w24;
-    w268 = w74 * w84;
+    w268 = w74 * w83;
     w269 = w108 / w30;
     w268 = w268 - w269;
     w270 = w33 * w268;
-    w271 = w35 * w84;
+    w271 = w35 * w83;
     w270 = w270 + w271;
     w271 = w110 / w41;
     w270 = w270 - w271;
@@ -44363,14 +44431,14 @@ pub fn velocity_logdet_gradient(
     w274 = w46 * w270;
     w275 = w76 * w268;
     w274 = w274 + w275;
-    w275 = w71 * w84;
+    w275 = w71 * w83;
     w274 = w274 - w275;
     w274 = w273 - w274;
     w275 = w61 * w274;
     w272 = w272 - w275;
     w275 = w66 * w268;
     w272 = w272 - w275;
-    w275 = w72 * w84;
+    w275 = w72 * w83;
     w272 = w272 - w275;
     w272 = w267 - w272;
     w275 = w68 * w272;
@@ -44380,7 +44448,7 @@ pub fn velocity_logdet_gradient(
     w275 = w275 + w276;
     w276 = w57 * w268;
     w275 = w275 + w276;
-    w276 = w50 * w84;
+    w276 = w50 * w83;
     w275 = w275 - w276;
     w275 = w266 + w275;
     w276 = w275 * w200;
@@ -44490,7 +44558,7 @@ pub fn velocity_logdet_gradient(
     w293 = w293 + w294;
     w294 = w80 * w204;
     w293 = w293 + w294;
-    w294 = w84 * w200;
+    w294 = w83 * w200;
     w293 = w293 - w294;
     w294 = w96 * w199;
     w293 = w293 + w294;
@@ -44734,7 +44802,7 @@ pub fn velocity_logdet_gradient(
     w336 = w336 - w343;
     w336 = w328 - w336;
     w343 = w207 * w336;
-    w344 = 1.0 / w114;
+    w344 = 1.0 / w113;
     w345 = w121 * w338;
     w346 = w145 * w336;
     w345 = w345 - w346;
@@ -44844,7 +44912,7 @@ pub fn velocity_logdet_gradient(
     w352 = w352 + w353;
     w353 = w80 * w342;
     w352 = w352 + w353;
-    w353 = w84 * w334;
+    w353 = w83 * w334;
     w352 = w352 - w353;
     w353 = w96 * w329;
     w352 = w352 + w353;
@@ -45231,7 +45299,7 @@ pub fn velocity_logdet_gradient(
     w393 = w393 + w394;
     w394 = w80 * w382;
     w393 = w393 + w394;
-    w394 = w84 * w376;
+    w394 = w83 * w376;
     w393 = w393 - w394;
     w394 = w96 * w372;
     w393 = w393 + w394;
@@ -45541,7 +45609,7 @@ pub fn velocity_logdet_gradient(
     w427 = w427 + w428;
     w428 = w80 * w417;
     w427 = w427 + w428;
-    w428 = w84 * w411;
+    w428 = w83 * w411;
     w427 = w427 - w428;
     w428 = w96 * w408;
     w427 = w427 + w428;
@@ -45867,7 +45935,7 @@ pub fn velocity_logdet_gradient(
     w461 = w461 - w462;
     w462 = w80 * w450;
     w461 = w461 + w462;
-    w462 = w84 * w446;
+    w462 = w83 * w446;
     w461 = w461 - w462;
     w462 = w96 * w444;
     w461 = w461 + w462;
@@ -46206,7 +46274,7 @@ pub fn velocity_logdet_gradient(
     w501 = w501 + w502;
     w502 = w80 * w482;
     w501 = w501 + w502;
-    w502 = w84 * w199;
+    w502 = w83 * w199;
     w501 = w501 + w502;
     w502 = w96 / w43;
     w501 = w501 - w502;
@@ -48846,7 +48914,7 @@ pub fn velocity_logdet_gradient(
     w356 = w96 * w356;
     w99 = w99 * w303;
     w356 = w356 - w99;
-    w327 = w84 * w327;
+    w327 = w83 * w327;
     w356 = w356 + w327;
     w108 = w108 * w435;
     w356 = w356 - w108;
@@ -48870,7 +48938,7 @@ pub fn velocity_logdet_gradient(
     w356 = w356 - w529;
     w529 = w96 / w6;
     w529 = w529 * w315;
-    w315 = w84 / w6;
+    w315 = w83 / w6;
     w315 = w315 * w401;
     w529 = w529 + w315;
     w315 = w80 / w6;
@@ -49021,7 +49089,7 @@ pub fn velocity_logdet_gradient(
     w488 = w96 * w488;
     w98 = w98 * w303;
     w488 = w488 - w98;
-    w310 = w84 * w310;
+    w310 = w83 * w310;
     w488 = w488 + w310;
     w110 = w110 * w435;
     w488 = w488 - w110;
@@ -49091,7 +49159,7 @@ pub fn velocity_logdet_gradient(
     w356 = w96 * w355;
     w97 = w97 * w303;
     w356 = w356 + w97;
-    w97 = w84 * w103;
+    w97 = w83 * w103;
     w356 = w356 + w97;
     w196 = w196 * w435;
     w356 = w356 + w196;
@@ -49233,7 +49301,7 @@ pub fn velocity_logdet_gradient(
     w247 = w96 * w313;
     w257 = w89 * w303;
     w247 = w247 + w257;
-    w257 = w84 * w324;
+    w257 = w83 * w324;
     w247 = w247 + w257;
     w257 = w11 * w435;
     w247 = w247 + w257;
@@ -49695,7 +49763,7 @@ pub fn velocity_logdet_gradient(
     w40 = w96 * w358;
     w81 = w81 * w303;
     w40 = w40 + w81;
-    w81 = w84 * w316;
+    w81 = w83 * w316;
     w40 = w40 + w81;
     w122 = w122 * w435;
     w40 = w40 + w122;
@@ -49796,7 +49864,7 @@ pub fn velocity_logdet_gradient(
     w281 = w281 + w56;
     w177 = w177 / w173;
     w56 = w268 * w308;
-    w215 = w84 * w323;
+    w215 = w83 * w323;
     w56 = w56 - w215;
     w215 = w270 * w206;
     w56 = w56 + w215;
@@ -49925,7 +49993,7 @@ pub fn velocity_logdet_gradient(
     w177 = w177 * w56;
     w198 = w198 / w173;
     w325 = w268 * w307;
-    w182 = w84 * w309;
+    w182 = w83 * w309;
     w325 = w325 - w182;
     w182 = w270 * w293;
     w325 = w325 + w182;
@@ -50053,7 +50121,7 @@ pub fn velocity_logdet_gradient(
     w177 = w177 - w198;
     w447 = w447 / w173;
     w198 = w268 * w397;
-    w291 = w84 * w359;
+    w291 = w83 * w359;
     w198 = w198 - w291;
     w291 = w270 * w295;
     w198 = w198 + w291;
@@ -50185,7 +50253,7 @@ pub fn velocity_logdet_gradient(
     w177 = w177 + w447;
     w412 = w412 / w173;
     w447 = w268 * w431;
-    w460 = w84 * w400;
+    w460 = w83 * w400;
     w447 = w447 - w460;
     w460 = w270 * w454;
     w447 = w447 + w460;
@@ -50319,7 +50387,7 @@ pub fn velocity_logdet_gradient(
     w177 = w177 + w412;
     w377 = w377 / w173;
     w412 = w268 * w465;
-    w426 = w84 * w434;
+    w426 = w83 * w434;
     w412 = w412 - w426;
     w426 = w270 * w420;
     w412 = w412 + w426;
@@ -50455,7 +50523,7 @@ pub fn velocity_logdet_gradient(
     w177 = w177 + w377;
     w335 = w335 / w173;
     w377 = w268 * w508;
-    w392 = w84 * w509;
+    w392 = w83 * w509;
     w377 = w377 - w392;
     w392 = w270 * w507;
     w377 = w377 + w392;
@@ -50592,17 +50660,17 @@ pub fn velocity_logdet_gradient(
     w335 = w335 * w377;
     w177 = w177 + w335;
     w335 = w174 / w173;
-    w84 = w84 * w320;
+    w83 = w83 * w320;
     w268 = w268 * w306;
-    w84 = w84 - w268;
+    w83 = w83 - w268;
     w270 = w270 * w501;
-    w84 = w84 - w270;
+    w83 = w83 - w270;
     w274 = w274 * w298;
-    w84 = w84 - w274;
+    w83 = w83 - w274;
     w272 = w272 * w300;
-    w84 = w84 - w272;
+    w83 = w83 - w272;
     w275 = w275 * w346;
-    w84 = w84 + w275;
+    w83 = w83 + w275;
     w294 = p_theta_dot_0_6 * w527;
     w292 = p_theta_dot_0_5 * w532;
     w294 = w294 + w292;
@@ -50619,7 +50687,7 @@ pub fn velocity_logdet_gradient(
     w213 = p_theta_dot_0_0 * w491;
     w294 = w294 + w213;
     w211 = w211 * w294;
-    w84 = w84 - w211;
+    w83 = w83 - w211;
     w197 = w197 * w294;
     w183 = w183 * w320;
     w231 = w231 * w306;
@@ -50634,7 +50702,7 @@ pub fn velocity_logdet_gradient(
     w183 = w183 + w235;
     w197 = w197 - w183;
     w183 = w116 * w197;
-    w84 = w84 + w183;
+    w83 = w83 + w183;
     w148 = w148 * w320;
     w217 = w217 * w306;
     w148 = w148 - w217;
@@ -50651,7 +50719,7 @@ pub fn velocity_logdet_gradient(
     w207 = w145 * w197;
     w148 = w148 + w207;
     w207 = w159 * w148;
-    w84 = w84 - w207;
+    w83 = w83 - w207;
     w95 = w95 * w320;
     w238 = w238 * w306;
     w95 = w95 - w238;
@@ -50670,7 +50738,7 @@ pub fn velocity_logdet_gradient(
     w208 = w147 * w148;
     w95 = w95 - w208;
     w208 = w161 * w95;
-    w84 = w84 - w208;
+    w83 = w83 - w208;
     w88 = w88 * w320;
     w248 = w248 * w306;
     w88 = w88 - w248;
@@ -50691,7 +50759,7 @@ pub fn velocity_logdet_gradient(
     w209 = w119 * w95;
     w88 = w88 - w209;
     w209 = w163 * w88;
-    w84 = w84 - w209;
+    w83 = w83 - w209;
     w80 = w80 * w320;
     w258 = w258 * w306;
     w80 = w80 - w258;
@@ -50714,8 +50782,8 @@ pub fn velocity_logdet_gradient(
     w210 = w124 * w88;
     w80 = w80 - w210;
     w210 = w164 * w80;
-    w84 = w84 - w210;
-    w210 = w84 / w43;
+    w83 = w83 - w210;
+    w210 = w83 / w43;
     w265 = w199 * w325;
     w210 = w210 + w265;
     w309 = w96 * w309;
@@ -50891,8 +50959,8 @@ pub fn velocity_logdet_gradient(
     w487 = w487 * w197;
     w502 = w502 + w487;
     w487 = w199 / w43;
-    w84 = w487 * w84;
-    w502 = w502 - w84;
+    w83 = w487 * w83;
+    w502 = w502 - w83;
     w481 = w481 / w43;
     w481 = w481 * w80;
     w502 = w502 - w481;
@@ -51561,10 +51629,10 @@ pub fn velocity_logdet_gradient(
     w345 = w345 * w503;
     w486 = w486 - w345;
     w486 = 0.0016666666666666668 * w486;
-    w344 = w344 / w114;
+    w344 = w344 / w113;
     w344 = w344 * w343;
     w486 = w486 - w344;
-    w344 = w93 / w114;
+    w344 = w93 / w113;
     w345 = w482 * w197;
     w383 = w204 * w225;
     w345 = w345 + w383;
@@ -51596,7 +51664,7 @@ pub fn velocity_logdet_gradient(
     w345 = w345 - w283;
     w344 = w344 * w345;
     w486 = w486 - w344;
-    w344 = w132 / w114;
+    w344 = w132 / w113;
     w283 = w483 * w197;
     w419 = w203 * w225;
     w283 = w283 + w419;
@@ -51619,7 +51687,7 @@ pub fn velocity_logdet_gradient(
     w283 = w283 - w419;
     w344 = w344 * w283;
     w486 = w486 - w344;
-    w344 = w121 / w114;
+    w344 = w121 / w113;
     w419 = w484 * w197;
     w453 = w202 * w225;
     w419 = w419 + w453;
@@ -51651,7 +51719,7 @@ pub fn velocity_logdet_gradient(
     w419 = w419 - w170;
     w344 = w344 * w419;
     w486 = w486 - w344;
-    w344 = w92 / w114;
+    w344 = w92 / w113;
     w170 = w199 * w225;
     w188 = w197 / w43;
     w170 = w170 - w188;
@@ -51683,7 +51751,7 @@ pub fn velocity_logdet_gradient(
     w170 = w170 - w91;
     w344 = w344 * w170;
     w486 = w486 - w344;
-    w344 = w116 / w114;
+    w344 = w116 / w113;
     w91 = w199 * w197;
     w188 = w200 * w225;
     w91 = w91 - w188;
@@ -51710,7 +51778,7 @@ pub fn velocity_logdet_gradient(
     w91 = w91 - w120;
     w344 = w344 * w91;
     w486 = w486 - w344;
-    w344 = w145 / w114;
+    w344 = w145 / w113;
     w197 = w485 * w197;
     w225 = w201 * w225;
     w197 = w197 + w225;
@@ -51765,7 +51833,7 @@ pub fn velocity_logdet_gradient(
     w413 = w413 - w338;
     w407 = w121 * w407;
     w413 = w413 + w407;
-    w419 = w419 / w114;
+    w419 = w419 / w113;
     w413 = w413 + w419;
     w419 = w92 * w95;
     w413 = w413 - w419;
@@ -51884,7 +51952,7 @@ pub fn velocity_logdet_gradient(
     w178 = w178 - w342;
     w342 = w93 * w125;
     w178 = w178 + w342;
-    w345 = w345 / w114;
+    w345 = w345 / w113;
     w178 = w178 + w345;
     w345 = w92 * w80;
     w178 = w178 - w345;
@@ -51964,7 +52032,7 @@ pub fn velocity_logdet_gradient(
     w43 = w534 + w43;
     w502 = w92 * w502;
     w43 = w43 - w502;
-    w170 = w170 / w114;
+    w170 = w170 / w113;
     w43 = w43 + w170;
     w170 = 0.7071067811865476 * w43;
     w413 = w413 - w170;
@@ -52110,7 +52178,7 @@ pub fn velocity_logdet_gradient(
     w478 = w478 - w212;
     w145 = w145 * w384;
     w478 = w478 + w145;
-    w197 = w197 / w114;
+    w197 = w197 / w113;
     w478 = w478 + w197;
     w385 = w385 * w512;
     w485 = w485 * w294;
@@ -52151,7 +52219,7 @@ pub fn velocity_logdet_gradient(
     w519 = w519 - w174;
     w132 = w132 * w443;
     w519 = w519 + w132;
-    w283 = w283 / w114;
+    w283 = w283 / w113;
     w519 = w519 + w283;
     w88 = w92 * w88;
     w519 = w519 - w88;
@@ -52201,7 +52269,7 @@ pub fn velocity_logdet_gradient(
     w535 = w535 - w116;
     w92 = w92 * w210;
     w535 = w535 - w92;
-    w91 = w91 / w114;
+    w91 = w91 / w113;
     w535 = w535 + w91;
     w91 = 0.7071067811865476 * w535;
     w487 = w487 - w91;
@@ -52243,8 +52311,8 @@ pub fn velocity_logdet_gradient(
     w91 = w385 + w91;
     w519 = 0.7071067811865476 * w91;
     w530 = w530 - w519;
-    w86 = w86 * w530;
-    w281 = w281 - w86;
+    w87 = w87 * w530;
+    w281 = w281 - w87;
     w502 = 0.7071067811865476 * w502;
     w435 = 0.7071067811865475 * w435;
     w502 = w502 + w435;
@@ -52252,34 +52320,34 @@ pub fn velocity_logdet_gradient(
     w502 = w502 - w136;
     w91 = 0.7071067811865475 * w91;
     w502 = w502 - w91;
-    w83 = w83 * w502;
-    w281 = w281 - w83;
-    w83 = (-4.2475144558350945e-16) * w102;
+    w84 = w84 * w502;
+    w281 = w281 - w84;
+    w84 = (-4.2475144558350945e-16) * w102;
     w100 = (-4.2475144558350945e-16) * w529;
-    w83 = w83 - w100;
+    w84 = w84 - w100;
     w100 = (-6.9367175234400325) * w74;
-    w83 = w83 + w100;
+    w84 = w84 + w100;
     w279 = 6.123233995736766e-17 * w279;
     w35 = w35 - w279;
     w279 = (-6.936717523440031) * w35;
-    w83 = w83 - w279;
+    w84 = w84 - w279;
     w26 = (-4.329780281177467e-17) * w47;
     w1 = (-0.7071067811865476) * w3;
     w26 = w26 - w1;
     w32 = 4.905000000000001 * w26;
-    w83 = w83 - w32;
+    w84 = w84 - w32;
     w187 = 6.936717523440031 * w187;
-    w83 = w83 - w187;
+    w84 = w84 - w187;
     w3 = (-0.7071067811865475) * w3;
     w90 = (-4.329780281177466e-17) * w47;
     w3 = w3 - w90;
     w90 = 4.905 * w3;
-    w83 = w83 + w90;
+    w84 = w84 + w90;
     w22 = 6.9367175234400325 * w22;
-    w83 = w83 + w22;
+    w84 = w84 + w22;
     w46 = w46 - w216;
     w216 = 4.904999999999999 * w46;
-    w83 = w83 - w216;
+    w84 = w84 - w216;
     w50 = w50 * w529;
     w45 = w45 / w51;
     w50 = w50 + w45;
@@ -52289,28 +52357,28 @@ pub fn velocity_logdet_gradient(
     w382 = w382 - w488;
     w2 = w2 + w382;
     w382 = 4.905 * w2;
-    w83 = w83 - w382;
+    w84 = w84 - w382;
     w50 = 0.7071067811865476 * w50;
     w50 = w50 - w61;
     w42 = (-4.905000000000001) * w50;
-    w83 = w83 - w42;
+    w84 = w84 - w42;
     w233 = (-6.9367175234400325) * w233;
-    w83 = w83 - w233;
+    w84 = w84 - w233;
     w70 = 6.936717523440031 * w70;
-    w83 = w83 + w70;
+    w84 = w84 + w70;
     w70 = 1.3682105688520791e-17 * w302;
     w135 = 0.22344574285494903 * w302;
     w70 = w70 - w135;
     w135 = (-0.0825) * w510;
     w70 = w70 - w135;
-    w87 = 2.3513218543629182e-17 * w510;
-    w70 = w70 + w87;
+    w86 = 2.3513218543629182e-17 * w510;
+    w70 = w70 + w86;
     w526 = (-0.058336309447890165) * w302;
     w70 = w70 + w526;
     w526 = (-3.5720687319714105e-18) * w302;
     w70 = w70 + w526;
     w526 = 0.7071067811865476 * w70;
-    w83 = w83 + w526;
+    w84 = w84 + w526;
     w170 = 0.384 * w170;
     w413 = 0.0825 * w413;
     w43 = 0.223445742854949 * w43;
@@ -52321,7 +52389,7 @@ pub fn velocity_logdet_gradient(
     w329 = 0.088 * w329;
     w170 = w170 + w329;
     w329 = 0.7071067811865475 * w170;
-    w83 = w83 - w329;
+    w84 = w84 - w329;
     w329 = 0.088 * w335;
     w413 = (-0.088) * w335;
     w329 = w329 - w413;
@@ -52331,7 +52399,7 @@ pub fn velocity_logdet_gradient(
     w36 = 0.088 * w156;
     w329 = w329 + w36;
     w36 = 0.7071067811865475 * w329;
-    w83 = w83 - w36;
+    w84 = w84 - w36;
     w36 = 5.388445916248354e-18 * w385;
     w151 = 0.223445742854949 * w57;
     w341 = 0.384 * w341;
@@ -52359,8 +52427,8 @@ pub fn velocity_logdet_gradient(
     w13 = (-0.088) * w56;
     w36 = w36 + w13;
     w13 = 0.7071067811865476 * w36;
-    w83 = w83 + w13;
-    w13 = params_2 * w83;
+    w84 = w84 + w13;
+    w13 = params_2 * w84;
     w281 = w281 + w13;
     w101 = (-4.247514455835095e-16) * w529;
     w529 = (-4.2475144558350955e-16) * w102;
@@ -52416,8 +52484,8 @@ pub fn velocity_logdet_gradient(
     w335 = w335 + w56;
     w4 = 0.7071067811865476 * w335;
     w36 = w36 + w4;
-    w113 = w113 * w36;
-    w281 = w281 - w113;
+    w114 = w114 * w36;
+    w281 = w281 - w114;
     w312 = 0.5000000000000001 * w342;
     w15 = 0.7071067811865475 * w335;
     w312 = w312 + w15;
@@ -52425,47 +52493,53 @@ pub fn velocity_logdet_gradient(
     w281 = w281 + w52;
     gradient[0] = w281;
     w101 = params_0 * w101;
-    w502 = params_0 * w502;
-    w281 = w12 * w502;
-    w101 = w101 - w281;
-    w36 = params_0 * w36;
-    w281 = params_2 * w36;
-    w101 = w101 - w281;
-    w281 = 2.0 * params_1;
-    w52 = params_0 * w312;
-    w15 = w281 * w52;
+    w281 = params_0 * w502;
+    w52 = w12 * w281;
+    w101 = w101 - w52;
+    w52 = params_0 * w36;
+    w15 = params_2 * w52;
     w101 = w101 - w15;
-    w15 = params_0 * w118;
-    w335 = params_0 * w417;
-    w52 = w335 + w52;
-    w15 = w15 + w52;
-    w281 = w281 * w15;
-    w101 = w101 + w281;
+    w15 = 2.0 * params_1;
+    w335 = params_0 * w312;
+    w342 = w15 * w335;
+    w101 = w101 - w342;
+    w342 = params_0 * w118;
+    w114 = params_0 * w417;
+    w335 = w114 + w335;
+    w342 = w342 + w335;
+    w15 = w15 * w342;
+    w101 = w101 + w15;
     gradient[1] = w101;
-    w83 = params_0 * w83;
-    w530 = params_0 * w530;
-    w101 = w12 * w530;
-    w83 = w83 - w101;
-    w101 = 2.0 * params_2;
-    w335 = w101 * w335;
-    w83 = w83 - w335;
-    w36 = params_1 * w36;
-    w83 = w83 - w36;
-    w101 = w101 * w15;
-    w83 = w83 + w101;
-    gradient[2] = w83;
+    w84 = params_0 * w84;
+    w101 = params_0 * w530;
+    w15 = w12 * w101;
+    w84 = w84 - w15;
+    w15 = 2.0 * params_2;
+    w114 = w15 * w114;
+    w84 = w84 - w114;
+    w52 = params_1 * w52;
+    w84 = w84 - w52;
+    w15 = w15 * w342;
+    w84 = w84 + w15;
+    gradient[2] = w84;
     w7 = params_0 * w372;
-    w8 = params_2 * w530;
+    w8 = params_2 * w101;
     w7 = w7 - w8;
-    w19 = params_1 * w502;
+    w19 = params_1 * w281;
     w7 = w7 - w19;
     w12 = 2.0 * w12;
-    w12 = w12 * w52;
+    w12 = w12 * w335;
     w7 = w7 + w12;
     gradient[3] = w7;
     gradient[4] = w312;
     gradient[5] = w417;
     gradient[6] = w118;
+    gradient[7] = w36;
+    gradient[8] = w502;
+    gradient[9] = w530;
+    gradient[10] = 0.0;
+    gradient[11] = 0.0;
+    gradient[12] = 0.0;
     gradient
 }
 
@@ -52473,13 +52547,13 @@ pub fn velocity_logdet_gradient(
 ///
 /// From appendix "Task specific controllers".
 ///
-/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
 ///
 /// Cost per call: 0 operations, weighted 0.
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
-pub fn acceleration_sensitivity(_params: &SVector<f64, 7>) -> SMatrix<f64, 7, 7> {
+pub fn acceleration_sensitivity(_params: &SVector<f64, 13>) -> SMatrix<f64, 7, 7> {
     // dtheta_ddot/dU = IO @ (A @ A @ dX_dU + A @ B)
     let mut d_theta_ddot_du = <SMatrix<f64, 7, 7>>::zeros();
     d_theta_ddot_du[(0, 0)] = 1.0;
@@ -52496,7 +52570,7 @@ pub fn acceleration_sensitivity(_params: &SVector<f64, 7>) -> SMatrix<f64, 7, 7>
 ///
 /// From eq. (control_conf) and the closed forms after it.
 ///
-/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
@@ -52505,7 +52579,7 @@ pub fn acceleration_sensitivity(_params: &SVector<f64, 7>) -> SMatrix<f64, 7, 7>
 #[inline]
 #[must_use]
 pub fn acceleration_control_confidence(
-    _params: &SVector<f64, 7>,
+    _params: &SVector<f64, 13>,
     p_theta_ddot: &SMatrix<f64, 7, 7>,
     p_u: &SMatrix<f64, 7, 7>,
 ) -> SMatrix<f64, 7, 7> {
@@ -52652,7 +52726,7 @@ pub fn acceleration_control_confidence(
 ///
 /// From eq. (control_conf) differentiated in the tool parameters.
 ///
-/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
 /// - `p_theta_ddot`: precision P of the joint accelerations theta_ddot (symmetric; the upper triangle is read)
 /// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
 ///
@@ -52661,12 +52735,12 @@ pub fn acceleration_control_confidence(
 #[inline]
 #[must_use]
 pub fn acceleration_logdet_gradient(
-    _params: &SVector<f64, 7>,
+    _params: &SVector<f64, 13>,
     _p_theta_ddot: &SMatrix<f64, 7, 7>,
     _p_u: &SMatrix<f64, 7, 7>,
-) -> SVector<f64, 7> {
+) -> SVector<f64, 13> {
     // d ln|Pi^U| / dp, one entry per tool parameter
-    let mut gradient = <SVector<f64, 7>>::zeros();
+    let mut gradient = <SVector<f64, 13>>::zeros();
     gradient[0] = 0.0;
     gradient[1] = 0.0;
     gradient[2] = 0.0;
@@ -52674,6 +52748,12 @@ pub fn acceleration_logdet_gradient(
     gradient[4] = 0.0;
     gradient[5] = 0.0;
     gradient[6] = 0.0;
+    gradient[7] = 0.0;
+    gradient[8] = 0.0;
+    gradient[9] = 0.0;
+    gradient[10] = 0.0;
+    gradient[11] = 0.0;
+    gradient[12] = 0.0;
     gradient
 }
 
@@ -52685,12 +52765,12 @@ pub struct RigidBodyDynamicsCoefficients {
 }
 
 impl RigidBodyDynamicsCoefficients {
-    /// - `params`: tool parameters `[tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]`
+    /// - `params`: tool parameters `[tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]`
     ///
-    /// Cost, once per tool: 35 operations, weighted 35 (13 ADD, 17 MUL, 5 SUB) (derive/toolconf_derive/cost.py).
+    /// Cost, once per tool: 38 operations, weighted 38 (16 ADD, 17 MUL, 5 SUB) (derive/toolconf_derive/cost.py).
     #[inline]
     #[must_use]
-    pub fn new(params: &SVector<f64, 7>) -> Self {
+    pub fn new(params: &SVector<f64, 13>) -> Self {
         let params_0 = params[0];
         let params_1 = params[1];
         let params_2 = params[2];
@@ -52698,6 +52778,9 @@ impl RigidBodyDynamicsCoefficients {
         let params_4 = params[4];
         let params_5 = params[5];
         let params_6 = params[6];
+        let params_7 = params[7];
+        let params_8 = params[8];
+        let params_9 = params[9];
         let s0_0 = 0.735522 + params_0;
         let s3_1 = params_0 * params_1;
         let s0_2 = 0.007735484874 + s3_1;
@@ -52724,18 +52807,21 @@ impl RigidBodyDynamicsCoefficients {
         let s6_23 = params_0 * s6_10;
         let s5_24 = params_6 + s6_23;
         let s0_25 = 0.004909651967360946 + s5_24;
-        let s5_26 = params_1 * params_2;
-        let s5_27 = params_0 * s5_26;
-        let s0_28 = (-0.000395108718315752) - s5_27;
-        let s2_29 = params_1 * s4_5;
-        let s2_30 = params_0 * s2_29;
-        let s0_31 = (-0.001672482661783778) - s2_30;
-        let s3_32 = params_2 * s4_5;
-        let s1_33 = params_0 * s3_32;
-        let s0_34 = (-0.000548359106408232) - s1_33;
+        let s6_26 = params_1 * params_2;
+        let s6_27 = params_0 * s6_26;
+        let s5_28 = params_7 - s6_27;
+        let s0_29 = (-0.000395108718315752) + s5_28;
+        let s2_30 = params_1 * s4_5;
+        let s2_31 = params_0 * s2_30;
+        let s5_32 = params_8 - s2_31;
+        let s0_33 = (-0.001672482661783778) + s5_32;
+        let s3_34 = params_2 * s4_5;
+        let s1_35 = params_0 * s3_34;
+        let s5_36 = params_9 - s1_35;
+        let s0_37 = (-0.000548359106408232) + s5_36;
         Self {
             k: [
-                s0_0, s0_2, s0_4, s0_7, s0_17, s0_22, s0_25, s0_28, s0_31, s0_34,
+                s0_0, s0_2, s0_4, s0_7, s0_17, s0_22, s0_25, s0_29, s0_33, s0_37,
             ],
         }
     }
@@ -52747,17 +52833,17 @@ impl RigidBodyDynamicsCoefficients {
 ///
 /// - `x`: state X = [panda_joint1 panda_joint2 panda_joint3 panda_joint4 panda_joint5 panda_joint6 panda_joint7 panda_joint1_dot panda_joint2_dot panda_joint3_dot panda_joint4_dot panda_joint5_dot panda_joint6_dot panda_joint7_dot]
 /// - `u`: control U = [panda_joint1_torque panda_joint2_torque panda_joint3_torque panda_joint4_torque panda_joint5_torque panda_joint6_torque panda_joint7_torque]
-/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz]
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
 ///
-/// Cost per call: 1541 operations, weighted 1737, plus 6 `sin_cos`: [`RigidBodyDynamicsCoefficients::new`] (35, weighted 35), then [`rigid_body_dynamics_with`] (1506, weighted 1702). Build the coefficients once per tool and call [`rigid_body_dynamics_with`] where it is called often.
-/// The same closed form with the parameters inline (not hoisted) would take 1539 operations, weighted 1735 (403 ADD, 28 DIV, 814 MUL, 294 SUB), plus 6 `sin_cos`.
+/// Cost per call: 1544 operations, weighted 1740, plus 6 `sin_cos`: [`RigidBodyDynamicsCoefficients::new`] (38, weighted 38), then [`rigid_body_dynamics_with`] (1506, weighted 1702). Build the coefficients once per tool and call [`rigid_body_dynamics_with`] where it is called often.
+/// The same closed form with the parameters inline (not hoisted) would take 1542 operations, weighted 1738 (406 ADD, 28 DIV, 814 MUL, 294 SUB), plus 6 `sin_cos`.
 /// (Counted by the generator, derive/toolconf_derive/cost.py.)
 #[inline]
 #[must_use]
 pub fn rigid_body_dynamics(
     x: &SVector<f64, 14>,
     u: &SVector<f64, 7>,
-    params: &SVector<f64, 7>,
+    params: &SVector<f64, 13>,
 ) -> SVector<f64, 14> {
     rigid_body_dynamics_with(x, u, &RigidBodyDynamicsCoefficients::new(params))
 }
@@ -54469,4 +54555,318 @@ pub fn rigid_body_dynamics_with(
     x_dot[12] = w136;
     x_dot[13] = w113;
     x_dot
+}
+
+/// The tool's tip (tool-centre point) y(q; p) in the base frame 'panda_link0', and its Jacobian J = dy/dq (geometric: z_i x (y - o_i) per revolute joint, z_i per prismatic one), what Pinocchio's frame placement and computeFrameJacobian (LOCAL_WORLD_ALIGNED, linear rows) give for a frame at the tip.
+///
+/// From forward kinematics of the URDF chain to the flange, then the tip offset (tool_tip_x/y/z).
+///
+/// - `q`: joint positions q = [panda_joint1 panda_joint2 panda_joint3 panda_joint4 panda_joint5 panda_joint6 panda_joint7]
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
+///
+/// Cost per call: 209 operations, weighted 209 (34 ADD, 123 MUL, 4 NEG, 48 SUB), plus 7 `sin_cos`.
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip(
+    q: &SVector<f64, 7>,
+    params: &SVector<f64, 13>,
+) -> (SVector<f64, 3>, SMatrix<f64, 3, 7>) {
+    let q_0 = q[0];
+    let q_1 = q[1];
+    let q_2 = q[2];
+    let q_3 = q[3];
+    let q_4 = q[4];
+    let q_5 = q[5];
+    let q_6 = q[6];
+    let params_10 = params[10];
+    let params_11 = params[11];
+    let params_12 = params[12];
+    let (sin_q_0, cos_q_0) = crate::trig::sin_cos(q_0);
+    let (sin_q_1, cos_q_1) = crate::trig::sin_cos(q_1);
+    let (sin_q_2, cos_q_2) = crate::trig::sin_cos(q_2);
+    let (sin_q_3, cos_q_3) = crate::trig::sin_cos(q_3);
+    let (sin_q_4, cos_q_4) = crate::trig::sin_cos(q_4);
+    let (sin_q_5, cos_q_5) = crate::trig::sin_cos(q_5);
+    let (sin_q_6, cos_q_6) = crate::trig::sin_cos(q_6);
+    // y (m, base frame)
+    let mut position = <SVector<f64, 3>>::zeros();
+    // J = dy/dq
+    let mut jacobian = <SMatrix<f64, 3, 7>>::zeros();
+    let mut w0: f64;
+    let mut w1: f64;
+    let mut w2: f64;
+    let mut w3: f64;
+    let mut w4: f64;
+    let mut w5: f64;
+    let mut w6: f64;
+    let mut w7: f64;
+    let mut w8: f64;
+    let mut w9: f64;
+    let mut w10: f64;
+    let mut w11: f64;
+    let mut w12: f64;
+    let mut w13: f64;
+    let mut w15: f64;
+    let mut w16: f64;
+    let mut w17: f64;
+    let mut w18: f64;
+    let mut w19: f64;
+    let mut w21: f64;
+    let mut w22: f64;
+    let mut w23: f64;
+    let mut w24: f64;
+    let mut w25: f64;
+    let mut w26: f64;
+    let mut w27: f64;
+    let mut w28: f64;
+    let w30: f64;
+    let mut w31: f64;
+    let mut w32: f64;
+    let mut w33: f64;
+    let mut w34: f64;
+    let mut w35: f64;
+    let mut w36: f64;
+    let mut w37: f64;
+    let mut w38: f64;
+    let mut w39: f64;
+    let mut w40: f64;
+    let mut w41: f64;
+    let mut w42: f64;
+    let mut w43: f64;
+    let mut w44: f64;
+    let mut w45: f64;
+    w5 = cos_q_0 * cos_q_1;
+    w8 = w5 * cos_q_2;
+    w9 = sin_q_0 * sin_q_2;
+    w8 = w8 - w9;
+    w9 = 0.0825 * w8;
+    w11 = cos_q_0 * sin_q_1;
+    w12 = (-0.316) * w11;
+    w9 = w9 - w12;
+    w16 = w8 * cos_q_3;
+    w17 = w11 * sin_q_3;
+    w16 = w16 + w17;
+    w17 = (-0.0825) * w16;
+    w19 = w11 * cos_q_3;
+    w8 = w8 * sin_q_3;
+    w19 = w19 - w8;
+    w8 = 0.384 * w19;
+    w17 = w17 + w8;
+    w17 = w9 + w17;
+    w22 = w16 * cos_q_4;
+    w5 = w5 * sin_q_2;
+    w23 = sin_q_0 * cos_q_2;
+    w5 = w5 + w23;
+    w23 = w5 * sin_q_4;
+    w22 = w22 - w23;
+    w25 = w22 * cos_q_5;
+    w26 = w19 * sin_q_5;
+    w25 = w25 + w26;
+    w26 = 0.088 * w25;
+    w26 = w17 + w26;
+    w28 = w19 * cos_q_5;
+    w22 = w22 * sin_q_5;
+    w28 = w28 - w22;
+    w22 = 0.107 * w28;
+    w22 = w26 - w22;
+    w31 = w25 * cos_q_6;
+    w16 = w16 * sin_q_4;
+    w32 = w5 * cos_q_4;
+    w16 = w16 + w32;
+    w32 = w16 * sin_q_6;
+    w31 = w31 + w32;
+    w31 = w31 * params_10;
+    w33 = w16 * cos_q_6;
+    w25 = w25 * sin_q_6;
+    w33 = w33 - w25;
+    w33 = w33 * params_11;
+    w31 = w31 + w33;
+    w34 = w28 * params_12;
+    w31 = w31 - w34;
+    w22 = w22 + w31;
+    position[0] = w22;
+    w31 = sin_q_0 * cos_q_1;
+    w34 = w31 * cos_q_2;
+    w35 = cos_q_0 * sin_q_2;
+    w34 = w34 + w35;
+    w35 = 0.0825 * w34;
+    w36 = sin_q_0 * sin_q_1;
+    w37 = (-0.316) * w36;
+    w35 = w35 - w37;
+    w38 = w34 * cos_q_3;
+    w39 = w36 * sin_q_3;
+    w38 = w38 + w39;
+    w39 = (-0.0825) * w38;
+    w40 = w36 * cos_q_3;
+    w34 = w34 * sin_q_3;
+    w40 = w40 - w34;
+    w34 = 0.384 * w40;
+    w39 = w39 + w34;
+    w39 = w35 + w39;
+    w34 = w38 * cos_q_4;
+    w41 = cos_q_0 * cos_q_2;
+    w31 = w31 * sin_q_2;
+    w41 = w41 - w31;
+    w31 = w41 * sin_q_4;
+    w34 = w34 + w31;
+    w31 = w34 * cos_q_5;
+    w42 = w40 * sin_q_5;
+    w31 = w31 + w42;
+    w42 = 0.088 * w31;
+    w42 = w39 + w42;
+    w43 = w40 * cos_q_5;
+    w34 = w34 * sin_q_5;
+    w43 = w43 - w34;
+    w34 = 0.107 * w43;
+    w34 = w42 - w34;
+    w44 = w31 * cos_q_6;
+    w45 = w41 * cos_q_4;
+    w38 = w38 * sin_q_4;
+    w45 = w45 - w38;
+    w38 = w45 * sin_q_6;
+    w44 = w44 - w38;
+    w44 = w44 * params_10;
+    w31 = w31 * sin_q_6;
+    w38 = w45 * cos_q_6;
+    w31 = w31 + w38;
+    w31 = w31 * params_11;
+    w44 = w44 - w31;
+    w31 = w43 * params_12;
+    w44 = w44 - w31;
+    w34 = w34 + w44;
+    position[1] = w34;
+    w10 = (-0.316) * cos_q_1;
+    w10 = 0.333 - w10;
+    w7 = sin_q_1 * cos_q_2;
+    w0 = 0.0825 * w7;
+    w0 = w10 - w0;
+    w31 = cos_q_1 * sin_q_3;
+    w38 = w7 * cos_q_3;
+    w31 = w31 - w38;
+    w13 = (-0.0825) * w31;
+    w7 = w7 * sin_q_3;
+    w15 = cos_q_1 * cos_q_3;
+    w7 = w7 + w15;
+    w18 = 0.384 * w7;
+    w13 = w13 + w18;
+    w13 = w0 + w13;
+    w18 = w31 * cos_q_4;
+    w3 = sin_q_1 * sin_q_2;
+    w6 = w3 * sin_q_4;
+    w18 = w18 + w6;
+    w6 = w18 * cos_q_5;
+    w15 = w7 * sin_q_5;
+    w6 = w6 + w15;
+    w8 = 0.088 * w6;
+    w8 = w13 + w8;
+    w24 = w7 * cos_q_5;
+    w18 = w18 * sin_q_5;
+    w24 = w24 - w18;
+    w27 = 0.107 * w24;
+    w27 = w8 - w27;
+    w18 = w6 * cos_q_6;
+    w21 = w3 * cos_q_4;
+    w31 = w31 * sin_q_4;
+    w21 = w21 - w31;
+    w31 = w21 * sin_q_6;
+    w18 = w18 - w31;
+    w18 = w18 * params_10;
+    w6 = w6 * sin_q_6;
+    w30 = w21 * cos_q_6;
+    w6 = w6 + w30;
+    w6 = w6 * params_11;
+    w18 = w18 - w6;
+    w33 = w24 * params_12;
+    w18 = w18 - w33;
+    w27 = w27 + w18;
+    position[2] = w27;
+    w18 = -w34;
+    jacobian[(0, 0)] = w18;
+    jacobian[(1, 0)] = w22;
+    w44 = w27 - 0.333;
+    w18 = cos_q_0 * w44;
+    jacobian[(0, 1)] = w18;
+    w44 = sin_q_0 * w44;
+    jacobian[(1, 1)] = w44;
+    w1 = sin_q_0 * w34;
+    w2 = cos_q_0 * w22;
+    w1 = w1 + w2;
+    w1 = -w1;
+    jacobian[(2, 1)] = w1;
+    w10 = w27 - w10;
+    w1 = w36 * w10;
+    w37 = w34 + w37;
+    w2 = cos_q_1 * w37;
+    w1 = w1 - w2;
+    jacobian[(0, 2)] = w1;
+    w12 = w22 + w12;
+    w4 = cos_q_1 * w12;
+    w10 = w11 * w10;
+    w4 = w4 - w10;
+    jacobian[(1, 2)] = w4;
+    w11 = w11 * w37;
+    w36 = w36 * w12;
+    w11 = w11 - w36;
+    jacobian[(2, 2)] = w11;
+    w35 = w34 - w35;
+    w11 = w3 * w35;
+    w0 = w27 - w0;
+    w36 = w41 * w0;
+    w11 = w11 - w36;
+    jacobian[(0, 3)] = w11;
+    w9 = w22 - w9;
+    w3 = w3 * w9;
+    w0 = w5 * w0;
+    w3 = w3 + w0;
+    w3 = -w3;
+    jacobian[(1, 3)] = w3;
+    w5 = w5 * w35;
+    w41 = w41 * w9;
+    w5 = w5 + w41;
+    jacobian[(2, 3)] = w5;
+    w13 = w27 - w13;
+    w5 = w40 * w13;
+    w39 = w34 - w39;
+    w41 = w7 * w39;
+    w5 = w5 - w41;
+    jacobian[(0, 4)] = w5;
+    w17 = w22 - w17;
+    w7 = w7 * w17;
+    w5 = w19 * w13;
+    w7 = w7 - w5;
+    jacobian[(1, 4)] = w7;
+    w19 = w19 * w39;
+    w40 = w40 * w17;
+    w19 = w19 - w40;
+    jacobian[(2, 4)] = w19;
+    w19 = w21 * w39;
+    w40 = w45 * w13;
+    w19 = w19 - w40;
+    jacobian[(0, 5)] = w19;
+    w21 = w21 * w17;
+    w13 = w16 * w13;
+    w21 = w21 + w13;
+    w21 = -w21;
+    jacobian[(1, 5)] = w21;
+    w16 = w16 * w39;
+    w45 = w45 * w17;
+    w16 = w16 + w45;
+    jacobian[(2, 5)] = w16;
+    w34 = w34 - w42;
+    w42 = w24 * w34;
+    w27 = w27 - w8;
+    w8 = w43 * w27;
+    w42 = w42 - w8;
+    jacobian[(0, 6)] = w42;
+    w27 = w28 * w27;
+    w22 = w22 - w26;
+    w24 = w24 * w22;
+    w27 = w27 - w24;
+    jacobian[(1, 6)] = w27;
+    w43 = w43 * w22;
+    w28 = w28 * w34;
+    w43 = w43 - w28;
+    jacobian[(2, 6)] = w43;
+    (position, jacobian)
 }

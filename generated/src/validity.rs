@@ -64,6 +64,77 @@ impl<const NP: usize> LinearRule<NP> {
     }
 }
 
+/// The parameters that are a rigid body's inertia tensor I about its centre of mass, by index:
+/// the moments xx, yy, zz and the products xy, xz, yz (URDF's `<inertia>`: the products are
+/// the tensor's off-diagonal entries).
+///
+/// A rigid body's I is positive definite with eigenvalues obeying the triangle inequality. Both
+/// say that its second moment of mass Σ = ½ tr(I)·1 − I (Σ = ∫ r rᵀ dm) is positive
+/// semi-definite, with I = tr(Σ)·1 − Σ then definite unless the body is a line. Σ ⪰ 0 is checked
+/// on its principal minors (no eigen-decomposition), each to the relative `slack` a printed
+/// decimal needs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InertiaRule {
+    pub moments: [usize; 3],
+    pub products: [usize; 3],
+    pub slack: f64,
+    /// The rule in words, with the parameters' names.
+    pub rule: &'static str,
+}
+
+impl InertiaRule {
+    /// The tensor I of `params`.
+    #[must_use]
+    pub fn tensor(&self, params: &[f64]) -> [[f64; 3]; 3] {
+        let [xx, yy, zz] = self.moments.map(|i| params[i]);
+        let [xy, xz, yz] = self.products.map(|i| params[i]);
+        [[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]
+    }
+
+    /// The smallest principal minor of Σ = ½ tr(I)·1 − I and of I's leading ones, each divided
+    /// by tr(I) to its order (so that it is a number of order 1): the rule holds when this is
+    /// ≥ −slack for Σ and > 0 for I. `None` when it holds.
+    #[must_use]
+    pub fn violation(&self, params: &[f64]) -> Option<f64> {
+        let i = self.tensor(params);
+        let t = i[0][0] + i[1][1] + i[2][2];
+        if !(t > 0.0) {
+            return Some(t);
+        }
+        let mut s = i.map(|row| row.map(|v| -v / t));
+        for (k, row) in s.iter_mut().enumerate() {
+            row[k] += 0.5;
+        }
+        let n = i.map(|row| row.map(|v| v / t));
+        let minor2 = |m: &[[f64; 3]; 3], a: usize, b: usize| m[a][a] * m[b][b] - m[a][b] * m[b][a];
+        let sigma = [
+            s[0][0],
+            s[1][1],
+            s[2][2],
+            minor2(&s, 0, 1),
+            minor2(&s, 0, 2),
+            minor2(&s, 1, 2),
+            determinant(&s),
+        ];
+        let worst = sigma.iter().copied().fold(f64::INFINITY, f64::min);
+        let definite = [n[0][0], minor2(&n, 0, 1), determinant(&n)];
+        let least = definite.iter().copied().fold(f64::INFINITY, f64::min);
+        if !(worst >= -self.slack) {
+            Some(worst)
+        } else if !(least > 0.0) {
+            Some(least)
+        } else {
+            None
+        }
+    }
+}
+
+fn determinant(m: &[[f64; 3]; 3]) -> f64 {
+    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+}
+
 /// One model's rule for its tools.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ToolRule<const NP: usize> {
@@ -73,14 +144,21 @@ pub struct ToolRule<const NP: usize> {
     /// Per parameter, the interval [lo, hi] random tools are drawn from (the mixed sampler, the
     /// design tests); every draw is checked against the rule, so the box may hold invalid tools.
     pub sample: [(f64, f64); NP],
+    /// Per parameter, the value a tools file that leaves its column out means (`None`: the
+    /// column is required).
+    pub defaults: [Option<f64>; NP],
+    /// The parameters that are a rigid body's inertia tensor, if some are.
+    pub inertia: Option<InertiaRule>,
 }
 
 /// Why a tool breaks its model's rule: the first parameter outside its domain, else the first
-/// constraint that fails (with c · p > 0).
+/// constraint that fails (with c · p > 0), else the inertia tensor
+/// ([`InertiaRule::violation`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Violation {
     Domain { index: usize, value: f64 },
     Constraint { index: usize, excess: f64 },
+    Inertia { minor: f64 },
 }
 
 impl<const NP: usize> ToolRule<NP> {
@@ -97,14 +175,17 @@ impl<const NP: usize> ToolRule<NP> {
                 return Err(Violation::Constraint { index, excess });
             }
         }
-        Ok(())
+        match self.inertia.and_then(|rule| rule.violation(params)) {
+            Some(minor) => Err(Violation::Inertia { minor }),
+            None => Ok(()),
+        }
     }
 }
 
 /// The tool rule of `arm2` (derive/models/arm2.toml).
 pub mod arm2 {
     #[allow(unused_imports)]
-    use super::{LinearRule, ParameterDomain, ToolRule};
+    use super::{InertiaRule, LinearRule, ParameterDomain, ToolRule};
 
     /// Domains in the order of `arm2::PARAMETER_NAMES`.
     pub const RULE: ToolRule<4> = ToolRule {
@@ -140,13 +221,15 @@ pub mod arm2 {
         ],
         constraints: &[],
         sample: [(0.1, 0.6), (0.1, 0.6), (0.1, 0.6), (0.1, 0.6)],
+        defaults: [None, None, None, None],
+        inertia: None,
     };
 }
 
 /// The tool rule of `arm2_exact` (derive/models/arm2_exact.toml).
 pub mod arm2_exact {
     #[allow(unused_imports)]
-    use super::{LinearRule, ParameterDomain, ToolRule};
+    use super::{InertiaRule, LinearRule, ParameterDomain, ToolRule};
 
     /// Domains in the order of `arm2_exact::PARAMETER_NAMES`.
     pub const RULE: ToolRule<4> = ToolRule {
@@ -182,13 +265,15 @@ pub mod arm2_exact {
         ],
         constraints: &[],
         sample: [(0.1, 0.6), (0.1, 0.6), (0.1, 0.6), (0.1, 0.6)],
+        defaults: [None, None, None, None],
+        inertia: None,
     };
 }
 
 /// The tool rule of `arm2_payload` (derive/models/arm2_payload.toml).
 pub mod arm2_payload {
     #[allow(unused_imports)]
-    use super::{LinearRule, ParameterDomain, ToolRule};
+    use super::{InertiaRule, LinearRule, ParameterDomain, ToolRule};
 
     /// Domains in the order of `arm2_payload::PARAMETER_NAMES`.
     pub const RULE: ToolRule<5> = ToolRule {
@@ -231,13 +316,15 @@ pub mod arm2_payload {
         ],
         constraints: &[],
         sample: [(0.1, 0.6), (0.1, 0.6), (0.1, 0.6), (0.1, 0.6), (0.1, 0.6)],
+        defaults: [None, None, None, None, None],
+        inertia: None,
     };
 }
 
 /// The tool rule of `arm3` (derive/models/arm3.toml).
 pub mod arm3 {
     #[allow(unused_imports)]
-    use super::{LinearRule, ParameterDomain, ToolRule};
+    use super::{InertiaRule, LinearRule, ParameterDomain, ToolRule};
 
     /// Domains in the order of `arm3::PARAMETER_NAMES`.
     pub const RULE: ToolRule<6> = ToolRule {
@@ -294,13 +381,15 @@ pub mod arm3 {
             (0.1, 0.6),
             (0.1, 0.6),
         ],
+        defaults: [None, None, None, None, None, None],
+        inertia: None,
     };
 }
 
 /// The tool rule of `msd` (derive/models/msd.toml).
 pub mod msd {
     #[allow(unused_imports)]
-    use super::{LinearRule, ParameterDomain, ToolRule};
+    use super::{InertiaRule, LinearRule, ParameterDomain, ToolRule};
 
     /// Domains in the order of `msd::PARAMETER_NAMES`.
     pub const RULE: ToolRule<3> = ToolRule {
@@ -329,179 +418,73 @@ pub mod msd {
         ],
         constraints: &[],
         sample: [(0.1, 0.6), (0.1, 0.6), (0.1, 0.6)],
+        defaults: [None, None, None],
+        inertia: None,
     };
 }
 
 /// The tool rule of `panda` (derive/models/panda.toml).
 pub mod panda {
     #[allow(unused_imports)]
-    use super::{LinearRule, ParameterDomain, ToolRule};
+    use super::{InertiaRule, LinearRule, ParameterDomain, ToolRule};
 
     /// Domains in the order of `panda::PARAMETER_NAMES`.
-    pub const RULE: ToolRule<7> = ToolRule {
+    pub const RULE: ToolRule<13> = ToolRule {
         domains: [
-            ParameterDomain {
-                lo: 0.0,
-                hi: f64::INFINITY,
-                lo_open: true,
-                hi_open: true,
-                rule: "a finite number > 0 kg",
-            },
-            ParameterDomain {
-                lo: -1.0,
-                hi: 1.0,
-                lo_open: false,
-                hi_open: false,
-                rule: "a finite number in [-1, 1] m",
-            },
-            ParameterDomain {
-                lo: -1.0,
-                hi: 1.0,
-                lo_open: false,
-                hi_open: false,
-                rule: "a finite number in [-1, 1] m",
-            },
-            ParameterDomain {
-                lo: -1.0,
-                hi: 1.0,
-                lo_open: false,
-                hi_open: false,
-                rule: "a finite number in [-1, 1] m",
-            },
-            ParameterDomain {
-                lo: 0.0,
-                hi: f64::INFINITY,
-                lo_open: true,
-                hi_open: true,
-                rule: "a finite number > 0 kg m^2",
-            },
-            ParameterDomain {
-                lo: 0.0,
-                hi: f64::INFINITY,
-                lo_open: true,
-                hi_open: true,
-                rule: "a finite number > 0 kg m^2",
-            },
-            ParameterDomain {
-                lo: 0.0,
-                hi: f64::INFINITY,
-                lo_open: true,
-                hi_open: true,
-                rule: "a finite number > 0 kg m^2",
-            },
+            ParameterDomain { lo: 0.0, hi: f64::INFINITY, lo_open: true, hi_open: true, rule: "a finite number > 0 kg" },
+            ParameterDomain { lo: -1.0, hi: 1.0, lo_open: false, hi_open: false, rule: "a finite number in [-1, 1] m" },
+            ParameterDomain { lo: -1.0, hi: 1.0, lo_open: false, hi_open: false, rule: "a finite number in [-1, 1] m" },
+            ParameterDomain { lo: -1.0, hi: 1.0, lo_open: false, hi_open: false, rule: "a finite number in [-1, 1] m" },
+            ParameterDomain { lo: 0.0, hi: f64::INFINITY, lo_open: true, hi_open: true, rule: "a finite number > 0 kg m^2" },
+            ParameterDomain { lo: 0.0, hi: f64::INFINITY, lo_open: true, hi_open: true, rule: "a finite number > 0 kg m^2" },
+            ParameterDomain { lo: 0.0, hi: f64::INFINITY, lo_open: true, hi_open: true, rule: "a finite number > 0 kg m^2" },
+            ParameterDomain { lo: f64::NEG_INFINITY, hi: f64::INFINITY, lo_open: true, hi_open: true, rule: "a finite number" },
+            ParameterDomain { lo: f64::NEG_INFINITY, hi: f64::INFINITY, lo_open: true, hi_open: true, rule: "a finite number" },
+            ParameterDomain { lo: f64::NEG_INFINITY, hi: f64::INFINITY, lo_open: true, hi_open: true, rule: "a finite number" },
+            ParameterDomain { lo: -1.0, hi: 1.0, lo_open: false, hi_open: false, rule: "a finite number in [-1, 1] m" },
+            ParameterDomain { lo: -1.0, hi: 1.0, lo_open: false, hi_open: false, rule: "a finite number in [-1, 1] m" },
+            ParameterDomain { lo: -1.0, hi: 1.0, lo_open: false, hi_open: false, rule: "a finite number in [-1, 1] m" },
         ],
         constraints: &[
-            LinearRule {
-                coefficients: [0.0, 0.0, 0.0, 0.0, 1.0, -1.000000001, -1.000000001],
-                rule:
-                    "tool_ixx <= tool_iyy + tool_izz (triangle inequality of the principal moments)",
-            },
-            LinearRule {
-                coefficients: [0.0, 0.0, 0.0, 0.0, -1.000000001, 1.0, -1.000000001],
-                rule:
-                    "tool_iyy <= tool_ixx + tool_izz (triangle inequality of the principal moments)",
-            },
-            LinearRule {
-                coefficients: [0.0, 0.0, 0.0, 0.0, -1.000000001, -1.000000001, 1.0],
-                rule:
-                    "tool_izz <= tool_ixx + tool_iyy (triangle inequality of the principal moments)",
-            },
+            LinearRule { coefficients: [0.0, 0.0, 0.0, 0.0, 1.0, -1.000000001, -1.000000001, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, ], rule: "tool_ixx <= tool_iyy + tool_izz (triangle inequality of the principal moments)" },
+            LinearRule { coefficients: [0.0, 0.0, 0.0, 0.0, -1.000000001, 1.0, -1.000000001, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, ], rule: "tool_iyy <= tool_ixx + tool_izz (triangle inequality of the principal moments)" },
+            LinearRule { coefficients: [0.0, 0.0, 0.0, 0.0, -1.000000001, -1.000000001, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, ], rule: "tool_izz <= tool_ixx + tool_iyy (triangle inequality of the principal moments)" },
         ],
-        sample: [
-            (0.05, 3.0),
-            (-0.05, 0.05),
-            (-0.05, 0.05),
-            (0.0, 0.25),
-            (0.0001, 0.02),
-            (0.0001, 0.02),
-            (0.0001, 0.02),
-        ],
+        sample: [(0.05, 3.0), (-0.05, 0.05), (-0.05, 0.05), (0.0, 0.25), (0.0001, 0.02), (0.0001, 0.02), (0.0001, 0.02), (-0.0001, 0.0001), (-0.0001, 0.0001), (-0.0001, 0.0001), (-0.05, 0.05), (-0.05, 0.05), (0.05, 0.35), ],
+        defaults: [None, None, None, None, None, None, None, Some(0.0), Some(0.0), Some(0.0), Some(0.0), Some(0.0), Some(0.0), ],
+        inertia: Some(InertiaRule { moments: [4, 5, 6], products: [7, 8, 9], slack: 1e-9, rule: "the inertia tensor [[tool_ixx, tool_ixy, tool_ixz], [tool_ixy, tool_iyy, tool_iyz], [tool_ixz, tool_iyz, tool_izz]] is positive definite with eigenvalues obeying the triangle inequality (a rigid body's)" }),
     };
 }
 
 /// The tool rule of `ur5` (derive/models/ur5.toml).
 pub mod ur5 {
     #[allow(unused_imports)]
-    use super::{LinearRule, ParameterDomain, ToolRule};
+    use super::{InertiaRule, LinearRule, ParameterDomain, ToolRule};
 
     /// Domains in the order of `ur5::PARAMETER_NAMES`.
-    pub const RULE: ToolRule<7> = ToolRule {
+    pub const RULE: ToolRule<13> = ToolRule {
         domains: [
-            ParameterDomain {
-                lo: 0.0,
-                hi: f64::INFINITY,
-                lo_open: true,
-                hi_open: true,
-                rule: "a finite number > 0 kg",
-            },
-            ParameterDomain {
-                lo: -1.0,
-                hi: 1.0,
-                lo_open: false,
-                hi_open: false,
-                rule: "a finite number in [-1, 1] m",
-            },
-            ParameterDomain {
-                lo: -1.0,
-                hi: 1.0,
-                lo_open: false,
-                hi_open: false,
-                rule: "a finite number in [-1, 1] m",
-            },
-            ParameterDomain {
-                lo: -1.0,
-                hi: 1.0,
-                lo_open: false,
-                hi_open: false,
-                rule: "a finite number in [-1, 1] m",
-            },
-            ParameterDomain {
-                lo: 0.0,
-                hi: f64::INFINITY,
-                lo_open: true,
-                hi_open: true,
-                rule: "a finite number > 0 kg m^2",
-            },
-            ParameterDomain {
-                lo: 0.0,
-                hi: f64::INFINITY,
-                lo_open: true,
-                hi_open: true,
-                rule: "a finite number > 0 kg m^2",
-            },
-            ParameterDomain {
-                lo: 0.0,
-                hi: f64::INFINITY,
-                lo_open: true,
-                hi_open: true,
-                rule: "a finite number > 0 kg m^2",
-            },
+            ParameterDomain { lo: 0.0, hi: f64::INFINITY, lo_open: true, hi_open: true, rule: "a finite number > 0 kg" },
+            ParameterDomain { lo: -1.0, hi: 1.0, lo_open: false, hi_open: false, rule: "a finite number in [-1, 1] m" },
+            ParameterDomain { lo: -1.0, hi: 1.0, lo_open: false, hi_open: false, rule: "a finite number in [-1, 1] m" },
+            ParameterDomain { lo: -1.0, hi: 1.0, lo_open: false, hi_open: false, rule: "a finite number in [-1, 1] m" },
+            ParameterDomain { lo: 0.0, hi: f64::INFINITY, lo_open: true, hi_open: true, rule: "a finite number > 0 kg m^2" },
+            ParameterDomain { lo: 0.0, hi: f64::INFINITY, lo_open: true, hi_open: true, rule: "a finite number > 0 kg m^2" },
+            ParameterDomain { lo: 0.0, hi: f64::INFINITY, lo_open: true, hi_open: true, rule: "a finite number > 0 kg m^2" },
+            ParameterDomain { lo: f64::NEG_INFINITY, hi: f64::INFINITY, lo_open: true, hi_open: true, rule: "a finite number" },
+            ParameterDomain { lo: f64::NEG_INFINITY, hi: f64::INFINITY, lo_open: true, hi_open: true, rule: "a finite number" },
+            ParameterDomain { lo: f64::NEG_INFINITY, hi: f64::INFINITY, lo_open: true, hi_open: true, rule: "a finite number" },
+            ParameterDomain { lo: -1.0, hi: 1.0, lo_open: false, hi_open: false, rule: "a finite number in [-1, 1] m" },
+            ParameterDomain { lo: -1.0, hi: 1.0, lo_open: false, hi_open: false, rule: "a finite number in [-1, 1] m" },
+            ParameterDomain { lo: -1.0, hi: 1.0, lo_open: false, hi_open: false, rule: "a finite number in [-1, 1] m" },
         ],
         constraints: &[
-            LinearRule {
-                coefficients: [0.0, 0.0, 0.0, 0.0, 1.0, -1.000000001, -1.000000001],
-                rule:
-                    "tool_ixx <= tool_iyy + tool_izz (triangle inequality of the principal moments)",
-            },
-            LinearRule {
-                coefficients: [0.0, 0.0, 0.0, 0.0, -1.000000001, 1.0, -1.000000001],
-                rule:
-                    "tool_iyy <= tool_ixx + tool_izz (triangle inequality of the principal moments)",
-            },
-            LinearRule {
-                coefficients: [0.0, 0.0, 0.0, 0.0, -1.000000001, -1.000000001, 1.0],
-                rule:
-                    "tool_izz <= tool_ixx + tool_iyy (triangle inequality of the principal moments)",
-            },
+            LinearRule { coefficients: [0.0, 0.0, 0.0, 0.0, 1.0, -1.000000001, -1.000000001, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, ], rule: "tool_ixx <= tool_iyy + tool_izz (triangle inequality of the principal moments)" },
+            LinearRule { coefficients: [0.0, 0.0, 0.0, 0.0, -1.000000001, 1.0, -1.000000001, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, ], rule: "tool_iyy <= tool_ixx + tool_izz (triangle inequality of the principal moments)" },
+            LinearRule { coefficients: [0.0, 0.0, 0.0, 0.0, -1.000000001, -1.000000001, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, ], rule: "tool_izz <= tool_ixx + tool_iyy (triangle inequality of the principal moments)" },
         ],
-        sample: [
-            (0.05, 5.0),
-            (-0.05, 0.05),
-            (-0.05, 0.05),
-            (0.0, 0.25),
-            (0.0001, 0.02),
-            (0.0001, 0.02),
-            (0.0001, 0.02),
-        ],
+        sample: [(0.05, 5.0), (-0.05, 0.05), (-0.05, 0.05), (0.0, 0.25), (0.0001, 0.02), (0.0001, 0.02), (0.0001, 0.02), (-0.0001, 0.0001), (-0.0001, 0.0001), (-0.0001, 0.0001), (-0.05, 0.05), (-0.05, 0.05), (0.05, 0.35), ],
+        defaults: [None, None, None, None, None, None, None, Some(0.0), Some(0.0), Some(0.0), Some(0.0), Some(0.0), Some(0.0), ],
+        inertia: Some(InertiaRule { moments: [4, 5, 6], products: [7, 8, 9], slack: 1e-9, rule: "the inertia tensor [[tool_ixx, tool_ixy, tool_ixz], [tool_ixy, tool_iyy, tool_iyz], [tool_ixz, tool_iyz, tool_izz]] is positive definite with eigenvalues obeying the triangle inequality (a rigid body's)" }),
     };
 }

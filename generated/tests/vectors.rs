@@ -745,13 +745,17 @@ mod panda {
                     m::rigid_body_dynamics(&input(i, "x"), &input(i, "u"), &input(i, "params"));
                 vec![("x_dot", rows(&x_dot))]
             }
+            "tip" => {
+                let (position, jacobian) = m::tip(&input(i, "q"), &input(i, "params"));
+                vec![("position", rows(&position)), ("jacobian", rows(&jacobian))]
+            }
             _ => return None,
         })
     }
 
     #[test]
     fn functions_match_casadi_vectors() {
-        check("panda", 14, evaluate);
+        check("panda", 15, evaluate);
     }
 }
 
@@ -858,12 +862,16 @@ mod ur5 {
                     m::rigid_body_dynamics(&input(i, "x"), &input(i, "u"), &input(i, "params"));
                 vec![("x_dot", rows(&x_dot))]
             }
+            "tip" => {
+                let (position, jacobian) = m::tip(&input(i, "q"), &input(i, "params"));
+                vec![("position", rows(&position)), ("jacobian", rows(&jacobian))]
+            }
             _ => return None,
         })
     }
 
     #[test]
     fn functions_match_casadi_vectors() {
-        check("ur5", 14, evaluate);
+        check("ur5", 15, evaluate);
     }
 }

@@ -128,3 +128,26 @@ pub fn collect<T>(items: impl ExactSizeIterator<Item = T>, what: &str) -> Result
     v.extend(items);
     Ok(v)
 }
+
+/// A tool-parameter argument (`params`: one tool, 1-D, or one per row, 2-D) of model `kind`, read
+/// as [`float_argument`] does; a tool that gives only the required parameters gets the model's
+/// trailing defaults (a URDF tool of toolconf's earlier 7: no products of inertia, tip at the
+/// flange; `ModelKind::with_defaults`), as a tools file without those columns does.
+pub fn tool_params(
+    kind: toolconf::registry::ModelKind,
+    value: &Bound<'_, PyAny>,
+) -> PyResult<(Vec<usize>, Vec<f64>)> {
+    let (mut shape, values) = float_argument("params", value)?;
+    let (required, all) = (kind.required_parameters(), kind.parameter_names().len());
+    if shape.last() != Some(&required) || required == all || required == 0 {
+        return Ok((shape, values));
+    }
+    let mut out = Vec::with_capacity(values.len() / required * all);
+    for row in values.chunks_exact(required) {
+        out.extend(kind.with_defaults(row).unwrap_or_else(|| row.to_vec()));
+    }
+    if let Some(last) = shape.last_mut() {
+        *last = all;
+    }
+    Ok((shape, out))
+}

@@ -167,7 +167,7 @@ fn run<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = model_kind(model).map_err(|f| f.into_pyerr(py))?;
     let np = kind.parameter_names().len();
-    let (shape, values) = crate::arrays::float_argument("params", params)?;
+    let (shape, values) = crate::arrays::tool_params(kind, params)?;
     if !matches!(shape.as_slice(), [n] | [_, n] if *n == np) {
         return Err(Failure::Input(format!(
             "params of shape {shape:?}: model {kind} takes {np} parameters ({}), as a 2-D array \

@@ -96,7 +96,7 @@ pub fn confidence<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = model_kind(model).map_err(|f| f.into_pyerr(py))?;
     let spec = task_spec(task, None)?;
-    let (shape, values) = crate::arrays::float_argument("params", params)?;
+    let (shape, values) = crate::arrays::tool_params(kind, params)?;
     let np = kind.parameter_names().len();
     let batch = match shape.as_slice() {
         [n] if *n == np => false,

@@ -1,4 +1,5 @@
-//! `toolconf.dynamics`: a robot's own rigid-body dynamics Ẋ = [q̇; q̈], for one state or a batch.
+//! `toolconf.dynamics`: a robot's own rigid-body dynamics Ẋ = [q̇; q̈], for one state or a batch;
+//! `toolconf.tip`: its tool's tip and the tip's Jacobian.
 
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
@@ -81,7 +82,7 @@ pub fn dynamics<'py>(
     let (n, np) = (kind.dof(), kind.parameter_names().len());
     let nx = 2 * n;
     let read = crate::arrays::float_argument;
-    let (p_shape, p_data) = read("params", params)?;
+    let (p_shape, p_data) = crate::arrays::tool_params(kind, params)?;
     let (x_shape, x_data) = read("state", state)?;
     let (u_shape, u_data) = read("control", control)?;
     let shapes = (p_shape, x_shape, u_shape);
@@ -110,13 +111,7 @@ pub fn dynamics<'py>(
             let mut out = crate::arrays::zeros(rows.saturating_mul(nx), &what)?;
             kind.model()
                 .rigid_body_dynamics(rows, &p, &x, &u, &mut out)
-                .map_err(|e| match e {
-                    BatchError::OutOfMemory { bytes } => {
-                        crate::arrays::out_of_memory::<f64>(bytes / 8, &what)
-                    }
-                    BatchError::Input(message) => Failure::Input(message),
-                    BatchError::Tool(i, e) => Failure::Input(format!("tool {i}: {e}")),
-                })?;
+                .map_err(|e| batch_failure(e, &what))?;
             Ok((out, k))
         })?;
     let (data, k) = out;
@@ -124,6 +119,97 @@ pub fn dynamics<'py>(
     match k {
         None => Ok(array.into_any()),
         Some(k) => Ok(array.reshape([k, nx])?.into_any()),
+    }
+}
+
+/// The tool's tip (tool-centre point) y(q) in the robot's base frame and its Jacobian
+/// J = ∂y/∂q, for one joint configuration or a batch.
+///
+/// For the URDF arms (``panda``, ``ur5``) the tip is the tool's ``tool_tip_x/y/z`` offset in the
+/// flange frame, carried through the arm's forward kinematics; J is the linear part of
+/// Pinocchio's ``computeFrameJacobian`` at that frame in ``LOCAL_WORLD_ALIGNED``.
+///
+/// Args:
+///     model: a generated model's name with a tip (``toolconf.models()[m]["has_tip"]``).
+///     params: the tool's parameters (1-D, one tool for every q, or 2-D, one per q), each tool
+///         obeying the model's rule; a URDF tool may leave out its trailing products of inertia
+///         and tip (zero).
+///     q: the joint positions, 1-D (one configuration) or 2-D (one per row).
+///
+/// Returns:
+///     dict: ``position`` of shape (3,) (m) and ``jacobian`` of shape (3, n) for 1-D arguments,
+///     else (k, 3) and (k, 3, n).
+///
+/// Raises:
+///     ValueError: an unknown model or one without a tip, shapes that do not fit, a tool outside
+///         the model's rule (naming the parameter and the row), a non-finite q.
+///     TypeError: an argument of booleans, complex numbers or text.
+///     MemoryError: a batch that does not fit in memory.
+#[pyfunction]
+pub fn tip<'py>(
+    py: Python<'py>,
+    model: &str,
+    params: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let kind = model_kind(model).map_err(|f| f.into_pyerr(py))?;
+    if !kind.has_tip() {
+        return Err(Failure::Input(format!(
+            "model {kind} has no tip (its description gives none)"
+        ))
+        .into_pyerr(py));
+    }
+    let (n, np) = (kind.dof(), kind.parameter_names().len());
+    let (p_shape, p_data) = crate::arrays::tool_params(kind, params)?;
+    let (q_shape, q_data) = crate::arrays::float_argument("q", q)?;
+    let out = detached(py, || {
+        let (p, kp) = rows("params", &p_shape, &p_data, np, kind, "tool parameters")?;
+        let (qs, kq) = rows("q", &q_shape, &q_data, n, kind, "joint positions")?;
+        if let (Some(a), Some(b)) = (kp, kq) {
+            if a != b {
+                return Err(Failure::Input(format!(
+                    "params and q have {a} and {b} rows: the 2-D ones must have the same number"
+                )));
+            }
+        }
+        let k = kq.or(kp);
+        let count = k.unwrap_or(1);
+        let what = format!("tips of {count} configurations");
+        let mut position = crate::arrays::zeros(count.saturating_mul(3), &what)?;
+        let mut jacobian = crate::arrays::zeros(count.saturating_mul(3 * n), &what)?;
+        let q_rows = Rows {
+            shared: qs.shared && kp.is_none(),
+            ..qs
+        };
+        kind.model()
+            .tip(count, &p, &q_rows, &mut position, &mut jacobian)
+            .map_err(|e| batch_failure(e, &what))?;
+        Ok((position, jacobian, k))
+    })?;
+    let (position, jacobian, k) = out;
+    let (position, jacobian) = (
+        PyArray1::from_vec(py, position),
+        PyArray1::from_vec(py, jacobian),
+    );
+    let dict = PyDict::new(py);
+    match k {
+        None => {
+            dict.set_item("position", position)?;
+            dict.set_item("jacobian", jacobian.reshape([3, n])?)?;
+        }
+        Some(k) => {
+            dict.set_item("position", position.reshape([k, 3])?)?;
+            dict.set_item("jacobian", jacobian.reshape([k, 3, n])?)?;
+        }
+    }
+    Ok(dict)
+}
+
+fn batch_failure(e: BatchError, what: &str) -> Failure {
+    match e {
+        BatchError::OutOfMemory { bytes } => crate::arrays::out_of_memory::<f64>(bytes / 8, what),
+        BatchError::Input(message) => Failure::Input(message),
+        BatchError::Tool(i, e) => Failure::Input(format!("tool {i}: {e}")),
     }
 }
 
@@ -138,7 +224,8 @@ pub fn equilibrium(py: Python<'_>, kind: ModelKind) -> PyResult<Bound<'_, PyDict
 }
 
 /// ``models()[m]["domains"]``: ``parameters`` (name → its domain in words), ``constraints``
-/// (texts) and ``sample`` (name → [lo, hi], the box random tools are drawn from).
+/// (texts, the inertia tensor's rule among them), ``sample`` (name → [lo, hi], the box random
+/// tools are drawn from) and ``defaults`` (name → the value of a parameter a tool may leave out).
 pub fn domains(py: Python<'_>, kind: ModelKind) -> PyResult<Bound<'_, PyDict>> {
     let (parameters, sample) = (PyDict::new(py), PyDict::new(py));
     for ((name, domain), (lo, hi)) in kind
@@ -155,5 +242,24 @@ pub fn domains(py: Python<'_>, kind: ModelKind) -> PyResult<Bound<'_, PyDict>> {
     let constraints: Vec<&str> = kind.parameter_constraints().iter().map(|c| c.1).collect();
     out.set_item("constraints", constraints)?;
     out.set_item("sample", sample)?;
+    let defaults = PyDict::new(py);
+    for (name, d) in kind.parameter_names().iter().zip(kind.parameter_defaults()) {
+        if let Some(d) = d {
+            defaults.set_item(name, *d)?;
+        }
+    }
+    out.set_item("defaults", defaults)?;
+    if let Some(rule) = kind.info().inertia {
+        constraints_with(&out, rule.rule)?;
+    }
     Ok(out)
+}
+
+/// The inertia rule's text added to `domains["constraints"]`.
+fn constraints_with(domains: &Bound<'_, PyDict>, rule: &str) -> PyResult<()> {
+    let constraints = domains.get_item("constraints")?;
+    if let Some(list) = constraints {
+        list.call_method1("append", (rule,))?;
+    }
+    Ok(())
 }

@@ -9,7 +9,8 @@
 //! * [`batch`]: `simulate_batch`, the episodes of many tools under many perturbations.
 //! * [`design`]: `toolconf design --json` as a dict.
 //! * [`dask_steps`]: the steps of `rank` that `toolconf.dask` spreads over a cluster.
-//! * [`dynamics`]: a robot's own rigid-body dynamics Ẋ = [q̇; q̈] for one state or a batch.
+//! * [`dynamics`]: a robot's own rigid-body dynamics Ẋ = [q̇; q̈] for one state or a batch, and
+//!   its tool's tip with the tip's Jacobian (`tip`).
 //! * [`task`]: a task given as a built-in name, a task file or a dict with a task file's keys,
 //!   all checked by the crate's task-file parser so errors name the key.
 //!
@@ -61,6 +62,7 @@ fn _toolconf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(dask_steps::episodes, m)?)?;
     m.add_function(wrap_pyfunction!(dask_steps::rank_table, m)?)?;
     m.add_function(wrap_pyfunction!(dynamics::dynamics, m)?)?;
+    m.add_function(wrap_pyfunction!(dynamics::tip, m)?)?;
     m.add(
         "SimulationError",
         m.py().get_type::<errors::SimulationError>(),

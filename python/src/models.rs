@@ -16,7 +16,8 @@ pub fn model_kind(name: &str) -> Result<ModelKind, Failure> {
 /// the order ``confidence`` and ``simulate`` take a tool's parameters in (masses in kg, lengths
 /// in m, ...); ``dof`` is the number of joints (torques); ``equilibrium`` the state and torque
 /// the model is linearised at; ``domains`` which tools are valid (each parameter's domain in
-/// words, the constraints across them, the box random tools are drawn from).
+/// words, the constraints across them, the box random tools are drawn from, the defaults of the
+/// parameters a tool may leave out); ``has_tip`` whether ``tip`` takes the model.
 #[pyfunction]
 pub fn models(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let out = PyDict::new(py);
@@ -27,6 +28,7 @@ pub fn models(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
         entry.set_item("parameters", kind.parameter_names().to_vec())?;
         entry.set_item("equilibrium", crate::dynamics::equilibrium(py, kind)?)?;
         entry.set_item("domains", crate::dynamics::domains(py, kind)?)?;
+        entry.set_item("has_tip", kind.has_tip())?;
         out.set_item(kind.name(), entry)?;
     }
     Ok(out)

@@ -93,7 +93,7 @@ pub fn simulate<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = model_kind(model).map_err(|f| f.into_pyerr(py))?;
     let np = kind.parameter_names().len();
-    let (shape, values) = crate::arrays::float_argument("params", params)?;
+    let (shape, values) = crate::arrays::tool_params(kind, params)?;
     if shape != [np] {
         return Err(Failure::Input(format!(
             "params of shape {shape:?}: model {kind} takes one tool's {np} parameters ({}) as a 1-D \

@@ -67,7 +67,8 @@ def test_acceleration_confidence_is_the_precisions_sum_for_every_model():
     p_ddot, p_u = 10.0, 0.0
     for name, info in toolconf.models().items():
         n = info["dof"]
-        params = np.linspace(0.2, 0.6, len(info["parameters"]))
+        # The parameters a tool must give (a URDF tool's products and tip default to zero).
+        params = np.linspace(0.2, 0.6, len(info["parameters"]) - len(info["domains"]["defaults"]))
         c = toolconf.confidence(name, params, "acceleration")
         np.testing.assert_allclose(c["pi_u"], (p_ddot + p_u) * np.eye(n), rtol=1e-12)
         assert c["logdet"] == pytest.approx(n * math.log(10.0), rel=1e-12)

@@ -37,6 +37,24 @@ def random_tool(rng, name):
     return [m, *com, m * (b * b + c * c) / 12, m * (a * a + c * c) / 12, m * (a * a + b * b) / 12]
 
 
+def random_rotation(rng):
+    """A uniformly random rotation (QR of a Gaussian matrix, signs fixed, det +1)."""
+    q, r = np.linalg.qr(rng.normal(size=(3, 3)))
+    q = q @ np.diag(np.sign(np.diag(r)))
+    return q if np.linalg.det(q) > 0 else -q
+
+
+def random_full_tool(rng, name):
+    """random_tool's box turned by a random rotation about its centre of mass (an inertia tensor
+    with products), with a tip anywhere in the model's sampling box: all 13 parameters."""
+    tool = random_tool(rng, name)
+    r = random_rotation(rng)
+    tensor = r @ np.diag(tool[4:7]) @ r.T
+    sample = toolconf.models()[name]["domains"]["sample"]
+    tip = [rng.uniform(*sample[k]) for k in ("tool_tip_x", "tool_tip_y", "tool_tip_z")]
+    return [*tool[:4], tensor[0, 0], tensor[1, 1], tensor[2, 2], tensor[0, 1], tensor[0, 2], tensor[1, 2], *tip]
+
+
 def relative(got, want):
     return float(np.max(np.abs(got - want)) / np.max(np.abs(want)))
 
@@ -131,3 +149,74 @@ def test_a_batch_names_the_bad_tool_row():
     tools[2, 3] = 2.0
     with pytest.raises(ValueError, match="tool 2: invalid tool parameter tool_com_z = 2"):
         toolconf.dynamics("panda", tools, np.zeros((3, 14)), np.zeros(7))
+
+
+@pytest.mark.parametrize("name", ["panda", "ur5"])
+def test_full_inertia_tensor_dynamics_equals_pinocchio_aba(name):
+    """A tool whose inertia tensor has products (a box turned about its centre of mass): the
+    dynamics with URDF's <inertia ixy ixz iyz> equal Pinocchio's aba on the same tool."""
+    rng = np.random.default_rng(29)
+    n = toolconf.models()[name]["dof"]
+    worst = 0.0
+    for _ in range(30):
+        tool = random_full_tool(rng, name)
+        model, data = pinocchio_model(name, tool)
+        q, qd, u = rng.uniform(-math.pi, math.pi, n), rng.uniform(-3.0, 3.0, n), rng.uniform(-20.0, 20.0, n)
+        got = toolconf.dynamics(name, tool, np.concatenate([q, qd]), u)
+        worst = max(worst, relative(got, np.concatenate([qd, pin.aba(model, data, q, qd, u)])))
+    assert worst <= TOLERANCE, f"{name}: worst normwise relative difference {worst:.2e}"
+
+
+@pytest.mark.parametrize("name", ["panda", "ur5"])
+def test_tip_equals_pinocchio_frame_placement_and_jacobian(name):
+    """toolconf.tip against Pinocchio with the tool's tip added as a frame: its placement and the
+    linear rows of computeFrameJacobian (LOCAL_WORLD_ALIGNED), 100 random states and tools, to
+    1e-10 (absolute: metres, and metres per radian)."""
+    rng = np.random.default_rng(31)
+    n = toolconf.models()[name]["dof"]
+    tools, qs, positions, jacobians = [], [], [], []
+    for _ in range(100):
+        tool = random_full_tool(rng, name)
+        model, data = pinocchio_model(name, tool)
+        frame = model.getFrameId("tool_tip")
+        q = rng.uniform(-math.pi, math.pi, n)
+        pin.framesForwardKinematics(model, data, q)
+        tools.append(tool)
+        qs.append(q)
+        positions.append(data.oMf[frame].translation.copy())
+        jacobians.append(pin.computeFrameJacobian(model, data, q, frame, pin.LOCAL_WORLD_ALIGNED)[:3])
+    got = toolconf.tip(name, np.array(tools), np.array(qs))
+    assert got["position"].shape == (100, 3) and got["jacobian"].shape == (100, 3, n)
+    assert np.max(np.abs(got["position"] - np.array(positions))) <= TOLERANCE
+    assert np.max(np.abs(got["jacobian"] - np.array(jacobians))) <= TOLERANCE
+    one = toolconf.tip(name, tools[0], qs[0])
+    assert one["position"].shape == (3,) and one["jacobian"].shape == (3, n)
+    np.testing.assert_array_equal(one["jacobian"], got["jacobian"][0])
+
+
+def test_a_tool_of_seven_parameters_has_no_products_and_its_tip_at_the_flange():
+    """The 7 parameters toolconf took before the products of inertia and the tip: the same
+    dynamics as with those six given as zero, and the tip at the flange (Pinocchio's panda_link8)."""
+    short = [0.5, 0.01, 0.0, 0.1, 1e-3, 2e-3, 2.5e-3]
+    full = short + [0.0] * 6
+    x = np.linspace(-1.0, 1.0, 14)
+    np.testing.assert_array_equal(toolconf.dynamics("panda", short, x, np.ones(7)),
+                                  toolconf.dynamics("panda", full, x, np.ones(7)))
+    model, data = pinocchio_model("panda", full)
+    pin.framesForwardKinematics(model, data, x[:7])
+    flange = data.oMf[model.getFrameId("panda_link8")].translation
+    assert np.max(np.abs(toolconf.tip("panda", short, x[:7])["position"] - flange)) <= TOLERANCE
+    assert toolconf.models()["panda"]["domains"]["defaults"]["tool_tip_z"] == 0.0
+
+
+def test_an_inertia_tensor_that_is_no_rigid_body_is_refused():
+    """Moments that obey the triangle inequality on the diagonal, with a product that makes the
+    tensor's eigenvalues break it (or the tensor indefinite): one ValueError naming the rule."""
+    bad = [0.5, 0, 0, 0.1, 1e-3, 1e-3, 1e-3, 9e-4, 0, 0, 0, 0, 0.1]
+    with pytest.raises(ValueError, match=r"the inertia tensor .* is positive definite with eigenvalues obeying the triangle inequality"):
+        toolconf.dynamics("panda", bad, np.zeros(14), np.zeros(7))
+
+
+def test_a_model_without_a_tip_says_so():
+    with pytest.raises(ValueError, match="model msd has no tip"):
+        toolconf.tip("msd", [1.0] * len(toolconf.models()["msd"]["parameters"]), [0.0])

@@ -15,6 +15,8 @@ The runtime is Rust (the ``toolconf`` crate); this package exposes it over NumPy
 * ``design(model, task, design)``: ``toolconf design --json``, which tool to build.
 * ``dynamics(model, params, state, control)``: a robot's own rigid-body dynamics
   Ẋ = [q̇; q̈] (U the joint torques), for one state or a batch.
+* ``tip(model, params, q)``: the tool's tip in the base frame and its Jacobian (3 × n), for one
+  joint configuration or a batch.
 * ``models()``: the generated models, their parameter names, equilibria and valid tools.
 * ``toolconf.dask`` (``pip install "./python[dask]"``): ``rank`` and ``simulate_batch`` on a
   Dask cluster, with the same results.
@@ -46,6 +48,7 @@ from ._toolconf import (
     simulate,
     simulate_batch,
     terms,
+    tip,
 )
 
 __all__ = [
@@ -59,6 +62,7 @@ __all__ = [
     "simulate",
     "simulate_batch",
     "terms",
+    "tip",
 ]
 
 

@@ -28,6 +28,7 @@ class Domains(TypedDict):
     parameters: dict[str, str]
     constraints: list[str]
     sample: dict[str, list[float]]
+    defaults: dict[str, float]
 
 class ModelInfo(TypedDict):
     title: str
@@ -35,6 +36,7 @@ class ModelInfo(TypedDict):
     parameters: list[str]
     equilibrium: Equilibrium
     domains: Domains
+    has_tip: bool
 
 class SimulationError(RuntimeError):
     """An episode that failed: the integrator gave up or the state diverged."""
@@ -55,6 +57,15 @@ def dynamics(model: str, params: Params, state: npt.ArrayLike, control: npt.Arra
     joint torques (for ``panda`` and ``ur5`` without the joint impedance of their plant): shape
     (state size,) when every argument is 1-D, else (k, state size). Raises ``ValueError`` for bad
     input."""
+
+class Tip(TypedDict):
+    position: npt.NDArray[np.float64]
+    jacobian: npt.NDArray[np.float64]
+
+def tip(model: str, params: Params, q: npt.ArrayLike) -> Tip:
+    """The tool's tip y(q) in the base frame (m) and its Jacobian dy/dq: ``position`` (3,) and
+    ``jacobian`` (3, n) for 1-D arguments, else (k, 3) and (k, 3, n). Raises ``ValueError`` for a
+    model without a tip or bad input."""
 
 class RangeInfo(TypedDict):
     low: float

@@ -85,6 +85,7 @@ pub(crate) fn tool_from_params(
             })
         })
         .collect::<Result<Vec<f64>, _>>()?;
+    let params = model.with_defaults(&params).unwrap_or(params);
     Ok(toolconf::registry::AnyTool::new(model, &params)?)
 }
 

@@ -73,6 +73,12 @@ pub trait ArmModel<const N: usize, const NX: usize, const NP: usize, const NZ: u
         u: &SVector<f64, N>,
         p: &SVector<f64, NP>,
     ) -> SVector<f64, NX>;
+    /// The tool's tip y(q; p) in the base frame (m) and its Jacobian J = ∂y/∂q (3 × N)
+    /// (`generated::tip::<name>`), `None` for a model whose description gives no tip.
+    fn tip(
+        q: &SVector<f64, N>,
+        p: &SVector<f64, NP>,
+    ) -> Option<(SVector<f64, 3>, SMatrix<f64, 3, N>)>;
     /// A = ∂f/∂X at the equilibrium.
     fn state_matrix(p: &SVector<f64, NP>) -> SMatrix<f64, NX, NX>;
     /// B = ∂f/∂U at the equilibrium.
@@ -163,6 +169,14 @@ macro_rules! arm_model {
                 p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
             ) -> SVector<f64, { generated::$module::STATE_DIM }> {
                 generated::rigid_body::$module(x, u, p)
+            }
+
+            #[inline]
+            fn tip(
+                q: &SVector<f64, { generated::$module::DOF }>,
+                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
+            ) -> Option<(SVector<f64, 3>, SMatrix<f64, 3, { generated::$module::DOF }>)> {
+                generated::tip::$module(q, p)
             }
 
             #[inline]

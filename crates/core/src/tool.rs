@@ -88,6 +88,13 @@ where
                 let rule = rule.constraints[index].rule;
                 return Err(Error::ToolConstraint { rule, excess });
             }
+            Err(Violation::Inertia { minor }) => {
+                let rule = rule.inertia.map_or("the inertia rule", |i| i.rule);
+                return Err(Error::ToolConstraint {
+                    rule,
+                    excess: -minor,
+                });
+            }
         }
         Ok(Self {
             params: SVector::from(params),
@@ -124,6 +131,12 @@ where
         u: &SVector<f64, N>,
     ) -> SVector<f64, NX> {
         M::rigid_body_dynamics(x, u, &self.params)
+    }
+
+    /// The tool's tip y(q) in the base frame (m) and its Jacobian ∂y/∂q ([`ArmModel::tip`]),
+    /// `None` for a model without a tip.
+    pub fn tip(&self, q: &SVector<f64, N>) -> Option<(SVector<f64, 3>, SMatrix<f64, 3, N>)> {
+        M::tip(q, &self.params)
     }
 
     /// A at the equilibrium.

@@ -314,20 +314,26 @@ fn build_row<'a>(
     };
     let names = model.parameter_names();
     let domains = model.parameter_domains();
+    let defaults = model.parameter_defaults();
     let mut params = Vec::with_capacity(names.len());
-    for (&key, domain) in names.iter().zip(domains) {
-        let value = match cell(key) {
-            Cell::Absent => {
+    for ((&key, domain), default) in names.iter().zip(domains).zip(defaults) {
+        let value = match (cell(key), default) {
+            // A column the model gives a default for (a URDF tool's products of inertia and
+            // tip, zero): files written before it was a parameter keep working.
+            (Cell::Absent, Some(d)) => *d,
+            (Cell::Absent, None) => {
                 return Err(format!(
                     "{key} is missing (model {model} needs it){}",
                     who()
                 ))
             }
-            Cell::Number(x) => x,
-            Cell::Text(t) => t
+            (Cell::Number(x), _) => x,
+            (Cell::Text(t), _) => t
                 .parse::<f64>()
                 .map_err(|_| format!("{key} = '{}' is not a number{}", Clip(t), who()))?,
-            Cell::Other(v) => return Err(format!("{key} = {} is not a number{}", Clip(&v), who())),
+            (Cell::Other(v), _) => {
+                return Err(format!("{key} = {} is not a number{}", Clip(&v), who()))
+            }
         };
         if let Err(why) = crate::validate::tool_parameter(domain, value) {
             return Err(format!("{key} = {why}{}", who()));

@@ -123,7 +123,22 @@ pub struct ToolRule {
     pub constraints: Vec<Constraint>,
     /// Per parameter, the interval [lo, hi] random tools are drawn from.
     pub sample: Vec<[f64; 2]>,
+    /// Per parameter, what a tools file that leaves its column out means (`None`: required).
+    pub defaults: Vec<Option<f64>>,
+    /// The parameters that are a rigid body's inertia tensor, if some are.
+    pub inertia: Option<Inertia>,
     pub source: String,
+}
+
+/// The parameters that are a rigid body's inertia tensor about its centre of mass, by index (the
+/// moments xx, yy, zz, the products xy, xz, yz): positive definite, its eigenvalues obeying the
+/// triangle inequality to a relative `slack`.
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Inertia {
+    pub moments: [usize; 3],
+    pub products: [usize; 3],
+    pub slack: f64,
 }
 
 /// One parameter's domain; a missing bound is none.

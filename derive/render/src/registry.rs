@@ -68,6 +68,10 @@ pub struct RegistryModel<'a> {
     pub function_count: usize,
     pub tool_rule: ToolRuleView,
     pub rigid_body: RigidBody,
+    /// The body of `generated::tip::<name>`: `Some(..)` of the model's `tip` function, or `None`
+    /// for a model whose description gives no tip.
+    pub tip_body: String,
+    pub has_tip: bool,
     /// The tasks the model offers, as `TaskKind` variants (`TaskKind::Position`).
     pub task_variants: Vec<String>,
 }
@@ -168,12 +172,23 @@ fn registry_model(ir: &Ir) -> Result<RegistryModel<'_>, RenderError> {
         function_count: ir.functions.len(),
         tool_rule: tool_rule_view(m)?,
         rigid_body: rigid_body(&ir.functions),
+        tip_body: tip_body(&m.name, &ir.functions),
+        has_tip: ir.functions.iter().any(|f| f.name == "tip"),
         task_variants: ir
             .tasks
             .iter()
             .map(|t| format!("TaskKind::{}", camel_case(&t.name)))
             .collect(),
     })
+}
+
+/// `generated::tip::<name>`'s body: the model's `tip` (position and Jacobian) where it has one.
+fn tip_body(name: &str, functions: &[Function]) -> String {
+    if functions.iter().any(|f| f.name == "tip") {
+        format!("Some(crate::{name}::tip(q, params))")
+    } else {
+        "let _ = (q, params);\n        None".to_string()
+    }
 }
 
 /// The URDF arms' `rigid_body_dynamics` (their plant adds joint impedance), else the model's

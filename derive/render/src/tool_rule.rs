@@ -5,7 +5,7 @@
 
 use serde::Serialize;
 
-use crate::ir::{Domain, Model, ToolRule};
+use crate::ir::{Domain, Inertia, Model, Parameter, ToolRule};
 use crate::tasks::string_literal;
 use crate::RenderError;
 
@@ -46,6 +46,12 @@ pub struct ToolRuleView {
     pub domains: Vec<DomainView>,
     pub constraints: Vec<ConstraintView>,
     pub sample: Vec<SampleView>,
+    /// Per parameter, its default as a Rust `Option<f64>` literal (`None`, `Some(0.0)`).
+    pub defaults: Vec<String>,
+    /// The inertia rule as a Rust `Option<InertiaRule>` expression.
+    pub inertia: String,
+    /// The inertia rule in words, if there is one (the URDF report).
+    pub inertia_text: Option<String>,
 }
 
 /// The planar arms' rule, for a model whose IR states none: every parameter (a mass, a length,
@@ -62,6 +68,8 @@ fn default_tool_rule(count: usize) -> ToolRule {
         domains: vec![positive; count],
         constraints: Vec::new(),
         sample: vec![[0.1, 0.6]; count],
+        defaults: vec![None; count],
+        inertia: None,
         source: String::new(),
     }
 }
@@ -89,6 +97,17 @@ pub fn tool_rule_view(model: &Model) -> Result<ToolRuleView, RenderError> {
     {
         return Err(bad("a constraint needs one coefficient per parameter"));
     }
+    if rule.defaults.len() != parameters.len()
+        || rule.defaults.iter().flatten().any(|d| !d.is_finite())
+    {
+        return Err(bad("one finite default (or null) per parameter"));
+    }
+    let inertia_text = match &rule.inertia {
+        Some(i) => Some(inertia_text(i, parameters).ok_or_else(|| {
+            bad("inertia: an index is not a parameter's, or the slack not in [0, 1e-3]")
+        })?),
+        None => None,
+    };
     let domains = rule
         .domains
         .iter()
@@ -113,11 +132,56 @@ pub fn tool_rule_view(model: &Model) -> Result<ToolRuleView, RenderError> {
             hi: rust_f64(hi),
         })
         .collect();
+    let defaults = rule
+        .defaults
+        .iter()
+        .map(|d| d.map_or("None".to_string(), |v| format!("Some({})", rust_f64(v))))
+        .collect();
+    let inertia = match (&rule.inertia, &inertia_text) {
+        (Some(i), Some(text)) => format!(
+            "Some(InertiaRule {{ moments: [{}], products: [{}], slack: {}, rule: {} }})",
+            join(&i.moments),
+            join(&i.products),
+            rust_f64(i.slack),
+            string_literal(text)
+        ),
+        _ => "None".to_string(),
+    };
     Ok(ToolRuleView {
         domains,
         constraints,
         sample,
+        defaults,
+        inertia,
+        inertia_text,
     })
+}
+
+fn join(indices: &[usize; 3]) -> String {
+    indices.map(|i| i.to_string()).join(", ")
+}
+
+/// "the inertia tensor [[tool_ixx, tool_ixy, ...]] is positive definite ...": `None` if an
+/// index is out of range or the slack unreasonable.
+fn inertia_text(i: &Inertia, parameters: &[Parameter]) -> Option<String> {
+    let name = |k: usize| parameters.get(k).map(|p| p.name.as_str());
+    let [xx, yy, zz] = [
+        name(i.moments[0])?,
+        name(i.moments[1])?,
+        name(i.moments[2])?,
+    ];
+    let [xy, xz, yz] = [
+        name(i.products[0])?,
+        name(i.products[1])?,
+        name(i.products[2])?,
+    ];
+    if !(0.0..=1e-3).contains(&i.slack) {
+        return None;
+    }
+    Some(format!(
+        "the inertia tensor [[{xx}, {xy}, {xz}], [{xy}, {yy}, {yz}], [{xz}, {yz}, {zz}]] is \
+         positive definite with eigenvalues obeying the triangle inequality (a rigid body's)"
+    ))
 }
 
 /// One domain: its bounds as Rust literals (a missing bound is infinite) and the rule in words,

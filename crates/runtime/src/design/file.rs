@@ -179,6 +179,13 @@ impl DesignSpec {
             }
             bounds[k] = Some(check_bounds(range, &domains[k]).map_err(|m| err(&key, m))?);
         }
+        // A parameter a tools file may leave out (a URDF tool's products of inertia and tip) is
+        // fixed at its default where the design file is silent on it.
+        for (k, default) in model.parameter_defaults().iter().enumerate() {
+            if fixed[k].is_none() && bounds[k].is_none() {
+                fixed[k] = *default;
+            }
+        }
         let mut out = Vec::with_capacity(names.len());
         for (k, name) in names.iter().enumerate() {
             match (fixed[k], bounds[k]) {

@@ -116,18 +116,7 @@ where
         u: &Rows,
         out: &mut [f64],
     ) -> Result<(), BatchError> {
-        let count = if params.shared { 1 } else { k };
-        let mut tools = room(count, count)?;
-        for i in 0..count {
-            let tool = tool::<M, N, NX, NP, NZ>(params.row(i)).map_err(|e| {
-                BatchError::Input(if params.shared || k == 1 {
-                    e.to_string()
-                } else {
-                    format!("tool {i}: {e}")
-                })
-            })?;
-            tools.push(tool);
-        }
+        let tools = tool_rows::<M, N, NX, NP, NZ>(k, params)?;
         for (i, v) in x.data.iter().chain(u.data).enumerate() {
             if !v.is_finite() {
                 let what = if i < x.data.len() { "state" } else { "control" };
@@ -151,6 +140,74 @@ where
                 Ok(())
             })
     }
+
+    fn tip(
+        &self,
+        k: usize,
+        params: &Rows,
+        q: &Rows,
+        position: &mut [f64],
+        jacobian: &mut [f64],
+    ) -> Result<(), BatchError> {
+        let tools = tool_rows::<M, N, NX, NP, NZ>(k, params)?;
+        if let Some(v) = q.data.iter().find(|v| !v.is_finite()) {
+            return Err(BatchError::Input(format!(
+                "joint position {v} is not finite"
+            )));
+        }
+        position
+            .par_chunks_exact_mut(3)
+            .zip(jacobian.par_chunks_exact_mut(3 * N))
+            .with_min_len(MIN_STATES_PER_THREAD)
+            .enumerate()
+            .try_for_each(|(i, (y_row, j_row))| {
+                let tool = &tools[if params.shared { 0 } else { i }];
+                let qi = SVector::<f64, N>::from_column_slice(q.row(i));
+                let Some((y, j)) = tool.tip(&qi) else {
+                    return Err(BatchError::Input(format!(
+                        "model {} has no tip (its description gives none)",
+                        M::NAME
+                    )));
+                };
+                if !(y.iter().chain(j.iter()).all(|v| v.is_finite())) {
+                    return Err(BatchError::Input(format!(
+                        "state {i}: the tip is not finite there (|q| too large)"
+                    )));
+                }
+                y_row.copy_from_slice(y.as_slice());
+                // Row major, as the batch's other arrays: J[r][c] at r·N + c.
+                for r in 0..3 {
+                    for c in 0..N {
+                        j_row[r * N + c] = j[(r, c)];
+                    }
+                }
+                Ok(())
+            })
+    }
+}
+
+/// The tools of a batch's `params` rows (one shared by every row, or one per row), each checked
+/// by the model's rule; the error names the row.
+fn tool_rows<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    k: usize,
+    params: &Rows,
+) -> Result<Vec<ToolN<M, N, NX, NP, NZ>>, BatchError>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let count = if params.shared { 1 } else { k };
+    let mut tools = room(count, count)?;
+    for i in 0..count {
+        let tool = tool::<M, N, NX, NP, NZ>(params.row(i)).map_err(|e| {
+            BatchError::Input(if params.shared || k == 1 {
+                e.to_string()
+            } else {
+                format!("tool {i}: {e}")
+            })
+        })?;
+        tools.push(tool);
+    }
+    Ok(tools)
 }
 
 /// `common`'s horizon, grid, perturbation, learning rate, integrator and recording, with model

@@ -74,6 +74,18 @@ pub trait Model: Send + Sync {
         u: &Rows,
         out: &mut [f64],
     ) -> Result<(), BatchError>;
+
+    /// The tool's tip y(q) (base frame, m) and its Jacobian ∂y/∂q of `k` rows of joint
+    /// positions into `position` (k × 3) and `jacobian` (k × 3 × N, row major); `params` one row
+    /// shared by every state or one per state. An error for a model without a tip.
+    fn tip(
+        &self,
+        k: usize,
+        params: &Rows,
+        q: &Rows,
+        position: &mut [f64],
+        jacobian: &mut [f64],
+    ) -> Result<(), BatchError>;
 }
 
 /// A task bound to one model ([`Model::bind`]): every method takes a tool as its parameters in
@@ -269,6 +281,33 @@ impl ModelKind {
         self.info().sample
     }
 
+    /// Per parameter, what a tools file that leaves its column out means (`None`: required).
+    pub fn parameter_defaults(self) -> &'static [Option<f64>] {
+        self.info().defaults
+    }
+
+    /// How many parameters a tool must give: all but the trailing ones with a default.
+    pub fn required_parameters(self) -> usize {
+        let d = self.parameter_defaults();
+        d.len() - d.iter().rev().take_while(|v| v.is_some()).count()
+    }
+
+    /// `params` with the trailing defaults added when it gives exactly the required ones (a
+    /// URDF tool of toolconf's earlier 7 parameters: no products of inertia, tip at the flange);
+    /// `None` when it needs none.
+    pub fn with_defaults(self, params: &[f64]) -> Option<Vec<f64>> {
+        let (required, d) = (self.required_parameters(), self.parameter_defaults());
+        (params.len() == required && required < d.len()).then(|| {
+            let tail = d[required..].iter().map(|v| v.unwrap_or(0.0));
+            params.iter().copied().chain(tail).collect()
+        })
+    }
+
+    /// Whether the model's tools have a tip ([`Model::tip`]).
+    pub fn has_tip(self) -> bool {
+        self.info().has_tip
+    }
+
     /// The equilibrium X^e = [q^e; q̇^e] the model is linearised at.
     pub fn equilibrium_state(self) -> &'static [f64] {
         self.info().equilibrium_state
@@ -418,7 +457,7 @@ mod tests {
         }
         assert_eq!(ModelKind::Arm2.name(), "arm2");
         assert_eq!(
-            ModelKind::of::<crate::model::Panda, 7, 14, 7, 21>(),
+            ModelKind::of::<crate::model::Panda, 7, 14, 13, 21>(),
             ModelKind::Panda
         );
     }
