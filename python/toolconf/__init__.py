@@ -15,6 +15,9 @@ The runtime is Rust (the ``toolconf`` crate); this package exposes it over NumPy
 * ``design(model, task, design)``: ``toolconf design --json``, which tool to build.
 * ``dynamics(model, params, state, control)``: a robot's own rigid-body dynamics
   Ẋ = [q̇; q̈] (U the joint torques), for one state or a batch.
+* ``tool_from_urdf(urdf, root, tip, opening=..., flange=...)``: ``toolconf tool --urdf``, a
+  tool's tools-file row (mass, centre of mass, full inertia, tip in the flange frame) from its
+  own URDF, as a dict.
 * ``models()``: the generated models, their parameter names, equilibria and valid tools.
 * ``toolconf.dask`` (``pip install "./python[dask]"``): ``rank`` and ``simulate_batch`` on a
   Dask cluster, with the same results.
@@ -46,6 +49,7 @@ from ._toolconf import (
     simulate,
     simulate_batch,
     terms,
+    tool_from_urdf,
 )
 
 __all__ = [
@@ -59,6 +63,7 @@ __all__ = [
     "simulate",
     "simulate_batch",
     "terms",
+    "tool_from_urdf",
 ]
 
 

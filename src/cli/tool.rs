@@ -68,25 +68,8 @@ fn parse_joint(s: &str) -> Result<(String, f64), String> {
     Ok((name.to_string(), value))
 }
 
-/// The generated models whose tool is a URDF tool (mass, centre of mass, inertia).
-fn flange_models() -> Vec<&'static str> {
-    toolconf::registry::ModelKind::ALL
-        .iter()
-        .filter(|m| m.parameter_names().contains(&"tool_mass"))
-        .map(|m| m.name())
-        .collect()
-}
-
 fn parse_flange_model(s: &str) -> Result<String, String> {
-    let models = flange_models();
-    match toolconf::registry::lookup(s) {
-        Ok(kind) if models.contains(&kind.name()) => Ok(kind.name().to_string()),
-        _ => Err(format!(
-            "'{}' is not a model with a tool at a URDF flange ({})",
-            Clip(s),
-            models.join(", ")
-        )),
-    }
+    toolconf::tool_urdf::flange_model(s).map(str::to_string)
 }
 
 pub fn run(args: &Args) -> Result<(), CliError> {

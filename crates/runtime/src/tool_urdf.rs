@@ -210,6 +210,29 @@ impl UrdfTool {
     }
 }
 
+/// The generated models whose tool is a URDF tool at a flange (their parameters are the row's
+/// `tool_mass`, ...: `panda`, `ur5`).
+pub fn flange_models() -> Vec<&'static str> {
+    crate::registry::ModelKind::ALL
+        .iter()
+        .filter(|m| m.parameter_names().contains(&"tool_mass"))
+        .map(|m| m.name())
+        .collect()
+}
+
+/// The row's `model`: one of [`flange_models`] (case and blanks ignored), or why not.
+pub fn flange_model(name: &str) -> Result<&'static str, String> {
+    let models = flange_models();
+    match crate::registry::lookup(name) {
+        Ok(kind) if models.contains(&kind.name()) => Ok(kind.name()),
+        _ => Err(format!(
+            "'{}' is not a model with a tool at a URDF flange ({})",
+            Clip(name),
+            models.join(", ")
+        )),
+    }
+}
+
 /// Bad input: one line naming the file and, where there is one, the line of the element, the
 /// link or joint, the attribute and the value.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -854,7 +877,7 @@ impl<'a, 'input> Robot<'a, 'input> {
             if !value.is_finite() {
                 return Err(cx.whole(format!("{flag}: the position is not finite")));
             }
-            if !below[joint.child] {
+            if !below[joint.parent] {
                 return Err(cx.whole(format!(
                     "{flag}: joint '{}' is not below --root '{root_name}'",
                     Clip(name)
@@ -886,7 +909,7 @@ impl<'a, 'input> Robot<'a, 'input> {
         }
         let mut held = vec![None; self.joints.len()];
         for (j, joint) in self.joints.iter().enumerate() {
-            if !below[joint.child] || joint.kind == Kind::Fixed {
+            if !below[joint.parent] || joint.kind == Kind::Fixed {
                 continue;
             }
             if !joint.kind.movable() {
@@ -943,7 +966,7 @@ impl<'a, 'input> Robot<'a, 'input> {
                     ),
                 ));
             }
-            if !below[mimicked.child] {
+            if !below[mimicked.parent] {
                 return Err(cx.at(
                     joint.node,
                     format!(
