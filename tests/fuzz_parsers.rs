@@ -380,13 +380,49 @@ const URDFS: &[&str] = &[
 
 /// What URDF edits insert besides the common tokens: XML's and URDF's own words.
 const URDF_TOKENS: &[&str] = &[
-    "<", ">", "/>", "</", "<!--", "-->", "&amp;", "&#0;", "&bogus;", "<![CDATA[", "<!DOCTYPE r>",
-    "<?xml", "xmlns=\"u\"", "<link name=\"panda_hand\"/>", "<link/>", "</link>", "<joint",
-    "</joint>", "<inertial>", "</inertial>", "<origin xyz=\"0 0 0\"/>", "<mass value=\"1\"/>",
-    "<mimic joint=\"slide\"/>", "<mimic joint=\"hinge\"/>", "<limit/>", "<axis xyz=\"0 0 0\"/>",
-    "type=\"floating\"", "type=\"fixed\"", "type=\"prismatic\"", "<parent link=\"panda_hand_tcp\"/>",
-    "<child link=\"panda_hand\"/>", "xyz=\"", "rpy=\"", "ixx=\"", "value=\"", " 1e308", " 1e-320",
-    " -0.73", " 0 0", "\"", "panda_hand", "panda_link8", "panda_finger_joint1",
+    "<",
+    ">",
+    "/>",
+    "</",
+    "<!--",
+    "-->",
+    "&amp;",
+    "&#0;",
+    "&bogus;",
+    "<![CDATA[",
+    "<!DOCTYPE r>",
+    "<?xml",
+    "xmlns=\"u\"",
+    "<link name=\"panda_hand\"/>",
+    "<link/>",
+    "</link>",
+    "<joint",
+    "</joint>",
+    "<inertial>",
+    "</inertial>",
+    "<origin xyz=\"0 0 0\"/>",
+    "<mass value=\"1\"/>",
+    "<mimic joint=\"slide\"/>",
+    "<mimic joint=\"hinge\"/>",
+    "<limit/>",
+    "<axis xyz=\"0 0 0\"/>",
+    "type=\"floating\"",
+    "type=\"fixed\"",
+    "type=\"prismatic\"",
+    "<parent link=\"panda_hand_tcp\"/>",
+    "<child link=\"panda_hand\"/>",
+    "xyz=\"",
+    "rpy=\"",
+    "ixx=\"",
+    "value=\"",
+    " 1e308",
+    " 1e-320",
+    " -0.73",
+    " 0 0",
+    "\"",
+    "panda_hand",
+    "panda_link8",
+    "panda_finger_joint1",
 ];
 
 /// A URDF with the common edits, then up to 6 of XML's and URDF's tokens inserted.
@@ -411,11 +447,27 @@ fn urdf_text() -> impl Strategy<Value = String> {
 /// flange, openings and named positions drawn from the words above.
 fn urdf_request() -> impl Strategy<Value = Request> {
     let names = prop::sample::select(vec![
-        "panda_link8", "panda_hand", "panda_hand_tcp", "finger_a", "panda_leftfinger", "slide",
-        "hinge", "wrist", "panda_finger_joint1", "panda_finger_joint2", "panda_link7", "", "é\n",
+        "panda_link8",
+        "panda_hand",
+        "panda_hand_tcp",
+        "finger_a",
+        "panda_leftfinger",
+        "slide",
+        "hinge",
+        "wrist",
+        "panda_finger_joint1",
+        "panda_finger_joint2",
+        "panda_link7",
+        "",
+        "é\n",
     ]);
     let value = prop_oneof![
-        Just(0.0), Just(0.02), Just(0.04), Just(-1.0), Just(1e308), Just(f64::NAN),
+        Just(0.0),
+        Just(0.02),
+        Just(0.04),
+        Just(-1.0),
+        Just(1e308),
+        Just(f64::NAN),
         -2.0..2.0f64,
     ];
     let hand = Request {
@@ -465,6 +517,27 @@ fn check_urdf(text: &str, request: &Request) -> Result<(), TestCaseError> {
             Ok(())
         }
     }
+}
+
+/// The unmutated bases merge, so that the fuzzing starts from tools that pass.
+#[test]
+fn the_urdf_bases_merge_into_tools() {
+    let hand = Request {
+        root: "panda_hand".into(),
+        tip: "panda_hand_tcp".into(),
+        flange: Some("panda_link8".into()),
+        opening: Some(0.02),
+        joints: vec![],
+    };
+    let panda = tool_from_urdf(URDFS[1], "panda.urdf", &hand).unwrap();
+    assert_eq!(panda.mass, 0.76);
+    let gripper = Request {
+        joints: vec![("wrist".into(), 1.0)],
+        ..hand
+    };
+    let tool = tool_from_urdf(GRIPPER, "gripper.urdf", &gripper).unwrap();
+    assert!((tool.mass - 0.86).abs() < 1e-15);
+    assert_eq!(tool.held.len(), 3);
 }
 
 proptest! {

@@ -86,8 +86,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         opening: args.opening,
         joints: args.joints.clone(),
     };
-    let tool = tool_from_urdf_file(&args.urdf, &request)
-        .map_err(|e| CliError::Usage(e.to_string()))?;
+    let tool =
+        tool_from_urdf_file(&args.urdf, &request).map_err(|e| CliError::Usage(e.to_string()))?;
     let file = args.urdf.to_string_lossy();
     let name = args.name.as_deref().unwrap_or(&args.root);
     let text = tool.tools_file(&file, &request, name, args.model.as_deref());

@@ -289,19 +289,30 @@ pub fn tool_from_urdf_file(path: &Path, request: &Request) -> Result<UrdfTool, U
 }
 
 /// Merges the tool from a URDF's text; `file` names it in errors.
-pub fn tool_from_urdf(text: &str, file: &str, request: &Request) -> Result<UrdfTool, UrdfToolError> {
+pub fn tool_from_urdf(
+    text: &str,
+    file: &str,
+    request: &Request,
+) -> Result<UrdfTool, UrdfToolError> {
     let file = Clip(file).to_string();
     let options = roxmltree::ParsingOptions {
         allow_dtd: false,
         nodes_limit: MAX_XML_NODES,
         ..roxmltree::ParsingOptions::default()
     };
-    let doc = roxmltree::Document::parse_with_options(text, options).map_err(|e| UrdfToolError {
-        file: file.clone(),
-        line: None,
-        message: format!("not a well-formed XML file: {}", ClipMessage(&e.to_string())),
-    })?;
-    let cx = Cx { file: &file, doc: &doc };
+    let doc =
+        roxmltree::Document::parse_with_options(text, options).map_err(|e| UrdfToolError {
+            file: file.clone(),
+            line: None,
+            message: format!(
+                "not a well-formed XML file: {}",
+                ClipMessage(&e.to_string())
+            ),
+        })?;
+    let cx = Cx {
+        file: &file,
+        doc: &doc,
+    };
     let robot = Robot::read(&cx)?;
     robot.merge(&cx, request)
 }
@@ -482,7 +493,10 @@ fn attribute<'a>(
     node.attribute(attr).ok_or_else(|| {
         cx.at(
             node,
-            format!("{owner}<{}> has no {attr} attribute", node.tag_name().name()),
+            format!(
+                "{owner}<{}> has no {attr} attribute",
+                node.tag_name().name()
+            ),
         )
     })
 }
@@ -499,7 +513,10 @@ fn number(
         return default.ok_or_else(|| {
             cx.at(
                 node,
-                format!("{owner}<{}> has no {attr} attribute", node.tag_name().name()),
+                format!(
+                    "{owner}<{}> has no {attr} attribute",
+                    node.tag_name().name()
+                ),
             )
         });
     };
@@ -547,7 +564,11 @@ fn triple(
             Ok(_) => {
                 return Err(cx.at(
                     node,
-                    format!("{owner}<{tag}> {attr} = '{}': '{}' is not finite", Clip(text), Clip(w)),
+                    format!(
+                        "{owner}<{tag}> {attr} = '{}': '{}' is not finite",
+                        Clip(text),
+                        Clip(w)
+                    ),
                 ))
             }
             Err(_) => {
@@ -696,7 +717,10 @@ impl<'a, 'input> Robot<'a, 'input> {
             self.link_index.get(link).copied().ok_or_else(|| {
                 cx.at(
                     element,
-                    format!("{owner}<{tag}> link = '{}' is no link of the file", Clip(link)),
+                    format!(
+                        "{owner}<{tag}> link = '{}' is no link of the file",
+                        Clip(link)
+                    ),
                 )
             })
         };
@@ -809,12 +833,7 @@ impl<'a, 'input> Robot<'a, 'input> {
     }
 
     /// The flange's pose and the fixed joints from the flange down to the root.
-    fn flange_to_root(
-        &self,
-        cx: &Cx,
-        flange: usize,
-        root: usize,
-    ) -> Result<Pose, UrdfToolError> {
+    fn flange_to_root(&self, cx: &Cx, flange: usize, root: usize) -> Result<Pose, UrdfToolError> {
         let mut chain = Vec::new();
         let mut link = root;
         let mut seen = HashSet::new();
@@ -1043,7 +1062,11 @@ impl<'a, 'input> Robot<'a, 'input> {
             ));
         };
         if !(lower <= value && value <= upper) {
-            let unit = if joint.kind == Kind::Prismatic { "m" } else { "rad" };
+            let unit = if joint.kind == Kind::Prismatic {
+                "m"
+            } else {
+                "rad"
+            };
             return Err(cx.at(
                 joint.node,
                 format!(
@@ -1113,7 +1136,7 @@ impl<'a, 'input> Robot<'a, 'input> {
         }
         let mass: f64 = bodies.iter().map(|b| b.0).sum();
         let root_name = Clip(&request.root);
-        if !(mass > 0.0) {
+        if mass.is_nan() || mass <= 0.0 {
             return Err(cx.whole(format!(
                 "the {} links at and below --root '{root_name}' have no mass (no <inertial> \
                  <mass> above 0)",
@@ -1178,11 +1201,7 @@ impl<'a, 'input> Robot<'a, 'input> {
     }
 }
 
-fn read_inertial(
-    cx: &Cx,
-    node: roxmltree::Node,
-    owner: &str,
-) -> Result<Inertial, UrdfToolError> {
+fn read_inertial(cx: &Cx, node: roxmltree::Node, owner: &str) -> Result<Inertial, UrdfToolError> {
     let owner = format!("{owner}<inertial>");
     let origin = origin(cx, only_child(cx, node, &owner, "origin")?, &owner)?;
     let mass_node = only_child(cx, node, &owner, "mass")?
@@ -1210,7 +1229,11 @@ fn read_inertial(
 /// or principal moments breaking the triangle inequality ([`DEFINITE_RATIO`],
 /// [`TRIANGLE_SLACK`]).
 pub fn check_rigid_body(inertia: &Matrix3<f64>) -> Result<(), String> {
-    let mut moments: Vec<f64> = SymmetricEigen::new(*inertia).eigenvalues.iter().copied().collect();
+    let mut moments: Vec<f64> = SymmetricEigen::new(*inertia)
+        .eigenvalues
+        .iter()
+        .copied()
+        .collect();
     moments.sort_by(f64::total_cmp);
     let [a, b, c] = [moments[0], moments[1], moments[2]];
     let shown = crate::display::ShortList(&moments).to_string();
@@ -1289,18 +1312,32 @@ mod tests {
             )
         };
         let q = std::f64::consts::FRAC_PI_2;
-        let tool = tool_from_urdf(&link(&format!("0 0 {q}")), "rod.urdf", &request("rod", "rod"))
-            .unwrap();
+        let tool = tool_from_urdf(
+            &link(&format!("0 0 {q}")),
+            "rod.urdf",
+            &request("rod", "rod"),
+        )
+        .unwrap();
         let i = tool.inertia;
-        assert!(close(i[0][0], l) && close(i[1][1], t) && close(i[2][2], l), "{i:?}");
+        assert!(
+            close(i[0][0], l) && close(i[1][1], t) && close(i[2][2], l),
+            "{i:?}"
+        );
         assert!(i[0][1].abs() < 1e-17 && i[0][2].abs() < 1e-17 && i[1][2].abs() < 1e-17);
         assert_eq!(tool.com, [0.1, 0.2, 0.3]);
         assert_eq!(tool.mass, 2.0);
         let e = std::f64::consts::FRAC_PI_4;
-        let tool = tool_from_urdf(&link(&format!("0 0 {e}")), "rod.urdf", &request("rod", "rod"))
-            .unwrap();
+        let tool = tool_from_urdf(
+            &link(&format!("0 0 {e}")),
+            "rod.urdf",
+            &request("rod", "rod"),
+        )
+        .unwrap();
         let i = tool.inertia;
-        assert!(close(i[0][0], (l + t) / 2.0) && close(i[1][1], (l + t) / 2.0), "{i:?}");
+        assert!(
+            close(i[0][0], (l + t) / 2.0) && close(i[1][1], (l + t) / 2.0),
+            "{i:?}"
+        );
         assert!(close(i[0][1], -(l - t) / 2.0), "{i:?}");
         // URDF's fixed-axis rpy is nalgebra's Euler angles (roll, then pitch, then yaw).
         let r = rpy_matrix(0.3, -0.7, 1.1);
@@ -1319,7 +1356,10 @@ mod tests {
 </robot>"#;
         let mut r = request("palm", "b");
         let e = tool_from_urdf(urdf, "g.urdf", &r).unwrap_err().to_string();
-        assert!(e.starts_with("g.urdf, line 5: joint 'ja' is prismatic and has no position"), "{e}");
+        assert!(
+            e.starts_with("g.urdf, line 5: joint 'ja' is prismatic and has no position"),
+            "{e}"
+        );
         r.opening = Some(0.02);
         let tool = tool_from_urdf(urdf, "g.urdf", &r).unwrap();
         assert!(close(tool.tip[1], -0.03), "{:?}", tool.tip);
@@ -1333,7 +1373,10 @@ mod tests {
         );
         r.joints = vec![("jb".into(), 0.01)];
         let e = tool_from_urdf(urdf, "g.urdf", &r).unwrap_err().to_string();
-        assert!(e.contains("mimics joint 'ja': give the position of 'ja'"), "{e}");
+        assert!(
+            e.contains("mimics joint 'ja': give the position of 'ja'"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -1342,14 +1385,42 @@ mod tests {
         assert!(tool_from_urdf(ok, "x.urdf", &request("a", "b")).is_ok());
         let cases: &[(&str, &str, &str)] = &[
             ("<robot", "", "not a well-formed XML file"),
-            ("xyz=\"0 0 1\"", "xyz=\"0 0\"", "xyz = '0 0' has 2 numbers, not 3"),
+            (
+                "xyz=\"0 0 1\"",
+                "xyz=\"0 0\"",
+                "xyz = '0 0' has 2 numbers, not 3",
+            ),
             ("xyz=\"0 0 1\"", "xyz=\"0 0 nan\"", "'nan' is not finite"),
-            ("value=\"1\"", "value=\"-1\"", "<mass> value = -1 is negative"),
-            ("value=\"1\"", "value=\"heavy\"", "value = 'heavy' is not a number"),
-            ("<child link=\"b\"/>", "<child link=\"c\"/>", "link = 'c' is no link of the file"),
-            ("<child link=\"b\"/>", "<child link=\"a\"/>", "joins link 'a' to itself"),
-            ("type=\"fixed\"", "type=\"hinge\"", "'hinge' is not a URDF joint type"),
-            ("<link name=\"b\"/>", "<link name=\"a\"/>", "a second link named 'a'"),
+            (
+                "value=\"1\"",
+                "value=\"-1\"",
+                "<mass> value = -1 is negative",
+            ),
+            (
+                "value=\"1\"",
+                "value=\"heavy\"",
+                "value = 'heavy' is not a number",
+            ),
+            (
+                "<child link=\"b\"/>",
+                "<child link=\"c\"/>",
+                "link = 'c' is no link of the file",
+            ),
+            (
+                "<child link=\"b\"/>",
+                "<child link=\"a\"/>",
+                "joins link 'a' to itself",
+            ),
+            (
+                "type=\"fixed\"",
+                "type=\"hinge\"",
+                "'hinge' is not a URDF joint type",
+            ),
+            (
+                "<link name=\"b\"/>",
+                "<link name=\"a\"/>",
+                "a second link named 'a'",
+            ),
             ("ixx=\"1\"", "ixx=\"10\"", "break the triangle inequality"),
             ("ixx=\"1\"", "ixx=\"0\"", "is not positive definite"),
             ("value=\"1\"", "value=\"0\"", "have no mass"),
@@ -1363,9 +1434,13 @@ mod tests {
             assert!(e.contains(expected), "{from} -> {to}: {e}");
             assert!(!e.contains('\n'), "{e}");
         }
-        let e = tool_from_urdf(ok, "x.urdf", &request("b", "a")).unwrap_err().to_string();
+        let e = tool_from_urdf(ok, "x.urdf", &request("b", "a"))
+            .unwrap_err()
+            .to_string();
         assert_eq!(e, "x.urdf: --tip 'a' is not --root 'b' or a link below it");
-        let e = tool_from_urdf(ok, "x.urdf", &request("zz", "a")).unwrap_err().to_string();
+        let e = tool_from_urdf(ok, "x.urdf", &request("zz", "a"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("--root 'zz' is no link of the file"), "{e}");
         let mut r = request("a", "b");
         r.flange = Some("b".into());
@@ -1374,26 +1449,38 @@ mod tests {
         let e = tool_from_urdf(&ok.replace("robot", "rob"), "x.urdf", &request("a", "b"))
             .unwrap_err()
             .to_string();
-        assert_eq!(e, "x.urdf, line 1: the top element is <rob>, not <robot>: not a URDF file");
+        assert_eq!(
+            e,
+            "x.urdf, line 1: the top element is <rob>, not <robot>: not a URDF file"
+        );
         // Finite numbers whose composite is not: 1e300 kg, 1e10 m apart.
         let body = r#"<inertial><mass value="1e300"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>"#;
         let huge = format!(
             r#"<robot name="x"><link name="a">{body}</link><link name="b">{body}</link><joint name="j" type="fixed"><parent link="a"/><child link="b"/><origin xyz="0 0 1e10"/></joint></robot>"#
         );
-        let e = tool_from_urdf(&huge, "x.urdf", &request("a", "b")).unwrap_err().to_string();
+        let e = tool_from_urdf(&huge, "x.urdf", &request("a", "b"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("that is not finite (mass 2e300 kg)"), "{e}");
         // Two parents; a loop.
         let two = ok.replace(
             "</robot>",
             r#"<link name="c"/><joint name="k" type="fixed"><parent link="c"/><child link="b"/></joint></robot>"#,
         );
-        let e = tool_from_urdf(&two, "x.urdf", &request("a", "b")).unwrap_err().to_string();
+        let e = tool_from_urdf(&two, "x.urdf", &request("a", "b"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("link 'b' has two parents"), "{e}");
         let cycle = ok.replace(
             "</robot>",
             r#"<joint name="k" type="fixed"><parent link="b"/><child link="a"/></joint></robot>"#,
         );
-        let e = tool_from_urdf(&cycle, "x.urdf", &request("a", "b")).unwrap_err().to_string();
-        assert!(e.contains("leads back to link 'a': the links form a loop"), "{e}");
+        let e = tool_from_urdf(&cycle, "x.urdf", &request("a", "b"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("leads back to link 'a': the links form a loop"),
+            "{e}"
+        );
     }
 }
