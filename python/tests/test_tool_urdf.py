@@ -21,8 +21,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 import toolconf
+from test_fuzz_arguments import FUZZ, call, mostly
 
 import pinocchio as pin  # in derive/requirements.txt: make test installs it
 
@@ -173,3 +176,23 @@ def test_a_position_of_the_wrong_type_is_a_type_error():
         toolconf.tool_from_urdf(PANDA, "panda_hand", "panda_hand_tcp", opening=True)
     with pytest.raises(TypeError, match="a position must be a real number"):
         toolconf.tool_from_urdf(PANDA, "panda_hand", "panda_hand_tcp", joints={"panda_finger_joint1": "wide"})
+
+
+LINKS = ["panda_hand", "panda_hand_tcp", "panda_link8", "panda_leftfinger", "panda_link0", "", "é\n"]
+JOINTS = ["panda_finger_joint1", "panda_finger_joint2", "panda_hand_joint", "nope"]
+
+
+@FUZZ
+@given(mostly(st.sampled_from([PANDA, str(PANDA), str(REPO)])), mostly(st.sampled_from(LINKS)),
+       mostly(st.sampled_from(LINKS)), mostly(st.one_of(st.none(), st.sampled_from(LINKS))),
+       mostly(st.one_of(st.none(), st.floats(-0.01, 0.05))),
+       mostly(st.one_of(st.none(), st.dictionaries(st.sampled_from(JOINTS), st.floats(-0.01, 0.05),
+                                                   max_size=2))),
+       mostly(st.one_of(st.none(), st.text(max_size=8))),
+       mostly(st.one_of(st.none(), st.sampled_from(["panda", "UR5", "arm2"]))))
+def test_arguments_of_any_type_give_a_row_or_one_line(urdf, root, tip, flange, opening, joints,
+                                                        name, model):
+    """As test_fuzz_arguments.py does for the other functions: finite numbers, or ValueError,
+    TypeError or MemoryError with a one-line message."""
+    call(toolconf.tool_from_urdf, urdf, root, tip, flange=flange, opening=opening, joints=joints,
+         name=name, model=model)
