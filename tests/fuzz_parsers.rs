@@ -1,5 +1,6 @@
 //! Fuzzing every parser of user input (property-based, on stable Rust with proptest): tools
-//! files (CSV and JSON), task files, design files, design constraints and sweeps, and `--arm`.
+//! files (CSV and JSON), task files, design files, design constraints and sweeps, `--arm`, and a
+//! tool's URDF (`toolconf tool --urdf`, with its links, joints and positions).
 //!
 //! Each input is a valid example mutated by random edits (characters and tokens that matter to
 //! the format: quotes, separators, brackets, `nan`, `1e308`, keys, long runs), or random text.
@@ -19,6 +20,7 @@ use toolconf::design::sweep::parse_sweep;
 use toolconf::rank::ModelTasks;
 use toolconf::registry::ModelKind;
 use toolconf::task_file::TaskSpec;
+use toolconf::tool_urdf::{check_rigid_body, tool_from_urdf, Request};
 use toolconf::tools_file::read_tools_from;
 use toolconf::validate::TOOL_PARAMETER;
 
@@ -350,6 +352,194 @@ fn check_csv_rows(cells: &[Vec<String>]) -> Result<(), TestCaseError> {
     Ok(())
 }
 
+/// A gripper on a flange: a turned fixed joint, an inertial turned in its link, a prismatic
+/// finger, a revolute one that mimics it, a continuous wrist, a massless tip.
+const GRIPPER: &str = r#"<?xml version="1.0"?>
+<robot name="gripper">
+  <link name="panda_link8"/>
+  <link name="panda_hand">
+    <inertial><origin xyz="-0.01 0 0.03" rpy="0.1 -0.2 0.3"/><mass value="0.73"/>
+      <inertia ixx="0.001" ixy="1e-5" ixz="-2e-5" iyy="0.0025" iyz="0" izz="0.0017"/></inertial>
+  </link>
+  <link name="panda_hand_tcp"/>
+  <link name="finger_a"><inertial><mass value="0.015"/><inertia ixx="2.4e-6" iyy="2.4e-6" izz="7.5e-7" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="finger_b"><inertial><origin xyz="0 0.01 0.02"/><mass value="0.015"/><inertia ixx="2.4e-6" iyy="2.4e-6" izz="7.5e-7" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="spinner"><inertial><mass value="0.1"/><inertia ixx="1e-5" iyy="1e-5" izz="1e-5" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="panda_hand_joint" type="fixed"><parent link="panda_link8"/><child link="panda_hand"/><origin rpy="0 0 -0.7853981633974483" xyz="0 0 0"/></joint>
+  <joint name="tcp" type="fixed"><parent link="panda_hand"/><child link="panda_hand_tcp"/><origin xyz="0 0 0.1034"/></joint>
+  <joint name="slide" type="prismatic"><parent link="panda_hand"/><child link="finger_a"/><origin xyz="0 0 0.0584"/><axis xyz="0 1 0"/><limit lower="0" upper="0.04" effort="1" velocity="1"/></joint>
+  <joint name="hinge" type="revolute"><parent link="panda_hand"/><child link="finger_b"/><origin xyz="0 0 0.0584" rpy="0 1.5 0"/><axis xyz="1 1 0"/><limit lower="-1" upper="1"/><mimic joint="slide" multiplier="-10" offset="0.1"/></joint>
+  <joint name="wrist" type="continuous"><parent link="panda_hand"/><child link="spinner"/><axis xyz="0 0 1"/></joint>
+</robot>
+"#;
+
+const URDFS: &[&str] = &[
+    GRIPPER,
+    include_str!("../derive/robots/panda_description/urdf/panda.urdf"),
+];
+
+/// What URDF edits insert besides the common tokens: XML's and URDF's own words.
+const URDF_TOKENS: &[&str] = &[
+    "<",
+    ">",
+    "/>",
+    "</",
+    "<!--",
+    "-->",
+    "&amp;",
+    "&#0;",
+    "&bogus;",
+    "<![CDATA[",
+    "<!DOCTYPE r>",
+    "<?xml",
+    "xmlns=\"u\"",
+    "<link name=\"panda_hand\"/>",
+    "<link/>",
+    "</link>",
+    "<joint",
+    "</joint>",
+    "<inertial>",
+    "</inertial>",
+    "<origin xyz=\"0 0 0\"/>",
+    "<mass value=\"1\"/>",
+    "<mimic joint=\"slide\"/>",
+    "<mimic joint=\"hinge\"/>",
+    "<limit/>",
+    "<axis xyz=\"0 0 0\"/>",
+    "type=\"floating\"",
+    "type=\"fixed\"",
+    "type=\"prismatic\"",
+    "<parent link=\"panda_hand_tcp\"/>",
+    "<child link=\"panda_hand\"/>",
+    "xyz=\"",
+    "rpy=\"",
+    "ixx=\"",
+    "value=\"",
+    " 1e308",
+    " 1e-320",
+    " -0.73",
+    " 0 0",
+    "\"",
+    "panda_hand",
+    "panda_link8",
+    "panda_finger_joint1",
+];
+
+/// A URDF with the common edits, then up to 6 of XML's and URDF's tokens inserted.
+fn urdf_text() -> impl Strategy<Value = String> {
+    (
+        mutated(URDFS),
+        prop::collection::vec((0.0..1.0f64, 0..URDF_TOKENS.len()), 0..6),
+    )
+        .prop_map(|(mut text, inserts)| {
+            for (at, t) in inserts {
+                let mut i = ((at * (text.len() + 1) as f64) as usize).min(text.len());
+                while !text.is_char_boundary(i) {
+                    i -= 1;
+                }
+                text.insert_str(i, URDF_TOKENS[t]);
+            }
+            text
+        })
+}
+
+/// The Franka Hand's request (the gripper's names are the hand's), or one of other links, a
+/// flange, openings and named positions drawn from the words above.
+fn urdf_request() -> impl Strategy<Value = Request> {
+    let names = prop::sample::select(vec![
+        "panda_link8",
+        "panda_hand",
+        "panda_hand_tcp",
+        "finger_a",
+        "panda_leftfinger",
+        "slide",
+        "hinge",
+        "wrist",
+        "panda_finger_joint1",
+        "panda_finger_joint2",
+        "panda_link7",
+        "",
+        "é\n",
+    ]);
+    let value = prop_oneof![
+        Just(0.0),
+        Just(0.02),
+        Just(0.04),
+        Just(-1.0),
+        Just(1e308),
+        Just(f64::NAN),
+        -2.0..2.0f64,
+    ];
+    let hand = Request {
+        root: "panda_hand".into(),
+        tip: "panda_hand_tcp".into(),
+        flange: Some("panda_link8".into()),
+        opening: Some(0.02),
+        joints: vec![("wrist".into(), 1.0)],
+    };
+    prop_oneof![
+        3 => Just(hand),
+        1 => (
+            names.clone(),
+            names.clone(),
+            prop::option::of(names.clone()),
+            prop::option::of(value.clone()),
+            prop::collection::vec((names, value), 0..3),
+        )
+            .prop_map(|(root, tip, flange, opening, joints)| Request {
+                root: root.into(),
+                tip: tip.into(),
+                flange: flange.map(Into::into),
+                opening,
+                joints: joints.into_iter().map(|(n, v)| (n.to_string(), v)).collect(),
+            }),
+    ]
+}
+
+/// A merged tool passes its own checks again and prints as three lines with finite numbers; an
+/// error is one line naming the file.
+fn check_urdf(text: &str, request: &Request) -> Result<(), TestCaseError> {
+    match tool_from_urdf(text, "fuzz.urdf", request) {
+        Err(e) => one_line(&e.to_string(), "fuzz.urdf"),
+        Ok(tool) => {
+            prop_assert!(tool.mass > 0.0);
+            prop_assert!(tool.values().iter().all(|(_, v)| v.is_finite()), "{tool:?}");
+            let i = nalgebra::Matrix3::from_fn(|r, c| tool.inertia[r][c]);
+            prop_assert_eq!(i, i.transpose());
+            prop_assert!(check_rigid_body(&i).is_ok(), "{tool:?}");
+            let file = tool.tools_file("fuzz.urdf", request, &request.root, Some("panda"));
+            prop_assert_eq!(file.lines().count(), 3, "{}", file);
+            for (column, v) in tool.values() {
+                let printed = toolconf::output::csv::format_number(v);
+                prop_assert_eq!(printed.parse::<f64>().ok(), Some(v), "{}", column);
+                prop_assert!(file.lines().nth(2).unwrap().contains(&printed));
+            }
+            Ok(())
+        }
+    }
+}
+
+/// The unmutated bases merge, so that the fuzzing starts from tools that pass.
+#[test]
+fn the_urdf_bases_merge_into_tools() {
+    let hand = Request {
+        root: "panda_hand".into(),
+        tip: "panda_hand_tcp".into(),
+        flange: Some("panda_link8".into()),
+        opening: Some(0.02),
+        joints: vec![],
+    };
+    let panda = tool_from_urdf(URDFS[1], "panda.urdf", &hand).unwrap();
+    assert_eq!(panda.mass, 0.76);
+    let gripper = Request {
+        joints: vec![("wrist".into(), 1.0)],
+        ..hand
+    };
+    let tool = tool_from_urdf(GRIPPER, "gripper.urdf", &gripper).unwrap();
+    assert!((tool.mass - 0.86).abs() < 1e-15);
+    assert_eq!(tool.held.len(), 3);
+}
+
 proptest! {
     #![proptest_config(config())]
 
@@ -397,5 +587,10 @@ proptest! {
                 prop_assert!(!m.contains('\n') && m.chars().count() <= MAX_MESSAGE, "{m:?}");
             }
         }
+    }
+
+    #[test]
+    fn tool_urdfs(text in urdf_text(), request in urdf_request()) {
+        check_urdf(&text, &request)?;
     }
 }

@@ -11,6 +11,7 @@
 //! * [`dask_steps`]: the steps of `rank` that `toolconf.dask` spreads over a cluster.
 //! * [`dynamics`]: a robot's own rigid-body dynamics Ẋ = [q̇; q̈] for one state or a batch, and
 //!   its tool's tip with the tip's Jacobian (`tip`).
+//! * [`tool_urdf`]: `toolconf tool --urdf`, a tool's tools-file row from its own URDF, as a dict.
 //! * [`task`]: a task given as a built-in name, a task file or a dict with a task file's keys,
 //!   all checked by the crate's task-file parser so errors name the key.
 //!
@@ -32,6 +33,7 @@ mod rank;
 mod simulate;
 mod task;
 mod tool_tables;
+mod tool_urdf;
 mod tools;
 
 use pyo3::prelude::*;
@@ -63,6 +65,7 @@ fn _toolconf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(dask_steps::rank_table, m)?)?;
     m.add_function(wrap_pyfunction!(dynamics::dynamics, m)?)?;
     m.add_function(wrap_pyfunction!(dynamics::tip, m)?)?;
+    m.add_function(wrap_pyfunction!(tool_urdf::tool_from_urdf, m)?)?;
     m.add(
         "SimulationError",
         m.py().get_type::<errors::SimulationError>(),

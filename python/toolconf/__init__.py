@@ -17,6 +17,9 @@ The runtime is Rust (the ``toolconf`` crate); this package exposes it over NumPy
   Ẋ = [q̇; q̈] (U the joint torques), for one state or a batch.
 * ``tip(model, params, q)``: the tool's tip in the base frame and its Jacobian (3 × n), for one
   joint configuration or a batch.
+* ``tool_from_urdf(urdf, root, tip, opening=..., flange=...)``: ``toolconf tool --urdf``, a
+  tool's tools-file row (mass, centre of mass, full inertia, tip in the flange frame) from its
+  own URDF, as a dict.
 * ``models()``: the generated models, their parameter names, equilibria and valid tools.
 * ``toolconf.dask`` (``pip install "./python[dask]"``): ``rank`` and ``simulate_batch`` on a
   Dask cluster, with the same results.
@@ -49,6 +52,7 @@ from ._toolconf import (
     simulate_batch,
     terms,
     tip,
+    tool_from_urdf,
 )
 
 __all__ = [
@@ -63,6 +67,7 @@ __all__ = [
     "simulate_batch",
     "terms",
     "tip",
+    "tool_from_urdf",
 ]
 
 

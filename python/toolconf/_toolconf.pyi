@@ -67,6 +67,46 @@ def tip(model: str, params: Params, q: npt.ArrayLike) -> Tip:
     ``jacobian`` (3, n) for 1-D arguments, else (k, 3) and (k, 3, n). Raises ``ValueError`` for a
     model without a tip or bad input."""
 
+ToolRow = TypedDict(
+    "ToolRow",
+    {
+        "name": str,
+        "model": Optional[str],
+        "tool_mass": float,
+        "tool_com_x": float,
+        "tool_com_y": float,
+        "tool_com_z": float,
+        "tool_ixx": float,
+        "tool_iyy": float,
+        "tool_izz": float,
+        "tool_ixy": float,
+        "tool_ixz": float,
+        "tool_iyz": float,
+        "tool_tip_x": float,
+        "tool_tip_y": float,
+        "tool_tip_z": float,
+    },
+)
+"""A tools file's row of a URDF tool, in the flange frame (kg, m, kg m² about the centre of
+mass; ``tool_ixy`` is I[0][1], URDF's ``<inertia ixy>``)."""
+
+def tool_from_urdf(
+    urdf: Union[str, "os.PathLike[str]"],
+    root: str,
+    tip: str,
+    *,
+    flange: Optional[str] = None,
+    opening: Optional[float] = None,
+    joints: Optional[Mapping[str, float]] = None,
+    name: Optional[str] = None,
+    model: Optional[str] = None,
+) -> ToolRow:
+    """``toolconf tool --urdf``: the links at and below ``root`` merged into one rigid body,
+    movable joints held at ``opening`` (mimics follow their joint) or ``joints[name]``, in the
+    frame of ``flange`` (default ``root``); the tip is ``tip``'s origin. Raises ``ValueError``
+    with the command line's one line for bad input, ``TypeError`` for a position that is not a
+    real number."""
+
 class RangeInfo(TypedDict):
     low: float
     high: float

@@ -32,6 +32,7 @@ mod reproduce;
 mod select;
 mod simulate;
 mod stdout;
+mod tool;
 
 use std::process::ExitCode;
 
@@ -61,6 +62,9 @@ enum Command {
     Design(design::Args),
     /// Run every experiment of the paper's Results section: CSVs, SVG figures, report.
     Reproduce(reproduce::Args),
+    /// A tool's row of a tools file from its own URDF: mass, centre of mass, inertia and tip
+    /// in the flange frame.
+    Tool(tool::Args),
 }
 
 pub(crate) fn parse_arm(s: &str) -> Result<Arm, String> {
@@ -111,6 +115,7 @@ pub fn run() -> ExitCode {
         Command::Rank(args) => rank::run(&args),
         Command::Reproduce(args) => reproduce::run(&args),
         Command::Design(args) => design::run(&args),
+        Command::Tool(args) => tool::run(&args),
     };
     let flushed = stdout::finish().map_err(output::CliError::Stdout);
     match result.and(flushed) {

@@ -49,6 +49,7 @@ pub mod stats;
 pub mod task;
 pub mod task_file;
 pub mod threads;
+pub mod tool_urdf;
 pub mod tools_file;
 pub mod validate;
 
