@@ -8,18 +8,22 @@ nominal one of the tool class, marked "assumed").
     python3 examples/tools/panda_tools.py --check    # exit 1 if the CSV differs from what it writes
 
 Frames. Every part is placed in the Panda's flange frame (panda_link8: z out of the flange).
-The Franka Hand's fingertip centre, where a grasped tool is held, is 0.1034 m out along z
-(Franka's flange-to-hand transform). A tool's parameters are its mass, its centre of mass and
-the diagonal of its inertia tensor about the centre of mass in flange axes (toolconf's
-tool_ixx, tool_iyy, tool_izz: it takes the principal axes along the flange's). Where parts are
-offset sideways the tensor has products of inertia; they are dropped, and the comment says how
-large the largest was against the largest moment. The diagonal of any inertia tensor obeys the triangle
-inequality, so every row is a valid rigid body for toolconf.
+The Franka Hand is mounted turned by -45 degrees about z (panda.urdf's panda_hand_joint, rpy
+0 0 -pi/4), and Franka gives its numbers in the hand's own frame: they are turned into the
+flange frame here (which is what `toolconf tool --urdf` gives for the hand of panda.urdf, within
+the manual's rounding). The Franka Hand's fingertip centre, its TCP, where a grasped tool is held,
+is 0.1034 m out along z (Franka's flange-to-hand transform). A tool's parameters are its mass,
+its centre of mass, its full inertia tensor about the centre of mass in flange axes (toolconf's
+tool_ixx, tool_iyy, tool_izz, tool_ixy, tool_ixz, tool_iyz, URDF's convention) and its tip
+(tool_tip_x/y/z, the point that does the work: the vendor's TCP where it publishes one,
+otherwise the end of the stated geometry; each row's comment says which). A sum of rigid bodies'
+tensors is a rigid body's, so every row is valid for toolconf.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,19 +34,33 @@ FINGERTIPS = 0.1034  # m along the flange z axis (Franka: flange to hand, the fi
 
 @dataclass(frozen=True)
 class Part:
-    """A rigid part: mass (kg), centre of mass (m, flange frame), inertia about its own centre
-    of mass in flange axes (kg m^2, diagonal: the shapes below are aligned with the flange)."""
+    """A rigid part: mass (kg), centre of mass (m, flange frame), inertia tensor about its own
+    centre of mass in flange axes (kg m^2, 3 x 3)."""
     name: str
     mass: float
     com: tuple[float, float, float]
-    inertia: tuple[float, float, float]
+    inertia: tuple
+
+
+def diagonal(moments):
+    return tuple(tuple(moments[i] if i == j else 0.0 for j in range(3)) for i in range(3))
+
+
+def turned_about_z(part: Part, angle: float) -> Part:
+    """The part turned by `angle` about the flange's z axis: R c and R I R^T."""
+    c, s = math.cos(angle), math.sin(angle)
+    r = ((c, -s, 0.0), (s, c, 0.0), (0.0, 0.0, 1.0))
+    com = tuple(sum(r[i][k] * part.com[k] for k in range(3)) for i in range(3))
+    tensor = tuple(tuple(sum(r[i][k] * part.inertia[k][l] * r[j][l] for k in range(3) for l in range(3))
+                         for j in range(3)) for i in range(3))
+    return Part(part.name, part.mass, com, tensor)
 
 
 def box(name, mass, com, sides):
     """A solid box with sides (a, b, c) along the flange's x, y, z."""
     a, b, c = sides
-    return Part(name, mass, com, (mass * (b * b + c * c) / 12, mass * (a * a + c * c) / 12,
-                                  mass * (a * a + b * b) / 12))
+    return Part(name, mass, com, diagonal((mass * (b * b + c * c) / 12, mass * (a * a + c * c) / 12,
+                                           mass * (a * a + b * b) / 12)))
 
 
 def cylinder(name, mass, com, diameter, length, axis="z"):
@@ -51,14 +69,12 @@ def cylinder(name, mass, com, diameter, length, axis="z"):
     along = mass * r2 / 2
     across = mass * (3 * r2 + length * length) / 12
     moments = tuple(along if a == axis else across for a in "xyz")
-    return Part(name, mass, com, moments)
+    return Part(name, mass, com, diagonal(moments))
 
 
 def combine(parts):
-    """Mass, centre of mass, inertia diagonal about it in flange axes, and the largest product of
-    inertia relative to the largest moment, the tensor's relative error when the products are
-    dropped (parallel-axis theorem; the parts' own tensors are diagonal, their offsets make the
-    products)."""
+    """Mass, centre of mass and the full inertia tensor about it in flange axes (parallel-axis
+    theorem)."""
     mass = sum(p.mass for p in parts)
     com = tuple(sum(p.mass * p.com[k] for p in parts) / mass for k in range(3))
     tensor = [[0.0] * 3 for _ in range(3)]
@@ -67,18 +83,20 @@ def combine(parts):
         dd = sum(x * x for x in d)
         for i in range(3):
             for j in range(3):
-                own = p.inertia[i] if i == j else 0.0
-                tensor[i][j] += own + p.mass * ((dd if i == j else 0.0) - d[i] * d[j])
-    diagonal = tuple(tensor[i][i] for i in range(3))
-    products = max(abs(tensor[i][j]) for i in range(3) for j in range(3) if i != j)
-    return mass, com, diagonal, products / max(diagonal)
+                tensor[i][j] += p.inertia[i][j] + p.mass * ((dd if i == j else 0.0) - d[i] * d[j])
+    return mass, com, tensor
 
 
 # The Franka Hand, as Franka Emika's Panda manual gives it ("Mechanical data of Hand", the values
 # to enter in Desk): 0.73 kg, centre of mass (-0.01, 0, 0.03) m from the flange, inertia
 # diag(0.001, 0.0025, 0.0017) kg m^2.
-FRANKA_HAND = Part("Franka Hand", 0.73, (-0.01, 0.0, 0.03), (0.001, 0.0025, 0.0017))
-HAND_SOURCE = "Franka Hand: mass, CoM and inertia from Franka Emika's Panda manual (Mechanical data of Hand)"
+# The numbers are in the hand's frame; FRANKA_HAND is turned into the flange's.
+FRANKA_HAND = turned_about_z(Part("Franka Hand", 0.73, (-0.01, 0.0, 0.03), diagonal((0.001, 0.0025, 0.0017))),
+                             -math.pi / 4)
+HAND_SOURCE = ("Franka Hand: mass, CoM and inertia from Franka Emika's Panda manual (Mechanical data of Hand), "
+               "turned by -45 deg about z into the flange frame")
+HAND_TCP = (0.0, 0.0, FINGERTIPS)
+TCP_SOURCE = "tip: the hand's TCP, 0.1034 m out (Franka's flange-to-TCP transform)"
 
 # Robotiq FT 300 manual, section 5.2.1 (moment of inertia and centre of mass of sensor
 # combinations): FT 300 alone 300 g at z = 17 mm; with the 2F-85 gripper 1205 g at z = 76 mm;
@@ -87,6 +105,12 @@ HAND_SOURCE = "Franka Hand: mass, CoM and inertia from Franka Emika's Panda manu
 # text, so the moments come from stated shapes that reproduce its masses and centres of mass.
 FT300 = cylinder("FT 300", 0.300, (0.0, 0.0, 0.017), 0.075, 0.034)
 FT300_SOURCE = "Robotiq FT 300 manual 5.2.1"
+
+
+def ft300_tip(total, com_z, length, com_xy=(0.0, 0.0)):
+    """The far end along z of the device box `on_ft300` places (its centre plus half its length)."""
+    box_part = on_ft300("device", total, com_z, (0.01, 0.01, length), com_xy)[1]
+    return (box_part.com[0], box_part.com[1], box_part.com[2] + length / 2)
 
 
 def on_ft300(name, total, com_z, sides, com_xy=(0.0, 0.0)):
@@ -103,77 +127,88 @@ class Tool:
     name: str
     parts: list
     source: str
+    tip: tuple
+    tip_source: str
 
 
 TOOLS = [
-    Tool("franka hand", [FRANKA_HAND], HAND_SOURCE + "; the hand as it ships, nothing grasped"),
+    Tool("franka hand", [FRANKA_HAND], HAND_SOURCE + "; the hand as it ships, nothing grasped",
+         HAND_TCP, TCP_SOURCE),
     Tool("ft300 sensor", [FT300],
          f"{FT300_SOURCE}: 0.300 kg, CoM z = 17 mm; inertia of a solid cylinder 75 mm across, 34 mm long "
-         "(twice the CoM height)"),
+         "(twice the CoM height)", (0.0, 0.0, 0.034), "tip: the sensor's tool face, the cylinder's far end"),
     Tool("2f-85 gripper on ft300", on_ft300("2F-85", 1.205, 0.076, (0.075, 0.085, 0.123)),
          f"{FT300_SOURCE}: FT 300 + 2F-85 1.205 kg, CoM z = 76 mm; inertia: the sensor's cylinder and a "
-         "solid box 75 x 85 x 123 mm for the gripper"),
+         "solid box 75 x 85 x 123 mm for the gripper", ft300_tip(1.205, 0.076, 0.123),
+         "tip: between the fingertips, the far end of the gripper's box"),
     Tool("2f-140 gripper on ft300", on_ft300("2F-140", 1.275, 0.083, (0.075, 0.140, 0.137)),
          f"{FT300_SOURCE}: FT 300 + 2F-140 1.275 kg, CoM z = 83 mm; inertia: the sensor's cylinder and a "
-         "solid box 75 x 140 x 137 mm for the gripper"),
+         "solid box 75 x 140 x 137 mm for the gripper", ft300_tip(1.275, 0.083, 0.137),
+         "tip: between the fingertips, the far end of the gripper's box"),
     Tool("wrist camera on ft300", on_ft300("Wrist Camera", 0.530, 0.030, (0.075, 0.075, 0.020), (0.0, 0.002)),
          f"{FT300_SOURCE}: FT 300 + Wrist Camera 0.530 kg, CoM (0, 2, 30) mm; inertia: the sensor's "
-         "cylinder and a solid box 75 x 75 x 20 mm for the camera"),
+         "cylinder and a solid box 75 x 75 x 20 mm for the camera", ft300_tip(0.530, 0.030, 0.020, (0.0, 0.002)),
+         "tip: the camera's face, the far end of its box"),
     Tool("2f-85 + wrist camera on ft300", on_ft300("Wrist Camera + 2F-85", 1.275, 0.077,
                                                    (0.075, 0.085, 0.140), (0.0, 0.001)),
          f"{FT300_SOURCE}: FT 300 + Wrist Camera + 2F-85 1.275 kg, CoM (0, 1, 77) mm; inertia: the sensor's "
-         "cylinder and a solid box 75 x 85 x 140 mm"),
+         "cylinder and a solid box 75 x 85 x 140 mm", ft300_tip(1.275, 0.077, 0.140, (0.0, 0.001)),
+         "tip: between the fingertips, the far end of the box"),
     Tool("hand + screwdriver 6x125", [FRANKA_HAND,
                                       cylinder("handle", 0.045, (0.0, 0.0, FINGERTIPS), 0.028, 0.100),
                                       cylinder("blade", 0.028, (0.0, 0.0, FINGERTIPS + 0.050 + 0.0625), 0.006,
                                                0.125)],
          HAND_SOURCE + "; grasped at its handle's middle, pointing out along z: a slotted 6 x 125 mm "
          "screwdriver (blade size by its designation; handle 28 x 100 mm, 45 g, and blade 28 g assumed), "
-         "solid cylinders"),
+         "solid cylinders", (0.0, 0.0, FINGERTIPS + 0.050 + 0.125), "tip: the blade's end"),
     Tool("hand + screwdriver ph2x250", [FRANKA_HAND,
                                         cylinder("handle", 0.060, (0.0, 0.0, FINGERTIPS), 0.032, 0.110),
                                         cylinder("blade", 0.065, (0.0, 0.0, FINGERTIPS + 0.055 + 0.125), 0.008,
                                                  0.250)],
          HAND_SOURCE + "; a Phillips PH2 x 250 mm screwdriver grasped at its handle (handle 32 x 110 mm, "
-         "60 g, and blade 65 g assumed), solid cylinders"),
+         "60 g, and blade 65 g assumed), solid cylinders", (0.0, 0.0, FINGERTIPS + 0.055 + 0.250),
+         "tip: the blade's end"),
     Tool("hand + claw hammer 16 oz", [FRANKA_HAND,
                                       cylinder("handle", 0.200, (0.0, 0.0, FINGERTIPS + 0.110), 0.030, 0.280),
                                       box("head", 0.454, (0.0, 0.0, FINGERTIPS + 0.265), (0.110, 0.025, 0.030))],
          HAND_SOURCE + "; grasped 30 mm from the end of its 280 mm handle: a 16 oz claw hammer (the head's "
          "0.454 kg is its designation; handle 0.2 kg assumed), head a solid box 110 x 25 x 30 mm across the "
-         "handle, handle a solid cylinder"),
+         "handle, handle a solid cylinder", (0.055, 0.0, FINGERTIPS + 0.265),
+         "tip: the centre of the striking face, the head's end along x"),
     Tool("hand + cordless drill", [FRANKA_HAND,
                                    box("drill", 1.1, (0.0, 0.0, FINGERTIPS + 0.04), (0.060, 0.180, 0.200))],
          HAND_SOURCE + "; grasped at its grip: a 12 V class cordless drill with battery, 1.1 kg and "
-         "200 x 180 x 60 mm (assumed, the class's typical size), its CoM 40 mm beyond the fingertips, a solid box"),
+         "200 x 180 x 60 mm (assumed, the class's typical size), its CoM 40 mm beyond the fingertips, a solid box",
+         (0.0, 0.0, FINGERTIPS + 0.04 + 0.100), "tip: the chuck, the box's far end along z"),
     Tool("touch probe on 100 mm extension", [cylinder("adapter", 0.060, (0.0, 0.0, 0.005), 0.063, 0.010),
                                              cylinder("extension", 0.085, (0.0, 0.0, 0.060), 0.020, 0.100),
                                              cylinder("probe", 0.035, (0.0, 0.0, 0.125), 0.025, 0.030)],
          "a touch probe on an aluminium extension bar on the flange, no hand: adapter plate 63 x 10 mm "
          "(60 g), bar 20 x 100 mm (85 g, aluminium's density), probe body 25 x 30 mm (35 g); masses assumed, "
-         "solid cylinders"),
+         "solid cylinders", (0.0, 0.0, 0.140), "tip: the probe's end (its body's far face)"),
 ]
 
 
 def number(x: float) -> str:
-    """Six significant digits, the way a catalogue prints them."""
-    return f"{x:.6g}"
+    """Six significant digits, the way a catalogue prints them (a rounding error from 0 is 0)."""
+    return "0" if abs(x) < 1e-15 else f"{x:.6g}"
 
 
 def render() -> str:
     lines = [
         "# Tools for the Franka Emika Panda (model panda), made by examples/tools/panda_tools.py: edit that,",
         "# not this file. Each row is a rigid body fixed to the flange panda_link8: mass (kg), centre of mass",
-        "# (m, flange frame, z out of the flange) and the diagonal of its inertia about the centre of mass in",
-        "# flange axes (kg m^2). Each comment names where the numbers come from, and which are assumed.",
-        "name,model,tool_mass,tool_com_x,tool_com_y,tool_com_z,tool_ixx,tool_iyy,tool_izz",
+        "# (m, flange frame, z out of the flange), its inertia tensor about the centre of mass in flange axes",
+        "# (kg m^2; URDF's ixy, ixz, iyz) and its tip (m, flange frame). Each comment names where the numbers",
+        "# come from, and which are assumed.",
+        "name,model,tool_mass,tool_com_x,tool_com_y,tool_com_z,tool_ixx,tool_iyy,tool_izz,tool_ixy,tool_ixz,"
+        "tool_iyz,tool_tip_x,tool_tip_y,tool_tip_z",
     ]
     for t in TOOLS:
-        mass, com, inertia, products = combine(t.parts)
-        note = (f" Products of inertia dropped: the largest is {products:.1%} of the largest moment."
-                if products >= 5e-4 else "")
-        lines.append(f"# {t.name}: {t.source}.{note}")
-        values = [mass, *com, *inertia]
+        mass, com, tensor = combine(t.parts)
+        lines.append(f"# {t.name}: {t.source}; {t.tip_source}.")
+        values = [mass, *com, tensor[0][0], tensor[1][1], tensor[2][2], tensor[0][1], tensor[0][2], tensor[1][2],
+                  *t.tip]
         lines.append(",".join([t.name, "panda", *(number(v) for v in values)]))
     return "\n".join(lines) + "\n"
 
