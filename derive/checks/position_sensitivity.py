@@ -2,7 +2,8 @@
 """Does a joint position task reach its goal on a real arm? The paper's task-1 sensitivity against
 the stabilised plant's static gain, measured (issue "Tool use in task space", item 3).
 
-For random physical tools (urdf_model._sample_tool, seeded) on a URDF model, the position task
+For random physical tools (urdf_model._sample_tool, seeded) on a URDF model, or tools from the
+paper's box [0.1, 0.6]^k on the paper's arms (kinds explicit, planar_chain), the position task
 of derive/tasks.toml (its four terms, default precisions, the description's [goals.position])
 is run from rest at X^e under the nonlinear plant the generated code integrates (`dynamics`),
 with the controller of crates/core/src/controller.rs written out:
@@ -80,6 +81,31 @@ def episode(dv: UrdfDerivation, p: np.ndarray, prec: dict, goal: np.ndarray, whi
     return progress, out[-1]
 
 
+class SymbolicPlant:
+    """What `episode` asks of a URDF derivation, for a model of kind `explicit` or `planar_chain`
+    (the paper's arms): its CasADi graph (numeric.CasadiModel, built from the description's strings),
+    A and B by AD at the equilibrium, and tools drawn from the paper's box [0.1, 0.6]^k."""
+
+    def __init__(self, model):
+        from toolconf_derive.numeric import CasadiModel
+        self.cm = CasadiModel(model)
+        self.n = model.dof
+        self.x_e = self.cm.x_e
+        self.k = len(model.parameters)
+        x, u, p = self.cm.x, self.cm.u, self.cm.p
+        f = self.cm.dynamics.f(x, u, p)
+        self.dynamics_inline = ca.Function("f", [x, u, p], [f])
+
+    def state_matrix(self, p):
+        return self.cm.jacobian.f(self.cm.x_e, self.cm.u_e, p)[0]
+
+    def input_matrix(self, p):
+        return self.cm.jacobian.f(self.cm.x_e, self.cm.u_e, p)[1]
+
+    def tools(self, rng, count):
+        return [rng.uniform(0.1, 0.6, self.k) for _ in range(count)]
+
+
 def main() -> int:
     model = load_model(Path(sys.argv[1]))
     count = int(sys.argv[2]) if len(sys.argv) > 2 else 20
@@ -89,11 +115,15 @@ def main() -> int:
         prec["u"] = float(sys.argv[3])
     if len(sys.argv) > 4:
         prec["theta"] = float(sys.argv[4])
-    dv = UrdfDerivation(model, model.chain, load_tasks(HERE / "tasks.toml"))
+    rng = np.random.default_rng(2026)
+    if model.dynamics_kind == "urdf":
+        dv = UrdfDerivation(model, model.chain, load_tasks(HERE / "tasks.toml"))
+        tools = [_sample_tool(rng).ravel() for _ in range(count)]
+    else:
+        dv = SymbolicPlant(model)
+        tools = dv.tools(rng, count)
     goal = np.array([float(parse(model, v, {}, f"goals.position.theta[{i}]").evalf(30))
                      for i, v in enumerate(model.goals["position"]["theta"])])
-    rng = np.random.default_rng(2026)
-    tools = [_sample_tool(rng).ravel() for _ in range(count)]
     print(f"{model.name}: {count} tools, goal |theta^g - q^e| = {np.linalg.norm(goal - dv.x_e[:dv.n]):.3f} rad, "
           f"{T_END:g} s, precisions {prec}")
     for which in ("paper", "static"):

@@ -55,6 +55,18 @@ class BrokenDescription(unittest.TestCase):
         r, _, path = self.derive(tasks=tasks)
         self.assert_stops(r, path, key, problem)
 
+    # [tip]: three expressions of q, the parameters and the constants, for kind explicit only.
+    def test_tip_needs_three_entries(self):
+        self.model_stops(PENDULUM + '\n[tip]\nposition = ["l*sin(theta)", "-l*cos(theta)"]\n', "tip.position",
+                         "has 2 entries, need 3")
+
+    def test_tip_may_not_use_rates_or_controls(self):
+        self.model_stops(PENDULUM + '\n[tip]\nposition = ["l*sin(theta)", "theta_dot", "0"]\n', "tip.position[1]",
+                         "uses theta_dot")
+
+    def test_tip_names_an_unknown_symbol(self):
+        self.model_stops(PENDULUM + '\n[tip]\nposition = ["l*sin(phi)", "0", "0"]\n', "tip.position[0]", "phi")
+
     # Unknown keys, in every kind of table (a misspelt key must not be silently ignored).
     def test_unknown_top_level_table(self):
         self.model_stops(PENDULUM + "\n[extras]\nfoo = 1\n", "extras", "unknown key")

@@ -58,6 +58,8 @@ class Model:
     # None for the other kinds: their parameters are masses, lengths, ... (> 0, drawn from the
     # paper's [0.1, 0.6]), the renderer's default (derive/render).
     tool_rule: dict | None = None
+    # explicit: the tip's position (x, y, z) in the base frame as expressions ([tip] position).
+    tip: list[str] | None = None
 
     @property
     def state(self) -> list[Named]:
@@ -190,6 +192,7 @@ MODEL_KEYS = {
     "link": (("mass", "string", True), ("length", "string", True)),
     "equilibrium": (("q", "values", True), ("q_dot", "values", True), ("u", "values", True)),
     "printed": (("where", "string", False), ("A", "matrix", False), ("B", "matrix", False)),
+    "tip": (("position", "strings", True), ("source", "string", False)),
     **URDF_KEYS,
 }
 # parameters and coordinates are required except for kind "urdf", where the URDF and the tool
@@ -197,7 +200,7 @@ MODEL_KEYS = {
 TOP_KEYS = (("model", "table", True), ("parameters", "tables", False), ("constants", "table", False),
             ("coordinates", "table", False), ("dynamics", "table", True), ("equilibrium", "table", True),
             ("goals", "table", False), ("printed", "table", False), ("urdf", "table", False),
-            ("impedance", "table", False), ("tool", "table", False))
+            ("impedance", "table", False), ("tool", "table", False), ("tip", "table", False))
 TASK_KEYS = (("name", "string", True), ("index", "integer", True), ("title", "string", False),
              ("doc", "string", False), ("terms", "strings", True), ("error", "string", True),
              ("sensitivity", "table", True),
@@ -244,6 +247,7 @@ def load_model(path: Path) -> Model:
     dyn = top.table("dynamics", MODEL_KEYS["dynamics"])
     eq = top.table("equilibrium", MODEL_KEYS["equilibrium"])
     printed = top.table("printed", MODEL_KEYS["printed"])
+    tip = _tip(path, top, dyn.get("kind"))
     if dyn.get("kind") == "urdf":
         parameters, q, q_dot, u, urdf = urdf_names(path, top)
     else:
@@ -281,10 +285,27 @@ def load_model(path: Path) -> Model:
         printed_where=printed.get("where", ""),
         printed_a=printed.get("A"),
         printed_b=printed.get("B"),
+        tip=tip,
         **urdf,
     )
     _validate_model(model)
     return model
+
+
+def _tip(path: Path, top: Table, kind: str) -> list[str] | None:
+    """`[tip] position`: the tip's (x, y, z) in the base frame as expressions of q and the
+    parameters, for kind `explicit`. A `planar_chain`'s tip is its chain's free end and a `urdf`
+    tool's its tool_tip_x/y/z, so neither takes the table."""
+    if "tip" not in top.raw:
+        return None
+    if kind != "explicit":
+        where = "the chain's free end" if kind == "planar_chain" else "the tool's tool_tip_x/y/z"
+        raise DescriptionError(path, "tip", f"only for dynamics.kind = 'explicit': a {kind} model's tip is {where}")
+    position = [str(v) for v in top.table("tip", MODEL_KEYS["tip"]).get("position")]
+    if len(position) != 3:
+        raise DescriptionError(path, "tip.position", f"has {len(position)} entries, need 3: x, y, z in the base "
+                                                     "frame (z = \"0\" for a planar arm)")
+    return position
 
 
 def _check_identifier(name: str, path: Path, key: str) -> None:

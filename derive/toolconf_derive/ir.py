@@ -178,6 +178,10 @@ def function_ir(fn: Function, d: Derivation) -> irt.Function:
         )
         entries = hoisted.entries
         call_args = [a for a in fn.args if a.name != "params"] + [k]
+    elif any(a.name == "q" for a in fn.args):
+        # A function of the joint positions alone (the tip): the same one sin_cos per joint.
+        angles = d.q
+        entries, compounds = joint_trigonometry(entries, angles)
     code = _code(entries, d, call_args, declared, "t", angles, compounds)
     unhoisted = None
     if coefficients is not None:

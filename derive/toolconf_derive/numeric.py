@@ -22,6 +22,7 @@ import mpmath
 import numpy as np
 
 from .planar_chain import casadi_chain
+from .planar_chain import tip as casadi_tip
 from .description import Model, Task, expression, sensitivity, value
 from .exact import Exact, ExactFunction
 from .expression import python_number
@@ -58,10 +59,30 @@ class CasadiModel:
         self.jacobian = ExactFunction(ca.Function(
             "dynamics_jacobian", [self.x, self.u, self.p], [ca.jacobian(f, self.x), ca.jacobian(f, self.u)]
         ))
+        self.tip = self._tip(names, functions)
+
         def values(label: str, texts: list[str]) -> list[float]:
             return [value(model.path, f"equilibrium.{label}[{i}]", v) for i, v in enumerate(texts)]
         self.x_e = np.array(values("q", model.equilibrium_q) + values("q_dot", model.equilibrium_q_dot))
         self.u_e = np.array(values("u", model.equilibrium_u))
+
+    def _tip(self, names: dict, functions: dict) -> ExactFunction | None:
+        """The tip y(q; p) from the description's strings (a planar chain's free end, or `[tip]
+        position`) with CasADi's symbols, and dy/dq by algorithmic differentiation."""
+        model, n = self.model, self.model.dof
+        q = self.x[:n]
+        if model.dynamics_kind == "planar_chain":
+            lengths = [names[link["length"]] for link in model.links]
+            x, y = casadi_tip([names[c.name] for c in model.q], lengths, ca.sin, ca.cos)
+            y_tip = ca.vertcat(x, y, 0)
+        elif model.tip is not None:
+            y_tip = ca.vertcat(*[expression(model.path, f"tip.position[{i}]", e, names).evaluate(
+                {**names, "pi": math.pi}, functions, python_number) for i, e in enumerate(model.tip)])
+        else:
+            return None
+        q_sym = ca.SX.sym("q", n)
+        y_q = ca.substitute(y_tip, q, q_sym)
+        return ExactFunction(ca.Function("tip", [q_sym, self.p], [y_q, ca.jacobian(y_q, q_sym)]))
 
     def linearisation(self, p: np.ndarray) -> tuple[Exact, Exact]:
         """A and B at the equilibrium, exactly (the equilibrium is taken as its doubles)."""

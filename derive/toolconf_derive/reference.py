@@ -28,7 +28,7 @@ SECTIONS = (
      "`[[parameters]]`, one table per tool parameter, in the order the runtime passes them (a tools "
      "file's columns). Every parameter's domain is > 0. A `urdf` model has none: its tool's parameters "
      "are fixed (`tool_mass`, `tool_com_x`, `tool_com_y`, `tool_com_z`, `tool_ixx`, `tool_iyy`, "
-     "`tool_izz`)."),
+     "`tool_izz`, `tool_ixy`, `tool_ixz`, `tool_iyz`, `tool_tip_x`, `tool_tip_y`, `tool_tip_z`)."),
     ("constants.NAME", MODEL_KEYS["constant"], "kinds `explicit`, `planar_chain`",
      "`[constants]` holds one table per constant, e.g. `g = { value = 9.81, unit = \"m/s^2\" }`; the "
      "expressions may use its name."),
@@ -46,6 +46,10 @@ SECTIONS = (
     ("printed", MODEL_KEYS["printed"], "optional",
      "A paper's printed A and B (expressions over the parameters), compared entry by entry with the "
      "derived ones in the model's report."),
+    ("tip", MODEL_KEYS["tip"], "kind `explicit` (optional)",
+     "Where the tip (the point a tip task moves) is: a `planar_chain`'s is its chain's free end, a "
+     "`urdf` model's the tool's `tool_tip_x/y/z` in the flange frame, so neither takes the table. A "
+     "model with a tip has a generated `tip` (its position and Jacobian dy/dq, `toolconf.tip`)."),
     ("urdf", URDF_KEYS["urdf"], "kind `urdf` (required)", "The robot and its chain."),
     ("impedance", URDF_KEYS["impedance"], "kind `urdf` (required)",
      "The joint impedance of the plant tau = U + K (q^e - q) - D q_dot + g(q^e) (docs/urdf.md): K and "
@@ -75,6 +79,7 @@ MEANING = {
     ("(top level)", "urdf"): ("none", "`[urdf]`: required for kind `urdf`, refused otherwise"),
     ("(top level)", "impedance"): ("none", "`[impedance]`: required for kind `urdf`, refused otherwise"),
     ("(top level)", "tool"): ("the defaults below", "`[tool]`: kind `urdf` only"),
+    ("(top level)", "tip"): ("no tip", "`[tip]`: kind `explicit` only (the other kinds have their tip)"),
     ("model", "name"): (None, "identifier of the model: `--model NAME`, the generated module and file names"),
     ("model", "title"): ('""', "one line for reports and `toolconf models`"),
     ("model", "source"): ('""', "where the equations come from"),
@@ -99,6 +104,9 @@ MEANING = {
     ("equilibrium", "q"): (None, "q^e, `model.dof` expressions; for `urdf`, within each joint's URDF limits"),
     ("equilibrium", "q_dot"): (None, "q_dot^e, `model.dof` expressions (zero at a rest equilibrium)"),
     ("equilibrium", "u"): (None, "U^e, `model.dof` expressions (zero for `urdf`: gravity is fed forward)"),
+    ("tip", "position"): (None, "3 expressions, the tip's x, y, z in the base frame (m), of the joint positions, "
+                                "the parameters and the constants (`\"0\"` for z of a planar arm)"),
+    ("tip", "source"): ('""', "where the geometry comes from"),
     ("printed", "where"): ('""', "where in the paper they are printed"),
     ("printed", "A"): ("none", "2n x 2n expressions"),
     ("printed", "B"): ("none", "2n x n expressions"),

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from .planar_chain import sympy_chain
+from .planar_chain import tip as planar_tip
 from .description import Model, Task, sensitivity, task_formula
 from .errors import DescriptionError
 from .expression import ExpressionError, sympy_expression
@@ -96,6 +97,9 @@ class Derivation:
     tasks: list[TaskDerivation]
     # T, V, M(q) and Q of a Lagrangian model (None for explicit equations of motion).
     lagrangian: dict | None = None
+    # The tip y(q; p) (3 x 1, base frame) and its Jacobian dy/dq (3 x n), if the model has one.
+    tip: sp.Matrix | None = None
+    tip_jacobian: sp.Matrix | None = None
 
     @property
     def x(self) -> list[sp.Symbol]:
@@ -165,7 +169,31 @@ def derive(model: Model, tasks: list[Task]) -> Derivation:
     derived_tasks = [derive_task(task, ns, model.dof) for task in tasks]
     for t in derived_tasks:
         t.logdet_gradient = logdet_gradient(t.confidence, params)
-    return Derivation(model, params, consts, q, q_dot, u, q_ddot, f, f_x, f_u, x_e, u_e, a, b, derived_tasks, lagrangian)
+    tip = derive_tip(model, symbols, q, params)
+    return Derivation(model, params, consts, q, q_dot, u, q_ddot, f, f_x, f_u, x_e, u_e, a, b, derived_tasks, lagrangian,
+                      tip, None if tip is None else tidy_matrix(tip.jacobian(q)))
+
+
+def derive_tip(model: Model, symbols: dict, q: list, params: list) -> sp.Matrix | None:
+    """The tip in the base frame: a planar chain's free end (x, y, 0), or an explicit model's
+    `[tip] position`, which may use the joint positions, the parameters and the constants."""
+    if model.dynamics_kind == "planar_chain":
+        lengths = [symbols[link["length"]] for link in model.links]
+        x, y = planar_tip(q, lengths, sp.sin, sp.cos)
+        return sp.Matrix([x, y, 0])
+    if model.tip is None:
+        return None
+    allowed = set(q) | set(params) | {s for s in symbols.values() if str(s) in {c.name for c in model.constants}}
+    entries = []
+    for i, text in enumerate(model.tip):
+        key = f"tip.position[{i}]"
+        e = parse(model, text, symbols, key)
+        extra = sorted(str(s) for s in e.free_symbols - allowed)
+        if extra:
+            raise DescriptionError(model.path, key, f"'{text}' uses {', '.join(extra)}: the tip depends on the joint "
+                                                    "positions, the parameters and the constants only")
+        entries.append(e)
+    return sp.Matrix(entries)
 
 
 def equilibrium(model: Model) -> tuple[sp.Matrix, sp.Matrix]:

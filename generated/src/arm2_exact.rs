@@ -1143,3 +1143,38 @@ pub fn acceleration_logdet_gradient(
     let gradient = <SVector<f64, 4>>::zeros();
     gradient
 }
+
+/// The tip y(q; p) in the base frame (the chain's free end; z = 0 in the plane of a planar arm) and its Jacobian J = dy/dq.
+///
+/// From forward kinematics of the tip.
+///
+/// - `q`: joint positions q = `[theta1 theta2]`
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
+///
+/// Cost per call: 8 operations, weighted 8 (2 ADD, 4 MUL, 2 NEG), plus 2 `sin_cos`.
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip(q: &SVector<f64, 2>, params: &SVector<f64, 4>) -> (SVector<f64, 3>, SMatrix<f64, 3, 2>) {
+    let theta1 = q[0];
+    let theta2 = q[1];
+    let l1 = params[2];
+    let l2 = params[3];
+    let (sin_theta1, cos_theta1) = crate::trig::sin_cos(theta1);
+    let (sin_theta2, cos_theta2) = crate::trig::sin_cos(theta2);
+    let t0 = cos_theta1 * l1;
+    let t1 = cos_theta2 * l2;
+    let t2 = l1 * sin_theta1;
+    let t3 = l2 * sin_theta2;
+    // y (m, base frame)
+    let mut position = <SVector<f64, 3>>::zeros();
+    position[0] = t0 + t1;
+    position[1] = t2 + t3;
+    // J = dy/dq
+    let mut jacobian = <SMatrix<f64, 3, 2>>::zeros();
+    jacobian[(0, 0)] = -t2;
+    jacobian[(0, 1)] = -t3;
+    jacobian[(1, 0)] = t0;
+    jacobian[(1, 1)] = t1;
+    (position, jacobian)
+}

@@ -2072,3 +2072,45 @@ pub fn acceleration_logdet_gradient(
     let gradient = <SVector<f64, 6>>::zeros();
     gradient
 }
+
+/// The tip y(q; p) in the base frame (the chain's free end; z = 0 in the plane of a planar arm) and its Jacobian J = dy/dq.
+///
+/// From forward kinematics of the tip.
+///
+/// - `q`: joint positions q = `[theta1 theta2 theta3]`
+/// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
+///
+/// Cost per call: 13 operations, weighted 13 (4 ADD, 6 MUL, 3 NEG), plus 3 `sin_cos`.
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip(q: &SVector<f64, 3>, params: &SVector<f64, 6>) -> (SVector<f64, 3>, SMatrix<f64, 3, 3>) {
+    let theta1 = q[0];
+    let theta2 = q[1];
+    let theta3 = q[2];
+    let l1 = params[3];
+    let l2 = params[4];
+    let l3 = params[5];
+    let (sin_theta1, cos_theta1) = crate::trig::sin_cos(theta1);
+    let (sin_theta2, cos_theta2) = crate::trig::sin_cos(theta2);
+    let (sin_theta3, cos_theta3) = crate::trig::sin_cos(theta3);
+    let t0 = cos_theta1 * l1;
+    let t1 = cos_theta2 * l2;
+    let t2 = cos_theta3 * l3;
+    let t3 = l1 * sin_theta1;
+    let t4 = l2 * sin_theta2;
+    let t5 = l3 * sin_theta3;
+    // y (m, base frame)
+    let mut position = <SVector<f64, 3>>::zeros();
+    position[0] = t0 + t1 + t2;
+    position[1] = t3 + t4 + t5;
+    // J = dy/dq
+    let mut jacobian = <SMatrix<f64, 3, 3>>::zeros();
+    jacobian[(0, 0)] = -t3;
+    jacobian[(0, 1)] = -t4;
+    jacobian[(0, 2)] = -t5;
+    jacobian[(1, 0)] = t0;
+    jacobian[(1, 1)] = t1;
+    jacobian[(1, 2)] = t2;
+    (position, jacobian)
+}

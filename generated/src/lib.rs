@@ -74,8 +74,7 @@ pub mod tip {
         q: &SVector<f64, { crate::arm2::DOF }>,
         params: &SVector<f64, { crate::arm2::PARAMETER_COUNT }>,
     ) -> Option<(SVector<f64, 3>, SMatrix<f64, 3, { crate::arm2::DOF }>)> {
-        let _ = (q, params);
-        None
+        Some(crate::arm2::tip(q, params))
     }
 
     /// `arm2_exact`'s tip.
@@ -85,8 +84,7 @@ pub mod tip {
         q: &SVector<f64, { crate::arm2_exact::DOF }>,
         params: &SVector<f64, { crate::arm2_exact::PARAMETER_COUNT }>,
     ) -> Option<(SVector<f64, 3>, SMatrix<f64, 3, { crate::arm2_exact::DOF }>)> {
-        let _ = (q, params);
-        None
+        Some(crate::arm2_exact::tip(q, params))
     }
 
     /// `arm2_payload`'s tip.
@@ -99,8 +97,7 @@ pub mod tip {
         SVector<f64, 3>,
         SMatrix<f64, 3, { crate::arm2_payload::DOF }>,
     )> {
-        let _ = (q, params);
-        None
+        Some(crate::arm2_payload::tip(q, params))
     }
 
     /// `arm3`'s tip.
@@ -110,8 +107,7 @@ pub mod tip {
         q: &SVector<f64, { crate::arm3::DOF }>,
         params: &SVector<f64, { crate::arm3::PARAMETER_COUNT }>,
     ) -> Option<(SVector<f64, 3>, SMatrix<f64, 3, { crate::arm3::DOF }>)> {
-        let _ = (q, params);
-        None
+        Some(crate::arm3::tip(q, params))
     }
 
     /// `msd`'s tip.
@@ -239,7 +235,7 @@ pub static MODELS: [ModelInfo; 7] = [
         sample: &validity::arm2::RULE.sample,
         defaults: &validity::arm2::RULE.defaults,
         inertia: validity::arm2::RULE.inertia,
-        has_tip: false,
+        has_tip: true,
         equilibrium_state: &arm2::EQUILIBRIUM_STATE,
         equilibrium_control: &arm2::EQUILIBRIUM_CONTROL,
         tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
@@ -259,7 +255,7 @@ pub static MODELS: [ModelInfo; 7] = [
         sample: &validity::arm2_exact::RULE.sample,
         defaults: &validity::arm2_exact::RULE.defaults,
         inertia: validity::arm2_exact::RULE.inertia,
-        has_tip: false,
+        has_tip: true,
         equilibrium_state: &arm2_exact::EQUILIBRIUM_STATE,
         equilibrium_control: &arm2_exact::EQUILIBRIUM_CONTROL,
         tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
@@ -279,7 +275,7 @@ pub static MODELS: [ModelInfo; 7] = [
         sample: &validity::arm2_payload::RULE.sample,
         defaults: &validity::arm2_payload::RULE.defaults,
         inertia: validity::arm2_payload::RULE.inertia,
-        has_tip: false,
+        has_tip: true,
         equilibrium_state: &arm2_payload::EQUILIBRIUM_STATE,
         equilibrium_control: &arm2_payload::EQUILIBRIUM_CONTROL,
         tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
@@ -299,7 +295,7 @@ pub static MODELS: [ModelInfo; 7] = [
         sample: &validity::arm3::RULE.sample,
         defaults: &validity::arm3::RULE.defaults,
         inertia: validity::arm3::RULE.inertia,
-        has_tip: false,
+        has_tip: true,
         equilibrium_state: &arm3::EQUILIBRIUM_STATE,
         equilibrium_control: &arm3::EQUILIBRIUM_CONTROL,
         tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],

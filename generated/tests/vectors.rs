@@ -200,13 +200,17 @@ mod arm2 {
                 );
                 vec![("gradient", rows(&gradient))]
             }
+            "tip" => {
+                let (position, jacobian) = m::tip(&input(i, "q"), &input(i, "params"));
+                vec![("position", rows(&position)), ("jacobian", rows(&jacobian))]
+            }
             _ => return None,
         })
     }
 
     #[test]
     fn functions_match_casadi_vectors() {
-        check("arm2", 13, evaluate);
+        check("arm2", 14, evaluate);
     }
 }
 
@@ -308,13 +312,17 @@ mod arm2_exact {
                 );
                 vec![("gradient", rows(&gradient))]
             }
+            "tip" => {
+                let (position, jacobian) = m::tip(&input(i, "q"), &input(i, "params"));
+                vec![("position", rows(&position)), ("jacobian", rows(&jacobian))]
+            }
             _ => return None,
         })
     }
 
     #[test]
     fn functions_match_casadi_vectors() {
-        check("arm2_exact", 13, evaluate);
+        check("arm2_exact", 14, evaluate);
     }
 }
 
@@ -416,13 +424,17 @@ mod arm2_payload {
                 );
                 vec![("gradient", rows(&gradient))]
             }
+            "tip" => {
+                let (position, jacobian) = m::tip(&input(i, "q"), &input(i, "params"));
+                vec![("position", rows(&position)), ("jacobian", rows(&jacobian))]
+            }
             _ => return None,
         })
     }
 
     #[test]
     fn functions_match_casadi_vectors() {
-        check("arm2_payload", 13, evaluate);
+        check("arm2_payload", 14, evaluate);
     }
 }
 
@@ -524,13 +536,17 @@ mod arm3 {
                 );
                 vec![("gradient", rows(&gradient))]
             }
+            "tip" => {
+                let (position, jacobian) = m::tip(&input(i, "q"), &input(i, "params"));
+                vec![("position", rows(&position)), ("jacobian", rows(&jacobian))]
+            }
             _ => return None,
         })
     }
 
     #[test]
     fn functions_match_casadi_vectors() {
-        check("arm3", 13, evaluate);
+        check("arm3", 14, evaluate);
     }
 }
 

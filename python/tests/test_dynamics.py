@@ -217,6 +217,32 @@ def test_an_inertia_tensor_that_is_no_rigid_body_is_refused():
         toolconf.dynamics("panda", bad, np.zeros(14), np.zeros(7))
 
 
+def test_planar_tips_are_the_end_of_the_last_link():
+    """arm2's tip (its description's [tip], the paper's absolute angles) equals the closed form
+    y = Σ l_i (cos θ_i, sin θ_i, 0) and arm2_exact's (the planar chain's free end, derived from its
+    links); arm3's likewise; J = ∂y/∂q in closed form (column i: l_i (−sin θ_i, cos θ_i, 0))."""
+    rng = np.random.default_rng(37)
+    for name in ("arm2", "arm2_exact", "arm3"):
+        info = toolconf.models()[name]
+        assert info["has_tip"]
+        n, k = info["dof"], len(info["parameters"])
+        for _ in range(20):
+            params = rng.uniform(0.1, 0.6, k)
+            q = rng.uniform(-math.pi, math.pi, n)
+            lengths = [params[info["parameters"].index(f"l{i + 1}")] for i in range(n)]
+            want = np.array([sum(l * math.cos(t) for l, t in zip(lengths, q)),
+                             sum(l * math.sin(t) for l, t in zip(lengths, q)), 0.0])
+            jac = np.array([[-l * math.sin(t) for l, t in zip(lengths, q)],
+                            [l * math.cos(t) for l, t in zip(lengths, q)], [0.0] * n])
+            got = toolconf.tip(name, params, q)
+            np.testing.assert_allclose(got["position"], want, rtol=0, atol=1e-15)
+            np.testing.assert_allclose(got["jacobian"], jac, rtol=0, atol=1e-15)
+    # The paper's arm hangs at its equilibrium: the tip straight below the base.
+    p = [0.3, 0.4, 0.5, 0.2]
+    eq = toolconf.models()["arm2"]["equilibrium"]["q"]
+    np.testing.assert_allclose(toolconf.tip("arm2", p, eq)["position"], [0.0, -0.7, 0.0], atol=1e-15)
+
+
 def test_a_model_without_a_tip_says_so():
     with pytest.raises(ValueError, match="model msd has no tip"):
         toolconf.tip("msd", [1.0] * len(toolconf.models()["msd"]["parameters"]), [0.0])
