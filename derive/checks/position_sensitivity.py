@@ -39,6 +39,7 @@ HERE = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(HERE))
 
 from toolconf_derive.description import load_model, load_tasks  # noqa: E402
+from toolconf_derive.numeric import CasadiModel  # noqa: E402
 from toolconf_derive.symbolic import parse  # noqa: E402
 from toolconf_derive.urdf_model import UrdfDerivation, _sample_tool  # noqa: E402
 
@@ -87,7 +88,6 @@ class SymbolicPlant:
     A and B by AD at the equilibrium, and tools drawn from the paper's box [0.1, 0.6]^k."""
 
     def __init__(self, model):
-        from toolconf_derive.numeric import CasadiModel
         self.cm = CasadiModel(model)
         self.n = model.dof
         self.x_e = self.cm.x_e
