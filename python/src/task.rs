@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use toolconf::bounded_read::read_text_file;
-use toolconf::display::Clip;
+use toolconf::display::{Clip, ClipPath};
 use toolconf::task_file::TaskSpec;
 use toolconf::TaskKind;
 
@@ -98,7 +98,7 @@ fn named(name: &Path, episode: Option<toml::Table>) -> Result<TaskSpec, Failure>
     if std::fs::metadata(name).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound) {
         return Err(Failure::Input(format!(
             "task '{}': neither a built-in task ({}) nor an existing task file",
-            Clip(&name.display().to_string()),
+            ClipPath(&name.to_string_lossy()),
             toolconf::task::task_choices()
         )));
     }

@@ -63,6 +63,27 @@ pub struct Clip<'a>(pub &'a str);
 /// Another crate's message, clipped as [`Clip`] is but at [`CLIP_MESSAGE_CHARS`].
 pub struct ClipMessage<'a>(pub &'a str);
 
+/// The most characters of a file's path a message repeats: any real path (Linux's PATH_MAX is
+/// 4096 bytes) fits, a hostile argument does not.
+pub const CLIP_PATH_CHARS: usize = 4096;
+
+/// A file's path as a message names it: whole, control characters escaped as [`Clip`] does; a
+/// longer one keeps its last [`CLIP_PATH_CHARS`] characters, so the file's own name is always
+/// there, whatever folder it sits in.
+pub struct ClipPath<'a>(pub &'a str);
+
+impl fmt::Display for ClipPath<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let total = self.0.chars().count();
+        let skip = total.saturating_sub(CLIP_PATH_CHARS);
+        if skip > 0 {
+            write!(f, "… ({total} characters) ")?;
+        }
+        let tail: String = self.0.chars().skip(skip).collect();
+        clip(f, &tail, usize::MAX)
+    }
+}
+
 impl fmt::Display for Clip<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         clip(f, self.0, CLIP_CHARS)
@@ -135,5 +156,16 @@ mod tests {
         // Escapes count as what they show: never more than CLIP_CHARS of message.
         let zeros = Clip(&"\0".repeat(100)).to_string();
         assert!(zeros.chars().count() <= CLIP_CHARS + 20, "{zeros}");
+    }
+
+    #[test]
+    fn a_path_keeps_its_file_name_however_deep() {
+        let deep = format!("/{}/panda.urdf", "d".repeat(200));
+        assert_eq!(ClipPath(&deep).to_string(), deep);
+        let hostile = format!("/{}/panda.urdf", "d".repeat(10_000));
+        let shown = ClipPath(&hostile).to_string();
+        assert!(shown.ends_with("/panda.urdf"), "{shown}");
+        assert!(shown.starts_with("… (10012 characters) "), "{shown}");
+        assert_eq!(ClipPath("a\nb.urdf").to_string(), "a\\nb.urdf");
     }
 }

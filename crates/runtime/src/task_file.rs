@@ -33,7 +33,7 @@ use nalgebra::{DMatrix, SMatrix, SVector};
 use serde::Deserialize;
 
 use crate::bounded_read::read_text_file;
-use crate::display::{Clip, ClipMessage, Short, ShortList, ShortRows as Rows};
+use crate::display::{Clip, ClipMessage, ClipPath, Short, ShortList, ShortRows as Rows};
 use crate::generated::TERMS;
 use crate::model::closed_loop_n::check_grid;
 use crate::model::{ArmModel, EpisodeOptionsN, TaskN};
@@ -233,7 +233,7 @@ impl TaskSpec {
 
     /// Reads and checks a task file.
     pub fn from_file(path: &Path) -> Result<Self, TaskFileError> {
-        let file = path.display().to_string();
+        let file = ClipPath(&path.to_string_lossy()).to_string();
         let text = read_text_file(path, "task file").map_err(|message| TaskFileError {
             file: file.clone(),
             place: String::new(),

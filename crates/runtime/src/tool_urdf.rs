@@ -49,7 +49,7 @@ use std::path::Path;
 
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 
-use crate::display::{Clip, ClipMessage, Short};
+use crate::display::{Clip, ClipMessage, ClipPath, Short};
 
 /// The largest URDF read: a tool's description is kilobytes (the Panda's with its hand is
 /// 15 kB); a whole robot's with inline comments rarely reaches a megabyte.
@@ -172,7 +172,7 @@ impl UrdfTool {
         let links: Vec<String> = self.links.iter().map(|l| Clip(l).to_string()).collect();
         format!(
             "from {}: links {} merged{opening} ({held}); tip {}, in the frame of {}",
-            Clip(file),
+            ClipPath(file),
             links.join(", "),
             Clip(&request.tip),
             Clip(&self.flange),
@@ -258,7 +258,7 @@ impl std::error::Error for UrdfToolError {}
 
 /// Reads the URDF at `path` (at most [`MAX_URDF_BYTES`], UTF-8) and merges the tool.
 pub fn tool_from_urdf_file(path: &Path, request: &Request) -> Result<UrdfTool, UrdfToolError> {
-    let file = Clip(&path.to_string_lossy()).to_string();
+    let file = ClipPath(&path.to_string_lossy()).to_string();
     let fail = |message: String| UrdfToolError {
         file: file.clone(),
         line: None,
@@ -285,7 +285,7 @@ pub fn tool_from_urdf_file(path: &Path, request: &Request) -> Result<UrdfTool, U
             e.utf8_error().valid_up_to()
         ))
     })?;
-    tool_from_urdf(&text, &file, request)
+    tool_from_urdf(&text, &path.to_string_lossy(), request)
 }
 
 /// Merges the tool from a URDF's text; `file` names it in errors.
@@ -294,7 +294,7 @@ pub fn tool_from_urdf(
     file: &str,
     request: &Request,
 ) -> Result<UrdfTool, UrdfToolError> {
-    let file = Clip(file).to_string();
+    let file = ClipPath(file).to_string();
     let options = roxmltree::ParsingOptions {
         allow_dtd: false,
         nodes_limit: MAX_XML_NODES,

@@ -30,7 +30,7 @@ use serde::{Deserialize, Deserializer};
 use serde_json::{Map, Value};
 
 use crate::bounded_read::{record_error, CsvRows, JsonElements, RecordLimit};
-use crate::display::{Clip, ClipMessage, Short};
+use crate::display::{Clip, ClipMessage, ClipPath, Short};
 use crate::registry::{AnyTool, ModelKind};
 
 /// One tool read from a file.
@@ -78,7 +78,7 @@ pub fn read_tools(
     path: &Path,
     each: impl FnMut(Result<ToolRow, ToolFileError>) -> Result<(), ToolFileError>,
 ) -> Result<usize, ToolFileError> {
-    let file_name = path.display().to_string();
+    let file_name = ClipPath(&path.to_string_lossy()).to_string();
     let fatal = |message: String| ToolFileError {
         file: file_name.clone(),
         place: String::new(),

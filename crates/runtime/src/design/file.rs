@@ -25,7 +25,7 @@ use serde::Deserialize;
 
 use super::constraint::{parse_constraint, LinearConstraint};
 use super::DesignError;
-use crate::display::{Clip, ClipMessage, ShortList};
+use crate::display::{Clip, ClipMessage, ClipPath, ShortList};
 use crate::generated::validity::ParameterDomain;
 use crate::registry::ModelKind;
 
@@ -110,7 +110,7 @@ struct RawSearch {
 impl DesignSpec {
     /// Reads and checks a design file for a tool of `model`.
     pub fn from_file(path: &Path, model: ModelKind) -> Result<Self, DesignError> {
-        let file = path.display().to_string();
+        let file = ClipPath(&path.to_string_lossy()).to_string();
         let text = crate::bounded_read::read_text_file(path, "design file")
             .map_err(|message| DesignError::input(&file, "", message))?;
         Self::parse(&text, &file, model)
