@@ -30,7 +30,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "derive"))
-from toolconf_derive.description import load_model, load_tasks  # noqa: E402
+from toolconf_derive.description import check_tasks, load_model, load_tasks  # noqa: E402
 from toolconf_derive.errors import DescriptionError  # noqa: E402
 from toolconf_derive.reference import description_reference  # noqa: E402
 
@@ -97,13 +97,17 @@ def validate_all(runs: list[Run]) -> None:
     of derivation (the checks of description.py; what only the derivation can find, such as an
     equilibrium residual, is reported as soon as that model's derivation stops)."""
     problems = []
+    tasks = None
     try:
-        load_tasks(ROOT / "derive" / "tasks.toml")
+        tasks = load_tasks(ROOT / "derive" / "tasks.toml")
     except DescriptionError as err:
         problems.append(str(err))
     for model in sorted({job[0] for run in runs for job in run.jobs()}):
         try:
-            load_model(model)
+            # Its goals and [formulation] against the tasks too, where the task file could be read.
+            description = load_model(model)
+            if tasks is not None:
+                check_tasks(description, tasks)
         except DescriptionError as err:
             problems.append(str(err))
     for p in problems:

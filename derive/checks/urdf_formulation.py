@@ -41,7 +41,9 @@ def logdets(task, a, b, n):
 
 def main() -> int:
     model = load_model(Path(sys.argv[1]))
-    tasks = load_tasks(HERE / "tasks.toml")
+    # The joint tasks, on the paper's formulas: the formulations of the plant are compared on them
+    # (the tip tasks' J is the same for both plants).
+    tasks = [t for t in load_tasks(HERE / "tasks.toml") if not any(t.term(x).on_tip for x in t.terms)]
     dv = UrdfDerivation(model, model.chain, tasks)
     n = dv.n
     k, d = np.diag(dv.stiffness), np.diag(dv.damping)

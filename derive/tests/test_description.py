@@ -55,17 +55,71 @@ class BrokenDescription(unittest.TestCase):
         r, _, path = self.derive(tasks=tasks)
         self.assert_stops(r, path, key, problem)
 
-    # [tip]: three expressions of q, the parameters and the constants, for kind explicit only.
+    # [tip]: three expressions of q, the parameters and the constants, required for kind explicit
+    # (the tip terms read it), its components at most model.dof.
+    TIP = 'position = ["l*cos(theta)", "l*sin(theta)", "0"]'
+
     def test_tip_needs_three_entries(self):
-        self.model_stops(PENDULUM + '\n[tip]\nposition = ["l*sin(theta)", "-l*cos(theta)"]\n', "tip.position",
+        self.model_stops(edit(PENDULUM, self.TIP, 'position = ["l*sin(theta)", "-l*cos(theta)"]'), "tip.position",
                          "has 2 entries, need 3")
 
     def test_tip_may_not_use_rates_or_controls(self):
-        self.model_stops(PENDULUM + '\n[tip]\nposition = ["l*sin(theta)", "theta_dot", "0"]\n', "tip.position[1]",
+        self.model_stops(edit(PENDULUM, self.TIP, 'position = ["l*sin(theta)", "theta_dot", "0"]'), "tip.position[1]",
                          "uses theta_dot")
 
     def test_tip_names_an_unknown_symbol(self):
-        self.model_stops(PENDULUM + '\n[tip]\nposition = ["l*sin(phi)", "0", "0"]\n', "tip.position[0]", "phi")
+        self.model_stops(edit(PENDULUM, self.TIP, 'position = ["l*sin(phi)", "0", "0"]'), "tip.position[0]", "phi")
+
+    def test_an_explicit_model_without_a_tip(self):
+        text = edit(edit(PENDULUM, "[tip]\n" + self.TIP + "\n", ""), "components = 1\n", "")
+        self.model_stops(text, "tip", "missing (required for dynamics.kind = 'explicit'): the tip terms of "
+                                      "derive/tasks.toml (tip, tip_dot) read the tip's position")
+
+    def test_more_tip_components_than_joints(self):
+        # A tip term's vectors are stored in the joints' slots: one joint holds one component.
+        self.model_stops(edit(PENDULUM, "\ncomponents = 1", "\ncomponents = 2"), "tip.components",
+                         "is 2, more than the model's 1 joint(s)")
+        self.model_stops(edit(PENDULUM, "\ncomponents = 1", "\ncomponents = 4"), "tip.components", "must be 1, 2 or 3")
+
+    def test_a_tip_goal_of_the_wrong_length(self):
+        self.model_stops(PENDULUM + '\n[goals.tip_position]\ntip = ["0.1", "0"]\n', "goals.tip_position.tip",
+                         "has 2 entries, the tip's components (TIP_DIM) is 1")
+        self.model_stops(PENDULUM + '\n[goals.tip_velocity]\ntip_dot = []\n', "goals.tip_velocity.tip_dot",
+                         "has 0 entries, the tip's components (TIP_DIM) is 1")
+
+    # [formulation]: a task of tasks.toml = one of its formulations, or "paper".
+    def test_an_unknown_formulation(self):
+        self.model_stops(PENDULUM + '\n[formulation]\nposition = "magic"\n', "formulation.position",
+                         "'magic' is not a formulation of task 'position' (known: paper, static_gain)")
+        self.model_stops(PENDULUM + '\n[formulation]\nposture = "paper"\n', "formulation.posture",
+                         "no task is named 'posture'")
+        self.model_stops(PENDULUM + '\n[formulation]\nvelocity = 2\n', "formulation.velocity", "must be a string")
+
+    def test_a_formulation_chosen_by_the_description_is_derived(self):
+        from toolconf_derive.description import load_model, load_tasks, model_tasks
+        path = Path(self.enterContext(tempfile.TemporaryDirectory())) / "p.toml"
+        path.write_text(PENDULUM + '\n[formulation]\ntip_position = "static_gain"\nposition = "paper"\n')
+        tasks = {t.name: t for t in model_tasks(load_model(path), load_tasks(ROOT / "derive" / "tasks.toml"))}
+        self.assertEqual((tasks["tip_position"].formulation, tasks["tip_position"].chosen_by),
+                         ("static_gain", "description"))
+        self.assertEqual(tasks["tip_position"].sensitivity["tip"], "-J @ IO @ inv(A) @ B")
+        self.assertEqual((tasks["position"].formulation, tasks["position"].chosen_by), ("paper", "description"))
+        self.assertEqual(tasks["position"].sensitivity["theta"], "IO @ inv(A) @ (E - B)")
+        self.assertEqual((tasks["velocity"].formulation, tasks["velocity"].chosen_by), ("paper", "default"))
+
+    def test_a_formulation_in_tasks_toml(self):
+        head = '[task.formulations.static_gain]\ndoc = """The stabilised'
+        self.tasks_stop(edit(TASKS, 'default_for = ["urdf"]\nsensitivity.theta =', 'default_for = ["ode"]\nsensitivity.theta ='),
+                        "task[0].formulations.static_gain.default_for[0]", "'ode' is not a dynamics kind")
+        self.tasks_stop(edit(TASKS, 'sensitivity.theta_ddot = "I"\n\n[[task]]', 'sensitivity.jerk = "I"\n\n[[task]]'),
+                        "task[0].formulations.static_gain.sensitivity.jerk", "unknown key")
+        self.tasks_stop(edit(TASKS, head, head.replace("static_gain", "paper")), "task[0].formulations.paper",
+                        "'paper' names the task's own sensitivity formulas")
+        self.tasks_stop(edit(TASKS, 'sensitivity.theta = "-IO @ inv(A) @ B"', 'sensitivity.theta = "-IO @ inv(A) @ K"'),
+                        "task[0].formulations.static_gain.sensitivity.theta", "'K' is not defined")
+        twice = head + '"""\ndefault_for = ["urdf"]\nsensitivity.theta = "I"\n\n[task.formulations.other]\ndoc = """The stabilised'
+        self.tasks_stop(edit(TASKS, head, twice), "task[0].formulations.other.default_for[0]",
+                        "'urdf' already has formulation 'static_gain' by default")
 
     # Unknown keys, in every kind of table (a misspelt key must not be silently ignored).
     def test_unknown_top_level_table(self):

@@ -129,8 +129,9 @@ class Reads(unittest.TestCase):
         a, b = rng.normal(size=(2 * n, 2 * n)), rng.normal(size=(2 * n, n))
         eye, zero = np.eye(n), np.zeros((n, n))
         io, oi, e = np.hstack([eye, zero]), np.hstack([zero, eye]), np.vstack([eye, eye])
+        j = np.vstack([rng.normal(size=(1, n)), np.zeros((1, n))])   # a tip of one component, padded
         ns = {"A": a, "B": b, "inv": np.linalg.inv, "I": eye, "O": zero, "IO": io, "OI": oi, "E": e,
-              "dX_dU": np.linalg.inv(a) @ (e - b)}
+              "dX_dU": np.linalg.inv(a) @ (e - b), "J": j}
         self.assertEqual(sorted(k for k in ns if k != "inv"), sorted(FORMULA_NAMES))
         tasks = {t.name: t for t in load_tasks(ROOT / "derive" / "tasks.toml")}
         inv = np.linalg.inv
@@ -140,10 +141,26 @@ class Reads(unittest.TestCase):
             ("position", "theta_ddot"): eye,
             ("velocity", "theta_dot"): -(io @ inv(a) @ b),
             ("acceleration", "theta_ddot"): io @ (a @ a @ (inv(a) @ (e - b)) + a @ b),
+            ("tip_position", "tip"): j @ io @ inv(a) @ (e - b),
+            ("tip_position", "tip_dot"): j @ oi @ inv(a) @ (e - b),
+            ("tip_velocity", "tip_dot"): -(j @ io @ inv(a) @ b),
         }
         for (task, term), value in want.items():
             with self.subTest(task=task, term=term):
                 got = task_formula(tasks[task], f"sensitivity.{term}", tasks[task].sensitivity[term], ns)
+                np.testing.assert_allclose(got, value, rtol=1e-12, atol=1e-12)
+        # The static gain (the URDF arms' default formulation of both position tasks).
+        static = {
+            ("position", "theta"): -(io @ inv(a) @ b),
+            ("position", "theta_dot"): -(oi @ inv(a) @ b),
+            ("position", "theta_ddot"): eye,
+            ("tip_position", "tip"): -(j @ io @ inv(a) @ b),
+            ("tip_position", "tip_dot"): -(j @ oi @ inv(a) @ b),
+        }
+        for (task, term), value in static.items():
+            with self.subTest(task=task, term=term, formulation="static_gain"):
+                text = tasks[task].formulations["static_gain"].sensitivity[term]
+                got = task_formula(tasks[task], f"formulations.static_gain.sensitivity.{term}", text, ns)
                 np.testing.assert_allclose(got, value, rtol=1e-12, atol=1e-12)
 
 

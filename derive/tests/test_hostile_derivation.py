@@ -26,19 +26,29 @@ TASKS = (ROOT / "derive" / "tasks.toml").read_text()
 SECONDS = 30
 KEY_EQ_Q = "equilibrium.q[0]"
 
+# Three joints (a URDF tool's tip has three components, which a tip term stores in the joints'
+# slots); each case breaks link a or joint j1.
 URDF = """<?xml version="1.0"?><robot name="test">
 <link name="base"/>
 <link name="a"><inertial><origin xyz="0 0 0.1" rpy="0 0 0"/><mass value="{mass}"/>
 <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="{izz}"/></inertial></link>
+<link name="b"><inertial><origin xyz="0 0 0.1" rpy="0 0 0"/><mass value="0.5"/>
+<inertia ixx="0.005" ixy="0" ixz="0" iyy="0.005" iyz="0" izz="0.005"/></inertial></link>
+<link name="c"><inertial><origin xyz="0 0 0.05" rpy="0 0 0"/><mass value="0.3"/>
+<inertia ixx="0.002" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="0.002"/></inertial></link>
 <link name="flange"/>
 <joint name="j1" type="revolute"><parent link="base"/><child link="a"/><origin xyz="{xyz}" rpy="0 0 0"/>
 <axis xyz="0 0 1"/></joint>
-<joint name="fix" type="fixed"><parent link="a"/><child link="flange"/><origin xyz="0 0 0.2" rpy="0 0 0"/></joint>
+<joint name="j2" type="revolute"><parent link="a"/><child link="b"/><origin xyz="0 0 0.2" rpy="0 0 0"/>
+<axis xyz="0 1 0"/></joint>
+<joint name="j3" type="revolute"><parent link="b"/><child link="c"/><origin xyz="0 0 0.2" rpy="0 0 0"/>
+<axis xyz="1 0 0"/></joint>
+<joint name="fix" type="fixed"><parent link="c"/><child link="flange"/><origin xyz="0 0 0.1" rpy="0 0 0"/></joint>
 </robot>"""
 URDF_MODEL = """
 [model]
-name = "one"
-dof = 1
+name = "three"
+dof = 3
 [dynamics]
 kind = "urdf"
 [urdf]
@@ -47,12 +57,12 @@ base = "base"
 flange = "flange"
 gravity = [0.0, 0.0, -9.81]
 [impedance]
-stiffness = [50.0]
-damping = [5.0]
+stiffness = [50.0, 50.0, 50.0]
+damping = [5.0, 5.0, 5.0]
 [equilibrium]
-q = ["0.3"]
-q_dot = ["{q_dot}"]
-u = ["{u}"]
+q = ["0.3", "0.2", "0.1"]
+q_dot = ["{q_dot}", "0", "0"]
+u = ["{u}", "0", "0"]
 """
 
 

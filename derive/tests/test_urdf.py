@@ -68,14 +68,16 @@ def _link(name, inertial=""):
     return f'<link name="{name}">{inertial}</link>'
 
 
+# Three joints: a URDF tool's tip has three components, which a tip term stores in the joints' slots.
 GOOD = [_link("base"), _link("a", _inertial(1.0, (0.0, 0.0, 0.1))), _link("b", _inertial(0.5, (0.0, 0.0, 0.1))),
-        _link("flange"), _joint("j1", "revolute", "base", "a"), _joint("j2", "revolute", "a", "b", "0 0 0.2", axis="0 1 0"),
-        _joint("fix", "fixed", "b", "flange", "0 0 0.2")]
+        _link("c", _inertial(0.3, (0.0, 0.0, 0.05))), _link("flange"), _joint("j1", "revolute", "base", "a"),
+        _joint("j2", "revolute", "a", "b", "0 0 0.2", axis="0 1 0"),
+        _joint("j3", "revolute", "b", "c", "0 0 0.2", axis="1 0 0"), _joint("fix", "fixed", "c", "flange", "0 0 0.2")]
 
 MODEL = """
 [model]
-name = "two"
-dof = 2
+name = "three"
+dof = 3
 [dynamics]
 kind = "urdf"
 [urdf]
@@ -84,12 +86,12 @@ base = "base"
 flange = "flange"
 gravity = [0.0, 0.0, -9.81]
 [impedance]
-stiffness = [{k1}, 50.0]
-damping = [5.0, 5.0]
+stiffness = [{k1}, 50.0, 50.0]
+damping = [5.0, 5.0, 5.0]
 [equilibrium]
-q = ["0", "0.3"]
-q_dot = ["0", "0"]
-u = ["0", "0"]
+q = ["0", "0.3", "0.2"]
+q_dot = ["0", "0", "0"]
+u = ["0", "0", "0"]
 """
 
 
@@ -100,8 +102,8 @@ class Refusals(unittest.TestCase):
     def derive(self, urdf: str, k1: str = "50.0", model: str = MODEL):
         tmp = Path(self.enterContext(tempfile.TemporaryDirectory()))
         (tmp / "robot.urdf").write_text(urdf)
-        (tmp / "two.toml").write_text(model.format(file="robot.urdf", k1=k1))
-        r = subprocess.run([sys.executable, str(DERIVE), str(tmp / "two.toml"), "--out", str(tmp / "two.json"),
+        (tmp / "three.toml").write_text(model.format(file="robot.urdf", k1=k1))
+        r = subprocess.run([sys.executable, str(DERIVE), str(tmp / "three.toml"), "--out", str(tmp / "three.json"),
                             "--vectors", "1"], capture_output=True, text=True)
         return r, tmp
 
@@ -111,10 +113,10 @@ class Refusals(unittest.TestCase):
         self.assertNotIn("Traceback", r.stderr)
         lines = r.stderr.splitlines()
         self.assertEqual(len(lines), 1, r.stderr)
-        file = tmp / ("two.toml" if in_model else "robot.urdf")
+        file = tmp / ("three.toml" if in_model else "robot.urdf")
         self.assertTrue(lines[0].startswith(f"derive: {file}: {where}"), lines[0])
         self.assertIn(problem, lines[0])
-        self.assertEqual(sorted(p.name for p in tmp.iterdir()), ["robot.urdf", "two.toml"], "nothing written")
+        self.assertEqual(sorted(p.name for p in tmp.iterdir()), ["robot.urdf", "three.toml"], "nothing written")
 
     def test_the_good_chain_derives(self):
         r, tmp = self.derive(_robot(*GOOD))
@@ -137,7 +139,7 @@ class Refusals(unittest.TestCase):
         self.stops(urdf, "joint 'jside'", "(prismatic) is a moving side branch at link 'base'")
         # Beyond the flange everything is dropped, moving or not (the tool replaces the hand).
         beyond = _robot(*GOOD, _link("finger", _inertial(0.2)), _joint("jf", "revolute", "flange", "finger"))
-        self.assertEqual(self.chain(beyond).dof, 2)
+        self.assertEqual(self.chain(beyond).dof, 3)
 
     def test_fixed_side_links_merge_but_a_fixed_side_link_with_a_moving_child_is_a_branch(self):
         merged = _robot(*GOOD, _link("cam", _inertial(0.2, (0.05, 0.0, 0.0))), _joint("jcam", "fixed", "a", "cam"))
@@ -179,7 +181,7 @@ class Refusals(unittest.TestCase):
     def test_flange_not_below_the_base_and_undefined_links(self):
         urdf = _robot(*GOOD, _link("elsewhere"))
         self.stops(urdf.replace('name="flange"/>', 'name="flange"/>', 1).replace(
-            _joint("fix", "fixed", "b", "flange", "0 0 0.2"), _joint("fix", "fixed", "elsewhere", "flange")),
+            _joint("fix", "fixed", "c", "flange", "0 0 0.2"), _joint("fix", "fixed", "elsewhere", "flange")),
             "link 'flange'", "is not below the base")
         self.stops(_robot(*GOOD).replace('<child link="flange"/>', '<child link="nowhere"/>'),
                    "joint 'fix'", "its child link 'nowhere' is not defined")
@@ -200,16 +202,29 @@ class Refusals(unittest.TestCase):
         # j1 turns about the vertical: gravity gives it no stiffness, so without K it has none.
         self.stops(_robot(*GOOD), "impedance.stiffness", "along joints j1", k1="0.0", in_model=True)
 
+    def test_fewer_joints_than_the_tip_has_components(self):
+        # A URDF tool's tip has 3 components, which a tip term stores in the joints' slots.
+        two = GOOD[:3] + [GOOD[4], GOOD[5], GOOD[6], _joint("fix", "fixed", "b", "flange", "0 0 0.2")]
+        model = (MODEL.replace("dof = 3", "dof = 2").replace("[{k1}, 50.0, 50.0]", "[{k1}, 50.0]")
+                 .replace("[5.0, 5.0, 5.0]", "[5.0, 5.0]").replace('["0", "0.3", "0.2"]', '["0", "0.3"]')
+                 .replace('["0", "0", "0"]', '["0", "0"]'))
+        r, tmp = self.derive(_robot(*two), model=model)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertEqual(r.stderr.splitlines(), [
+            f"derive: {tmp / 'three.toml'}: model.dof: is 2: model 'three' (dynamics.kind = 'urdf') has a tip of 3 "
+            "components (x, y, z of the tool's tip), more than its joints: a tip term's vectors are stored padded in "
+            "the joints' slots"])
+
     def test_description_keys(self):
         tmp = Path(self.enterContext(tempfile.TemporaryDirectory()))
         (tmp / "robot.urdf").write_text(_robot(*GOOD))
-        for text, key in ((MODEL.replace("dof = 2", "dof = 3"), "model.dof"),
-                          (MODEL.replace("damping = [5.0, 5.0]", "damping = [5.0]"), "impedance.damping"),
+        for text, key in ((MODEL.replace("dof = 3", "dof = 4"), "model.dof"),
+                          (MODEL.replace("damping = [5.0, 5.0, 5.0]", "damping = [5.0]"), "impedance.damping"),
                           (MODEL + '[[parameters]]\nname = "m"\n', "parameters"),
                           (MODEL.replace("gravity = [0.0, 0.0, -9.81]", "gravity = [0.0, -9.81]"), "urdf.gravity")):
-            (tmp / "two.toml").write_text(text.format(file="robot.urdf", k1="50.0"))
+            (tmp / "three.toml").write_text(text.format(file="robot.urdf", k1="50.0"))
             with self.assertRaises(DescriptionError) as caught:
-                load_model(tmp / "two.toml")
+                load_model(tmp / "three.toml")
             self.assertIn(f": {key}: ", str(caught.exception))
 
 

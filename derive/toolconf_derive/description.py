@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from .errors import DescriptionError
@@ -58,8 +58,13 @@ class Model:
     # None for the other kinds: their parameters are masses, lengths, ... (> 0, drawn from the
     # paper's [0.1, 0.6]), the renderer's default (derive/render).
     tool_rule: dict | None = None
-    # explicit: the tip's position (x, y, z) in the base frame as expressions ([tip] position).
+    # explicit: the tip's position (x, y, z) in the base frame as expressions ([tip] position), and
+    # how many of x, y, z the tip terms use ([tip] components).
     tip: list[str] | None = None
+    tip_components: int | None = None
+    # [formulation]: per task name, the formulation the description chooses ("paper" or a name of
+    # the task's [task.formulations]); a task it does not name takes its default (Task.formulation).
+    formulation: dict[str, str] = field(default_factory=dict)
 
     @property
     def state(self) -> list[Named]:
@@ -68,6 +73,13 @@ class Model:
     @property
     def state_dim(self) -> int:
         return 2 * self.dof
+
+    @property
+    def tip_dim(self) -> int:
+        """TIP_DIM, the components of the tip the tip terms use: x, y, z of a URDF arm's tool tip,
+        x, y of a planar chain's free end in its plane, the first [tip] components of an explicit
+        model's."""
+        return TIP_DIMS.get(self.dynamics_kind, self.tip_components)
 
 
 @dataclass(frozen=True)
@@ -79,8 +91,10 @@ class TermDef:
     doc: str
     label: str
     unit: str
-    # Where its value is read (READS): a block of n rows of the state X, of its rate X_dot, or the
-    # control U; a term read from the control has no sensitivity dU/dU to derive.
+    # Where its value is read (READS): a block of n rows of the state X, of its rate X_dot, the
+    # control U (a term read from the control has no sensitivity dU/dU to derive), or the tool's
+    # tip (`tip`, block = the order of the time derivative: y, y_dot), whose TIP_DIM components
+    # fill the first rows of the n.
     source: str
     block: int
     # The documented range (toolconf.ranges()) a goal of it lies in; None: it has no goal (the
@@ -91,12 +105,31 @@ class TermDef:
     def has_sensitivity(self) -> bool:
         return self.source != "control"
 
+    @property
+    def on_tip(self) -> bool:
+        """Whether it is read at the tool's tip: its goal has TIP_DIM entries."""
+        return self.source == "tip"
+
 
 @dataclass(frozen=True)
 class Remark:
     term: str
     alternative: str
     text: str
+
+
+# The formulation a task's own sensitivity formulas are: the paper's.
+PAPER = "paper"
+
+
+@dataclass(frozen=True)
+class Formulation:
+    """A named alternative to some of a task's sensitivity formulas ([task.formulations.<name>]),
+    the default of the models whose dynamics kind is in `default_for`."""
+    name: str
+    doc: str
+    default_for: tuple[str, ...]
+    sensitivity: dict[str, str]
 
 
 @dataclass(frozen=True)
@@ -118,6 +151,12 @@ class Task:
     # Where the task is defined, for messages: the file and its key (task[0]).
     path: Path | str = ""
     key: str = ""
+    # Its named formulations, and which one `sensitivity` is for the model it was resolved for
+    # (for_model): PAPER or a name of `formulations`, and why ("default", "default_for",
+    # "description").
+    formulations: dict[str, Formulation] = field(default_factory=dict)
+    formulation: str = PAPER
+    chosen_by: str = "default"
 
     @property
     def sensitivity_terms(self) -> list[str]:
@@ -164,8 +203,8 @@ class Task:
 RESERVED_MODEL_NAMES = ("lib", "mod", "powi", "rigid_body", "tasks", "trig", "validity")
 # The constants templates/model.rs.tera declares in every model's module (a test keeps the list
 # and the template in step); a description constant `g` becomes the Rust constant `G` beside them.
-MODULE_CONSTANTS = ("NAME", "DOF", "STATE_DIM", "PARAMETER_COUNT", "PARAMETER_NAMES", "PARAMETER_UNITS",
-                    "STATE_NAMES", "CONTROL_NAMES", "EQUILIBRIUM_STATE", "EQUILIBRIUM_CONTROL")
+MODULE_CONSTANTS = ("NAME", "DOF", "STATE_DIM", "TIP_DIM", "PARAMETER_COUNT", "PARAMETER_NAMES",
+                    "PARAMETER_UNITS", "STATE_NAMES", "CONTROL_NAMES", "EQUILIBRIUM_STATE", "EQUILIBRIUM_CONTROL")
 RUST_NAME = re.compile(r"[a-z][a-z0-9_]*")
 # Every edition's strict and reserved keywords (the Rust Reference, "Keywords"), which no
 # generated `let`, `fn` or `mod` may be named.
@@ -192,29 +231,38 @@ MODEL_KEYS = {
     "link": (("mass", "string", True), ("length", "string", True)),
     "equilibrium": (("q", "values", True), ("q_dot", "values", True), ("u", "values", True)),
     "printed": (("where", "string", False), ("A", "matrix", False), ("B", "matrix", False)),
-    "tip": (("position", "strings", True), ("source", "string", False)),
+    "tip": (("position", "strings", True), ("components", "integer", False), ("source", "string", False)),
     **URDF_KEYS,
 }
+# The dynamics kinds, and the tip dimension TIP_DIM of those whose tip is not described: a URDF
+# tool's tip moves in space, a planar chain's in its plane (an explicit model's: [tip] components).
+KINDS = ("explicit", "planar_chain", "urdf")
+TIP_DIMS = {"urdf": 3, "planar_chain": 2}
+# An explicit model's tip components when [tip] does not say: x, y and z.
+TIP_COMPONENTS = 3
 # parameters and coordinates are required except for kind "urdf", where the URDF and the tool
 # define them (urdf_description.urdf_names).
 TOP_KEYS = (("model", "table", True), ("parameters", "tables", False), ("constants", "table", False),
             ("coordinates", "table", False), ("dynamics", "table", True), ("equilibrium", "table", True),
             ("goals", "table", False), ("printed", "table", False), ("urdf", "table", False),
-            ("impedance", "table", False), ("tool", "table", False), ("tip", "table", False))
+            ("impedance", "table", False), ("tool", "table", False), ("tip", "table", False),
+            ("formulation", "table", False))
 TASK_KEYS = (("name", "string", True), ("index", "integer", True), ("title", "string", False),
              ("doc", "string", False), ("terms", "strings", True), ("error", "string", True),
              ("sensitivity", "table", True),
-             ("defaults", "table", False), ("remarks", "tables", False))
+             ("defaults", "table", False), ("remarks", "tables", False), ("formulations", "table", False))
+FORMULATION_KEYS = (("doc", "string", True), ("default_for", "strings", False), ("sensitivity", "table", True))
 DEFAULTS_KEYS = (("precision", "table", True),)
 REMARK_KEYS = (("term", "string", True), ("alternative", "string", True), ("text", "string", True))
 TERM_KEYS = (("name", "string", True), ("symbol", "string", True), ("latex", "string", True),
              ("doc", "string", True), ("label", "string", True), ("unit", "string", True), ("read", "string", True),
              ("goal_range", "string", False))
-# How a term's value is read, as tasks.toml writes it (white space aside): (source, block).
+# How a term's value is read, as tasks.toml writes it (white space aside): (source, block); for
+# the tip, block is the order of the derivative (y, then y_dot = J(q) q_dot).
 READS = {"IO @ X": ("state", 0), "OI @ X": ("state", 1), "IO @ X_dot": ("state_rate", 0),
-         "OI @ X_dot": ("state_rate", 1), "U": ("control", 0)}
+         "OI @ X_dot": ("state_rate", 1), "U": ("control", 0), "tip(q)": ("tip", 0), "J(q) @ q_dot": ("tip", 1)}
 # The documented ranges a goal may be checked against (crates/core/src/validate.rs).
-GOAL_RANGES = ("joint_angle", "joint_rate", "joint_acceleration")
+GOAL_RANGES = ("joint_angle", "joint_rate", "joint_acceleration", "tip_position", "tip_velocity")
 
 
 def _named(t: Table) -> Named:
@@ -247,7 +295,7 @@ def load_model(path: Path) -> Model:
     dyn = top.table("dynamics", MODEL_KEYS["dynamics"])
     eq = top.table("equilibrium", MODEL_KEYS["equilibrium"])
     printed = top.table("printed", MODEL_KEYS["printed"])
-    tip = _tip(path, top, dyn.get("kind"))
+    tip, components = _tip(path, top, dyn.get("kind"))
     if dyn.get("kind") == "urdf":
         parameters, q, q_dot, u, urdf = urdf_names(path, top)
     else:
@@ -286,26 +334,44 @@ def load_model(path: Path) -> Model:
         printed_a=printed.get("A"),
         printed_b=printed.get("B"),
         tip=tip,
+        tip_components=components,
+        formulation=_formulation(top),
         **urdf,
     )
     _validate_model(model)
     return model
 
 
-def _tip(path: Path, top: Table, kind: str) -> list[str] | None:
+def _tip(path: Path, top: Table, kind: str) -> tuple[list[str] | None, int | None]:
     """`[tip] position`: the tip's (x, y, z) in the base frame as expressions of q and the
-    parameters, for kind `explicit`. A `planar_chain`'s tip is its chain's free end and a `urdf`
-    tool's its tool_tip_x/y/z, so neither takes the table."""
+    parameters, and `components`, how many of x, y, z the tip terms use, for kind `explicit`,
+    which must have one: tasks.toml's tip terms read it. A `planar_chain`'s tip is its chain's free
+    end and a `urdf` tool's its tool_tip_x/y/z, so neither takes the table."""
     if "tip" not in top.raw:
-        return None
+        if kind == "explicit":
+            raise DescriptionError(path, "tip", "missing (required for dynamics.kind = 'explicit'): the tip terms of "
+                                                "derive/tasks.toml (tip, tip_dot) read the tip's position; give "
+                                                "[tip] position = [x, y, z] and components")
+        return None, None
     if kind != "explicit":
         where = "the chain's free end" if kind == "planar_chain" else "the tool's tool_tip_x/y/z"
         raise DescriptionError(path, "tip", f"only for dynamics.kind = 'explicit': a {kind} model's tip is {where}")
-    position = [str(v) for v in top.table("tip", MODEL_KEYS["tip"]).get("position")]
+    table = top.table("tip", MODEL_KEYS["tip"])
+    position = [str(v) for v in table.get("position")]
     if len(position) != 3:
         raise DescriptionError(path, "tip.position", f"has {len(position)} entries, need 3: x, y, z in the base "
                                                      "frame (z = \"0\" for a planar arm)")
-    return position
+    components = table.get("components", TIP_COMPONENTS)
+    if not 1 <= components <= 3:
+        raise DescriptionError(path, "tip.components", f"is {components}, must be 1, 2 or 3: the first components "
+                                                       "of the tip's x, y, z that the tip terms use")
+    return position, components
+
+
+def _formulation(top: Table) -> dict[str, str]:
+    """`[formulation]`: task name = formulation name (checked against the tasks by check_tasks)."""
+    table = top.table("formulation", tuple((k, "string", True) for k in top.get("formulation", {})))
+    return dict(table.raw)
 
 
 def _check_identifier(name: str, path: Path, key: str) -> None:
@@ -368,13 +434,26 @@ def _validate_shapes(m: Model) -> None:
                      ("equilibrium.q", m.equilibrium_q), ("equilibrium.q_dot", m.equilibrium_q_dot),
                      ("equilibrium.u", m.equilibrium_u)):
         _check_length(path, key, seq, n, "model.dof")
-    for task, terms in m.goals.items():
-        for term, values in terms.items():
-            _check_length(path, f"goals.{task}.{term}", values, n, "model.dof")
     for label, matrix, cols in (("A", m.printed_a, n2), ("B", m.printed_b, n)):
         if matrix is not None and (len(matrix) != n2 or any(len(r) != cols for r in matrix)):
             shape = f"{len(matrix)} rows of {sorted({len(r) for r in matrix})} entries"
             raise DescriptionError(path, f"printed.{label}", f"must be {n2}x{cols} for model.dof = {n}, got {shape}")
+
+
+def _validate_tip(m: Model) -> None:
+    """TIP_DIM <= n: a tip term's vectors and matrices are stored in the joints' n slots."""
+    if m.dynamics_kind not in KINDS or m.tip_dim <= m.dof:
+        return
+    if m.dynamics_kind == "explicit":
+        raise DescriptionError(m.path, "tip.components", f"is {m.tip_dim}, more than the model's {m.dof} "
+                                                         "joint(s): a tip term's vectors are stored padded in the "
+                                                         "joints' slots, so the tip may use at most model.dof "
+                                                         "components")
+    what = "x, y, z of the tool's tip" if m.dynamics_kind == "urdf" else "x, y of the chain's free end"
+    raise DescriptionError(m.path, "model.dof", f"is {m.dof}: model '{m.name}' (dynamics.kind = "
+                                                f"'{m.dynamics_kind}') has a tip of {m.tip_dim} components ({what}), "
+                                                "more than its joints: a tip term's vectors are stored padded in "
+                                                "the joints' slots")
 
 
 def _validate_dynamics(m: Model) -> None:
@@ -397,13 +476,14 @@ def _validate_dynamics(m: Model) -> None:
         pass  # checked against the URDF when it was read (urdf_description)
     else:
         raise DescriptionError(path, "dynamics.kind",
-                               f"'{m.dynamics_kind}' is not known (known: explicit, planar_chain, urdf)")
+                               f"'{m.dynamics_kind}' is not known (known: {', '.join(KINDS)})")
 
 
 def _validate_model(m: Model) -> None:
     _validate_names(m)
     _validate_shapes(m)
     _validate_dynamics(m)
+    _validate_tip(m)
     _validate_expressions(m)
 
 
@@ -460,7 +540,36 @@ def _task(path: Path, t: Table, all_terms: tuple[TermDef, ...], cost_order: tupl
     return Task(name=t.get("name"), index=t.get("index"), title=t.get("title", ""), doc=t.get("doc", ""),
                 terms=terms, error=t.get("error"), sensitivity=dict(sens.raw), remarks=remarks,
                 default_precision={k: float(v) for k, v in precision.raw.items()}, path=path, key=t.key,
-                all_terms=all_terms, cost_order=cost_order)
+                all_terms=all_terms, cost_order=cost_order, formulations=_formulations(path, t, used))
+
+
+def _formulations(path: Path, t: Table, used: list[str]) -> dict[str, Formulation]:
+    """[task.formulations.<name>]: each replaces some of the task's sensitivities (of its own
+    kinematic terms) and is the default for the dynamics kinds of `default_for`, of which no kind
+    may name two."""
+    table = t.table("formulations", tuple((k, "table", True) for k in t.get("formulations", {})))
+    out: dict[str, Formulation] = {}
+    for name in table.raw:
+        f = table.table(name, FORMULATION_KEYS)
+        _check_identifier(name, path, f.key)
+        if name == PAPER:
+            raise DescriptionError(path, f.key, f"'{PAPER}' names the task's own sensitivity formulas; "
+                                                "give the formulation another name")
+        sens = f.table("sensitivity", tuple((s, "string", False) for s in used))
+        if not sens.raw:
+            raise DescriptionError(path, sens.key, f"empty: a formulation replaces some of {used}")
+        kinds = tuple(f.get("default_for", []))
+        for i, kind in enumerate(kinds):
+            if kind not in KINDS:
+                raise DescriptionError(path, f.sub(f"default_for[{i}]"), f"'{kind}' is not a dynamics kind "
+                                                                          f"(known: {', '.join(KINDS)})")
+            taken = next((o.name for o in out.values() if kind in o.default_for), None)
+            if taken is not None:
+                raise DescriptionError(path, f.sub(f"default_for[{i}]"), f"'{kind}' already has formulation "
+                                                                          f"'{taken}' by default")
+        out[name] = Formulation(name=name, doc=" ".join(f.get("doc").split()), default_for=kinds,
+                                sensitivity=dict(sens.raw))
+    return out
 
 
 def load_tasks(path: Path) -> list[Task]:
@@ -481,10 +590,64 @@ def load_tasks(path: Path) -> list[Task]:
     return tasks
 
 
+# --- a model's tasks: its goals and the formulation of each task's sensitivities ------------------
+
+def check_tasks(model: Model, tasks: list[Task]) -> None:
+    """What of a description only the task list can check: its goals name a task and a term that
+    task has a goal of, with model.dof entries (TIP_DIM for a term at the tip), and its
+    [formulation] names a task and one of its formulations."""
+    by_name = {t.name: t for t in tasks}
+    for name, terms in model.goals.items():
+        if name not in by_name:
+            raise DescriptionError(model.path, f"goals.{name}", f"no task is named '{name}' (tasks: {', '.join(by_name)})")
+        task = by_name[name]
+        known = [t.name for t in task.all_terms if t.goal_range is not None]
+        for term, values in terms.items():
+            key = f"goals.{name}.{term}"
+            if term not in known:
+                raise DescriptionError(model.path, key, f"unknown key: a goal is given for a term of the task "
+                                                        f"definitions ({', '.join(known)})")
+            if term not in task.sensitivity_terms:
+                raise DescriptionError(model.path, key, f"task '{name}' does not use {term}")
+            if task.term(term).on_tip:
+                _check_length(model.path, key, values, model.tip_dim, "the tip's components (TIP_DIM)")
+            else:
+                _check_length(model.path, key, values, model.dof, "model.dof")
+    for name, chosen in model.formulation.items():
+        if name not in by_name:
+            raise DescriptionError(model.path, f"formulation.{name}",
+                                   f"no task is named '{name}' (tasks: {', '.join(by_name)})")
+        known = [PAPER, *by_name[name].formulations]
+        if chosen not in known:
+            raise DescriptionError(model.path, f"formulation.{name}", f"'{chosen}' is not a formulation of task "
+                                                                      f"'{name}' (known: {', '.join(known)})")
+
+
+def formulated(task: Task, model: Model) -> Task:
+    """The task as `model` derives it: its sensitivities those of the formulation the
+    description's [formulation] names, else of the one whose default_for has the model's dynamics
+    kind, else the paper's (the task's own). A remark on a replaced formula no longer applies."""
+    chosen, why = model.formulation.get(task.name), "description"
+    if chosen is None:
+        chosen = next((f.name for f in task.formulations.values() if model.dynamics_kind in f.default_for), None)
+        why = "default_for"
+    if chosen is None or chosen == PAPER:
+        return replace(task, formulation=PAPER, chosen_by="default" if chosen is None else why)
+    f = task.formulations[chosen]
+    return replace(task, sensitivity={**task.sensitivity, **f.sensitivity}, formulation=chosen, chosen_by=why,
+                   remarks=[r for r in task.remarks if r.term not in f.sensitivity])
+
+
+def model_tasks(model: Model, tasks: list[Task]) -> list[Task]:
+    """The tasks as `model` derives them (check_tasks, then formulated)."""
+    check_tasks(model, tasks)
+    return [formulated(t, model) for t in tasks]
+
+
 # --- the expressions a description holds (the grammar of expression.py) ----------------------------
 
 # The names tasks.toml's formulas may use besides inv (see that file's header).
-FORMULA_NAMES = ("A", "B", "I", "O", "IO", "OI", "E", "dX_dU")
+FORMULA_NAMES = ("A", "B", "I", "O", "IO", "OI", "E", "dX_dU", "J")
 # The largest magnitude of a description's value (a constant, an equilibrium, a goal) and of a
 # precision: beyond it a number means nothing physical, and it would only overflow later.
 MAX_VALUE = 1e6
@@ -582,6 +745,9 @@ def _validate_task_expressions(path: Path, t: Task) -> None:
         formula_expression(path, f"{t.key}.sensitivity.{term}", text, FORMULA_NAMES)
     for i, r in enumerate(t.remarks):
         formula_expression(path, f"{t.key}.remarks[{i}].alternative", r.alternative, FORMULA_NAMES)
+    for name, f in t.formulations.items():
+        for term, text in f.sensitivity.items():
+            formula_expression(path, f"{t.key}.formulations.{name}.sensitivity.{term}", text, FORMULA_NAMES)
     for term, v in t.default_precision.items():
         if not (0 <= v <= MAX_PRECISION):
             raise DescriptionError(path, f"{t.key}.defaults.precision.{term}",

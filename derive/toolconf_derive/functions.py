@@ -217,17 +217,17 @@ def build_functions(d: Derivation, cm: CasadiModel) -> list[Function]:
             [Output("gradient", "d ln|Pi^U| / dp, one entry per tool parameter", td.logdet_gradient)],
             gradient_eval,
         ))
-    if d.tip is not None:
-        q = Arg("q", f"joint positions q = `[{' '.join(s.name for s in m.q)}]`", (n, 1), _vector_reads(d.q), False,
-                lambda rng: _sample_state(n)(rng)[:n])
-        where = "the chain's free end" if m.dynamics_kind == "planar_chain" else "the description's [tip] position"
-        fns.append(Function(
-            "tip",
-            f"The tip y(q; p) in the base frame ({where}; z = 0 in the plane of a planar arm) and its Jacobian "
-            "J = dy/dq.",
-            "forward kinematics of the tip", [q, p],
-            [Output("position", "y (m, base frame)", d.tip), Output("jacobian", "J = dy/dq", d.tip_jacobian)],
-            lambda v: cm.tip.checked(v["q"], v["params"]),
-        ))
+    # Every model has a tip (a planar chain's free end, an explicit model's [tip] position).
+    q = Arg("q", f"joint positions q = `[{' '.join(s.name for s in m.q)}]`", (n, 1), _vector_reads(d.q), False,
+            lambda rng: _sample_state(n)(rng)[:n])
+    where = "the chain's free end" if m.dynamics_kind == "planar_chain" else "the description's [tip] position"
+    fns.append(Function(
+        "tip",
+        f"The tip y(q; p) in the base frame ({where}; z = 0 in the plane of a planar arm) and its Jacobian "
+        "J = dy/dq.",
+        "forward kinematics of the tip", [q, p],
+        [Output("position", "y (m, base frame)", d.tip), Output("jacobian", "J = dy/dq", d.tip_jacobian)],
+        lambda v: cm.tip.checked(v["q"], v["params"]),
+    ))
     return fns
 

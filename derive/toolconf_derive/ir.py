@@ -19,8 +19,8 @@ from .hoist import hoist
 from .rust_printer import RustPrinter, float_literal
 from .symbolic import Derivation
 
-# 4: each function carries its cost (cost.py).
-IR_SCHEMA = 5
+# 4: each function carries its cost (cost.py); 6: the model's tip_dim, the tasks' formulation.
+IR_SCHEMA = 6
 
 
 def _rust_type(shape: tuple[int, int]) -> str:
@@ -257,6 +257,18 @@ def vectors_document(d: Derivation, functions: list[Function], generator: irt.Ge
     }
 
 
+def _goal(m, task, term: str) -> list[str]:
+    """The description's goal of `term` in `task` (zero where it gives none), one entry per joint:
+    a goal at the tip (TIP_DIM entries) padded with zeros, as tasks.toml's J pads its rows."""
+    values = m.goals.get(task.name, {}).get(term, [])
+    return list(values) + ["0"] * (m.dof - len(values))
+
+
+def _formulation(task) -> irt.Formulation:
+    doc = task.formulations[task.formulation].doc if task.formulation in task.formulations else ""
+    return irt.Formulation(name=task.formulation, doc=doc, chosen_by=task.chosen_by)
+
+
 def model_ir(d: Derivation, functions: list[Function], generator: irt.Generator, report: irt.ClosedFormReport,
              vectors: int) -> irt.Ir:
     """The IR; `vectors` is the number of test vectors per function, which live in their own file."""
@@ -282,6 +294,7 @@ def model_document(m, x_e: list[str], u_e: list[str], tasks: list, functions: li
             source=m.source,
             dof=m.dof,
             state_dim=m.state_dim,
+            tip_dim=m.tip_dim,
             parameters=[irt.Parameter(p.name, p.latex, p.unit, p.doc) for p in m.parameters],
             constants=[irt.Constant(c.name, rust_constant(c.name), c.value, c.unit, c.doc) for c in m.constants],
             state=[irt.Variable(s.name, s.latex) for s in m.state],
@@ -301,10 +314,11 @@ def model_document(m, x_e: list[str], u_e: list[str], tasks: list, functions: li
                 sensitivity_function=t.sensitivity_function,
                 confidence_function=t.confidence_function,
                 gradient_function=t.gradient_function,
-                goals=[irt.Goal(term, [printer(sympy_expression(v, {}, rational=False)) for v in m.goals.get(t.name, {}).get(term, ["0"] * m.dof)])
+                goals=[irt.Goal(term, [printer(sympy_expression(v, {}, rational=False)) for v in _goal(m, t, term)])
                        for term in t.sensitivity_terms],
                 precisions=[irt.Precision(term, float_literal(t.default_precision[term]), t.default_precision[term])
                             for term in t.terms],
+                formulation=_formulation(t),
             )
             for t in tasks
         ],

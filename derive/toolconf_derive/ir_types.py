@@ -130,6 +130,8 @@ class Model:
     source: str
     dof: int
     state_dim: int
+    # TIP_DIM: the components of the tip the tip terms use (their first rows of the n).
+    tip_dim: int
     parameters: list[Parameter]
     constants: list[Constant]
     state: list[Variable]
@@ -141,7 +143,8 @@ class Model:
 @dataclass
 class TermRead:
     """Where a term's value is read: `block` (n rows) of the state X (`state`), of its rate
-    (`state_rate`), or the control (`control`, block 0)."""
+    (`state_rate`), the control (`control`, block 0), or the tool's tip (`tip`, block = the order
+    of the derivative: 0 the position y(q), 1 the velocity J(q) q_dot)."""
     source: str
     block: int
 
@@ -173,6 +176,17 @@ class Precision:
 
 
 @dataclass
+class Formulation:
+    """Which formulation of its sensitivities a task has in this model: `paper` (tasks.toml's
+    formulas) or a name of its [task.formulations] (with that table's doc), and why: `default`
+    (nothing chose another), `default_for` (the formulation's default_for names the model's
+    dynamics kind) or `description` (the model's [formulation] names it)."""
+    name: str
+    doc: str
+    chosen_by: str
+
+
+@dataclass
 class Task:
     name: str
     index: int
@@ -186,6 +200,7 @@ class Task:
     gradient_function: str
     goals: list[Goal]
     precisions: list[Precision]
+    formulation: Formulation
 
 
 @dataclass

@@ -24,7 +24,7 @@ import numpy as np
 from .planar_chain import casadi_chain
 from .planar_chain import tip as casadi_tip
 from .description import Model, Task, expression, sensitivity, value
-from .exact import Exact, ExactFunction
+from .exact import DIGITS, Exact, ExactFunction
 from .expression import python_number
 
 
@@ -66,20 +66,19 @@ class CasadiModel:
         self.x_e = np.array(values("q", model.equilibrium_q) + values("q_dot", model.equilibrium_q_dot))
         self.u_e = np.array(values("u", model.equilibrium_u))
 
-    def _tip(self, names: dict, functions: dict) -> ExactFunction | None:
+    def _tip(self, names: dict, functions: dict) -> ExactFunction:
         """The tip y(q; p) from the description's strings (a planar chain's free end, or `[tip]
-        position`) with CasADi's symbols, and dy/dq by algorithmic differentiation."""
+        position`, which every explicit model has) with CasADi's symbols, and dy/dq by algorithmic
+        differentiation."""
         model, n = self.model, self.model.dof
         q = self.x[:n]
         if model.dynamics_kind == "planar_chain":
             lengths = [names[link["length"]] for link in model.links]
             x, y = casadi_tip([names[c.name] for c in model.q], lengths, ca.sin, ca.cos)
             y_tip = ca.vertcat(x, y, 0)
-        elif model.tip is not None:
+        else:
             y_tip = ca.vertcat(*[expression(model.path, f"tip.position[{i}]", e, names).evaluate(
                 {**names, "pi": math.pi}, functions, python_number) for i, e in enumerate(model.tip)])
-        else:
-            return None
         q_sym = ca.SX.sym("q", n)
         y_q = ca.substitute(y_tip, q, q_sym)
         return ExactFunction(ca.Function("tip", [q_sym, self.p], [y_q, ca.jacobian(y_q, q_sym)]))
@@ -89,6 +88,15 @@ class CasadiModel:
         a, b = self.jacobian.checked(self.x_e, self.u_e, p)
         return a, b
 
+    def tip_jacobian(self, p: np.ndarray) -> Exact:
+        """tasks.toml's J, exactly: CasADi's AD Jacobian of the tip at q^e (taken as its doubles),
+        its first TIP_DIM rows, and zero rows below them up to n."""
+        n, k = self.model.dof, self.model.tip_dim
+        jacobian = self.tip.checked(self.x_e[:n], p)[1]
+        with mpmath.workdps(DIGITS):
+            return Exact(mpmath.matrix([[jacobian.m[i, j] if i < k else mpmath.mpf(0) for j in range(n)]
+                                        for i in range(n)]))
+
     def task_namespace(self, p: np.ndarray) -> dict:
         n = self.model.dof
         a, b = self.linearisation(p)
@@ -97,7 +105,7 @@ class CasadiModel:
         return {
             "A": a, "B": b, "inv": Exact.inv, "I": eye, "O": zero,
             "IO": Exact.hstack(eye, zero), "OI": Exact.hstack(zero, eye),
-            "E": e, "dX_dU": Exact.inv(a) @ (e - b),
+            "E": e, "dX_dU": Exact.inv(a) @ (e - b), "J": self.tip_jacobian(p),
         }
 
     def sensitivity_exact(self, task: Task, p: np.ndarray) -> dict[str, "Exact"]:
@@ -125,10 +133,12 @@ class CasadiModel:
         a, b = self.jacobian.f(ca.DM(self.x_e), ca.DM(self.u_e), self.p)
         eye, zero = ca.SX.eye(n), ca.SX.zeros(n, n)
         e = ca.vertcat(eye, eye)
+        jacobian = self.tip.f(ca.DM(self.x_e[:n]), self.p)[1]
+        j = ca.vertcat(jacobian[:self.model.tip_dim, :], ca.SX.zeros(n - self.model.tip_dim, n))
         ns = {
             "A": a, "B": b, "inv": ca.inv_minor, "I": eye, "O": zero,
             "IO": ca.horzcat(eye, zero), "OI": ca.horzcat(zero, eye),
-            "E": e, "dX_dU": ca.inv_minor(a) @ (e - b),
+            "E": e, "dX_dU": ca.inv_minor(a) @ (e - b), "J": j,
         }
         precisions = {t: ca.SX.sym(f"p_{t}", n, n) for t in task.precision_terms}
         pi = precisions[task.control_term]

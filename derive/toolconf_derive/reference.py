@@ -46,10 +46,14 @@ SECTIONS = (
     ("printed", MODEL_KEYS["printed"], "optional",
      "A paper's printed A and B (expressions over the parameters), compared entry by entry with the "
      "derived ones in the model's report."),
-    ("tip", MODEL_KEYS["tip"], "kind `explicit` (optional)",
-     "Where the tip (the point a tip task moves) is: a `planar_chain`'s is its chain's free end, a "
-     "`urdf` model's the tool's `tool_tip_x/y/z` in the flange frame, so neither takes the table. A "
-     "model with a tip has a generated `tip` (its position and Jacobian dy/dq, `toolconf.tip`)."),
+    ("tip", MODEL_KEYS["tip"], "kind `explicit` (required)",
+     "Where the tip (the point a tip task moves) is: required for kind `explicit`, since the tip terms "
+     "of derive/tasks.toml (`tip`, `tip_dot`) read it; a `planar_chain`'s is its chain's free end "
+     "(TIP_DIM 2: x, y in its plane), a `urdf` model's the tool's `tool_tip_x/y/z` in the flange frame "
+     "(TIP_DIM 3), so neither takes the table. Every model has a generated `tip` (its position and "
+     "Jacobian dy/dq, `toolconf.tip`) and `TIP_DIM`, the components its tip terms use, which must not "
+     "exceed `model.dof`: a tip term's goal, precision and sensitivity are stored in the first TIP_DIM "
+     "of the joints' slots (derive/tasks.toml, J)."),
     ("urdf", URDF_KEYS["urdf"], "kind `urdf` (required)", "The robot and its chain."),
     ("impedance", URDF_KEYS["impedance"], "kind `urdf` (required)",
      "The joint impedance of the plant tau = U + K (q^e - q) - D q_dot + g(q^e) (docs/urdf.md): K and "
@@ -71,15 +75,25 @@ MEANING = {
     ("(top level)", "dynamics"): (None, "`[dynamics]`"),
     ("(top level)", "equilibrium"): (None, "`[equilibrium]`"),
     ("(top level)", "goals"): ("zero goals", "`[goals.<task>]`, one table per task of derive/tasks.toml "
-                                             "(`position`, `velocity`, `acceleration`), each key a term "
-                                             "(`theta`, `theta_dot`, `theta_ddot`) with `model.dof` "
-                                             "expressions: the default goal of that task; a term it omits "
-                                             "has goal 0"),
+                                             "(`position`, `velocity`, `acceleration`, `tip_position`, "
+                                             "`tip_velocity`), each key a term the task uses (`theta`, "
+                                             "`theta_dot`, `theta_ddot` with `model.dof` expressions; `tip` "
+                                             "in m and `tip_dot` in m/s with TIP_DIM, absolute in the base "
+                                             "frame): the default goal of that task; a term it omits has "
+                                             "goal 0"),
+    ("(top level)", "formulation"): ("each task's default", "`[formulation]`: `<task> = \"<name>\"`, the "
+                                                           "formulation of the task's sensitivities the model "
+                                                           "uses: `\"paper\"` (derive/tasks.toml's formulas) or "
+                                                           "a name of the task's `[task.formulations]`; a task "
+                                                           "not named takes the formulation whose `default_for` "
+                                                           "lists the model's dynamics kind, else the paper's "
+                                                           "(docs/urdf.md, \"The static gain\")"),
     ("(top level)", "printed"): ("none", "`[printed]`"),
     ("(top level)", "urdf"): ("none", "`[urdf]`: required for kind `urdf`, refused otherwise"),
     ("(top level)", "impedance"): ("none", "`[impedance]`: required for kind `urdf`, refused otherwise"),
     ("(top level)", "tool"): ("the defaults below", "`[tool]`: kind `urdf` only"),
-    ("(top level)", "tip"): ("no tip", "`[tip]`: kind `explicit` only (the other kinds have their tip)"),
+    ("(top level)", "tip"): ("none", "`[tip]`: required for kind `explicit`, refused for the other kinds "
+                                     "(they have their tip)"),
     ("model", "name"): (None, "identifier of the model: `--model NAME`, the generated module and file names"),
     ("model", "title"): ('""', "one line for reports and `toolconf models`"),
     ("model", "source"): ('""', "where the equations come from"),
@@ -106,6 +120,8 @@ MEANING = {
     ("equilibrium", "u"): (None, "U^e, `model.dof` expressions (zero for `urdf`: gravity is fed forward)"),
     ("tip", "position"): (None, "3 expressions, the tip's x, y, z in the base frame (m), of the joint positions, "
                                 "the parameters and the constants (`\"0\"` for z of a planar arm)"),
+    ("tip", "components"): ("3", "TIP_DIM, how many of the tip's x, y, z (the first ones) the tip terms use: 1, "
+                                 "2 or 3, at most `model.dof` (2 for a planar arm: x, y)"),
     ("tip", "source"): ('""', "where the geometry comes from"),
     ("printed", "where"): ('""', "where in the paper they are printed"),
     ("printed", "A"): ("none", "2n x 2n expressions"),

@@ -13,7 +13,7 @@ import sympy as sp
 
 from .planar_chain import sympy_chain
 from .planar_chain import tip as planar_tip
-from .description import Model, Task, sensitivity, task_formula
+from .description import Model, Task, model_tasks, sensitivity, task_formula
 from .errors import DescriptionError
 from .expression import ExpressionError, sympy_expression
 
@@ -54,16 +54,24 @@ def symmetric_matrix(name: str, n: int) -> tuple[sp.Matrix, list[tuple[sp.Symbol
     return sp.Matrix(n, n, lambda i, j: entries[(i, j)]), reads
 
 
-def task_namespace(a: sp.Matrix, b: sp.Matrix, n: int, inv) -> dict:
-    """The names the task formulas in tasks.toml may use (see that file's header)."""
+def task_namespace(a: sp.Matrix, b: sp.Matrix, j: sp.Matrix, n: int, inv) -> dict:
+    """The names the task formulas in tasks.toml may use (see that file's header); `j` is J, the
+    padded n x n tip Jacobian at the equilibrium (padded_jacobian)."""
     eye, zero = sp.eye(n), sp.zeros(n, n)
     e = sp.Matrix.vstack(eye, eye)
     a_inv = inv(a)
     return {
         "A": a, "B": b, "inv": inv, "I": eye, "O": zero,
         "IO": sp.Matrix.hstack(eye, zero), "OI": sp.Matrix.hstack(zero, eye),
-        "E": e, "dX_dU": a_inv @ (e - b),
+        "E": e, "dX_dU": a_inv @ (e - b), "J": j,
     }
+
+
+def padded_jacobian(jacobian: sp.Matrix, at_q: dict, tip_dim: int, n: int) -> sp.Matrix:
+    """tasks.toml's J: the first `tip_dim` rows of the tip's Jacobian dy/dq at the equilibrium
+    (`at_q`, q -> q^e), in closed form in the parameters, and zero rows below them up to n."""
+    rows = tidy_matrix(jacobian[:tip_dim, :].subs(at_q))
+    return sp.Matrix.vstack(rows, sp.zeros(n - tip_dim, n)) if tip_dim < n else rows
 
 
 @dataclass
@@ -97,7 +105,7 @@ class Derivation:
     tasks: list[TaskDerivation]
     # T, V, M(q) and Q of a Lagrangian model (None for explicit equations of motion).
     lagrangian: dict | None = None
-    # The tip y(q; p) (3 x 1, base frame) and its Jacobian dy/dq (3 x n), if the model has one.
+    # The tip y(q; p) (3 x 1, base frame) and its Jacobian dy/dq (3 x n): every model has one.
     tip: sp.Matrix | None = None
     tip_jacobian: sp.Matrix | None = None
 
@@ -164,25 +172,26 @@ def derive(model: Model, tasks: list[Task]) -> Derivation:
                                                           "the derivatives at the equilibrium)")
     if a.det() == 0:
         raise DescriptionError(model.path, "equilibrium", "A is singular there; the task sensitivities need A^-1")
-    check_goals(model, tasks)
-    ns = task_namespace(a, b, model.dof, lambda m: tidy_matrix(m.inv()))
+    tasks = model_tasks(model, tasks)
+    tip = derive_tip(model, symbols, q, params)
+    tip_jacobian = tidy_matrix(tip.jacobian(q))
+    j = padded_jacobian(tip_jacobian, dict(zip(q, x_e[:model.dof])), model.tip_dim, model.dof)
+    ns = task_namespace(a, b, j, model.dof, lambda m: tidy_matrix(m.inv()))
     derived_tasks = [derive_task(task, ns, model.dof) for task in tasks]
     for t in derived_tasks:
         t.logdet_gradient = logdet_gradient(t.confidence, params)
-    tip = derive_tip(model, symbols, q, params)
     return Derivation(model, params, consts, q, q_dot, u, q_ddot, f, f_x, f_u, x_e, u_e, a, b, derived_tasks, lagrangian,
-                      tip, None if tip is None else tidy_matrix(tip.jacobian(q)))
+                      tip, tip_jacobian)
 
 
-def derive_tip(model: Model, symbols: dict, q: list, params: list) -> sp.Matrix | None:
+def derive_tip(model: Model, symbols: dict, q: list, params: list) -> sp.Matrix:
     """The tip in the base frame: a planar chain's free end (x, y, 0), or an explicit model's
-    `[tip] position`, which may use the joint positions, the parameters and the constants."""
+    `[tip] position` (which every explicit model has: the reader requires it), which may use the
+    joint positions, the parameters and the constants."""
     if model.dynamics_kind == "planar_chain":
         lengths = [symbols[link["length"]] for link in model.links]
         x, y = planar_tip(q, lengths, sp.sin, sp.cos)
         return sp.Matrix([x, y, 0])
-    if model.tip is None:
-        return None
     allowed = set(q) | set(params) | {s for s in symbols.values() if str(s) in {c.name for c in model.constants}}
     entries = []
     for i, text in enumerate(model.tip):
@@ -202,25 +211,6 @@ def equilibrium(model: Model) -> tuple[sp.Matrix, sp.Matrix]:
         return [parse(model, v, {}, f"equilibrium.{label}[{i}]") for i, v in enumerate(texts)]
     x_e = sp.Matrix(values("q", model.equilibrium_q) + values("q_dot", model.equilibrium_q_dot))
     return x_e, sp.Matrix(values("u", model.equilibrium_u))
-
-
-def check_goals(model: Model, tasks: list[Task]) -> None:
-    """Goals name a task of tasks.toml and term that task uses, and are numbers."""
-    by_name = {t.name: t for t in tasks}
-    for name, terms in model.goals.items():
-        if name not in by_name:
-            raise DescriptionError(model.path, f"goals.{name}",
-                                   f"no task is named '{name}' (tasks: {', '.join(by_name)})")
-        known = [t.name for t in by_name[name].all_terms if t.goal_range is not None]
-        for term, values in terms.items():
-            if term not in known:
-                raise DescriptionError(model.path, f"goals.{name}.{term}",
-                                       f"unknown key: a goal is given for a term of the task definitions "
-                                       f"({', '.join(known)})")
-            if term not in by_name[name].sensitivity_terms:
-                raise DescriptionError(model.path, f"goals.{name}.{term}", f"task '{name}' does not use {term}")
-            for i, v in enumerate(values):
-                parse(model, v, {}, f"goals.{name}.{term}[{i}]")
 
 
 def derive_task(task: Task, ns: dict, n: int) -> TaskDerivation:

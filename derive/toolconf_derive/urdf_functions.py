@@ -15,7 +15,7 @@ import mpmath
 import numpy as np
 
 from . import ir_types as irt
-from .description import Model, sensitivity
+from .description import Model, model_tasks, sensitivity
 from .errors import DescriptionError
 from .exact import ExactFunction
 from .functions import _sample_control, _sample_precision, _sample_state
@@ -379,6 +379,7 @@ def not_an_equilibrium(chain, residual) -> str:
 
 def urdf_documents(model: Model, tasks, generator: irt.Generator, vectors: int, schema: int) -> tuple[irt.Ir, dict]:
     """The IR and the test vectors of a URDF model."""
+    tasks = model_tasks(model, tasks)
     dv = UrdfDerivation(model, model.chain, tasks)
     residual = dv.reference_dynamics(dv.x_e, dv.u_e, report_tool(*REPORT_TOOLS[1][1:]))[0].to_numpy()
     # Not exactly zero: the graphs' constants were folded in double while they were built.

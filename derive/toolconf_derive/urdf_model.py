@@ -18,7 +18,7 @@ arithmetic at every test point before code is written (`check`):
 | f(X, U) | CRBA M(q) + RNEA bias, LDL^T solve | articulated-body algorithm (6-D spatial) |
 | df/dX, df/dU | -M^-1 [K + dID/dq, D + dID/dq_dot] at q_ddot = f, M^-1 | CasADi AD of the ABA graph |
 | A, B | the structured form above, dg/dq by AD of RNEA | AD of the ABA graph at X^e |
-| sensitivities, Pi^U | tasks.toml's formulas on SX, inv(A) in block form | the same formulas in mpmath on the reference A, B (general inverse) |
+| sensitivities, Pi^U | tasks.toml's formulas on SX, inv(A) in block form, J the geometric tip Jacobian | the same formulas in mpmath on the reference A, B (general inverse), J by AD of the inward tip |
 | d ln|Pi^U|/dp | reverse AD of sum ln D_ii (LDL^T of Pi^U) | 50-digit forward differences of ln det Pi^U |
 
 The tool's parameters reach everything through the last body's ten inertial numbers, so the
@@ -283,6 +283,8 @@ class UrdfDerivation:
         self.tip = ca.Function("tip", [q, p], [ca.cse(y), ca.cse(jac)])
         y_ref = self._reference_tip(qs, self._symbolic_trig(qs), p)
         self.reference_tip = ExactFunction(ca.Function("tip_ref", [q, p], [y_ref, ca.jacobian(y_ref, q)]))
+        # tasks.toml's J on the code side: the geometric Jacobian at q^e, its trigonometry exact.
+        self.j_code = _padded(self.tip_with(self.q_e, self.trig_e, p)[1], self.n)
 
     def _build_rigid_body(self):
         """The robot's own rigid-body dynamics, U the joint torques and no impedance:
@@ -368,8 +370,9 @@ class UrdfDerivation:
         n = self.n
         eye, zero = ca.SX.eye(n), ca.SX(n, n)
         values = {"A": self.a_code, "B": self.b_code, "inv(A)": self.a_inv_code, "I": eye, "O": zero,
-                  "IO": ca.horzcat(eye, zero), "OI": ca.horzcat(zero, eye), "E": ca.vertcat(eye, eye)}
-        ns = {name: MatrixAlgebra.symbol(name, values) for name in ("A", "B", "I", "O", "IO", "OI", "E")}
+                  "IO": ca.horzcat(eye, zero), "OI": ca.horzcat(zero, eye), "E": ca.vertcat(eye, eye),
+                  "J": self.j_code}
+        ns = {name: MatrixAlgebra.symbol(name, values) for name in ("A", "B", "I", "O", "IO", "OI", "E", "J")}
         ns["inv"] = MatrixAlgebra.inverse
         ns["dX_dU"] = MatrixAlgebra.inverse(ns["A"]) @ (ns["E"] - ns["B"])
         return ns
@@ -444,7 +447,8 @@ class UrdfDerivation:
 
     def reference_namespace(self, p) -> dict:
         a, b = self.reference_ab.checked(p)
-        return exact_namespace(a, b, self.n)
+        jacobian = self.reference_tip.checked(self.q_e, p)[1]
+        return exact_namespace(a, b, jacobian, self.n)
 
     def reference_sensitivity(self, task: Task, p) -> dict:
         ns = self.reference_namespace(p)
@@ -464,7 +468,8 @@ class UrdfDerivation:
         def logdet(params):
             with mpmath.workdps(DIGITS):
                 a, b = self.reference_ab.exact_at([params])
-                ns = exact_namespace(a, b, self.n)
+                jacobian = self.reference_tip.exact_at([[mpmath.mpf(v) for v in self.q_e], params])[1]
+                ns = exact_namespace(a, b, jacobian, self.n)
                 s = {t: sensitivity(task, t, ns) for t in task.sensitivity_terms}
                 pi = Exact.of(precision[task.control_term])
                 for t in task.sensitivity_terms:
@@ -554,9 +559,23 @@ def equilibrium_values(model: Model) -> list[float]:
                 for i, v in enumerate(model.equilibrium_q)]
 
 
-def exact_namespace(a: Exact, b: Exact, n: int) -> dict:
-    """The names of tasks.toml's formulas over exact A and B (the general inverse)."""
+def exact_namespace(a: Exact, b: Exact, tip_jacobian: Exact, n: int) -> dict:
+    """The names of tasks.toml's formulas over exact A and B (the general inverse) and the tip's
+    3 x n Jacobian at q^e (J: padded to n x n with zero rows)."""
     eye, zero = Exact(mpmath.eye(n)), Exact(mpmath.zeros(n, n))
     e = Exact.vstack(eye, eye)
+    with mpmath.workdps(DIGITS):
+        rows = tip_jacobian.m.rows
+        j = Exact(mpmath.matrix([[tip_jacobian.m[i, k] if i < rows else mpmath.mpf(0) for k in range(n)]
+                                 for i in range(n)]))
     return {"A": a, "B": b, "inv": Exact.inv, "I": eye, "O": zero, "IO": Exact.hstack(eye, zero),
-            "OI": Exact.hstack(zero, eye), "E": e, "dX_dU": Exact.inv(a) @ (e - b)}
+            "OI": Exact.hstack(zero, eye), "E": e, "dX_dU": Exact.inv(a) @ (e - b), "J": j}
+
+
+def _padded(jacobian, n: int):
+    """A 3 x n SX Jacobian as tasks.toml's J: n x n, the rows below the third structurally zero."""
+    out = ca.SX(n, n)
+    for i in range(jacobian.size1()):
+        for k in range(n):
+            out[i, k] = jacobian[i, k]
+    return out

@@ -22,6 +22,10 @@ pub const NAME: &str = "arm2";
 pub const DOF: usize = 2;
 /// Dimension of the state X = [q; q_dot].
 pub const STATE_DIM: usize = 4;
+/// Components of the tool's tip the tip terms use (x, y, z in the base frame, the first
+/// TIP_DIM of them): a tip term's goal, precision and sensitivity fill the first TIP_DIM of
+/// the DOF rows, zero in the others.
+pub const TIP_DIM: usize = 2;
 /// Number of tool parameters.
 pub const PARAMETER_COUNT: usize = 4;
 /// Tool parameters, in the order every function takes them.
@@ -95,6 +99,38 @@ pub mod acceleration {
     pub const PRECISION_U: f64 = 0.0;
 }
 
+/// Task 4 (tip position control): the paper's default goals and precisions ("Implementation details").
+pub mod tip_position {
+    #[allow(unused_imports)]
+    use super::PI;
+    /// Free-energy terms the controller uses (eq. U_dot_deriv).
+    pub const TERMS: [&str; 3] = ["tip", "tip_dot", "u"];
+    /// Default goal for `tip`.
+    pub const GOAL_TIP: [f64; 2] = [0.08, -0.69];
+    /// Default goal for `tip_dot`.
+    pub const GOAL_TIP_DOT: [f64; 2] = [0.0, 0.0];
+    /// Default precision for `tip`: P = 100.0 I.
+    pub const PRECISION_TIP: f64 = 100.0;
+    /// Default precision for `tip_dot`: P = 50.0 I.
+    pub const PRECISION_TIP_DOT: f64 = 50.0;
+    /// Default precision for `u`: P = 1.0 I.
+    pub const PRECISION_U: f64 = 1.0;
+}
+
+/// Task 5 (tip velocity control): the paper's default goals and precisions ("Implementation details").
+pub mod tip_velocity {
+    #[allow(unused_imports)]
+    use super::PI;
+    /// Free-energy terms the controller uses (eq. U_dot_deriv).
+    pub const TERMS: [&str; 2] = ["tip_dot", "u"];
+    /// Default goal for `tip_dot`.
+    pub const GOAL_TIP_DOT: [f64; 2] = [0.1, 0.0];
+    /// Default precision for `tip_dot`: P = 50.0 I.
+    pub const PRECISION_TIP_DOT: f64 = 50.0;
+    /// Default precision for `u`: P = 1.0 I.
+    pub const PRECISION_U: f64 = 1.0;
+}
+
 /// The default goals and precisions of `task` for this model (the modules above); zero for a
 /// term the task does not use.
 #[must_use]
@@ -106,12 +142,16 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 position::GOAL_THETA_DOT,
                 position::GOAL_THETA_DDOT,
                 [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 position::PRECISION_THETA,
                 position::PRECISION_THETA_DOT,
                 position::PRECISION_THETA_DDOT,
                 position::PRECISION_U,
+                0.0,
+                0.0,
             ],
         },
         super::TaskKind::Velocity => super::TaskDefaults {
@@ -120,12 +160,16 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 velocity::GOAL_THETA_DOT,
                 velocity::GOAL_THETA_DDOT,
                 [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
                 velocity::PRECISION_THETA_DOT,
                 velocity::PRECISION_THETA_DDOT,
                 velocity::PRECISION_U,
+                0.0,
+                0.0,
             ],
         },
         super::TaskKind::Acceleration => super::TaskDefaults {
@@ -134,12 +178,52 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 acceleration::GOAL_THETA_DDOT,
                 [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
                 0.0,
                 acceleration::PRECISION_THETA_DDOT,
                 acceleration::PRECISION_U,
+                0.0,
+                0.0,
+            ],
+        },
+        super::TaskKind::TipPosition => super::TaskDefaults {
+            goal: [
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                tip_position::GOAL_TIP,
+                tip_position::GOAL_TIP_DOT,
+            ],
+            precision: [
+                0.0,
+                0.0,
+                0.0,
+                tip_position::PRECISION_U,
+                tip_position::PRECISION_TIP,
+                tip_position::PRECISION_TIP_DOT,
+            ],
+        },
+        super::TaskKind::TipVelocity => super::TaskDefaults {
+            goal: [
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                tip_velocity::GOAL_TIP_DOT,
+            ],
+            precision: [
+                0.0,
+                0.0,
+                0.0,
+                tip_velocity::PRECISION_U,
+                0.0,
+                tip_velocity::PRECISION_TIP_DOT,
             ],
         },
     }
@@ -162,19 +246,40 @@ pub fn task_sensitivities(
                     Some(d_theta_dot_du),
                     Some(d_theta_ddot_du),
                     None,
+                    None,
+                    None,
                 ],
             }
         }
         super::TaskKind::Velocity => {
             let (d_theta_dot_du, d_theta_ddot_du) = velocity_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, Some(d_theta_dot_du), Some(d_theta_ddot_du), None],
+                d_du: [
+                    None,
+                    Some(d_theta_dot_du),
+                    Some(d_theta_ddot_du),
+                    None,
+                    None,
+                    None,
+                ],
             }
         }
         super::TaskKind::Acceleration => {
             let d_theta_ddot_du = acceleration_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, None, Some(d_theta_ddot_du), None],
+                d_du: [None, None, Some(d_theta_ddot_du), None, None, None],
+            }
+        }
+        super::TaskKind::TipPosition => {
+            let (d_tip_du, d_tip_dot_du) = tip_position_sensitivity(params);
+            super::TaskSensitivities {
+                d_du: [None, None, None, None, Some(d_tip_du), Some(d_tip_dot_du)],
+            }
+        }
+        super::TaskKind::TipVelocity => {
+            let d_tip_dot_du = tip_velocity_sensitivity(params);
+            super::TaskSensitivities {
+                d_du: [None, None, None, None, None, Some(d_tip_dot_du)],
             }
         }
     }
@@ -213,6 +318,17 @@ pub fn task_control_confidence(
             &precision[Term::ThetaDdot as usize],
             &precision[Term::U as usize],
         ),
+        super::TaskKind::TipPosition => tip_position_control_confidence(
+            params,
+            &precision[Term::Tip as usize],
+            &precision[Term::TipDot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::TipVelocity => tip_velocity_control_confidence(
+            params,
+            &precision[Term::TipDot as usize],
+            &precision[Term::U as usize],
+        ),
     }
 }
 
@@ -247,6 +363,17 @@ pub fn task_logdet_gradient(
         super::TaskKind::Acceleration => acceleration_logdet_gradient(
             params,
             &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::TipPosition => tip_position_logdet_gradient(
+            params,
+            &precision[Term::Tip as usize],
+            &precision[Term::TipDot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::TipVelocity => tip_velocity_logdet_gradient(
+            params,
+            &precision[Term::TipDot as usize],
             &precision[Term::U as usize],
         ),
     }
@@ -1071,6 +1198,308 @@ pub fn acceleration_logdet_gradient(
 ) -> SVector<f64, 4> {
     // d ln|Pi^U| / dp, one entry per tool parameter
     let gradient = <SVector<f64, 4>>::zeros();
+    gradient
+}
+
+/// Task 4 (tip position control): the sensitivities d(task variable)/dU the controller uses, in the order (d_tip_du, d_tip_dot_du).
+///
+/// From appendix "Task specific controllers".
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
+///
+/// Cost per call: 33 operations, weighted 57 (4 ADD, 3 DIV, 18 MUL, 2 NEG, 3 POW, 3 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_position_sensitivity(
+    params: &SVector<f64, 4>,
+) -> (SMatrix<f64, 2, 2>, SMatrix<f64, 2, 2>) {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let l1 = params[2];
+    let l2 = params[3];
+    let t0 = l1.powi(2);
+    let t1 = 2.0 * m2;
+    let t2 = 1.0 / (g * (m1 + t1));
+    let t3 = m2.powi(2);
+    let t4 = l2.powi(2);
+    // dtip/dU = J @ IO @ inv(A) @ (E - B)
+    let mut d_tip_du = <SMatrix<f64, 2, 2>>::zeros();
+    d_tip_du[(0, 0)] = -(2.0 / 3.0) * t2 * (m1 * t0 + 3.0 * m2 * t0 - 3.0);
+    d_tip_du[(0, 1)] = -t2
+        * (3.0 * l1 * l2 * t3 + m1 * t1 * t4 - 6.0 * m1 - 6.0 * m2 + 4.0 * t3 * t4)
+        / (3.0 * m2);
+    // dtip_dot/dU = J @ OI @ inv(A) @ (E - B)
+    let mut d_tip_dot_du = <SMatrix<f64, 2, 2>>::zeros();
+    d_tip_dot_du[(0, 0)] = l1;
+    d_tip_dot_du[(0, 1)] = l2;
+    (d_tip_du, d_tip_dot_du)
+}
+
+/// Task 4 (tip position control): the control confidence Pi^U = d2F/dU2 = S_tip^T P_tip S_tip + S_tip_dot^T P_tip_dot S_tip_dot + P_u.
+///
+/// From eq. (control_conf) and the closed forms after it.
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
+/// - `p_tip`: precision P of the tool tip's position tip (symmetric; the upper triangle is read)
+/// - `p_tip_dot`: precision P of the tool tip's velocity tip_dot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 49 operations, weighted 84 (10 ADD, 4 DIV, 25 MUL, 7 POW, 3 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_position_control_confidence(
+    params: &SVector<f64, 4>,
+    p_tip: &SMatrix<f64, 2, 2>,
+    p_tip_dot: &SMatrix<f64, 2, 2>,
+    p_u: &SMatrix<f64, 2, 2>,
+) -> SMatrix<f64, 2, 2> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let l1 = params[2];
+    let l2 = params[3];
+    let p_tip_00 = p_tip[(0, 0)];
+    let p_tip_dot_00 = p_tip_dot[(0, 0)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_11 = p_u[(1, 1)];
+    let t0 = l1.powi(2);
+    let t1 = m1 * t0 + 3.0 * m2 * t0 - 3.0;
+    let t2 = 2.0 * m2;
+    let t3 = p_tip_00 / (g.powi(2) * (m1 + t2).powi(2));
+    let t4 = l1 * l2;
+    let t5 = m2.powi(2);
+    let t6 = l2.powi(2);
+    let t7 = m1 * t2 * t6 - 6.0 * m1 - 6.0 * m2 + 3.0 * t4 * t5 + 4.0 * t5 * t6;
+    // Pi^U (symmetric)
+    let mut pi_u = <SMatrix<f64, 2, 2>>::zeros();
+    pi_u[(0, 0)] = p_tip_dot_00 * t0 + p_u_00 + (4.0 / 9.0) * t1.powi(2) * t3;
+    pi_u[(0, 1)] = p_tip_dot_00 * t4 + p_u_01 + (2.0 / 9.0) * t1 * t3 * t7 / m2;
+    pi_u[(1, 1)] = p_tip_dot_00 * t6 + p_u_11 + t3 * t7.powi(2) / (9.0 * t5);
+    pi_u[(1, 0)] = pi_u[(0, 1)];
+    pi_u
+}
+
+/// Task 4 (tip position control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
+/// - `p_tip`: precision P of the tool tip's position tip (symmetric; the upper triangle is read)
+/// - `p_tip_dot`: precision P of the tool tip's velocity tip_dot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 197 operations, weighted 340 (34 ADD, 19 DIV, 114 MUL, 4 NEG, 10 POW, 16 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_position_logdet_gradient(
+    params: &SVector<f64, 4>,
+    p_tip: &SMatrix<f64, 2, 2>,
+    p_tip_dot: &SMatrix<f64, 2, 2>,
+    p_u: &SMatrix<f64, 2, 2>,
+) -> SVector<f64, 4> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let l1 = params[2];
+    let l2 = params[3];
+    let p_tip_00 = p_tip[(0, 0)];
+    let p_tip_dot_00 = p_tip_dot[(0, 0)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_11 = p_u[(1, 1)];
+    let t0 = l2 * p_tip_dot_00;
+    let t1 = 1.0 / m2;
+    let t2 = 6.0 * m2;
+    let t3 = m2.powi(2);
+    let t4 = l1 * t3;
+    let t5 = 3.0 * t4;
+    let t6 = l2.powi(2);
+    let t7 = 2.0 * m2;
+    let t8 = t6 * t7;
+    let t9 = 4.0 * t6;
+    let t10 = l2 * t5 + m1 * t8 - 6.0 * m1 - t2 + t3 * t9;
+    let t11 = t1 * t10;
+    let t12 = l1.powi(2);
+    let t13 = m1 * t12 + 3.0 * m2 * t12 - 3.0;
+    let t14 = m1 + t7;
+    let t15 = t14.powi(-2);
+    let t16 = g.powi(-2);
+    let t17 = p_tip_00 * t16;
+    let t18 = t15 * t17;
+    let t19 = t13 * t18;
+    let t20 = (2.0 / 9.0) * t19;
+    let t21 = l1 * t0 + p_u_01 + t11 * t20;
+    let t22 = t13.powi(2) * t17;
+    let t23 = (4.0 / 9.0) * t15;
+    let t24 = p_tip_dot_00 * t12 + p_u_00 + t22 * t23;
+    let t25 = 1.0 / t3;
+    let t26 = t10.powi(2);
+    let t27 = t25 * t26;
+    let t28 = t18 / 9.0;
+    let t29 = p_tip_dot_00 * t6 + p_u_11 + t27 * t28;
+    let t30 = 1.0 / (-t21.powi(2) + t24 * t29);
+    let t31 = t14.powi(-3);
+    let t32 = t22 * t31;
+    let t33 = t12 * t19;
+    let t34 = t17 * t31;
+    let t35 = t27 * t34;
+    let t36 = t10 * t25;
+    let t37 = t28 * t36;
+    let t38 = t1 * t20;
+    let t39 = (2.0 / 9.0) * t18;
+    let t40 = t11 * t12;
+    let t41 = t11 * t13 * t34;
+    let t42 = -2.0 * t21;
+    let t43 = 12.0 * l1 * m2;
+    let t44 = m2 * t6;
+    let t45 = (2.0 / 3.0) * t18;
+    let t46 = l1 * t2;
+    let t47 = 2.0 * m1;
+    let t48 = l1 * p_tip_dot_00;
+    let t49 = 4.0 * m1;
+    let t50 = l2 * m2;
+    let t51 = l2 * t3;
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 4>>::zeros();
+    gradient[0] = t30
+        * (t24 * (-(2.0 / 9.0) * t35 + t37 * (m2 * t9 - 12.0))
+            + t29 * (-(8.0 / 9.0) * t32 + (8.0 / 9.0) * t33)
+            + t42 * (t38 * (t8 - 6.0) + t39 * t40 - (4.0 / 9.0) * t41));
+    gradient[1] = t30
+        * (t24
+            * (p_tip_00 * t10 * t15 * t16 * t25 * (l2 * t43 + m1 * t9 + 16.0 * t44 - 12.0) / 9.0
+                - (4.0 / 9.0) * t35
+                - t26 * t39 / m2.powi(3))
+            + t29 * (-(16.0 / 9.0) * t32 + (8.0 / 3.0) * t33)
+            + t42
+                * (-t20 * t36 + t38 * (l2 * t46 + 8.0 * t44 + t47 * t6 - 6.0) + t40 * t45
+                    - (8.0 / 9.0) * t41));
+    gradient[2] = t30
+        * (l2 * t10 * t24 * t45
+            + t29 * (t13 * t17 * t23 * (l1 * t49 + t43) + 2.0 * t48)
+            + t42 * (t0 + t11 * t39 * (l1 * t47 + t46) + (2.0 / 3.0) * t19 * t50));
+    gradient[3] = t30
+        * (t24 * (2.0 * t0 + t37 * (8.0 * m1 * t50 + 6.0 * t4 + 16.0 * t51))
+            + t42 * (t38 * (t49 * t50 + t5 + 8.0 * t51) + t48));
+    gradient
+}
+
+/// Task 5 (tip velocity control): the sensitivities d(task variable)/dU the controller uses, in the order (d_tip_dot_du).
+///
+/// From appendix "Task specific controllers".
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
+///
+/// Cost per call: 7 operations, weighted 21 (2 ADD, 2 DIV, 3 MUL).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_velocity_sensitivity(params: &SVector<f64, 4>) -> SMatrix<f64, 2, 2> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let t0 = 2.0 / (g * (m1 + 2.0 * m2));
+    // dtip_dot/dU = -J @ IO @ inv(A) @ B
+    let mut d_tip_dot_du = <SMatrix<f64, 2, 2>>::zeros();
+    d_tip_dot_du[(0, 0)] = t0;
+    d_tip_dot_du[(0, 1)] = t0 * (m1 + m2) / m2;
+    d_tip_dot_du
+}
+
+/// Task 5 (tip velocity control): the control confidence Pi^U = d2F/dU2 = S_tip_dot^T P_tip_dot S_tip_dot + P_u.
+///
+/// From eq. (control_conf) and the closed forms after it.
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
+/// - `p_tip_dot`: precision P of the tool tip's velocity tip_dot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 17 operations, weighted 42 (5 ADD, 3 DIV, 5 MUL, 4 POW).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_velocity_control_confidence(
+    params: &SVector<f64, 4>,
+    p_tip_dot: &SMatrix<f64, 2, 2>,
+    p_u: &SMatrix<f64, 2, 2>,
+) -> SMatrix<f64, 2, 2> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let p_tip_dot_00 = p_tip_dot[(0, 0)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_11 = p_u[(1, 1)];
+    let t0 = 4.0 * p_tip_dot_00 / (g.powi(2) * (m1 + 2.0 * m2).powi(2));
+    let t1 = m1 + m2;
+    // Pi^U (symmetric)
+    let mut pi_u = <SMatrix<f64, 2, 2>>::zeros();
+    pi_u[(0, 0)] = p_u_00 + t0;
+    pi_u[(0, 1)] = p_u_01 + t0 * t1 / m2;
+    pi_u[(1, 1)] = p_u_11 + t0 * t1.powi(2) / m2.powi(2);
+    pi_u[(1, 0)] = pi_u[(0, 1)];
+    pi_u
+}
+
+/// Task 5 (tip velocity control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
+/// - `p_tip_dot`: precision P of the tool tip's velocity tip_dot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 78 operations, weighted 113 (8 ADD, 4 DIV, 40 MUL, 10 NEG, 7 POW, 9 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_velocity_logdet_gradient(
+    params: &SVector<f64, 4>,
+    p_tip_dot: &SMatrix<f64, 2, 2>,
+    p_u: &SMatrix<f64, 2, 2>,
+) -> SVector<f64, 4> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let p_tip_dot_00 = p_tip_dot[(0, 0)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_11 = p_u[(1, 1)];
+    let t0 = m1 + m2;
+    let t1 = 1.0 / m2;
+    let t2 = 2.0 * m2;
+    let t3 = m1 + t2;
+    let t4 = t3.powi(-2);
+    let t5 = g.powi(-2);
+    let t6 = p_tip_dot_00 * t5;
+    let t7 = t4 * t6;
+    let t8 = 4.0 * t7;
+    let t9 = p_u_01 + t0 * t1 * t8;
+    let t10 = p_u_00 + t8;
+    let t11 = m2.powi(-2);
+    let t12 = t0.powi(2);
+    let t13 = t11 * t12;
+    let t14 = p_u_11 + t13 * t8;
+    let t15 = 1.0 / (t10 * t14 - t9.powi(2));
+    let t16 = t6 / t3.powi(3);
+    let t17 = t14 * t16;
+    let t18 = 8.0 * t16;
+    let t19 = -4.0 * p_tip_dot_00 * t11 * t4 * t5 * (2.0 * m1 + t2);
+    let t20 = -4.0 * p_tip_dot_00 * t1 * t4 * t5;
+    let t21 = t0 * t1;
+    let t22 = -2.0 * t9;
+    let t23 = 16.0 * t16;
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 4>>::zeros();
+    gradient[0] = t15 * (t10 * (-t13 * t18 - t19) - 8.0 * t17 + t22 * (-t18 * t21 - t20));
+    gradient[1] = t15
+        * (t10 * (-t13 * t23 - t19 - 8.0 * t12 * t7 / m2.powi(3)) - 16.0 * t17
+            + t22 * (-t0 * t11 * t8 - t20 - t21 * t23));
     gradient
 }
 

@@ -22,6 +22,10 @@ pub const NAME: &str = "arm2_exact";
 pub const DOF: usize = 2;
 /// Dimension of the state X = [q; q_dot].
 pub const STATE_DIM: usize = 4;
+/// Components of the tool's tip the tip terms use (x, y, z in the base frame, the first
+/// TIP_DIM of them): a tip term's goal, precision and sensitivity fill the first TIP_DIM of
+/// the DOF rows, zero in the others.
+pub const TIP_DIM: usize = 2;
 /// Number of tool parameters.
 pub const PARAMETER_COUNT: usize = 4;
 /// Tool parameters, in the order every function takes them.
@@ -95,6 +99,38 @@ pub mod acceleration {
     pub const PRECISION_U: f64 = 0.0;
 }
 
+/// Task 4 (tip position control): the paper's default goals and precisions ("Implementation details").
+pub mod tip_position {
+    #[allow(unused_imports)]
+    use super::PI;
+    /// Free-energy terms the controller uses (eq. U_dot_deriv).
+    pub const TERMS: [&str; 3] = ["tip", "tip_dot", "u"];
+    /// Default goal for `tip`.
+    pub const GOAL_TIP: [f64; 2] = [0.08, -0.69];
+    /// Default goal for `tip_dot`.
+    pub const GOAL_TIP_DOT: [f64; 2] = [0.0, 0.0];
+    /// Default precision for `tip`: P = 100.0 I.
+    pub const PRECISION_TIP: f64 = 100.0;
+    /// Default precision for `tip_dot`: P = 50.0 I.
+    pub const PRECISION_TIP_DOT: f64 = 50.0;
+    /// Default precision for `u`: P = 1.0 I.
+    pub const PRECISION_U: f64 = 1.0;
+}
+
+/// Task 5 (tip velocity control): the paper's default goals and precisions ("Implementation details").
+pub mod tip_velocity {
+    #[allow(unused_imports)]
+    use super::PI;
+    /// Free-energy terms the controller uses (eq. U_dot_deriv).
+    pub const TERMS: [&str; 2] = ["tip_dot", "u"];
+    /// Default goal for `tip_dot`.
+    pub const GOAL_TIP_DOT: [f64; 2] = [0.1, 0.0];
+    /// Default precision for `tip_dot`: P = 50.0 I.
+    pub const PRECISION_TIP_DOT: f64 = 50.0;
+    /// Default precision for `u`: P = 1.0 I.
+    pub const PRECISION_U: f64 = 1.0;
+}
+
 /// The default goals and precisions of `task` for this model (the modules above); zero for a
 /// term the task does not use.
 #[must_use]
@@ -106,12 +142,16 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 position::GOAL_THETA_DOT,
                 position::GOAL_THETA_DDOT,
                 [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 position::PRECISION_THETA,
                 position::PRECISION_THETA_DOT,
                 position::PRECISION_THETA_DDOT,
                 position::PRECISION_U,
+                0.0,
+                0.0,
             ],
         },
         super::TaskKind::Velocity => super::TaskDefaults {
@@ -120,12 +160,16 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 velocity::GOAL_THETA_DOT,
                 velocity::GOAL_THETA_DDOT,
                 [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
                 velocity::PRECISION_THETA_DOT,
                 velocity::PRECISION_THETA_DDOT,
                 velocity::PRECISION_U,
+                0.0,
+                0.0,
             ],
         },
         super::TaskKind::Acceleration => super::TaskDefaults {
@@ -134,12 +178,52 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 acceleration::GOAL_THETA_DDOT,
                 [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
                 0.0,
                 acceleration::PRECISION_THETA_DDOT,
                 acceleration::PRECISION_U,
+                0.0,
+                0.0,
+            ],
+        },
+        super::TaskKind::TipPosition => super::TaskDefaults {
+            goal: [
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                tip_position::GOAL_TIP,
+                tip_position::GOAL_TIP_DOT,
+            ],
+            precision: [
+                0.0,
+                0.0,
+                0.0,
+                tip_position::PRECISION_U,
+                tip_position::PRECISION_TIP,
+                tip_position::PRECISION_TIP_DOT,
+            ],
+        },
+        super::TaskKind::TipVelocity => super::TaskDefaults {
+            goal: [
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                tip_velocity::GOAL_TIP_DOT,
+            ],
+            precision: [
+                0.0,
+                0.0,
+                0.0,
+                tip_velocity::PRECISION_U,
+                0.0,
+                tip_velocity::PRECISION_TIP_DOT,
             ],
         },
     }
@@ -162,19 +246,40 @@ pub fn task_sensitivities(
                     Some(d_theta_dot_du),
                     Some(d_theta_ddot_du),
                     None,
+                    None,
+                    None,
                 ],
             }
         }
         super::TaskKind::Velocity => {
             let (d_theta_dot_du, d_theta_ddot_du) = velocity_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, Some(d_theta_dot_du), Some(d_theta_ddot_du), None],
+                d_du: [
+                    None,
+                    Some(d_theta_dot_du),
+                    Some(d_theta_ddot_du),
+                    None,
+                    None,
+                    None,
+                ],
             }
         }
         super::TaskKind::Acceleration => {
             let d_theta_ddot_du = acceleration_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, None, Some(d_theta_ddot_du), None],
+                d_du: [None, None, Some(d_theta_ddot_du), None, None, None],
+            }
+        }
+        super::TaskKind::TipPosition => {
+            let (d_tip_du, d_tip_dot_du) = tip_position_sensitivity(params);
+            super::TaskSensitivities {
+                d_du: [None, None, None, None, Some(d_tip_du), Some(d_tip_dot_du)],
+            }
+        }
+        super::TaskKind::TipVelocity => {
+            let d_tip_dot_du = tip_velocity_sensitivity(params);
+            super::TaskSensitivities {
+                d_du: [None, None, None, None, None, Some(d_tip_dot_du)],
             }
         }
     }
@@ -213,6 +318,17 @@ pub fn task_control_confidence(
             &precision[Term::ThetaDdot as usize],
             &precision[Term::U as usize],
         ),
+        super::TaskKind::TipPosition => tip_position_control_confidence(
+            params,
+            &precision[Term::Tip as usize],
+            &precision[Term::TipDot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::TipVelocity => tip_velocity_control_confidence(
+            params,
+            &precision[Term::TipDot as usize],
+            &precision[Term::U as usize],
+        ),
     }
 }
 
@@ -247,6 +363,17 @@ pub fn task_logdet_gradient(
         super::TaskKind::Acceleration => acceleration_logdet_gradient(
             params,
             &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::TipPosition => tip_position_logdet_gradient(
+            params,
+            &precision[Term::Tip as usize],
+            &precision[Term::TipDot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::TipVelocity => tip_velocity_logdet_gradient(
+            params,
+            &precision[Term::TipDot as usize],
             &precision[Term::U as usize],
         ),
     }
@@ -1141,6 +1268,316 @@ pub fn acceleration_logdet_gradient(
 ) -> SVector<f64, 4> {
     // d ln|Pi^U| / dp, one entry per tool parameter
     let gradient = <SVector<f64, 4>>::zeros();
+    gradient
+}
+
+/// Task 4 (tip position control): the sensitivities d(task variable)/dU the controller uses, in the order (d_tip_du, d_tip_dot_du).
+///
+/// From appendix "Task specific controllers".
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
+///
+/// Cost per call: 35 operations, weighted 52 (6 ADD, 2 DIV, 19 MUL, 2 NEG, 3 POW, 3 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_position_sensitivity(
+    params: &SVector<f64, 4>,
+) -> (SMatrix<f64, 2, 2>, SMatrix<f64, 2, 2>) {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let l1 = params[2];
+    let l2 = params[3];
+    let t0 = l1 * l2;
+    let t1 = 3.0 * t0;
+    let t2 = 6.0 * m2;
+    let t3 = l1.powi(2);
+    let t4 = 2.0 * m2;
+    let t5 = 1.0 / (3.0 * g * (m1 + t4));
+    let t6 = m2.powi(2);
+    let t7 = l2.powi(2);
+    // dtip/dU = J @ IO @ inv(A) @ (E - B)
+    let mut d_tip_du = <SMatrix<f64, 2, 2>>::zeros();
+    d_tip_du[(0, 0)] = -t5 * (m1 * t1 + 2.0 * m1 * t3 + t0 * t2 + t2 * t3 - 6.0);
+    d_tip_du[(0, 1)] = -t5 * (m1 * t4 * t7 - 6.0 * m1 + t1 * t6 - t2 + 4.0 * t6 * t7) / m2;
+    // dtip_dot/dU = J @ OI @ inv(A) @ (E - B)
+    let mut d_tip_dot_du = <SMatrix<f64, 2, 2>>::zeros();
+    d_tip_dot_du[(0, 0)] = l1;
+    d_tip_dot_du[(0, 1)] = l2;
+    (d_tip_du, d_tip_dot_du)
+}
+
+/// Task 4 (tip position control): the control confidence Pi^U = d2F/dU2 = S_tip^T P_tip S_tip + S_tip_dot^T P_tip_dot S_tip_dot + P_u.
+///
+/// From eq. (control_conf) and the closed forms after it.
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
+/// - `p_tip`: precision P of the tool tip's position tip (symmetric; the upper triangle is read)
+/// - `p_tip_dot`: precision P of the tool tip's velocity tip_dot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 49 operations, weighted 77 (12 ADD, 3 DIV, 24 MUL, 7 POW, 3 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_position_control_confidence(
+    params: &SVector<f64, 4>,
+    p_tip: &SMatrix<f64, 2, 2>,
+    p_tip_dot: &SMatrix<f64, 2, 2>,
+    p_u: &SMatrix<f64, 2, 2>,
+) -> SMatrix<f64, 2, 2> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let l1 = params[2];
+    let l2 = params[3];
+    let p_tip_00 = p_tip[(0, 0)];
+    let p_tip_dot_00 = p_tip_dot[(0, 0)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_11 = p_u[(1, 1)];
+    let t0 = l1.powi(2);
+    let t1 = l1 * l2;
+    let t2 = 3.0 * t1;
+    let t3 = 6.0 * m2;
+    let t4 = 2.0 * m1 * t0 + m1 * t2 + t0 * t3 + t1 * t3 - 6.0;
+    let t5 = 2.0 * m2;
+    let t6 = p_tip_00 / (9.0 * g.powi(2) * (m1 + t5).powi(2));
+    let t7 = m2.powi(2);
+    let t8 = l2.powi(2);
+    let t9 = m1 * t5 * t8 - 6.0 * m1 + t2 * t7 - t3 + 4.0 * t7 * t8;
+    // Pi^U (symmetric)
+    let mut pi_u = <SMatrix<f64, 2, 2>>::zeros();
+    pi_u[(0, 0)] = p_tip_dot_00 * t0 + p_u_00 + t4.powi(2) * t6;
+    pi_u[(0, 1)] = p_tip_dot_00 * t1 + p_u_01 + t4 * t6 * t9 / m2;
+    pi_u[(1, 1)] = p_tip_dot_00 * t8 + p_u_11 + t6 * t9.powi(2) / t7;
+    pi_u[(1, 0)] = pi_u[(0, 1)];
+    pi_u
+}
+
+/// Task 4 (tip position control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
+/// - `p_tip`: precision P of the tool tip's position tip (symmetric; the upper triangle is read)
+/// - `p_tip_dot`: precision P of the tool tip's velocity tip_dot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 218 operations, weighted 312 (48 ADD, 12 DIV, 129 MUL, 4 NEG, 10 POW, 15 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_position_logdet_gradient(
+    params: &SVector<f64, 4>,
+    p_tip: &SMatrix<f64, 2, 2>,
+    p_tip_dot: &SMatrix<f64, 2, 2>,
+    p_u: &SMatrix<f64, 2, 2>,
+) -> SVector<f64, 4> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let l1 = params[2];
+    let l2 = params[3];
+    let p_tip_00 = p_tip[(0, 0)];
+    let p_tip_dot_00 = p_tip_dot[(0, 0)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_11 = p_u[(1, 1)];
+    let t0 = l2 * p_tip_dot_00;
+    let t1 = l1.powi(2);
+    let t2 = 2.0 * t1;
+    let t3 = 6.0 * m2;
+    let t4 = l1 * l2;
+    let t5 = 3.0 * t4;
+    let t6 = t3 * t4 - 6.0;
+    let t7 = m1 * t2 + m1 * t5 + t1 * t3 + t6;
+    let t8 = g.powi(-2);
+    let t9 = p_tip_00 * t8;
+    let t10 = 2.0 * m2;
+    let t11 = m1 + t10;
+    let t12 = t11.powi(-2);
+    let t13 = t12 / 9.0;
+    let t14 = t13 * t9;
+    let t15 = t14 * t7;
+    let t16 = 1.0 / m2;
+    let t17 = 6.0 * m1;
+    let t18 = m2.powi(2);
+    let t19 = l2.powi(2);
+    let t20 = t10 * t19;
+    let t21 = 4.0 * t19;
+    let t22 = m1 * t20 - t17 + t18 * t21 + t18 * t5 - t3;
+    let t23 = t16 * t22;
+    let t24 = l1 * t0 + p_u_01 + t15 * t23;
+    let t25 = t7.powi(2) * t9;
+    let t26 = p_tip_dot_00 * t1 + p_u_00 + t13 * t25;
+    let t27 = 1.0 / t18;
+    let t28 = t22.powi(2);
+    let t29 = t27 * t28;
+    let t30 = p_tip_dot_00 * t19 + p_u_11 + t14 * t29;
+    let t31 = 1.0 / (-t24.powi(2) + t26 * t30);
+    let t32 = t11.powi(-3);
+    let t33 = t25 * t32;
+    let t34 = 6.0 * t4;
+    let t35 = (2.0 / 9.0) * t9;
+    let t36 = t29 * t32;
+    let t37 = t22 * t27;
+    let t38 = t14 * t37;
+    let t39 = t15 * t16;
+    let t40 = t14 * t23;
+    let t41 = t23 * t32 * t7;
+    let t42 = -2.0 * t24;
+    let t43 = 12.0 * t4;
+    let t44 = (4.0 / 9.0) * t9;
+    let t45 = m2 * t19;
+    let t46 = l2 * t12 * t9;
+    let t47 = l1 * p_tip_dot_00;
+    let t48 = l1 * m1;
+    let t49 = 12.0 * m2;
+    let t50 = l1 * t49;
+    let t51 = l2 * m1;
+    let t52 = m2 * t51;
+    let t53 = l1 * t18;
+    let t54 = l2 * t18;
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 4>>::zeros();
+    gradient[0] = t31
+        * (t26 * (-t35 * t36 + t38 * (m2 * t21 - 12.0))
+            + t30 * (t15 * (4.0 * t1 + t34) - (2.0 / 9.0) * t33)
+            + t42 * (-t35 * t41 + t39 * (t20 - 6.0) + t40 * (t2 + t5)));
+    gradient[1] = t31
+        * (t26
+            * (p_tip_00 * t12 * t22 * t27 * t8 * (m1 * t21 + m2 * t43 + 16.0 * t45 - 12.0) / 9.0
+                - t36 * t44
+                - t12 * t28 * t35 / m2.powi(3))
+            + t30 * (t15 * (12.0 * t1 + t43) - (4.0 / 9.0) * t33)
+            + t42
+                * (-t15 * t37 + t39 * (2.0 * m1 * t19 + 8.0 * t45 + t6) + t40 * (6.0 * t1 + t34)
+                    - t41 * t44));
+    gradient[2] = t31
+        * ((2.0 / 3.0) * t22 * t26 * t46
+            + t30 * (t15 * (24.0 * l1 * m2 + l2 * t17 + l2 * t49 + 8.0 * t48) + 2.0 * t47)
+            + t42 * (m2 * t46 * t7 / 3.0 + t0 + t40 * (l2 * t3 + 4.0 * t48 + t50 + 3.0 * t51)));
+    gradient[3] = t31
+        * (t15 * t30 * (l1 * t17 + t50)
+            + t26 * (2.0 * t0 + t38 * (8.0 * t52 + 6.0 * t53 + 16.0 * t54))
+            + t42
+                * (t39 * (4.0 * t52 + 3.0 * t53 + 8.0 * t54) + t40 * (l1 * t3 + 3.0 * t48) + t47));
+    gradient
+}
+
+/// Task 5 (tip velocity control): the sensitivities d(task variable)/dU the controller uses, in the order (d_tip_dot_du).
+///
+/// From appendix "Task specific controllers".
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
+///
+/// Cost per call: 7 operations, weighted 21 (2 ADD, 2 DIV, 3 MUL).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_velocity_sensitivity(params: &SVector<f64, 4>) -> SMatrix<f64, 2, 2> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let t0 = 2.0 / (g * (m1 + 2.0 * m2));
+    // dtip_dot/dU = -J @ IO @ inv(A) @ B
+    let mut d_tip_dot_du = <SMatrix<f64, 2, 2>>::zeros();
+    d_tip_dot_du[(0, 0)] = t0;
+    d_tip_dot_du[(0, 1)] = t0 * (m1 + m2) / m2;
+    d_tip_dot_du
+}
+
+/// Task 5 (tip velocity control): the control confidence Pi^U = d2F/dU2 = S_tip_dot^T P_tip_dot S_tip_dot + P_u.
+///
+/// From eq. (control_conf) and the closed forms after it.
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
+/// - `p_tip_dot`: precision P of the tool tip's velocity tip_dot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 17 operations, weighted 42 (5 ADD, 3 DIV, 5 MUL, 4 POW).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_velocity_control_confidence(
+    params: &SVector<f64, 4>,
+    p_tip_dot: &SMatrix<f64, 2, 2>,
+    p_u: &SMatrix<f64, 2, 2>,
+) -> SMatrix<f64, 2, 2> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let p_tip_dot_00 = p_tip_dot[(0, 0)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_11 = p_u[(1, 1)];
+    let t0 = 4.0 * p_tip_dot_00 / (g.powi(2) * (m1 + 2.0 * m2).powi(2));
+    let t1 = m1 + m2;
+    // Pi^U (symmetric)
+    let mut pi_u = <SMatrix<f64, 2, 2>>::zeros();
+    pi_u[(0, 0)] = p_u_00 + t0;
+    pi_u[(0, 1)] = p_u_01 + t0 * t1 / m2;
+    pi_u[(1, 1)] = p_u_11 + t0 * t1.powi(2) / m2.powi(2);
+    pi_u[(1, 0)] = pi_u[(0, 1)];
+    pi_u
+}
+
+/// Task 5 (tip velocity control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2]`
+/// - `p_tip_dot`: precision P of the tool tip's velocity tip_dot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 78 operations, weighted 113 (8 ADD, 4 DIV, 40 MUL, 10 NEG, 7 POW, 9 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_velocity_logdet_gradient(
+    params: &SVector<f64, 4>,
+    p_tip_dot: &SMatrix<f64, 2, 2>,
+    p_u: &SMatrix<f64, 2, 2>,
+) -> SVector<f64, 4> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let p_tip_dot_00 = p_tip_dot[(0, 0)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_11 = p_u[(1, 1)];
+    let t0 = m1 + m2;
+    let t1 = 1.0 / m2;
+    let t2 = 2.0 * m2;
+    let t3 = m1 + t2;
+    let t4 = t3.powi(-2);
+    let t5 = g.powi(-2);
+    let t6 = p_tip_dot_00 * t5;
+    let t7 = t4 * t6;
+    let t8 = 4.0 * t7;
+    let t9 = p_u_01 + t0 * t1 * t8;
+    let t10 = p_u_00 + t8;
+    let t11 = m2.powi(-2);
+    let t12 = t0.powi(2);
+    let t13 = t11 * t12;
+    let t14 = p_u_11 + t13 * t8;
+    let t15 = 1.0 / (t10 * t14 - t9.powi(2));
+    let t16 = t6 / t3.powi(3);
+    let t17 = t14 * t16;
+    let t18 = 8.0 * t16;
+    let t19 = -4.0 * p_tip_dot_00 * t11 * t4 * t5 * (2.0 * m1 + t2);
+    let t20 = -4.0 * p_tip_dot_00 * t1 * t4 * t5;
+    let t21 = t0 * t1;
+    let t22 = -2.0 * t9;
+    let t23 = 16.0 * t16;
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 4>>::zeros();
+    gradient[0] = t15 * (t10 * (-t13 * t18 - t19) - 8.0 * t17 + t22 * (-t18 * t21 - t20));
+    gradient[1] = t15
+        * (t10 * (-t13 * t23 - t19 - 8.0 * t12 * t7 / m2.powi(3)) - 16.0 * t17
+            + t22 * (-t0 * t11 * t8 - t20 - t21 * t23));
     gradient
 }
 

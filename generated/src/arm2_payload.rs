@@ -22,6 +22,10 @@ pub const NAME: &str = "arm2_payload";
 pub const DOF: usize = 2;
 /// Dimension of the state X = [q; q_dot].
 pub const STATE_DIM: usize = 4;
+/// Components of the tool's tip the tip terms use (x, y, z in the base frame, the first
+/// TIP_DIM of them): a tip term's goal, precision and sensitivity fill the first TIP_DIM of
+/// the DOF rows, zero in the others.
+pub const TIP_DIM: usize = 2;
 /// Number of tool parameters.
 pub const PARAMETER_COUNT: usize = 5;
 /// Tool parameters, in the order every function takes them.
@@ -95,6 +99,38 @@ pub mod acceleration {
     pub const PRECISION_U: f64 = 0.0;
 }
 
+/// Task 4 (tip position control): the paper's default goals and precisions ("Implementation details").
+pub mod tip_position {
+    #[allow(unused_imports)]
+    use super::PI;
+    /// Free-energy terms the controller uses (eq. U_dot_deriv).
+    pub const TERMS: [&str; 3] = ["tip", "tip_dot", "u"];
+    /// Default goal for `tip`.
+    pub const GOAL_TIP: [f64; 2] = [0.08, -0.69];
+    /// Default goal for `tip_dot`.
+    pub const GOAL_TIP_DOT: [f64; 2] = [0.0, 0.0];
+    /// Default precision for `tip`: P = 100.0 I.
+    pub const PRECISION_TIP: f64 = 100.0;
+    /// Default precision for `tip_dot`: P = 50.0 I.
+    pub const PRECISION_TIP_DOT: f64 = 50.0;
+    /// Default precision for `u`: P = 1.0 I.
+    pub const PRECISION_U: f64 = 1.0;
+}
+
+/// Task 5 (tip velocity control): the paper's default goals and precisions ("Implementation details").
+pub mod tip_velocity {
+    #[allow(unused_imports)]
+    use super::PI;
+    /// Free-energy terms the controller uses (eq. U_dot_deriv).
+    pub const TERMS: [&str; 2] = ["tip_dot", "u"];
+    /// Default goal for `tip_dot`.
+    pub const GOAL_TIP_DOT: [f64; 2] = [0.1, 0.0];
+    /// Default precision for `tip_dot`: P = 50.0 I.
+    pub const PRECISION_TIP_DOT: f64 = 50.0;
+    /// Default precision for `u`: P = 1.0 I.
+    pub const PRECISION_U: f64 = 1.0;
+}
+
 /// The default goals and precisions of `task` for this model (the modules above); zero for a
 /// term the task does not use.
 #[must_use]
@@ -106,12 +142,16 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 position::GOAL_THETA_DOT,
                 position::GOAL_THETA_DDOT,
                 [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 position::PRECISION_THETA,
                 position::PRECISION_THETA_DOT,
                 position::PRECISION_THETA_DDOT,
                 position::PRECISION_U,
+                0.0,
+                0.0,
             ],
         },
         super::TaskKind::Velocity => super::TaskDefaults {
@@ -120,12 +160,16 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 velocity::GOAL_THETA_DOT,
                 velocity::GOAL_THETA_DDOT,
                 [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
                 velocity::PRECISION_THETA_DOT,
                 velocity::PRECISION_THETA_DDOT,
                 velocity::PRECISION_U,
+                0.0,
+                0.0,
             ],
         },
         super::TaskKind::Acceleration => super::TaskDefaults {
@@ -134,12 +178,52 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 acceleration::GOAL_THETA_DDOT,
                 [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
                 0.0,
                 acceleration::PRECISION_THETA_DDOT,
                 acceleration::PRECISION_U,
+                0.0,
+                0.0,
+            ],
+        },
+        super::TaskKind::TipPosition => super::TaskDefaults {
+            goal: [
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                tip_position::GOAL_TIP,
+                tip_position::GOAL_TIP_DOT,
+            ],
+            precision: [
+                0.0,
+                0.0,
+                0.0,
+                tip_position::PRECISION_U,
+                tip_position::PRECISION_TIP,
+                tip_position::PRECISION_TIP_DOT,
+            ],
+        },
+        super::TaskKind::TipVelocity => super::TaskDefaults {
+            goal: [
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                tip_velocity::GOAL_TIP_DOT,
+            ],
+            precision: [
+                0.0,
+                0.0,
+                0.0,
+                tip_velocity::PRECISION_U,
+                0.0,
+                tip_velocity::PRECISION_TIP_DOT,
             ],
         },
     }
@@ -162,19 +246,40 @@ pub fn task_sensitivities(
                     Some(d_theta_dot_du),
                     Some(d_theta_ddot_du),
                     None,
+                    None,
+                    None,
                 ],
             }
         }
         super::TaskKind::Velocity => {
             let (d_theta_dot_du, d_theta_ddot_du) = velocity_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, Some(d_theta_dot_du), Some(d_theta_ddot_du), None],
+                d_du: [
+                    None,
+                    Some(d_theta_dot_du),
+                    Some(d_theta_ddot_du),
+                    None,
+                    None,
+                    None,
+                ],
             }
         }
         super::TaskKind::Acceleration => {
             let d_theta_ddot_du = acceleration_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, None, Some(d_theta_ddot_du), None],
+                d_du: [None, None, Some(d_theta_ddot_du), None, None, None],
+            }
+        }
+        super::TaskKind::TipPosition => {
+            let (d_tip_du, d_tip_dot_du) = tip_position_sensitivity(params);
+            super::TaskSensitivities {
+                d_du: [None, None, None, None, Some(d_tip_du), Some(d_tip_dot_du)],
+            }
+        }
+        super::TaskKind::TipVelocity => {
+            let d_tip_dot_du = tip_velocity_sensitivity(params);
+            super::TaskSensitivities {
+                d_du: [None, None, None, None, None, Some(d_tip_dot_du)],
             }
         }
     }
@@ -213,6 +318,17 @@ pub fn task_control_confidence(
             &precision[Term::ThetaDdot as usize],
             &precision[Term::U as usize],
         ),
+        super::TaskKind::TipPosition => tip_position_control_confidence(
+            params,
+            &precision[Term::Tip as usize],
+            &precision[Term::TipDot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::TipVelocity => tip_velocity_control_confidence(
+            params,
+            &precision[Term::TipDot as usize],
+            &precision[Term::U as usize],
+        ),
     }
 }
 
@@ -247,6 +363,17 @@ pub fn task_logdet_gradient(
         super::TaskKind::Acceleration => acceleration_logdet_gradient(
             params,
             &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::TipPosition => tip_position_logdet_gradient(
+            params,
+            &precision[Term::Tip as usize],
+            &precision[Term::TipDot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::TipVelocity => tip_velocity_logdet_gradient(
+            params,
+            &precision[Term::TipDot as usize],
             &precision[Term::U as usize],
         ),
     }
@@ -1262,6 +1389,423 @@ pub fn acceleration_logdet_gradient(
 ) -> SVector<f64, 5> {
     // d ln|Pi^U| / dp, one entry per tool parameter
     let gradient = <SVector<f64, 5>>::zeros();
+    gradient
+}
+
+/// Task 4 (tip position control): the sensitivities d(task variable)/dU the controller uses, in the order (d_tip_du, d_tip_dot_du).
+///
+/// From appendix "Task specific controllers".
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
+///
+/// Cost per call: 59 operations, weighted 77 (15 ADD, 2 DIV, 33 MUL, 2 NEG, 4 POW, 3 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_position_sensitivity(
+    params: &SVector<f64, 5>,
+) -> (SMatrix<f64, 2, 2>, SMatrix<f64, 2, 2>) {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let l1 = params[2];
+    let l2 = params[3];
+    let mp = params[4];
+    let t0 = l1 * l2;
+    let t1 = 3.0 * t0;
+    let t2 = 6.0 * m2;
+    let t3 = 6.0 * mp;
+    let t4 = l1.powi(2);
+    let t5 = 2.0 * m2;
+    let t6 = 2.0 * mp;
+    let t7 = 1.0 / (3.0 * g * (m1 + t5 + t6));
+    let t8 = 6.0 * m1;
+    let t9 = m2.powi(2);
+    let t10 = 12.0 * mp.powi(2);
+    let t11 = l2.powi(2);
+    let t12 = mp * t11;
+    // dtip/dU = J @ IO @ inv(A) @ (E - B)
+    let mut d_tip_du = <SMatrix<f64, 2, 2>>::zeros();
+    d_tip_du[(0, 0)] =
+        -t7 * (m1 * t1 + 2.0 * m1 * t4 + t0 * t2 + t0 * t3 + t2 * t4 + t3 * t4 - 6.0);
+    d_tip_du[(0, 1)] = -t7
+        * (m1 * t11 * t5
+            + 12.0 * m2 * mp * t0
+            + 16.0 * m2 * t12
+            + t0 * t10
+            + t1 * t9
+            + t10 * t11
+            + 4.0 * t11 * t9
+            + t12 * t8
+            - t2
+            - t8)
+        / (m2 + t6);
+    // dtip_dot/dU = J @ OI @ inv(A) @ (E - B)
+    let mut d_tip_dot_du = <SMatrix<f64, 2, 2>>::zeros();
+    d_tip_dot_du[(0, 0)] = l1;
+    d_tip_dot_du[(0, 1)] = l2;
+    (d_tip_du, d_tip_dot_du)
+}
+
+/// Task 4 (tip position control): the control confidence Pi^U = d2F/dU2 = S_tip^T P_tip S_tip + S_tip_dot^T P_tip_dot S_tip_dot + P_u.
+///
+/// From eq. (control_conf) and the closed forms after it.
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
+/// - `p_tip`: precision P of the tool tip's position tip (symmetric; the upper triangle is read)
+/// - `p_tip_dot`: precision P of the tool tip's velocity tip_dot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 74 operations, weighted 104 (21 ADD, 3 DIV, 38 MUL, 9 POW, 3 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_position_control_confidence(
+    params: &SVector<f64, 5>,
+    p_tip: &SMatrix<f64, 2, 2>,
+    p_tip_dot: &SMatrix<f64, 2, 2>,
+    p_u: &SMatrix<f64, 2, 2>,
+) -> SMatrix<f64, 2, 2> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let l1 = params[2];
+    let l2 = params[3];
+    let mp = params[4];
+    let p_tip_00 = p_tip[(0, 0)];
+    let p_tip_dot_00 = p_tip_dot[(0, 0)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_11 = p_u[(1, 1)];
+    let t0 = l1.powi(2);
+    let t1 = l1 * l2;
+    let t2 = 3.0 * t1;
+    let t3 = 6.0 * m2;
+    let t4 = 6.0 * mp;
+    let t5 = 2.0 * m1 * t0 + m1 * t2 + t0 * t3 + t0 * t4 + t1 * t3 + t1 * t4 - 6.0;
+    let t6 = 2.0 * m2;
+    let t7 = 2.0 * mp;
+    let t8 = p_tip_00 / (9.0 * g.powi(2) * (m1 + t6 + t7).powi(2));
+    let t9 = m2 + t7;
+    let t10 = 6.0 * m1;
+    let t11 = m2.powi(2);
+    let t12 = 12.0 * mp.powi(2);
+    let t13 = l2.powi(2);
+    let t14 = mp * t13;
+    let t15 = m1 * t13 * t6 + 12.0 * m2 * mp * t1 + 16.0 * m2 * t14 + t1 * t12 + t10 * t14 - t10
+        + 4.0 * t11 * t13
+        + t11 * t2
+        + t12 * t13
+        - t3;
+    // Pi^U (symmetric)
+    let mut pi_u = <SMatrix<f64, 2, 2>>::zeros();
+    pi_u[(0, 0)] = p_tip_dot_00 * t0 + p_u_00 + t5.powi(2) * t8;
+    pi_u[(0, 1)] = p_tip_dot_00 * t1 + p_u_01 + t15 * t5 * t8 / t9;
+    pi_u[(1, 1)] = p_tip_dot_00 * t13 + p_u_11 + t15.powi(2) * t8 / t9.powi(2);
+    pi_u[(1, 0)] = pi_u[(0, 1)];
+    pi_u
+}
+
+/// Task 4 (tip position control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
+/// - `p_tip`: precision P of the tool tip's position tip (symmetric; the upper triangle is read)
+/// - `p_tip_dot`: precision P of the tool tip's velocity tip_dot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 327 operations, weighted 409 (91 ADD, 10 DIV, 191 MUL, 5 NEG, 12 POW, 18 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_position_logdet_gradient(
+    params: &SVector<f64, 5>,
+    p_tip: &SMatrix<f64, 2, 2>,
+    p_tip_dot: &SMatrix<f64, 2, 2>,
+    p_u: &SMatrix<f64, 2, 2>,
+) -> SVector<f64, 5> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let l1 = params[2];
+    let l2 = params[3];
+    let mp = params[4];
+    let p_tip_00 = p_tip[(0, 0)];
+    let p_tip_dot_00 = p_tip_dot[(0, 0)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_11 = p_u[(1, 1)];
+    let t0 = l2 * p_tip_dot_00;
+    let t1 = l1.powi(2);
+    let t2 = 2.0 * t1;
+    let t3 = 6.0 * m2;
+    let t4 = 6.0 * t1;
+    let t5 = l1 * l2;
+    let t6 = 3.0 * t5;
+    let t7 = 6.0 * t5;
+    let t8 = t3 * t5 - 6.0;
+    let t9 = m1 * t2 + m1 * t6 + mp * t4 + mp * t7 + t1 * t3 + t8;
+    let t10 = g.powi(-2);
+    let t11 = p_tip_00 * t10;
+    let t12 = 2.0 * m2;
+    let t13 = 2.0 * mp;
+    let t14 = m1 + t12 + t13;
+    let t15 = t14.powi(-2);
+    let t16 = t15 / 9.0;
+    let t17 = t11 * t16;
+    let t18 = t17 * t9;
+    let t19 = m2 + t13;
+    let t20 = 1.0 / t19;
+    let t21 = 6.0 * m1;
+    let t22 = 12.0 * t5;
+    let t23 = m2 * t22;
+    let t24 = m2.powi(2);
+    let t25 = mp.powi(2);
+    let t26 = l2.powi(2);
+    let t27 = t12 * t26;
+    let t28 = mp * t26;
+    let t29 = 16.0 * t28;
+    let t30 = 4.0 * t26;
+    let t31 = 12.0 * t26;
+    let t32 = m1 * t27 + m2 * t29 + mp * t23 + t21 * t28 - t21
+        + t22 * t25
+        + t24 * t30
+        + t24 * t6
+        + t25 * t31
+        - t3;
+    let t33 = t20 * t32;
+    let t34 = l1 * t0 + p_u_01 + t18 * t33;
+    let t35 = t11 * t9.powi(2);
+    let t36 = p_tip_dot_00 * t1 + p_u_00 + t16 * t35;
+    let t37 = t19.powi(-2);
+    let t38 = t32.powi(2);
+    let t39 = t37 * t38;
+    let t40 = p_tip_dot_00 * t26 + p_u_11 + t17 * t39;
+    let t41 = 1.0 / (-t34.powi(2) + t36 * t40);
+    let t42 = t14.powi(-3);
+    let t43 = t35 * t42;
+    let t44 = (2.0 / 9.0) * t11;
+    let t45 = t39 * t42;
+    let t46 = t32 * t37;
+    let t47 = t17 * t46;
+    let t48 = t18 * t20;
+    let t49 = t17 * t33;
+    let t50 = t33 * t42 * t9;
+    let t51 = -2.0 * t34;
+    let t52 = t40 * (t18 * (12.0 * t1 + t22) - (4.0 / 9.0) * t43);
+    let t53 = t15 * t44;
+    let t54 = t38 / t19.powi(3);
+    let t55 = (4.0 / 9.0) * t11;
+    let t56 = t45 * t55;
+    let t57 = m2 * t26;
+    let t58 = 24.0 * mp;
+    let t59 = t23 + t5 * t58 + 16.0 * t57;
+    let t60 = t49 * (t4 + t7) - t50 * t55;
+    let t61 = l2 * m2;
+    let t62 = 6.0 * l2;
+    let t63 = l2 * t25;
+    let t64 = 24.0 * t63;
+    let t65 = l1 * p_tip_dot_00;
+    let t66 = l1 * m1;
+    let t67 = 24.0 * l1;
+    let t68 = m2 * t67;
+    let t69 = 12.0 * l2;
+    let t70 = m2 * t69;
+    let t71 = mp * t69;
+    let t72 = 3.0 * l2;
+    let t73 = 12.0 * l1;
+    let t74 = m2 * t73;
+    let t75 = mp * t73 + t74;
+    let t76 = m1 * t61;
+    let t77 = mp * t61;
+    let t78 = 6.0 * l1;
+    let t79 = l2 * t24;
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 5>>::zeros();
+    gradient[0] = t41
+        * (t36 * (-t44 * t45 + t47 * (m2 * t30 + mp * t31 - 12.0))
+            + t40 * (t18 * (4.0 * t1 + t7) - (2.0 / 9.0) * t43)
+            + t51 * (-t44 * t50 + t48 * (t27 + 6.0 * t28 - 6.0) + t49 * (t2 + t6)));
+    gradient[1] = t41
+        * (t36
+            * (p_tip_00 * t10 * t15 * t32 * t37 * (m1 * t30 + 32.0 * t28 + t59 - 12.0) / 9.0
+                - t53 * t54
+                - t56)
+            + t51 * (-t18 * t46 + t48 * (2.0 * m1 * t26 + mp * t22 + t29 + 8.0 * t57 + t8) + t60)
+            + t52);
+    gradient[2] = t41
+        * (t36 * t47 * (t24 * t62 + t58 * t61 + t64)
+            + t40 * (t18 * (l2 * t21 + mp * t67 + 8.0 * t66 + t68 + t70 + t71) + 2.0 * t65)
+            + t51
+                * (t0
+                    + t48 * (mp * t70 + t24 * t72 + t25 * t69)
+                    + t49 * (l2 * t3 + m1 * t72 + mp * t62 + 4.0 * t66 + t75)));
+    gradient[3] = t41
+        * (t18 * t40 * (l1 * t21 + t75)
+            + t36
+                * (2.0 * t0
+                    + t47
+                        * (l2 * m1 * t58
+                            + mp * t68
+                            + t24 * t78
+                            + t25 * t67
+                            + 48.0 * t63
+                            + 8.0 * t76
+                            + 64.0 * t77
+                            + 16.0 * t79))
+            + t51
+                * (t48
+                    * (3.0 * l1 * t24
+                        + m1 * t71
+                        + mp * t74
+                        + t25 * t73
+                        + t64
+                        + 4.0 * t76
+                        + 32.0 * t77
+                        + 8.0 * t79)
+                    + t49 * (l1 * t3 + mp * t78 + 3.0 * t66)
+                    + t65));
+    gradient[4] = t41
+        * (t36
+            * (p_tip_00
+                * t10
+                * t15
+                * t32
+                * t37
+                * (m1 * t31 + 24.0 * m2 * t5 + 48.0 * mp * t5 + 48.0 * t28 + 32.0 * t57)
+                / 9.0
+                - t15 * t54 * t55
+                - t56)
+            + t51 * (-t46 * t53 * t9 + t48 * (t21 * t26 + 24.0 * t28 + t59) + t60)
+            + t52);
+    gradient
+}
+
+/// Task 5 (tip velocity control): the sensitivities d(task variable)/dU the controller uses, in the order (d_tip_dot_du).
+///
+/// From appendix "Task specific controllers".
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
+///
+/// Cost per call: 10 operations, weighted 24 (4 ADD, 2 DIV, 4 MUL).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_velocity_sensitivity(params: &SVector<f64, 5>) -> SMatrix<f64, 2, 2> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let mp = params[4];
+    let t0 = 2.0 * mp;
+    let t1 = 2.0 / (g * (m1 + 2.0 * m2 + t0));
+    // dtip_dot/dU = -J @ IO @ inv(A) @ B
+    let mut d_tip_dot_du = <SMatrix<f64, 2, 2>>::zeros();
+    d_tip_dot_du[(0, 0)] = t1;
+    d_tip_dot_du[(0, 1)] = t1 * (m1 + m2) / (m2 + t0);
+    d_tip_dot_du
+}
+
+/// Task 5 (tip velocity control): the control confidence Pi^U = d2F/dU2 = S_tip_dot^T P_tip_dot S_tip_dot + P_u.
+///
+/// From eq. (control_conf) and the closed forms after it.
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
+/// - `p_tip_dot`: precision P of the tool tip's velocity tip_dot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 20 operations, weighted 45 (7 ADD, 3 DIV, 6 MUL, 4 POW).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_velocity_control_confidence(
+    params: &SVector<f64, 5>,
+    p_tip_dot: &SMatrix<f64, 2, 2>,
+    p_u: &SMatrix<f64, 2, 2>,
+) -> SMatrix<f64, 2, 2> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let mp = params[4];
+    let p_tip_dot_00 = p_tip_dot[(0, 0)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_11 = p_u[(1, 1)];
+    let t0 = 2.0 * mp;
+    let t1 = 4.0 * p_tip_dot_00 / (g.powi(2) * (m1 + 2.0 * m2 + t0).powi(2));
+    let t2 = m2 + t0;
+    let t3 = m1 + m2;
+    // Pi^U (symmetric)
+    let mut pi_u = <SMatrix<f64, 2, 2>>::zeros();
+    pi_u[(0, 0)] = p_u_00 + t1;
+    pi_u[(0, 1)] = p_u_01 + t1 * t3 / t2;
+    pi_u[(1, 1)] = p_u_11 + t1 * t3.powi(2) / t2.powi(2);
+    pi_u[(1, 0)] = pi_u[(0, 1)];
+    pi_u
+}
+
+/// Task 5 (tip velocity control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
+/// - `p_tip_dot`: precision P of the tool tip's velocity tip_dot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 95 operations, weighted 130 (13 ADD, 4 DIV, 48 MUL, 13 NEG, 7 POW, 10 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_velocity_logdet_gradient(
+    params: &SVector<f64, 5>,
+    p_tip_dot: &SMatrix<f64, 2, 2>,
+    p_u: &SMatrix<f64, 2, 2>,
+) -> SVector<f64, 5> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let mp = params[4];
+    let p_tip_dot_00 = p_tip_dot[(0, 0)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_11 = p_u[(1, 1)];
+    let t0 = m1 + m2;
+    let t1 = 2.0 * mp;
+    let t2 = m2 + t1;
+    let t3 = 1.0 / t2;
+    let t4 = 2.0 * m2;
+    let t5 = m1 + t1 + t4;
+    let t6 = t5.powi(-2);
+    let t7 = g.powi(-2);
+    let t8 = p_tip_dot_00 * t7;
+    let t9 = t6 * t8;
+    let t10 = 4.0 * t9;
+    let t11 = p_u_01 + t0 * t10 * t3;
+    let t12 = p_u_00 + t10;
+    let t13 = t0.powi(2);
+    let t14 = t2.powi(-2);
+    let t15 = t13 * t14;
+    let t16 = p_u_11 + t10 * t15;
+    let t17 = 1.0 / (-t11.powi(2) + t12 * t16);
+    let t18 = t8 / t5.powi(3);
+    let t19 = t16 * t18;
+    let t20 = 8.0 * t18;
+    let t21 = -4.0 * p_tip_dot_00 * t14 * t6 * t7 * (2.0 * m1 + t4);
+    let t22 = -4.0 * p_tip_dot_00 * t3 * t6 * t7;
+    let t23 = t0 * t3;
+    let t24 = -2.0 * t11;
+    let t25 = -16.0 * t19;
+    let t26 = 8.0 * t9;
+    let t27 = t13 / t2.powi(3);
+    let t28 = 16.0 * t18;
+    let t29 = t15 * t28;
+    let t30 = t23 * t28;
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 5>>::zeros();
+    gradient[0] = t17 * (t12 * (-t15 * t20 - t21) - 8.0 * t19 + t24 * (-t20 * t23 - t22));
+    gradient[1] =
+        t17 * (t12 * (-t21 - t26 * t27 - t29) + t24 * (-t0 * t10 * t14 - t22 - t30) + t25);
+    gradient[4] = t17 * (t12 * (-16.0 * t27 * t9 - t29) + t24 * (-t0 * t14 * t26 - t30) + t25);
     gradient
 }
 

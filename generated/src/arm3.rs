@@ -22,6 +22,10 @@ pub const NAME: &str = "arm3";
 pub const DOF: usize = 3;
 /// Dimension of the state X = [q; q_dot].
 pub const STATE_DIM: usize = 6;
+/// Components of the tool's tip the tip terms use (x, y, z in the base frame, the first
+/// TIP_DIM of them): a tip term's goal, precision and sensitivity fill the first TIP_DIM of
+/// the DOF rows, zero in the others.
+pub const TIP_DIM: usize = 2;
 /// Number of tool parameters.
 pub const PARAMETER_COUNT: usize = 6;
 /// Tool parameters, in the order every function takes them.
@@ -102,6 +106,38 @@ pub mod acceleration {
     pub const PRECISION_U: f64 = 0.0;
 }
 
+/// Task 4 (tip position control): the paper's default goals and precisions ("Implementation details").
+pub mod tip_position {
+    #[allow(unused_imports)]
+    use super::PI;
+    /// Free-energy terms the controller uses (eq. U_dot_deriv).
+    pub const TERMS: [&str; 3] = ["tip", "tip_dot", "u"];
+    /// Default goal for `tip`.
+    pub const GOAL_TIP: [f64; 3] = [0.08, -1.04, 0.0];
+    /// Default goal for `tip_dot`.
+    pub const GOAL_TIP_DOT: [f64; 3] = [0.0, 0.0, 0.0];
+    /// Default precision for `tip`: P = 100.0 I.
+    pub const PRECISION_TIP: f64 = 100.0;
+    /// Default precision for `tip_dot`: P = 50.0 I.
+    pub const PRECISION_TIP_DOT: f64 = 50.0;
+    /// Default precision for `u`: P = 1.0 I.
+    pub const PRECISION_U: f64 = 1.0;
+}
+
+/// Task 5 (tip velocity control): the paper's default goals and precisions ("Implementation details").
+pub mod tip_velocity {
+    #[allow(unused_imports)]
+    use super::PI;
+    /// Free-energy terms the controller uses (eq. U_dot_deriv).
+    pub const TERMS: [&str; 2] = ["tip_dot", "u"];
+    /// Default goal for `tip_dot`.
+    pub const GOAL_TIP_DOT: [f64; 3] = [0.1, 0.0, 0.0];
+    /// Default precision for `tip_dot`: P = 50.0 I.
+    pub const PRECISION_TIP_DOT: f64 = 50.0;
+    /// Default precision for `u`: P = 1.0 I.
+    pub const PRECISION_U: f64 = 1.0;
+}
+
 /// The default goals and precisions of `task` for this model (the modules above); zero for a
 /// term the task does not use.
 #[must_use]
@@ -113,12 +149,16 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 position::GOAL_THETA_DOT,
                 position::GOAL_THETA_DDOT,
                 [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 position::PRECISION_THETA,
                 position::PRECISION_THETA_DOT,
                 position::PRECISION_THETA_DDOT,
                 position::PRECISION_U,
+                0.0,
+                0.0,
             ],
         },
         super::TaskKind::Velocity => super::TaskDefaults {
@@ -127,12 +167,16 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 velocity::GOAL_THETA_DOT,
                 velocity::GOAL_THETA_DDOT,
                 [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
                 velocity::PRECISION_THETA_DOT,
                 velocity::PRECISION_THETA_DDOT,
                 velocity::PRECISION_U,
+                0.0,
+                0.0,
             ],
         },
         super::TaskKind::Acceleration => super::TaskDefaults {
@@ -141,12 +185,52 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 acceleration::GOAL_THETA_DDOT,
                 [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
                 0.0,
                 acceleration::PRECISION_THETA_DDOT,
                 acceleration::PRECISION_U,
+                0.0,
+                0.0,
+            ],
+        },
+        super::TaskKind::TipPosition => super::TaskDefaults {
+            goal: [
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                tip_position::GOAL_TIP,
+                tip_position::GOAL_TIP_DOT,
+            ],
+            precision: [
+                0.0,
+                0.0,
+                0.0,
+                tip_position::PRECISION_U,
+                tip_position::PRECISION_TIP,
+                tip_position::PRECISION_TIP_DOT,
+            ],
+        },
+        super::TaskKind::TipVelocity => super::TaskDefaults {
+            goal: [
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                tip_velocity::GOAL_TIP_DOT,
+            ],
+            precision: [
+                0.0,
+                0.0,
+                0.0,
+                tip_velocity::PRECISION_U,
+                0.0,
+                tip_velocity::PRECISION_TIP_DOT,
             ],
         },
     }
@@ -169,19 +253,40 @@ pub fn task_sensitivities(
                     Some(d_theta_dot_du),
                     Some(d_theta_ddot_du),
                     None,
+                    None,
+                    None,
                 ],
             }
         }
         super::TaskKind::Velocity => {
             let (d_theta_dot_du, d_theta_ddot_du) = velocity_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, Some(d_theta_dot_du), Some(d_theta_ddot_du), None],
+                d_du: [
+                    None,
+                    Some(d_theta_dot_du),
+                    Some(d_theta_ddot_du),
+                    None,
+                    None,
+                    None,
+                ],
             }
         }
         super::TaskKind::Acceleration => {
             let d_theta_ddot_du = acceleration_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, None, Some(d_theta_ddot_du), None],
+                d_du: [None, None, Some(d_theta_ddot_du), None, None, None],
+            }
+        }
+        super::TaskKind::TipPosition => {
+            let (d_tip_du, d_tip_dot_du) = tip_position_sensitivity(params);
+            super::TaskSensitivities {
+                d_du: [None, None, None, None, Some(d_tip_du), Some(d_tip_dot_du)],
+            }
+        }
+        super::TaskKind::TipVelocity => {
+            let d_tip_dot_du = tip_velocity_sensitivity(params);
+            super::TaskSensitivities {
+                d_du: [None, None, None, None, None, Some(d_tip_dot_du)],
             }
         }
     }
@@ -220,6 +325,17 @@ pub fn task_control_confidence(
             &precision[Term::ThetaDdot as usize],
             &precision[Term::U as usize],
         ),
+        super::TaskKind::TipPosition => tip_position_control_confidence(
+            params,
+            &precision[Term::Tip as usize],
+            &precision[Term::TipDot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::TipVelocity => tip_velocity_control_confidence(
+            params,
+            &precision[Term::TipDot as usize],
+            &precision[Term::U as usize],
+        ),
     }
 }
 
@@ -254,6 +370,17 @@ pub fn task_logdet_gradient(
         super::TaskKind::Acceleration => acceleration_logdet_gradient(
             params,
             &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::TipPosition => tip_position_logdet_gradient(
+            params,
+            &precision[Term::Tip as usize],
+            &precision[Term::TipDot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::TipVelocity => tip_velocity_logdet_gradient(
+            params,
+            &precision[Term::TipDot as usize],
             &precision[Term::U as usize],
         ),
     }
@@ -2070,6 +2197,849 @@ pub fn acceleration_logdet_gradient(
 ) -> SVector<f64, 6> {
     // d ln|Pi^U| / dp, one entry per tool parameter
     let gradient = <SVector<f64, 6>>::zeros();
+    gradient
+}
+
+/// Task 4 (tip position control): the sensitivities d(task variable)/dU the controller uses, in the order (d_tip_du, d_tip_dot_du).
+///
+/// From appendix "Task specific controllers".
+///
+/// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
+///
+/// Cost per call: 122 operations, weighted 149 (32 ADD, 3 DIV, 70 MUL, 3 NEG, 6 POW, 8 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_position_sensitivity(
+    params: &SVector<f64, 6>,
+) -> (SMatrix<f64, 3, 3>, SMatrix<f64, 3, 3>) {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let m3 = params[2];
+    let l1 = params[3];
+    let l2 = params[4];
+    let l3 = params[5];
+    let t0 = l1 * l2;
+    let t1 = 3.0 * m1;
+    let t2 = 6.0 * m2;
+    let t3 = 6.0 * m3;
+    let t4 = l1 * l3;
+    let t5 = l1.powi(2);
+    let t6 = 2.0 * m2;
+    let t7 = 2.0 * m3;
+    let t8 = 1.0 / (3.0 * g * (m1 + t6 + t7));
+    let t9 = 6.0 * m1;
+    let t10 = m2 * m3;
+    let t11 = l2 * l3;
+    let t12 = t1 * t11;
+    let t13 = m3 * t9;
+    let t14 = m2.powi(2);
+    let t15 = m3.powi(2);
+    let t16 = 12.0 * t15;
+    let t17 = 6.0 * t11;
+    let t18 = l2.powi(2);
+    let t19 = m1 * t6;
+    let t20 = 4.0 * t14;
+    let t21 = t8 / (m2 + t7);
+    let t22 = m3.powi(3);
+    let t23 = l3.powi(2);
+    let t24 = m3 * t23;
+    // dtip/dU = J @ IO @ inv(A) @ (E - B)
+    let mut d_tip_du = <SMatrix<f64, 3, 3>>::zeros();
+    d_tip_du[(0, 0)] = -t8
+        * (2.0 * m1 * t5
+            + t0 * t1
+            + t0 * t2
+            + t0 * t3
+            + t1 * t4
+            + t2 * t4
+            + t2 * t5
+            + t3 * t4
+            + t3 * t5
+            - 6.0);
+    d_tip_du[(0, 1)] = -t21
+        * (m2 * t12
+            + 12.0 * t0 * t10
+            + 3.0 * t0 * t14
+            + t0 * t16
+            + 18.0 * t10 * t11
+            + 16.0 * t10 * t18
+            + t11 * t13
+            + t11 * t16
+            + t13 * t18
+            + t14 * t17
+            + t16 * t18
+            + t18 * t19
+            + t18 * t20
+            - t2
+            - t9);
+    d_tip_du[(0, 2)] = -t21
+        * (4.0 * m1 * t15 * t23 + 3.0 * m2 * t15 * t4 + m2 * t16 * t23 - m2 * t9 - 24.0 * t10
+            + t11 * t15 * t2
+            + t12 * t15
+            - t13
+            - 12.0 * t14
+            - t16
+            + t17 * t22
+            + t19 * t24
+            + t20 * t24
+            + 8.0 * t22 * t23
+            + 6.0 * t22 * t4)
+        / m3;
+    // dtip_dot/dU = J @ OI @ inv(A) @ (E - B)
+    let mut d_tip_dot_du = <SMatrix<f64, 3, 3>>::zeros();
+    d_tip_dot_du[(0, 0)] = l1;
+    d_tip_dot_du[(0, 1)] = l2;
+    d_tip_dot_du[(0, 2)] = l3;
+    (d_tip_du, d_tip_dot_du)
+}
+
+/// Task 4 (tip position control): the control confidence Pi^U = d2F/dU2 = S_tip^T P_tip S_tip + S_tip_dot^T P_tip_dot S_tip_dot + P_u.
+///
+/// From eq. (control_conf) and the closed forms after it.
+///
+/// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
+/// - `p_tip`: precision P of the tool tip's position tip (symmetric; the upper triangle is read)
+/// - `p_tip_dot`: precision P of the tool tip's velocity tip_dot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 151 operations, weighted 198 (44 ADD, 5 DIV, 82 MUL, 12 POW, 8 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_position_control_confidence(
+    params: &SVector<f64, 6>,
+    p_tip: &SMatrix<f64, 3, 3>,
+    p_tip_dot: &SMatrix<f64, 3, 3>,
+    p_u: &SMatrix<f64, 3, 3>,
+) -> SMatrix<f64, 3, 3> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let m3 = params[2];
+    let l1 = params[3];
+    let l2 = params[4];
+    let l3 = params[5];
+    let p_tip_00 = p_tip[(0, 0)];
+    let p_tip_dot_00 = p_tip_dot[(0, 0)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_02 = p_u[(0, 2)];
+    let p_u_11 = p_u[(1, 1)];
+    let p_u_12 = p_u[(1, 2)];
+    let p_u_22 = p_u[(2, 2)];
+    let t0 = l1.powi(2);
+    let t1 = l1 * l2;
+    let t2 = 3.0 * m1;
+    let t3 = 6.0 * m2;
+    let t4 = 6.0 * m3;
+    let t5 = l1 * l3;
+    let t6 = 2.0 * m1 * t0
+        + t0 * t3
+        + t0 * t4
+        + t1 * t2
+        + t1 * t3
+        + t1 * t4
+        + t2 * t5
+        + t3 * t5
+        + t4 * t5
+        - 6.0;
+    let t7 = 2.0 * m2;
+    let t8 = 2.0 * m3;
+    let t9 = p_tip_00 / (9.0 * g.powi(2) * (m1 + t7 + t8).powi(2));
+    let t10 = l1 * p_tip_dot_00;
+    let t11 = 6.0 * m1;
+    let t12 = m2 * m3;
+    let t13 = l2 * l3;
+    let t14 = t13 * t2;
+    let t15 = m3 * t11;
+    let t16 = m2.powi(2);
+    let t17 = m3.powi(2);
+    let t18 = 12.0 * t17;
+    let t19 = 6.0 * t13;
+    let t20 = l2.powi(2);
+    let t21 = m1 * t7;
+    let t22 = 4.0 * t16;
+    let t23 = m2 * t14 + 12.0 * t1 * t12 + 3.0 * t1 * t16 + t1 * t18 - t11
+        + 18.0 * t12 * t13
+        + 16.0 * t12 * t20
+        + t13 * t15
+        + t13 * t18
+        + t15 * t20
+        + t16 * t19
+        + t18 * t20
+        + t20 * t21
+        + t20 * t22
+        - t3;
+    let t24 = m2 + t8;
+    let t25 = t6 * t9 / t24;
+    let t26 = m3.powi(3);
+    let t27 = l3.powi(2);
+    let t28 = m3 * t27;
+    let t29 = 4.0 * m1 * t17 * t27 - m2 * t11 + 3.0 * m2 * t17 * t5 + m2 * t18 * t27 - 24.0 * t12
+        + t13 * t17 * t3
+        + t14 * t17
+        - t15
+        - 12.0 * t16
+        - t18
+        + t19 * t26
+        + t21 * t28
+        + t22 * t28
+        + 8.0 * t26 * t27
+        + 6.0 * t26 * t5;
+    let t30 = t29 / m3;
+    let t31 = t9 / t24.powi(2);
+    // Pi^U (symmetric)
+    let mut pi_u = <SMatrix<f64, 3, 3>>::zeros();
+    pi_u[(0, 0)] = p_tip_dot_00 * t0 + p_u_00 + t6.powi(2) * t9;
+    pi_u[(0, 1)] = l2 * t10 + p_u_01 + t23 * t25;
+    pi_u[(0, 2)] = l3 * t10 + p_u_02 + t25 * t30;
+    pi_u[(1, 1)] = p_tip_dot_00 * t20 + p_u_11 + t23.powi(2) * t31;
+    pi_u[(1, 2)] = p_tip_dot_00 * t13 + p_u_12 + t23 * t30 * t31;
+    pi_u[(2, 2)] = p_tip_dot_00 * t27 + p_u_22 + t29.powi(2) * t31 / t17;
+    pi_u[(1, 0)] = pi_u[(0, 1)];
+    pi_u[(2, 0)] = pi_u[(0, 2)];
+    pi_u[(2, 1)] = pi_u[(1, 2)];
+    pi_u
+}
+
+/// Task 4 (tip position control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
+/// - `p_tip`: precision P of the tool tip's position tip (symmetric; the upper triangle is read)
+/// - `p_tip_dot`: precision P of the tool tip's velocity tip_dot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 836 operations, weighted 986 (255 ADD, 19 DIV, 485 MUL, 8 NEG, 17 POW, 52 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_position_logdet_gradient(
+    params: &SVector<f64, 6>,
+    p_tip: &SMatrix<f64, 3, 3>,
+    p_tip_dot: &SMatrix<f64, 3, 3>,
+    p_u: &SMatrix<f64, 3, 3>,
+) -> SVector<f64, 6> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let m3 = params[2];
+    let l1 = params[3];
+    let l2 = params[4];
+    let l3 = params[5];
+    let p_tip_00 = p_tip[(0, 0)];
+    let p_tip_dot_00 = p_tip_dot[(0, 0)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_02 = p_u[(0, 2)];
+    let p_u_11 = p_u[(1, 1)];
+    let p_u_12 = p_u[(1, 2)];
+    let p_u_22 = p_u[(2, 2)];
+    let t0 = l1.powi(2);
+    let t1 = 2.0 * t0;
+    let t2 = 6.0 * m2;
+    let t3 = 6.0 * m3;
+    let t4 = 3.0 * l1;
+    let t5 = l2 * t4;
+    let t6 = l3 * t4;
+    let t7 = l2 * t3;
+    let t8 = l3 * t2;
+    let t9 = l1 * t8;
+    let t10 = l3 * t3;
+    let t11 = l2 * t2;
+    let t12 = l1 * t11 - 6.0;
+    let t13 = l1 * t10 + l1 * t7 + m1 * t1 + m1 * t5 + m1 * t6 + t0 * t2 + t0 * t3 + t12 + t9;
+    let t14 = g.powi(-2);
+    let t15 = p_tip_00 * t14;
+    let t16 = t13.powi(2) * t15;
+    let t17 = 2.0 * m2;
+    let t18 = 2.0 * m3;
+    let t19 = m1 + t17 + t18;
+    let t20 = t19.powi(-2);
+    let t21 = t20 / 9.0;
+    let t22 = p_tip_dot_00 * t0 + p_u_00 + t16 * t21;
+    let t23 = l3 * p_tip_dot_00;
+    let t24 = 6.0 * m1;
+    let t25 = -t24;
+    let t26 = -t2;
+    let t27 = 12.0 * m2;
+    let t28 = l2 * t27;
+    let t29 = l1 * t28;
+    let t30 = 3.0 * l2;
+    let t31 = m1 * t30;
+    let t32 = l3 * t31;
+    let t33 = m3 * t24;
+    let t34 = l2 * l3;
+    let t35 = t33 * t34;
+    let t36 = m3 * t34;
+    let t37 = 18.0 * t36;
+    let t38 = m2.powi(2);
+    let t39 = m3.powi(2);
+    let t40 = 12.0 * t39;
+    let t41 = l2 * t40;
+    let t42 = l2 * t38;
+    let t43 = 6.0 * t42;
+    let t44 = l3 * t41;
+    let t45 = l2.powi(2);
+    let t46 = t17 * t45;
+    let t47 = m2 * t45;
+    let t48 = 16.0 * t47;
+    let t49 = 4.0 * t45;
+    let t50 = l1 * t41
+        + l3 * t43
+        + m1 * t46
+        + m2 * t32
+        + m2 * t37
+        + m3 * t29
+        + m3 * t48
+        + t25
+        + t26
+        + t33 * t45
+        + t35
+        + t38 * t49
+        + t38 * t5
+        + t40 * t45
+        + t44;
+    let t51 = m2 + t18;
+    let t52 = t51.powi(-2);
+    let t53 = t15 * t21;
+    let t54 = t52 * t53;
+    let t55 = t50 * t54;
+    let t56 = 1.0 / m3;
+    let t57 = m2 * t24;
+    let t58 = 24.0 * m2;
+    let t59 = m3 * t58;
+    let t60 = 12.0 * t38;
+    let t61 = m3.powi(3);
+    let t62 = 6.0 * l1;
+    let t63 = l3 * t62;
+    let t64 = l3 * t61;
+    let t65 = 6.0 * t64;
+    let t66 = l3.powi(2);
+    let t67 = 8.0 * t66;
+    let t68 = t39 * t6;
+    let t69 = l3 * t11;
+    let t70 = m2 * t66;
+    let t71 = t18 * t70;
+    let t72 = t39 * t66;
+    let t73 = 4.0 * t72;
+    let t74 = t40 * t66;
+    let t75 = 4.0 * t66;
+    let t76 = t38 * t75;
+    let t77 = l2 * t65 + m1 * t71 + m1 * t73 + m2 * t68 + m2 * t74 + m3 * t76 + t32 * t39 - t33
+        + t39 * t69
+        - t40
+        - t57
+        - t59
+        - t60
+        + t61 * t63
+        + t61 * t67;
+    let t78 = t56 * t77;
+    let t79 = l2 * t23 + p_u_12 + t55 * t78;
+    let t80 = t50.powi(2);
+    let t81 = t52 * t80;
+    let t82 = p_tip_dot_00 * t45 + p_u_11 + t53 * t81;
+    let t83 = 1.0 / t39;
+    let t84 = t77.powi(2);
+    let t85 = t83 * t84;
+    let t86 = p_tip_dot_00 * t66 + p_u_22 + t54 * t85;
+    let t87 = -t79.powi(2) + t82 * t86;
+    let t88 = 1.0 / t51;
+    let t89 = t13 * t53;
+    let t90 = t88 * t89;
+    let t91 = l1 * t23 + p_u_02 + t78 * t90;
+    let t92 = l2 * p_tip_dot_00;
+    let t93 = t50 * t88;
+    let t94 = l1 * t92 + p_u_01 + t89 * t93;
+    let t95 = t79 * t94 - t82 * t91;
+    let t96 = -t79 * t91 + t86 * t94;
+    let t97 = 1.0 / (t22 * t87 + t91 * t95 - t94 * t96);
+    let t98 = t19.powi(-3);
+    let t99 = t16 * t98;
+    let t100 = l2 * t62 + t63;
+    let t101 = (2.0 / 9.0) * t15;
+    let t102 = t81 * t98;
+    let t103 = 12.0 * m3;
+    let t104 = l2 * t103;
+    let t105 = l3 * t104;
+    let t106 = t22 * t86 - t91.powi(2);
+    let t107 = t101 * t98;
+    let t108 = t52 * t85;
+    let t109 = l2 * t39;
+    let t110 = 6.0 * l3;
+    let t111 = t109 * t110;
+    let t112 = m3 * t75;
+    let t113 = t77 * t83;
+    let t114 = t113 * t54;
+    let t115 = t22 * t82 - t94.powi(2);
+    let t116 = l3 * t30;
+    let t117 = l3 * t7 + m2 * t116 + t3 * t45 + t46 - 6.0;
+    let t118 = t1 + t5 + t6;
+    let t119 = t53 * t93;
+    let t120 = t13 * t93;
+    let t121 = -2.0 * t96;
+    let t122 = t56 * (t116 * t39 + t26 - t3 + t71 + t73);
+    let t123 = t53 * t78 * t88;
+    let t124 = t107 * t78;
+    let t125 = t13 * t88;
+    let t126 = 2.0 * t95;
+    let t127 = t54 * t78;
+    let t128 = t50 * t52;
+    let t129 = -2.0 * t22 * t79 + 2.0 * t91 * t94;
+    let t130 = 12.0 * l1;
+    let t131 = t87 * (t89 * (l2 * t130 + l3 * t130 + 12.0 * t0) - (4.0 / 9.0) * t99);
+    let t132 = t20 / t51.powi(3);
+    let t133 = t132 * t80;
+    let t134 = (4.0 / 9.0) * t15;
+    let t135 = t102 * t134;
+    let t136 = m3 * t45;
+    let t137 = l2 * t24;
+    let t138 = 24.0 * m3;
+    let t139 = l1 * t138;
+    let t140 = l2 * t139 + l3 * t137 + t29 + t48;
+    let t141 = t132 * t85;
+    let t142 = t134 * t98;
+    let t143 = t108 * t142;
+    let t144 = 24.0 * t72;
+    let t145 = 16.0 * m3;
+    let t146 = 48.0 * m2;
+    let t147 = 48.0 * m3;
+    let t148 = 12.0 * m1;
+    let t149 = -t146 - t147 - t148;
+    let t150 = l3 * t28;
+    let t151 = l1 * t104 + 2.0 * m1 * t45 + t12 + 16.0 * t136 + t150 + t32 + t37 + 8.0 * t47;
+    let t152 = 6.0 * t0 + t100;
+    let t153 = t119 * t152 - t120 * t142;
+    let t154 = m1 * t66;
+    let t155 = m3 * t67;
+    let t156 = -t138 + t25 - t58;
+    let t157 = t56 * (m2 * t155 + t111 + t154 * t18 + t156 + t68 + t74);
+    let t158 = t142 * t78;
+    let t159 = t125 * t158;
+    let t160 = t132 * t50 * t78;
+    let t161 = t128 * t158;
+    let t162 = l1 * t58;
+    let t163 = m2 * t34;
+    let t164 = t101 * t20;
+    let t165 = t164 * t52;
+    let t166 = m1 * m2;
+    let t167 = 36.0 * l3;
+    let t168 = l1 * t39;
+    let t169 = l3 * t27;
+    let t170 = t138 * t34 + t138 * t45 + t140 + 18.0 * t163 + t24 * t45;
+    let t171 = 18.0 * l3;
+    let t172 = m1 * t155
+        + m3 * t150
+        + m3 * t9
+        + t109 * t171
+        + t144
+        + t154 * t17
+        + t156
+        + t168 * t171
+        + t35
+        + t59 * t66
+        + t76;
+    let t173 = 12.0 * t64;
+    let t174 = t39 * t8;
+    let t175 = t114 * t115;
+    let t176 = 24.0 * t39;
+    let t177 = l2 * t176;
+    let t178 = t106 * t55;
+    let t179 = l1 * p_tip_dot_00;
+    let t180 = l1 * m1;
+    let t181 = l3 * t24;
+    let t182 = l3 * t103;
+    let t183 = 3.0 * l3;
+    let t184 = m2 * t39;
+    let t185 = t56 * (t183 * t184 + t65);
+    let t186 = m3 * t28 + t30 * t38 + t41;
+    let t187 = m1 * t183;
+    let t188 = l1 * t27;
+    let t189 = l1 * t103 + t188;
+    let t190 = t10 + t11 + 4.0 * t180 + t187 + t189 + t31 + t7 + t8;
+    let t191 = l3 * t40;
+    let t192 = t87 * t89 * (l1 * t24 + t189);
+    let t193 = l2 * t166;
+    let t194 = m2 * m3;
+    let t195 = l2 * t194;
+    let t196 = t56 * (t174 + t187 * t39 + t65);
+    let t197 = l1 * t2;
+    let t198 = l1 * t3 + m1 * t4 + t197;
+    let t199 = t123 * t198;
+    let t200 = t119 * t198;
+    let t201 = m1 * t104 + t177;
+    let t202 = l1 * t40
+        + l3 * t33
+        + m2 * t187
+        + m3 * t188
+        + t110 * t38
+        + t171 * t194
+        + t191
+        + 4.0 * t193
+        + 32.0 * t195
+        + t201
+        + t38 * t4
+        + 8.0 * t42;
+    let t203 = l2 * t61;
+    let t204 = 8.0 * m3;
+    let t205 = l3 * t166;
+    let t206 = l3 * t39;
+    let t207 = m1 * t206;
+    let t208 = l3 * t38;
+    let t209 = l2 * t33 + m2 * t31 + 18.0 * t195 + t41 + t43;
+    let t210 = t56
+        * (4.0 * m3 * t205
+            + t11 * t39
+            + t184 * t4
+            + 6.0 * t203
+            + t204 * t208
+            + t206 * t58
+            + 8.0 * t207
+            + t31 * t39
+            + t61 * t62
+            + 16.0 * t64);
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 6>>::zeros();
+    gradient[0] = t97
+        * (t106 * (-t101 * t102 + t55 * (m2 * t49 + t103 * t45 + t105 + t69 - 12.0))
+            + t115 * (-t107 * t108 + t114 * (m2 * t112 - t103 + t111 - t27 + t39 * t67))
+            + t121 * (-t107 * t120 + t117 * t90 + t118 * t119)
+            + t126 * (t118 * t123 + t122 * t90 - t124 * t125)
+            + t129 * (t117 * t127 + t122 * t55 - t124 * t128)
+            + t87 * (t89 * (4.0 * t0 + t100) - (2.0 / 9.0) * t99));
+    gradient[1] = t97
+        * (t106
+            * (p_tip_00
+                * t14
+                * t20
+                * t50
+                * t52
+                * (m1 * t49 + 32.0 * t136 + t140 + t34 * t58 + 36.0 * t36 - 12.0)
+                / 9.0
+                - t101 * t133
+                - t135)
+            + t115
+                * (p_tip_00
+                    * t14
+                    * t20
+                    * t52
+                    * t77
+                    * t83
+                    * (m1 * t112 + t144 + t145 * t70 + t149 + t39 * t63 + t44)
+                    / 9.0
+                    - t101 * t141
+                    - t143)
+            + t121 * (-t128 * t89 + t151 * t90 + t153)
+            + t126 * (t123 * t152 + t157 * t90 - t159 - t52 * t78 * t89)
+            + t129 * (-t101 * t160 + t127 * t151 + t157 * t55 - t161)
+            + t131);
+    gradient[2] = t97
+        * (t106
+            * (p_tip_00
+                * t14
+                * t20
+                * t50
+                * t52
+                * (l1 * l2 * t147
+                    + l2 * t162
+                    + t147 * t34
+                    + t147 * t45
+                    + t148 * t34
+                    + t148 * t45
+                    + 36.0 * t163
+                    + 32.0 * t47)
+                / 9.0
+                - t133 * t134
+                - t135)
+            + t115
+                * (p_tip_00
+                    * t14
+                    * t20
+                    * t52
+                    * t77
+                    * t83
+                    * (l1 * m3 * t169
+                        + m1 * t105
+                        + m3 * t146 * t66
+                        + t109 * t167
+                        + t145 * t154
+                        + t149
+                        + t166 * t75
+                        + t167 * t168
+                        + t34 * t59
+                        + t38 * t67
+                        + 48.0 * t72)
+                    / 9.0
+                    - t134 * t141
+                    - t143
+                    - t165 * t84 / t61)
+            + t121 * (-t128 * t13 * t164 + t153 + t170 * t90)
+            + t126
+                * (p_tip_00 * t13 * t14 * t172 * t20 * t56 * t88 / 9.0
+                    + p_tip_00 * t14 * t152 * t20 * t56 * t77 * t88 / 9.0
+                    - t113 * t90
+                    - t13 * t165 * t78
+                    - t159)
+            + t129
+                * (p_tip_00 * t14 * t170 * t20 * t52 * t56 * t77 / 9.0
+                    + p_tip_00 * t14 * t172 * t20 * t50 * t52 * t56 / 9.0
+                    - t113 * t55
+                    - t134 * t160
+                    - t161)
+            + t131);
+    gradient[3] = t97
+        * (t121 * (t119 * t190 + t186 * t90 + t92)
+            + t126 * (t123 * t190 + t185 * t90 + t23)
+            + t129 * (t127 * t186 + t185 * t55)
+            + t175 * (t173 + t174)
+            + t178 * (l2 * t59 + t177 + t43)
+            + t87
+                * (2.0 * t179
+                    + t89 * (t104 + t137 + t139 + t162 + t169 + 8.0 * t180 + t181 + t182 + t28)));
+    gradient[4] = t97
+        * (t106
+            * (t55
+                * (l1 * t176
+                    + l1 * t59
+                    + l2 * m1 * t138
+                    + l3 * t176
+                    + l3 * t57
+                    + l3 * t60
+                    + m1 * t182
+                    + 48.0 * t109
+                    + t167 * t194
+                    + 8.0 * t193
+                    + 64.0 * t195
+                    + t38 * t62
+                    + 16.0 * t42)
+                + 2.0 * t92)
+            + t121 * (t179 + t200 + t202 * t90)
+            + t126 * (t196 * t90 + t199)
+            + t129 * (t127 * t202 + t196 * t55 + t23)
+            + t175 * (m2 * t191 + t173 + t181 * t39)
+            + t192);
+    gradient[5] = t97
+        * (t115
+            * (t114
+                * (m2 * t41
+                    + t130 * t61
+                    + t137 * t39
+                    + t145 * t208
+                    + t146 * t206
+                    + t197 * t39
+                    + 12.0 * t203
+                    + t204 * t205
+                    + 16.0 * t207
+                    + 32.0 * t64)
+                + 2.0 * t23)
+            + t121 * (t200 + t209 * t90)
+            + t126 * (t179 + t199 + t210 * t90)
+            + t129 * (t127 * t209 + t210 * t55 + t92)
+            + t178 * (l2 * t57 + l2 * t60 + 36.0 * t195 + t201)
+            + t192);
+    gradient
+}
+
+/// Task 5 (tip velocity control): the sensitivities d(task variable)/dU the controller uses, in the order (d_tip_dot_du).
+///
+/// From appendix "Task specific controllers".
+///
+/// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
+///
+/// Cost per call: 15 operations, weighted 43 (5 ADD, 4 DIV, 6 MUL).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_velocity_sensitivity(params: &SVector<f64, 6>) -> SMatrix<f64, 3, 3> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let m3 = params[2];
+    let t0 = 2.0 * m3;
+    let t1 = 2.0 / g;
+    let t2 = t1 / (m1 + 2.0 * m2 + t0);
+    let t3 = 1.0 / (m2 + t0);
+    // dtip_dot/dU = -J @ IO @ inv(A) @ B
+    let mut d_tip_dot_du = <SMatrix<f64, 3, 3>>::zeros();
+    d_tip_dot_du[(0, 0)] = t2;
+    d_tip_dot_du[(0, 1)] = t2 * t3 * (m1 + m2);
+    d_tip_dot_du[(0, 2)] = t1 * t3 * (m2 + m3) / m3;
+    d_tip_dot_du
+}
+
+/// Task 5 (tip velocity control): the control confidence Pi^U = d2F/dU2 = S_tip_dot^T P_tip_dot S_tip_dot + P_u.
+///
+/// From eq. (control_conf) and the closed forms after it.
+///
+/// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
+/// - `p_tip_dot`: precision P of the tool tip's velocity tip_dot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 37 operations, weighted 78 (11 ADD, 5 DIV, 14 MUL, 1 NEG, 6 POW).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_velocity_control_confidence(
+    params: &SVector<f64, 6>,
+    p_tip_dot: &SMatrix<f64, 3, 3>,
+    p_u: &SMatrix<f64, 3, 3>,
+) -> SMatrix<f64, 3, 3> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let m3 = params[2];
+    let p_tip_dot_00 = p_tip_dot[(0, 0)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_02 = p_u[(0, 2)];
+    let p_u_11 = p_u[(1, 1)];
+    let p_u_12 = p_u[(1, 2)];
+    let p_u_22 = p_u[(2, 2)];
+    let t0 = 2.0 * m3;
+    let t1 = m1 + 2.0 * m2 + t0;
+    let t2 = 4.0 * p_tip_dot_00 / g.powi(2);
+    let t3 = t2 / t1.powi(2);
+    let t4 = m2 + t0;
+    let t5 = 1.0 / t4;
+    let t6 = m1 + m2;
+    let t7 = m2 + m3;
+    let t8 = t7 / (m3 * t1);
+    let t9 = t4.powi(-2);
+    let t10 = t2 * t9;
+    // Pi^U (symmetric)
+    let mut pi_u = <SMatrix<f64, 3, 3>>::zeros();
+    pi_u[(0, 0)] = p_u_00 + t3;
+    pi_u[(0, 1)] = p_u_01 + t3 * t5 * t6;
+    pi_u[(0, 2)] = p_u_02 + t2 * t5 * t8;
+    pi_u[(1, 1)] = p_u_11 + t3 * t6.powi(2) * t9;
+    pi_u[(1, 2)] = p_u_12 + t10 * t6 * t8;
+    pi_u[(2, 2)] = p_u_22 + t10 * t7.powi(2) / m3.powi(2);
+    pi_u[(1, 0)] = pi_u[(0, 1)];
+    pi_u[(2, 0)] = pi_u[(0, 2)];
+    pi_u[(2, 1)] = pi_u[(1, 2)];
+    pi_u
+}
+
+/// Task 5 (tip velocity control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters `[m1 m2 m3 l1 l2 l3]`
+/// - `p_tip_dot`: precision P of the tool tip's velocity tip_dot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 217 operations, weighted 264 (25 ADD, 5 DIV, 120 MUL, 25 NEG, 12 POW, 30 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_velocity_logdet_gradient(
+    params: &SVector<f64, 6>,
+    p_tip_dot: &SMatrix<f64, 3, 3>,
+    p_u: &SMatrix<f64, 3, 3>,
+) -> SVector<f64, 6> {
+    let g = G;
+    let m1 = params[0];
+    let m2 = params[1];
+    let m3 = params[2];
+    let p_tip_dot_00 = p_tip_dot[(0, 0)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_02 = p_u[(0, 2)];
+    let p_u_11 = p_u[(1, 1)];
+    let p_u_12 = p_u[(1, 2)];
+    let p_u_22 = p_u[(2, 2)];
+    let t0 = 2.0 * m2;
+    let t1 = 2.0 * m3;
+    let t2 = t0 + t1;
+    let t3 = m1 + t2;
+    let t4 = t3.powi(-2);
+    let t5 = g.powi(-2);
+    let t6 = p_tip_dot_00 * t5;
+    let t7 = 4.0 * t6;
+    let t8 = t4 * t7;
+    let t9 = p_u_00 + t8;
+    let t10 = m1 + m2;
+    let t11 = m2 + m3;
+    let t12 = m2 + t1;
+    let t13 = t12.powi(-2);
+    let t14 = t13 * t7;
+    let t15 = 1.0 / m3;
+    let t16 = 1.0 / t3;
+    let t17 = t15 * t16;
+    let t18 = t11 * t14 * t17;
+    let t19 = p_u_12 + t10 * t18;
+    let t20 = m3.powi(-2);
+    let t21 = t11.powi(2);
+    let t22 = t20 * t21;
+    let t23 = p_u_22 + t14 * t22;
+    let t24 = t10.powi(2);
+    let t25 = t13 * t24;
+    let t26 = p_u_11 + t25 * t8;
+    let t27 = -t19.powi(2) + t23 * t26;
+    let t28 = 1.0 / t12;
+    let t29 = p_u_01 + t10 * t28 * t8;
+    let t30 = t28 * t7;
+    let t31 = p_u_02 + t11 * t17 * t30;
+    let t32 = -t19 * t31 + t23 * t29;
+    let t33 = t19 * t29 - t26 * t31;
+    let t34 = 1.0 / (t27 * t9 - t29 * t32 + t31 * t33);
+    let t35 = 8.0 * t6;
+    let t36 = t3.powi(-3);
+    let t37 = t27 * t36;
+    let t38 = t35 * t36;
+    let t39 = -4.0 * p_tip_dot_00 * t13 * t4 * t5 * (2.0 * m1 + t0);
+    let t40 = t23 * t9 - t31.powi(2);
+    let t41 = t11 * t15;
+    let t42 = t28 * t35 * t4 * t41;
+    let t43 = -4.0 * p_tip_dot_00 * t28 * t4 * t5;
+    let t44 = t10 * t28;
+    let t45 = -2.0 * t32;
+    let t46 = -t18;
+    let t47 = t10 * t13 * t8;
+    let t48 = -2.0 * t19 * t9 + 2.0 * t29 * t31;
+    let t49 = 16.0 * t6;
+    let t50 = -t37 * t49;
+    let t51 = t12.powi(-3);
+    let t52 = t35 * t51;
+    let t53 = -4.0 * p_tip_dot_00 * t13 * t2 * t20 * t5;
+    let t54 = t26 * t9 - t29.powi(2);
+    let t55 = t24 * t4;
+    let t56 = t36 * t49;
+    let t57 = t25 * t56;
+    let t58 = t44 * t56;
+    let t59 = -4.0 * p_tip_dot_00 * t15 * t16 * t28 * t5 + t42;
+    let t60 = 2.0 * t33;
+    let t61 = t11 * t17;
+    let t62 = t10 * t61;
+    let t63 = t13 * t35;
+    let t64 = t10 * t4 * t63;
+    let t65 = -4.0 * p_tip_dot_00 * t10 * t13 * t15 * t16 * t5 + t41 * t64;
+    let t66 = t49 * t51;
+    let t67 = t11 * t16;
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 6>>::zeros();
+    gradient[0] = t34
+        * (-t33 * t42 - t35 * t37
+            + t40 * (-t25 * t38 - t39)
+            + t45 * (-t38 * t44 - t43)
+            + t48 * (-t41 * t47 - t46));
+    gradient[1] = t34
+        * (t40 * (-t39 - t52 * t55 - t57)
+            + t45 * (-t43 - t47 - t58)
+            + t48 * (-t46 - t52 * t62 - t65)
+            + t50
+            + t54 * (-t22 * t52 - t53)
+            + t60 * (-t18 - t59));
+    gradient[2] = t34
+        * (t40 * (-t55 * t66 - t57)
+            + t45 * (-t58 - t64)
+            + t48 * (-t10 * t14 * t20 * t67 - t62 * t66 - t65)
+            + t50
+            + t54 * (-t22 * t66 - t53 - t21 * t63 / m3.powi(3))
+            + t60 * (-t20 * t30 * t67 - t59 - t61 * t63));
     gradient
 }
 

@@ -117,8 +117,7 @@ pub mod tip {
         q: &SVector<f64, { crate::msd::DOF }>,
         params: &SVector<f64, { crate::msd::PARAMETER_COUNT }>,
     ) -> Option<(SVector<f64, 3>, SMatrix<f64, 3, { crate::msd::DOF }>)> {
-        let _ = (q, params);
-        None
+        Some(crate::msd::tip(q, params))
     }
 
     /// `panda`'s tip.
@@ -210,6 +209,9 @@ pub struct ModelInfo {
     pub inertia: Option<validity::InertiaRule>,
     /// Whether the model's tools have a tip (`tip::<name>` gives `Some`).
     pub has_tip: bool,
+    /// The components of the tip the tip terms use (`<model>::TIP_DIM`): their goals,
+    /// precisions and sensitivities fill the first `tip_dim` of the `dof` rows.
+    pub tip_dim: usize,
     /// The equilibrium X^e = [q^e; q̇^e] the model is linearised at.
     pub equilibrium_state: &'static [f64],
     /// The equilibrium torque U^e.
@@ -236,9 +238,10 @@ pub static MODELS: [ModelInfo; 7] = [
         defaults: &validity::arm2::RULE.defaults,
         inertia: validity::arm2::RULE.inertia,
         has_tip: true,
+        tip_dim: arm2::TIP_DIM,
         equilibrium_state: &arm2::EQUILIBRIUM_STATE,
         equilibrium_control: &arm2::EQUILIBRIUM_CONTROL,
-        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity],
     },
     ModelInfo {
         name: arm2_exact::NAME,
@@ -256,9 +259,10 @@ pub static MODELS: [ModelInfo; 7] = [
         defaults: &validity::arm2_exact::RULE.defaults,
         inertia: validity::arm2_exact::RULE.inertia,
         has_tip: true,
+        tip_dim: arm2_exact::TIP_DIM,
         equilibrium_state: &arm2_exact::EQUILIBRIUM_STATE,
         equilibrium_control: &arm2_exact::EQUILIBRIUM_CONTROL,
-        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity],
     },
     ModelInfo {
         name: arm2_payload::NAME,
@@ -276,9 +280,10 @@ pub static MODELS: [ModelInfo; 7] = [
         defaults: &validity::arm2_payload::RULE.defaults,
         inertia: validity::arm2_payload::RULE.inertia,
         has_tip: true,
+        tip_dim: arm2_payload::TIP_DIM,
         equilibrium_state: &arm2_payload::EQUILIBRIUM_STATE,
         equilibrium_control: &arm2_payload::EQUILIBRIUM_CONTROL,
-        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity],
     },
     ModelInfo {
         name: arm3::NAME,
@@ -296,9 +301,10 @@ pub static MODELS: [ModelInfo; 7] = [
         defaults: &validity::arm3::RULE.defaults,
         inertia: validity::arm3::RULE.inertia,
         has_tip: true,
+        tip_dim: arm3::TIP_DIM,
         equilibrium_state: &arm3::EQUILIBRIUM_STATE,
         equilibrium_control: &arm3::EQUILIBRIUM_CONTROL,
-        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity],
     },
     ModelInfo {
         name: msd::NAME,
@@ -315,10 +321,11 @@ pub static MODELS: [ModelInfo; 7] = [
         sample: &validity::msd::RULE.sample,
         defaults: &validity::msd::RULE.defaults,
         inertia: validity::msd::RULE.inertia,
-        has_tip: false,
+        has_tip: true,
+        tip_dim: msd::TIP_DIM,
         equilibrium_state: &msd::EQUILIBRIUM_STATE,
         equilibrium_control: &msd::EQUILIBRIUM_CONTROL,
-        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity],
     },
     ModelInfo {
         name: panda::NAME,
@@ -340,9 +347,10 @@ pub static MODELS: [ModelInfo; 7] = [
         defaults: &validity::panda::RULE.defaults,
         inertia: validity::panda::RULE.inertia,
         has_tip: true,
+        tip_dim: panda::TIP_DIM,
         equilibrium_state: &panda::EQUILIBRIUM_STATE,
         equilibrium_control: &panda::EQUILIBRIUM_CONTROL,
-        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity],
     },
     ModelInfo {
         name: ur5::NAME,
@@ -364,9 +372,10 @@ pub static MODELS: [ModelInfo; 7] = [
         defaults: &validity::ur5::RULE.defaults,
         inertia: validity::ur5::RULE.inertia,
         has_tip: true,
+        tip_dim: ur5::TIP_DIM,
         equilibrium_state: &ur5::EQUILIBRIUM_STATE,
         equilibrium_control: &ur5::EQUILIBRIUM_CONTROL,
-        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration],
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity],
     },
 ];
 

@@ -22,6 +22,10 @@ pub const NAME: &str = "msd";
 pub const DOF: usize = 1;
 /// Dimension of the state X = [q; q_dot].
 pub const STATE_DIM: usize = 2;
+/// Components of the tool's tip the tip terms use (x, y, z in the base frame, the first
+/// TIP_DIM of them): a tip term's goal, precision and sensitivity fill the first TIP_DIM of
+/// the DOF rows, zero in the others.
+pub const TIP_DIM: usize = 1;
 /// Number of tool parameters.
 pub const PARAMETER_COUNT: usize = 3;
 /// Tool parameters, in the order every function takes them.
@@ -92,6 +96,38 @@ pub mod acceleration {
     pub const PRECISION_U: f64 = 0.0;
 }
 
+/// Task 4 (tip position control): the paper's default goals and precisions ("Implementation details").
+pub mod tip_position {
+    #[allow(unused_imports)]
+    use super::PI;
+    /// Free-energy terms the controller uses (eq. U_dot_deriv).
+    pub const TERMS: [&str; 3] = ["tip", "tip_dot", "u"];
+    /// Default goal for `tip`.
+    pub const GOAL_TIP: [f64; 1] = [0.5];
+    /// Default goal for `tip_dot`.
+    pub const GOAL_TIP_DOT: [f64; 1] = [0.0];
+    /// Default precision for `tip`: P = 100.0 I.
+    pub const PRECISION_TIP: f64 = 100.0;
+    /// Default precision for `tip_dot`: P = 50.0 I.
+    pub const PRECISION_TIP_DOT: f64 = 50.0;
+    /// Default precision for `u`: P = 1.0 I.
+    pub const PRECISION_U: f64 = 1.0;
+}
+
+/// Task 5 (tip velocity control): the paper's default goals and precisions ("Implementation details").
+pub mod tip_velocity {
+    #[allow(unused_imports)]
+    use super::PI;
+    /// Free-energy terms the controller uses (eq. U_dot_deriv).
+    pub const TERMS: [&str; 2] = ["tip_dot", "u"];
+    /// Default goal for `tip_dot`.
+    pub const GOAL_TIP_DOT: [f64; 1] = [0.2];
+    /// Default precision for `tip_dot`: P = 50.0 I.
+    pub const PRECISION_TIP_DOT: f64 = 50.0;
+    /// Default precision for `u`: P = 1.0 I.
+    pub const PRECISION_U: f64 = 1.0;
+}
+
 /// The default goals and precisions of `task` for this model (the modules above); zero for a
 /// term the task does not use.
 #[must_use]
@@ -103,12 +139,16 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 position::GOAL_THETA_DOT,
                 position::GOAL_THETA_DDOT,
                 [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 position::PRECISION_THETA,
                 position::PRECISION_THETA_DOT,
                 position::PRECISION_THETA_DDOT,
                 position::PRECISION_U,
+                0.0,
+                0.0,
             ],
         },
         super::TaskKind::Velocity => super::TaskDefaults {
@@ -117,12 +157,16 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 velocity::GOAL_THETA_DOT,
                 velocity::GOAL_THETA_DDOT,
                 [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
                 velocity::PRECISION_THETA_DOT,
                 velocity::PRECISION_THETA_DDOT,
                 velocity::PRECISION_U,
+                0.0,
+                0.0,
             ],
         },
         super::TaskKind::Acceleration => super::TaskDefaults {
@@ -131,12 +175,52 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 acceleration::GOAL_THETA_DDOT,
                 [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
                 0.0,
                 acceleration::PRECISION_THETA_DDOT,
                 acceleration::PRECISION_U,
+                0.0,
+                0.0,
+            ],
+        },
+        super::TaskKind::TipPosition => super::TaskDefaults {
+            goal: [
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                tip_position::GOAL_TIP,
+                tip_position::GOAL_TIP_DOT,
+            ],
+            precision: [
+                0.0,
+                0.0,
+                0.0,
+                tip_position::PRECISION_U,
+                tip_position::PRECISION_TIP,
+                tip_position::PRECISION_TIP_DOT,
+            ],
+        },
+        super::TaskKind::TipVelocity => super::TaskDefaults {
+            goal: [
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                tip_velocity::GOAL_TIP_DOT,
+            ],
+            precision: [
+                0.0,
+                0.0,
+                0.0,
+                tip_velocity::PRECISION_U,
+                0.0,
+                tip_velocity::PRECISION_TIP_DOT,
             ],
         },
     }
@@ -159,19 +243,40 @@ pub fn task_sensitivities(
                     Some(d_theta_dot_du),
                     Some(d_theta_ddot_du),
                     None,
+                    None,
+                    None,
                 ],
             }
         }
         super::TaskKind::Velocity => {
             let (d_theta_dot_du, d_theta_ddot_du) = velocity_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, Some(d_theta_dot_du), Some(d_theta_ddot_du), None],
+                d_du: [
+                    None,
+                    Some(d_theta_dot_du),
+                    Some(d_theta_ddot_du),
+                    None,
+                    None,
+                    None,
+                ],
             }
         }
         super::TaskKind::Acceleration => {
             let d_theta_ddot_du = acceleration_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, None, Some(d_theta_ddot_du), None],
+                d_du: [None, None, Some(d_theta_ddot_du), None, None, None],
+            }
+        }
+        super::TaskKind::TipPosition => {
+            let (d_tip_du, d_tip_dot_du) = tip_position_sensitivity(params);
+            super::TaskSensitivities {
+                d_du: [None, None, None, None, Some(d_tip_du), Some(d_tip_dot_du)],
+            }
+        }
+        super::TaskKind::TipVelocity => {
+            let d_tip_dot_du = tip_velocity_sensitivity(params);
+            super::TaskSensitivities {
+                d_du: [None, None, None, None, None, Some(d_tip_dot_du)],
             }
         }
     }
@@ -210,6 +315,17 @@ pub fn task_control_confidence(
             &precision[Term::ThetaDdot as usize],
             &precision[Term::U as usize],
         ),
+        super::TaskKind::TipPosition => tip_position_control_confidence(
+            params,
+            &precision[Term::Tip as usize],
+            &precision[Term::TipDot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::TipVelocity => tip_velocity_control_confidence(
+            params,
+            &precision[Term::TipDot as usize],
+            &precision[Term::U as usize],
+        ),
     }
 }
 
@@ -244,6 +360,17 @@ pub fn task_logdet_gradient(
         super::TaskKind::Acceleration => acceleration_logdet_gradient(
             params,
             &precision[Term::ThetaDdot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::TipPosition => tip_position_logdet_gradient(
+            params,
+            &precision[Term::Tip as usize],
+            &precision[Term::TipDot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::TipVelocity => tip_velocity_logdet_gradient(
+            params,
+            &precision[Term::TipDot as usize],
             &precision[Term::U as usize],
         ),
     }
@@ -672,4 +799,187 @@ pub fn acceleration_logdet_gradient(
     // d ln|Pi^U| / dp, one entry per tool parameter
     let gradient = <SVector<f64, 3>>::zeros();
     gradient
+}
+
+/// Task 4 (tip position control): the sensitivities d(task variable)/dU the controller uses, in the order (d_tip_du, d_tip_dot_du).
+///
+/// From appendix "Task specific controllers".
+///
+/// - `params`: tool parameters `[m k c]`
+///
+/// Cost per call: 4 operations, weighted 11 (1 ADD, 1 DIV, 1 NEG, 1 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_position_sensitivity(params: &SVector<f64, 3>) -> (SVector<f64, 1>, SVector<f64, 1>) {
+    let m = params[0];
+    let k = params[1];
+    let c = params[2];
+    // dtip/dU = J @ IO @ inv(A) @ (E - B)
+    let mut d_tip_du = <SVector<f64, 1>>::zeros();
+    d_tip_du[0] = -(c + m - 1.0) / k;
+    // dtip_dot/dU = J @ OI @ inv(A) @ (E - B)
+    let mut d_tip_dot_du = <SVector<f64, 1>>::zeros();
+    d_tip_dot_du[0] = 1.0;
+    (d_tip_du, d_tip_dot_du)
+}
+
+/// Task 4 (tip position control): the control confidence Pi^U = d2F/dU2 = S_tip^T P_tip S_tip + S_tip_dot^T P_tip_dot S_tip_dot + P_u.
+///
+/// From eq. (control_conf) and the closed forms after it.
+///
+/// - `params`: tool parameters `[m k c]`
+/// - `p_tip`: precision P of the tool tip's position tip (symmetric; the upper triangle is read)
+/// - `p_tip_dot`: precision P of the tool tip's velocity tip_dot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 8 operations, weighted 17 (3 ADD, 1 DIV, 1 MUL, 2 POW, 1 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_position_control_confidence(
+    params: &SVector<f64, 3>,
+    p_tip: &SVector<f64, 1>,
+    p_tip_dot: &SVector<f64, 1>,
+    p_u: &SVector<f64, 1>,
+) -> SVector<f64, 1> {
+    let m = params[0];
+    let k = params[1];
+    let c = params[2];
+    let p_tip_00 = p_tip[0];
+    let p_tip_dot_00 = p_tip_dot[0];
+    let p_u_00 = p_u[0];
+    // Pi^U (symmetric)
+    let mut pi_u = <SVector<f64, 1>>::zeros();
+    pi_u[0] = p_tip_dot_00 + p_u_00 + p_tip_00 * (c + m - 1.0).powi(2) / k.powi(2);
+    pi_u
+}
+
+/// Task 4 (tip position control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters `[m k c]`
+/// - `p_tip`: precision P of the tool tip's position tip (symmetric; the upper triangle is read)
+/// - `p_tip_dot`: precision P of the tool tip's velocity tip_dot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 21 operations, weighted 45 (4 ADD, 3 DIV, 8 MUL, 1 NEG, 3 POW, 2 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_position_logdet_gradient(
+    params: &SVector<f64, 3>,
+    p_tip: &SVector<f64, 1>,
+    p_tip_dot: &SVector<f64, 1>,
+    p_u: &SVector<f64, 1>,
+) -> SVector<f64, 3> {
+    let m = params[0];
+    let k = params[1];
+    let c = params[2];
+    let p_tip_00 = p_tip[0];
+    let p_tip_dot_00 = p_tip_dot[0];
+    let p_u_00 = p_u[0];
+    let t0 = (c + m - 1.0).powi(2);
+    let t1 = p_tip_00 / k.powi(2);
+    let t2 = 1.0 / (p_tip_dot_00 + p_u_00 + t0 * t1);
+    let t3 = t1 * t2 * (2.0 * c + 2.0 * m - 2.0);
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 3>>::zeros();
+    gradient[0] = t3;
+    gradient[1] = -2.0 * p_tip_00 * t0 * t2 / k.powi(3);
+    gradient[2] = t3;
+    gradient
+}
+
+/// Task 5 (tip velocity control): the sensitivities d(task variable)/dU the controller uses, in the order (d_tip_dot_du).
+///
+/// From appendix "Task specific controllers".
+///
+/// - `params`: tool parameters `[m k c]`
+///
+/// Cost per call: 1 operation, weighted 8 (1 DIV).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_velocity_sensitivity(params: &SVector<f64, 3>) -> SVector<f64, 1> {
+    let k = params[1];
+    // dtip_dot/dU = -J @ IO @ inv(A) @ B
+    let mut d_tip_dot_du = <SVector<f64, 1>>::zeros();
+    d_tip_dot_du[0] = 1.0 / k;
+    d_tip_dot_du
+}
+
+/// Task 5 (tip velocity control): the control confidence Pi^U = d2F/dU2 = S_tip_dot^T P_tip_dot S_tip_dot + P_u.
+///
+/// From eq. (control_conf) and the closed forms after it.
+///
+/// - `params`: tool parameters `[m k c]`
+/// - `p_tip_dot`: precision P of the tool tip's velocity tip_dot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 3 operations, weighted 11 (1 ADD, 1 DIV, 1 POW).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_velocity_control_confidence(
+    params: &SVector<f64, 3>,
+    p_tip_dot: &SVector<f64, 1>,
+    p_u: &SVector<f64, 1>,
+) -> SVector<f64, 1> {
+    let k = params[1];
+    let p_tip_dot_00 = p_tip_dot[0];
+    let p_u_00 = p_u[0];
+    // Pi^U (symmetric)
+    let mut pi_u = <SVector<f64, 1>>::zeros();
+    pi_u[0] = p_u_00 + p_tip_dot_00 / k.powi(2);
+    pi_u
+}
+
+/// Task 5 (tip velocity control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters `[m k c]`
+/// - `p_tip_dot`: precision P of the tool tip's velocity tip_dot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 8 operations, weighted 24 (1 ADD, 2 DIV, 2 MUL, 1 NEG, 2 POW).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_velocity_logdet_gradient(
+    params: &SVector<f64, 3>,
+    p_tip_dot: &SVector<f64, 1>,
+    p_u: &SVector<f64, 1>,
+) -> SVector<f64, 3> {
+    let k = params[1];
+    let p_tip_dot_00 = p_tip_dot[0];
+    let p_u_00 = p_u[0];
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 3>>::zeros();
+    gradient[1] = -2.0 * p_tip_dot_00 / (k.powi(3) * (p_u_00 + p_tip_dot_00 / k.powi(2)));
+    gradient
+}
+
+/// The tip y(q; p) in the base frame (the description's [tip] position; z = 0 in the plane of a planar arm) and its Jacobian J = dy/dq.
+///
+/// From forward kinematics of the tip.
+///
+/// - `q`: joint positions q = `[z]`
+/// - `params`: tool parameters `[m k c]`
+///
+/// Cost per call: 0 operations, weighted 0.
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip(q: &SVector<f64, 1>, _params: &SVector<f64, 3>) -> (SVector<f64, 3>, SVector<f64, 3>) {
+    let z = q[0];
+    // y (m, base frame)
+    let mut position = <SVector<f64, 3>>::zeros();
+    position[0] = z;
+    // J = dy/dq
+    let mut jacobian = <SVector<f64, 3>>::zeros();
+    jacobian[0] = 1.0;
+    (position, jacobian)
 }

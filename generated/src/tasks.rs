@@ -12,7 +12,7 @@ use core::str::FromStr;
 use nalgebra::SMatrix;
 
 /// How many free-energy terms there are: the length of a task's goals and precisions.
-pub const TERMS: usize = 4;
+pub const TERMS: usize = 6;
 
 /// A term of the free energy F (eq. free_energy), as `derive/tasks.toml` lists them, in the
 /// order of the controller's sum (eq. U_dot_deriv). `Term::ALL[t.index()] == t`.
@@ -26,34 +26,57 @@ pub enum Term {
     ThetaDdot,
     /// "U": the control.
     U,
+    /// "y": the tool tip's position.
+    Tip,
+    /// "ẏ": the tool tip's velocity.
+    TipDot,
 }
 
 /// Where a term's value is read, for n joints: rows `block·n..(block+1)·n` of the state
-/// X = [q; q̇] or of its rate Ẋ, or the control U.
+/// X = [q; q̇] or of its rate Ẋ, the control U, or the tool's tip from the model's forward
+/// kinematics (`tip::<model>`): its position y(q) (`order` 0) or velocity J(q) q̇ (`order` 1),
+/// whose TIP_DIM components (the model's `TIP_DIM`) fill the first rows of n, zero below.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Read {
     State { block: usize },
     StateRate { block: usize },
     Control,
+    Tip { order: usize },
 }
 
 impl Term {
     /// Every term, in order.
-    pub const ALL: [Term; TERMS] = [Term::Theta, Term::ThetaDot, Term::ThetaDdot, Term::U];
+    pub const ALL: [Term; TERMS] = [
+        Term::Theta,
+        Term::ThetaDot,
+        Term::ThetaDdot,
+        Term::U,
+        Term::Tip,
+        Term::TipDot,
+    ];
 
     /// The terms a goal is given for (all but the control's), by name: the keys of a task file's
     /// `[goal]`.
-    pub const GOAL_NAMES: [&'static str; 3] = ["theta", "theta_dot", "theta_ddot"];
+    pub const GOAL_NAMES: [&'static str; 5] =
+        ["theta", "theta_dot", "theta_ddot", "tip", "tip_dot"];
 
     /// Every term by name: the keys of a task file's `[precision]`.
-    pub const NAMES: [&'static str; TERMS] = ["theta", "theta_dot", "theta_ddot", "u"];
+    pub const NAMES: [&'static str; TERMS] =
+        ["theta", "theta_dot", "theta_ddot", "u", "tip", "tip_dot"];
 
     /// The control's own term, the one [`Read::Control`] reads.
     pub const CONTROL: Term = Term::U;
 
     /// The order the summands of the cost J are added in (floating-point addition is not
     /// associative; `cost_order` of `derive/tasks.toml`).
-    pub const COST_ORDER: [Term; TERMS] = [Term::ThetaDdot, Term::U, Term::ThetaDot, Term::Theta];
+    pub const COST_ORDER: [Term; TERMS] = [
+        Term::ThetaDdot,
+        Term::U,
+        Term::ThetaDot,
+        Term::Theta,
+        Term::Tip,
+        Term::TipDot,
+    ];
 
     /// The term's position in [`Term::ALL`], and in a task's goals and precisions.
     #[must_use]
@@ -69,6 +92,8 @@ impl Term {
             Term::ThetaDot => "theta_dot",
             Term::ThetaDdot => "theta_ddot",
             Term::U => "u",
+            Term::Tip => "tip",
+            Term::TipDot => "tip_dot",
         }
     }
 
@@ -80,6 +105,8 @@ impl Term {
             Term::ThetaDot => "d_theta_dot_du",
             Term::ThetaDdot => "d_theta_ddot_du",
             Term::U => "d_u_du",
+            Term::Tip => "d_tip_du",
+            Term::TipDot => "d_tip_dot_du",
         }
     }
 
@@ -91,6 +118,8 @@ impl Term {
             Term::ThetaDot => "θ\u{307}",
             Term::ThetaDdot => "θ\u{308}",
             Term::U => "U",
+            Term::Tip => "y",
+            Term::TipDot => "ẏ",
         }
     }
 
@@ -102,6 +131,8 @@ impl Term {
             Term::ThetaDot => "the joint velocities",
             Term::ThetaDdot => "the joint accelerations",
             Term::U => "the control",
+            Term::Tip => "the tool tip's position",
+            Term::TipDot => "the tool tip's velocity",
         }
     }
 
@@ -113,6 +144,8 @@ impl Term {
             Term::ThetaDot => "joint velocity",
             Term::ThetaDdot => "joint acceleration",
             Term::U => "torque",
+            Term::Tip => "tip position",
+            Term::TipDot => "tip velocity",
         }
     }
 
@@ -124,6 +157,8 @@ impl Term {
             Term::ThetaDot => "rad/s",
             Term::ThetaDdot => "rad/s²",
             Term::U => "N m",
+            Term::Tip => "m",
+            Term::TipDot => "m/s",
         }
     }
 
@@ -135,6 +170,8 @@ impl Term {
             Term::ThetaDot => Read::State { block: 1 },
             Term::ThetaDdot => Read::StateRate { block: 1 },
             Term::U => Read::Control,
+            Term::Tip => Read::Tip { order: 0 },
+            Term::TipDot => Read::Tip { order: 1 },
         }
     }
 
@@ -147,6 +184,8 @@ impl Term {
             Term::ThetaDot => Some("joint_rate"),
             Term::ThetaDdot => Some("joint_acceleration"),
             Term::U => None,
+            Term::Tip => Some("tip_position"),
+            Term::TipDot => Some("tip_velocity"),
         }
     }
 
@@ -185,14 +224,20 @@ pub enum TaskKind {
     Velocity,
     /// Task 3 (acceleration control): Hold a goal joint acceleration.
     Acceleration,
+    /// Task 4 (tip position control): Reach and hold a goal point with the tool's tip (zero goal tip velocity).
+    TipPosition,
+    /// Task 5 (tip velocity control): Move the tool's tip at a goal velocity.
+    TipVelocity,
 }
 
 impl TaskKind {
     /// Every task, in the order of `derive/tasks.toml`.
-    pub const ALL: [TaskKind; 3] = [
+    pub const ALL: [TaskKind; 5] = [
         TaskKind::Position,
         TaskKind::Velocity,
         TaskKind::Acceleration,
+        TaskKind::TipPosition,
+        TaskKind::TipVelocity,
     ];
 
     /// The task's name in `derive/tasks.toml` (and on the command line).
@@ -202,6 +247,8 @@ impl TaskKind {
             TaskKind::Position => "position",
             TaskKind::Velocity => "velocity",
             TaskKind::Acceleration => "acceleration",
+            TaskKind::TipPosition => "tip_position",
+            TaskKind::TipVelocity => "tip_velocity",
         }
     }
 
@@ -212,6 +259,8 @@ impl TaskKind {
             TaskKind::Position => 1,
             TaskKind::Velocity => 2,
             TaskKind::Acceleration => 3,
+            TaskKind::TipPosition => 4,
+            TaskKind::TipVelocity => 5,
         }
     }
 
@@ -222,6 +271,8 @@ impl TaskKind {
             TaskKind::Position => "Task 1 (position control)",
             TaskKind::Velocity => "Task 2 (velocity control)",
             TaskKind::Acceleration => "Task 3 (acceleration control)",
+            TaskKind::TipPosition => "Task 4 (tip position control)",
+            TaskKind::TipVelocity => "Task 5 (tip velocity control)",
         }
     }
 
@@ -232,6 +283,8 @@ impl TaskKind {
             TaskKind::Position => "Reach and hold a goal configuration of the joints (zero goal velocity and acceleration).",
             TaskKind::Velocity => "Move the joints at a goal velocity (zero goal acceleration).",
             TaskKind::Acceleration => "Hold a goal joint acceleration.",
+            TaskKind::TipPosition => "Reach and hold a goal point with the tool's tip (zero goal tip velocity).",
+            TaskKind::TipVelocity => "Move the tool's tip at a goal velocity.",
         }
     }
 
@@ -243,6 +296,8 @@ impl TaskKind {
             TaskKind::Position => &[Term::Theta, Term::ThetaDot, Term::ThetaDdot, Term::U],
             TaskKind::Velocity => &[Term::ThetaDot, Term::ThetaDdot, Term::U],
             TaskKind::Acceleration => &[Term::ThetaDdot, Term::U],
+            TaskKind::TipPosition => &[Term::Tip, Term::TipDot, Term::U],
+            TaskKind::TipVelocity => &[Term::TipDot, Term::U],
         }
     }
 
@@ -253,6 +308,8 @@ impl TaskKind {
             TaskKind::Position => Term::Theta,
             TaskKind::Velocity => Term::ThetaDot,
             TaskKind::Acceleration => Term::ThetaDdot,
+            TaskKind::TipPosition => Term::Tip,
+            TaskKind::TipVelocity => Term::TipDot,
         }
     }
 
@@ -264,7 +321,8 @@ impl TaskKind {
 }
 
 /// The names and numbers a task may be given by, as messages and `--help` list them.
-pub const TASK_CHOICES: &str = "position, velocity or acceleration (or 1, 2, 3)";
+pub const TASK_CHOICES: &str =
+    "position, velocity, acceleration, tip_position or tip_velocity (or 1, 2, 3, 4, 5)";
 
 /// The task's name.
 impl fmt::Display for TaskKind {

@@ -86,6 +86,9 @@ pub struct CoefficientsView<'a> {
 pub struct FunctionView<'a> {
     pub name: &'a str,
     pub doc: &'a str,
+    /// Paragraphs the doc comment adds after `doc` (a task's formulation, for its sensitivity
+    /// function).
+    pub notes: Vec<String>,
     pub equation: &'a str,
     pub args: &'a [Arg],
     /// The doc comment's lines on the cost per call.
@@ -117,8 +120,11 @@ pub fn ops_text(c: &Cost) -> String {
 }
 
 /// The views of a model's functions, in order; each coefficient struct is defined once, by the
-/// first function that takes it.
-pub fn function_views(functions: &[Function]) -> Result<Vec<FunctionView<'_>>, RenderError> {
+/// first function that takes it. `notes` are the paragraphs a function's doc adds, by its name.
+pub fn function_views<'a>(
+    functions: &'a [Function],
+    notes: &[(&str, Vec<String>)],
+) -> Result<Vec<FunctionView<'a>>, RenderError> {
     let mut defined: Vec<(&str, &Coefficients)> = Vec::new();
     functions
         .iter()
@@ -127,7 +133,9 @@ pub fn function_views(functions: &[Function]) -> Result<Vec<FunctionView<'_>>, R
                 .coefficients
                 .as_ref()
                 .and_then(|c| defined.iter().copied().find(|(_, d)| same_factors(d, c)));
-            let view = function_view(f, shared)?;
+            let own = notes.iter().find(|(name, _)| *name == f.name);
+            let mut view = function_view(f, shared)?;
+            view.notes = own.map_or_else(Vec::new, |(_, lines)| lines.clone());
             if let (Some(c), None) = (&f.coefficients, shared) {
                 defined.push((&f.name, c));
             }
@@ -171,6 +179,7 @@ fn function_view<'a>(
         return Ok(FunctionView {
             name: &f.name,
             doc: &f.doc,
+            notes: Vec::new(),
             equation: &f.equation,
             args: &f.args,
             cost_doc: vec![format!("Cost per call: {}.", ops_text(&f.cost))],
@@ -232,6 +241,7 @@ fn function_view<'a>(
     Ok(FunctionView {
         name: &f.name,
         doc: &f.doc,
+        notes: Vec::new(),
         equation: &f.equation,
         args: &f.args,
         cost_doc,
@@ -385,7 +395,13 @@ fn body_view(f: &Function, result: String) -> Result<BodyView<'_>, RenderError> 
             .iter()
             .map(|o| OutputView {
                 doc: &o.doc,
-                binding: format!("mut {}", o.name),
+                // An output the steps never write (a sensitivity that is zero by structure,
+                // the static gain's ∂θ̇/∂U) stays immutable.
+                binding: if o.entries.is_empty() {
+                    o.name.clone()
+                } else {
+                    format!("mut {}", o.name)
+                },
                 rust_type: &o.rust_type,
                 assignments: Vec::new(),
             })
@@ -425,7 +441,7 @@ mod tests {
     #[test]
     fn different_coefficients_are_two_structs() {
         let ir = fixture();
-        let views = function_views(&ir.functions).unwrap();
+        let views = function_views(&ir.functions, &[]).unwrap();
         let (d, j) = (
             coefficients(&views, "dynamics"),
             coefficients(&views, "dynamics_jacobian"),
@@ -450,7 +466,7 @@ mod tests {
         second.temporaries = first.temporaries;
         second.values = first.values;
         second.cost = first.cost;
-        let views = function_views(&ir.functions).unwrap();
+        let views = function_views(&ir.functions, &[]).unwrap();
         let j = coefficients(&views, "dynamics_jacobian");
         assert_eq!(j.r#struct, "DynamicsCoefficients");
         assert!(j.definition.is_none());

@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 use crate::RenderError;
 
 /// The IR schema this renderer understands (`schema` in the JSON).
-pub const IR_SCHEMA: u64 = 5;
+pub const IR_SCHEMA: u64 = 6;
 
 /// One model's IR. `R` is its report: [`ClosedFormReport`] for a model derived by SymPy,
 /// [`UrdfReport`] for a URDF arm (derived on CasADi SX).
@@ -67,6 +67,8 @@ pub struct Model {
     pub source: String,
     pub dof: usize,
     pub state_dim: usize,
+    /// TIP_DIM: the components of the tip the tip terms use (their first rows of the `dof`).
+    pub tip_dim: usize,
     pub parameters: Vec<Parameter>,
     pub constants: Vec<Constant>,
     pub state: Vec<Variable>,
@@ -176,7 +178,8 @@ pub struct Term {
     pub goal_range: Option<String>,
 }
 
-/// Where a term's value is read: `block` (n rows) of the state X, of its rate Ẋ, or the control.
+/// Where a term's value is read: `block` (n rows) of the state X, of its rate Ẋ, or the control;
+/// for the tool's tip, `block` is the order of the derivative (0: y(q), 1: J(q) q̇).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct TermRead {
@@ -191,6 +194,7 @@ pub enum Source {
     State,
     StateRate,
     Control,
+    Tip,
 }
 
 impl Term {
@@ -216,9 +220,39 @@ pub struct Task {
     pub gradient_function: String,
     pub goals: Vec<Goal>,
     pub precisions: Vec<Precision>,
+    pub formulation: Formulation,
 }
 
-/// A default goal, one Rust literal per joint.
+/// Which formulation of its sensitivities a task has in this model: `paper` (the formulas of
+/// `derive/tasks.toml`'s task) or one of the task's named `[task.formulations]`, and why.
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Formulation {
+    pub name: String,
+    /// The named formulation's doc (empty for the paper's).
+    pub doc: String,
+    pub chosen_by: ChosenBy,
+}
+
+impl Formulation {
+    /// The name of the task's own formulas.
+    pub const PAPER: &'static str = "paper";
+}
+
+/// Why a task has its formulation in a model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ChosenBy {
+    /// Nothing chose another: the paper's.
+    Default,
+    /// The formulation's `default_for` names the model's dynamics kind.
+    DefaultFor,
+    /// The model description's `[formulation]` names it.
+    Description,
+}
+
+/// A default goal, one Rust literal per joint (a goal at the tip: its TIP_DIM components, then
+/// zeros).
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Goal {

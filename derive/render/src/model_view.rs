@@ -20,6 +20,7 @@ pub struct ModelView<'a> {
     pub source: &'a str,
     pub dof: usize,
     pub state_dim: usize,
+    pub tip_dim: usize,
     pub parameters: &'a [Parameter],
     pub parameter_count: usize,
     /// The parameters' names, space-separated, as the coefficient structs' docs list them.
@@ -45,6 +46,15 @@ pub struct ModelContext<'a> {
 
 pub fn model_context(ir: &Ir) -> Result<ModelContext<'_>, RenderError> {
     let m: &Model = &ir.model;
+    let tasks = task_views(ir)?;
+    // A task's formulation, where it is not the paper's, in its sensitivity function's doc.
+    let notes: Vec<(&str, Vec<String>)> = ir
+        .tasks
+        .iter()
+        .zip(&tasks)
+        .map(|(t, v)| (t.sensitivity_function.as_str(), v.sensitivity_notes.clone()))
+        .collect();
+    let functions = function_views(&ir.functions, &notes)?;
     Ok(ModelContext {
         model: ModelView {
             name: &m.name,
@@ -52,6 +62,7 @@ pub fn model_context(ir: &Ir) -> Result<ModelContext<'_>, RenderError> {
             source: &m.source,
             dof: m.dof,
             state_dim: m.state_dim,
+            tip_dim: m.tip_dim,
             parameters: &m.parameters,
             parameter_count: m.parameters.len(),
             parameter_list: join(m.parameters.iter().map(|p| p.name.as_str()), " "),
@@ -62,14 +73,14 @@ pub fn model_context(ir: &Ir) -> Result<ModelContext<'_>, RenderError> {
         },
         generator: &ir.generator,
         test_vectors: &ir.test_vectors,
-        functions: function_views(&ir.functions)?,
         function_count: ir.functions.len(),
-        tasks: task_views(ir)?,
-        tool_rule: tool_rule_view(m)?,
         report: match &ir.report {
-            Report::ClosedForm(r) => ReportView::ClosedForm(closed_form_report(m, r)),
+            Report::ClosedForm(r) => ReportView::ClosedForm(closed_form_report(m, r, &tasks)),
             Report::Urdf(r) => ReportView::Urdf(urdf_report(r)),
         },
+        functions,
+        tasks,
+        tool_rule: tool_rule_view(m)?,
     })
 }
 
@@ -136,6 +147,8 @@ pub struct TaskReportView<'a> {
     pub gradient_values: String,
     pub gradient_closed: Option<&'a [GradientClosedForm]>,
     pub remarks: Vec<RemarkView<'a>>,
+    /// The formulation of its sensitivities in this model, in words.
+    pub formulation: String,
 }
 
 /// A task's remark, the comparison in words ("equals", "is **not** equal to").
@@ -149,7 +162,11 @@ pub struct RemarkView<'a> {
     pub relation: &'static str,
 }
 
-fn closed_form_report<'a>(m: &'a Model, r: &'a ClosedFormReport) -> ClosedFormReportView<'a> {
+fn closed_form_report<'a>(
+    m: &'a Model,
+    r: &'a ClosedFormReport,
+    tasks: &[TaskView],
+) -> ClosedFormReportView<'a> {
     let latex = |vs: &'a [Variable]| join(vs.iter().map(|v| v.latex.as_str()), "\\ ");
     let compared = (!r.comparisons.is_empty()).then(|| ComparedView {
         printed_where: &r.printed_where,
@@ -212,6 +229,10 @@ fn closed_form_report<'a>(m: &'a Model, r: &'a ClosedFormReport) -> ClosedFormRe
                     },
                 })
                 .collect(),
+            formulation: tasks
+                .iter()
+                .find(|v| v.name == t.name)
+                .map_or_else(String::new, |v| v.formulation.clone()),
         })
         .collect();
     ClosedFormReportView {

@@ -4,7 +4,7 @@
 
 use serde::Serialize;
 
-use crate::ir::{Function, Ir};
+use crate::ir::{Function, Ir, Task};
 use crate::tasks::{
     binding_pattern, camel_case, cost_order, string_literal, task_choices, task_list, term_views,
     TaskView, TermView,
@@ -47,6 +47,9 @@ pub struct VectorTestView<'a> {
     pub args: Vec<&'a str>,
     pub outputs: Vec<&'a str>,
     pub pattern: String,
+    /// For a task's ∂ln|Π^U|/∂p, the function giving its Π^U (the same arguments), whose
+    /// condition number bounds how accurately any double evaluation gives it.
+    pub conditioned_by: Option<&'a str>,
 }
 
 /// The registry's view of one model: what the runtime needs to name and size it. The marker
@@ -168,7 +171,11 @@ fn registry_model(ir: &Ir) -> Result<RegistryModel<'_>, RenderError> {
         description: &ir.generator.model,
         description_literal: string_literal(&ir.generator.model),
         parameter_count: m.parameters.len(),
-        functions: ir.functions.iter().map(vector_test_view).collect(),
+        functions: ir
+            .functions
+            .iter()
+            .map(|f| vector_test_view(f, &ir.tasks))
+            .collect(),
         function_count: ir.functions.len(),
         tool_rule: tool_rule_view(m)?,
         rigid_body: rigid_body(&ir.functions),
@@ -208,13 +215,17 @@ fn rigid_body(functions: &[Function]) -> RigidBody {
     }
 }
 
-fn vector_test_view(f: &Function) -> VectorTestView<'_> {
+fn vector_test_view<'a>(f: &'a Function, tasks: &'a [Task]) -> VectorTestView<'a> {
     let outputs: Vec<String> = f.outputs.iter().map(|o| o.name.clone()).collect();
     VectorTestView {
         name: &f.name,
         args: f.args.iter().map(|a| a.name.as_str()).collect(),
         outputs: f.outputs.iter().map(|o| o.name.as_str()).collect(),
         pattern: binding_pattern(&outputs),
+        conditioned_by: tasks
+            .iter()
+            .find(|t| t.gradient_function == f.name)
+            .map(|t| t.confidence_function.as_str()),
     }
 }
 

@@ -1,14 +1,15 @@
 //! The Rust each task needs, decided here so that the templates only loop: the task's variant of
 //! `TaskKind` (its name in CamelCase), how a model's sensitivity function's outputs fill the
-//! three kinematic terms, which precisions its control confidence takes, each default goal or
-//! precision (zero for a term the task does not use), and the terms as `Term` variants.
+//! kinematic terms, which precisions its control confidence takes, each default goal or
+//! precision (zero for a term the task does not use), the terms as `Term` variants, and the
+//! formulation of its sensitivities in words.
 //!
 //! The tasks are those of `derive/tasks.toml`, the same for every model; [`task_list`] checks
 //! that every model's IR agrees before the registry renders `TaskKind` from them.
 
 use serde::Serialize;
 
-use crate::ir::{Ir, Source, Task, Term};
+use crate::ir::{ChosenBy, Formulation, Ir, Source, Task, Term};
 use crate::RenderError;
 
 /// `arm2_exact` → `Arm2Exact`, `position` → `Position`.
@@ -60,7 +61,7 @@ pub struct TermView<'a> {
     pub doc_literal: String,
     pub label_literal: String,
     pub unit_literal: String,
-    /// `Read::State { block: 0 }`.
+    /// `Read::State { block: 0 }`, `Read::Tip { order: 1 }`.
     pub read: String,
     /// `Some("joint_angle")` or `None`.
     pub goal_range: String,
@@ -93,6 +94,7 @@ fn term_view((index, t): (usize, &Term)) -> TermView<'_> {
         Source::State => format!("Read::State {{ block: {} }}", t.read.block),
         Source::StateRate => format!("Read::StateRate {{ block: {} }}", t.read.block),
         Source::Control => "Read::Control".to_string(),
+        Source::Tip => format!("Read::Tip {{ order: {} }}", t.read.block),
     };
     TermView {
         name: &t.name,
@@ -158,6 +160,11 @@ pub struct TaskView<'a> {
     pub error_variant: String,
     pub title_literal: String,
     pub doc_literal: String,
+    /// The formulation of its sensitivities in this model, in words (the reports' line).
+    pub formulation: String,
+    /// What its sensitivity function's doc comment adds: a paragraph naming a formulation other
+    /// than the paper's, none for the paper's (whose formulas the outputs' docs state).
+    pub sensitivity_notes: Vec<String>,
 }
 
 /// `pub const GOAL_THETA: [f64; count] = [values];` of a task's module.
@@ -311,7 +318,43 @@ pub fn task_view<'a>(task: &'a Task, terms: &'a [Term]) -> Result<TaskView<'a>, 
         error_variant: variant(&task.error),
         title_literal: string_literal(&task.title),
         doc_literal: string_literal(&task.doc),
+        formulation: formulation_text(&task.formulation),
+        sensitivity_notes: sensitivity_notes(&task.formulation),
     })
+}
+
+/// Why the model has the formulation, in words.
+fn chosen_by(by: ChosenBy) -> &'static str {
+    match by {
+        ChosenBy::Default => "the default",
+        ChosenBy::DefaultFor => "the default for this model's kind of dynamics, its `default_for`",
+        ChosenBy::Description => "chosen by the model description's `[formulation]`",
+    }
+}
+
+/// "the paper's formulas (the default)", "`static_gain` of ... (why), not the paper's formulas:
+/// doc", without a final full stop.
+pub fn formulation_text(f: &Formulation) -> String {
+    if f.name == Formulation::PAPER {
+        format!("the paper's formulas ({})", chosen_by(f.chosen_by))
+    } else {
+        format!(
+            "`{}` of `derive/tasks.toml`'s `[task.formulations]` ({}), not the paper's formulas: {}",
+            f.name,
+            chosen_by(f.chosen_by),
+            f.doc.trim_end_matches('.')
+        )
+    }
+}
+
+/// The sensitivity function's extra doc paragraph: only for a named formulation, so that a
+/// model with the paper's formulas keeps its functions' docs as they were.
+fn sensitivity_notes(f: &Formulation) -> Vec<String> {
+    if f.name == Formulation::PAPER {
+        Vec::new()
+    } else {
+        vec![format!("Formulation: {}.", formulation_text(f))]
+    }
 }
 
 /// The pattern that binds a function's outputs: a one-output function returns the matrix
@@ -373,7 +416,7 @@ pub fn task_choices(tasks: &[TaskView]) -> String {
 mod tests {
     use super::*;
 
-    /// The paper's four terms, as tasks.toml lists them.
+    /// The paper's four terms and the tip's two, as tasks.toml lists them.
     fn terms() -> Vec<Term> {
         let term = |name: &str, source: &str, block: usize, range: Option<&str>| {
             let range = range.map_or(String::new(), |r| format!(r#", "goal_range": "{r}""#));
@@ -388,11 +431,13 @@ mod tests {
             term("theta_dot", "state", 1, Some("joint_rate")),
             term("theta_ddot", "state_rate", 1, Some("joint_acceleration")),
             term("u", "control", 0, None),
+            term("tip", "tip", 0, Some("tip_position")),
+            term("tip_dot", "tip", 1, Some("tip_velocity")),
         ]
     }
 
     fn task(name: &str, terms: &[&str], error: &str) -> Task {
-        let used: Vec<&str> = ["theta", "theta_dot", "theta_ddot"]
+        let used: Vec<&str> = ["theta", "theta_dot", "theta_ddot", "tip", "tip_dot"]
             .into_iter()
             .filter(|t| terms.contains(t))
             .collect();
@@ -407,7 +452,8 @@ mod tests {
                 "sensitivity_terms": [{}], "error": {error:?},
                 "sensitivity_function": "{name}_sensitivity",
                 "confidence_function": "{name}_control_confidence",
-                "gradient_function": "{name}_logdet_gradient", "goals": [], "precisions": []}}"#,
+                "gradient_function": "{name}_logdet_gradient", "goals": [], "precisions": [],
+                "formulation": {{"name": "paper", "doc": "", "chosen_by": "default"}}}}"#,
             quoted(terms),
             quoted(&used)
         );
@@ -424,7 +470,14 @@ mod tests {
         );
         assert_eq!(
             t.sensitivity_values,
-            ["None", "None", "Some(d_theta_ddot_du)", "None"]
+            [
+                "None",
+                "None",
+                "Some(d_theta_ddot_du)",
+                "None",
+                "None",
+                "None"
+            ]
         );
         assert_eq!(t.default_goals[0], "[0.0; DOF]");
         assert_eq!(t.default_goals[2], "hold::GOAL_THETA_DDOT");
@@ -451,6 +504,51 @@ mod tests {
             "let (d_theta_du, d_theta_dot_du) = reach_sensitivity(params);"
         );
         assert_eq!(t.sensitivity_values[2], "None");
+    }
+
+    #[test]
+    fn a_tip_task_reads_the_tip_and_fills_its_terms_slots() {
+        let (task, terms) = (task("touch", &["tip", "tip_dot", "u"], "tip"), terms());
+        let t = task_view(&task, &terms).unwrap();
+        assert_eq!(
+            t.sensitivity_binding,
+            "let (d_tip_du, d_tip_dot_du) = touch_sensitivity(params);"
+        );
+        assert_eq!(
+            t.sensitivity_values[4..],
+            ["Some(d_tip_du)", "Some(d_tip_dot_du)"]
+        );
+        assert_eq!(t.default_goals[4], "touch::GOAL_TIP");
+        assert_eq!(t.default_goals[0], "[0.0; DOF]");
+        assert_eq!(t.error_variant, "Term::Tip");
+        let views = term_views(&terms).unwrap();
+        assert_eq!(views[4].read, "Read::Tip { order: 0 }");
+        assert_eq!(views[5].read, "Read::Tip { order: 1 }");
+        assert_eq!(views[5].variant, "TipDot");
+    }
+
+    #[test]
+    fn a_named_formulation_is_in_the_sensitivity_doc_and_the_papers_is_not() {
+        let mut task = task("reach", &["theta", "u"], "theta");
+        let terms = terms();
+        let paper = task_view(&task, &terms).unwrap();
+        assert!(paper.sensitivity_notes.is_empty());
+        assert_eq!(paper.formulation, "the paper's formulas (the default)");
+        task.formulation = Formulation {
+            name: "static_gain".into(),
+            doc: "The static gain.".into(),
+            chosen_by: ChosenBy::DefaultFor,
+        };
+        let named = task_view(&task, &terms).unwrap();
+        assert_eq!(
+            named.formulation,
+            "`static_gain` of `derive/tasks.toml`'s `[task.formulations]` (the default for this \
+             model's kind of dynamics, its `default_for`), not the paper's formulas: The static gain"
+        );
+        assert_eq!(
+            named.sensitivity_notes,
+            [format!("Formulation: {}.", named.formulation)]
+        );
     }
 
     #[test]
