@@ -330,3 +330,34 @@ fn urdf_report(r: &UrdfReport) -> UrdfReportView<'_> {
             .collect(),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ir::{ChosenBy, Formulation};
+
+    fn fixture() -> Ir {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../tests/fixtures/pendulum.json");
+        crate::ir::read_ir(&path).expect("fixture")
+    }
+
+    #[test]
+    fn a_named_formulation_is_in_its_sensitivity_functions_doc_alone() {
+        let mut ir = fixture();
+        let paper = model_context(&ir).unwrap();
+        assert!(paper.functions.iter().all(|f| f.notes.is_empty()));
+        assert_eq!(paper.model.tip_dim, 1);
+        ir.tasks[0].formulation = Formulation {
+            name: "static_gain".into(),
+            doc: "The static gain.".into(),
+            chosen_by: ChosenBy::Description,
+        };
+        let named = model_context(&ir).unwrap();
+        for f in &named.functions {
+            let expected = usize::from(f.name == ir.tasks[0].sensitivity_function);
+            assert_eq!(f.notes.len(), expected, "{}", f.name);
+        }
+        assert!(named.tasks[0].formulation.contains("`[formulation]`"));
+    }
+}

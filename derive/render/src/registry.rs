@@ -246,3 +246,30 @@ fn shared_generator(
         None => Ok(first),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_gradients_vector_test_is_conditioned_by_its_tasks_confidence() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../tests/fixtures/pendulum.json");
+        let irs = [crate::ir::read_ir(&path).expect("fixture")];
+        let context = registry_context(&irs, &Package::in_repository()).unwrap();
+        let view = |name: &str| {
+            context.models[0]
+                .functions
+                .iter()
+                .find(|f| f.name == name)
+                .unwrap_or_else(|| panic!("{name}"))
+                .conditioned_by
+        };
+        assert_eq!(
+            view("tip_position_logdet_gradient"),
+            Some("tip_position_control_confidence")
+        );
+        assert_eq!(view("tip_position_control_confidence"), None);
+        assert_eq!(view("dynamics"), None);
+    }
+}
