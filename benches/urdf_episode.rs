@@ -53,7 +53,7 @@ fn closed_loop_rhs(c: &mut Criterion) {
     }
     let mut group = c.benchmark_group("panda_closed_loop_rhs");
     for kind in TaskKind::ALL {
-        let task = <Panda as toolconf::model::ArmModel<7, 14, 7, 21>>::paper_task(kind);
+        let task = <Panda as toolconf::model::ArmModel<7, 14, 13, 21>>::paper_task(kind);
         let system = ClosedLoopN::<Panda, 7, 14, 13, 21>::new(&tool, &task, 1.0, 0.0).unwrap();
         group.bench_function(kind.name(), |b| b.iter(|| system.rhs(black_box(&z))));
     }
@@ -88,6 +88,7 @@ fn rank_1000(c: &mut Criterion) {
                 row: i + 1,
                 name: None,
                 tool,
+                defaulted: Vec::new(),
             },
             logdet: Ok(0.0),
         })

@@ -16,8 +16,9 @@ use toolconf::generated::{panda, ur5};
 const POPULATION: usize = 1000;
 
 /// A tool within the derivation's sampling box: 0.05–3 kg, centre of mass within 5 cm of the
-/// flange axis and up to 25 cm out, the principal moments of a 1–30 cm box.
-fn tool(rng: &mut ChaCha8Rng) -> SVector<f64, 7> {
+/// flange axis and up to 25 cm out, the principal moments of a 1–30 cm box (no products of
+/// inertia), its tip 5–35 cm out along the flange axis.
+fn tool(rng: &mut ChaCha8Rng) -> SVector<f64, 13> {
     let m = rng.random_range(0.05..3.0);
     let (a, b, c): (f64, f64, f64) = (
         rng.random_range(0.01..0.3),
@@ -32,6 +33,12 @@ fn tool(rng: &mut ChaCha8Rng) -> SVector<f64, 7> {
         m * (b * b + c * c) / 12.0,
         m * (a * a + c * c) / 12.0,
         m * (a * a + b * b) / 12.0,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        rng.random_range(0.05..0.35),
     ])
 }
 

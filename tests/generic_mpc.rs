@@ -10,7 +10,7 @@ use toolconf::{Arm, Task, TaskKind};
 fn the_plant_choice_runs_the_generic_mpc_episode_on_that_model() {
     let arm = Arm::new([0.3, 0.4, 0.5, 0.2]).unwrap();
     let mpc = MpcOptions::default();
-    for kind in TaskKind::ALL {
+    for kind in toolconf::mpc::tasks() {
         let options = EpisodeOptions {
             perturbation: -0.8,
             record_trajectory: true,
@@ -59,7 +59,7 @@ fn arm3_mpc_runs_with_finite_metrics() {
         t_end: 1.0,
         ..EpisodeOptionsN::paper::<Arm3, 6, 9>()
     };
-    for kind in TaskKind::ALL {
+    for kind in toolconf::mpc::tasks() {
         let task = Arm3::paper_task(kind);
         let episode = simulate_mpc_on::<Arm3, Arm3, 3, 6, 6, 9>(
             &tool,

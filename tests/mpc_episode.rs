@@ -220,7 +220,7 @@ fn measure_model_and_observer_choices() {
                 perturbation,
                 ..EpisodeOptions::default()
             };
-            for kind in TaskKind::ALL {
+            for kind in toolconf::mpc::tasks() {
                 let task = Task::paper(kind);
                 let (mut errors, mut costs, mut times) = (vec![], vec![], vec![]);
                 for arm in &tools {

@@ -154,9 +154,11 @@ fn fine_step_task_error(arm: [f64; 4]) -> f64 {
     let p = |s: f64| nalgebra::Matrix2::identity() * s;
     let task = TaskN::<2> {
         kind: TaskKind::Position,
-        // θ, θ̇, θ̈, U.
+        // θ, θ̇, θ̈, U, then the tip's y and ẏ, which a joint task does not use.
         goal: [
             nalgebra::Vector2::new(0.9, -0.3),
+            nalgebra::Vector2::zeros(),
+            nalgebra::Vector2::zeros(),
             nalgebra::Vector2::zeros(),
             nalgebra::Vector2::zeros(),
             nalgebra::Vector2::zeros(),
@@ -166,6 +168,8 @@ fn fine_step_task_error(arm: [f64; 4]) -> f64 {
             p(30.0),
             p(0.5),
             p(2.0),
+            p(0.0),
+            p(0.0),
         ],
     };
     let tool = Arm2Tool::new(arm).unwrap();

@@ -127,8 +127,8 @@ fn to_dict(py: Python<'_>, c: Confidences, batch: bool) -> PyResult<Bound<'_, Py
     out.set_item("A", array(c.a, c.nx, c.nx)?)?;
     out.set_item("B", array(c.b, c.nx, c.n)?)?;
     let sensitivities = PyDict::new(py);
-    for (name, s) in c.sensitivities {
-        sensitivities.set_item(name, array(s, c.n, c.n)?)?;
+    for (name, rows, s) in c.sensitivities {
+        sensitivities.set_item(name, array(s, rows, c.n)?)?;
     }
     out.set_item("sensitivities", sensitivities)?;
     out.set_item("pi_u", array(c.pi_u, c.n, c.n)?)?;

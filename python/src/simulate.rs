@@ -16,10 +16,10 @@ use crate::task::task_spec;
 /// (time, joint).
 pub struct Episode {
     pub metrics: Metrics,
-    pub n: usize,
     pub t: Vec<f64>,
-    /// Every term's values by [`Term::index`], under its name.
-    pub series: [(&'static str, Vec<f64>); TERMS],
+    /// Every term's values by [`Term::index`], under its name, with its number of components
+    /// (the joints, or the tip's; a tip term of a joint-space task has none and is left out).
+    pub series: [(&'static str, usize, Vec<f64>); TERMS],
 }
 
 /// One episode of the tool `params` on `spec` bound to model `kind`, with the trajectory: the
@@ -43,8 +43,7 @@ pub fn episode_of(kind: ModelKind, spec: &TaskSpec, params: &[f64]) -> Result<Ep
     };
     Ok(Episode {
         metrics: e.metrics,
-        n: kind.dof(),
-        series: Term::ALL.map(|term| (term.name(), flat(tr.of(term)))),
+        series: Term::ALL.map(|term| (term.name(), tr.of(term).len(), flat(tr.of(term)))),
         t: tr.t,
     })
 }
@@ -131,8 +130,15 @@ fn to_dict(py: Python<'_>, e: Episode) -> PyResult<Bound<'_, PyDict>> {
     }
     let points = e.t.len();
     out.set_item("t", PyArray1::from_vec(py, e.t))?;
-    for (key, series) in e.series {
-        out.set_item(key, PyArray1::from_vec(py, series).reshape([points, e.n])?)?;
+    out.set_item("progress", e.metrics.progress)?;
+    for (key, components, series) in e.series {
+        if components == 0 {
+            continue;
+        }
+        out.set_item(
+            key,
+            PyArray1::from_vec(py, series).reshape([points, components])?,
+        )?;
     }
     Ok(out)
 }

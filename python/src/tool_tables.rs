@@ -34,6 +34,8 @@ pub struct Shown {
     pub free_energy: f64,
     pub cost_j: f64,
     pub rhs_evals: i64,
+    /// 1 − e(T)/e(0) on a position task (joint or tip), NaN on the others.
+    pub progress: f64,
     /// What the objective minimises ([`objective_value`]).
     pub score: f64,
 }
@@ -45,6 +47,7 @@ impl Outcome {
             free_energy: m.free_energy,
             cost_j: m.cost_j,
             rhs_evals: m.rhs_evals as i64,
+            progress: m.progress.unwrap_or(f64::NAN),
             score: objective_value(objective, &m),
         };
         Outcome {
@@ -130,6 +133,7 @@ fn outcomes_to_py<'py>(
     out.set_item("task_error", shown(|s| s.task_error))?;
     out.set_item("free_energy", shown(|s| s.free_energy))?;
     out.set_item("cost_j", shown(|s| s.cost_j))?;
+    out.set_item("progress", shown(|s| s.progress))?;
     let evals: Vec<i64> = items
         .iter()
         .map(|o| o.episode.as_ref().map_or(-1, |s| s.rhs_evals))
@@ -225,7 +229,13 @@ fn tools_from_py(block: &Bound<'_, PyDict>) -> Result<Vec<ToolRow>, Failure> {
         let tool = AnyTool::new(model, &values).map_err(Failure::input)?;
         let row = usize::try_from(row)
             .map_err(|_| Failure::Input(format!("tools block: row {row} is not a row number")))?;
-        tools.push(ToolRow { row, name, tool });
+        // A block carries every parameter column (float_column refuses a missing one).
+        tools.push(ToolRow {
+            row,
+            name,
+            tool,
+            defaulted: Vec::new(),
+        });
     }
     Ok(tools)
 }
@@ -259,6 +269,7 @@ pub fn outcomes_from_py(block: &Bound<'_, PyDict>) -> Result<Vec<Outcome>, Failu
     let task_error = float_column(block, "task_error")?;
     let free_energy = float_column(block, "free_energy")?;
     let cost_j = float_column(block, "cost_j")?;
+    let progress = float_column(block, "progress")?;
     let score = float_column(block, "score")?;
     let evals: Vec<i64> = numeric_column(block, "rhs_evals", "int64")?;
     let errors: Vec<Option<String>> = column(block, "error")?;
@@ -268,6 +279,7 @@ pub fn outcomes_from_py(block: &Bound<'_, PyDict>) -> Result<Vec<Outcome>, Failu
         task_error.len(),
         free_energy.len(),
         cost_j.len(),
+        progress.len(),
         score.len(),
         evals.len(),
         errors.len(),
@@ -293,6 +305,7 @@ pub fn outcomes_from_py(block: &Bound<'_, PyDict>) -> Result<Vec<Outcome>, Failu
                     free_energy: free_energy[i],
                     cost_j: cost_j[i],
                     rhs_evals: evals[i],
+                    progress: progress[i],
                     score: score[i],
                 }),
             },

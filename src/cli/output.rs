@@ -23,8 +23,8 @@ pub fn print_matrix<const R: usize, const C: usize>(title: &str, m: &SMatrix<f64
 }
 
 /// Adds a tool's confidence and episode outcome to its JSON object: `logdet` (or
-/// `logdet_error`), then `task_error`, `free_energy`, `cost_j`, `rhs_evals` (or `error`), the keys
-/// `select` and `rank` share.
+/// `logdet_error`), then `task_error`, `free_energy`, `cost_j`, `rhs_evals` and on a position task
+/// `progress` (or `error`), the keys `select` and `rank` share.
 pub fn add_outcome<E: std::fmt::Display, F: std::fmt::Display>(
     v: &mut Value,
     logdet: &Result<f64, E>,
@@ -40,6 +40,9 @@ pub fn add_outcome<E: std::fmt::Display, F: std::fmt::Display>(
             v["free_energy"] = Value::from(m.free_energy);
             v["cost_j"] = Value::from(m.cost_j);
             v["rhs_evals"] = Value::from(m.rhs_evals);
+            if let Some(p) = m.progress {
+                v["progress"] = Value::from(p);
+            }
         }
         Err(e) => v["error"] = Value::from(e.to_string()),
     }

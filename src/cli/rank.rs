@@ -143,10 +143,17 @@ fn csv_cells(r: &RankedTool, columns: &[&str]) -> Vec<Cell> {
                 cells.push(Cell::from(v));
             }
             cells.push(Cell::from(m.rhs_evals));
+            cells.push(Cell::from(m.progress));
             cells.push(Cell::Empty);
         }
         Err(e) => {
-            cells.extend([Cell::Empty, Cell::Empty, Cell::Empty, Cell::Empty]);
+            cells.extend([
+                Cell::Empty,
+                Cell::Empty,
+                Cell::Empty,
+                Cell::Empty,
+                Cell::Empty,
+            ]);
             cells.push(Cell::from(e.to_string()));
         }
     }
@@ -183,8 +190,12 @@ fn print_table(results: &[RankedTool], order: &[usize]) {
         .max()
         .unwrap_or(4)
         .clamp(4, NAME_COLUMN);
+    // A position task (joint or tip) also shows how far each tool got towards its goal.
+    let with_progress = results
+        .iter()
+        .any(|r| r.episode.as_ref().is_ok_and(|m| m.progress.is_some()));
     outln!(
-        "{:>5} {:>6}  {:<w$} {:<10} {:>12}  {:>14} {:>14} {:>14}  parameters",
+        "{:>5} {:>6}  {:<w$} {:<10} {:>12}  {:>14} {:>14} {:>14}{}  parameters",
         "rank",
         "row",
         "name",
@@ -192,7 +203,12 @@ fn print_table(results: &[RankedTool], order: &[usize]) {
         "ln|Pi^U|",
         "task error",
         "int F dt",
-        "int J dt"
+        "int J dt",
+        if with_progress {
+            format!(" {:>9}", "progress")
+        } else {
+            String::new()
+        }
     );
     for (k, &i) in order.iter().enumerate() {
         let r = &results[i];
@@ -202,8 +218,15 @@ fn print_table(results: &[RankedTool], order: &[usize]) {
             .map_or("error".into(), |l| format!("{l:.6}"));
         let metrics = match &r.episode {
             Ok(m) => format!(
-                "{:>14.6e} {:>14.6e} {:>14.6e}",
-                m.task_error, m.free_energy, m.cost_j
+                "{:>14.6e} {:>14.6e} {:>14.6e}{}",
+                m.task_error,
+                m.free_energy,
+                m.cost_j,
+                match (with_progress, m.progress) {
+                    (true, Some(p)) => format!(" {p:>9.4}"),
+                    (true, None) => format!(" {:>9}", "-"),
+                    (false, _) => String::new(),
+                }
             ),
             Err(e) => format!("failed: {e}"),
         };
@@ -318,6 +341,7 @@ fn simulate_streaming(
                 "free_energy",
                 "cost_j",
                 "rhs_evals",
+                "progress",
                 "error",
             ]);
             Some(CsvWriter::create(path, &header)?)

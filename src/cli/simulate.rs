@@ -183,6 +183,9 @@ fn print_episode(args: &Args, mut out: Value, heading: &str, m: &Metrics) -> Res
         ] {
             out[key] = value;
         }
+        if let Some(p) = m.progress {
+            out["progress"] = json!(p);
+        }
         if let Some(path) = &args.task.task_file {
             out["task_file"] = json!(path);
         }
@@ -198,6 +201,9 @@ fn print_episode(args: &Args, mut out: Value, heading: &str, m: &Metrics) -> Res
     outln!("integral F dt  {:.9e}", m.free_energy);
     outln!("integral J dt  {:.9e}", m.cost_j);
     outln!("ln|Pi^U|       {:.9e}", m.logdet);
+    if let Some(p) = m.progress {
+        outln!("progress       {p:.6}  (1 - e(T)/e(0), e the distance to the goal)");
+    }
     outln!(
         "rhs evals      {} ({} steps, {} rejected)",
         m.rhs_evals,

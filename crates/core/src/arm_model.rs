@@ -23,6 +23,9 @@ pub trait ArmModel<const N: usize, const NX: usize, const NP: usize, const NZ: u
     const EQUILIBRIUM_STATE: [f64; NX];
     /// The equilibrium torque U^e.
     const EQUILIBRIUM_CONTROL: [f64; N];
+    /// How many components of the tip a tip task uses (3; 2 for a planar arm, in its plane;
+    /// the description's `[tip] components`): see [`TaskN`] for how they are stored.
+    const TIP_DIM: usize;
     /// Which tools are valid (each parameter's domain, constraints across them) and the box
     /// random tools are drawn from: the model description's, `generated::validity::<name>`.
     const TOOL_RULE: generated::validity::ToolRule<NP>;
@@ -122,6 +125,7 @@ macro_rules! arm_model {
                 generated::$module::EQUILIBRIUM_STATE;
             const EQUILIBRIUM_CONTROL: [f64; generated::$module::DOF] =
                 generated::$module::EQUILIBRIUM_CONTROL;
+            const TIP_DIM: usize = generated::$module::TIP_DIM;
             const TOOL_RULE: generated::validity::ToolRule<{ generated::$module::PARAMETER_COUNT }> =
                 generated::validity::$module::RULE;
             type DynamicsCoefficients = generated::$module::DynamicsCoefficients;
@@ -227,7 +231,11 @@ macro_rules! arm_model {
             }
 
             fn paper_task(kind: TaskKind) -> TaskN<{ generated::$module::DOF }> {
-                TaskN::from_defaults(kind, &generated::$module::task_defaults(kind))
+                TaskN::from_defaults(
+                    kind,
+                    &generated::$module::task_defaults(kind),
+                    generated::$module::TIP_DIM,
+                )
             }
         }
     };

@@ -11,7 +11,8 @@ use crate::{control_confidence, ArmModel, Error, TaskN, ToolN};
 /// the paper's terms): what the controller observes ([`observe`]).
 pub type ObservationN<const N: usize> = [SVector<f64, N>; TERMS];
 
-/// Every term read from the state X, its rate Ẋ and the control U, as [`Term::read`] says.
+/// Every term read from the state X, its rate Ẋ and the control U, as [`Term::read`] says; a
+/// term read from the tool's tip ([`Read::Tip`]) is zero here: [`observe_with_tip`] reads it.
 #[inline]
 pub fn observe<const N: usize, const NX: usize>(
     x: &SVector<f64, NX>,
@@ -22,7 +23,61 @@ pub fn observe<const N: usize, const NX: usize>(
         Read::State { block } => x.fixed_rows::<N>(block * N).into_owned(),
         Read::StateRate { block } => x_dot.fixed_rows::<N>(block * N).into_owned(),
         Read::Control => *u,
+        Read::Tip { .. } => SVector::zeros(),
     })
+}
+
+/// The tool tip's kinematics at the measured joint positions q: y(q) in the base frame and
+/// J(q) = ∂y/∂q (the generated `tip::<model>`), of which a tip task uses the first `dim`
+/// components ([`crate::ArmModel::TIP_DIM`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TipKinematics<const N: usize> {
+    pub position: SVector<f64, 3>,
+    pub jacobian: SMatrix<f64, 3, N>,
+    pub dim: usize,
+}
+
+impl<const N: usize> TipKinematics<N> {
+    /// The first `dim` components of a tip vector in the N slots of a term, zeros after
+    /// ([`crate::TaskN`]'s padding).
+    #[inline]
+    pub fn pad(&self, v: &SVector<f64, 3>) -> SVector<f64, N> {
+        SVector::from_fn(|i, _| if i < self.dim.min(3) { v[i] } else { 0.0 })
+    }
+
+    /// J's first `dim` rows in an N × N matrix, zero rows after: ∂(padded y)/∂q.
+    #[inline]
+    pub fn padded_jacobian(&self) -> SMatrix<f64, N, N> {
+        SMatrix::from_fn(|i, j| {
+            if i < self.dim.min(3) {
+                self.jacobian[(i, j)]
+            } else {
+                0.0
+            }
+        })
+    }
+}
+
+/// [`observe`], and the terms read from the tool's tip at the same instant: y = y(q) (the
+/// generated forward kinematics, not its linearisation) and ẏ = J(q) q̇, each padded.
+#[inline]
+pub fn observe_with_tip<const N: usize, const NX: usize>(
+    x: &SVector<f64, NX>,
+    x_dot: &SVector<f64, NX>,
+    u: &SVector<f64, N>,
+    tip: &TipKinematics<N>,
+) -> ObservationN<N> {
+    let mut observed = observe(x, x_dot, u);
+    for term in Term::ALL {
+        if let Read::Tip { order } = term.read() {
+            observed[term.index()] = match order {
+                0 => tip.pad(&tip.position),
+                // The derivation emits orders 0 and 1 (y, ẏ) only (derive/tasks.toml).
+                _ => tip.pad(&(tip.jacobian * x.fixed_rows::<N>(N))),
+            };
+        }
+    }
+    observed
 }
 
 /// The control U of an observation (the value of the term [`Read::Control`] reads).
@@ -121,7 +176,7 @@ impl<const N: usize> ActiveInferenceN<N> {
         let instantaneous = sum(Term::ALL.iter().filter_map(|&term| {
             let k = self.gain[term.index()];
             match term.read() {
-                Read::State { .. } => None,
+                Read::State { .. } | Read::Tip { .. } => None,
                 Read::StateRate { block } => Some(k * b.fixed_rows::<N>(block * N)),
                 Read::Control => Some(k),
             }

@@ -62,6 +62,9 @@ pub enum Error {
         rank: usize,
         joints: usize,
     },
+    /// A task on the tool's tip for a model whose description gives no tip.
+    #[error("the {kind} task reads the tool's tip, and model {model} has none (its description gives no [tip])")]
+    NoTip { kind: TaskKind, model: &'static str },
 }
 
 /// Why a precision matrix is refused.

@@ -48,10 +48,12 @@ pub use toolconf_generated as generated;
 
 pub use arm_model::*;
 pub use confidence::{control_confidence, logdet_of, ControlConfidenceN, ValidatedTaskN};
-pub use controller::{control_of, observe, ActiveInferenceN, ObservationN};
+pub use controller::{
+    control_of, observe, observe_with_tip, ActiveInferenceN, ObservationN, TipKinematics,
+};
 pub use error::{Error, PrecisionKeys, PrecisionProblem};
 pub use generated::{Read, TaskKind, Term, TERMS};
-pub use task::TaskN;
+pub use task::{reads_tip, term_components, term_identity, TaskN};
 pub use tool::{SensitivitiesN, ToolN};
 
 /// ln x: the platform's with the `std` feature (glibc's on Linux), else the `libm` crate's.

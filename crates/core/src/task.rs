@@ -3,7 +3,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use crate::generated;
-use crate::generated::{TaskKind, Term, TERMS};
+use crate::generated::{Read, TaskKind, Term, TERMS};
 use crate::{Error, PrecisionProblem};
 
 use super::{ArmModel, ValidatedTaskN};
@@ -12,6 +12,13 @@ use super::{ArmModel, ValidatedTaskN};
 /// (eq. free_energy), indexed by [`Term::index`]: θ^g, θ̇^g, θ̈^g and P^θ, P^θ̇, P^θ̈, P^U for the
 /// paper's terms. A term the task's controller does not use has precision zero (task 2 ignores θ,
 /// task 3 θ and θ̇); the goal of the control's own term is zero (η^U = 0).
+///
+/// A term read from the tool's tip ([`Read::Tip`]: y, ẏ) has the tip's `d` components
+/// ([`ArmModel::TIP_DIM`]: 3, 2 for a planar arm), stored padded in the N slots: its goal in the
+/// first d rows and zeros after, its precision in the upper-left d × d block and zeros elsewhere
+/// (as its generated sensitivity J ∂θ/∂U has zero rows after the d-th; derive/tasks.toml, `J`).
+/// Every sum the controller and Π^U form is then the same for joint and tip terms, on the stack,
+/// and a padded zero adds nothing. It needs d ≤ N, which the derivation checks.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TaskN<const N: usize> {
     pub kind: TaskKind,
@@ -38,13 +45,13 @@ impl<const N: usize> TaskN<N> {
         &self.precision[term.index()]
     }
 
-    /// The task with a model's generated defaults (goals; precisions P = value · I).
-    pub fn from_defaults(kind: TaskKind, d: &generated::TaskDefaults<N>) -> Self {
-        let eye = SMatrix::<f64, N, N>::identity();
+    /// The task with a model's generated defaults (goals; precisions P = value · I, the
+    /// identity of the term's own components: the tip's `tip_dim` for a tip term).
+    pub fn from_defaults(kind: TaskKind, d: &generated::TaskDefaults<N>, tip_dim: usize) -> Self {
         TaskN {
             kind,
             goal: d.goal.map(SVector::from),
-            precision: d.precision.map(|p| eye * p),
+            precision: Term::ALL.map(|t| term_identity(t, tip_dim) * d.precision[t.index()]),
         }
     }
 
@@ -102,6 +109,29 @@ impl TaskN<2> {
     pub fn paper(kind: TaskKind) -> Self {
         crate::Arm2::paper_task(kind)
     }
+}
+
+/// How many components `term` has for N joints and a tip of `tip_dim` ([`TaskN`]'s padding):
+/// `tip_dim` for a term read from the tip, N for the others.
+pub const fn term_components(term: Term, n: usize, tip_dim: usize) -> usize {
+    match term.read() {
+        Read::Tip { .. } => tip_dim,
+        _ => n,
+    }
+}
+
+/// The identity of `term`'s own components in the N × N slots: I for a joint term, the tip's
+/// `tip_dim` × `tip_dim` identity padded with zeros for a tip term ([`TaskN`]).
+pub fn term_identity<const N: usize>(term: Term, tip_dim: usize) -> SMatrix<f64, N, N> {
+    let d = term_components(term, N, tip_dim);
+    SMatrix::from_fn(|i, j| if i == j && i < d { 1.0 } else { 0.0 })
+}
+
+/// Whether the task's controller reads the tool's tip (a tip task).
+pub fn reads_tip(kind: TaskKind) -> bool {
+    kind.terms()
+        .iter()
+        .any(|t| matches!(t.read(), Read::Tip { .. }))
 }
 
 /// The rank of a symmetric positive semi-definite matrix: the pivots of a Cholesky

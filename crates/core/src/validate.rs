@@ -106,12 +106,23 @@ pub const JOINT_RATE: Range = Range::closed(-100.0, 100.0, "rad/s");
 /// bound from rest in 10 ms (the shipped arms are rated at 10-40 rad/s²).
 pub const JOINT_ACCELERATION: Range = Range::closed(-1e4, 1e4, "rad/s²");
 
+/// The tool tip's position in the base frame, a goal y_g of a tip task: |y| ≤ 10 m in each
+/// component, five times the reach of the largest shipped arm (the UR5's 0.85 m, the Panda's
+/// 0.855 m, plus a tool): a point an arm cannot touch is a valid goal it moves towards, but one
+/// further out only scales the error, which the generated arithmetic's range bounds.
+pub const TIP_POSITION: Range = Range::closed(-10.0, 10.0, "m");
+/// The tool tip's velocity, a goal ẏ_g: |ẏ| ≤ 10 m/s in each component, several times an
+/// industrial arm's rated tool speed (the Panda's 2 m/s, the UR5's ≈ 1 m/s).
+pub const TIP_VELOCITY: Range = Range::closed(-10.0, 10.0, "m/s");
+
 /// The ranges a goal may be checked against, by the name `derive/tasks.toml` gives a term's
 /// `goal_range` (and `toolconf.ranges()` its key).
-pub const GOAL_RANGES: [(&str, Range); 3] = [
+pub const GOAL_RANGES: [(&str, Range); 5] = [
     ("joint_angle", JOINT_ANGLE),
     ("joint_rate", JOINT_RATE),
     ("joint_acceleration", JOINT_ACCELERATION),
+    ("tip_position", TIP_POSITION),
+    ("tip_velocity", TIP_VELOCITY),
 ];
 
 /// The range a goal of `term` must lie in; `None` for a term without a goal (the control's).

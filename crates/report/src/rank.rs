@@ -1,6 +1,7 @@
 //! The report of a ranking (`toolconf rank --report DIR`): `report.md` and `report.html` (the
-//! same text, figures inline), written for a reader who has not read the paper, with two
-//! figures: confidence against task error, and the best and worst tools over time.
+//! same text, figures inline), written for a reader who has not read the paper, with its
+//! figures: confidence against task error, the best and worst tools over time, and on a tip
+//! task the tip's path.
 
 use std::path::{Path, PathBuf};
 
@@ -12,8 +13,9 @@ use crate::select::Objective;
 use crate::stats::spearman;
 use crate::task_file::{PerJoint, PrecisionSpec, TaskSpec};
 use crate::{TaskKind, Term};
+use toolconf::generated::Read;
 use toolconf::rank::{score, ModelTasks, RankedTool, StageTimings, TaskTrace};
-use toolconf::registry::ModelKind;
+use toolconf::registry::{ModelKind, AXES};
 
 /// What the report describes.
 pub struct ReportInput<'a> {
@@ -309,8 +311,14 @@ fn ranking_table(input: &ReportInput) -> Vec<Block> {
                 number(m.task_error),
                 number(m.free_energy),
                 number(m.cost_j),
+                m.progress.map_or("–".into(), |p| format!("{p:.3}")),
             ],
-            Err(e) => vec![format!("failed: {e}"), String::new(), String::new()],
+            Err(e) => vec![
+                format!("failed: {e}"),
+                String::new(),
+                String::new(),
+                String::new(),
+            ],
         };
         let mut row = vec![
             (rank + 1).to_string(),
@@ -342,6 +350,7 @@ fn ranking_table(input: &ReportInput) -> Vec<Block> {
             "task error",
             "∫F dt",
             "∫J dt",
+            "progress",
         ],
         rows,
     ));
@@ -483,7 +492,7 @@ fn trajectory_figure(dir: &Path, input: &ReportInput) -> Result<Vec<Block>, Repr
                 );
             }
             Panel::Xy(XyPanel {
-                title: format!("joint {}", j + 1),
+                title: component_title(input.spec.kind, j),
                 x_label: "time t [s]".into(),
                 y_label: axis.as_str().into(),
                 dots: Vec::new(),
@@ -514,5 +523,109 @@ fn trajectory_figure(dir: &Path, input: &ReportInput) -> Result<Vec<Block>, Repr
     if !notes.is_empty() {
         blocks.push(Block::Bullets(notes));
     }
+    blocks.extend(tip_path_figure(dir, input, &traces)?);
     Ok(blocks)
+}
+
+/// A panel's title: `joint 2`, or `tip y` for a component of a tip term.
+fn component_title(kind: TaskKind, j: usize) -> String {
+    match kind.error_term().read() {
+        Read::Tip { .. } => format!("tip {}", AXES.get(j).copied().unwrap_or("?")),
+        _ => format!("joint {}", j + 1),
+    }
+}
+
+const TIP_PATH_SVG: &str = "tip_paths.svg";
+
+/// On a tip task, the tip's path of the best and worst tools in two projections of the base
+/// frame (x–y seen from above, x–z from the side; the plane of a planar arm alone), with the
+/// goal point of a tip position task marked.
+fn tip_path_figure(
+    dir: &Path,
+    input: &ReportInput,
+    traces: &[(String, Colour, bool, TaskTrace)],
+) -> Result<Vec<Block>, ReproduceError> {
+    let paths: Vec<_> = traces
+        .iter()
+        .filter_map(|(label, colour, dashed, t)| {
+            Some((label, colour, dashed, t.tip_path.as_ref()?, t))
+        })
+        .collect();
+    let Some(dims) = paths.iter().map(|p| p.3.len()).min().filter(|&d| d >= 2) else {
+        return Ok(Vec::new());
+    };
+    let goal_is_point = matches!(input.spec.kind.error_term().read(), Read::Tip { order: 0 });
+    let projections: &[(usize, usize, &str)] = if dims >= 3 {
+        &[
+            (0, 1, "seen from above (x–y)"),
+            (0, 2, "seen from the side (x–z)"),
+        ]
+    } else {
+        &[(0, 1, "in the arm's plane (x–y)")]
+    };
+    let panels: Vec<Panel> = projections
+        .iter()
+        .map(|&(a, b, title)| {
+            let lines: Vec<Series> = paths
+                .iter()
+                .map(|(label, colour, dashed, path, _)| {
+                    let points = path[a]
+                        .iter()
+                        .copied()
+                        .zip(path[b].iter().copied())
+                        .collect();
+                    let s = Series::new((*label).clone(), **colour, points);
+                    if **dashed {
+                        s.dashed()
+                    } else {
+                        s
+                    }
+                })
+                .collect();
+            let mut dots = Vec::new();
+            if let Some((_, _, _, _, t)) = paths.first().filter(|_| goal_is_point) {
+                dots.push(Series::new(
+                    "goal",
+                    plot::GOAL_GREY,
+                    vec![(t.goal[a], t.goal[b])],
+                ));
+            }
+            let starts: Vec<(f64, f64)> = paths
+                .iter()
+                .filter_map(|p| Some((*p.3[a].first()?, *p.3[b].first()?)))
+                .collect();
+            dots.push(Series::new("start", Colour(190, 190, 190), starts));
+            Panel::Xy(XyPanel {
+                title: title.into(),
+                x_label: format!("tip {} [m]", AXES[a]),
+                y_label: format!("tip {} [m]", AXES[b]),
+                dots,
+                lines,
+                log_y: false,
+                legend: Legend::UpperLeft,
+                headroom: 0.6,
+            })
+        })
+        .collect();
+    let svg = plot::save(&dir.join(TIP_PATH_SVG), &panels, (560, 420))?;
+    Ok(vec![
+        Block::Heading(2, "Where the tool's tip went".into()),
+        Block::p(format!(
+            "The path of the tool's tip y(q(t)) in the robot's base frame, for the same best \
+             (solid) and worst (dashed) tools{}. Each tool starts where its own tip rests (the \
+             light grey dots), so tools of different lengths start at different points.",
+            if goal_is_point {
+                "; the grey dot is the goal point"
+            } else {
+                ""
+            }
+        )),
+        Block::Figure {
+            file: TIP_PATH_SVG.into(),
+            caption: "The tip's path over one episode, in two projections; #k is the tool's \
+                      rank."
+                .into(),
+            svg,
+        },
+    ])
 }

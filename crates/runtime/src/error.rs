@@ -44,6 +44,15 @@ pub enum Error {
     /// A combination of options that is not supported, with the reason.
     #[error("unsupported: {0}")]
     Unsupported(String),
+    /// A tool of a tools file that leaves its tip out, on a task that reads the tip: the file,
+    /// the row and the missing columns.
+    #[error("{file}, tool {row}: the {kind} task reads the tool's tip, and the row leaves out {columns} (the tip's offset in the flange frame, m)")]
+    ToolWithoutTip {
+        file: String,
+        row: usize,
+        kind: crate::TaskKind,
+        columns: String,
+    },
     /// A result that is not a finite number: the last line of defence at the output
     /// ([`crate::validate::finite_output`]), so that no NaN, inf or null is ever printed. The
     /// input ranges ([`crate::validate`]) are chosen so that it does not happen.

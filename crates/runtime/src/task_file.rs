@@ -1,7 +1,10 @@
 //! Task files: a task of the user's own, in TOML, for any model.
 //!
 //! ```toml
-//! kind = "position"              # position | velocity | acceleration: the paper's three task structures
+//! kind = "position"              # position | velocity | acceleration: the paper's three task structures;
+//!                                # tip_position | tip_velocity: on the tool's tip (goal keys tip, tip_dot:
+//!                                # the tip's components in the base frame, m and m/s, 3 for a URDF arm,
+//!                                # 2 for a planar one; a scalar precision weighs those components alone)
 //! description = "reach 45°"      # optional, shown in reports
 //! [goal]                         # optional, each key defaulting to the model's paper goal
 //! theta = [0.7853981633974483, 0.0]
@@ -39,6 +42,7 @@ use crate::model::closed_loop_n::check_grid;
 use crate::model::{ArmModel, EpisodeOptionsN, TaskN};
 use crate::validate::goal_range;
 use crate::{TaskKind, Term};
+use toolconf_core::{term_components, term_identity};
 
 /// A bad task file: the file, where in it (a key or a line), and what is wrong.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -378,27 +382,28 @@ impl TaskSpec {
         for term in Term::ALL {
             if let Some(v) = &self.goal[term.index()] {
                 task.goal[term.index()] =
-                    self.vector::<M, N, NX, NP, NZ>(&format!("goal.{term}"), v)?;
+                    self.term_vector::<M, N, NX, NP, NZ>(term, &format!("goal.{term}"), v)?;
             }
         }
         for term in Term::ALL {
             let Some(given) = &self.precision[term.index()] else {
                 continue;
             };
+            let d = term_components(term, N, M::TIP_DIM);
             task.precision[term.index()] = match given {
-                PrecisionSpec::Scalar(s) => SMatrix::identity() * *s,
+                PrecisionSpec::Scalar(s) => term_identity::<N>(term, M::TIP_DIM) * *s,
                 PrecisionSpec::Matrix(rows) => {
-                    if rows.len() != N {
+                    if rows.len() != d {
                         return Err(self.error(
                             &format!("precision.{term}"),
                             format!(
-                                "a {0}×{0} matrix, but model {1} has {N} joints",
+                                "a {0}×{0} matrix, but {term} of model {1} has {d} components",
                                 rows.len(),
                                 M::NAME
                             ),
                         ));
                     }
-                    SMatrix::from_fn(|i, j| rows[i][j])
+                    SMatrix::from_fn(|i, j| if i < d && j < d { rows[i][j] } else { 0.0 })
                 }
             };
         }
@@ -442,6 +447,36 @@ impl TaskSpec {
             None => {}
         }
         Ok(o)
+    }
+
+    /// A goal of `term` for model `M`: N values for a joint term, the tip's
+    /// [`ArmModel::TIP_DIM`] for a tip term, padded with zeros ([`TaskN`]).
+    fn term_vector<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+        &self,
+        term: Term,
+        key: &str,
+        v: &[f64],
+    ) -> Result<SVector<f64, N>, TaskFileError>
+    where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
+        if !matches!(term.read(), crate::generated::Read::Tip { .. }) {
+            return self.vector::<M, N, NX, NP, NZ>(key, v);
+        }
+        let d = term_components(term, N, M::TIP_DIM);
+        if v.len() != d {
+            return Err(self.error(
+                key,
+                format!(
+                    "{} values {}, but the tip of model {} has {d} components ({})",
+                    v.len(),
+                    ShortList(v),
+                    M::NAME,
+                    ["x", "y", "z"][..d.min(3)].join(", ")
+                ),
+            ));
+        }
+        Ok(SVector::from_fn(|i, _| if i < d { v[i] } else { 0.0 }))
     }
 
     fn vector<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(

@@ -40,9 +40,20 @@ pub struct ToolRow {
     pub row: usize,
     pub name: Option<String>,
     pub tool: AnyTool,
+    /// The parameter columns the row left out, which took their model's default (a URDF tool's
+    /// products of inertia and tip, zero): a task that reads the tip refuses a tool whose tip
+    /// columns are among them ([`ToolRow::missing_tip`]).
+    pub defaulted: Vec<&'static str>,
 }
 
 impl ToolRow {
+    /// The tip columns (`tool_tip_*`) the row left out: a URDF tool's tip is its offset from the
+    /// flange, and zero would silently put it at the flange.
+    pub fn missing_tip(&self) -> Vec<&'static str> {
+        let tip = |c: &&&str| c.starts_with("tool_tip_");
+        self.defaulted.iter().filter(tip).copied().collect()
+    }
+
     /// The name, or `row N` when the file gives none.
     pub fn label(&self) -> String {
         self.name
@@ -316,11 +327,15 @@ fn build_row<'a>(
     let domains = model.parameter_domains();
     let defaults = model.parameter_defaults();
     let mut params = Vec::with_capacity(names.len());
+    let mut defaulted = Vec::new();
     for ((&key, domain), default) in names.iter().zip(domains).zip(defaults) {
         let value = match (cell(key), default) {
             // A column the model gives a default for (a URDF tool's products of inertia and
             // tip, zero): files written before it was a parameter keep working.
-            (Cell::Absent, Some(d)) => *d,
+            (Cell::Absent, Some(d)) => {
+                defaulted.push(key);
+                *d
+            }
             (Cell::Absent, None) => {
                 return Err(format!(
                     "{key} is missing (model {model} needs it){}",
@@ -350,7 +365,12 @@ fn build_row<'a>(
         }
     }
     let tool = AnyTool::new(model, &params).map_err(|e| format!("{e}{}", who()))?;
-    Ok(ToolRow { row, name, tool })
+    Ok(ToolRow {
+        row,
+        name,
+        tool,
+        defaulted,
+    })
 }
 
 /// Visits the top-level array one element at a time.

@@ -19,6 +19,10 @@
 //! The KKT residual reported is, at the last QP, max(max_j x_j·|∇φ_j − (Gᵀz)_j|,
 //! max_i z_i·slack_i) with z ≥ 0 the QP's multipliers: near zero at a constrained maximum. Above
 //! [`KKT_TOLERANCE`] the optimum is reported as not converged.
+//!
+//! A parameter whose box holds 0 (a centre of mass, a tip offset) can sit at or near 0, where a
+//! scale of x_j would freeze it (d_j = σ_j x_j = 0) and make c/x_j² infinite: its scale is
+//! max(|x_j|, 10⁻³ of its box's width) instead ([`scales`]). The others keep x_j.
 
 use super::constraint::dot;
 use super::polytope::Polytope;
@@ -154,18 +158,19 @@ fn climb_with(
             start: 0,
         }));
     }
-    let mut b = log_curvature(&x, &grad);
+    let mut b = log_curvature(&scales(polytope, &x), &grad);
     let mut fresh = true;
     let mut kkt = None;
     let mut iterations = 0;
     while iterations < MAX_ITERATIONS {
         iterations += 1;
-        let step = match scaled_step(&b, &x, &grad, &g_rows, &h, robust) {
+        let scale = scales(polytope, &x);
+        let step = match scaled_step(&b, &x, &scale, &grad, &g_rows, &h, robust) {
             Ok(step) => step,
             Err(reason) if kkt.is_none() => return Err(reason),
             // As for a failed line search below: restart B once, then stop.
             Err(_) if !fresh => {
-                b = log_curvature(&x, &grad);
+                b = log_curvature(&scale, &grad);
                 fresh = true;
                 continue;
             }
@@ -196,7 +201,7 @@ fn climb_with(
             if fresh {
                 break;
             }
-            b = log_curvature(&x, &grad);
+            b = log_curvature(&scale, &grad);
             fresh = true;
             continue;
         };
@@ -242,7 +247,10 @@ fn climb_with(
     // At a degenerate vertex (a box corner, every bound active) the QP's multipliers, an
     // interior point's, are good to only about 1e-5 of the largest; the active rows' own give
     // the residual exactly.
-    let kkt = match (kkt, active_set_residual(&x, &grad, &g_rows, &h)) {
+    let kkt = match (
+        kkt,
+        active_set_residual(&x, &scales(polytope, &x), &grad, &g_rows, &h),
+    ) {
         (Some(a), Some(b)) => Some(a.min(b)),
         (a, b) => a.or(b),
     };
@@ -259,12 +267,19 @@ fn climb_with(
 
 /// The KKT residual at x with the multipliers of the active rows (relative slack ≤ 1e-9)
 /// solved for directly, least squares in the scaled space of [`scaled_step`]:
-/// max(‖x∘∇φ − G̃_Aᵀz‖∞, max_i max(−z_i, 0), max_i z_i·s̃_i). None without active rows.
-fn active_set_residual(x: &[f64], grad: &[f64], g_rows: &[Vec<f64>], h: &[f64]) -> Option<f64> {
+/// max(‖s∘∇φ − G̃_Aᵀz‖∞, max_i max(−z_i, 0), max_i z_i·s̃_i), s the [`scales`]. None without
+/// active rows.
+fn active_set_residual(
+    x: &[f64],
+    s: &[f64],
+    grad: &[f64],
+    g_rows: &[Vec<f64>],
+    h: &[f64],
+) -> Option<f64> {
     let n = x.len();
     let mut active: Vec<(Vec<f64>, f64)> = Vec::new();
     for (r, hi) in g_rows.iter().zip(h) {
-        let row: Vec<f64> = r.iter().zip(x).map(|(a, xj)| a * xj).collect();
+        let row: Vec<f64> = r.iter().zip(s).map(|(a, sj)| a * sj).collect();
         let scale = row.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         if scale == 0.0 {
             continue;
@@ -278,9 +293,9 @@ fn active_set_residual(x: &[f64], grad: &[f64], g_rows: &[Vec<f64>], h: &[f64]) 
         return None;
     }
     let k = active.len();
-    // Columns: the active rows; G̃_Aᵀ z = x∘∇φ.
+    // Columns: the active rows; G̃_Aᵀ z = s∘∇φ.
     let at = nalgebra::DMatrix::from_fn(n, k, |j, i| active[i].0[j]);
-    let target = nalgebra::DVector::from_fn(n, |j, _| x[j] * grad[j]);
+    let target = nalgebra::DVector::from_fn(n, |j, _| s[j] * grad[j]);
     let z = at.clone().svd(true, true).solve(&target, 1e-12).ok()?;
     let stationarity = (&at * &z - &target).amax();
     let negative = z.iter().fold(0.0_f64, |m, zi| m.max(-zi));
@@ -291,8 +306,24 @@ fn active_set_residual(x: &[f64], grad: &[f64], g_rows: &[Vec<f64>], h: &[f64]) 
     Some(stationarity.max(negative).max(complementarity))
 }
 
-/// diag(c/x_j²), c = max_j |x_j ∂φ/∂x_j| (at least 1): the curvature of c·ln x_j, a first
-/// model of the BFGS matrix on the scale of each parameter.
+/// Each free parameter's scale at x: x_j, or for a parameter whose box holds 0,
+/// max(|x_j|, 10⁻³ of the box's width), so that it can leave 0 (module doc, "Scaling").
+fn scales(polytope: &Polytope, x: &[f64]) -> Vec<f64> {
+    x.iter()
+        .enumerate()
+        .map(|(j, &v)| {
+            let (lo, hi) = (polytope.lo[j], polytope.hi[j]);
+            if lo <= 0.0 && hi >= 0.0 {
+                v.abs().max(1e-3 * (hi - lo))
+            } else {
+                v
+            }
+        })
+        .collect()
+}
+
+/// diag(c/s_j²), c = max_j |s_j ∂φ/∂x_j| (at least 1), s the [`scales`]: the curvature of
+/// c·ln x_j, a first model of the BFGS matrix on the scale of each parameter.
 fn log_curvature(x: &[f64], grad: &[f64]) -> Vec<Vec<f64>> {
     let c = x
         .iter()
@@ -317,14 +348,16 @@ struct Step {
     kkt_residual: f64,
 }
 
-/// The QP  min ½ dᵀB d − ∇φᵀd  s.t.  G(x + d) ≤ h, solved in the relative step σ = d/x
-/// (d = Dσ, D = diag(x)) with every row scaled to a largest coefficient of 1 and |σ| at most
-/// [`MAX_RELATIVE_STEP`]: the same step, but data Clarabel sees on one scale however many
+/// The QP  min ½ dᵀB d − ∇φᵀd  s.t.  G(x + d) ≤ h, solved in the relative step σ = d/s
+/// (d = Dσ, D = diag(s), s the [`scales`]) with every row scaled to a largest coefficient of 1
+/// and |σ| at most [`MAX_RELATIVE_STEP`]: the same step, but data Clarabel sees on one scale however many
 /// decades the parameters span. The multipliers z̃ of the scaled rows then give the residual of
 /// [`kkt_residual`] directly.
+#[allow(clippy::too_many_arguments)]
 fn scaled_step(
     b: &[Vec<f64>],
     x: &[f64],
+    s: &[f64],
     grad: &[f64],
     g_rows: &[Vec<f64>],
     h: &[f64],
@@ -332,13 +365,13 @@ fn scaled_step(
 ) -> Result<Step, QpFailure> {
     let n = x.len();
     let scaled_b: Vec<Vec<f64>> = (0..n)
-        .map(|i| (0..n).map(|j| x[i] * b[i][j] * x[j]).collect())
+        .map(|i| (0..n).map(|j| s[i] * b[i][j] * s[j]).collect())
         .collect();
-    let q: Vec<f64> = (0..n).map(|j| -x[j] * grad[j]).collect();
+    let q: Vec<f64> = (0..n).map(|j| -s[j] * grad[j]).collect();
     let mut rows = Vec::with_capacity(g_rows.len());
     let mut rhs = Vec::with_capacity(g_rows.len());
     for (r, hi) in g_rows.iter().zip(h) {
-        let row: Vec<f64> = r.iter().zip(x).map(|(a, xj)| a * xj).collect();
+        let row: Vec<f64> = r.iter().zip(s).map(|(a, sj)| a * sj).collect();
         let scale = row.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         let scale = if scale > 0.0 { scale } else { 1.0 };
         rows.push(row.iter().map(|v| v / scale).collect::<Vec<f64>>());
@@ -357,7 +390,7 @@ fn scaled_step(
         QpOutcome::Failed { reason, tight } => return Err(QpFailure { reason, tight }),
     };
     Ok(Step {
-        d: sigma.iter().zip(x).map(|(s, xj)| s * xj).collect(),
+        d: sigma.iter().zip(s).map(|(sigma, sj)| sigma * sj).collect(),
         relative: sigma.iter().fold(0.0_f64, |m, s| m.max(s.abs())),
         kkt_residual: kkt_residual(&q, &rows, &z, &rhs),
     })

@@ -10,7 +10,7 @@ use crate::integrate::{
     solve_grid_with_jacobian, uniform_grid, IntegrationError, Method, Options as IntegratorOptions,
 };
 use crate::Error;
-use toolconf_core::{observe, ObservationN};
+use toolconf_core::{observe, observe_with_tip, reads_tip, ObservationN, TipKinematics};
 
 /// A grid state whose magnitude passes this is a diverging simulation, not a result.
 pub(crate) const DIVERGENCE_BOUND: f64 = crate::validate::STATE_BOUND;
@@ -39,6 +39,10 @@ where
     jacobian: P::JacobianCoefficients,
     pub controller: ActiveInferenceN<N>,
     perturbation: SVector<f64, N>,
+    /// The tool's parameters, for the tip's kinematics y(q; p).
+    params: SVector<f64, NP>,
+    /// Whether the task reads the tool's tip (then every right-hand side evaluates y(q), J(q)).
+    reads_tip: bool,
 }
 
 impl<P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>
@@ -79,21 +83,50 @@ where
             });
         }
         let params = tool.params();
+        let reads_tip = reads_tip(task.kind);
+        let q_e = P::equilibrium_state().fixed_rows::<N>(0).into_owned();
+        if reads_tip && P::tip(&q_e, &params).is_none() {
+            return Err(toolconf_core::Error::NoTip {
+                kind: task.kind,
+                model: P::NAME,
+            }
+            .into());
+        }
         Ok(Self {
             dynamics: P::dynamics_coefficients(&params),
             jacobian: P::jacobian_coefficients(&params),
             controller: ActiveInferenceN::new(tool, task, learning_rate)?,
             perturbation: *perturbation,
+            params,
+            reads_tip,
         })
     }
 
-    /// Ż and the terms the controller observes (the plant's θ̈ among them).
+    /// The tip's kinematics at the joint positions q (checked to exist in [`Self::new`]).
+    #[inline]
+    fn tip(&self, q: &SVector<f64, N>) -> TipKinematics<N> {
+        let (position, jacobian) =
+            P::tip(q, &self.params).unwrap_or((SVector::zeros(), SMatrix::zeros()));
+        TipKinematics {
+            position,
+            jacobian,
+            dim: P::TIP_DIM,
+        }
+    }
+
+    /// Ż and the terms the controller observes (the plant's θ̈ among them, and the tip's y, ẏ
+    /// on a tip task).
     #[inline]
     pub fn rhs_and_observation(&self, z: &SVector<f64, NZ>) -> (SVector<f64, NZ>, ObservationN<N>) {
         let x = z.fixed_rows::<NX>(0).into_owned();
         let u = z.fixed_rows::<N>(NX).into_owned();
         let x_dot = P::dynamics_with(&x, &(u + self.perturbation), &self.dynamics);
-        let observed = observe(&x, &x_dot, &u);
+        let observed = if self.reads_tip {
+            let tip = self.tip(&x.fixed_rows::<N>(0).into_owned());
+            observe_with_tip(&x, &x_dot, &u, &tip)
+        } else {
+            observe(&x, &x_dot, &u)
+        };
         let u_dot = self.controller.control_rate(&observed);
         let mut z_dot = SVector::<f64, NZ>::zeros();
         z_dot.fixed_rows_mut::<NX>(0).copy_from(&x_dot);
@@ -143,12 +176,63 @@ where
                     columns -= k;
                 }
                 Read::Control => du_du -= k,
-                Read::StateRate { .. } => {}
+                Read::StateRate { .. } | Read::Tip { .. } => {}
             }
+        }
+        if self.reads_tip {
+            self.subtract_tip_gains(&x, &gains, &mut du_dx);
         }
         j.fixed_view_mut::<N, NX>(NX, 0).copy_from(&du_dx);
         j.fixed_view_mut::<N, N>(NX, NX).copy_from(&du_du);
         j
+    }
+}
+
+impl<P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>
+    ClosedLoopN<P, N, NX, NP, NZ>
+where
+    P: ArmModel<N, NX, NP, NZ>,
+{
+    /// The tip terms' part of ∂U̇/∂X: y = y(q) has ∂y/∂q = J; ẏ = J(q) q̇ has ∂ẏ/∂q̇ = J and
+    /// ∂ẏ/∂q = J̇ = Σ_k ∂J/∂q_k q̇_k (column k of ∂(J q̇)/∂q is Σ_j ∂²y/∂q_k∂q_j q̇_j, and the
+    /// Hessian of y is symmetric), the directional derivative of J along q̇, taken here by a
+    /// central difference of the generated J (the tip's second derivatives are not generated).
+    /// Its step h·|q̇|∞ = 1e-5 rad leaves an error ~1e-10 relative: this matrix only steers the
+    /// stiff integrator's Newton-like stages, whose error control does not depend on it being
+    /// exact, while the right-hand side itself is exact.
+    fn subtract_tip_gains(
+        &self,
+        x: &SVector<f64, NX>,
+        gains: &[SMatrix<f64, N, N>; TERMS],
+        du_dx: &mut SMatrix<f64, N, NX>,
+    ) {
+        let q = x.fixed_rows::<N>(0).into_owned();
+        let q_dot = x.fixed_rows::<N>(N).into_owned();
+        let tip = self.tip(&q);
+        let j = tip.padded_jacobian();
+        for term in Term::ALL {
+            let k = gains[term.index()];
+            match term.read() {
+                Read::Tip { order: 0 } => {
+                    let mut columns = du_dx.fixed_view_mut::<N, N>(0, 0);
+                    columns -= k * j;
+                }
+                Read::Tip { .. } => {
+                    let mut rates = du_dx.fixed_view_mut::<N, N>(0, N);
+                    rates -= k * j;
+                    let speed = q_dot.amax();
+                    if speed > 0.0 {
+                        let h = 1e-5 / speed;
+                        let ahead = self.tip(&(q + q_dot * h)).padded_jacobian();
+                        let behind = self.tip(&(q - q_dot * h)).padded_jacobian();
+                        let j_dot = (ahead - behind) / (2.0 * h);
+                        let mut positions = du_dx.fixed_view_mut::<N, N>(0, 0);
+                        positions -= k * j_dot;
+                    }
+                }
+                _ => {}
+            }
+        }
     }
 }
 
@@ -227,6 +311,11 @@ pub struct Metrics {
     pub factorisations: usize,
     /// ∫|U|² dt, trapezoidal on the grid (the controller's torque, without ΔT).
     pub control_effort: f64,
+    /// On a position task (joint or tip: the error term is a position, θ or y), how far the
+    /// episode went towards the goal: 1 − e(T)/e(0), with e = |term − goal| the Euclidean
+    /// distance (rad, or m for the tip). 1 is the goal reached, 0 no progress, negative moved
+    /// away. `None` on the other tasks, or when the episode starts at its goal (e(0) = 0).
+    pub progress: Option<f64>,
 }
 
 impl Metrics {
@@ -239,6 +328,7 @@ impl Metrics {
             self.cost_j,
             self.logdet,
             self.control_effort,
+            self.progress.unwrap_or(0.0),
         ];
         crate::validate::finite_output(tool, "the episode's metrics", values)
     }
@@ -250,6 +340,10 @@ impl Metrics {
 pub struct TrajectoryN<const N: usize> {
     pub t: Vec<f64>,
     pub terms: [Vec<SVector<f64, N>>; TERMS],
+    /// On a task that reads the tool's tip, how many components its tip terms have (their
+    /// first rows, padded: [`toolconf_core::TaskN`]); `None` otherwise, where they are zero
+    /// and not part of the trajectory ([`Self::components`]).
+    pub tip_dim: Option<usize>,
 }
 
 impl<const N: usize> Default for TrajectoryN<N> {
@@ -257,6 +351,7 @@ impl<const N: usize> Default for TrajectoryN<N> {
         Self {
             t: Vec::new(),
             terms: core::array::from_fn(|_| Vec::new()),
+            tip_dim: None,
         }
     }
 }
@@ -265,6 +360,15 @@ impl<const N: usize> TrajectoryN<N> {
     /// The values of `term` on the grid.
     pub fn of(&self, term: Term) -> &[SVector<f64, N>] {
         &self.terms[term.index()]
+    }
+
+    /// How many of `term`'s rows are its own: N for a joint term, the tip's components for a
+    /// tip term on a tip task, 0 for a tip term otherwise.
+    pub fn components(&self, term: Term) -> usize {
+        match term.read() {
+            Read::Tip { .. } => self.tip_dim.unwrap_or(0),
+            _ => N,
+        }
     }
 
     /// Appends the observation at time `t`.
@@ -430,6 +534,7 @@ where
 
     let mut trajectory = options.record_trajectory.then(|| TrajectoryN {
         t: Vec::with_capacity(grid.len()),
+        tip_dim: reads_tip(task.kind).then_some(P::TIP_DIM),
         ..TrajectoryN::default()
     });
     let mut task_error = 0.0;
@@ -437,6 +542,10 @@ where
     // (t, F, J, |U|²) at the previous grid point, for the trapezoidal rule.
     let mut previous: Option<(f64, f64, f64, f64)> = None;
     let mut divergence: Option<(f64, f64)> = None;
+    // The distance to the goal at the first and the latest grid point, for `progress`.
+    let error_term = task.kind.error_term();
+    let position_task = is_position(error_term);
+    let (mut first_distance, mut distance) = (None::<f64>, 0.0);
 
     let rhs = |_t: f64, z: &SVector<f64, NZ>| system.rhs(z);
     // The closed loop is autonomous: ∂Ż/∂t = 0.
@@ -464,6 +573,10 @@ where
             divergence = Some((t, magnitude));
         }
         task_error += controller.task_error(&observed);
+        if position_task {
+            distance = (observed[error_term.index()] - task.goal(error_term)).norm();
+            first_distance.get_or_insert(distance);
+        }
         let j = controller.cost_j(&observed);
         let f = j - 0.5 * controller.logdet;
         let e = u.norm_squared();
@@ -494,6 +607,9 @@ where
         control_effort: effort,
         jacobian_evals: stats.jacobian_evals,
         factorisations: stats.factorisations,
+        progress: first_distance
+            .filter(|&d0| d0 > 0.0)
+            .map(|d0| 1.0 - distance / d0),
     };
     if ![metrics.task_error, metrics.free_energy, metrics.cost_j]
         .iter()
@@ -508,6 +624,14 @@ where
         metrics,
         trajectory,
     })
+}
+
+/// Whether `term` is a position, joint or tip (θ, y): what [`Metrics::progress`] measures.
+pub fn is_position(term: Term) -> bool {
+    matches!(
+        term.read(),
+        Read::State { block: 0 } | Read::Tip { order: 0 }
+    )
 }
 
 /// [`IntegrationError::TooManySteps`] at the episode's budget (below the integrator's own limit

@@ -176,6 +176,13 @@ where
     M: ArmModel<N, NX, NP, NZ>,
     P: ArmModel<N, NX, NP, NZ>,
 {
+    if toolconf_core::reads_tip(task.kind) {
+        return Err(Error::Unsupported(format!(
+            "the MPC baseline minimises J over the linearised joint state; the {} task reads the tool's tip, whose cost it does not model (run it with the active-inference controller)",
+            task.kind
+        ))
+        .into());
+    }
     let metrics_of = ActiveInferenceN::new(tool, task, 1.0).map_err(Error::from)?;
     // The QP log holds one entry per control period: refuse horizons too long to keep.
     for step in [options.dt, mpc_options.period] {

@@ -175,3 +175,12 @@ pub use episode::{
     MpcMetricsN, MpcSimulationError,
 };
 pub use options::{MpcError, MpcModel, MpcOptions, SolveInfo};
+
+/// The tasks the MPC baseline takes: the joint-space ones. It minimises J over the linearised
+/// joint state, which does not hold the tool's tip (a task that reads the tip,
+/// [`toolconf_core::reads_tip`], is refused with a message).
+pub fn tasks() -> impl Iterator<Item = crate::TaskKind> {
+    crate::TaskKind::ALL
+        .into_iter()
+        .filter(|k| !toolconf_core::reads_tip(*k))
+}

@@ -68,7 +68,8 @@ impl<const N: usize, const NX: usize, const NZ: usize> StageCost<N, NX, NZ> {
                         .copy_from(&(goal - c.fixed_rows::<N>(block * N)));
                     NX
                 }
-                Read::Control => continue,
+                // Refused before any QP is built (mpc::episode): the tip is not in the QP's state.
+                Read::Control | Read::Tip { .. } => continue,
             };
             w.fixed_view_mut::<N, N>(rows, rows).copy_from(p);
         }
@@ -425,7 +426,7 @@ fn write_q<const N: usize, const NX: usize, const NZ: usize>(
 mod tests {
     use super::*;
     use crate::model::{Arm2, ArmModel};
-    use crate::{Arm, TaskKind};
+    use crate::Arm;
 
     /// The paper's J times the period, evaluated directly.
     fn direct_cost(arm: &Arm, task: &Task, x: &State, u: &Vector2, period: f64) -> f64 {
@@ -489,7 +490,7 @@ mod tests {
             Arm::new([0.6, 0.1, 0.1, 0.6]),
         ] {
             let arm = arm.unwrap();
-            for kind in TaskKind::ALL {
+            for kind in crate::mpc::tasks() {
                 let task = Task::paper(kind);
                 let ((m0, c0), (m1, c1)) = equilibrium_and_local(&arm, &task);
                 for limit in [5.0, f64::INFINITY] {
@@ -567,7 +568,7 @@ mod tests {
             (State::new(0.7, 0.1, -2.0, 1.0), Vector2::new(-3.0, 2.0)),
             (Arm2::equilibrium_state(), Vector2::zeros()),
         ];
-        for kind in TaskKind::ALL {
+        for kind in crate::mpc::tasks() {
             let task = Task::paper(kind);
             let a = arm.state_matrix();
             let cost = StageCost::new(

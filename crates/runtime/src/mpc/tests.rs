@@ -43,7 +43,7 @@ fn unconstrained_mpc_equals_finite_horizon_lqr() {
             Arm2::equilibrium_state(),
         );
         let model = discretise(&a, &b, &(-a * xe), options.period);
-        for kind in TaskKind::ALL {
+        for kind in crate::mpc::tasks() {
             let task = Task::paper(kind);
             let cost = StageCost::new(&a, &b, &(-a * xe), &task, options.period);
             let mut mpc = Mpc::new(&arm, &task, &options).unwrap();
@@ -70,7 +70,7 @@ fn unconstrained_mpc_equals_finite_horizon_lqr() {
 #[test]
 fn torque_bound_holds_and_is_active_far_from_goal() {
     for arm in arms() {
-        for kind in TaskKind::ALL {
+        for kind in crate::mpc::tasks() {
             let mut mpc = Mpc::new(&arm, &Task::paper(kind), &MpcOptions::default()).unwrap();
             for x in states() {
                 mpc.control(&x).unwrap();
@@ -239,7 +239,7 @@ fn local_model_at_the_equilibrium_is_the_equilibrium_model() {
         assert!((a - arm.state_matrix()).amax() < 1e-12 * arm.state_matrix().amax());
         assert!((b - arm.input_matrix()).amax() < 1e-12 * arm.input_matrix().amax());
         assert!(arm.dynamics(&xe, &Vector2::zeros()).amax() < 1e-12);
-        for kind in TaskKind::ALL {
+        for kind in crate::mpc::tasks() {
             let task = Task::paper(kind);
             let mut reference = Mpc::new(&arm, &task, &MpcOptions::original_linear()).unwrap();
             let want = reference.control(&xe).unwrap();

@@ -241,6 +241,7 @@ mod tests {
             jacobian_evals: 0,
             factorisations: 0,
             control_effort: 0.0,
+            progress: None,
         };
         let failed = Err(ModelSimulationError::Input(Error::Unsupported("x".into())));
         let results: Vec<RankedTool> = [

@@ -217,7 +217,19 @@ pub fn screen_rows(
                     row_level: false,
                 });
             }
-            let logdet = tasks.logdet(&row.tool);
+            let missing_tip = match toolconf_core::reads_tip(tasks.kind) {
+                true => row.missing_tip(),
+                false => Vec::new(),
+            };
+            let logdet = match missing_tip.is_empty() {
+                true => tasks.logdet(&row.tool),
+                false => Err(Error::ToolWithoutTip {
+                    file: tools_file.into(),
+                    row: row.row,
+                    kind: tasks.kind,
+                    columns: missing_tip.join(", "),
+                }),
+            };
             screen.push(Candidate { row, logdet });
             Ok(())
         }
@@ -269,6 +281,7 @@ pub(super) mod tests {
                 row,
                 name: None,
                 tool: AnyTool::new(ModelKind::Arm2, &[0.3, 0.3, 0.3, 0.3]).unwrap(),
+                defaulted: Vec::new(),
             },
             logdet,
         }

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use nalgebra::SVector;
 use rayon::prelude::*;
 
-use super::results::{per_joint, push_c_order, room, rows, BatchError};
+use super::results::{components, push_c_order, room, rows, BatchError};
 use super::{
     AnyEpisode, BoundTask, Confidences, Linearisation, Model, ModelInfo, Rows, TaskTrace,
     TrajectoryTable,
@@ -299,7 +299,16 @@ where
         let s = tool.sensitivities(self.kind);
         let sensitivities = Term::ALL
             .into_iter()
-            .filter_map(|term| s.of(term).map(|m| (term.sensitivity_name(), rows(&m))))
+            .filter_map(|term| {
+                // A tip term's sensitivity J ∂θ/∂U: its first TIP_DIM rows (the rest are padding).
+                let own = toolconf_core::term_components(term, N, M::TIP_DIM);
+                s.of(term).map(|m| {
+                    (
+                        term.sensitivity_name(),
+                        rows(&m).into_iter().take(own).collect(),
+                    )
+                })
+            })
             .collect();
         Ok(Linearisation {
             a: rows(&tool.state_matrix()),
@@ -341,11 +350,18 @@ where
             .trajectory
             .expect("a recorded episode has a trajectory");
         let term = self.kind.error_term();
-        let (series, goal) = (tr.of(term), task.goal(term));
+        let (series, goal, count) = (tr.of(term), task.goal(term), tr.components(term));
+        let tip = Term::ALL
+            .into_iter()
+            .find(|t| matches!(t.read(), generated::Read::Tip { order: 0 }));
+        let tip_path = tip
+            .filter(|&t| tr.components(t) > 0)
+            .map(|t| components(tr.of(t), tr.components(t)));
         Ok(TaskTrace {
             t: tr.t.clone(),
-            value: per_joint(series),
-            goal: goal.iter().copied().collect(),
+            value: components(series, count),
+            goal: goal.iter().take(count).copied().collect(),
+            tip_path,
         })
     }
 }
@@ -410,7 +426,7 @@ where
     }
     // A term the task does not use has no sensitivity (the command line leaves it out too).
     let used = Term::ALL.map(|t| t.has_sensitivity() && kind.uses(t));
-    let mut out = allocate(k, N, NX, used)?;
+    let mut out = allocate(k, N, NX, used, M::TIP_DIM)?;
     let chunk = (CHUNK_BYTES / std::mem::size_of::<Result<One<N, NX>, Error>>()).max(1);
     for (c, tools) in params.chunks(chunk * NP).enumerate() {
         let mut results: Vec<Result<One<N, NX>, Error>> = room(tools.len() / NP, tools.len() / NP)?;
@@ -442,16 +458,30 @@ where
 /// The results of one chunk of tools, before they are copied into the output arrays.
 const CHUNK_BYTES: usize = 8 << 20;
 
-/// Room for k tools' results (the sensitivities of the `used` terms only).
-fn allocate(k: usize, n: usize, nx: usize, used: [bool; TERMS]) -> Result<Confidences, BatchError> {
+/// Room for k tools' results (the sensitivities of the `used` terms only, a tip term's its
+/// `tip_dim` rows).
+fn allocate(
+    k: usize,
+    n: usize,
+    nx: usize,
+    used: [bool; TERMS],
+    tip_dim: usize,
+) -> Result<Confidences, BatchError> {
+    let rows = |term: Term| toolconf_core::term_components(term, n, tip_dim);
+    let used_rows: usize = Term::ALL
+        .into_iter()
+        .zip(used)
+        .filter(|(_, u)| *u)
+        .map(|(t, _)| rows(t))
+        .sum();
     // The error says what all the arrays need, not the one that failed.
-    let per_tool = nx * nx + nx * n + (used.iter().filter(|u| **u).count() + 1) * n * n + 1;
+    let per_tool = nx * nx + nx * n + (used_rows + n) * n + 1;
     let total = k.saturating_mul(per_tool);
     let part = |per_tool: usize| room(k.saturating_mul(per_tool), total);
     let mut sensitivities = Vec::new();
     for (term, used) in Term::ALL.into_iter().zip(used) {
         if used {
-            sensitivities.push((term.sensitivity_name(), part(n * n)?));
+            sensitivities.push((term.sensitivity_name(), rows(term), part(rows(term) * n)?));
         }
     }
     Ok(Confidences {
@@ -474,7 +504,8 @@ fn push<const N: usize, const NX: usize>(out: &mut Confidences, one: &One<N, NX>
     out.logdet.push(one.logdet);
     let s = &one.sensitivities;
     let present = s.d_du.into_iter().flatten();
-    for ((_, all), m) in out.sensitivities.iter_mut().zip(present) {
-        push_c_order(all, &m);
+    for ((_, rows, all), m) in out.sensitivities.iter_mut().zip(present) {
+        // A tip term's first rows: the rest are its padding (toolconf_core::TaskN).
+        all.extend((0..*rows).flat_map(|i| (0..N).map(move |j| m[(i, j)])));
     }
 }

@@ -33,7 +33,7 @@ use crate::{Error, TaskKind};
 pub use entry::paper_options;
 pub use generated::{Constraint, ModelInfo, MAX_PARAMETER_COUNT};
 pub use results::{
-    AnyEpisode, BatchError, Confidences, Linearisation, Rows, TaskTrace, TrajectoryTable,
+    AnyEpisode, BatchError, Confidences, Linearisation, Rows, TaskTrace, TrajectoryTable, AXES,
 };
 
 /// One model, with the sizes known only at run time: its metadata, the rule its tools obey,

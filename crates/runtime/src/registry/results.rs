@@ -3,7 +3,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::generated::{Term, TERMS};
+use crate::generated::{Read, Term, TERMS};
 use crate::model::{Metrics, TrajectoryN};
 use crate::Error;
 
@@ -67,7 +67,7 @@ impl TrajectoryTable {
     pub fn from_trajectory<const N: usize>(tr: &TrajectoryN<N>) -> Self {
         TrajectoryTable {
             t: tr.t.clone(),
-            terms: Term::ALL.map(|term| per_joint(tr.of(term))),
+            terms: Term::ALL.map(|term| components(tr.of(term), tr.components(term))),
         }
     }
 
@@ -77,11 +77,13 @@ impl TrajectoryTable {
     }
 
     /// As CSV: `t`, then every term of each joint (`theta1, …, theta1_dot, …, u<n>`: the joint's
-    /// number after the name's first word), one row per time.
+    /// number after the name's first word), then on a tip task the tip's components (`tip_x`,
+    /// `tip_dot_x`, …), one row per time.
     pub fn to_csv(&self) -> String {
-        let column = |term: Term, j: usize| match term.name().split_once('_') {
-            Some((first, rest)) => format!("{first}{j}_{rest}"),
-            None => format!("{}{j}", term.name()),
+        let column = |term: Term, j: usize| match (term.read(), term.name().split_once('_')) {
+            (Read::Tip { .. }, _) => format!("{}_{}", term.name(), AXES[j - 1]),
+            (_, Some((first, rest))) => format!("{first}{j}_{rest}"),
+            (_, None) => format!("{}{j}", term.name()),
         };
         let blocks: Vec<(Term, &Vec<Vec<f64>>)> = Term::ALL
             .iter()
@@ -103,9 +105,16 @@ impl TrajectoryTable {
     }
 }
 
-/// `series[i][j]` (time i, joint j) as `out[j][i]`.
-pub(super) fn per_joint<const N: usize>(series: &[SVector<f64, N>]) -> Vec<Vec<f64>> {
-    (0..N)
+/// The names of a tip term's components, in the base frame.
+pub const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// The first `count` rows of `series[i]` (time i) as `out[j][i]`: every joint of a joint term,
+/// a tip term's own components.
+pub(super) fn components<const N: usize>(
+    series: &[SVector<f64, N>],
+    count: usize,
+) -> Vec<Vec<f64>> {
+    (0..count.min(N))
         .map(|j| series.iter().map(|v| v[j]).collect())
         .collect()
 }
@@ -114,9 +123,12 @@ pub(super) fn per_joint<const N: usize>(series: &[SVector<f64, N>]) -> Vec<Vec<f
 #[derive(Debug, Clone, PartialEq)]
 pub struct TaskTrace {
     pub t: Vec<f64>,
-    /// `value[j][i]`: joint j at `t[i]`.
+    /// `value[j][i]`: joint j (or the tip's component j, on a tip task) at `t[i]`.
     pub value: Vec<Vec<f64>>,
     pub goal: Vec<f64>,
+    /// On a tip task, the tip's path in the base frame: `tip_path[j][i]` is component j of
+    /// y(q(t_i)) (whatever the error term: ẏ on a tip velocity task).
+    pub tip_path: Option<Vec<Vec<f64>>>,
 }
 
 /// Why a batch over many tools or states gave no result.
@@ -151,8 +163,9 @@ pub struct Confidences {
     pub a: Vec<f64>,
     /// B = ∂f/∂U at the equilibrium (k × NX × N).
     pub b: Vec<f64>,
-    /// The task's sensitivities by name (each k × N × N); a term the task does not use is absent.
-    pub sensitivities: Vec<(&'static str, Vec<f64>)>,
+    /// The task's sensitivities by name, with their rows (each k × rows × N: N rows for a joint
+    /// term, the tip's components for a tip term); a term the task does not use is absent.
+    pub sensitivities: Vec<(&'static str, usize, Vec<f64>)>,
     /// Π^U (k × N × N).
     pub pi_u: Vec<f64>,
     /// ln|Π^U| (k).
