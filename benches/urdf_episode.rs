@@ -3,6 +3,11 @@
 //! of tools, and 1000 Panda tools ranked (`rank`'s simulation stage) on 2 threads, all with
 //! `rank`'s default method `fast`.
 //!
+//! `panda_tip_episode`: one episode of the tip task a user runs (examples/tasks/
+//! panda_touch_point.toml, touching a point with the tool's tip, σ = 1 mm) per iteration,
+//! cycling through the same 50 tools, with `rank`'s default method; goal ≤ 1 ms (issue 30: the
+//! joint tasks take 0.36–0.41 ms).
+//!
 //! `cargo bench --bench urdf_episode`; goals: an episode ≤ 2 ms, ≥ 100× SciPy's
 //! `solve_ivp` with Pinocchio's `aba` on the same loop (bench/peers/urdf_peers.py, which times the
 //! peers and toolconf on one population side by side, mean and percentiles).
@@ -113,5 +118,25 @@ fn rank_1000(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, closed_loop_rhs, episode, rank_1000);
+/// One episode of the user's tip task per iteration, cycling through 50 tools.
+fn tip_episode(c: &mut Criterion) {
+    let population = tools(50, 2);
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples/tasks/panda_touch_point.toml");
+    let mut spec = TaskSpec::from_file(&file).expect("the example task file");
+    spec.episode.method = Some(Method::Fast);
+    let tasks = ModelTasks::new(&spec);
+    let mut group = c.benchmark_group("panda_tip_episode");
+    group.sample_size(20);
+    let mut i = 0;
+    group.bench_function("touch_point", |b| {
+        b.iter(|| {
+            i = (i + 1) % population.len();
+            tasks.simulate(black_box(&population[i])).unwrap()
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, closed_loop_rhs, episode, tip_episode, rank_1000);
 criterion_main!(benches);

@@ -243,6 +243,9 @@ def test_planar_tips_are_the_end_of_the_last_link():
     np.testing.assert_allclose(toolconf.tip("arm2", p, eq)["position"], [0.0, -0.7, 0.0], atol=1e-15)
 
 
-def test_a_model_without_a_tip_says_so():
-    with pytest.raises(ValueError, match="model msd has no tip"):
-        toolconf.tip("msd", [1.0] * len(toolconf.models()["msd"]["parameters"]), [0.0])
+def test_the_mass_spring_dampers_tip_is_its_mass():
+    # derive/models/msd.toml: [tip] position = ["z", "0", "0"], components = 1 (the mass is the
+    # tool's working point), so tip tasks run on it too.
+    t = toolconf.tip("msd", [1.0] * len(toolconf.models()["msd"]["parameters"]), [0.3])
+    np.testing.assert_array_equal(t["position"], [0.3, 0.0, 0.0])
+    np.testing.assert_array_equal(t["jacobian"], [[1.0], [0.0], [0.0]])
