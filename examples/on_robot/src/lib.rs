@@ -76,7 +76,9 @@
 #![no_std]
 
 use nalgebra::SVector;
-use toolconf_core::{ActiveInferenceN, ArmModel, ControlConfidenceN, Error, TaskN, ToolN};
+use toolconf_core::{
+    ActiveInferenceN, ArmModel, ControlConfidenceN, Error, TaskN, TipKinematics, ToolN,
+};
 
 pub use toolconf_core::{Arm2, Arm2Tool, Arm3, Arm3Tool, TaskKind};
 
@@ -105,6 +107,9 @@ where
     confidence: ControlConfidenceN<N>,
     torque: SVector<f64, N>,
     period: f64,
+    /// On a task on the tool's tip, the tool's parameters: each tick then reads the tip's
+    /// y(q) and J(q) q̇ from the generated forward kinematics (`None`: a joint-space task).
+    tip: Option<SVector<f64, NP>>,
 }
 
 /// The paper's arm (`arm2`).
@@ -150,12 +155,21 @@ where
                 value: rate_hz,
             });
         }
+        let tip = toolconf_core::reads_tip(task.kind).then(|| tool.params());
+        let q_e = M::equilibrium_state().fixed_rows::<N>(0).into_owned();
+        if tip.is_some_and(|p| M::tip(&q_e, &p).is_none()) {
+            return Err(Error::NoTip {
+                kind: task.kind,
+                model: M::NAME,
+            });
+        }
         Ok(Self {
             controller,
             dynamics: M::dynamics_coefficients(&tool.params()),
             confidence: toolconf_core::control_confidence(tool, task)?,
             torque: SVector::from(initial_torque),
             period,
+            tip,
         })
     }
 
@@ -187,14 +201,32 @@ where
         let acceleration = measured(acceleration)?;
         // Ẋ = [q̇; q̈]: the measured velocity and acceleration.
         let mut x_dot = SVector::<f64, NX>::zeros();
-        x_dot.fixed_rows_mut::<N>(0).copy_from(&x.fixed_rows::<N>(N));
+        x_dot
+            .fixed_rows_mut::<N>(0)
+            .copy_from(&x.fixed_rows::<N>(N));
         x_dot.fixed_rows_mut::<N>(N).copy_from(&acceleration);
         self.step(&x, &x_dot)
     }
 
     #[inline]
-    fn step(&mut self, x: &SVector<f64, NX>, x_dot: &SVector<f64, NX>) -> Result<Command<N>, Error> {
-        let observed = toolconf_core::observe(x, x_dot, &self.torque);
+    fn step(
+        &mut self,
+        x: &SVector<f64, NX>,
+        x_dot: &SVector<f64, NX>,
+    ) -> Result<Command<N>, Error> {
+        let q = x.fixed_rows::<N>(0).into_owned();
+        let tip = self.tip.and_then(|p| M::tip(&q, &p));
+        let observed = match tip {
+            Some((position, jacobian)) => {
+                let tip = TipKinematics {
+                    position,
+                    jacobian,
+                    dim: M::TIP_DIM,
+                };
+                toolconf_core::observe_with_tip(x, x_dot, &self.torque, &tip)
+            }
+            None => toolconf_core::observe(x, x_dot, &self.torque),
+        };
         let next = self.controller.tick(&observed, self.period);
         if let Some(&value) = next.iter().find(|v| !v.is_finite()) {
             return Err(Error::InvalidOption {

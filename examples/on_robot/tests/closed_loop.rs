@@ -63,7 +63,10 @@ fn episode(p: [f64; 4], kind: TaskKind, rate_hz: f64) -> Run {
 /// (e − e^g)ᵀP(e − e^g) on the task's error term (θ for task 1, θ̇ for task 2).
 fn weighted_error(task: &TaskN<2>, x: &nalgebra::Vector4<f64>) -> f64 {
     let (e, p) = match task.kind {
-        TaskKind::Position => (x.fixed_rows::<2>(0) - task.goal[Term::Theta.index()], task.precision[Term::Theta.index()]),
+        TaskKind::Position => (
+            x.fixed_rows::<2>(0) - task.goal[Term::Theta.index()],
+            task.precision[Term::Theta.index()],
+        ),
         TaskKind::Velocity => (
             x.fixed_rows::<2>(2) - task.goal[Term::ThetaDot.index()],
             task.precision[Term::ThetaDot.index()],
@@ -234,4 +237,40 @@ fn the_confidence_is_the_closed_form_and_arm3_ticks_too() {
     let start = (toolconf_core::Arm3::equilibrium_state().fixed_rows::<3>(0) - goal).norm();
     assert!((x.fixed_rows::<3>(0) - goal).norm() < 0.5 * start, "{x}");
     assert!(last.iter().all(|u| u.is_finite() && u.abs() < 50.0));
+}
+
+/// On a task on the tool's tip a tick reads the tip: its torque is U + period·U̇ with
+/// U̇ = −γ(Σ Sᵀ P (term − goal) + P^U U) over y and ẏ written out from the arm's closed form
+/// (y = (l1 cos θ1 + l2 cos θ2, l1 sin θ1 + l2 sin θ2), angles absolute), not the generated tip.
+#[test]
+fn a_tick_on_a_tip_task_reads_the_tips_closed_form() {
+    let p = [0.3, 0.4, 0.5, 0.2];
+    let tool = Arm2Tool::new(p).unwrap();
+    let task = Arm2::paper_task(TaskKind::TipPosition);
+    let mut controller = Arm2Controller::new(&tool, &task, 1.0, [0.1; 2], 1000.0).unwrap();
+    let x = nalgebra::Vector4::new(-1.4, -1.9, 0.3, -0.2);
+    let torque = controller.tick(&x.into()).unwrap().torque;
+
+    let (l1, l2) = (p[2], p[3]);
+    let (s1, c1, s2, c2) = (x[0].sin(), x[0].cos(), x[1].sin(), x[1].cos());
+    let y = nalgebra::Vector2::new(l1 * c1 + l2 * c2, l1 * s1 + l2 * s2);
+    let j = nalgebra::Matrix2::new(-l1 * s1, -l2 * s2, l1 * c1, l2 * c2);
+    let y_dot = j * x.fixed_rows::<2>(2);
+    let s = tool.sensitivities(TaskKind::TipPosition);
+    let u = nalgebra::Vector2::new(0.1, 0.1);
+    let gradient = [(Term::Tip, y), (Term::TipDot, y_dot)]
+        .iter()
+        .map(|(term, v)| {
+            let k = s.of(*term).unwrap().transpose() * task.precision[term.index()];
+            k * (v - task.goal[term.index()])
+        })
+        .fold(task.precision[Term::U.index()] * u, |a, b| a + b);
+    let expected = u - gradient * 1e-3;
+    for i in 0..2 {
+        let scale = expected[i].abs().max(1.0);
+        assert!(
+            (torque[i] - expected[i]).abs() <= 1e-12 * scale,
+            "{torque:?} vs {expected}"
+        );
+    }
 }
