@@ -100,8 +100,8 @@ pub fn batch(
 ///     dict of arrays, one entry per (tool, perturbation), tool-major (row ``i * P + j`` is
 ///     tool ``i`` under perturbation ``j``): ``tool`` and ``perturbation`` (the 0-based indices),
 ///     ``task_error``, ``free_energy``, ``cost_j``, ``logdet``, ``control_effort`` (NaN for a
-///     failed episode), ``progress`` (1 − e(T)/e(0) on a position task, joint or tip; NaN on
-///     the other tasks and for a failed episode), ``rhs_evals``, ``steps``, ``rejected_steps``, ``jacobian_evals``,
+///     failed episode), on a position task (joint or tip) ``progress`` (1 − e(T)/e(0), NaN
+///     for a failed episode), ``rhs_evals``, ``steps``, ``rejected_steps``, ``jacobian_evals``,
 ///     ``factorisations`` (-1 for one) and ``error`` (a list: None, or why the episode failed).
 ///
 /// Raises:
@@ -272,18 +272,28 @@ fn to_dict(
     };
     set("tool", ints(&|i, _| (first_tool + i / p) as i64)?)?;
     set("perturbation", ints(&|i, _| (i % p) as i64)?)?;
-    let floats: [Column<f64>; 6] = [
+    let floats: [Column<f64>; 5] = [
         ("task_error", |m| m.task_error),
         ("free_energy", |m| m.free_energy),
         ("cost_j", |m| m.cost_j),
         ("logdet", |m| m.logdet),
         ("control_effort", |m| m.control_effort),
-        ("progress", |m| m.progress.unwrap_or(f64::NAN)),
     ];
     for (key, f) in floats {
         let column = rows.iter().map(|r| r.as_ref().map_or(f64::NAN, f));
         let column = crate::arrays::collect(column, &what)?;
         set(key, PyArray1::from_vec(py, column).into_any())?;
+    }
+    // A position task's progress (NaN only for a failed episode); other tasks have no column.
+    if rows
+        .iter()
+        .any(|r| r.as_ref().is_ok_and(|m| m.progress.is_some()))
+    {
+        let column = rows
+            .iter()
+            .map(|r| r.as_ref().ok().and_then(|m| m.progress).unwrap_or(f64::NAN));
+        let column = crate::arrays::collect(column, &what)?;
+        set("progress", PyArray1::from_vec(py, column).into_any())?;
     }
     let counts: [Column<usize>; 5] = [
         ("rhs_evals", |m| m.rhs_evals),

@@ -34,8 +34,8 @@ pub struct Shown {
     pub free_energy: f64,
     pub cost_j: f64,
     pub rhs_evals: i64,
-    /// 1 − e(T)/e(0) on a position task (joint or tip), NaN on the others.
-    pub progress: f64,
+    /// 1 − e(T)/e(0) on a position task (joint or tip), `None` on the others.
+    pub progress: Option<f64>,
     /// What the objective minimises ([`objective_value`]).
     pub score: f64,
 }
@@ -47,7 +47,7 @@ impl Outcome {
             free_energy: m.free_energy,
             cost_j: m.cost_j,
             rhs_evals: m.rhs_evals as i64,
-            progress: m.progress.unwrap_or(f64::NAN),
+            progress: m.progress,
             score: objective_value(objective, &m),
         };
         Outcome {
@@ -133,7 +133,15 @@ fn outcomes_to_py<'py>(
     out.set_item("task_error", shown(|s| s.task_error))?;
     out.set_item("free_energy", shown(|s| s.free_energy))?;
     out.set_item("cost_j", shown(|s| s.cost_j))?;
-    out.set_item("progress", shown(|s| s.progress))?;
+    // A position task's column (NaN only for a failed episode); other tasks have none, rather
+    // than a column of NaN. A block, the workers' own exchange, always carries it.
+    let progress = items
+        .iter()
+        .any(|o| o.episode.as_ref().is_ok_and(|s| s.progress.is_some()));
+    if progress || !ranked {
+        let value = |o: &Outcome| o.episode.as_ref().ok().and_then(|s| s.progress);
+        out.set_item("progress", floats(py, &items, value))?;
+    }
     let evals: Vec<i64> = items
         .iter()
         .map(|o| o.episode.as_ref().map_or(-1, |s| s.rhs_evals))
@@ -305,7 +313,7 @@ pub fn outcomes_from_py(block: &Bound<'_, PyDict>) -> Result<Vec<Outcome>, Failu
                     free_energy: free_energy[i],
                     cost_j: cost_j[i],
                     rhs_evals: evals[i],
-                    progress: progress[i],
+                    progress: Some(progress[i]).filter(|p| !p.is_nan()),
                     score: score[i],
                 }),
             },

@@ -118,9 +118,9 @@ def rank(
         The ranked tools, best first, with the columns ``rank``, ``row`` (1-based in the file
         or table), ``name``, ``model``, one per parameter of the models present (NaN where a
         tool's model has none), ``logdet``, ``task_error``, ``free_energy``, ``cost_j`` (NaN
-        for a failed episode), ``progress`` (1 − e(T)/e(0) with e the distance to the goal, on a
-        position task, joint or tip; NaN on the others), ``rhs_evals`` (-1 for one) and
-        ``error`` (None, or why the
+        for a failed episode), on a position task (joint or tip) ``progress`` (1 − e(T)/e(0)
+        with e the distance to the goal; NaN for a failed episode), ``rhs_evals`` (-1 for one)
+        and ``error`` (None, or why the
         episode failed: such tools rank last, in row order). A pandas DataFrame when ``tools``
         was one; otherwise a dict of columns (NumPy arrays and lists), so that pandas stays
         optional (``pandas.DataFrame(result)`` makes the same frame). The numbers are
