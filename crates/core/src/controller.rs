@@ -38,6 +38,23 @@ pub struct TipKinematics<const N: usize> {
 }
 
 impl<const N: usize> TipKinematics<N> {
+    /// The tip of the tool with parameters `p` at joint positions `q` (`None` for a model
+    /// without one).
+    #[inline]
+    pub fn of<M, const NX: usize, const NP: usize, const NZ: usize>(
+        q: &SVector<f64, N>,
+        p: &SVector<f64, NP>,
+    ) -> Option<Self>
+    where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
+        M::tip(q, p).map(|(position, jacobian)| Self {
+            position,
+            jacobian,
+            dim: M::TIP_DIM,
+        })
+    }
+
     /// The first `dim` components of a tip vector in the N slots of a term, zeros after
     /// ([`crate::TaskN`]'s padding).
     #[inline]
@@ -78,6 +95,48 @@ pub fn observe_with_tip<const N: usize, const NX: usize>(
         }
     }
     observed
+}
+
+/// What observing a tool's tip on model `M` needs: on a task that reads the tip
+/// ([`crate::reads_tip`]), the tool's parameters `p`, for y(q; p); `None` on a joint-space task,
+/// which never evaluates the tip. A tip task on a model without a tip is [`Error::NoTip`].
+pub fn tip_parameters<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    p: &SVector<f64, NP>,
+    kind: crate::TaskKind,
+) -> Result<Option<SVector<f64, NP>>, Error>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    if !crate::reads_tip(kind) {
+        return Ok(None);
+    }
+    let q_e = M::equilibrium_state().fixed_rows::<N>(0).into_owned();
+    match M::tip(&q_e, p) {
+        Some(_) => Ok(Some(*p)),
+        None => Err(Error::NoTip {
+            kind,
+            model: M::NAME,
+        }),
+    }
+}
+
+/// [`observe_with_tip`] of the tool with parameters `tip` ([`tip_parameters`]), or
+/// [`observe`] on a joint-space task (`None`).
+#[inline]
+pub fn observe_tool<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    x: &SVector<f64, NX>,
+    x_dot: &SVector<f64, NX>,
+    u: &SVector<f64, N>,
+    tip: Option<&SVector<f64, NP>>,
+) -> ObservationN<N>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let q = x.fixed_rows::<N>(0).into_owned();
+    match tip.and_then(|p| TipKinematics::of::<M, NX, NP, NZ>(&q, p)) {
+        Some(tip) => observe_with_tip(x, x_dot, u, &tip),
+        None => observe(x, x_dot, u),
+    }
 }
 
 /// The control U of an observation (the value of the term [`Read::Control`] reads).

@@ -472,7 +472,7 @@ impl TaskSpec {
                     v.len(),
                     ShortList(v),
                     M::NAME,
-                    ["x", "y", "z"][..d.min(3)].join(", ")
+                    crate::registry::AXES[..d.min(3)].join(", ")
                 ),
             ));
         }

@@ -76,9 +76,7 @@
 #![no_std]
 
 use nalgebra::SVector;
-use toolconf_core::{
-    ActiveInferenceN, ArmModel, ControlConfidenceN, Error, TaskN, TipKinematics, ToolN,
-};
+use toolconf_core::{ActiveInferenceN, ArmModel, ControlConfidenceN, Error, TaskN, ToolN};
 
 pub use toolconf_core::{Arm2, Arm2Tool, Arm3, Arm3Tool, TaskKind};
 
@@ -155,14 +153,7 @@ where
                 value: rate_hz,
             });
         }
-        let tip = toolconf_core::reads_tip(task.kind).then(|| tool.params());
-        let q_e = M::equilibrium_state().fixed_rows::<N>(0).into_owned();
-        if tip.is_some_and(|p| M::tip(&q_e, &p).is_none()) {
-            return Err(Error::NoTip {
-                kind: task.kind,
-                model: M::NAME,
-            });
-        }
+        let tip = toolconf_core::tip_parameters::<M, N, NX, NP, NZ>(&tool.params(), task.kind)?;
         Ok(Self {
             controller,
             dynamics: M::dynamics_coefficients(&tool.params()),
@@ -214,19 +205,12 @@ where
         x: &SVector<f64, NX>,
         x_dot: &SVector<f64, NX>,
     ) -> Result<Command<N>, Error> {
-        let q = x.fixed_rows::<N>(0).into_owned();
-        let tip = self.tip.and_then(|p| M::tip(&q, &p));
-        let observed = match tip {
-            Some((position, jacobian)) => {
-                let tip = TipKinematics {
-                    position,
-                    jacobian,
-                    dim: M::TIP_DIM,
-                };
-                toolconf_core::observe_with_tip(x, x_dot, &self.torque, &tip)
-            }
-            None => toolconf_core::observe(x, x_dot, &self.torque),
-        };
+        let observed = toolconf_core::observe_tool::<M, N, NX, NP, NZ>(
+            x,
+            x_dot,
+            &self.torque,
+            self.tip.as_ref(),
+        );
         let next = self.controller.tick(&observed, self.period);
         if let Some(&value) = next.iter().find(|v| !v.is_finite()) {
             return Err(Error::InvalidOption {

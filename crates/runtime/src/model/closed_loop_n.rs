@@ -10,7 +10,7 @@ use crate::integrate::{
     solve_grid_with_jacobian, uniform_grid, IntegrationError, Method, Options as IntegratorOptions,
 };
 use crate::Error;
-use toolconf_core::{observe, observe_with_tip, reads_tip, ObservationN, TipKinematics};
+use toolconf_core::{observe_tool, reads_tip, tip_parameters, ObservationN, TipKinematics};
 
 /// A grid state whose magnitude passes this is a diverging simulation, not a result.
 pub(crate) const DIVERGENCE_BOUND: f64 = crate::validate::STATE_BOUND;
@@ -39,10 +39,9 @@ where
     jacobian: P::JacobianCoefficients,
     pub controller: ActiveInferenceN<N>,
     perturbation: SVector<f64, N>,
-    /// The tool's parameters, for the tip's kinematics y(q; p).
-    params: SVector<f64, NP>,
-    /// Whether the task reads the tool's tip (then every right-hand side evaluates y(q), J(q)).
-    reads_tip: bool,
+    /// On a task that reads the tool's tip, the tool's parameters for y(q; p): then every
+    /// right-hand side evaluates y(q), J(q) ([`tip_parameters`]).
+    tip: Option<SVector<f64, NP>>,
 }
 
 impl<P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>
@@ -83,35 +82,15 @@ where
             });
         }
         let params = tool.params();
-        let reads_tip = reads_tip(task.kind);
-        let q_e = P::equilibrium_state().fixed_rows::<N>(0).into_owned();
-        if reads_tip && P::tip(&q_e, &params).is_none() {
-            return Err(toolconf_core::Error::NoTip {
-                kind: task.kind,
-                model: P::NAME,
-            }
-            .into());
-        }
+        // The plant's tip, as the plant is what the controller measures.
+        let tip = tip_parameters::<P, N, NX, NP, NZ>(&params, task.kind)?;
         Ok(Self {
             dynamics: P::dynamics_coefficients(&params),
             jacobian: P::jacobian_coefficients(&params),
             controller: ActiveInferenceN::new(tool, task, learning_rate)?,
             perturbation: *perturbation,
-            params,
-            reads_tip,
+            tip,
         })
-    }
-
-    /// The tip's kinematics at the joint positions q (checked to exist in [`Self::new`]).
-    #[inline]
-    fn tip(&self, q: &SVector<f64, N>) -> TipKinematics<N> {
-        let (position, jacobian) =
-            P::tip(q, &self.params).unwrap_or((SVector::zeros(), SMatrix::zeros()));
-        TipKinematics {
-            position,
-            jacobian,
-            dim: P::TIP_DIM,
-        }
     }
 
     /// Ż and the terms the controller observes (the plant's θ̈ among them, and the tip's y, ẏ
@@ -121,12 +100,7 @@ where
         let x = z.fixed_rows::<NX>(0).into_owned();
         let u = z.fixed_rows::<N>(NX).into_owned();
         let x_dot = P::dynamics_with(&x, &(u + self.perturbation), &self.dynamics);
-        let observed = if self.reads_tip {
-            let tip = self.tip(&x.fixed_rows::<N>(0).into_owned());
-            observe_with_tip(&x, &x_dot, &u, &tip)
-        } else {
-            observe(&x, &x_dot, &u)
-        };
+        let observed = observe_tool::<P, N, NX, NP, NZ>(&x, &x_dot, &u, self.tip.as_ref());
         let u_dot = self.controller.control_rate(&observed);
         let mut z_dot = SVector::<f64, NZ>::zeros();
         z_dot.fixed_rows_mut::<NX>(0).copy_from(&x_dot);
@@ -179,8 +153,8 @@ where
                 Read::StateRate { .. } | Read::Tip { .. } => {}
             }
         }
-        if self.reads_tip {
-            self.subtract_tip_gains(&x, &gains, &mut du_dx);
+        if let Some(p) = &self.tip {
+            subtract_tip_gains::<P, N, NX, NP, NZ>(p, &x, &gains, &mut du_dx);
         }
         j.fixed_view_mut::<N, NX>(NX, 0).copy_from(&du_dx);
         j.fixed_view_mut::<N, N>(NX, NX).copy_from(&du_du);
@@ -188,50 +162,51 @@ where
     }
 }
 
-impl<P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>
-    ClosedLoopN<P, N, NX, NP, NZ>
-where
+/// The tip terms' part of ∂U̇/∂X for the tool with parameters `p`: y = y(q) has ∂y/∂q = J;
+/// ẏ = J(q) q̇ has ∂ẏ/∂q̇ = J and ∂ẏ/∂q = J̇ = Σ_k ∂J/∂q_k q̇_k (column k of ∂(J q̇)/∂q is
+/// Σ_j ∂²y/∂q_k∂q_j q̇_j, and the Hessian of y is symmetric), the directional derivative of J
+/// along q̇, taken here by a central difference of the generated J (the tip's second derivatives
+/// are not generated). Its step h·|q̇|∞ = 1e-5 rad leaves an error ~1e-10 relative: this matrix
+/// only steers the stiff integrator's Newton-like stages, whose error control does not depend on
+/// it being exact, while the right-hand side itself is exact.
+fn subtract_tip_gains<P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    p: &SVector<f64, NP>,
+    x: &SVector<f64, NX>,
+    gains: &[SMatrix<f64, N, N>; TERMS],
+    du_dx: &mut SMatrix<f64, N, NX>,
+) where
     P: ArmModel<N, NX, NP, NZ>,
 {
-    /// The tip terms' part of ∂U̇/∂X: y = y(q) has ∂y/∂q = J; ẏ = J(q) q̇ has ∂ẏ/∂q̇ = J and
-    /// ∂ẏ/∂q = J̇ = Σ_k ∂J/∂q_k q̇_k (column k of ∂(J q̇)/∂q is Σ_j ∂²y/∂q_k∂q_j q̇_j, and the
-    /// Hessian of y is symmetric), the directional derivative of J along q̇, taken here by a
-    /// central difference of the generated J (the tip's second derivatives are not generated).
-    /// Its step h·|q̇|∞ = 1e-5 rad leaves an error ~1e-10 relative: this matrix only steers the
-    /// stiff integrator's Newton-like stages, whose error control does not depend on it being
-    /// exact, while the right-hand side itself is exact.
-    fn subtract_tip_gains(
-        &self,
-        x: &SVector<f64, NX>,
-        gains: &[SMatrix<f64, N, N>; TERMS],
-        du_dx: &mut SMatrix<f64, N, NX>,
-    ) {
-        let q = x.fixed_rows::<N>(0).into_owned();
-        let q_dot = x.fixed_rows::<N>(N).into_owned();
-        let tip = self.tip(&q);
-        let j = tip.padded_jacobian();
-        for term in Term::ALL {
-            let k = gains[term.index()];
-            match term.read() {
-                Read::Tip { order: 0 } => {
-                    let mut columns = du_dx.fixed_view_mut::<N, N>(0, 0);
-                    columns -= k * j;
-                }
-                Read::Tip { .. } => {
-                    let mut rates = du_dx.fixed_view_mut::<N, N>(0, N);
-                    rates -= k * j;
-                    let speed = q_dot.amax();
-                    if speed > 0.0 {
-                        let h = 1e-5 / speed;
-                        let ahead = self.tip(&(q + q_dot * h)).padded_jacobian();
-                        let behind = self.tip(&(q - q_dot * h)).padded_jacobian();
-                        let j_dot = (ahead - behind) / (2.0 * h);
-                        let mut positions = du_dx.fixed_view_mut::<N, N>(0, 0);
-                        positions -= k * j_dot;
-                    }
-                }
-                _ => {}
+    let jacobian =
+        |q: &SVector<f64, N>| TipKinematics::of::<P, NX, NP, NZ>(q, p).map(|t| t.padded_jacobian());
+    let q = x.fixed_rows::<N>(0).into_owned();
+    let q_dot = x.fixed_rows::<N>(N).into_owned();
+    let Some(j) = jacobian(&q) else {
+        return;
+    };
+    // At rest J̇ = 0; otherwise the step h that moves q by 1e-5 rad at most.
+    let speed = q_dot.amax();
+    let step = (speed > 0.0).then(|| 1e-5 / speed);
+    let j_dot = step
+        .and_then(|h| {
+            let (ahead, behind) = (jacobian(&(q + q_dot * h))?, jacobian(&(q - q_dot * h))?);
+            Some((ahead - behind) / (2.0 * h))
+        })
+        .unwrap_or_else(SMatrix::zeros);
+    for term in Term::ALL {
+        let k = gains[term.index()];
+        match term.read() {
+            Read::Tip { order: 0 } => {
+                let mut positions = du_dx.fixed_view_mut::<N, N>(0, 0);
+                positions -= k * j;
             }
+            Read::Tip { .. } => {
+                let mut rates = du_dx.fixed_view_mut::<N, N>(0, N);
+                rates -= k * j;
+                let mut positions = du_dx.fixed_view_mut::<N, N>(0, 0);
+                positions -= k * j_dot;
+            }
+            _ => {}
         }
     }
 }
@@ -365,10 +340,7 @@ impl<const N: usize> TrajectoryN<N> {
     /// How many of `term`'s rows are its own: N for a joint term, the tip's components for a
     /// tip term on a tip task, 0 for a tip term otherwise.
     pub fn components(&self, term: Term) -> usize {
-        match term.read() {
-            Read::Tip { .. } => self.tip_dim.unwrap_or(0),
-            _ => N,
-        }
+        toolconf_core::term_components(term, N, self.tip_dim.unwrap_or(0))
     }
 
     /// Appends the observation at time `t`.

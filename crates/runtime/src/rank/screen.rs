@@ -221,14 +221,15 @@ pub fn screen_rows(
                 true => row.missing_tip(),
                 false => Vec::new(),
             };
-            let logdet = match missing_tip.is_empty() {
-                true => tasks.logdet(&row.tool),
-                false => Err(Error::ToolWithoutTip {
+            let logdet = if missing_tip.is_empty() {
+                tasks.logdet(&row.tool)
+            } else {
+                Err(Error::ToolWithoutTip {
                     file: tools_file.into(),
                     row: row.row,
                     kind: tasks.kind,
                     columns: missing_tip.join(", "),
-                }),
+                })
             };
             screen.push(Candidate { row, logdet });
             Ok(())
