@@ -29,6 +29,8 @@ TASKS = [
     ("panda", "examples/tasks/panda_draw_line.toml"),
     ("ur5", "examples/tasks/ur5_touch_point.toml"),
     ("ur5", "examples/tasks/ur5_draw_line.toml"),
+    ("panda", "examples/tasks/panda_push_off.toml"),
+    ("ur5", "examples/tasks/ur5_push_off.toml"),
 ]
 
 

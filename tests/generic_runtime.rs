@@ -139,7 +139,18 @@ fn arm3_runs_every_task_with_finite_metrics() {
                 perturbation,
                 ..EpisodeOptionsN::paper::<Arm3, 6, 9>()
             };
-            let m = simulate(&tool, &task, &options).unwrap();
+            let result = simulate(&tool, &task, &options);
+            if kind == TaskKind::TipAcceleration && perturbation != 0.0 {
+                // arm3 hangs straight at q^e, a kinematic singularity: J(q^e)'s radial row is
+                // zero, so the tip acceleration task controls the tip's x alone, and ΔT swings
+                // the joints it does not see until J(q) and J(q^e) disagree in sign (measured:
+                // from t ≈ 1.5 s; it diverges by t = 3.43 s, DP5 and Rodas5P alike). That is an
+                // error naming the divergence, never a metric of NaN.
+                let e = result.unwrap_err().to_string();
+                assert!(e.contains("the state left the joints' range"), "{e}");
+                continue;
+            }
+            let m = result.unwrap();
             for v in [
                 m.task_error,
                 m.free_energy,

@@ -154,23 +154,19 @@ fn fine_step_task_error(arm: [f64; 4]) -> f64 {
     let p = |s: f64| nalgebra::Matrix2::identity() * s;
     let task = TaskN::<2> {
         kind: TaskKind::Position,
-        // θ, θ̇, θ̈, U, then the tip's y and ẏ, which a joint task does not use.
-        goal: [
-            nalgebra::Vector2::new(0.9, -0.3),
-            nalgebra::Vector2::zeros(),
-            nalgebra::Vector2::zeros(),
-            nalgebra::Vector2::zeros(),
-            nalgebra::Vector2::zeros(),
-            nalgebra::Vector2::zeros(),
-        ],
-        precision: [
-            nalgebra::Matrix2::new(90.0, 15.0, 15.0, 40.0),
-            p(30.0),
-            p(0.5),
-            p(2.0),
-            p(0.0),
-            p(0.0),
-        ],
+        // θ's goal and the four joint terms' precisions; the tip's terms, which a joint task
+        // does not use, zero.
+        goal: std::array::from_fn(|i| match i {
+            i if i == Term::Theta.index() => nalgebra::Vector2::new(0.9, -0.3),
+            _ => nalgebra::Vector2::zeros(),
+        }),
+        precision: std::array::from_fn(|i| match i {
+            i if i == Term::Theta.index() => nalgebra::Matrix2::new(90.0, 15.0, 15.0, 40.0),
+            i if i == Term::ThetaDot.index() => p(30.0),
+            i if i == Term::ThetaDdot.index() => p(0.5),
+            i if i == Term::CONTROL.index() => p(2.0),
+            _ => p(0.0),
+        }),
     };
     let tool = Arm2Tool::new(arm).unwrap();
     let system = ClosedLoopN::<Arm2, 2, 4, 4, 6>::with_perturbation(

@@ -1,5 +1,7 @@
 //! Tasks on the tool's tip (issue 30) through the model-generic runtime: the controller observes
-//! the tip's forward kinematics y(q) and ẏ = J(q) q̇, not their linearisation; the closed loop's
+//! the tip's forward kinematics y(q), ẏ = J(q) q̇ and ÿ = J(q) q̈ + J̇ q̇, not their
+//! linearisation, and ÿ is the time derivative of ẏ along the closed loop's flow; the generated
+//! J̇ q̇ is the second derivative of the generated y along q̇; the closed loop's
 //! Jacobian (what the stiff integrator steers by) agrees with central differences of its
 //! right-hand side; the tip sensitivities are J times the joints' ones; a tip position episode
 //! reaches its goal on every tool of the Panda catalogue; tools files without a tip are refused
@@ -10,7 +12,8 @@ use std::path::Path;
 use nalgebra::{SMatrix, SVector};
 use toolconf::generated::Read;
 use toolconf::model::{
-    reads_tip, term_components, Arm2, Arm2Tool, ArmModel, ClosedLoopN, Panda, PandaTool, TaskN,
+    reads_tip, term_components, Arm2, Arm2Tool, Arm3, ArmModel, ClosedLoopN, Panda, PandaTool,
+    TaskN, Ur5,
 };
 use toolconf::rank::{screen_file, ModelTasks};
 use toolconf::task_file::TaskSpec;
@@ -28,7 +31,9 @@ fn tip_tasks() -> Vec<TaskKind> {
         .filter(|k| reads_tip(*k))
         .collect();
     assert!(
-        kinds.contains(&TaskKind::TipPosition) && kinds.contains(&TaskKind::TipVelocity),
+        [TaskKind::TipPosition, TaskKind::TipVelocity, TaskKind::TipAcceleration]
+            .iter()
+            .all(|k| kinds.contains(k)),
         "{kinds:?}"
     );
     kinds
@@ -102,29 +107,110 @@ fn the_tip_tasks_closed_loop_jacobian_matches_central_differences() {
 #[test]
 fn the_controller_observes_the_tips_forward_kinematics() {
     let tool = panda_tool([0.0, 0.03, 0.2]);
-    let task = Panda::paper_task(TaskKind::TipPosition);
-    let system = ClosedLoopN::<Panda, 7, 14, 13, 21>::new(&tool, &task, 1.0, 0.0).unwrap();
-    let z = moving_state::<7, 14, 21>(&Panda::equilibrium_state());
-    let (_, observed) = system.rhs_and_observation(&z);
-    let q = z.fixed_rows::<7>(0).into_owned();
-    let q_dot = z.fixed_rows::<7>(7).into_owned();
-    let (y, j) = Panda::tip(&q, &tool.params()).unwrap();
-    let tip_dot = j * q_dot;
-    for term in Term::ALL {
-        let expected: Option<SVector<f64, 3>> = match term.read() {
-            Read::Tip { order: 0 } => Some(y),
-            Read::Tip { .. } => Some(tip_dot),
-            _ => None,
-        };
-        if let Some(e) = expected {
-            let v = observed[term.index()];
-            assert_eq!(v.fixed_rows::<3>(0).into_owned(), e, "{term}");
-            assert!(
-                v.rows(3, 4).iter().all(|x| *x == 0.0),
-                "{term}: padding {v}"
-            );
+    let p = tool.params();
+    for kind in [TaskKind::TipPosition, TaskKind::TipAcceleration] {
+        let task = Panda::paper_task(kind);
+        let system = ClosedLoopN::<Panda, 7, 14, 13, 21>::new(&tool, &task, 1.0, 0.2).unwrap();
+        let z = moving_state::<7, 14, 21>(&Panda::equilibrium_state());
+        let (z_dot, observed) = system.rhs_and_observation(&z);
+        let q = z.fixed_rows::<7>(0).into_owned();
+        let q_dot = z.fixed_rows::<7>(7).into_owned();
+        let q_ddot = z_dot.fixed_rows::<7>(7).into_owned();
+        let (y, j) = Panda::tip(&q, &p).unwrap();
+        let bias = Panda::tip_bias(&q, &q_dot, &p).unwrap();
+        for term in Term::ALL {
+            let expected: Option<SVector<f64, 3>> = match term.read() {
+                Read::Tip { order: 0 } => Some(y),
+                Read::Tip { order: 1 } => Some(j * q_dot),
+                // ÿ is evaluated only on a task that reads it (J̇ q̇ costs a function call).
+                Read::Tip { .. } if task.kind.uses(term) => Some(j * q_ddot + bias),
+                Read::Tip { .. } => Some(SVector::zeros()),
+                _ => None,
+            };
+            if let Some(e) = expected {
+                let v = observed[term.index()];
+                assert_eq!(v.fixed_rows::<3>(0).into_owned(), e, "{kind} {term}");
+                assert!(
+                    v.rows(3, 4).iter().all(|x| *x == 0.0),
+                    "{term}: padding {v}"
+                );
+            }
         }
     }
+}
+
+/// ÿ as observed is the time derivative of ẏ as observed along the closed loop's own flow:
+/// (ẏ(Z + hŻ) − ẏ(Z − hŻ)) / 2h, an identity the generated J̇ q̇ and the plant's q̈ must satisfy
+/// together (a wrong sign or a missing term in either shows at once).
+#[test]
+fn the_tips_acceleration_is_the_rate_of_its_velocity_along_the_flow() {
+    fn check<P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+        system: &ClosedLoopN<P, N, NX, NP, NZ>,
+        z: &SVector<f64, NZ>,
+        label: &str,
+    ) where
+        P: ArmModel<N, NX, NP, NZ>,
+    {
+        let (z_dot, observed) = system.rhs_and_observation(z);
+        let h = 1e-6;
+        let velocity = |z: &SVector<f64, NZ>| system.rhs_and_observation(z).1[Term::TipDot.index()];
+        let rate = (velocity(&(z + z_dot * h)) - velocity(&(z - z_dot * h))) / (2.0 * h);
+        let acceleration = observed[Term::TipDdot.index()];
+        let error = (acceleration - rate).amax() / acceleration.amax().max(1.0);
+        assert!(error < 1e-7, "{label}: ÿ {acceleration} vs dẏ/dt {rate}: {error:e}");
+        assert!(acceleration.amax() > 1e-3, "{label}: a trivial state {acceleration}");
+    }
+    let kind = TaskKind::TipAcceleration;
+    for tip in [[0.0, 0.0, 0.1], [0.05, -0.02, 0.37]] {
+        let tool = panda_tool(tip);
+        let task = Panda::paper_task(kind);
+        let system = ClosedLoopN::<Panda, 7, 14, 13, 21>::new(&tool, &task, 1.0, 0.3).unwrap();
+        check(&system, &moving_state::<7, 14, 21>(&Panda::equilibrium_state()), "panda");
+    }
+    let tool = Arm2Tool::new([0.3, 0.4, 0.5, 0.2]).unwrap();
+    let system = ClosedLoopN::<Arm2, 2, 4, 4, 6>::new(&tool, &Arm2::paper_task(kind), 1.0, -0.4)
+        .unwrap();
+    check(&system, &moving_state::<2, 4, 6>(&Arm2::equilibrium_state()), "arm2");
+}
+
+/// The generated J̇ q̇ against the generated y alone: d²/ds² y(q + s q̇) at s = 0 is q̇ᵀ∇²y q̇ =
+/// J̇ q̇, taken by a second central difference (step 1e-4: truncation ~1e-8, rounding ~1e-8
+/// relative), on the URDF arms, the paper's arm and the 3-link chain, at random states and tools.
+#[test]
+fn the_generated_tip_bias_is_the_tips_second_derivative_along_q_dot() {
+    fn check<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+        p: &SVector<f64, NP>,
+        seed: u64,
+    ) where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
+        let mut state = seed;
+        let mut uniform = |lo: f64, hi: f64| {
+            // A 64-bit LCG (Knuth's MMIX): reproducible without a dependency.
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            lo + (hi - lo) * ((state >> 11) as f64 / (1u64 << 53) as f64)
+        };
+        for _ in 0..20 {
+            let q = SVector::<f64, N>::from_fn(|_, _| uniform(-3.0, 3.0));
+            let v = SVector::<f64, N>::from_fn(|_, _| uniform(-2.0, 2.0));
+            let y = |s: f64| M::tip(&(q + v * s), p).unwrap().0;
+            let h = 1e-4;
+            let second = (y(h) - y(0.0) * 2.0 + y(-h)) / (h * h);
+            let bias = M::tip_bias(&q, &v, p).unwrap();
+            let error = (bias - second).amax() / bias.amax().max(1.0);
+            assert!(error < 1e-6, "{}: J̇q̇ {bias} vs {second}: {error:e}", M::NAME);
+        }
+    }
+    check::<Panda, 7, 14, 13, 21>(&panda_tool([0.05, -0.02, 0.37]).params(), 1);
+    let ur5 = SVector::<f64, 13>::from_row_slice(&[
+        1.2, 0.01, 0.0, 0.08, 4e-3, 4e-3, 2e-3, 1e-4, 0.0, 0.0, 0.0, 0.02, 0.25,
+    ]);
+    check::<Ur5, 6, 12, 13, 18>(&ur5, 2);
+    check::<Arm2, 2, 4, 4, 6>(&SVector::from([0.3, 0.4, 0.5, 0.2]), 3);
+    let arm3 = SVector::from_fn(|i, _| 0.3 + 0.1 * i as f64);
+    check::<Arm3, 3, 6, { Arm3::PARAMETER_NAMES.len() }, 9>(&arm3, 4);
 }
 
 /// The derivation writes ∂y/∂U = J ∂θ/∂U (J at q^e, its first TIP_DIM rows): the generated
@@ -135,10 +221,14 @@ fn the_tip_sensitivities_are_the_tip_jacobian_times_the_joints() {
         let tool = panda_tool(tip);
         let q_e = Panda::equilibrium_state().fixed_rows::<7>(0).into_owned();
         let (_, j) = Panda::tip(&q_e, &tool.params()).unwrap();
-        let joints = tool.sensitivities(TaskKind::Position);
-        let at_tip = tool.sensitivities(TaskKind::TipPosition);
-        let pairs = [(Term::Theta, Term::Tip), (Term::ThetaDot, Term::TipDot)];
-        for (joint, tip_term) in pairs {
+        let pairs = [
+            (TaskKind::Position, TaskKind::TipPosition, Term::Theta, Term::Tip),
+            (TaskKind::Position, TaskKind::TipPosition, Term::ThetaDot, Term::TipDot),
+            (TaskKind::Acceleration, TaskKind::TipAcceleration, Term::ThetaDdot, Term::TipDdot),
+        ];
+        for (joint_task, tip_task, joint, tip_term) in pairs {
+            let joints = tool.sensitivities(joint_task);
+            let at_tip = tool.sensitivities(tip_task);
             let (Some(s), Some(t)) = (joints.of(joint), at_tip.of(tip_term)) else {
                 panic!("{joint} or {tip_term} has no sensitivity");
             };

@@ -258,11 +258,14 @@ TERM_KEYS = (("name", "string", True), ("symbol", "string", True), ("latex", "st
              ("doc", "string", True), ("label", "string", True), ("unit", "string", True), ("read", "string", True),
              ("goal_range", "string", False))
 # How a term's value is read, as tasks.toml writes it (white space aside): (source, block); for
-# the tip, block is the order of the derivative (y, then y_dot = J(q) q_dot).
+# the tip, block is the order of the derivative (y, y_dot = J(q) q_dot, then
+# y_ddot = J(q) q_ddot + Jdot(q, q_dot) q_dot, the generated tip_bias giving Jdot q_dot).
 READS = {"IO @ X": ("state", 0), "OI @ X": ("state", 1), "IO @ X_dot": ("state_rate", 0),
-         "OI @ X_dot": ("state_rate", 1), "U": ("control", 0), "tip(q)": ("tip", 0), "J(q) @ q_dot": ("tip", 1)}
+         "OI @ X_dot": ("state_rate", 1), "U": ("control", 0), "tip(q)": ("tip", 0), "J(q) @ q_dot": ("tip", 1),
+         "J(q) @ q_ddot + Jdot(q, q_dot) @ q_dot": ("tip", 2)}
 # The documented ranges a goal may be checked against (crates/core/src/validate.rs).
-GOAL_RANGES = ("joint_angle", "joint_rate", "joint_acceleration", "tip_position", "tip_velocity")
+GOAL_RANGES = ("joint_angle", "joint_rate", "joint_acceleration", "tip_position", "tip_velocity",
+               "tip_acceleration")
 
 
 def _named(t: Table) -> Named:

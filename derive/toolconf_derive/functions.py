@@ -229,5 +229,15 @@ def build_functions(d: Derivation, cm: CasadiModel) -> list[Function]:
         [Output("position", "y (m, base frame)", d.tip), Output("jacobian", "J = dy/dq", d.tip_jacobian)],
         lambda v: cm.tip.checked(v["q"], v["params"]),
     ))
+    q_dot = Arg("q_dot", f"joint velocities q_dot = `[{' '.join(s.name for s in m.q_dot)}]`", (n, 1),
+                _vector_reads(d.q_dot), False, lambda rng: _sample_state(n)(rng)[n:])
+    fns.append(Function(
+        "tip_bias",
+        "The tip's acceleration at rest joints' acceleration, Jdot(q, q_dot) q_dot = d(J q_dot)/dq q_dot "
+        "(base frame), so that y_ddot = J(q) q_ddot + tip_bias(q, q_dot).",
+        "forward kinematics of the tip, differentiated twice in time", [q, q_dot, p],
+        [Output("bias", "Jdot q_dot (m/s^2, base frame)", d.tip_bias)],
+        lambda v: cm.tip_bias.checked(v["q"], v["q_dot"], v["params"]),
+    ))
     return fns
 

@@ -60,6 +60,7 @@ class CasadiModel:
             "dynamics_jacobian", [self.x, self.u, self.p], [ca.jacobian(f, self.x), ca.jacobian(f, self.u)]
         ))
         self.tip = self._tip(names, functions)
+        self.tip_bias = self._tip_bias()
 
         def values(label: str, texts: list[str]) -> list[float]:
             return [value(model.path, f"equilibrium.{label}[{i}]", v) for i, v in enumerate(texts)]
@@ -82,6 +83,15 @@ class CasadiModel:
         q_sym = ca.SX.sym("q", n)
         y_q = ca.substitute(y_tip, q, q_sym)
         return ExactFunction(ca.Function("tip", [q_sym, self.p], [y_q, ca.jacobian(y_q, q_sym)]))
+
+    def _tip_bias(self) -> ExactFunction:
+        """Jdot(q, q_dot) q_dot as the second directional derivative of y along q_dot, by CasADi's
+        forward mode twice (no Jacobian matrix formed, unlike the symbolic d(J q_dot)/dq q_dot)."""
+        n = self.model.dof
+        q, q_dot = ca.SX.sym("q", n), ca.SX.sym("q_dot", n)
+        y = self.tip.f(q, self.p)[0]
+        bias = ca.jtimes(ca.jtimes(y, q, q_dot), q, q_dot)
+        return ExactFunction(ca.Function("tip_bias", [q, q_dot, self.p], [bias]))
 
     def linearisation(self, p: np.ndarray) -> tuple[Exact, Exact]:
         """A and B at the equilibrium, exactly (the equilibrium is taken as its doubles)."""

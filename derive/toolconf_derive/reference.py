@@ -76,11 +76,11 @@ MEANING = {
     ("(top level)", "equilibrium"): (None, "`[equilibrium]`"),
     ("(top level)", "goals"): ("zero goals", "`[goals.<task>]`, one table per task of derive/tasks.toml "
                                              "(`position`, `velocity`, `acceleration`, `tip_position`, "
-                                             "`tip_velocity`), each key a term the task uses (`theta`, "
-                                             "`theta_dot`, `theta_ddot` with `model.dof` expressions; `tip` "
-                                             "in m and `tip_dot` in m/s with TIP_DIM, absolute in the base "
-                                             "frame): the default goal of that task; a term it omits has "
-                                             "goal 0"),
+                                             "`tip_velocity`, `tip_acceleration`), each key a term the task "
+                                             "uses (`theta`, `theta_dot`, `theta_ddot` with `model.dof` "
+                                             "expressions; `tip` in m, `tip_dot` in m/s and `tip_ddot` in "
+                                             "m/s² with TIP_DIM, absolute in the base frame): the default "
+                                             "goal of that task; a term it omits has goal 0"),
     ("(top level)", "formulation"): ("each task's default", "`[formulation]`: `<task> = \"<name>\"`, the "
                                                            "formulation of the task's sensitivities the model "
                                                            "uses: `\"paper\"` (derive/tasks.toml's formulas) or "

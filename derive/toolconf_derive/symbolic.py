@@ -108,6 +108,8 @@ class Derivation:
     # The tip y(q; p) (3 x 1, base frame) and its Jacobian dy/dq (3 x n): every model has one.
     tip: sp.Matrix | None = None
     tip_jacobian: sp.Matrix | None = None
+    # Jdot(q, q_dot) q_dot (3 x 1): the tip's acceleration at q_ddot = 0, d(J q_dot)/dq q_dot.
+    tip_bias: sp.Matrix | None = None
 
     @property
     def x(self) -> list[sp.Symbol]:
@@ -175,13 +177,14 @@ def derive(model: Model, tasks: list[Task]) -> Derivation:
     tasks = model_tasks(model, tasks)
     tip = derive_tip(model, symbols, q, params)
     tip_jacobian = tidy_matrix(tip.jacobian(q))
+    tip_bias = tidy_matrix((tip_jacobian * sp.Matrix(q_dot)).jacobian(q) * sp.Matrix(q_dot))
     j = padded_jacobian(tip_jacobian, dict(zip(q, x_e[:model.dof])), model.tip_dim, model.dof)
     ns = task_namespace(a, b, j, model.dof, lambda m: tidy_matrix(m.inv()))
     derived_tasks = [derive_task(task, ns, model.dof) for task in tasks]
     for t in derived_tasks:
         t.logdet_gradient = logdet_gradient(t.confidence, params)
     return Derivation(model, params, consts, q, q_dot, u, q_ddot, f, f_x, f_u, x_e, u_e, a, b, derived_tasks, lagrangian,
-                      tip, tip_jacobian)
+                      tip, tip_jacobian, tip_bias)
 
 
 def derive_tip(model: Model, symbols: dict, q: list, params: list) -> sp.Matrix:

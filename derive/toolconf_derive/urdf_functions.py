@@ -98,6 +98,17 @@ def build_functions(dv: UrdfDerivation) -> list[SeqFunction]:
         [q, p], [SeqOutput("position", "y (m, base frame)", 3, 1), SeqOutput("jacobian", "J = dy/dq", 3, n)],
         dv.tip, lambda v: dv.reference_tip.checked(v["q"], v["params"]),
     ))
+    q_dot = SeqArg("q_dot", f"joint velocities q_dot = [{' '.join(s.name for s in m.state[n:])}]", n, 1, False,
+                   lambda rng: _sample_state(n)(rng)[n:])
+    fns.append(SeqFunction(
+        "tip_bias",
+        "The tip's acceleration at zero joint acceleration, Jdot(q, q_dot) q_dot = d(J q_dot)/dq q_dot "
+        "(base frame), so that y_ddot = J(q) q_ddot + tip_bias(q, q_dot): the linear part of Pinocchio's "
+        "frame classical acceleration (LOCAL_WORLD_ALIGNED) at q_ddot = 0 for a frame at the tip.",
+        "forward kinematics of the URDF chain, differentiated twice in time", [q, q_dot, p],
+        [SeqOutput("bias", "Jdot q_dot (m/s^2, base frame)", 3, 1)],
+        dv.tip_bias, lambda v: dv.reference_tip_bias.checked(v["q"], v["q_dot"], v["params"]),
+    ))
     return fns
 
 

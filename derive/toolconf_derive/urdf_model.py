@@ -283,6 +283,12 @@ class UrdfDerivation:
         self.tip = ca.Function("tip", [q, p], [ca.cse(y), ca.cse(jac)])
         y_ref = self._reference_tip(qs, self._symbolic_trig(qs), p)
         self.reference_tip = ExactFunction(ca.Function("tip_ref", [q, p], [y_ref, ca.jacobian(y_ref, q)]))
+        # Jdot q_dot: the code differentiates the geometric J q_dot along q_dot once (forward mode);
+        # the reference differentiates the inward tip twice, never forming J.
+        q_dot = ca.SX.sym("q_dot", n)
+        self.tip_bias = ca.Function("tip_bias", [q, q_dot, p], [ca.cse(ca.jtimes(jac @ q_dot, q, q_dot))])
+        self.reference_tip_bias = ExactFunction(ca.Function(
+            "tip_bias_ref", [q, q_dot, p], [ca.jtimes(ca.jtimes(y_ref, q, q_dot), q, q_dot)]))
         # tasks.toml's J on the code side: the geometric Jacobian at q^e, its trigonometry exact.
         self.j_code = _padded(self.tip_with(self.q_e, self.trig_e, p)[1], self.n)
 

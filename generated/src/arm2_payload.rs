@@ -131,6 +131,20 @@ pub mod tip_velocity {
     pub const PRECISION_U: f64 = 1.0;
 }
 
+/// Task 6 (tip acceleration control): the paper's default goals and precisions ("Implementation details").
+pub mod tip_acceleration {
+    #[allow(unused_imports)]
+    use super::PI;
+    /// Free-energy terms the controller uses (eq. U_dot_deriv).
+    pub const TERMS: [&str; 2] = ["tip_ddot", "u"];
+    /// Default goal for `tip_ddot`.
+    pub const GOAL_TIP_DDOT: [f64; 2] = [0.0, 0.0];
+    /// Default precision for `tip_ddot`: P = 10.0 I.
+    pub const PRECISION_TIP_DDOT: f64 = 10.0;
+    /// Default precision for `u`: P = 1.0 I.
+    pub const PRECISION_U: f64 = 1.0;
+}
+
 /// The default goals and precisions of `task` for this model (the modules above); zero for a
 /// term the task does not use.
 #[must_use]
@@ -144,12 +158,14 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 [0.0; DOF],
                 [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 position::PRECISION_THETA,
                 position::PRECISION_THETA_DOT,
                 position::PRECISION_THETA_DDOT,
                 position::PRECISION_U,
+                0.0,
                 0.0,
                 0.0,
             ],
@@ -162,12 +178,14 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 [0.0; DOF],
                 [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
                 velocity::PRECISION_THETA_DOT,
                 velocity::PRECISION_THETA_DDOT,
                 velocity::PRECISION_U,
+                0.0,
                 0.0,
                 0.0,
             ],
@@ -180,12 +198,14 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 [0.0; DOF],
                 [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
                 0.0,
                 acceleration::PRECISION_THETA_DDOT,
                 acceleration::PRECISION_U,
+                0.0,
                 0.0,
                 0.0,
             ],
@@ -198,6 +218,7 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 tip_position::GOAL_TIP,
                 tip_position::GOAL_TIP_DOT,
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
@@ -206,6 +227,7 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 tip_position::PRECISION_U,
                 tip_position::PRECISION_TIP,
                 tip_position::PRECISION_TIP_DOT,
+                0.0,
             ],
         },
         super::TaskKind::TipVelocity => super::TaskDefaults {
@@ -216,6 +238,7 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 [0.0; DOF],
                 tip_velocity::GOAL_TIP_DOT,
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
@@ -224,6 +247,27 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 tip_velocity::PRECISION_U,
                 0.0,
                 tip_velocity::PRECISION_TIP_DOT,
+                0.0,
+            ],
+        },
+        super::TaskKind::TipAcceleration => super::TaskDefaults {
+            goal: [
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                tip_acceleration::GOAL_TIP_DDOT,
+            ],
+            precision: [
+                0.0,
+                0.0,
+                0.0,
+                tip_acceleration::PRECISION_U,
+                0.0,
+                0.0,
+                tip_acceleration::PRECISION_TIP_DDOT,
             ],
         },
     }
@@ -248,6 +292,7 @@ pub fn task_sensitivities(
                     None,
                     None,
                     None,
+                    None,
                 ],
             }
         }
@@ -261,25 +306,40 @@ pub fn task_sensitivities(
                     None,
                     None,
                     None,
+                    None,
                 ],
             }
         }
         super::TaskKind::Acceleration => {
             let d_theta_ddot_du = acceleration_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, None, Some(d_theta_ddot_du), None, None, None],
+                d_du: [None, None, Some(d_theta_ddot_du), None, None, None, None],
             }
         }
         super::TaskKind::TipPosition => {
             let (d_tip_du, d_tip_dot_du) = tip_position_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, None, None, None, Some(d_tip_du), Some(d_tip_dot_du)],
+                d_du: [
+                    None,
+                    None,
+                    None,
+                    None,
+                    Some(d_tip_du),
+                    Some(d_tip_dot_du),
+                    None,
+                ],
             }
         }
         super::TaskKind::TipVelocity => {
             let d_tip_dot_du = tip_velocity_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, None, None, None, None, Some(d_tip_dot_du)],
+                d_du: [None, None, None, None, None, Some(d_tip_dot_du), None],
+            }
+        }
+        super::TaskKind::TipAcceleration => {
+            let d_tip_ddot_du = tip_acceleration_sensitivity(params);
+            super::TaskSensitivities {
+                d_du: [None, None, None, None, None, None, Some(d_tip_ddot_du)],
             }
         }
     }
@@ -329,6 +389,11 @@ pub fn task_control_confidence(
             &precision[Term::TipDot as usize],
             &precision[Term::U as usize],
         ),
+        super::TaskKind::TipAcceleration => tip_acceleration_control_confidence(
+            params,
+            &precision[Term::TipDdot as usize],
+            &precision[Term::U as usize],
+        ),
     }
 }
 
@@ -374,6 +439,11 @@ pub fn task_logdet_gradient(
         super::TaskKind::TipVelocity => tip_velocity_logdet_gradient(
             params,
             &precision[Term::TipDot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::TipAcceleration => tip_acceleration_logdet_gradient(
+            params,
+            &precision[Term::TipDdot as usize],
             &precision[Term::U as usize],
         ),
     }
@@ -1809,6 +1879,96 @@ pub fn tip_velocity_logdet_gradient(
     gradient
 }
 
+/// Task 6 (tip acceleration control): the sensitivities d(task variable)/dU the controller uses, in the order (d_tip_ddot_du).
+///
+/// From appendix "Task specific controllers".
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
+///
+/// Cost per call: 0 operations, weighted 0.
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_acceleration_sensitivity(params: &SVector<f64, 5>) -> SMatrix<f64, 2, 2> {
+    let l1 = params[2];
+    let l2 = params[3];
+    // dtip_ddot/dU = J @ IO @ (A @ A @ dX_dU + A @ B)
+    let mut d_tip_ddot_du = <SMatrix<f64, 2, 2>>::zeros();
+    d_tip_ddot_du[(0, 0)] = l1;
+    d_tip_ddot_du[(0, 1)] = l2;
+    d_tip_ddot_du
+}
+
+/// Task 6 (tip acceleration control): the control confidence Pi^U = d2F/dU2 = S_tip_ddot^T P_tip_ddot S_tip_ddot + P_u.
+///
+/// From eq. (control_conf) and the closed forms after it.
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
+/// - `p_tip_ddot`: precision P of the tool tip's acceleration tip_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 9 operations, weighted 11 (3 ADD, 4 MUL, 2 POW).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_acceleration_control_confidence(
+    params: &SVector<f64, 5>,
+    p_tip_ddot: &SMatrix<f64, 2, 2>,
+    p_u: &SMatrix<f64, 2, 2>,
+) -> SMatrix<f64, 2, 2> {
+    let l1 = params[2];
+    let l2 = params[3];
+    let p_tip_ddot_00 = p_tip_ddot[(0, 0)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_11 = p_u[(1, 1)];
+    // Pi^U (symmetric)
+    let mut pi_u = <SMatrix<f64, 2, 2>>::zeros();
+    pi_u[(0, 0)] = l1.powi(2) * p_tip_ddot_00 + p_u_00;
+    pi_u[(0, 1)] = l1 * l2 * p_tip_ddot_00 + p_u_01;
+    pi_u[(1, 1)] = l2.powi(2) * p_tip_ddot_00 + p_u_11;
+    pi_u[(1, 0)] = pi_u[(0, 1)];
+    pi_u
+}
+
+/// Task 6 (tip acceleration control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
+/// - `p_tip_ddot`: precision P of the tool tip's acceleration tip_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 25 operations, weighted 35 (5 ADD, 1 DIV, 14 MUL, 1 NEG, 3 POW, 1 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_acceleration_logdet_gradient(
+    params: &SVector<f64, 5>,
+    p_tip_ddot: &SMatrix<f64, 2, 2>,
+    p_u: &SMatrix<f64, 2, 2>,
+) -> SVector<f64, 5> {
+    let l1 = params[2];
+    let l2 = params[3];
+    let p_tip_ddot_00 = p_tip_ddot[(0, 0)];
+    let p_u_00 = p_u[(0, 0)];
+    let p_u_01 = p_u[(0, 1)];
+    let p_u_11 = p_u[(1, 1)];
+    let t0 = l2.powi(2) * p_tip_ddot_00 + p_u_11;
+    let t1 = l1 * p_tip_ddot_00;
+    let t2 = 2.0 * t1;
+    let t3 = l2 * t1 + p_u_01;
+    let t4 = -t3;
+    let t5 = 2.0 * l2 * p_tip_ddot_00;
+    let t6 = l1.powi(2) * p_tip_ddot_00 + p_u_00;
+    let t7 = 1.0 / (t0 * t6 - t3.powi(2));
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 5>>::zeros();
+    gradient[2] = t7 * (t0 * t2 + t4 * t5);
+    gradient[3] = t7 * (t2 * t4 + t5 * t6);
+    gradient
+}
+
 /// The tip y(q; p) in the base frame (the chain's free end; z = 0 in the plane of a planar arm) and its Jacobian J = dy/dq.
 ///
 /// From forward kinematics of the tip.
@@ -1842,4 +2002,38 @@ pub fn tip(q: &SVector<f64, 2>, params: &SVector<f64, 5>) -> (SVector<f64, 3>, S
     jacobian[(1, 0)] = t0;
     jacobian[(1, 1)] = t1;
     (position, jacobian)
+}
+
+/// The tip's acceleration at rest joints' acceleration, Jdot(q, q_dot) q_dot = d(J q_dot)/dq q_dot (base frame), so that y_ddot = J(q) q_ddot + tip_bias(q, q_dot).
+///
+/// From forward kinematics of the tip, differentiated twice in time.
+///
+/// - `q`: joint positions q = `[theta1 theta2]`
+/// - `q_dot`: joint velocities q_dot = `[theta1_dot theta2_dot]`
+/// - `params`: tool parameters `[m1 m2 l1 l2 mp]`
+///
+/// Cost per call: 12 operations, weighted 14 (6 MUL, 2 NEG, 2 POW, 2 SUB), plus 2 `sin_cos`.
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_bias(
+    q: &SVector<f64, 2>,
+    q_dot: &SVector<f64, 2>,
+    params: &SVector<f64, 5>,
+) -> SVector<f64, 3> {
+    let theta1 = q[0];
+    let theta2 = q[1];
+    let theta1_dot = q_dot[0];
+    let theta2_dot = q_dot[1];
+    let l1 = params[2];
+    let l2 = params[3];
+    let (sin_theta1, cos_theta1) = crate::trig::sin_cos(theta1);
+    let (sin_theta2, cos_theta2) = crate::trig::sin_cos(theta2);
+    let t0 = l1 * theta1_dot.powi(2);
+    let t1 = l2 * theta2_dot.powi(2);
+    // Jdot q_dot (m/s^2, base frame)
+    let mut bias = <SVector<f64, 3>>::zeros();
+    bias[0] = -cos_theta1 * t0 - cos_theta2 * t1;
+    bias[1] = -sin_theta1 * t0 - sin_theta2 * t1;
+    bias
 }

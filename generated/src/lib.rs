@@ -141,6 +141,91 @@ pub mod tip {
     }
 }
 
+/// Each model's tip acceleration at zero joint acceleration, J̇(q, q̇) q̇ (base frame, m/s²):
+/// `tip_bias::<model>(q, q_dot, params)`, so that ÿ = J(q) q̈ + J̇ q̇; `None` for a model whose
+/// description gives no tip.
+pub mod tip_bias {
+    #[allow(unused_imports)]
+    use nalgebra::SVector;
+
+    /// `arm2`'s tip bias.
+    #[inline]
+    #[must_use]
+    pub fn arm2(
+        q: &SVector<f64, { crate::arm2::DOF }>,
+        q_dot: &SVector<f64, { crate::arm2::DOF }>,
+        params: &SVector<f64, { crate::arm2::PARAMETER_COUNT }>,
+    ) -> Option<SVector<f64, 3>> {
+        Some(crate::arm2::tip_bias(q, q_dot, params))
+    }
+
+    /// `arm2_exact`'s tip bias.
+    #[inline]
+    #[must_use]
+    pub fn arm2_exact(
+        q: &SVector<f64, { crate::arm2_exact::DOF }>,
+        q_dot: &SVector<f64, { crate::arm2_exact::DOF }>,
+        params: &SVector<f64, { crate::arm2_exact::PARAMETER_COUNT }>,
+    ) -> Option<SVector<f64, 3>> {
+        Some(crate::arm2_exact::tip_bias(q, q_dot, params))
+    }
+
+    /// `arm2_payload`'s tip bias.
+    #[inline]
+    #[must_use]
+    pub fn arm2_payload(
+        q: &SVector<f64, { crate::arm2_payload::DOF }>,
+        q_dot: &SVector<f64, { crate::arm2_payload::DOF }>,
+        params: &SVector<f64, { crate::arm2_payload::PARAMETER_COUNT }>,
+    ) -> Option<SVector<f64, 3>> {
+        Some(crate::arm2_payload::tip_bias(q, q_dot, params))
+    }
+
+    /// `arm3`'s tip bias.
+    #[inline]
+    #[must_use]
+    pub fn arm3(
+        q: &SVector<f64, { crate::arm3::DOF }>,
+        q_dot: &SVector<f64, { crate::arm3::DOF }>,
+        params: &SVector<f64, { crate::arm3::PARAMETER_COUNT }>,
+    ) -> Option<SVector<f64, 3>> {
+        Some(crate::arm3::tip_bias(q, q_dot, params))
+    }
+
+    /// `msd`'s tip bias.
+    #[inline]
+    #[must_use]
+    pub fn msd(
+        q: &SVector<f64, { crate::msd::DOF }>,
+        q_dot: &SVector<f64, { crate::msd::DOF }>,
+        params: &SVector<f64, { crate::msd::PARAMETER_COUNT }>,
+    ) -> Option<SVector<f64, 3>> {
+        Some(crate::msd::tip_bias(q, q_dot, params))
+    }
+
+    /// `panda`'s tip bias.
+    #[inline]
+    #[must_use]
+    pub fn panda(
+        q: &SVector<f64, { crate::panda::DOF }>,
+        q_dot: &SVector<f64, { crate::panda::DOF }>,
+        params: &SVector<f64, { crate::panda::PARAMETER_COUNT }>,
+    ) -> Option<SVector<f64, 3>> {
+        Some(crate::panda::tip_bias(q, q_dot, params))
+    }
+
+    /// `ur5`'s tip bias.
+    #[inline]
+    #[must_use]
+    pub fn ur5(
+        q: &SVector<f64, { crate::ur5::DOF }>,
+        q_dot: &SVector<f64, { crate::ur5::DOF }>,
+        params: &SVector<f64, { crate::ur5::PARAMETER_COUNT }>,
+    ) -> Option<SVector<f64, 3>> {
+        Some(crate::ur5::tip_bias(q, q_dot, params))
+    }
+}
+
 /// The names of the generated models, in registry order.
 pub const MODEL_NAMES: [&str; 7] = [
     "arm2",
@@ -241,7 +326,7 @@ pub static MODELS: [ModelInfo; 7] = [
         tip_dim: arm2::TIP_DIM,
         equilibrium_state: &arm2::EQUILIBRIUM_STATE,
         equilibrium_control: &arm2::EQUILIBRIUM_CONTROL,
-        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity],
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity, TaskKind::TipAcceleration],
     },
     ModelInfo {
         name: arm2_exact::NAME,
@@ -262,7 +347,7 @@ pub static MODELS: [ModelInfo; 7] = [
         tip_dim: arm2_exact::TIP_DIM,
         equilibrium_state: &arm2_exact::EQUILIBRIUM_STATE,
         equilibrium_control: &arm2_exact::EQUILIBRIUM_CONTROL,
-        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity],
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity, TaskKind::TipAcceleration],
     },
     ModelInfo {
         name: arm2_payload::NAME,
@@ -283,7 +368,7 @@ pub static MODELS: [ModelInfo; 7] = [
         tip_dim: arm2_payload::TIP_DIM,
         equilibrium_state: &arm2_payload::EQUILIBRIUM_STATE,
         equilibrium_control: &arm2_payload::EQUILIBRIUM_CONTROL,
-        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity],
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity, TaskKind::TipAcceleration],
     },
     ModelInfo {
         name: arm3::NAME,
@@ -304,7 +389,7 @@ pub static MODELS: [ModelInfo; 7] = [
         tip_dim: arm3::TIP_DIM,
         equilibrium_state: &arm3::EQUILIBRIUM_STATE,
         equilibrium_control: &arm3::EQUILIBRIUM_CONTROL,
-        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity],
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity, TaskKind::TipAcceleration],
     },
     ModelInfo {
         name: msd::NAME,
@@ -325,7 +410,7 @@ pub static MODELS: [ModelInfo; 7] = [
         tip_dim: msd::TIP_DIM,
         equilibrium_state: &msd::EQUILIBRIUM_STATE,
         equilibrium_control: &msd::EQUILIBRIUM_CONTROL,
-        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity],
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity, TaskKind::TipAcceleration],
     },
     ModelInfo {
         name: panda::NAME,
@@ -350,7 +435,7 @@ pub static MODELS: [ModelInfo; 7] = [
         tip_dim: panda::TIP_DIM,
         equilibrium_state: &panda::EQUILIBRIUM_STATE,
         equilibrium_control: &panda::EQUILIBRIUM_CONTROL,
-        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity],
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity, TaskKind::TipAcceleration],
     },
     ModelInfo {
         name: ur5::NAME,
@@ -375,7 +460,7 @@ pub static MODELS: [ModelInfo; 7] = [
         tip_dim: ur5::TIP_DIM,
         equilibrium_state: &ur5::EQUILIBRIUM_STATE,
         equilibrium_control: &ur5::EQUILIBRIUM_CONTROL,
-        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity],
+        tasks: &[TaskKind::Position, TaskKind::Velocity, TaskKind::Acceleration, TaskKind::TipPosition, TaskKind::TipVelocity, TaskKind::TipAcceleration],
     },
 ];
 

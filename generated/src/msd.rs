@@ -128,6 +128,20 @@ pub mod tip_velocity {
     pub const PRECISION_U: f64 = 1.0;
 }
 
+/// Task 6 (tip acceleration control): the paper's default goals and precisions ("Implementation details").
+pub mod tip_acceleration {
+    #[allow(unused_imports)]
+    use super::PI;
+    /// Free-energy terms the controller uses (eq. U_dot_deriv).
+    pub const TERMS: [&str; 2] = ["tip_ddot", "u"];
+    /// Default goal for `tip_ddot`.
+    pub const GOAL_TIP_DDOT: [f64; 1] = [0.0];
+    /// Default precision for `tip_ddot`: P = 10.0 I.
+    pub const PRECISION_TIP_DDOT: f64 = 10.0;
+    /// Default precision for `u`: P = 1.0 I.
+    pub const PRECISION_U: f64 = 1.0;
+}
+
 /// The default goals and precisions of `task` for this model (the modules above); zero for a
 /// term the task does not use.
 #[must_use]
@@ -141,12 +155,14 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 [0.0; DOF],
                 [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 position::PRECISION_THETA,
                 position::PRECISION_THETA_DOT,
                 position::PRECISION_THETA_DDOT,
                 position::PRECISION_U,
+                0.0,
                 0.0,
                 0.0,
             ],
@@ -159,12 +175,14 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 [0.0; DOF],
                 [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
                 velocity::PRECISION_THETA_DOT,
                 velocity::PRECISION_THETA_DDOT,
                 velocity::PRECISION_U,
+                0.0,
                 0.0,
                 0.0,
             ],
@@ -177,12 +195,14 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 [0.0; DOF],
                 [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
                 0.0,
                 acceleration::PRECISION_THETA_DDOT,
                 acceleration::PRECISION_U,
+                0.0,
                 0.0,
                 0.0,
             ],
@@ -195,6 +215,7 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 tip_position::GOAL_TIP,
                 tip_position::GOAL_TIP_DOT,
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
@@ -203,6 +224,7 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 tip_position::PRECISION_U,
                 tip_position::PRECISION_TIP,
                 tip_position::PRECISION_TIP_DOT,
+                0.0,
             ],
         },
         super::TaskKind::TipVelocity => super::TaskDefaults {
@@ -213,6 +235,7 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 [0.0; DOF],
                 tip_velocity::GOAL_TIP_DOT,
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
@@ -221,6 +244,27 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 tip_velocity::PRECISION_U,
                 0.0,
                 tip_velocity::PRECISION_TIP_DOT,
+                0.0,
+            ],
+        },
+        super::TaskKind::TipAcceleration => super::TaskDefaults {
+            goal: [
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                tip_acceleration::GOAL_TIP_DDOT,
+            ],
+            precision: [
+                0.0,
+                0.0,
+                0.0,
+                tip_acceleration::PRECISION_U,
+                0.0,
+                0.0,
+                tip_acceleration::PRECISION_TIP_DDOT,
             ],
         },
     }
@@ -245,6 +289,7 @@ pub fn task_sensitivities(
                     None,
                     None,
                     None,
+                    None,
                 ],
             }
         }
@@ -258,25 +303,40 @@ pub fn task_sensitivities(
                     None,
                     None,
                     None,
+                    None,
                 ],
             }
         }
         super::TaskKind::Acceleration => {
             let d_theta_ddot_du = acceleration_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, None, Some(d_theta_ddot_du), None, None, None],
+                d_du: [None, None, Some(d_theta_ddot_du), None, None, None, None],
             }
         }
         super::TaskKind::TipPosition => {
             let (d_tip_du, d_tip_dot_du) = tip_position_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, None, None, None, Some(d_tip_du), Some(d_tip_dot_du)],
+                d_du: [
+                    None,
+                    None,
+                    None,
+                    None,
+                    Some(d_tip_du),
+                    Some(d_tip_dot_du),
+                    None,
+                ],
             }
         }
         super::TaskKind::TipVelocity => {
             let d_tip_dot_du = tip_velocity_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, None, None, None, None, Some(d_tip_dot_du)],
+                d_du: [None, None, None, None, None, Some(d_tip_dot_du), None],
+            }
+        }
+        super::TaskKind::TipAcceleration => {
+            let d_tip_ddot_du = tip_acceleration_sensitivity(params);
+            super::TaskSensitivities {
+                d_du: [None, None, None, None, None, None, Some(d_tip_ddot_du)],
             }
         }
     }
@@ -326,6 +386,11 @@ pub fn task_control_confidence(
             &precision[Term::TipDot as usize],
             &precision[Term::U as usize],
         ),
+        super::TaskKind::TipAcceleration => tip_acceleration_control_confidence(
+            params,
+            &precision[Term::TipDdot as usize],
+            &precision[Term::U as usize],
+        ),
     }
 }
 
@@ -371,6 +436,11 @@ pub fn task_logdet_gradient(
         super::TaskKind::TipVelocity => tip_velocity_logdet_gradient(
             params,
             &precision[Term::TipDot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::TipAcceleration => tip_acceleration_logdet_gradient(
+            params,
+            &precision[Term::TipDdot as usize],
             &precision[Term::U as usize],
         ),
     }
@@ -962,6 +1032,70 @@ pub fn tip_velocity_logdet_gradient(
     gradient
 }
 
+/// Task 6 (tip acceleration control): the sensitivities d(task variable)/dU the controller uses, in the order (d_tip_ddot_du).
+///
+/// From appendix "Task specific controllers".
+///
+/// - `params`: tool parameters `[m k c]`
+///
+/// Cost per call: 0 operations, weighted 0.
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_acceleration_sensitivity(_params: &SVector<f64, 3>) -> SVector<f64, 1> {
+    // dtip_ddot/dU = J @ IO @ (A @ A @ dX_dU + A @ B)
+    let mut d_tip_ddot_du = <SVector<f64, 1>>::zeros();
+    d_tip_ddot_du[0] = 1.0;
+    d_tip_ddot_du
+}
+
+/// Task 6 (tip acceleration control): the control confidence Pi^U = d2F/dU2 = S_tip_ddot^T P_tip_ddot S_tip_ddot + P_u.
+///
+/// From eq. (control_conf) and the closed forms after it.
+///
+/// - `params`: tool parameters `[m k c]`
+/// - `p_tip_ddot`: precision P of the tool tip's acceleration tip_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 1 operation, weighted 1 (1 ADD).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_acceleration_control_confidence(
+    _params: &SVector<f64, 3>,
+    p_tip_ddot: &SVector<f64, 1>,
+    p_u: &SVector<f64, 1>,
+) -> SVector<f64, 1> {
+    let p_tip_ddot_00 = p_tip_ddot[0];
+    let p_u_00 = p_u[0];
+    // Pi^U (symmetric)
+    let mut pi_u = <SVector<f64, 1>>::zeros();
+    pi_u[0] = p_tip_ddot_00 + p_u_00;
+    pi_u
+}
+
+/// Task 6 (tip acceleration control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (Jacobi's formula), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters `[m k c]`
+/// - `p_tip_ddot`: precision P of the tool tip's acceleration tip_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 0 operations, weighted 0.
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_acceleration_logdet_gradient(
+    _params: &SVector<f64, 3>,
+    _p_tip_ddot: &SVector<f64, 1>,
+    _p_u: &SVector<f64, 1>,
+) -> SVector<f64, 3> {
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let gradient = <SVector<f64, 3>>::zeros();
+    gradient
+}
+
 /// The tip y(q; p) in the base frame (the description's [tip] position; z = 0 in the plane of a planar arm) and its Jacobian J = dy/dq.
 ///
 /// From forward kinematics of the tip.
@@ -982,4 +1116,26 @@ pub fn tip(q: &SVector<f64, 1>, _params: &SVector<f64, 3>) -> (SVector<f64, 3>, 
     let mut jacobian = <SVector<f64, 3>>::zeros();
     jacobian[0] = 1.0;
     (position, jacobian)
+}
+
+/// The tip's acceleration at rest joints' acceleration, Jdot(q, q_dot) q_dot = d(J q_dot)/dq q_dot (base frame), so that y_ddot = J(q) q_ddot + tip_bias(q, q_dot).
+///
+/// From forward kinematics of the tip, differentiated twice in time.
+///
+/// - `q`: joint positions q = `[z]`
+/// - `q_dot`: joint velocities q_dot = `[z_dot]`
+/// - `params`: tool parameters `[m k c]`
+///
+/// Cost per call: 0 operations, weighted 0.
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_bias(
+    _q: &SVector<f64, 1>,
+    _q_dot: &SVector<f64, 1>,
+    _params: &SVector<f64, 3>,
+) -> SVector<f64, 3> {
+    // Jdot q_dot (m/s^2, base frame)
+    let bias = <SVector<f64, 3>>::zeros();
+    bias
 }

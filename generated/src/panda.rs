@@ -190,6 +190,20 @@ pub mod tip_velocity {
     pub const PRECISION_U: f64 = 1.0;
 }
 
+/// Task 6 (tip acceleration control): the paper's default goals and precisions ("Implementation details").
+pub mod tip_acceleration {
+    #[allow(unused_imports)]
+    use super::PI;
+    /// Free-energy terms the controller uses (eq. U_dot_deriv).
+    pub const TERMS: [&str; 2] = ["tip_ddot", "u"];
+    /// Default goal for `tip_ddot`.
+    pub const GOAL_TIP_DDOT: [f64; 7] = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+    /// Default precision for `tip_ddot`: P = 10.0 I.
+    pub const PRECISION_TIP_DDOT: f64 = 10.0;
+    /// Default precision for `u`: P = 1.0 I.
+    pub const PRECISION_U: f64 = 1.0;
+}
+
 /// The default goals and precisions of `task` for this model (the modules above); zero for a
 /// term the task does not use.
 #[must_use]
@@ -203,12 +217,14 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 [0.0; DOF],
                 [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 position::PRECISION_THETA,
                 position::PRECISION_THETA_DOT,
                 position::PRECISION_THETA_DDOT,
                 position::PRECISION_U,
+                0.0,
                 0.0,
                 0.0,
             ],
@@ -221,12 +237,14 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 [0.0; DOF],
                 [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
                 velocity::PRECISION_THETA_DOT,
                 velocity::PRECISION_THETA_DDOT,
                 velocity::PRECISION_U,
+                0.0,
                 0.0,
                 0.0,
             ],
@@ -239,12 +257,14 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 [0.0; DOF],
                 [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
                 0.0,
                 acceleration::PRECISION_THETA_DDOT,
                 acceleration::PRECISION_U,
+                0.0,
                 0.0,
                 0.0,
             ],
@@ -257,6 +277,7 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 tip_position::GOAL_TIP,
                 tip_position::GOAL_TIP_DOT,
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
@@ -265,6 +286,7 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 tip_position::PRECISION_U,
                 tip_position::PRECISION_TIP,
                 tip_position::PRECISION_TIP_DOT,
+                0.0,
             ],
         },
         super::TaskKind::TipVelocity => super::TaskDefaults {
@@ -275,6 +297,7 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 [0.0; DOF],
                 tip_velocity::GOAL_TIP_DOT,
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
@@ -283,6 +306,27 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 tip_velocity::PRECISION_U,
                 0.0,
                 tip_velocity::PRECISION_TIP_DOT,
+                0.0,
+            ],
+        },
+        super::TaskKind::TipAcceleration => super::TaskDefaults {
+            goal: [
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                tip_acceleration::GOAL_TIP_DDOT,
+            ],
+            precision: [
+                0.0,
+                0.0,
+                0.0,
+                tip_acceleration::PRECISION_U,
+                0.0,
+                0.0,
+                tip_acceleration::PRECISION_TIP_DDOT,
             ],
         },
     }
@@ -307,6 +351,7 @@ pub fn task_sensitivities(
                     None,
                     None,
                     None,
+                    None,
                 ],
             }
         }
@@ -320,25 +365,40 @@ pub fn task_sensitivities(
                     None,
                     None,
                     None,
+                    None,
                 ],
             }
         }
         super::TaskKind::Acceleration => {
             let d_theta_ddot_du = acceleration_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, None, Some(d_theta_ddot_du), None, None, None],
+                d_du: [None, None, Some(d_theta_ddot_du), None, None, None, None],
             }
         }
         super::TaskKind::TipPosition => {
             let (d_tip_du, d_tip_dot_du) = tip_position_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, None, None, None, Some(d_tip_du), Some(d_tip_dot_du)],
+                d_du: [
+                    None,
+                    None,
+                    None,
+                    None,
+                    Some(d_tip_du),
+                    Some(d_tip_dot_du),
+                    None,
+                ],
             }
         }
         super::TaskKind::TipVelocity => {
             let d_tip_dot_du = tip_velocity_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, None, None, None, None, Some(d_tip_dot_du)],
+                d_du: [None, None, None, None, None, Some(d_tip_dot_du), None],
+            }
+        }
+        super::TaskKind::TipAcceleration => {
+            let d_tip_ddot_du = tip_acceleration_sensitivity(params);
+            super::TaskSensitivities {
+                d_du: [None, None, None, None, None, None, Some(d_tip_ddot_du)],
             }
         }
     }
@@ -388,6 +448,11 @@ pub fn task_control_confidence(
             &precision[Term::TipDot as usize],
             &precision[Term::U as usize],
         ),
+        super::TaskKind::TipAcceleration => tip_acceleration_control_confidence(
+            params,
+            &precision[Term::TipDdot as usize],
+            &precision[Term::U as usize],
+        ),
     }
 }
 
@@ -433,6 +498,11 @@ pub fn task_logdet_gradient(
         super::TaskKind::TipVelocity => tip_velocity_logdet_gradient(
             params,
             &precision[Term::TipDot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::TipAcceleration => tip_acceleration_logdet_gradient(
+            params,
+            &precision[Term::TipDdot as usize],
             &precision[Term::U as usize],
         ),
     }
@@ -77249,6 +77319,1624 @@ pub fn tip_velocity_logdet_gradient(
     gradient
 }
 
+/// Task 6 (tip acceleration control): the sensitivities d(task variable)/dU the controller uses, in the order (d_tip_ddot_du).
+///
+/// From appendix "Task specific controllers".
+///
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
+///
+/// Cost per call: 35 operations, weighted 35 (7 ADD, 13 MUL, 6 NEG, 9 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_acceleration_sensitivity(params: &SVector<f64, 13>) -> SMatrix<f64, 7, 7> {
+    let params_10 = params[10];
+    let params_11 = params[11];
+    let params_12 = params[12];
+    // dtip_ddot/dU = J @ IO @ (A @ A @ dX_dU + A @ B)
+    let mut d_tip_ddot_du = <SMatrix<f64, 7, 7>>::zeros();
+    let mut w0: f64;
+    let w1: f64;
+    let mut w2: f64;
+    let mut w3: f64;
+    let mut w5: f64;
+    let mut w6: f64;
+    let mut w7: f64;
+    let mut w9: f64;
+    let mut w10: f64;
+    w2 = (-0.7071067811865475) * params_10;
+    w3 = (-0.7071067811865476) * params_11;
+    w2 = w2 + w3;
+    w3 = -w2;
+    d_tip_ddot_du[(0, 0)] = w3;
+    w6 = 0.7071067811865476 * params_10;
+    w7 = (-0.7071067811865475) * params_11;
+    w6 = w6 + w7;
+    w9 = (-6.123233995736766e-17) * params_12;
+    w6 = w6 + w9;
+    w3 = 0.30689056659294117 + w6;
+    d_tip_ddot_du[(1, 0)] = w3;
+    w10 = (-4.329780281177467e-17) * params_10;
+    w1 = 4.329780281177466e-17 * params_11;
+    w10 = w10 + w1;
+    w10 = w10 - params_12;
+    w9 = 0.5902820523028393 + w10;
+    w10 = w9 - 0.333;
+    d_tip_ddot_du[(0, 1)] = w10;
+    w10 = -w3;
+    d_tip_ddot_du[(2, 1)] = w10;
+    w10 = 0.7071067811865476 * w2;
+    w10 = -w10;
+    d_tip_ddot_du[(0, 2)] = w10;
+    w10 = w3 - (-0.223445742854949);
+    w5 = 0.7071067811865476 * w10;
+    w10 = w9 - 0.5564457428549491;
+    w10 = (-0.7071067811865475) * w10;
+    w5 = w5 - w10;
+    d_tip_ddot_du[(1, 2)] = w5;
+    w0 = (-0.7071067811865475) * w2;
+    d_tip_ddot_du[(2, 2)] = w0;
+    w0 = w9 - 0.6147820523028392;
+    w0 = -w0;
+    d_tip_ddot_du[(0, 3)] = w0;
+    w0 = w3 - (-0.16510943340705883);
+    d_tip_ddot_du[(2, 3)] = w0;
+    w9 = w9 - 0.6972820523028392;
+    w0 = -w9;
+    d_tip_ddot_du[(1, 4)] = w0;
+    d_tip_ddot_du[(2, 4)] = w2;
+    d_tip_ddot_du[(0, 5)] = w0;
+    w3 = w3 - 0.21889056659294118;
+    d_tip_ddot_du[(2, 5)] = w3;
+    d_tip_ddot_du[(0, 6)] = w2;
+    w9 = (-6.123233995736766e-17) * w9;
+    w6 = w6 + w9;
+    w6 = -w6;
+    d_tip_ddot_du[(1, 6)] = w6;
+    w7 = (-6.123233995736766e-17) * w2;
+    d_tip_ddot_du[(2, 6)] = w7;
+    d_tip_ddot_du
+}
+
+/// Task 6 (tip acceleration control): the control confidence Pi^U = d2F/dU2 = S_tip_ddot^T P_tip_ddot S_tip_ddot + P_u.
+///
+/// From eq. (control_conf) and the closed forms after it.
+///
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
+/// - `p_tip_ddot`: precision P of the tool tip's acceleration tip_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 229 operations, weighted 229 (51 ADD, 120 MUL, 58 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_acceleration_control_confidence(
+    params: &SVector<f64, 13>,
+    p_tip_ddot: &SMatrix<f64, 7, 7>,
+    p_u: &SMatrix<f64, 7, 7>,
+) -> SMatrix<f64, 7, 7> {
+    let p_u_0_0 = p_u[(0, 0)];
+    let params_10 = params[10];
+    let params_11 = params[11];
+    let params_12 = params[12];
+    let p_tip_ddot_1_1 = p_tip_ddot[(1, 1)];
+    let p_tip_ddot_0_1 = p_tip_ddot[(0, 1)];
+    let p_tip_ddot_0_0 = p_tip_ddot[(0, 0)];
+    let p_u_0_1 = p_u[(0, 1)];
+    let p_tip_ddot_1_2 = p_tip_ddot[(1, 2)];
+    let p_tip_ddot_0_2 = p_tip_ddot[(0, 2)];
+    let p_u_1_1 = p_u[(1, 1)];
+    let p_tip_ddot_2_2 = p_tip_ddot[(2, 2)];
+    let p_u_0_2 = p_u[(0, 2)];
+    let p_u_1_2 = p_u[(1, 2)];
+    let p_u_2_2 = p_u[(2, 2)];
+    let p_u_0_3 = p_u[(0, 3)];
+    let p_u_1_3 = p_u[(1, 3)];
+    let p_u_2_3 = p_u[(2, 3)];
+    let p_u_3_3 = p_u[(3, 3)];
+    let p_u_0_4 = p_u[(0, 4)];
+    let p_u_1_4 = p_u[(1, 4)];
+    let p_u_2_4 = p_u[(2, 4)];
+    let p_u_3_4 = p_u[(3, 4)];
+    let p_u_4_4 = p_u[(4, 4)];
+    let p_u_0_5 = p_u[(0, 5)];
+    let p_u_1_5 = p_u[(1, 5)];
+    let p_u_2_5 = p_u[(2, 5)];
+    let p_u_3_5 = p_u[(3, 5)];
+    let p_u_4_5 = p_u[(4, 5)];
+    let p_u_5_5 = p_u[(5, 5)];
+    let p_u_0_6 = p_u[(0, 6)];
+    let p_u_1_6 = p_u[(1, 6)];
+    let p_u_2_6 = p_u[(2, 6)];
+    let p_u_3_6 = p_u[(3, 6)];
+    let p_u_4_6 = p_u[(4, 6)];
+    let p_u_5_6 = p_u[(5, 6)];
+    let p_u_6_6 = p_u[(6, 6)];
+    // Pi^U (symmetric)
+    let mut pi_u = <SMatrix<f64, 7, 7>>::zeros();
+    let mut w0: f64;
+    let mut w1: f64;
+    let mut w2: f64;
+    let w3: f64;
+    let mut w4: f64;
+    let mut w5: f64;
+    let mut w6: f64;
+    let mut w7: f64;
+    let mut w8: f64;
+    let mut w9: f64;
+    let mut w10: f64;
+    let mut w11: f64;
+    let mut w12: f64;
+    let mut w13: f64;
+    let mut w14: f64;
+    let mut w15: f64;
+    let mut w16: f64;
+    let mut w17: f64;
+    let mut w18: f64;
+    let mut w19: f64;
+    let w20: f64;
+    let mut w21: f64;
+    let mut w22: f64;
+    let mut w23: f64;
+    let mut w24: f64;
+    let w25: f64;
+    let mut w26: f64;
+    let mut w27: f64;
+    let mut w28: f64;
+    let mut w29: f64;
+    let mut w30: f64;
+    let mut w31: f64;
+    let mut w32: f64;
+    let mut w33: f64;
+    w4 = 0.7071067811865476 * params_10;
+    w7 = (-0.7071067811865475) * params_11;
+    w4 = w4 + w7;
+    w9 = (-6.123233995736766e-17) * params_12;
+    w4 = w4 + w9;
+    w1 = 0.30689056659294117 + w4;
+    w10 = w1 * p_tip_ddot_1_1;
+    w11 = (-0.7071067811865475) * params_10;
+    w12 = (-0.7071067811865476) * params_11;
+    w11 = w11 + w12;
+    w13 = w11 * p_tip_ddot_0_1;
+    w10 = w10 - w13;
+    w14 = w10 * w1;
+    w15 = w1 * p_tip_ddot_0_1;
+    w17 = w11 * p_tip_ddot_0_0;
+    w15 = w15 - w17;
+    w18 = w15 * w11;
+    w14 = w14 - w18;
+    w0 = p_u_0_0 + w14;
+    pi_u[(0, 0)] = w0;
+    w19 = (-4.329780281177467e-17) * params_10;
+    w3 = 4.329780281177466e-17 * params_11;
+    w19 = w19 + w3;
+    w19 = w19 - params_12;
+    w14 = 0.5902820523028393 + w19;
+    w19 = w14 - 0.333;
+    w8 = w15 * w19;
+    w6 = w1 * p_tip_ddot_1_2;
+    w21 = w11 * p_tip_ddot_0_2;
+    w22 = w6 - w21;
+    w23 = w22 * w1;
+    w8 = w8 - w23;
+    w0 = p_u_0_1 + w8;
+    pi_u[(0, 1)] = w0;
+    w8 = w19 * p_tip_ddot_0_0;
+    w23 = w1 * p_tip_ddot_0_2;
+    w8 = w8 - w23;
+    w23 = w8 * w19;
+    w24 = w19 * p_tip_ddot_0_2;
+    w26 = w1 * p_tip_ddot_2_2;
+    w24 = w24 - w26;
+    w26 = w24 * w1;
+    w23 = w23 - w26;
+    w0 = p_u_1_1 + w23;
+    pi_u[(1, 1)] = w0;
+    w23 = w1 - (-0.223445742854949);
+    w23 = 0.7071067811865476 * w23;
+    w26 = w14 - 0.5564457428549491;
+    w26 = (-0.7071067811865475) * w26;
+    w23 = w23 - w26;
+    w26 = w10 * w23;
+    w2 = 0.7071067811865476 * w11;
+    w27 = w15 * w2;
+    w26 = w26 - w27;
+    w5 = (-0.7071067811865475) * w11;
+    w27 = w22 * w5;
+    w26 = w26 + w27;
+    w0 = p_u_0_2 + w26;
+    pi_u[(0, 2)] = w0;
+    w19 = w19 * p_tip_ddot_0_1;
+    w19 = w19 - w6;
+    w6 = w19 * w23;
+    w26 = w8 * w2;
+    w6 = w6 - w26;
+    w26 = w24 * w5;
+    w6 = w6 + w26;
+    w0 = p_u_1_2 + w6;
+    pi_u[(1, 2)] = w0;
+    w6 = w23 * p_tip_ddot_1_1;
+    w26 = w2 * p_tip_ddot_0_1;
+    w6 = w6 - w26;
+    w26 = w5 * p_tip_ddot_1_2;
+    w6 = w6 + w26;
+    w26 = w6 * w23;
+    w27 = w23 * p_tip_ddot_0_1;
+    w28 = w2 * p_tip_ddot_0_0;
+    w27 = w27 - w28;
+    w28 = w5 * p_tip_ddot_0_2;
+    w27 = w27 + w28;
+    w28 = w27 * w2;
+    w26 = w26 - w28;
+    w23 = w23 * p_tip_ddot_1_2;
+    w2 = w2 * p_tip_ddot_0_2;
+    w23 = w23 - w2;
+    w2 = w5 * p_tip_ddot_2_2;
+    w23 = w23 + w2;
+    w5 = w23 * w5;
+    w26 = w26 + w5;
+    w0 = p_u_2_2 + w26;
+    pi_u[(2, 2)] = w0;
+    w26 = w1 - (-0.16510943340705883);
+    w5 = w22 * w26;
+    w2 = w14 - 0.6147820523028392;
+    w28 = w15 * w2;
+    w5 = w5 - w28;
+    w0 = p_u_0_3 + w5;
+    pi_u[(0, 3)] = w0;
+    w5 = w24 * w26;
+    w28 = w8 * w2;
+    w5 = w5 - w28;
+    w0 = p_u_1_3 + w5;
+    pi_u[(1, 3)] = w0;
+    w5 = w23 * w26;
+    w28 = w27 * w2;
+    w5 = w5 - w28;
+    w0 = p_u_2_3 + w5;
+    pi_u[(2, 3)] = w0;
+    w5 = w26 * p_tip_ddot_2_2;
+    w28 = w2 * p_tip_ddot_0_2;
+    w5 = w5 - w28;
+    w28 = w5 * w26;
+    w29 = w26 * p_tip_ddot_0_2;
+    w30 = w2 * p_tip_ddot_0_0;
+    w29 = w29 - w30;
+    w30 = w29 * w2;
+    w28 = w28 - w30;
+    w0 = p_u_3_3 + w28;
+    pi_u[(3, 3)] = w0;
+    w28 = w22 * w11;
+    w14 = w14 - 0.6972820523028392;
+    w30 = w10 * w14;
+    w28 = w28 - w30;
+    w0 = p_u_0_4 + w28;
+    pi_u[(0, 4)] = w0;
+    w28 = w24 * w11;
+    w30 = w19 * w14;
+    w28 = w28 - w30;
+    w0 = p_u_1_4 + w28;
+    pi_u[(1, 4)] = w0;
+    w28 = w23 * w11;
+    w30 = w6 * w14;
+    w28 = w28 - w30;
+    w0 = p_u_2_4 + w28;
+    pi_u[(2, 4)] = w0;
+    w28 = w5 * w11;
+    w26 = w26 * p_tip_ddot_1_2;
+    w2 = w2 * p_tip_ddot_0_1;
+    w26 = w26 - w2;
+    w2 = w26 * w14;
+    w28 = w28 - w2;
+    w0 = p_u_3_4 + w28;
+    pi_u[(3, 4)] = w0;
+    w28 = w11 * p_tip_ddot_2_2;
+    w2 = w14 * p_tip_ddot_1_2;
+    w28 = w28 - w2;
+    w2 = w28 * w11;
+    w30 = w11 * p_tip_ddot_1_2;
+    w31 = w14 * p_tip_ddot_1_1;
+    w30 = w30 - w31;
+    w31 = w30 * w14;
+    w2 = w2 - w31;
+    w0 = p_u_4_4 + w2;
+    pi_u[(4, 4)] = w0;
+    w1 = w1 - 0.21889056659294118;
+    w2 = w22 * w1;
+    w15 = w15 * w14;
+    w2 = w2 - w15;
+    w0 = p_u_0_5 + w2;
+    pi_u[(0, 5)] = w0;
+    w2 = w24 * w1;
+    w15 = w8 * w14;
+    w2 = w2 - w15;
+    w0 = p_u_1_5 + w2;
+    pi_u[(1, 5)] = w0;
+    w2 = w23 * w1;
+    w15 = w27 * w14;
+    w2 = w2 - w15;
+    w0 = p_u_2_5 + w2;
+    pi_u[(2, 5)] = w0;
+    w2 = w5 * w1;
+    w15 = w29 * w14;
+    w2 = w2 - w15;
+    w0 = p_u_3_5 + w2;
+    pi_u[(3, 5)] = w0;
+    w2 = w28 * w1;
+    w15 = w14 * p_tip_ddot_0_1;
+    w31 = w21 - w15;
+    w32 = w31 * w14;
+    w2 = w2 - w32;
+    w0 = p_u_4_5 + w2;
+    pi_u[(4, 5)] = w0;
+    w2 = w1 * p_tip_ddot_2_2;
+    w32 = w14 * p_tip_ddot_0_2;
+    w2 = w2 - w32;
+    w32 = w2 * w1;
+    w33 = w1 * p_tip_ddot_0_2;
+    w16 = w14 * p_tip_ddot_0_0;
+    w33 = w33 - w16;
+    w16 = w33 * w14;
+    w32 = w32 - w16;
+    w0 = p_u_5_5 + w32;
+    pi_u[(5, 5)] = w0;
+    w14 = (-6.123233995736766e-17) * w14;
+    w4 = w4 + w14;
+    w10 = w10 * w4;
+    w18 = w18 - w10;
+    w7 = (-6.123233995736766e-17) * w11;
+    w22 = w22 * w7;
+    w18 = w18 + w22;
+    w0 = p_u_0_6 + w18;
+    pi_u[(0, 6)] = w0;
+    w8 = w8 * w11;
+    w19 = w19 * w4;
+    w8 = w8 - w19;
+    w24 = w24 * w7;
+    w8 = w8 + w24;
+    w0 = p_u_1_6 + w8;
+    pi_u[(1, 6)] = w0;
+    w27 = w27 * w11;
+    w6 = w6 * w4;
+    w27 = w27 - w6;
+    w23 = w23 * w7;
+    w27 = w27 + w23;
+    w0 = p_u_2_6 + w27;
+    pi_u[(2, 6)] = w0;
+    w29 = w29 * w11;
+    w26 = w26 * w4;
+    w29 = w29 - w26;
+    w5 = w5 * w7;
+    w29 = w29 + w5;
+    w0 = p_u_3_6 + w29;
+    pi_u[(3, 6)] = w0;
+    w31 = w31 * w11;
+    w30 = w30 * w4;
+    w31 = w31 - w30;
+    w28 = w28 * w7;
+    w31 = w31 + w28;
+    w0 = p_u_4_6 + w31;
+    pi_u[(4, 6)] = w0;
+    w33 = w33 * w11;
+    w1 = w1 * p_tip_ddot_1_2;
+    w1 = w1 - w15;
+    w1 = w1 * w4;
+    w33 = w33 - w1;
+    w2 = w2 * w7;
+    w33 = w33 + w2;
+    w0 = p_u_5_6 + w33;
+    pi_u[(5, 6)] = w0;
+    w12 = w4 * p_tip_ddot_0_1;
+    w17 = w17 - w12;
+    w20 = w7 * p_tip_ddot_0_2;
+    w17 = w17 + w20;
+    w17 = w17 * w11;
+    w9 = w4 * p_tip_ddot_1_1;
+    w13 = w13 - w9;
+    w9 = w7 * p_tip_ddot_1_2;
+    w13 = w13 + w9;
+    w13 = w13 * w4;
+    w17 = w17 - w13;
+    w4 = w4 * p_tip_ddot_1_2;
+    w21 = w21 - w4;
+    w25 = w7 * p_tip_ddot_2_2;
+    w21 = w21 + w25;
+    w21 = w21 * w7;
+    w17 = w17 + w21;
+    w0 = p_u_6_6 + w17;
+    pi_u[(6, 6)] = w0;
+    pi_u[(1, 0)] = pi_u[(0, 1)];
+    pi_u[(2, 0)] = pi_u[(0, 2)];
+    pi_u[(3, 0)] = pi_u[(0, 3)];
+    pi_u[(4, 0)] = pi_u[(0, 4)];
+    pi_u[(5, 0)] = pi_u[(0, 5)];
+    pi_u[(6, 0)] = pi_u[(0, 6)];
+    pi_u[(2, 1)] = pi_u[(1, 2)];
+    pi_u[(3, 1)] = pi_u[(1, 3)];
+    pi_u[(4, 1)] = pi_u[(1, 4)];
+    pi_u[(5, 1)] = pi_u[(1, 5)];
+    pi_u[(6, 1)] = pi_u[(1, 6)];
+    pi_u[(3, 2)] = pi_u[(2, 3)];
+    pi_u[(4, 2)] = pi_u[(2, 4)];
+    pi_u[(5, 2)] = pi_u[(2, 5)];
+    pi_u[(6, 2)] = pi_u[(2, 6)];
+    pi_u[(4, 3)] = pi_u[(3, 4)];
+    pi_u[(5, 3)] = pi_u[(3, 5)];
+    pi_u[(6, 3)] = pi_u[(3, 6)];
+    pi_u[(5, 4)] = pi_u[(4, 5)];
+    pi_u[(6, 4)] = pi_u[(4, 6)];
+    pi_u[(6, 5)] = pi_u[(5, 6)];
+    pi_u
+}
+
+/// Task 6 (tip acceleration control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (by reverse-mode AD of sum ln D_ii, Pi^U = L D L^T), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
+/// - `p_tip_ddot`: precision P of the tool tip's acceleration tip_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 983 operations, weighted 1592 (226 ADD, 87 DIV, 470 MUL, 200 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_acceleration_logdet_gradient(
+    params: &SVector<f64, 13>,
+    p_tip_ddot: &SMatrix<f64, 7, 7>,
+    p_u: &SMatrix<f64, 7, 7>,
+) -> SVector<f64, 13> {
+    let params_10 = params[10];
+    let params_11 = params[11];
+    let p_tip_ddot_0_0 = p_tip_ddot[(0, 0)];
+    let params_12 = params[12];
+    let p_tip_ddot_0_1 = p_tip_ddot[(0, 1)];
+    let p_tip_ddot_0_2 = p_tip_ddot[(0, 2)];
+    let p_u_5_6 = p_u[(5, 6)];
+    let p_tip_ddot_1_2 = p_tip_ddot[(1, 2)];
+    let p_tip_ddot_2_2 = p_tip_ddot[(2, 2)];
+    let p_u_0_6 = p_u[(0, 6)];
+    let p_tip_ddot_1_1 = p_tip_ddot[(1, 1)];
+    let p_u_0_0 = p_u[(0, 0)];
+    let p_u_0_5 = p_u[(0, 5)];
+    let p_u_1_6 = p_u[(1, 6)];
+    let p_u_0_1 = p_u[(0, 1)];
+    let p_u_1_1 = p_u[(1, 1)];
+    let p_u_1_5 = p_u[(1, 5)];
+    let p_u_2_6 = p_u[(2, 6)];
+    let p_u_0_2 = p_u[(0, 2)];
+    let p_u_1_2 = p_u[(1, 2)];
+    let p_u_2_2 = p_u[(2, 2)];
+    let p_u_2_5 = p_u[(2, 5)];
+    let p_u_3_6 = p_u[(3, 6)];
+    let p_u_0_3 = p_u[(0, 3)];
+    let p_u_1_3 = p_u[(1, 3)];
+    let p_u_2_3 = p_u[(2, 3)];
+    let p_u_3_3 = p_u[(3, 3)];
+    let p_u_3_5 = p_u[(3, 5)];
+    let p_u_4_6 = p_u[(4, 6)];
+    let p_u_0_4 = p_u[(0, 4)];
+    let p_u_1_4 = p_u[(1, 4)];
+    let p_u_2_4 = p_u[(2, 4)];
+    let p_u_3_4 = p_u[(3, 4)];
+    let p_u_4_4 = p_u[(4, 4)];
+    let p_u_4_5 = p_u[(4, 5)];
+    let p_u_5_5 = p_u[(5, 5)];
+    let p_u_6_6 = p_u[(6, 6)];
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 13>>::zeros();
+    let mut w0: f64;
+    let w1: f64;
+    let mut w2: f64;
+    let mut w3: f64;
+    let w4: f64;
+    let mut w5: f64;
+    let mut w6: f64;
+    let mut w7: f64;
+    let w8: f64;
+    let mut w9: f64;
+    let mut w10: f64;
+    let mut w11: f64;
+    let mut w12: f64;
+    let mut w13: f64;
+    let mut w14: f64;
+    let mut w15: f64;
+    let w16: f64;
+    let mut w17: f64;
+    let mut w18: f64;
+    let w19: f64;
+    let mut w20: f64;
+    let w21: f64;
+    let mut w22: f64;
+    let mut w23: f64;
+    let mut w24: f64;
+    let w25: f64;
+    let mut w26: f64;
+    let mut w27: f64;
+    let mut w28: f64;
+    let mut w29: f64;
+    let mut w30: f64;
+    let mut w31: f64;
+    let mut w32: f64;
+    let mut w33: f64;
+    let mut w34: f64;
+    let mut w35: f64;
+    let mut w36: f64;
+    let mut w37: f64;
+    let mut w38: f64;
+    let mut w39: f64;
+    let mut w40: f64;
+    let mut w41: f64;
+    let mut w42: f64;
+    let mut w43: f64;
+    let mut w44: f64;
+    let mut w45: f64;
+    let mut w46: f64;
+    let mut w47: f64;
+    let mut w48: f64;
+    let mut w49: f64;
+    let mut w50: f64;
+    let mut w51: f64;
+    let mut w52: f64;
+    let mut w53: f64;
+    let mut w54: f64;
+    let mut w55: f64;
+    let mut w56: f64;
+    let mut w57: f64;
+    let mut w58: f64;
+    let mut w59: f64;
+    let mut w60: f64;
+    let mut w61: f64;
+    let mut w62: f64;
+    let mut w63: f64;
+    let mut w64: f64;
+    let mut w65: f64;
+    let mut w66: f64;
+    let mut w67: f64;
+    let mut w68: f64;
+    let mut w69: f64;
+    let mut w70: f64;
+    let mut w71: f64;
+    let mut w72: f64;
+    let mut w73: f64;
+    let mut w74: f64;
+    let mut w75: f64;
+    let mut w76: f64;
+    let mut w77: f64;
+    let mut w78: f64;
+    let mut w79: f64;
+    let mut w80: f64;
+    let mut w81: f64;
+    let mut w82: f64;
+    let mut w83: f64;
+    let mut w84: f64;
+    let mut w85: f64;
+    let mut w86: f64;
+    let mut w87: f64;
+    let mut w88: f64;
+    let mut w89: f64;
+    let mut w90: f64;
+    let mut w91: f64;
+    let mut w92: f64;
+    let mut w93: f64;
+    let mut w94: f64;
+    let mut w95: f64;
+    let mut w96: f64;
+    let mut w97: f64;
+    let mut w98: f64;
+    let mut w99: f64;
+    let mut w100: f64;
+    let mut w101: f64;
+    let mut w102: f64;
+    let mut w103: f64;
+    let mut w104: f64;
+    let mut w105: f64;
+    let mut w106: f64;
+    let mut w107: f64;
+    let mut w108: f64;
+    let mut w109: f64;
+    let mut w110: f64;
+    let mut w111: f64;
+    let w112: f64;
+    gradient[0] = 0.0;
+    gradient[1] = 0.0;
+    gradient[2] = 0.0;
+    gradient[3] = 0.0;
+    gradient[4] = 0.0;
+    gradient[5] = 0.0;
+    gradient[6] = 0.0;
+    gradient[7] = 0.0;
+    gradient[8] = 0.0;
+    gradient[9] = 0.0;
+    w3 = (-0.7071067811865475) * params_10;
+    w6 = (-0.7071067811865476) * params_11;
+    w3 = w3 + w6;
+    w7 = w3 * p_tip_ddot_0_0;
+    w9 = 0.7071067811865476 * params_10;
+    w10 = (-0.7071067811865475) * params_11;
+    w9 = w9 + w10;
+    w12 = (-6.123233995736766e-17) * params_12;
+    w9 = w9 + w12;
+    w2 = (-4.329780281177467e-17) * params_10;
+    w5 = 4.329780281177466e-17 * params_11;
+    w2 = w2 + w5;
+    w2 = w2 - params_12;
+    w12 = 0.5902820523028393 + w2;
+    w2 = w12 - 0.6972820523028392;
+    w11 = (-6.123233995736766e-17) * w2;
+    w11 = w9 + w11;
+    w14 = w11 * p_tip_ddot_0_1;
+    w14 = w7 - w14;
+    w15 = (-6.123233995736766e-17) * w3;
+    w17 = w15 * p_tip_ddot_0_2;
+    w14 = w14 + w17;
+    w18 = w3 * p_tip_ddot_0_2;
+    w20 = w11 * p_tip_ddot_1_2;
+    w20 = w18 - w20;
+    w22 = w15 * p_tip_ddot_2_2;
+    w20 = w20 + w22;
+    w22 = 0.30689056659294117 + w9;
+    w9 = w22 - 0.21889056659294118;
+    w23 = w20 * w9;
+    w24 = w14 * w2;
+    w23 = w23 - w24;
+    w17 = p_u_5_6 + w23;
+    w24 = w3 * p_tip_ddot_0_1;
+    w26 = w11 * p_tip_ddot_1_1;
+    w26 = w24 - w26;
+    w27 = w15 * p_tip_ddot_1_2;
+    w26 = w26 + w27;
+    w27 = w26 * w22;
+    w28 = w14 * w3;
+    w27 = w27 - w28;
+    w23 = p_u_0_6 + w27;
+    w29 = w22 * p_tip_ddot_1_1;
+    w29 = w29 - w24;
+    w24 = w29 * w22;
+    w30 = w22 * p_tip_ddot_0_1;
+    w30 = w30 - w7;
+    w7 = w30 * w3;
+    w24 = w24 - w7;
+    w27 = p_u_0_0 + w24;
+    w24 = w23 / w27;
+    w31 = w9 * p_tip_ddot_1_2;
+    w32 = w2 * p_tip_ddot_0_1;
+    w31 = w31 - w32;
+    w33 = w31 * w22;
+    w34 = w9 * p_tip_ddot_0_2;
+    w35 = w2 * p_tip_ddot_0_0;
+    w34 = w34 - w35;
+    w35 = w34 * w3;
+    w33 = w33 - w35;
+    w7 = p_u_0_5 + w33;
+    w33 = w24 * w7;
+    w36 = w12 - 0.333;
+    w37 = w14 * w36;
+    w38 = w20 * w22;
+    w37 = w37 - w38;
+    w35 = p_u_1_6 + w37;
+    w38 = w36 * p_tip_ddot_0_1;
+    w39 = w22 * p_tip_ddot_1_2;
+    w38 = w38 - w39;
+    w39 = w38 * w22;
+    w40 = w36 * p_tip_ddot_0_0;
+    w41 = w22 * p_tip_ddot_0_2;
+    w40 = w40 - w41;
+    w41 = w40 * w3;
+    w39 = w39 - w41;
+    w37 = p_u_0_1 + w39;
+    w39 = w24 * w37;
+    w35 = w35 - w39;
+    w41 = w40 * w36;
+    w42 = w36 * p_tip_ddot_0_2;
+    w43 = w22 * p_tip_ddot_2_2;
+    w42 = w42 - w43;
+    w43 = w42 * w22;
+    w41 = w41 - w43;
+    w39 = p_u_1_1 + w41;
+    w41 = w37 / w27;
+    w43 = w37 * w41;
+    w39 = w39 - w43;
+    w43 = w35 / w39;
+    w45 = w34 * w36;
+    w46 = w9 * p_tip_ddot_2_2;
+    w47 = w2 * p_tip_ddot_0_2;
+    w46 = w46 - w47;
+    w47 = w46 * w22;
+    w45 = w45 - w47;
+    w44 = p_u_1_5 + w45;
+    w45 = w7 / w27;
+    w47 = w45 * w37;
+    w44 = w44 - w47;
+    w47 = w43 * w44;
+    w33 = w33 + w47;
+    w48 = w22 - (-0.223445742854949);
+    w48 = 0.7071067811865476 * w48;
+    w49 = w12 - 0.5564457428549491;
+    w49 = (-0.7071067811865475) * w49;
+    w48 = w48 - w49;
+    w49 = w26 * w48;
+    w50 = 0.7071067811865476 * w3;
+    w51 = w14 * w50;
+    w49 = w49 - w51;
+    w51 = (-0.7071067811865475) * w3;
+    w52 = w20 * w51;
+    w49 = w49 + w52;
+    w47 = p_u_2_6 + w49;
+    w52 = w48 * p_tip_ddot_1_1;
+    w53 = w50 * p_tip_ddot_0_1;
+    w52 = w52 - w53;
+    w53 = w51 * p_tip_ddot_1_2;
+    w52 = w52 + w53;
+    w53 = w52 * w22;
+    w54 = w48 * p_tip_ddot_0_1;
+    w55 = w50 * p_tip_ddot_0_0;
+    w54 = w54 - w55;
+    w55 = w51 * p_tip_ddot_0_2;
+    w54 = w54 + w55;
+    w55 = w54 * w3;
+    w53 = w53 - w55;
+    w49 = p_u_0_2 + w53;
+    w53 = w24 * w49;
+    w56 = w54 * w36;
+    w57 = w48 * p_tip_ddot_1_2;
+    w58 = w50 * p_tip_ddot_0_2;
+    w57 = w57 - w58;
+    w58 = w51 * p_tip_ddot_2_2;
+    w57 = w57 + w58;
+    w58 = w57 * w22;
+    w56 = w56 - w58;
+    w55 = p_u_1_2 + w56;
+    w56 = w49 / w27;
+    w58 = w56 * w37;
+    w55 = w55 - w58;
+    w58 = w43 * w55;
+    w53 = w53 + w58;
+    w47 = w47 - w53;
+    w58 = w52 * w48;
+    w59 = w54 * w50;
+    w58 = w58 - w59;
+    w59 = w57 * w51;
+    w58 = w58 + w59;
+    w53 = p_u_2_2 + w58;
+    w58 = w49 * w56;
+    w59 = w55 / w39;
+    w60 = w55 * w59;
+    w58 = w58 + w60;
+    w53 = w53 - w58;
+    w58 = w47 / w53;
+    w61 = w31 * w48;
+    w62 = w34 * w50;
+    w61 = w61 - w62;
+    w62 = w46 * w51;
+    w61 = w61 + w62;
+    w60 = p_u_2_5 + w61;
+    w61 = w45 * w49;
+    w62 = w44 / w39;
+    w63 = w62 * w55;
+    w61 = w61 + w63;
+    w60 = w60 - w61;
+    w61 = w58 * w60;
+    w33 = w33 + w61;
+    w63 = w22 - (-0.16510943340705883);
+    w64 = w20 * w63;
+    w12 = w12 - 0.6147820523028392;
+    w65 = w14 * w12;
+    w64 = w64 - w65;
+    w61 = p_u_3_6 + w64;
+    w65 = w63 * p_tip_ddot_1_2;
+    w66 = w12 * p_tip_ddot_0_1;
+    w65 = w65 - w66;
+    w66 = w65 * w22;
+    w67 = w63 * p_tip_ddot_0_2;
+    w68 = w12 * p_tip_ddot_0_0;
+    w67 = w67 - w68;
+    w68 = w67 * w3;
+    w66 = w66 - w68;
+    w64 = p_u_0_3 + w66;
+    w66 = w24 * w64;
+    w69 = w67 * w36;
+    w70 = w63 * p_tip_ddot_2_2;
+    w71 = w12 * p_tip_ddot_0_2;
+    w70 = w70 - w71;
+    w71 = w70 * w22;
+    w69 = w69 - w71;
+    w68 = p_u_1_3 + w69;
+    w69 = w64 / w27;
+    w71 = w69 * w37;
+    w68 = w68 - w71;
+    w71 = w43 * w68;
+    w66 = w66 + w71;
+    w72 = w65 * w48;
+    w73 = w67 * w50;
+    w72 = w72 - w73;
+    w73 = w70 * w51;
+    w72 = w72 + w73;
+    w71 = p_u_2_3 + w72;
+    w72 = w69 * w49;
+    w73 = w68 / w39;
+    w74 = w73 * w55;
+    w72 = w72 + w74;
+    w71 = w71 - w72;
+    w72 = w58 * w71;
+    w66 = w66 + w72;
+    w61 = w61 - w66;
+    w72 = w70 * w63;
+    w74 = w67 * w12;
+    w72 = w72 - w74;
+    w66 = p_u_3_3 + w72;
+    w72 = w64 * w69;
+    w74 = w68 * w73;
+    w72 = w72 + w74;
+    w74 = w71 / w53;
+    w75 = w71 * w74;
+    w72 = w72 + w75;
+    w66 = w66 - w72;
+    w72 = w61 / w66;
+    w76 = w46 * w63;
+    w77 = w34 * w12;
+    w76 = w76 - w77;
+    w75 = p_u_3_5 + w76;
+    w76 = w45 * w64;
+    w77 = w62 * w68;
+    w76 = w76 + w77;
+    w77 = w60 / w53;
+    w78 = w77 * w71;
+    w76 = w76 + w78;
+    w75 = w75 - w76;
+    w76 = w72 * w75;
+    w33 = w33 + w76;
+    w78 = w20 * w3;
+    w79 = w26 * w2;
+    w78 = w78 - w79;
+    w76 = p_u_4_6 + w78;
+    w79 = w3 * p_tip_ddot_1_2;
+    w80 = w2 * p_tip_ddot_1_1;
+    w79 = w79 - w80;
+    w80 = w79 * w22;
+    w18 = w18 - w32;
+    w32 = w18 * w3;
+    w80 = w80 - w32;
+    w78 = p_u_0_4 + w80;
+    w80 = w24 * w78;
+    w81 = w18 * w36;
+    w82 = w3 * p_tip_ddot_2_2;
+    w83 = w2 * p_tip_ddot_1_2;
+    w82 = w82 - w83;
+    w83 = w82 * w22;
+    w81 = w81 - w83;
+    w32 = p_u_1_4 + w81;
+    w81 = w78 / w27;
+    w83 = w81 * w37;
+    w32 = w32 - w83;
+    w83 = w43 * w32;
+    w80 = w80 + w83;
+    w84 = w79 * w48;
+    w85 = w18 * w50;
+    w84 = w84 - w85;
+    w85 = w82 * w51;
+    w84 = w84 + w85;
+    w83 = p_u_2_4 + w84;
+    w84 = w81 * w49;
+    w85 = w32 / w39;
+    w86 = w85 * w55;
+    w84 = w84 + w86;
+    w83 = w83 - w84;
+    w84 = w58 * w83;
+    w80 = w80 + w84;
+    w86 = w82 * w63;
+    w87 = w18 * w12;
+    w86 = w86 - w87;
+    w84 = p_u_3_4 + w86;
+    w86 = w81 * w64;
+    w87 = w85 * w68;
+    w86 = w86 + w87;
+    w87 = w83 / w53;
+    w88 = w87 * w71;
+    w86 = w86 + w88;
+    w84 = w84 - w86;
+    w86 = w72 * w84;
+    w80 = w80 + w86;
+    w76 = w76 - w80;
+    w86 = w82 * w3;
+    w88 = w79 * w2;
+    w86 = w86 - w88;
+    w80 = p_u_4_4 + w86;
+    w86 = w78 * w81;
+    w88 = w32 * w85;
+    w86 = w86 + w88;
+    w88 = w83 * w87;
+    w86 = w86 + w88;
+    w88 = w84 / w66;
+    w89 = w84 * w88;
+    w86 = w86 + w89;
+    w80 = w80 - w86;
+    w86 = w76 / w80;
+    w90 = w46 * w3;
+    w91 = w31 * w2;
+    w90 = w90 - w91;
+    w89 = p_u_4_5 + w90;
+    w90 = w45 * w78;
+    w91 = w62 * w32;
+    w90 = w90 + w91;
+    w91 = w77 * w83;
+    w90 = w90 + w91;
+    w91 = w75 / w66;
+    w92 = w91 * w84;
+    w90 = w90 + w92;
+    w89 = w89 - w90;
+    w90 = w86 * w89;
+    w33 = w33 + w90;
+    w17 = w17 - w33;
+    w90 = w46 * w9;
+    w92 = w34 * w2;
+    w90 = w90 - w92;
+    w33 = p_u_5_5 + w90;
+    w90 = w7 * w45;
+    w92 = w44 * w62;
+    w90 = w90 + w92;
+    w92 = w60 * w77;
+    w90 = w90 + w92;
+    w92 = w75 * w91;
+    w90 = w90 + w92;
+    w92 = w89 / w80;
+    w93 = w89 * w92;
+    w90 = w90 + w93;
+    w33 = w33 - w90;
+    w90 = w17 / w33;
+    w94 = w26 * w11;
+    w28 = w28 - w94;
+    w94 = w20 * w15;
+    w28 = w28 + w94;
+    w93 = p_u_6_6 + w28;
+    w28 = w23 * w24;
+    w94 = w35 * w43;
+    w28 = w28 + w94;
+    w94 = w47 * w58;
+    w28 = w28 + w94;
+    w94 = w61 * w72;
+    w28 = w28 + w94;
+    w94 = w76 * w86;
+    w28 = w28 + w94;
+    w94 = w17 * w90;
+    w28 = w28 + w94;
+    w93 = w93 - w28;
+    w28 = w90 / w93;
+    w17 = w17 / w93;
+    w94 = w17 / w33;
+    w28 = w28 + w94;
+    w94 = w14 * w28;
+    w95 = w58 * w28;
+    w90 = w90 / w33;
+    w90 = w90 * w17;
+    w33 = 1.0 / w33;
+    w90 = w90 + w33;
+    w33 = w77 * w90;
+    w95 = w95 - w33;
+    w33 = w86 * w28;
+    w17 = w92 * w90;
+    w33 = w33 - w17;
+    w17 = w89 * w90;
+    w96 = w17 / w80;
+    w33 = w33 - w96;
+    w96 = w83 * w33;
+    w97 = w72 * w28;
+    w98 = w91 * w90;
+    w97 = w97 - w98;
+    w98 = w84 * w33;
+    w99 = w75 * w90;
+    w98 = w98 + w99;
+    w99 = w98 / w66;
+    w97 = w97 - w99;
+    w99 = w71 * w97;
+    w96 = w96 + w99;
+    w99 = w60 * w90;
+    w96 = w96 + w99;
+    w99 = w96 / w53;
+    w95 = w95 - w99;
+    w99 = w48 * w95;
+    w100 = w2 * w33;
+    w99 = w99 - w100;
+    w100 = w24 * w28;
+    w101 = w45 * w90;
+    w100 = w100 - w101;
+    w101 = w78 * w33;
+    w102 = w64 * w97;
+    w101 = w101 + w102;
+    w102 = w49 * w95;
+    w101 = w101 + w102;
+    w102 = w43 * w28;
+    w103 = w62 * w90;
+    w102 = w102 - w103;
+    w103 = w32 * w33;
+    w104 = w68 * w97;
+    w103 = w103 + w104;
+    w104 = w55 * w95;
+    w103 = w103 + w104;
+    w104 = w44 * w90;
+    w103 = w103 + w104;
+    w104 = w103 / w39;
+    w102 = w102 - w104;
+    w104 = w37 * w102;
+    w101 = w101 + w104;
+    w104 = w7 * w90;
+    w101 = w101 + w104;
+    w104 = w101 / w27;
+    w100 = w100 - w104;
+    w104 = w22 * w100;
+    w99 = w99 + w104;
+    w104 = p_tip_ddot_0_1 * w99;
+    w94 = w94 - w104;
+    w104 = w34 * w90;
+    w94 = w94 - w104;
+    w104 = w36 * w102;
+    w105 = w12 * w97;
+    w106 = w50 * w95;
+    w105 = w105 + w106;
+    w104 = w104 - w105;
+    w105 = w3 * w100;
+    w104 = w104 - w105;
+    w105 = w2 * w90;
+    w104 = w104 - w105;
+    w105 = p_tip_ddot_0_0 * w104;
+    w94 = w94 - w105;
+    w105 = w3 * w33;
+    w106 = w63 * w97;
+    w105 = w105 + w106;
+    w106 = w51 * w95;
+    w105 = w105 + w106;
+    w106 = w22 * w102;
+    w105 = w105 - w106;
+    w106 = w9 * w90;
+    w105 = w105 + w106;
+    w106 = p_tip_ddot_0_2 * w105;
+    w94 = w94 - w106;
+    w89 = w89 * w28;
+    w76 = w76 / w93;
+    w89 = w89 - w76;
+    w76 = w89 / w80;
+    w106 = w86 / w93;
+    w76 = w76 - w106;
+    w106 = w3 * w76;
+    w9 = w9 * w28;
+    w106 = w106 - w9;
+    w75 = w75 * w28;
+    w9 = w84 * w76;
+    w75 = w75 - w9;
+    w61 = w61 / w93;
+    w75 = w75 - w61;
+    w61 = w75 / w66;
+    w9 = w72 / w93;
+    w61 = w61 - w9;
+    w9 = w63 * w61;
+    w106 = w106 + w9;
+    w60 = w60 * w28;
+    w9 = w83 * w76;
+    w60 = w60 - w9;
+    w9 = w71 * w61;
+    w60 = w60 - w9;
+    w47 = w47 / w93;
+    w60 = w60 - w47;
+    w47 = w60 / w53;
+    w9 = w58 / w93;
+    w47 = w47 - w9;
+    w9 = w51 * w47;
+    w106 = w106 + w9;
+    w44 = w44 * w28;
+    w9 = w32 * w76;
+    w44 = w44 - w9;
+    w9 = w68 * w61;
+    w44 = w44 - w9;
+    w9 = w55 * w47;
+    w44 = w44 - w9;
+    w35 = w35 / w93;
+    w44 = w44 - w35;
+    w35 = w44 / w39;
+    w9 = w43 / w93;
+    w35 = w35 - w9;
+    w9 = w22 * w35;
+    w106 = w106 - w9;
+    w15 = w15 / w93;
+    w106 = w106 + w15;
+    w15 = p_tip_ddot_1_2 * w106;
+    w9 = w26 / w93;
+    w15 = w15 + w9;
+    w9 = w48 * w47;
+    w107 = w2 * w76;
+    w9 = w9 - w107;
+    w7 = w7 * w28;
+    w107 = w78 * w76;
+    w7 = w7 - w107;
+    w107 = w64 * w61;
+    w7 = w7 - w107;
+    w107 = w49 * w47;
+    w7 = w7 - w107;
+    w107 = w37 * w35;
+    w7 = w7 - w107;
+    w23 = w23 / w93;
+    w7 = w7 - w23;
+    w23 = w7 / w27;
+    w107 = w24 / w93;
+    w23 = w23 - w107;
+    w107 = w22 * w23;
+    w9 = w9 + w107;
+    w11 = w11 / w93;
+    w9 = w9 - w11;
+    w11 = p_tip_ddot_1_1 * w9;
+    w15 = w15 + w11;
+    w11 = w2 * w28;
+    w107 = w12 * w61;
+    w11 = w11 - w107;
+    w107 = w50 * w47;
+    w11 = w11 - w107;
+    w107 = w36 * w35;
+    w11 = w11 + w107;
+    w107 = w3 * w23;
+    w11 = w11 - w107;
+    w107 = w3 / w93;
+    w11 = w11 + w107;
+    w107 = p_tip_ddot_0_1 * w11;
+    w15 = w15 + w107;
+    w107 = (-6.123233995736766e-17) * w15;
+    w94 = w94 - w107;
+    w107 = w26 * w76;
+    w108 = w31 * w33;
+    w107 = w107 + w108;
+    w108 = w72 * w76;
+    w109 = w91 * w33;
+    w108 = w108 + w109;
+    w92 = w92 / w80;
+    w92 = w92 * w17;
+    w86 = w86 / w80;
+    w86 = w86 * w89;
+    w92 = w92 - w86;
+    w80 = 1.0 / w80;
+    w92 = w92 + w80;
+    w80 = w88 * w92;
+    w108 = w108 + w80;
+    w84 = w84 * w92;
+    w80 = w84 / w66;
+    w108 = w108 + w80;
+    w80 = w12 * w108;
+    w86 = w71 * w108;
+    w83 = w83 * w92;
+    w86 = w86 - w83;
+    w83 = w86 / w53;
+    w89 = w58 * w76;
+    w17 = w77 * w33;
+    w89 = w89 + w17;
+    w17 = w87 * w92;
+    w89 = w89 + w17;
+    w83 = w83 - w89;
+    w89 = w50 * w83;
+    w80 = w80 - w89;
+    w89 = w68 * w108;
+    w17 = w55 * w83;
+    w89 = w89 - w17;
+    w32 = w32 * w92;
+    w89 = w89 - w32;
+    w32 = w89 / w39;
+    w17 = w43 * w76;
+    w109 = w62 * w33;
+    w17 = w17 + w109;
+    w109 = w85 * w92;
+    w17 = w17 + w109;
+    w32 = w32 - w17;
+    w17 = w36 * w32;
+    w80 = w80 + w17;
+    w17 = w64 * w108;
+    w109 = w49 * w83;
+    w17 = w17 - w109;
+    w109 = w37 * w32;
+    w17 = w17 - w109;
+    w78 = w78 * w92;
+    w17 = w17 - w78;
+    w78 = w17 / w27;
+    w109 = w24 * w76;
+    w110 = w45 * w33;
+    w109 = w109 + w110;
+    w110 = w81 * w92;
+    w109 = w109 + w110;
+    w78 = w78 - w109;
+    w109 = w3 * w78;
+    w80 = w80 - w109;
+    w109 = p_tip_ddot_0_1 * w80;
+    w107 = w107 + w109;
+    w109 = w79 * w92;
+    w107 = w107 + w109;
+    w109 = w48 * w83;
+    w110 = w22 * w78;
+    w109 = w109 + w110;
+    w2 = w2 * w92;
+    w109 = w109 - w2;
+    w2 = p_tip_ddot_1_1 * w109;
+    w107 = w107 + w2;
+    w2 = w51 * w83;
+    w110 = w63 * w108;
+    w2 = w2 - w110;
+    w110 = w22 * w32;
+    w2 = w2 - w110;
+    w110 = w3 * w92;
+    w2 = w2 + w110;
+    w110 = p_tip_ddot_1_2 * w2;
+    w107 = w107 + w110;
+    w94 = w94 - w107;
+    w107 = w18 * w108;
+    w110 = w14 * w61;
+    w111 = w34 * w97;
+    w110 = w110 + w111;
+    w107 = w107 - w110;
+    w110 = w87 * w108;
+    w111 = w58 * w61;
+    w112 = w77 * w97;
+    w111 = w111 + w112;
+    w110 = w110 - w111;
+    w91 = w91 / w66;
+    w91 = w91 * w98;
+    w72 = w72 / w66;
+    w72 = w72 * w75;
+    w91 = w91 - w72;
+    w88 = w88 / w66;
+    w88 = w88 * w84;
+    w91 = w91 + w88;
+    w66 = 1.0 / w66;
+    w91 = w91 + w66;
+    w66 = w74 * w91;
+    w110 = w110 - w66;
+    w71 = w71 * w91;
+    w66 = w71 / w53;
+    w110 = w110 - w66;
+    w66 = w48 * w110;
+    w88 = w81 * w108;
+    w84 = w24 * w61;
+    w72 = w45 * w97;
+    w84 = w84 + w72;
+    w88 = w88 - w84;
+    w84 = w69 * w91;
+    w88 = w88 - w84;
+    w84 = w49 * w110;
+    w72 = w85 * w108;
+    w75 = w43 * w61;
+    w98 = w62 * w97;
+    w75 = w75 + w98;
+    w72 = w72 - w75;
+    w75 = w73 * w91;
+    w72 = w72 - w75;
+    w75 = w55 * w110;
+    w68 = w68 * w91;
+    w75 = w75 + w68;
+    w68 = w75 / w39;
+    w72 = w72 - w68;
+    w68 = w37 * w72;
+    w84 = w84 + w68;
+    w64 = w64 * w91;
+    w84 = w84 + w64;
+    w64 = w84 / w27;
+    w88 = w88 - w64;
+    w64 = w22 * w88;
+    w66 = w66 + w64;
+    w64 = p_tip_ddot_0_1 * w66;
+    w107 = w107 - w64;
+    w64 = w67 * w91;
+    w107 = w107 - w64;
+    w64 = w36 * w72;
+    w68 = w50 * w110;
+    w64 = w64 - w68;
+    w68 = w3 * w88;
+    w64 = w64 - w68;
+    w12 = w12 * w91;
+    w64 = w64 - w12;
+    w12 = p_tip_ddot_0_0 * w64;
+    w107 = w107 - w12;
+    w12 = w51 * w110;
+    w68 = w22 * w72;
+    w12 = w12 - w68;
+    w63 = w63 * w91;
+    w12 = w12 + w63;
+    w63 = p_tip_ddot_0_2 * w12;
+    w107 = w107 - w63;
+    w94 = w94 + w107;
+    w107 = w26 * w47;
+    w63 = w31 * w95;
+    w107 = w107 + w63;
+    w63 = w79 * w83;
+    w107 = w107 + w63;
+    w63 = w65 * w110;
+    w107 = w107 + w63;
+    w63 = w43 * w47;
+    w68 = w62 * w95;
+    w63 = w63 + w68;
+    w68 = w85 * w83;
+    w63 = w63 + w68;
+    w68 = w73 * w110;
+    w63 = w63 + w68;
+    w77 = w77 / w53;
+    w77 = w77 * w96;
+    w58 = w58 / w53;
+    w58 = w58 * w60;
+    w77 = w77 - w58;
+    w87 = w87 / w53;
+    w87 = w87 * w86;
+    w77 = w77 - w87;
+    w74 = w74 / w53;
+    w74 = w74 * w71;
+    w77 = w77 + w74;
+    w53 = 1.0 / w53;
+    w77 = w77 + w53;
+    w53 = w59 * w77;
+    w63 = w63 + w53;
+    w55 = w55 * w77;
+    w53 = w55 / w39;
+    w63 = w63 + w53;
+    w53 = w22 * w63;
+    w51 = w51 * w77;
+    w53 = w53 + w51;
+    w51 = p_tip_ddot_1_2 * w53;
+    w107 = w107 + w51;
+    w51 = w36 * w63;
+    w74 = w37 * w63;
+    w49 = w49 * w77;
+    w74 = w74 - w49;
+    w49 = w74 / w27;
+    w71 = w24 * w47;
+    w87 = w45 * w95;
+    w71 = w71 + w87;
+    w87 = w81 * w83;
+    w71 = w71 + w87;
+    w87 = w69 * w110;
+    w71 = w71 + w87;
+    w87 = w56 * w77;
+    w71 = w71 + w87;
+    w49 = w49 - w71;
+    w71 = w3 * w49;
+    w51 = w51 + w71;
+    w50 = w50 * w77;
+    w51 = w51 + w50;
+    w50 = p_tip_ddot_0_1 * w51;
+    w107 = w107 - w50;
+    w50 = w52 * w77;
+    w107 = w107 + w50;
+    w50 = w22 * w49;
+    w48 = w48 * w77;
+    w50 = w50 + w48;
+    w48 = p_tip_ddot_1_1 * w50;
+    w107 = w107 + w48;
+    w48 = (-0.7071067811865475) * w107;
+    w94 = w94 - w48;
+    w48 = w14 * w35;
+    w71 = w34 * w102;
+    w48 = w48 + w71;
+    w71 = w18 * w32;
+    w48 = w48 + w71;
+    w71 = w67 * w72;
+    w48 = w48 + w71;
+    w71 = w54 * w63;
+    w48 = w48 - w71;
+    w71 = w56 * w63;
+    w87 = w24 * w35;
+    w86 = w45 * w102;
+    w87 = w87 + w86;
+    w86 = w81 * w32;
+    w87 = w87 + w86;
+    w86 = w69 * w72;
+    w87 = w87 + w86;
+    w71 = w71 - w87;
+    w62 = w62 / w39;
+    w62 = w62 * w103;
+    w43 = w43 / w39;
+    w43 = w43 * w44;
+    w62 = w62 - w43;
+    w85 = w85 / w39;
+    w85 = w85 * w89;
+    w62 = w62 - w85;
+    w73 = w73 / w39;
+    w73 = w73 * w75;
+    w62 = w62 + w73;
+    w59 = w59 / w39;
+    w59 = w59 * w55;
+    w62 = w62 + w59;
+    w39 = 1.0 / w39;
+    w62 = w62 + w39;
+    w39 = w41 * w62;
+    w71 = w71 - w39;
+    w37 = w37 * w62;
+    w39 = w37 / w27;
+    w71 = w71 - w39;
+    w39 = w22 * w71;
+    w59 = p_tip_ddot_0_1 * w39;
+    w48 = w48 + w59;
+    w59 = w22 * w62;
+    w55 = p_tip_ddot_0_2 * w59;
+    w48 = w48 - w55;
+    w55 = w40 * w62;
+    w48 = w48 + w55;
+    w36 = w36 * w62;
+    w55 = w3 * w71;
+    w36 = w36 - w55;
+    w55 = p_tip_ddot_0_0 * w36;
+    w48 = w48 + w55;
+    w94 = w94 + w48;
+    w0 = (-4.329780281177467e-17) * w94;
+    w76 = w20 * w76;
+    w48 = w14 * w23;
+    w76 = w76 - w48;
+    w48 = p_tip_ddot_0_2 * w106;
+    w76 = w76 + w48;
+    w48 = p_tip_ddot_0_1 * w9;
+    w76 = w76 + w48;
+    w48 = w14 / w93;
+    w76 = w76 + w48;
+    w93 = w20 / w93;
+    w106 = p_tip_ddot_2_2 * w106;
+    w93 = w93 + w106;
+    w9 = p_tip_ddot_1_2 * w9;
+    w93 = w93 + w9;
+    w9 = p_tip_ddot_0_2 * w11;
+    w93 = w93 + w9;
+    w93 = (-6.123233995736766e-17) * w93;
+    w76 = w76 + w93;
+    w11 = p_tip_ddot_0_0 * w11;
+    w76 = w76 + w11;
+    w33 = w46 * w33;
+    w76 = w76 + w33;
+    w33 = w34 * w100;
+    w76 = w76 - w33;
+    w33 = w18 * w78;
+    w76 = w76 - w33;
+    w80 = p_tip_ddot_0_2 * w80;
+    w76 = w76 + w80;
+    w109 = p_tip_ddot_1_2 * w109;
+    w76 = w76 + w109;
+    w92 = w82 * w92;
+    w76 = w76 + w92;
+    w2 = p_tip_ddot_2_2 * w2;
+    w76 = w76 + w2;
+    w2 = w67 * w88;
+    w76 = w76 - w2;
+    w2 = w54 * w49;
+    w76 = w76 - w2;
+    w2 = w20 * w47;
+    w92 = w46 * w95;
+    w2 = w2 + w92;
+    w92 = w82 * w83;
+    w2 = w2 + w92;
+    w92 = w70 * w110;
+    w2 = w2 + w92;
+    w92 = w57 * w77;
+    w2 = w2 + w92;
+    w92 = p_tip_ddot_2_2 * w53;
+    w2 = w2 + w92;
+    w92 = p_tip_ddot_0_2 * w51;
+    w2 = w2 - w92;
+    w92 = p_tip_ddot_1_2 * w50;
+    w2 = w2 + w92;
+    w2 = (-0.7071067811865475) * w2;
+    w76 = w76 + w2;
+    w51 = p_tip_ddot_0_0 * w51;
+    w14 = w14 * w47;
+    w34 = w34 * w95;
+    w14 = w14 + w34;
+    w18 = w18 * w83;
+    w14 = w14 + w18;
+    w67 = w67 * w110;
+    w14 = w14 + w67;
+    w53 = p_tip_ddot_0_2 * w53;
+    w14 = w14 + w53;
+    w54 = w54 * w77;
+    w14 = w14 + w54;
+    w51 = w51 - w14;
+    w50 = p_tip_ddot_0_1 * w50;
+    w51 = w51 - w50;
+    w51 = 0.7071067811865476 * w51;
+    w76 = w76 + w51;
+    w40 = w40 * w71;
+    w76 = w76 - w40;
+    w45 = w45 / w27;
+    w45 = w45 * w101;
+    w24 = w24 / w27;
+    w24 = w24 * w7;
+    w45 = w45 - w24;
+    w81 = w81 / w27;
+    w81 = w81 * w17;
+    w45 = w45 - w81;
+    w69 = w69 / w27;
+    w69 = w69 * w84;
+    w45 = w45 + w69;
+    w56 = w56 / w27;
+    w56 = w56 * w74;
+    w45 = w45 - w56;
+    w41 = w41 / w27;
+    w41 = w41 * w37;
+    w45 = w45 + w41;
+    w27 = 1.0 / w27;
+    w45 = w45 + w27;
+    w30 = w30 * w45;
+    w76 = w76 - w30;
+    w3 = w3 * w45;
+    w6 = p_tip_ddot_0_0 * w3;
+    w76 = w76 + w6;
+    w22 = w22 * w45;
+    w6 = p_tip_ddot_0_1 * w22;
+    w76 = w76 - w6;
+    w6 = (-0.7071067811865475) * w76;
+    w0 = w0 + w6;
+    w26 = w26 * w23;
+    w35 = w20 * w35;
+    w26 = w26 - w35;
+    w102 = w46 * w102;
+    w26 = w26 - w102;
+    w31 = w31 * w100;
+    w26 = w26 + w31;
+    w99 = p_tip_ddot_1_2 * w99;
+    w28 = w20 * w28;
+    w99 = w99 - w28;
+    w104 = p_tip_ddot_0_2 * w104;
+    w99 = w99 + w104;
+    w90 = w46 * w90;
+    w99 = w99 + w90;
+    w105 = p_tip_ddot_2_2 * w105;
+    w99 = w99 + w105;
+    w26 = w26 + w99;
+    w32 = w82 * w32;
+    w26 = w26 - w32;
+    w79 = w79 * w78;
+    w26 = w26 + w79;
+    w72 = w70 * w72;
+    w26 = w26 - w72;
+    w65 = w65 * w88;
+    w26 = w26 + w65;
+    w20 = w20 * w61;
+    w46 = w46 * w97;
+    w20 = w20 + w46;
+    w82 = w82 * w108;
+    w20 = w20 - w82;
+    w66 = p_tip_ddot_1_2 * w66;
+    w20 = w20 + w66;
+    w64 = p_tip_ddot_0_2 * w64;
+    w20 = w20 + w64;
+    w70 = w70 * w91;
+    w20 = w20 + w70;
+    w12 = p_tip_ddot_2_2 * w12;
+    w20 = w20 + w12;
+    w26 = w26 + w20;
+    w57 = w57 * w63;
+    w26 = w26 + w57;
+    w52 = w52 * w49;
+    w26 = w26 + w52;
+    w107 = 0.7071067811865476 * w107;
+    w26 = w26 + w107;
+    w38 = w38 * w71;
+    w26 = w26 + w38;
+    w19 = p_tip_ddot_1_2 * w39;
+    w26 = w26 - w19;
+    w42 = w42 * w62;
+    w26 = w26 - w42;
+    w21 = p_tip_ddot_2_2 * w59;
+    w26 = w26 + w21;
+    w16 = p_tip_ddot_0_2 * w36;
+    w26 = w26 - w16;
+    w5 = p_tip_ddot_0_1 * w3;
+    w26 = w26 - w5;
+    w29 = w29 * w45;
+    w26 = w26 + w29;
+    w25 = p_tip_ddot_1_1 * w22;
+    w26 = w26 + w25;
+    w26 = w26 - w15;
+    w8 = 0.7071067811865476 * w26;
+    w0 = w0 + w8;
+    gradient[10] = w0;
+    w13 = 4.329780281177466e-17 * w94;
+    w4 = (-0.7071067811865476) * w76;
+    w13 = w13 + w4;
+    w1 = (-0.7071067811865475) * w26;
+    w13 = w13 + w1;
+    gradient[11] = w13;
+    w10 = (-6.123233995736766e-17) * w26;
+    w10 = w10 - w94;
+    gradient[12] = w10;
+    gradient
+}
+
 /// The parameter-only factors of [`rigid_body_dynamics`], computed once per tool: [`rigid_body_dynamics_with`]
 /// then only combines them with the state and control (derive/toolconf_derive/hoist.py).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -79361,4 +81049,744 @@ pub fn tip(
     w43 = w43 - w28;
     jacobian[(2, 6)] = w43;
     (position, jacobian)
+}
+
+/// The tip's acceleration at zero joint acceleration, Jdot(q, q_dot) q_dot = d(J q_dot)/dq q_dot (base frame), so that y_ddot = J(q) q_ddot + tip_bias(q, q_dot): the linear part of Pinocchio's frame classical acceleration (LOCAL_WORLD_ALIGNED) at q_ddot = 0 for a frame at the tip.
+///
+/// From forward kinematics of the URDF chain, differentiated twice in time.
+///
+/// - `q`: joint positions q = [panda_joint1 panda_joint2 panda_joint3 panda_joint4 panda_joint5 panda_joint6 panda_joint7]
+/// - `q_dot`: joint velocities q_dot = [panda_joint1_dot panda_joint2_dot panda_joint3_dot panda_joint4_dot panda_joint5_dot panda_joint6_dot panda_joint7_dot]
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
+///
+/// Cost per call: 601 operations, weighted 601 (134 ADD, 342 MUL, 125 SUB), plus 7 `sin_cos`.
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_bias(
+    q: &SVector<f64, 7>,
+    q_dot: &SVector<f64, 7>,
+    params: &SVector<f64, 13>,
+) -> SVector<f64, 3> {
+    let q_dot_1 = q_dot[1];
+    let q_0 = q[0];
+    let q_1 = q[1];
+    let q_2 = q[2];
+    let q_dot_2 = q_dot[2];
+    let q_3 = q[3];
+    let q_dot_3 = q_dot[3];
+    let q_5 = q[5];
+    let q_4 = q[4];
+    let q_dot_4 = q_dot[4];
+    let q_dot_5 = q_dot[5];
+    let params_10 = params[10];
+    let q_6 = q[6];
+    let q_dot_6 = q_dot[6];
+    let params_11 = params[11];
+    let params_12 = params[12];
+    let q_dot_0 = q_dot[0];
+    let (sin_q_0, cos_q_0) = crate::trig::sin_cos(q_0);
+    let (sin_q_1, cos_q_1) = crate::trig::sin_cos(q_1);
+    let (sin_q_2, cos_q_2) = crate::trig::sin_cos(q_2);
+    let (sin_q_3, cos_q_3) = crate::trig::sin_cos(q_3);
+    let (sin_q_5, cos_q_5) = crate::trig::sin_cos(q_5);
+    let (sin_q_4, cos_q_4) = crate::trig::sin_cos(q_4);
+    let (sin_q_6, cos_q_6) = crate::trig::sin_cos(q_6);
+    // Jdot q_dot (m/s^2, base frame)
+    let mut bias = <SVector<f64, 3>>::zeros();
+    let w0: f64;
+    let w1: f64;
+    let mut w2: f64;
+    let mut w3: f64;
+    let mut w4: f64;
+    let mut w5: f64;
+    let mut w6: f64;
+    let mut w7: f64;
+    let mut w8: f64;
+    let mut w9: f64;
+    let mut w10: f64;
+    let mut w11: f64;
+    let mut w12: f64;
+    let mut w13: f64;
+    let mut w14: f64;
+    let mut w15: f64;
+    let mut w16: f64;
+    let mut w17: f64;
+    let mut w18: f64;
+    let w19: f64;
+    let mut w20: f64;
+    let mut w21: f64;
+    let mut w22: f64;
+    let mut w23: f64;
+    let mut w24: f64;
+    let mut w25: f64;
+    let mut w26: f64;
+    let mut w27: f64;
+    let mut w28: f64;
+    let mut w29: f64;
+    let mut w30: f64;
+    let mut w31: f64;
+    let mut w32: f64;
+    let mut w33: f64;
+    let mut w34: f64;
+    let mut w35: f64;
+    let mut w36: f64;
+    let mut w37: f64;
+    let mut w38: f64;
+    let mut w39: f64;
+    let mut w40: f64;
+    let mut w41: f64;
+    let mut w42: f64;
+    let mut w43: f64;
+    let mut w44: f64;
+    let mut w45: f64;
+    let mut w46: f64;
+    let mut w47: f64;
+    let mut w48: f64;
+    let mut w50: f64;
+    let mut w51: f64;
+    let mut w52: f64;
+    let mut w53: f64;
+    let mut w54: f64;
+    let mut w55: f64;
+    let mut w56: f64;
+    let mut w57: f64;
+    let mut w58: f64;
+    let mut w59: f64;
+    let mut w60: f64;
+    let mut w61: f64;
+    let mut w62: f64;
+    let mut w63: f64;
+    let mut w64: f64;
+    let mut w65: f64;
+    let mut w66: f64;
+    let mut w67: f64;
+    let mut w68: f64;
+    let mut w69: f64;
+    let mut w70: f64;
+    let mut w71: f64;
+    let mut w72: f64;
+    let mut w73: f64;
+    let mut w74: f64;
+    let mut w75: f64;
+    let mut w76: f64;
+    let mut w77: f64;
+    let mut w78: f64;
+    let mut w79: f64;
+    let mut w80: f64;
+    let mut w81: f64;
+    let mut w82: f64;
+    let mut w83: f64;
+    let mut w84: f64;
+    let mut w85: f64;
+    let mut w86: f64;
+    let mut w87: f64;
+    let mut w88: f64;
+    let mut w89: f64;
+    let mut w90: f64;
+    w6 = sin_q_1 * q_dot_1;
+    w7 = (-0.316) * w6;
+    w11 = cos_q_1 * q_dot_1;
+    w12 = cos_q_2 * w11;
+    w14 = sin_q_2 * q_dot_2;
+    w15 = sin_q_1 * w14;
+    w12 = w12 - w15;
+    w15 = 0.0825 * w12;
+    w15 = w7 - w15;
+    w20 = cos_q_3 * q_dot_3;
+    w21 = cos_q_1 * w20;
+    w22 = sin_q_3 * w6;
+    w21 = w21 - w22;
+    w22 = cos_q_3 * w12;
+    w23 = sin_q_1 * cos_q_2;
+    w24 = sin_q_3 * q_dot_3;
+    w25 = w23 * w24;
+    w22 = w22 - w25;
+    w21 = w21 - w22;
+    w22 = (-0.0825) * w21;
+    w12 = sin_q_3 * w12;
+    w26 = w23 * w20;
+    w12 = w12 + w26;
+    w26 = cos_q_3 * w6;
+    w27 = cos_q_1 * w24;
+    w26 = w26 + w27;
+    w12 = w12 - w26;
+    w26 = 0.384 * w12;
+    w22 = w22 + w26;
+    w22 = w15 + w22;
+    w31 = cos_q_4 * w21;
+    w32 = cos_q_1 * sin_q_3;
+    w33 = w23 * cos_q_3;
+    w32 = w32 - w33;
+    w34 = sin_q_4 * q_dot_4;
+    w35 = w32 * w34;
+    w31 = w31 - w35;
+    w35 = sin_q_2 * w11;
+    w36 = cos_q_2 * q_dot_2;
+    w37 = sin_q_1 * w36;
+    w35 = w35 + w37;
+    w37 = sin_q_4 * w35;
+    w38 = sin_q_1 * sin_q_2;
+    w39 = cos_q_4 * q_dot_4;
+    w40 = w38 * w39;
+    w37 = w37 + w40;
+    w31 = w31 + w37;
+    w37 = cos_q_5 * w31;
+    w40 = w32 * cos_q_4;
+    w41 = w38 * sin_q_4;
+    w40 = w40 + w41;
+    w42 = sin_q_5 * q_dot_5;
+    w43 = w40 * w42;
+    w37 = w37 - w43;
+    w43 = sin_q_5 * w12;
+    w44 = w23 * sin_q_3;
+    w45 = cos_q_1 * cos_q_3;
+    w44 = w44 + w45;
+    w45 = cos_q_5 * q_dot_5;
+    w46 = w44 * w45;
+    w43 = w43 + w46;
+    w37 = w37 + w43;
+    w43 = 0.088 * w37;
+    w43 = w22 + w43;
+    w47 = cos_q_5 * w12;
+    w48 = w44 * w42;
+    w47 = w47 - w48;
+    w31 = sin_q_5 * w31;
+    w48 = w40 * w45;
+    w31 = w31 + w48;
+    w47 = w47 - w31;
+    w31 = 0.107 * w47;
+    w31 = w43 - w31;
+    w51 = cos_q_6 * w37;
+    w52 = w40 * cos_q_5;
+    w53 = w44 * sin_q_5;
+    w52 = w52 + w53;
+    w54 = sin_q_6 * q_dot_6;
+    w55 = w52 * w54;
+    w51 = w51 - w55;
+    w55 = cos_q_4 * w35;
+    w56 = w38 * w34;
+    w55 = w55 - w56;
+    w21 = sin_q_4 * w21;
+    w56 = w32 * w39;
+    w21 = w21 + w56;
+    w55 = w55 - w21;
+    w21 = sin_q_6 * w55;
+    w56 = w38 * cos_q_4;
+    w57 = w32 * sin_q_4;
+    w56 = w56 - w57;
+    w57 = cos_q_6 * q_dot_6;
+    w58 = w56 * w57;
+    w21 = w21 + w58;
+    w51 = w51 - w21;
+    w51 = params_10 * w51;
+    w37 = sin_q_6 * w37;
+    w58 = w52 * w57;
+    w37 = w37 + w58;
+    w58 = cos_q_6 * w55;
+    w59 = w56 * w54;
+    w58 = w58 - w59;
+    w37 = w37 + w58;
+    w37 = params_11 * w37;
+    w51 = w51 - w37;
+    w58 = params_12 * w47;
+    w51 = w51 - w58;
+    w31 = w31 + w51;
+    w51 = cos_q_0 * w31;
+    w59 = (-0.316) * cos_q_1;
+    w59 = 0.333 - w59;
+    w23 = 0.0825 * w23;
+    w23 = w59 - w23;
+    w32 = (-0.0825) * w32;
+    w60 = 0.384 * w44;
+    w32 = w32 + w60;
+    w32 = w23 + w32;
+    w60 = 0.088 * w52;
+    w60 = w32 + w60;
+    w61 = w44 * cos_q_5;
+    w40 = w40 * sin_q_5;
+    w61 = w61 - w40;
+    w40 = 0.107 * w61;
+    w40 = w60 - w40;
+    w62 = w52 * cos_q_6;
+    w63 = w56 * sin_q_6;
+    w62 = w62 - w63;
+    w62 = w62 * params_10;
+    w52 = w52 * sin_q_6;
+    w63 = w56 * cos_q_6;
+    w52 = w52 + w63;
+    w52 = w52 * params_11;
+    w62 = w62 - w52;
+    w52 = w61 * params_12;
+    w62 = w62 - w52;
+    w40 = w40 + w62;
+    w58 = w40 - 0.333;
+    w52 = sin_q_0 * q_dot_0;
+    w63 = w58 * w52;
+    w51 = w51 - w63;
+    w51 = q_dot_1 * w51;
+    w63 = cos_q_0 * q_dot_0;
+    w64 = cos_q_1 * w63;
+    w65 = sin_q_0 * w6;
+    w64 = w64 - w65;
+    w65 = cos_q_2 * w64;
+    w66 = sin_q_0 * cos_q_1;
+    w67 = w66 * w14;
+    w65 = w65 - w67;
+    w67 = cos_q_0 * w36;
+    w68 = sin_q_2 * w52;
+    w67 = w67 - w68;
+    w65 = w65 + w67;
+    w67 = 0.0825 * w65;
+    w68 = sin_q_1 * w63;
+    w69 = sin_q_0 * w11;
+    w68 = w68 + w69;
+    w69 = (-0.316) * w68;
+    w67 = w67 - w69;
+    w70 = cos_q_3 * w65;
+    w71 = w66 * cos_q_2;
+    w72 = cos_q_0 * sin_q_2;
+    w71 = w71 + w72;
+    w72 = w71 * w24;
+    w70 = w70 - w72;
+    w72 = sin_q_3 * w68;
+    w73 = sin_q_0 * sin_q_1;
+    w74 = w73 * w20;
+    w72 = w72 + w74;
+    w70 = w70 + w72;
+    w72 = (-0.0825) * w70;
+    w74 = cos_q_3 * w68;
+    w75 = w73 * w24;
+    w74 = w74 - w75;
+    w65 = sin_q_3 * w65;
+    w75 = w71 * w20;
+    w65 = w65 + w75;
+    w74 = w74 - w65;
+    w65 = 0.384 * w74;
+    w72 = w72 + w65;
+    w72 = w67 + w72;
+    w65 = cos_q_4 * w70;
+    w75 = w71 * cos_q_3;
+    w76 = w73 * sin_q_3;
+    w75 = w75 + w76;
+    w76 = w75 * w34;
+    w65 = w65 - w76;
+    w76 = cos_q_0 * cos_q_2;
+    w77 = w66 * sin_q_2;
+    w76 = w76 - w77;
+    w77 = w76 * w39;
+    w78 = cos_q_2 * w52;
+    w79 = cos_q_0 * w14;
+    w78 = w78 + w79;
+    w64 = sin_q_2 * w64;
+    w66 = w66 * w36;
+    w64 = w64 + w66;
+    w78 = w78 + w64;
+    w64 = sin_q_4 * w78;
+    w77 = w77 - w64;
+    w65 = w65 + w77;
+    w77 = cos_q_5 * w65;
+    w64 = w75 * cos_q_4;
+    w66 = w76 * sin_q_4;
+    w64 = w64 + w66;
+    w66 = w64 * w42;
+    w77 = w77 - w66;
+    w66 = sin_q_5 * w74;
+    w79 = w73 * cos_q_3;
+    w80 = w71 * sin_q_3;
+    w79 = w79 - w80;
+    w80 = w79 * w45;
+    w66 = w66 + w80;
+    w77 = w77 + w66;
+    w66 = 0.088 * w77;
+    w66 = w72 + w66;
+    w80 = cos_q_5 * w74;
+    w81 = w79 * w42;
+    w80 = w80 - w81;
+    w65 = sin_q_5 * w65;
+    w81 = w64 * w45;
+    w65 = w65 + w81;
+    w80 = w80 - w65;
+    w65 = 0.107 * w80;
+    w65 = w66 - w65;
+    w81 = cos_q_6 * w77;
+    w82 = w64 * cos_q_5;
+    w83 = w79 * sin_q_5;
+    w82 = w82 + w83;
+    w83 = w82 * w54;
+    w81 = w81 - w83;
+    w83 = w76 * cos_q_4;
+    w84 = w75 * sin_q_4;
+    w83 = w83 - w84;
+    w84 = w83 * w57;
+    w85 = cos_q_4 * w78;
+    w86 = w76 * w34;
+    w85 = w85 + w86;
+    w70 = sin_q_4 * w70;
+    w86 = w75 * w39;
+    w70 = w70 + w86;
+    w85 = w85 + w70;
+    w70 = sin_q_6 * w85;
+    w84 = w84 - w70;
+    w81 = w81 - w84;
+    w81 = params_10 * w81;
+    w77 = sin_q_6 * w77;
+    w84 = w82 * w57;
+    w77 = w77 + w84;
+    w84 = cos_q_6 * w85;
+    w70 = w83 * w54;
+    w84 = w84 + w70;
+    w77 = w77 - w84;
+    w77 = params_11 * w77;
+    w81 = w81 - w77;
+    w77 = params_12 * w80;
+    w81 = w81 - w77;
+    w65 = w65 + w81;
+    w81 = q_dot_0 * w65;
+    w51 = w51 - w81;
+    w59 = w40 - w59;
+    w81 = w59 * w68;
+    w7 = w31 - w7;
+    w77 = w73 * w7;
+    w81 = w81 + w77;
+    w69 = w65 + w69;
+    w77 = cos_q_1 * w69;
+    w71 = 0.0825 * w71;
+    w84 = (-0.316) * w73;
+    w71 = w71 - w84;
+    w75 = (-0.0825) * w75;
+    w70 = 0.384 * w79;
+    w75 = w75 + w70;
+    w75 = w71 + w75;
+    w70 = 0.088 * w82;
+    w70 = w75 + w70;
+    w86 = w79 * cos_q_5;
+    w64 = w64 * sin_q_5;
+    w86 = w86 - w64;
+    w64 = 0.107 * w86;
+    w64 = w70 - w64;
+    w87 = w82 * cos_q_6;
+    w88 = w83 * sin_q_6;
+    w87 = w87 - w88;
+    w87 = w87 * params_10;
+    w82 = w82 * sin_q_6;
+    w88 = w83 * cos_q_6;
+    w82 = w82 + w88;
+    w82 = w82 * params_11;
+    w87 = w87 - w82;
+    w82 = w86 * params_12;
+    w87 = w87 - w82;
+    w64 = w64 + w87;
+    w84 = w64 + w84;
+    w87 = w84 * w6;
+    w77 = w77 - w87;
+    w81 = w81 - w77;
+    w81 = q_dot_2 * w81;
+    w51 = w51 + w81;
+    w71 = w64 - w71;
+    w81 = w71 * w35;
+    w67 = w65 - w67;
+    w77 = w38 * w67;
+    w81 = w81 + w77;
+    w15 = w31 - w15;
+    w77 = w76 * w15;
+    w23 = w40 - w23;
+    w87 = w23 * w78;
+    w77 = w77 - w87;
+    w81 = w81 - w77;
+    w81 = q_dot_3 * w81;
+    w51 = w51 + w81;
+    w32 = w40 - w32;
+    w81 = w32 * w74;
+    w22 = w31 - w22;
+    w77 = w79 * w22;
+    w81 = w81 + w77;
+    w75 = w64 - w75;
+    w77 = w75 * w12;
+    w72 = w65 - w72;
+    w87 = w44 * w72;
+    w77 = w77 + w87;
+    w81 = w81 - w77;
+    w81 = q_dot_4 * w81;
+    w51 = w51 + w81;
+    w81 = w75 * w55;
+    w77 = w56 * w72;
+    w81 = w81 + w77;
+    w77 = w83 * w22;
+    w87 = w32 * w85;
+    w77 = w77 - w87;
+    w81 = w81 - w77;
+    w81 = q_dot_5 * w81;
+    w51 = w51 + w81;
+    w70 = w64 - w70;
+    w81 = w70 * w47;
+    w66 = w65 - w66;
+    w77 = w61 * w66;
+    w81 = w81 + w77;
+    w40 = w40 - w60;
+    w60 = w40 * w80;
+    w43 = w31 - w43;
+    w77 = w86 * w43;
+    w60 = w60 + w77;
+    w81 = w81 - w60;
+    w81 = q_dot_6 * w81;
+    w51 = w51 + w81;
+    bias[0] = w51;
+    w11 = cos_q_0 * w11;
+    w51 = sin_q_1 * w52;
+    w11 = w11 - w51;
+    w51 = sin_q_3 * w11;
+    w5 = cos_q_0 * sin_q_1;
+    w81 = w5 * w20;
+    w51 = w51 + w81;
+    w81 = cos_q_1 * w52;
+    w60 = cos_q_0 * w6;
+    w81 = w81 + w60;
+    w60 = cos_q_2 * w81;
+    w77 = cos_q_0 * cos_q_1;
+    w87 = w77 * w14;
+    w60 = w60 + w87;
+    w87 = sin_q_2 * w63;
+    w82 = sin_q_0 * w36;
+    w87 = w87 + w82;
+    w60 = w60 + w87;
+    w87 = cos_q_3 * w60;
+    w82 = w77 * cos_q_2;
+    w88 = sin_q_0 * sin_q_2;
+    w82 = w82 - w88;
+    w88 = w82 * w24;
+    w87 = w87 + w88;
+    w51 = w51 - w87;
+    w87 = (-0.0825) * w51;
+    w88 = cos_q_3 * w11;
+    w24 = w5 * w24;
+    w88 = w88 - w24;
+    w20 = w82 * w20;
+    w24 = sin_q_3 * w60;
+    w20 = w20 - w24;
+    w88 = w88 - w20;
+    w20 = 0.384 * w88;
+    w87 = w87 + w20;
+    w60 = 0.0825 * w60;
+    w20 = (-0.316) * w11;
+    w60 = w60 + w20;
+    w87 = w87 - w60;
+    w24 = cos_q_4 * w51;
+    w89 = w82 * cos_q_3;
+    w90 = w5 * sin_q_3;
+    w89 = w89 + w90;
+    w90 = w89 * w34;
+    w24 = w24 - w90;
+    w36 = w77 * w36;
+    w81 = sin_q_2 * w81;
+    w36 = w36 - w81;
+    w81 = cos_q_2 * w63;
+    w14 = sin_q_0 * w14;
+    w81 = w81 - w14;
+    w36 = w36 + w81;
+    w81 = sin_q_4 * w36;
+    w77 = w77 * sin_q_2;
+    w10 = sin_q_0 * cos_q_2;
+    w77 = w77 + w10;
+    w10 = w77 * w39;
+    w81 = w81 + w10;
+    w24 = w24 - w81;
+    w81 = cos_q_5 * w24;
+    w10 = w89 * cos_q_4;
+    w9 = w77 * sin_q_4;
+    w10 = w10 - w9;
+    w9 = w10 * w42;
+    w81 = w81 - w9;
+    w9 = sin_q_5 * w88;
+    w18 = w5 * cos_q_3;
+    w17 = w82 * sin_q_3;
+    w18 = w18 - w17;
+    w17 = w18 * w45;
+    w9 = w9 + w17;
+    w81 = w81 + w9;
+    w9 = 0.088 * w81;
+    w9 = w87 + w9;
+    w17 = cos_q_5 * w88;
+    w42 = w18 * w42;
+    w17 = w17 - w42;
+    w24 = sin_q_5 * w24;
+    w45 = w10 * w45;
+    w24 = w24 + w45;
+    w17 = w17 - w24;
+    w24 = 0.107 * w17;
+    w24 = w9 - w24;
+    w45 = cos_q_6 * w81;
+    w42 = w10 * cos_q_5;
+    w14 = w18 * sin_q_5;
+    w42 = w42 + w14;
+    w14 = w42 * w54;
+    w45 = w45 - w14;
+    w51 = sin_q_4 * w51;
+    w39 = w89 * w39;
+    w51 = w51 + w39;
+    w39 = cos_q_4 * w36;
+    w34 = w77 * w34;
+    w39 = w39 - w34;
+    w51 = w51 + w39;
+    w39 = sin_q_6 * w51;
+    w29 = w89 * sin_q_4;
+    w30 = w77 * cos_q_4;
+    w29 = w29 + w30;
+    w30 = w29 * w57;
+    w39 = w39 + w30;
+    w45 = w45 + w39;
+    w45 = params_10 * w45;
+    w39 = cos_q_6 * w51;
+    w54 = w29 * w54;
+    w39 = w39 - w54;
+    w81 = sin_q_6 * w81;
+    w57 = w42 * w57;
+    w81 = w81 + w57;
+    w39 = w39 - w81;
+    w39 = params_11 * w39;
+    w45 = w45 + w39;
+    w39 = params_12 * w17;
+    w45 = w45 - w39;
+    w24 = w24 + w45;
+    w62 = q_dot_0 * w24;
+    w58 = w58 * w63;
+    w31 = sin_q_0 * w31;
+    w58 = w58 + w31;
+    w58 = q_dot_1 * w58;
+    w62 = w62 + w58;
+    w20 = w24 + w20;
+    w4 = cos_q_1 * w20;
+    w8 = 0.0825 * w82;
+    w3 = (-0.316) * w5;
+    w8 = w8 - w3;
+    w16 = (-0.0825) * w89;
+    w25 = 0.384 * w18;
+    w16 = w16 + w25;
+    w16 = w8 + w16;
+    w26 = 0.088 * w42;
+    w26 = w16 + w26;
+    w28 = w18 * cos_q_5;
+    w10 = w10 * sin_q_5;
+    w28 = w28 - w10;
+    w46 = 0.107 * w28;
+    w46 = w26 - w46;
+    w10 = w42 * cos_q_6;
+    w27 = w29 * sin_q_6;
+    w10 = w10 + w27;
+    w10 = w10 * params_10;
+    w50 = w29 * cos_q_6;
+    w42 = w42 * sin_q_6;
+    w50 = w50 - w42;
+    w50 = w50 * params_11;
+    w10 = w10 + w50;
+    w37 = w28 * params_12;
+    w10 = w10 - w37;
+    w46 = w46 + w10;
+    w3 = w46 + w3;
+    w6 = w3 * w6;
+    w4 = w4 - w6;
+    w59 = w59 * w11;
+    w7 = w5 * w7;
+    w59 = w59 + w7;
+    w4 = w4 - w59;
+    w4 = q_dot_2 * w4;
+    w62 = w62 + w4;
+    w8 = w46 - w8;
+    w35 = w8 * w35;
+    w60 = w24 + w60;
+    w38 = w38 * w60;
+    w35 = w35 + w38;
+    w23 = w23 * w36;
+    w15 = w77 * w15;
+    w23 = w23 + w15;
+    w35 = w35 + w23;
+    w35 = q_dot_3 * w35;
+    w62 = w62 - w35;
+    w16 = w46 - w16;
+    w12 = w16 * w12;
+    w87 = w24 - w87;
+    w44 = w44 * w87;
+    w12 = w12 + w44;
+    w44 = w32 * w88;
+    w35 = w18 * w22;
+    w44 = w44 + w35;
+    w12 = w12 - w44;
+    w12 = q_dot_4 * w12;
+    w62 = w62 + w12;
+    w55 = w16 * w55;
+    w56 = w56 * w87;
+    w55 = w55 + w56;
+    w32 = w32 * w51;
+    w22 = w29 * w22;
+    w32 = w32 + w22;
+    w55 = w55 + w32;
+    w55 = q_dot_5 * w55;
+    w62 = w62 - w55;
+    w40 = w40 * w17;
+    w43 = w28 * w43;
+    w40 = w40 + w43;
+    w26 = w46 - w26;
+    w47 = w26 * w47;
+    w9 = w24 - w9;
+    w61 = w61 * w9;
+    w47 = w47 + w61;
+    w40 = w40 - w47;
+    w40 = q_dot_6 * w40;
+    w62 = w62 + w40;
+    bias[1] = w62;
+    w84 = w84 * w11;
+    w5 = w5 * w69;
+    w84 = w84 + w5;
+    w3 = w3 * w68;
+    w73 = w73 * w20;
+    w3 = w3 + w73;
+    w84 = w84 - w3;
+    w13 = q_dot_2 * w84;
+    w64 = w64 * w63;
+    w1 = sin_q_0 * w65;
+    w64 = w64 + w1;
+    w2 = cos_q_0 * w24;
+    w46 = w46 * w52;
+    w2 = w2 - w46;
+    w64 = w64 + w2;
+    w0 = q_dot_1 * w64;
+    w13 = w13 - w0;
+    w71 = w71 * w36;
+    w77 = w77 * w67;
+    w71 = w71 + w77;
+    w76 = w76 * w60;
+    w8 = w8 * w78;
+    w76 = w76 - w8;
+    w71 = w71 + w76;
+    w19 = q_dot_3 * w71;
+    w13 = w13 + w19;
+    w88 = w75 * w88;
+    w18 = w18 * w72;
+    w88 = w88 + w18;
+    w74 = w16 * w74;
+    w79 = w79 * w87;
+    w74 = w74 + w79;
+    w88 = w88 - w74;
+    w33 = q_dot_4 * w88;
+    w13 = w13 + w33;
+    w75 = w75 * w51;
+    w29 = w29 * w72;
+    w75 = w75 + w29;
+    w83 = w83 * w87;
+    w16 = w16 * w85;
+    w83 = w83 - w16;
+    w75 = w75 + w83;
+    w41 = q_dot_5 * w75;
+    w13 = w13 + w41;
+    w26 = w26 * w80;
+    w86 = w86 * w9;
+    w26 = w26 + w86;
+    w70 = w70 * w17;
+    w28 = w28 * w66;
+    w70 = w70 + w28;
+    w26 = w26 - w70;
+    w53 = q_dot_6 * w26;
+    w13 = w13 + w53;
+    bias[2] = w13;
+    bias
 }

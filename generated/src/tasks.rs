@@ -12,7 +12,7 @@ use core::str::FromStr;
 use nalgebra::SMatrix;
 
 /// How many free-energy terms there are: the length of a task's goals and precisions.
-pub const TERMS: usize = 6;
+pub const TERMS: usize = 7;
 
 /// A term of the free energy F (eq. free_energy), as `derive/tasks.toml` lists them, in the
 /// order of the controller's sum (eq. U_dot_deriv). `Term::ALL[t.index()] == t`.
@@ -30,6 +30,8 @@ pub enum Term {
     Tip,
     /// "ẏ": the tool tip's velocity.
     TipDot,
+    /// "ÿ": the tool tip's acceleration.
+    TipDdot,
 }
 
 /// Where a term's value is read, for n joints: rows `block·n..(block+1)·n` of the state
@@ -53,16 +55,30 @@ impl Term {
         Term::U,
         Term::Tip,
         Term::TipDot,
+        Term::TipDdot,
     ];
 
     /// The terms a goal is given for (all but the control's), by name: the keys of a task file's
     /// `[goal]`.
-    pub const GOAL_NAMES: [&'static str; 5] =
-        ["theta", "theta_dot", "theta_ddot", "tip", "tip_dot"];
+    pub const GOAL_NAMES: [&'static str; 6] = [
+        "theta",
+        "theta_dot",
+        "theta_ddot",
+        "tip",
+        "tip_dot",
+        "tip_ddot",
+    ];
 
     /// Every term by name: the keys of a task file's `[precision]`.
-    pub const NAMES: [&'static str; TERMS] =
-        ["theta", "theta_dot", "theta_ddot", "u", "tip", "tip_dot"];
+    pub const NAMES: [&'static str; TERMS] = [
+        "theta",
+        "theta_dot",
+        "theta_ddot",
+        "u",
+        "tip",
+        "tip_dot",
+        "tip_ddot",
+    ];
 
     /// The control's own term, the one [`Read::Control`] reads.
     pub const CONTROL: Term = Term::U;
@@ -76,6 +92,7 @@ impl Term {
         Term::Theta,
         Term::Tip,
         Term::TipDot,
+        Term::TipDdot,
     ];
 
     /// The term's position in [`Term::ALL`], and in a task's goals and precisions.
@@ -94,6 +111,7 @@ impl Term {
             Term::U => "u",
             Term::Tip => "tip",
             Term::TipDot => "tip_dot",
+            Term::TipDdot => "tip_ddot",
         }
     }
 
@@ -107,6 +125,7 @@ impl Term {
             Term::U => "d_u_du",
             Term::Tip => "d_tip_du",
             Term::TipDot => "d_tip_dot_du",
+            Term::TipDdot => "d_tip_ddot_du",
         }
     }
 
@@ -120,6 +139,7 @@ impl Term {
             Term::U => "U",
             Term::Tip => "y",
             Term::TipDot => "ẏ",
+            Term::TipDdot => "ÿ",
         }
     }
 
@@ -133,6 +153,7 @@ impl Term {
             Term::U => "the control",
             Term::Tip => "the tool tip's position",
             Term::TipDot => "the tool tip's velocity",
+            Term::TipDdot => "the tool tip's acceleration",
         }
     }
 
@@ -146,6 +167,7 @@ impl Term {
             Term::U => "torque",
             Term::Tip => "tip position",
             Term::TipDot => "tip velocity",
+            Term::TipDdot => "tip acceleration",
         }
     }
 
@@ -159,6 +181,7 @@ impl Term {
             Term::U => "N m",
             Term::Tip => "m",
             Term::TipDot => "m/s",
+            Term::TipDdot => "m/s²",
         }
     }
 
@@ -172,6 +195,7 @@ impl Term {
             Term::U => Read::Control,
             Term::Tip => Read::Tip { order: 0 },
             Term::TipDot => Read::Tip { order: 1 },
+            Term::TipDdot => Read::Tip { order: 2 },
         }
     }
 
@@ -186,6 +210,7 @@ impl Term {
             Term::U => None,
             Term::Tip => Some("tip_position"),
             Term::TipDot => Some("tip_velocity"),
+            Term::TipDdot => Some("tip_acceleration"),
         }
     }
 
@@ -228,16 +253,19 @@ pub enum TaskKind {
     TipPosition,
     /// Task 5 (tip velocity control): Move the tool's tip at a goal velocity.
     TipVelocity,
+    /// Task 6 (tip acceleration control): Hold a goal acceleration of the tool's tip.
+    TipAcceleration,
 }
 
 impl TaskKind {
     /// Every task, in the order of `derive/tasks.toml`.
-    pub const ALL: [TaskKind; 5] = [
+    pub const ALL: [TaskKind; 6] = [
         TaskKind::Position,
         TaskKind::Velocity,
         TaskKind::Acceleration,
         TaskKind::TipPosition,
         TaskKind::TipVelocity,
+        TaskKind::TipAcceleration,
     ];
 
     /// The task's name in `derive/tasks.toml` (and on the command line).
@@ -249,6 +277,7 @@ impl TaskKind {
             TaskKind::Acceleration => "acceleration",
             TaskKind::TipPosition => "tip_position",
             TaskKind::TipVelocity => "tip_velocity",
+            TaskKind::TipAcceleration => "tip_acceleration",
         }
     }
 
@@ -261,6 +290,7 @@ impl TaskKind {
             TaskKind::Acceleration => 3,
             TaskKind::TipPosition => 4,
             TaskKind::TipVelocity => 5,
+            TaskKind::TipAcceleration => 6,
         }
     }
 
@@ -273,6 +303,7 @@ impl TaskKind {
             TaskKind::Acceleration => "Task 3 (acceleration control)",
             TaskKind::TipPosition => "Task 4 (tip position control)",
             TaskKind::TipVelocity => "Task 5 (tip velocity control)",
+            TaskKind::TipAcceleration => "Task 6 (tip acceleration control)",
         }
     }
 
@@ -285,6 +316,7 @@ impl TaskKind {
             TaskKind::Acceleration => "Hold a goal joint acceleration.",
             TaskKind::TipPosition => "Reach and hold a goal point with the tool's tip (zero goal tip velocity).",
             TaskKind::TipVelocity => "Move the tool's tip at a goal velocity.",
+            TaskKind::TipAcceleration => "Hold a goal acceleration of the tool's tip.",
         }
     }
 
@@ -298,6 +330,7 @@ impl TaskKind {
             TaskKind::Acceleration => &[Term::ThetaDdot, Term::U],
             TaskKind::TipPosition => &[Term::Tip, Term::TipDot, Term::U],
             TaskKind::TipVelocity => &[Term::TipDot, Term::U],
+            TaskKind::TipAcceleration => &[Term::TipDdot, Term::U],
         }
     }
 
@@ -310,6 +343,7 @@ impl TaskKind {
             TaskKind::Acceleration => Term::ThetaDdot,
             TaskKind::TipPosition => Term::Tip,
             TaskKind::TipVelocity => Term::TipDot,
+            TaskKind::TipAcceleration => Term::TipDdot,
         }
     }
 
@@ -321,8 +355,7 @@ impl TaskKind {
 }
 
 /// The names and numbers a task may be given by, as messages and `--help` list them.
-pub const TASK_CHOICES: &str =
-    "position, velocity, acceleration, tip_position or tip_velocity (or 1, 2, 3, 4, 5)";
+pub const TASK_CHOICES: &str = "position, velocity, acceleration, tip_position, tip_velocity or tip_acceleration (or 1, 2, 3, 4, 5, 6)";
 
 /// The task's name.
 impl fmt::Display for TaskKind {

@@ -184,6 +184,20 @@ pub mod tip_velocity {
     pub const PRECISION_U: f64 = 1.0;
 }
 
+/// Task 6 (tip acceleration control): the paper's default goals and precisions ("Implementation details").
+pub mod tip_acceleration {
+    #[allow(unused_imports)]
+    use super::PI;
+    /// Free-energy terms the controller uses (eq. U_dot_deriv).
+    pub const TERMS: [&str; 2] = ["tip_ddot", "u"];
+    /// Default goal for `tip_ddot`.
+    pub const GOAL_TIP_DDOT: [f64; 6] = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+    /// Default precision for `tip_ddot`: P = 10.0 I.
+    pub const PRECISION_TIP_DDOT: f64 = 10.0;
+    /// Default precision for `u`: P = 1.0 I.
+    pub const PRECISION_U: f64 = 1.0;
+}
+
 /// The default goals and precisions of `task` for this model (the modules above); zero for a
 /// term the task does not use.
 #[must_use]
@@ -197,12 +211,14 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 [0.0; DOF],
                 [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 position::PRECISION_THETA,
                 position::PRECISION_THETA_DOT,
                 position::PRECISION_THETA_DDOT,
                 position::PRECISION_U,
+                0.0,
                 0.0,
                 0.0,
             ],
@@ -215,12 +231,14 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 [0.0; DOF],
                 [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
                 velocity::PRECISION_THETA_DOT,
                 velocity::PRECISION_THETA_DDOT,
                 velocity::PRECISION_U,
+                0.0,
                 0.0,
                 0.0,
             ],
@@ -233,12 +251,14 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 [0.0; DOF],
                 [0.0; DOF],
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
                 0.0,
                 acceleration::PRECISION_THETA_DDOT,
                 acceleration::PRECISION_U,
+                0.0,
                 0.0,
                 0.0,
             ],
@@ -251,6 +271,7 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 tip_position::GOAL_TIP,
                 tip_position::GOAL_TIP_DOT,
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
@@ -259,6 +280,7 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 tip_position::PRECISION_U,
                 tip_position::PRECISION_TIP,
                 tip_position::PRECISION_TIP_DOT,
+                0.0,
             ],
         },
         super::TaskKind::TipVelocity => super::TaskDefaults {
@@ -269,6 +291,7 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 [0.0; DOF],
                 [0.0; DOF],
                 tip_velocity::GOAL_TIP_DOT,
+                [0.0; DOF],
             ],
             precision: [
                 0.0,
@@ -277,6 +300,27 @@ pub const fn task_defaults(task: super::TaskKind) -> super::TaskDefaults<DOF> {
                 tip_velocity::PRECISION_U,
                 0.0,
                 tip_velocity::PRECISION_TIP_DOT,
+                0.0,
+            ],
+        },
+        super::TaskKind::TipAcceleration => super::TaskDefaults {
+            goal: [
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                [0.0; DOF],
+                tip_acceleration::GOAL_TIP_DDOT,
+            ],
+            precision: [
+                0.0,
+                0.0,
+                0.0,
+                tip_acceleration::PRECISION_U,
+                0.0,
+                0.0,
+                tip_acceleration::PRECISION_TIP_DDOT,
             ],
         },
     }
@@ -301,6 +345,7 @@ pub fn task_sensitivities(
                     None,
                     None,
                     None,
+                    None,
                 ],
             }
         }
@@ -314,25 +359,40 @@ pub fn task_sensitivities(
                     None,
                     None,
                     None,
+                    None,
                 ],
             }
         }
         super::TaskKind::Acceleration => {
             let d_theta_ddot_du = acceleration_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, None, Some(d_theta_ddot_du), None, None, None],
+                d_du: [None, None, Some(d_theta_ddot_du), None, None, None, None],
             }
         }
         super::TaskKind::TipPosition => {
             let (d_tip_du, d_tip_dot_du) = tip_position_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, None, None, None, Some(d_tip_du), Some(d_tip_dot_du)],
+                d_du: [
+                    None,
+                    None,
+                    None,
+                    None,
+                    Some(d_tip_du),
+                    Some(d_tip_dot_du),
+                    None,
+                ],
             }
         }
         super::TaskKind::TipVelocity => {
             let d_tip_dot_du = tip_velocity_sensitivity(params);
             super::TaskSensitivities {
-                d_du: [None, None, None, None, None, Some(d_tip_dot_du)],
+                d_du: [None, None, None, None, None, Some(d_tip_dot_du), None],
+            }
+        }
+        super::TaskKind::TipAcceleration => {
+            let d_tip_ddot_du = tip_acceleration_sensitivity(params);
+            super::TaskSensitivities {
+                d_du: [None, None, None, None, None, None, Some(d_tip_ddot_du)],
             }
         }
     }
@@ -382,6 +442,11 @@ pub fn task_control_confidence(
             &precision[Term::TipDot as usize],
             &precision[Term::U as usize],
         ),
+        super::TaskKind::TipAcceleration => tip_acceleration_control_confidence(
+            params,
+            &precision[Term::TipDdot as usize],
+            &precision[Term::U as usize],
+        ),
     }
 }
 
@@ -427,6 +492,11 @@ pub fn task_logdet_gradient(
         super::TaskKind::TipVelocity => tip_velocity_logdet_gradient(
             params,
             &precision[Term::TipDot as usize],
+            &precision[Term::U as usize],
+        ),
+        super::TaskKind::TipAcceleration => tip_acceleration_logdet_gradient(
+            params,
+            &precision[Term::TipDdot as usize],
             &precision[Term::U as usize],
         ),
     }
@@ -49823,6 +49893,1251 @@ pub fn tip_velocity_logdet_gradient(
     gradient
 }
 
+/// Task 6 (tip acceleration control): the sensitivities d(task variable)/dU the controller uses, in the order (d_tip_ddot_du).
+///
+/// From appendix "Task specific controllers".
+///
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
+///
+/// Cost per call: 32 operations, weighted 32 (7 ADD, 10 MUL, 6 NEG, 9 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_acceleration_sensitivity(params: &SVector<f64, 13>) -> SMatrix<f64, 6, 6> {
+    let params_12 = params[12];
+    let params_10 = params[10];
+    let params_11 = params[11];
+    // dtip_ddot/dU = J @ IO @ (A @ A @ dX_dU + A @ B)
+    let mut d_tip_ddot_du = <SMatrix<f64, 6, 6>>::zeros();
+    let mut w0: f64;
+    let w1: f64;
+    let w2: f64;
+    let mut w3: f64;
+    let mut w4: f64;
+    let mut w5: f64;
+    let w6: f64;
+    let mut w7: f64;
+    let mut w8: f64;
+    w3 = 6.123233995736766e-17 * params_12;
+    w3 = w3 - params_10;
+    w0 = 0.10915 + w3;
+    w0 = -w0;
+    d_tip_ddot_du[(0, 0)] = w0;
+    w5 = (-3.749399456654644e-33) * params_10;
+    w5 = w5 - params_11;
+    w8 = (-6.123233995736766e-17) * params_12;
+    w5 = w5 + w8;
+    w0 = 0.4869 + w5;
+    d_tip_ddot_du[(1, 0)] = w0;
+    w4 = (-6.123233995736766e-17) * params_10;
+    w6 = 6.123233995736766e-17 * params_11;
+    w4 = w4 + w6;
+    w4 = w4 - params_12;
+    w8 = 0.43185900000000005 + w4;
+    w4 = w8 - 0.089159;
+    d_tip_ddot_du[(0, 1)] = w4;
+    w4 = -w0;
+    d_tip_ddot_du[(2, 1)] = w4;
+    w8 = w8 - 0.514159;
+    d_tip_ddot_du[(0, 2)] = w8;
+    w4 = w0 - 2.6023744481881253e-17;
+    w4 = -w4;
+    d_tip_ddot_du[(2, 2)] = w4;
+    d_tip_ddot_du[(0, 3)] = w8;
+    w0 = w0 - 0.39225;
+    w4 = -w0;
+    d_tip_ddot_du[(2, 3)] = w4;
+    w4 = (-6.123233995736766e-17) * w3;
+    w2 = -w4;
+    d_tip_ddot_du[(0, 4)] = w2;
+    w0 = (-6.123233995736766e-17) * w0;
+    w0 = w0 - w8;
+    d_tip_ddot_du[(1, 4)] = w0;
+    d_tip_ddot_du[(2, 4)] = w3;
+    w0 = 6.123233995736766e-17 * w8;
+    w0 = w0 + w3;
+    d_tip_ddot_du[(0, 5)] = w0;
+    w7 = (-6.123233995736766e-17) * w8;
+    w7 = w5 + w7;
+    w7 = -w7;
+    d_tip_ddot_du[(1, 5)] = w7;
+    w1 = 6.123233995736766e-17 * w5;
+    w4 = w4 - w1;
+    d_tip_ddot_du[(2, 5)] = w4;
+    d_tip_ddot_du
+}
+
+/// Task 6 (tip acceleration control): the control confidence Pi^U = d2F/dU2 = S_tip_ddot^T P_tip_ddot S_tip_ddot + P_u.
+///
+/// From eq. (control_conf) and the closed forms after it.
+///
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
+/// - `p_tip_ddot`: precision P of the tool tip's acceleration tip_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 191 operations, weighted 191 (45 ADD, 98 MUL, 48 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_acceleration_control_confidence(
+    params: &SVector<f64, 13>,
+    p_tip_ddot: &SMatrix<f64, 6, 6>,
+    p_u: &SMatrix<f64, 6, 6>,
+) -> SMatrix<f64, 6, 6> {
+    let p_u_0_0 = p_u[(0, 0)];
+    let params_10 = params[10];
+    let params_11 = params[11];
+    let params_12 = params[12];
+    let p_tip_ddot_1_1 = p_tip_ddot[(1, 1)];
+    let p_tip_ddot_0_1 = p_tip_ddot[(0, 1)];
+    let p_tip_ddot_0_0 = p_tip_ddot[(0, 0)];
+    let p_u_0_1 = p_u[(0, 1)];
+    let p_tip_ddot_1_2 = p_tip_ddot[(1, 2)];
+    let p_tip_ddot_0_2 = p_tip_ddot[(0, 2)];
+    let p_u_1_1 = p_u[(1, 1)];
+    let p_tip_ddot_2_2 = p_tip_ddot[(2, 2)];
+    let p_u_0_2 = p_u[(0, 2)];
+    let p_u_1_2 = p_u[(1, 2)];
+    let p_u_2_2 = p_u[(2, 2)];
+    let p_u_0_3 = p_u[(0, 3)];
+    let p_u_1_3 = p_u[(1, 3)];
+    let p_u_2_3 = p_u[(2, 3)];
+    let p_u_3_3 = p_u[(3, 3)];
+    let p_u_0_4 = p_u[(0, 4)];
+    let p_u_1_4 = p_u[(1, 4)];
+    let p_u_2_4 = p_u[(2, 4)];
+    let p_u_3_4 = p_u[(3, 4)];
+    let p_u_4_4 = p_u[(4, 4)];
+    let p_u_0_5 = p_u[(0, 5)];
+    let p_u_1_5 = p_u[(1, 5)];
+    let p_u_2_5 = p_u[(2, 5)];
+    let p_u_3_5 = p_u[(3, 5)];
+    let p_u_4_5 = p_u[(4, 5)];
+    let p_u_5_5 = p_u[(5, 5)];
+    // Pi^U (symmetric)
+    let mut pi_u = <SMatrix<f64, 6, 6>>::zeros();
+    let mut w0: f64;
+    let mut w1: f64;
+    let mut w2: f64;
+    let mut w3: f64;
+    let w4: f64;
+    let mut w5: f64;
+    let mut w6: f64;
+    let mut w7: f64;
+    let mut w8: f64;
+    let mut w9: f64;
+    let w10: f64;
+    let mut w11: f64;
+    let mut w12: f64;
+    let mut w13: f64;
+    let mut w14: f64;
+    let mut w15: f64;
+    let mut w16: f64;
+    let mut w18: f64;
+    let mut w19: f64;
+    let w20: f64;
+    let mut w21: f64;
+    let mut w22: f64;
+    let mut w23: f64;
+    let mut w24: f64;
+    let mut w25: f64;
+    let mut w26: f64;
+    let mut w27: f64;
+    let mut w28: f64;
+    let mut w29: f64;
+    w2 = (-3.749399456654644e-33) * params_10;
+    w2 = w2 - params_11;
+    w7 = (-6.123233995736766e-17) * params_12;
+    w2 = w2 + w7;
+    w1 = 0.4869 + w2;
+    w8 = w1 * p_tip_ddot_1_1;
+    w11 = 6.123233995736766e-17 * params_12;
+    w11 = w11 - params_10;
+    w9 = 0.10915 + w11;
+    w13 = w9 * p_tip_ddot_0_1;
+    w8 = w8 - w13;
+    w13 = w8 * w1;
+    w14 = w1 * p_tip_ddot_0_1;
+    w16 = w9 * p_tip_ddot_0_0;
+    w14 = w14 - w16;
+    w16 = w14 * w9;
+    w13 = w13 - w16;
+    w0 = p_u_0_0 + w13;
+    pi_u[(0, 0)] = w0;
+    w3 = (-6.123233995736766e-17) * params_10;
+    w4 = 6.123233995736766e-17 * params_11;
+    w3 = w3 + w4;
+    w3 = w3 - params_12;
+    w13 = 0.43185900000000005 + w3;
+    w3 = w13 - 0.089159;
+    w6 = w14 * w3;
+    w16 = w1 * p_tip_ddot_1_2;
+    w9 = w9 * p_tip_ddot_0_2;
+    w9 = w16 - w9;
+    w18 = w9 * w1;
+    w6 = w6 - w18;
+    w0 = p_u_0_1 + w6;
+    pi_u[(0, 1)] = w0;
+    w6 = w3 * p_tip_ddot_0_0;
+    w18 = w1 * p_tip_ddot_0_2;
+    w6 = w6 - w18;
+    w18 = w6 * w3;
+    w19 = w3 * p_tip_ddot_0_2;
+    w21 = w1 * p_tip_ddot_2_2;
+    w19 = w19 - w21;
+    w21 = w19 * w1;
+    w18 = w18 - w21;
+    w0 = p_u_1_1 + w18;
+    pi_u[(1, 1)] = w0;
+    w13 = w13 - 0.514159;
+    w18 = w14 * w13;
+    w21 = w1 - 2.6023744481881253e-17;
+    w22 = w9 * w21;
+    w22 = w18 - w22;
+    w0 = p_u_0_2 + w22;
+    pi_u[(0, 2)] = w0;
+    w22 = w6 * w13;
+    w23 = w19 * w21;
+    w23 = w22 - w23;
+    w0 = p_u_1_2 + w23;
+    pi_u[(1, 2)] = w0;
+    w23 = w13 * p_tip_ddot_0_0;
+    w24 = w21 * p_tip_ddot_0_2;
+    w24 = w23 - w24;
+    w25 = w24 * w13;
+    w26 = w13 * p_tip_ddot_0_2;
+    w27 = w21 * p_tip_ddot_2_2;
+    w27 = w26 - w27;
+    w28 = w27 * w21;
+    w28 = w25 - w28;
+    w0 = p_u_2_2 + w28;
+    pi_u[(2, 2)] = w0;
+    w1 = w1 - 0.39225;
+    w28 = w9 * w1;
+    w18 = w18 - w28;
+    w0 = p_u_0_3 + w18;
+    pi_u[(0, 3)] = w0;
+    w18 = w19 * w1;
+    w22 = w22 - w18;
+    w0 = p_u_1_3 + w22;
+    pi_u[(1, 3)] = w0;
+    w22 = w27 * w1;
+    w25 = w25 - w22;
+    w0 = p_u_2_3 + w25;
+    pi_u[(2, 3)] = w0;
+    w25 = w1 * p_tip_ddot_0_2;
+    w23 = w23 - w25;
+    w25 = w23 * w13;
+    w22 = w1 * p_tip_ddot_2_2;
+    w26 = w26 - w22;
+    w22 = w26 * w1;
+    w25 = w25 - w22;
+    w0 = p_u_3_3 + w25;
+    pi_u[(3, 3)] = w0;
+    w25 = (-6.123233995736766e-17) * w1;
+    w25 = w25 - w13;
+    w22 = w8 * w25;
+    w18 = (-6.123233995736766e-17) * w11;
+    w28 = w14 * w18;
+    w22 = w22 - w28;
+    w28 = w9 * w11;
+    w22 = w22 + w28;
+    w0 = p_u_0_4 + w22;
+    pi_u[(0, 4)] = w0;
+    w3 = w3 * p_tip_ddot_0_1;
+    w3 = w3 - w16;
+    w16 = w3 * w25;
+    w22 = w6 * w18;
+    w16 = w16 - w22;
+    w22 = w19 * w11;
+    w16 = w16 + w22;
+    w0 = p_u_1_4 + w16;
+    pi_u[(1, 4)] = w0;
+    w16 = w13 * p_tip_ddot_0_1;
+    w21 = w21 * p_tip_ddot_1_2;
+    w21 = w16 - w21;
+    w22 = w21 * w25;
+    w28 = w24 * w18;
+    w22 = w22 - w28;
+    w28 = w27 * w11;
+    w22 = w22 + w28;
+    w0 = p_u_2_4 + w22;
+    pi_u[(2, 4)] = w0;
+    w1 = w1 * p_tip_ddot_1_2;
+    w16 = w16 - w1;
+    w1 = w16 * w25;
+    w22 = w23 * w18;
+    w1 = w1 - w22;
+    w22 = w26 * w11;
+    w1 = w1 + w22;
+    w0 = p_u_3_4 + w1;
+    pi_u[(3, 4)] = w0;
+    w1 = w25 * p_tip_ddot_1_1;
+    w22 = w18 * p_tip_ddot_0_1;
+    w1 = w1 - w22;
+    w22 = w11 * p_tip_ddot_1_2;
+    w1 = w1 + w22;
+    w22 = w1 * w25;
+    w28 = w25 * p_tip_ddot_0_1;
+    w29 = w18 * p_tip_ddot_0_0;
+    w28 = w28 - w29;
+    w29 = w11 * p_tip_ddot_0_2;
+    w28 = w28 + w29;
+    w29 = w28 * w18;
+    w22 = w22 - w29;
+    w25 = w25 * p_tip_ddot_1_2;
+    w29 = w18 * p_tip_ddot_0_2;
+    w25 = w25 - w29;
+    w29 = w11 * p_tip_ddot_2_2;
+    w25 = w25 + w29;
+    w29 = w25 * w11;
+    w22 = w22 + w29;
+    w0 = p_u_4_4 + w22;
+    pi_u[(4, 4)] = w0;
+    w22 = 6.123233995736766e-17 * w13;
+    w22 = w22 + w11;
+    w14 = w14 * w22;
+    w5 = (-6.123233995736766e-17) * w13;
+    w5 = w2 + w5;
+    w8 = w8 * w5;
+    w14 = w14 - w8;
+    w10 = 6.123233995736766e-17 * w2;
+    w18 = w18 - w10;
+    w9 = w9 * w18;
+    w14 = w14 + w9;
+    w0 = p_u_0_5 + w14;
+    pi_u[(0, 5)] = w0;
+    w6 = w6 * w22;
+    w3 = w3 * w5;
+    w6 = w6 - w3;
+    w19 = w19 * w18;
+    w6 = w6 + w19;
+    w0 = p_u_1_5 + w6;
+    pi_u[(1, 5)] = w0;
+    w24 = w24 * w22;
+    w21 = w21 * w5;
+    w24 = w24 - w21;
+    w27 = w27 * w18;
+    w24 = w24 + w27;
+    w0 = p_u_2_5 + w24;
+    pi_u[(2, 5)] = w0;
+    w23 = w23 * w22;
+    w16 = w16 * w5;
+    w23 = w23 - w16;
+    w26 = w26 * w18;
+    w23 = w23 + w26;
+    w0 = p_u_3_5 + w23;
+    pi_u[(3, 5)] = w0;
+    w28 = w28 * w22;
+    w1 = w1 * w5;
+    w28 = w28 - w1;
+    w25 = w25 * w18;
+    w28 = w28 + w25;
+    w0 = p_u_4_5 + w28;
+    pi_u[(4, 5)] = w0;
+    w15 = w22 * p_tip_ddot_0_0;
+    w28 = w5 * p_tip_ddot_0_1;
+    w15 = w15 - w28;
+    w28 = w18 * p_tip_ddot_0_2;
+    w15 = w15 + w28;
+    w15 = w15 * w22;
+    w12 = w22 * p_tip_ddot_0_1;
+    w7 = w5 * p_tip_ddot_1_1;
+    w12 = w12 - w7;
+    w7 = w18 * p_tip_ddot_1_2;
+    w12 = w12 + w7;
+    w12 = w12 * w5;
+    w15 = w15 - w12;
+    w22 = w22 * p_tip_ddot_0_2;
+    w5 = w5 * p_tip_ddot_1_2;
+    w22 = w22 - w5;
+    w20 = w18 * p_tip_ddot_2_2;
+    w22 = w22 + w20;
+    w22 = w22 * w18;
+    w15 = w15 + w22;
+    w0 = p_u_5_5 + w15;
+    pi_u[(5, 5)] = w0;
+    pi_u[(1, 0)] = pi_u[(0, 1)];
+    pi_u[(2, 0)] = pi_u[(0, 2)];
+    pi_u[(3, 0)] = pi_u[(0, 3)];
+    pi_u[(4, 0)] = pi_u[(0, 4)];
+    pi_u[(5, 0)] = pi_u[(0, 5)];
+    pi_u[(2, 1)] = pi_u[(1, 2)];
+    pi_u[(3, 1)] = pi_u[(1, 3)];
+    pi_u[(4, 1)] = pi_u[(1, 4)];
+    pi_u[(5, 1)] = pi_u[(1, 5)];
+    pi_u[(3, 2)] = pi_u[(2, 3)];
+    pi_u[(4, 2)] = pi_u[(2, 4)];
+    pi_u[(5, 2)] = pi_u[(2, 5)];
+    pi_u[(4, 3)] = pi_u[(3, 4)];
+    pi_u[(5, 3)] = pi_u[(3, 5)];
+    pi_u[(5, 4)] = pi_u[(4, 5)];
+    pi_u
+}
+
+/// Task 6 (tip acceleration control): the gradient of the confidence term, d ln|Pi^U| / dp = tr((Pi^U)^-1 dPi^U/dp_i) for every tool parameter p_i (by reverse-mode AD of sum ln D_ii, Pi^U = L D L^T), what a tool design search climbs.
+///
+/// From eq. (control_conf) differentiated in the tool parameters.
+///
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
+/// - `p_tip_ddot`: precision P of the tool tip's acceleration tip_ddot (symmetric; the upper triangle is read)
+/// - `p_u`: precision P of the control u (symmetric; the upper triangle is read)
+///
+/// Cost per call: 708 operations, weighted 1170 (163 ADD, 66 DIV, 334 MUL, 145 SUB).
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_acceleration_logdet_gradient(
+    params: &SVector<f64, 13>,
+    p_tip_ddot: &SMatrix<f64, 6, 6>,
+    p_u: &SMatrix<f64, 6, 6>,
+) -> SVector<f64, 13> {
+    let p_tip_ddot_0_2 = p_tip_ddot[(0, 2)];
+    let params_12 = params[12];
+    let params_10 = params[10];
+    let params_11 = params[11];
+    let p_u_5_5 = p_u[(5, 5)];
+    let p_tip_ddot_0_0 = p_tip_ddot[(0, 0)];
+    let p_tip_ddot_0_1 = p_tip_ddot[(0, 1)];
+    let p_tip_ddot_1_1 = p_tip_ddot[(1, 1)];
+    let p_tip_ddot_1_2 = p_tip_ddot[(1, 2)];
+    let p_tip_ddot_2_2 = p_tip_ddot[(2, 2)];
+    let p_u_0_5 = p_u[(0, 5)];
+    let p_u_0_0 = p_u[(0, 0)];
+    let p_u_1_5 = p_u[(1, 5)];
+    let p_u_0_1 = p_u[(0, 1)];
+    let p_u_1_1 = p_u[(1, 1)];
+    let p_u_2_5 = p_u[(2, 5)];
+    let p_u_0_2 = p_u[(0, 2)];
+    let p_u_1_2 = p_u[(1, 2)];
+    let p_u_2_2 = p_u[(2, 2)];
+    let p_u_3_5 = p_u[(3, 5)];
+    let p_u_0_3 = p_u[(0, 3)];
+    let p_u_1_3 = p_u[(1, 3)];
+    let p_u_2_3 = p_u[(2, 3)];
+    let p_u_3_3 = p_u[(3, 3)];
+    let p_u_4_5 = p_u[(4, 5)];
+    let p_u_0_4 = p_u[(0, 4)];
+    let p_u_1_4 = p_u[(1, 4)];
+    let p_u_2_4 = p_u[(2, 4)];
+    let p_u_3_4 = p_u[(3, 4)];
+    let p_u_4_4 = p_u[(4, 4)];
+    // d ln|Pi^U| / dp, one entry per tool parameter
+    let mut gradient = <SVector<f64, 13>>::zeros();
+    let w0: f64;
+    let mut w1: f64;
+    let w2: f64;
+    let mut w3: f64;
+    let mut w4: f64;
+    let mut w5: f64;
+    let mut w6: f64;
+    let w7: f64;
+    let mut w8: f64;
+    let mut w9: f64;
+    let mut w10: f64;
+    let mut w11: f64;
+    let mut w12: f64;
+    let mut w13: f64;
+    let mut w14: f64;
+    let w15: f64;
+    let mut w16: f64;
+    let mut w17: f64;
+    let w18: f64;
+    let mut w19: f64;
+    let mut w20: f64;
+    let mut w21: f64;
+    let mut w22: f64;
+    let mut w23: f64;
+    let mut w24: f64;
+    let mut w25: f64;
+    let mut w26: f64;
+    let mut w27: f64;
+    let mut w28: f64;
+    let mut w29: f64;
+    let mut w30: f64;
+    let mut w31: f64;
+    let mut w32: f64;
+    let mut w33: f64;
+    let mut w34: f64;
+    let mut w35: f64;
+    let mut w36: f64;
+    let mut w37: f64;
+    let mut w38: f64;
+    let mut w39: f64;
+    let mut w40: f64;
+    let mut w41: f64;
+    let mut w42: f64;
+    let mut w43: f64;
+    let mut w44: f64;
+    let mut w45: f64;
+    let mut w46: f64;
+    let mut w47: f64;
+    let mut w48: f64;
+    let mut w49: f64;
+    let mut w50: f64;
+    let mut w51: f64;
+    let mut w52: f64;
+    let mut w53: f64;
+    let mut w54: f64;
+    let mut w55: f64;
+    let mut w56: f64;
+    let mut w57: f64;
+    let mut w58: f64;
+    let mut w59: f64;
+    let mut w60: f64;
+    let mut w61: f64;
+    let mut w62: f64;
+    let mut w63: f64;
+    let mut w64: f64;
+    let mut w65: f64;
+    let mut w66: f64;
+    let mut w67: f64;
+    let mut w68: f64;
+    let mut w69: f64;
+    let mut w70: f64;
+    let mut w71: f64;
+    let mut w72: f64;
+    let mut w73: f64;
+    let mut w74: f64;
+    let mut w75: f64;
+    let mut w76: f64;
+    let mut w77: f64;
+    let mut w78: f64;
+    let mut w79: f64;
+    let mut w80: f64;
+    let mut w81: f64;
+    let mut w82: f64;
+    let mut w83: f64;
+    let mut w84: f64;
+    let mut w85: f64;
+    let mut w86: f64;
+    let mut w87: f64;
+    let mut w88: f64;
+    let w89: f64;
+    gradient[0] = 0.0;
+    gradient[1] = 0.0;
+    gradient[2] = 0.0;
+    gradient[3] = 0.0;
+    gradient[4] = 0.0;
+    gradient[5] = 0.0;
+    gradient[6] = 0.0;
+    gradient[7] = 0.0;
+    gradient[8] = 0.0;
+    gradient[9] = 0.0;
+    w4 = 6.123233995736766e-17 * params_12;
+    w4 = w4 - params_10;
+    w6 = (-6.123233995736766e-17) * w4;
+    w8 = (-3.749399456654644e-33) * params_10;
+    w8 = w8 - params_11;
+    w10 = (-6.123233995736766e-17) * params_12;
+    w8 = w8 + w10;
+    w10 = 6.123233995736766e-17 * w8;
+    w10 = w6 - w10;
+    w5 = (-6.123233995736766e-17) * params_10;
+    w9 = 6.123233995736766e-17 * params_11;
+    w5 = w5 + w9;
+    w5 = w5 - params_12;
+    w12 = 0.43185900000000005 + w5;
+    w5 = w12 - 0.514159;
+    w3 = 6.123233995736766e-17 * w5;
+    w3 = w3 + w4;
+    w13 = w3 * p_tip_ddot_0_0;
+    w14 = (-6.123233995736766e-17) * w5;
+    w14 = w8 + w14;
+    w16 = w14 * p_tip_ddot_0_1;
+    w13 = w13 - w16;
+    w16 = w10 * p_tip_ddot_0_2;
+    w13 = w13 + w16;
+    w16 = w13 * w3;
+    w17 = w3 * p_tip_ddot_0_1;
+    w19 = w14 * p_tip_ddot_1_1;
+    w17 = w17 - w19;
+    w20 = w10 * p_tip_ddot_1_2;
+    w17 = w17 + w20;
+    w20 = w17 * w14;
+    w16 = w16 - w20;
+    w20 = w3 * p_tip_ddot_0_2;
+    w21 = w14 * p_tip_ddot_1_2;
+    w20 = w20 - w21;
+    w22 = w10 * p_tip_ddot_2_2;
+    w20 = w20 + w22;
+    w22 = w20 * w10;
+    w16 = w16 + w22;
+    w11 = p_u_5_5 + w16;
+    w22 = 0.4869 + w8;
+    w8 = w17 * w22;
+    w23 = 0.10915 + w4;
+    w24 = w13 * w23;
+    w8 = w8 - w24;
+    w16 = p_u_0_5 + w8;
+    w24 = w22 * p_tip_ddot_1_1;
+    w25 = w23 * p_tip_ddot_0_1;
+    w24 = w24 - w25;
+    w25 = w24 * w22;
+    w26 = w22 * p_tip_ddot_0_1;
+    w27 = w23 * p_tip_ddot_0_0;
+    w26 = w26 - w27;
+    w27 = w26 * w23;
+    w25 = w25 - w27;
+    w8 = p_u_0_0 + w25;
+    w25 = w16 / w8;
+    w27 = w16 * w25;
+    w12 = w12 - 0.089159;
+    w29 = w13 * w12;
+    w30 = w20 * w22;
+    w29 = w29 - w30;
+    w28 = p_u_1_5 + w29;
+    w30 = w12 * p_tip_ddot_0_1;
+    w31 = w22 * p_tip_ddot_1_2;
+    w30 = w30 - w31;
+    w31 = w30 * w22;
+    w32 = w12 * p_tip_ddot_0_0;
+    w33 = w22 * p_tip_ddot_0_2;
+    w32 = w32 - w33;
+    w33 = w32 * w23;
+    w31 = w31 - w33;
+    w29 = p_u_0_1 + w31;
+    w31 = w25 * w29;
+    w28 = w28 - w31;
+    w33 = w32 * w12;
+    w34 = w12 * p_tip_ddot_0_2;
+    w35 = w22 * p_tip_ddot_2_2;
+    w34 = w34 - w35;
+    w35 = w34 * w22;
+    w33 = w33 - w35;
+    w31 = p_u_1_1 + w33;
+    w33 = w29 / w8;
+    w35 = w29 * w33;
+    w31 = w31 - w35;
+    w35 = w28 / w31;
+    w36 = w28 * w35;
+    w27 = w27 + w36;
+    w37 = w13 * w5;
+    w38 = w22 - 2.6023744481881253e-17;
+    w39 = w20 * w38;
+    w39 = w37 - w39;
+    w36 = p_u_2_5 + w39;
+    w40 = w5 * p_tip_ddot_0_1;
+    w41 = w38 * p_tip_ddot_1_2;
+    w41 = w40 - w41;
+    w42 = w41 * w22;
+    w43 = w5 * p_tip_ddot_0_0;
+    w44 = w38 * p_tip_ddot_0_2;
+    w44 = w43 - w44;
+    w45 = w44 * w23;
+    w42 = w42 - w45;
+    w39 = p_u_0_2 + w42;
+    w42 = w25 * w39;
+    w46 = w44 * w12;
+    w47 = w5 * p_tip_ddot_0_2;
+    w48 = w38 * p_tip_ddot_2_2;
+    w48 = w47 - w48;
+    w49 = w48 * w22;
+    w46 = w46 - w49;
+    w45 = p_u_1_2 + w46;
+    w46 = w39 / w8;
+    w49 = w46 * w29;
+    w45 = w45 - w49;
+    w49 = w35 * w45;
+    w42 = w42 + w49;
+    w36 = w36 - w42;
+    w49 = w44 * w5;
+    w50 = w48 * w38;
+    w49 = w49 - w50;
+    w42 = p_u_2_2 + w49;
+    w49 = w39 * w46;
+    w50 = w45 / w31;
+    w51 = w45 * w50;
+    w49 = w49 + w51;
+    w42 = w42 - w49;
+    w49 = w36 / w42;
+    w51 = w36 * w49;
+    w27 = w27 + w51;
+    w52 = w22 - 0.39225;
+    w53 = w20 * w52;
+    w37 = w37 - w53;
+    w51 = p_u_3_5 + w37;
+    w53 = w52 * p_tip_ddot_1_2;
+    w40 = w40 - w53;
+    w53 = w40 * w22;
+    w54 = w52 * p_tip_ddot_0_2;
+    w43 = w43 - w54;
+    w54 = w43 * w23;
+    w53 = w53 - w54;
+    w37 = p_u_0_3 + w53;
+    w53 = w25 * w37;
+    w55 = w43 * w12;
+    w56 = w52 * p_tip_ddot_2_2;
+    w47 = w47 - w56;
+    w56 = w47 * w22;
+    w55 = w55 - w56;
+    w54 = p_u_1_3 + w55;
+    w55 = w37 / w8;
+    w56 = w55 * w29;
+    w54 = w54 - w56;
+    w56 = w35 * w54;
+    w53 = w53 + w56;
+    w57 = w43 * w5;
+    w58 = w47 * w38;
+    w58 = w57 - w58;
+    w56 = p_u_2_3 + w58;
+    w58 = w55 * w39;
+    w59 = w54 / w31;
+    w60 = w59 * w45;
+    w58 = w58 + w60;
+    w56 = w56 - w58;
+    w58 = w49 * w56;
+    w53 = w53 + w58;
+    w51 = w51 - w53;
+    w58 = w47 * w52;
+    w57 = w57 - w58;
+    w53 = p_u_3_3 + w57;
+    w57 = w37 * w55;
+    w58 = w54 * w59;
+    w57 = w57 + w58;
+    w58 = w56 / w42;
+    w60 = w56 * w58;
+    w57 = w57 + w60;
+    w53 = w53 - w57;
+    w57 = w51 / w53;
+    w60 = w51 * w57;
+    w27 = w27 + w60;
+    w61 = (-6.123233995736766e-17) * w52;
+    w61 = w61 - w5;
+    w62 = w17 * w61;
+    w63 = w13 * w6;
+    w62 = w62 - w63;
+    w63 = w20 * w4;
+    w62 = w62 + w63;
+    w60 = p_u_4_5 + w62;
+    w63 = w61 * p_tip_ddot_1_1;
+    w64 = w6 * p_tip_ddot_0_1;
+    w63 = w63 - w64;
+    w64 = w4 * p_tip_ddot_1_2;
+    w63 = w63 + w64;
+    w64 = w63 * w22;
+    w65 = w61 * p_tip_ddot_0_1;
+    w66 = w6 * p_tip_ddot_0_0;
+    w65 = w65 - w66;
+    w66 = w4 * p_tip_ddot_0_2;
+    w65 = w65 + w66;
+    w66 = w65 * w23;
+    w64 = w64 - w66;
+    w62 = p_u_0_4 + w64;
+    w64 = w25 * w62;
+    w67 = w65 * w12;
+    w68 = w61 * p_tip_ddot_1_2;
+    w69 = w6 * p_tip_ddot_0_2;
+    w68 = w68 - w69;
+    w69 = w4 * p_tip_ddot_2_2;
+    w68 = w68 + w69;
+    w69 = w68 * w22;
+    w67 = w67 - w69;
+    w66 = p_u_1_4 + w67;
+    w67 = w62 / w8;
+    w69 = w67 * w29;
+    w66 = w66 - w69;
+    w69 = w35 * w66;
+    w64 = w64 + w69;
+    w70 = w65 * w5;
+    w71 = w68 * w38;
+    w71 = w70 - w71;
+    w69 = p_u_2_4 + w71;
+    w71 = w67 * w39;
+    w72 = w66 / w31;
+    w73 = w72 * w45;
+    w71 = w71 + w73;
+    w69 = w69 - w71;
+    w71 = w49 * w69;
+    w64 = w64 + w71;
+    w73 = w68 * w52;
+    w70 = w70 - w73;
+    w71 = p_u_3_4 + w70;
+    w70 = w67 * w37;
+    w73 = w72 * w54;
+    w70 = w70 + w73;
+    w73 = w69 / w42;
+    w74 = w73 * w56;
+    w70 = w70 + w74;
+    w71 = w71 - w70;
+    w70 = w57 * w71;
+    w64 = w64 + w70;
+    w60 = w60 - w64;
+    w70 = w63 * w61;
+    w74 = w65 * w6;
+    w70 = w70 - w74;
+    w74 = w68 * w4;
+    w70 = w70 + w74;
+    w64 = p_u_4_4 + w70;
+    w70 = w62 * w67;
+    w74 = w66 * w72;
+    w70 = w70 + w74;
+    w74 = w69 * w73;
+    w70 = w70 + w74;
+    w74 = w71 / w53;
+    w75 = w71 * w74;
+    w70 = w70 + w75;
+    w64 = w64 - w70;
+    w70 = w60 / w64;
+    w75 = w60 * w70;
+    w27 = w27 + w75;
+    w11 = w11 - w27;
+    w10 = w10 / w11;
+    w27 = w70 / w11;
+    w60 = w60 / w11;
+    w75 = w60 / w64;
+    w27 = w27 + w75;
+    w75 = w4 * w27;
+    w76 = w71 * w27;
+    w51 = w51 / w11;
+    w76 = w76 - w51;
+    w51 = w76 / w53;
+    w77 = w57 / w11;
+    w51 = w51 - w77;
+    w77 = w52 * w51;
+    w75 = w75 + w77;
+    w77 = w69 * w27;
+    w78 = w56 * w51;
+    w77 = w77 - w78;
+    w36 = w36 / w11;
+    w77 = w77 - w36;
+    w36 = w77 / w42;
+    w78 = w49 / w11;
+    w36 = w36 - w78;
+    w78 = w38 * w36;
+    w75 = w75 + w78;
+    w78 = w66 * w27;
+    w79 = w54 * w51;
+    w78 = w78 - w79;
+    w79 = w45 * w36;
+    w78 = w78 - w79;
+    w28 = w28 / w11;
+    w78 = w78 - w28;
+    w28 = w78 / w31;
+    w79 = w35 / w11;
+    w28 = w28 - w79;
+    w79 = w22 * w28;
+    w75 = w75 + w79;
+    w10 = w10 - w75;
+    w75 = p_tip_ddot_0_2 * w10;
+    w79 = w62 * w27;
+    w80 = w37 * w51;
+    w79 = w79 - w80;
+    w80 = w39 * w36;
+    w79 = w79 - w80;
+    w80 = w29 * w28;
+    w79 = w79 - w80;
+    w16 = w16 / w11;
+    w79 = w79 - w16;
+    w16 = w79 / w8;
+    w80 = w25 / w11;
+    w16 = w16 - w80;
+    w80 = w22 * w16;
+    w81 = w61 * w27;
+    w80 = w80 - w81;
+    w14 = w14 / w11;
+    w80 = w80 - w14;
+    w14 = p_tip_ddot_0_1 * w80;
+    w75 = w75 + w14;
+    w14 = w13 / w11;
+    w75 = w75 + w14;
+    w14 = w6 * w27;
+    w81 = w5 * w51;
+    w14 = w14 + w81;
+    w81 = w5 * w36;
+    w14 = w14 + w81;
+    w81 = w12 * w28;
+    w14 = w14 + w81;
+    w81 = w23 * w16;
+    w14 = w14 - w81;
+    w3 = w3 / w11;
+    w14 = w14 + w3;
+    w3 = p_tip_ddot_0_0 * w14;
+    w75 = w75 + w3;
+    w3 = 6.123233995736766e-17 * w75;
+    w81 = p_tip_ddot_1_2 * w10;
+    w82 = w17 / w11;
+    w81 = w81 + w82;
+    w82 = p_tip_ddot_1_1 * w80;
+    w81 = w81 + w82;
+    w82 = p_tip_ddot_0_1 * w14;
+    w81 = w81 + w82;
+    w82 = (-6.123233995736766e-17) * w81;
+    w3 = w3 - w82;
+    w70 = w70 / w64;
+    w70 = w70 * w60;
+    w64 = 1.0 / w64;
+    w70 = w70 + w64;
+    w4 = w4 * w70;
+    w64 = w57 * w27;
+    w60 = w74 * w70;
+    w64 = w64 - w60;
+    w71 = w71 * w70;
+    w60 = w71 / w53;
+    w64 = w64 - w60;
+    w60 = w52 * w64;
+    w82 = w49 * w27;
+    w83 = w73 * w70;
+    w82 = w82 - w83;
+    w83 = w56 * w64;
+    w69 = w69 * w70;
+    w83 = w83 + w69;
+    w69 = w83 / w42;
+    w82 = w82 - w69;
+    w69 = w38 * w82;
+    w60 = w60 + w69;
+    w69 = w35 * w27;
+    w84 = w72 * w70;
+    w69 = w69 - w84;
+    w84 = w54 * w64;
+    w85 = w45 * w82;
+    w84 = w84 + w85;
+    w66 = w66 * w70;
+    w84 = w84 + w66;
+    w66 = w84 / w31;
+    w69 = w69 - w66;
+    w66 = w22 * w69;
+    w60 = w60 + w66;
+    w4 = w4 - w60;
+    w60 = p_tip_ddot_1_2 * w4;
+    w66 = w17 * w27;
+    w60 = w60 - w66;
+    w66 = w5 * w64;
+    w85 = w5 * w82;
+    w66 = w66 + w85;
+    w85 = w12 * w69;
+    w66 = w66 + w85;
+    w85 = w25 * w27;
+    w86 = w67 * w70;
+    w85 = w85 - w86;
+    w86 = w37 * w64;
+    w87 = w39 * w82;
+    w86 = w86 + w87;
+    w87 = w29 * w69;
+    w86 = w86 + w87;
+    w62 = w62 * w70;
+    w86 = w86 + w62;
+    w62 = w86 / w8;
+    w85 = w85 - w62;
+    w62 = w23 * w85;
+    w66 = w66 - w62;
+    w6 = w6 * w70;
+    w66 = w66 - w6;
+    w6 = p_tip_ddot_0_1 * w66;
+    w60 = w60 + w6;
+    w6 = w63 * w70;
+    w60 = w60 + w6;
+    w6 = w22 * w85;
+    w61 = w61 * w70;
+    w6 = w6 + w61;
+    w61 = p_tip_ddot_1_1 * w6;
+    w60 = w60 + w61;
+    w3 = w3 - w60;
+    w61 = w13 * w51;
+    w62 = w65 * w64;
+    w61 = w61 + w62;
+    w62 = w49 * w51;
+    w87 = w73 * w64;
+    w62 = w62 + w87;
+    w74 = w74 / w53;
+    w74 = w74 * w71;
+    w57 = w57 / w53;
+    w57 = w57 * w76;
+    w74 = w74 - w57;
+    w53 = 1.0 / w53;
+    w74 = w74 + w53;
+    w53 = w58 * w74;
+    w62 = w62 + w53;
+    w56 = w56 * w74;
+    w53 = w56 / w42;
+    w62 = w62 + w53;
+    w53 = w39 * w62;
+    w57 = w45 * w62;
+    w54 = w54 * w74;
+    w57 = w57 - w54;
+    w54 = w57 / w31;
+    w76 = w35 * w51;
+    w71 = w72 * w64;
+    w76 = w76 + w71;
+    w71 = w59 * w74;
+    w76 = w76 + w71;
+    w54 = w54 - w76;
+    w76 = w29 * w54;
+    w53 = w53 - w76;
+    w37 = w37 * w74;
+    w53 = w53 - w37;
+    w37 = w53 / w8;
+    w76 = w25 * w51;
+    w71 = w67 * w64;
+    w76 = w76 + w71;
+    w71 = w55 * w74;
+    w76 = w76 + w71;
+    w37 = w37 - w76;
+    w76 = w22 * w37;
+    w71 = p_tip_ddot_0_1 * w76;
+    w61 = w61 + w71;
+    w71 = w38 * w62;
+    w87 = w22 * w54;
+    w71 = w71 - w87;
+    w52 = w52 * w74;
+    w71 = w71 - w52;
+    w52 = p_tip_ddot_0_2 * w71;
+    w61 = w61 + w52;
+    w52 = w43 * w74;
+    w61 = w61 + w52;
+    w52 = w12 * w54;
+    w87 = w5 * w62;
+    w52 = w52 - w87;
+    w87 = w23 * w37;
+    w52 = w52 - w87;
+    w87 = w5 * w74;
+    w52 = w52 + w87;
+    w87 = p_tip_ddot_0_0 * w52;
+    w61 = w61 + w87;
+    w3 = w3 + w61;
+    w61 = w13 * w36;
+    w87 = w65 * w82;
+    w61 = w61 + w87;
+    w87 = w43 * w62;
+    w61 = w61 - w87;
+    w87 = w55 * w62;
+    w88 = w25 * w36;
+    w89 = w67 * w82;
+    w88 = w88 + w89;
+    w87 = w87 - w88;
+    w73 = w73 / w42;
+    w73 = w73 * w83;
+    w49 = w49 / w42;
+    w49 = w49 * w77;
+    w73 = w73 - w49;
+    w58 = w58 / w42;
+    w58 = w58 * w56;
+    w73 = w73 + w58;
+    w42 = 1.0 / w42;
+    w73 = w73 + w42;
+    w42 = w46 * w73;
+    w87 = w87 - w42;
+    w42 = w59 * w62;
+    w58 = w35 * w36;
+    w56 = w72 * w82;
+    w58 = w58 + w56;
+    w42 = w42 - w58;
+    w58 = w50 * w73;
+    w42 = w42 - w58;
+    w45 = w45 * w73;
+    w58 = w45 / w31;
+    w42 = w42 - w58;
+    w58 = w29 * w42;
+    w39 = w39 * w73;
+    w58 = w58 + w39;
+    w39 = w58 / w8;
+    w87 = w87 - w39;
+    w39 = w22 * w87;
+    w56 = p_tip_ddot_0_1 * w39;
+    w61 = w61 + w56;
+    w56 = w22 * w42;
+    w38 = w38 * w73;
+    w56 = w56 + w38;
+    w38 = p_tip_ddot_0_2 * w56;
+    w61 = w61 - w38;
+    w38 = w44 * w73;
+    w61 = w61 + w38;
+    w38 = w12 * w42;
+    w49 = w23 * w87;
+    w38 = w38 - w49;
+    w5 = w5 * w73;
+    w38 = w38 + w5;
+    w5 = p_tip_ddot_0_0 * w38;
+    w61 = w61 + w5;
+    w3 = w3 + w61;
+    w61 = w13 * w28;
+    w5 = w65 * w69;
+    w61 = w61 + w5;
+    w5 = w43 * w54;
+    w61 = w61 + w5;
+    w5 = w44 * w42;
+    w61 = w61 + w5;
+    w5 = w25 * w28;
+    w49 = w67 * w69;
+    w5 = w5 + w49;
+    w49 = w55 * w54;
+    w5 = w5 + w49;
+    w49 = w46 * w42;
+    w5 = w5 + w49;
+    w72 = w72 / w31;
+    w72 = w72 * w84;
+    w35 = w35 / w31;
+    w35 = w35 * w78;
+    w72 = w72 - w35;
+    w59 = w59 / w31;
+    w59 = w59 * w57;
+    w72 = w72 - w59;
+    w50 = w50 / w31;
+    w50 = w50 * w45;
+    w72 = w72 + w50;
+    w31 = 1.0 / w31;
+    w72 = w72 + w31;
+    w31 = w33 * w72;
+    w5 = w5 + w31;
+    w29 = w29 * w72;
+    w31 = w29 / w8;
+    w5 = w5 + w31;
+    w31 = w22 * w5;
+    w50 = p_tip_ddot_0_1 * w31;
+    w61 = w61 - w50;
+    w50 = w22 * w72;
+    w45 = p_tip_ddot_0_2 * w50;
+    w61 = w61 - w45;
+    w45 = w32 * w72;
+    w61 = w61 + w45;
+    w45 = w23 * w5;
+    w12 = w12 * w72;
+    w45 = w45 + w12;
+    w12 = p_tip_ddot_0_0 * w45;
+    w61 = w61 + w12;
+    w3 = w3 + w61;
+    w61 = (-6.123233995736766e-17) * w3;
+    w11 = w20 / w11;
+    w10 = p_tip_ddot_2_2 * w10;
+    w11 = w11 + w10;
+    w80 = p_tip_ddot_1_2 * w80;
+    w11 = w11 + w80;
+    w14 = p_tip_ddot_0_2 * w14;
+    w11 = w11 + w14;
+    w14 = (-6.123233995736766e-17) * w11;
+    w80 = w20 * w27;
+    w14 = w14 - w80;
+    w14 = w14 + w75;
+    w75 = w68 * w70;
+    w14 = w14 + w75;
+    w75 = p_tip_ddot_2_2 * w4;
+    w14 = w14 + w75;
+    w75 = p_tip_ddot_0_2 * w66;
+    w14 = w14 + w75;
+    w75 = p_tip_ddot_1_2 * w6;
+    w14 = w14 + w75;
+    w27 = w13 * w27;
+    w4 = p_tip_ddot_0_2 * w4;
+    w27 = w27 - w4;
+    w70 = w65 * w70;
+    w27 = w27 - w70;
+    w66 = p_tip_ddot_0_0 * w66;
+    w27 = w27 - w66;
+    w6 = p_tip_ddot_0_1 * w6;
+    w27 = w27 - w6;
+    w27 = (-6.123233995736766e-17) * w27;
+    w14 = w14 + w27;
+    w32 = w32 * w5;
+    w13 = w13 * w16;
+    w65 = w65 * w85;
+    w13 = w13 + w65;
+    w43 = w43 * w37;
+    w13 = w13 + w43;
+    w44 = w44 * w87;
+    w13 = w13 + w44;
+    w32 = w32 - w13;
+    w67 = w67 / w8;
+    w67 = w67 * w86;
+    w25 = w25 / w8;
+    w25 = w25 * w79;
+    w67 = w67 - w25;
+    w55 = w55 / w8;
+    w55 = w55 * w53;
+    w67 = w67 - w55;
+    w46 = w46 / w8;
+    w46 = w46 * w58;
+    w67 = w67 + w46;
+    w33 = w33 / w8;
+    w33 = w33 * w29;
+    w67 = w67 + w33;
+    w8 = 1.0 / w8;
+    w67 = w67 + w8;
+    w26 = w26 * w67;
+    w32 = w32 - w26;
+    w23 = w23 * w67;
+    w9 = p_tip_ddot_0_0 * w23;
+    w32 = w32 + w9;
+    w22 = w22 * w67;
+    w9 = p_tip_ddot_0_1 * w22;
+    w32 = w32 - w9;
+    w14 = w14 + w32;
+    w61 = w61 - w14;
+    w17 = w17 * w16;
+    w28 = w20 * w28;
+    w17 = w17 - w28;
+    w69 = w68 * w69;
+    w17 = w17 - w69;
+    w63 = w63 * w85;
+    w17 = w17 + w63;
+    w60 = (-6.123233995736766e-17) * w60;
+    w17 = w17 + w60;
+    w54 = w47 * w54;
+    w17 = w17 - w54;
+    w40 = w40 * w37;
+    w17 = w17 + w40;
+    w51 = w20 * w51;
+    w64 = w68 * w64;
+    w51 = w51 + w64;
+    w76 = p_tip_ddot_1_2 * w76;
+    w51 = w51 + w76;
+    w74 = w47 * w74;
+    w51 = w51 + w74;
+    w71 = p_tip_ddot_2_2 * w71;
+    w51 = w51 + w71;
+    w52 = p_tip_ddot_0_2 * w52;
+    w51 = w51 + w52;
+    w17 = w17 - w51;
+    w42 = w48 * w42;
+    w17 = w17 - w42;
+    w41 = w41 * w87;
+    w17 = w17 + w41;
+    w47 = w47 * w62;
+    w20 = w20 * w36;
+    w68 = w68 * w82;
+    w20 = w20 + w68;
+    w47 = w47 - w20;
+    w39 = p_tip_ddot_1_2 * w39;
+    w47 = w47 - w39;
+    w48 = w48 * w73;
+    w47 = w47 - w48;
+    w56 = p_tip_ddot_2_2 * w56;
+    w47 = w47 + w56;
+    w38 = p_tip_ddot_0_2 * w38;
+    w47 = w47 - w38;
+    w17 = w17 + w47;
+    w30 = w30 * w5;
+    w17 = w17 - w30;
+    w19 = p_tip_ddot_1_2 * w31;
+    w17 = w17 + w19;
+    w34 = w34 * w72;
+    w17 = w17 - w34;
+    w21 = p_tip_ddot_2_2 * w50;
+    w17 = w17 + w21;
+    w2 = p_tip_ddot_0_2 * w45;
+    w17 = w17 - w2;
+    w15 = p_tip_ddot_0_1 * w23;
+    w17 = w17 - w15;
+    w24 = w24 * w67;
+    w17 = w17 + w24;
+    w18 = p_tip_ddot_1_1 * w22;
+    w17 = w17 + w18;
+    w11 = 6.123233995736766e-17 * w11;
+    w11 = w11 + w81;
+    w17 = w17 - w11;
+    w7 = (-3.749399456654644e-33) * w17;
+    w61 = w61 + w7;
+    gradient[10] = w61;
+    w61 = 6.123233995736766e-17 * w3;
+    w61 = w61 - w17;
+    gradient[11] = w61;
+    w1 = 6.123233995736766e-17 * w14;
+    w1 = w1 - w3;
+    w0 = (-6.123233995736766e-17) * w17;
+    w1 = w1 + w0;
+    gradient[12] = w1;
+    gradient
+}
+
 /// The parameter-only factors of [`rigid_body_dynamics`], computed once per tool: [`rigid_body_dynamics_with`]
 /// then only combines them with the state and control (derive/toolconf_derive/hoist.py).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -51341,4 +52656,619 @@ pub fn tip(
     w24 = -w24;
     jacobian[(2, 5)] = w24;
     (position, jacobian)
+}
+
+/// The tip's acceleration at zero joint acceleration, Jdot(q, q_dot) q_dot = d(J q_dot)/dq q_dot (base frame), so that y_ddot = J(q) q_ddot + tip_bias(q, q_dot): the linear part of Pinocchio's frame classical acceleration (LOCAL_WORLD_ALIGNED) at q_ddot = 0 for a frame at the tip.
+///
+/// From forward kinematics of the URDF chain, differentiated twice in time.
+///
+/// - `q`: joint positions q = [shoulder_pan_joint shoulder_lift_joint elbow_joint wrist_1_joint wrist_2_joint wrist_3_joint]
+/// - `q_dot`: joint velocities q_dot = [shoulder_pan_joint_dot shoulder_lift_joint_dot elbow_joint_dot wrist_1_joint_dot wrist_2_joint_dot wrist_3_joint_dot]
+/// - `params`: tool parameters [tool_mass tool_com_x tool_com_y tool_com_z tool_ixx tool_iyy tool_izz tool_ixy tool_ixz tool_iyz tool_tip_x tool_tip_y tool_tip_z]
+///
+/// Cost per call: 498 operations, weighted 498 (114 ADD, 281 MUL, 103 SUB), plus 6 `sin_cos`.
+/// (Counted by the generator, derive/toolconf_derive/cost.py.)
+#[inline]
+#[must_use]
+pub fn tip_bias(
+    q: &SVector<f64, 6>,
+    q_dot: &SVector<f64, 6>,
+    params: &SVector<f64, 13>,
+) -> SVector<f64, 3> {
+    let q_dot_1 = q_dot[1];
+    let q_0 = q[0];
+    let q_3 = q[3];
+    let q_2 = q[2];
+    let q_1 = q[1];
+    let q_dot_2 = q_dot[2];
+    let q_dot_3 = q_dot[3];
+    let q_4 = q[4];
+    let q_dot_4 = q_dot[4];
+    let params_10 = params[10];
+    let q_5 = q[5];
+    let q_dot_5 = q_dot[5];
+    let params_11 = params[11];
+    let params_12 = params[12];
+    let q_dot_0 = q_dot[0];
+    let (sin_q_0, cos_q_0) = crate::trig::sin_cos(q_0);
+    let (sin_q_3, cos_q_3) = crate::trig::sin_cos(q_3);
+    let (sin_q_2, cos_q_2) = crate::trig::sin_cos(q_2);
+    let (sin_q_1, cos_q_1) = crate::trig::sin_cos(q_1);
+    let (sin_q_4, cos_q_4) = crate::trig::sin_cos(q_4);
+    let (sin_q_5, cos_q_5) = crate::trig::sin_cos(q_5);
+    // Jdot q_dot (m/s^2, base frame)
+    let mut bias = <SVector<f64, 3>>::zeros();
+    let mut w0: f64;
+    let w1: f64;
+    let mut w2: f64;
+    let mut w3: f64;
+    let mut w4: f64;
+    let mut w6: f64;
+    let mut w7: f64;
+    let mut w8: f64;
+    let mut w9: f64;
+    let mut w10: f64;
+    let mut w11: f64;
+    let w12: f64;
+    let mut w13: f64;
+    let mut w14: f64;
+    let mut w15: f64;
+    let mut w16: f64;
+    let mut w17: f64;
+    let mut w18: f64;
+    let mut w19: f64;
+    let mut w20: f64;
+    let mut w21: f64;
+    let mut w22: f64;
+    let mut w23: f64;
+    let mut w24: f64;
+    let mut w25: f64;
+    let mut w26: f64;
+    let mut w27: f64;
+    let mut w28: f64;
+    let mut w29: f64;
+    let w30: f64;
+    let mut w31: f64;
+    let mut w32: f64;
+    let mut w33: f64;
+    let mut w34: f64;
+    let w37: f64;
+    let mut w38: f64;
+    let mut w39: f64;
+    let mut w40: f64;
+    let w41: f64;
+    let mut w42: f64;
+    let mut w43: f64;
+    let mut w44: f64;
+    let mut w45: f64;
+    let mut w46: f64;
+    let mut w47: f64;
+    let mut w48: f64;
+    let mut w49: f64;
+    let mut w50: f64;
+    let mut w51: f64;
+    let mut w52: f64;
+    let w53: f64;
+    let mut w54: f64;
+    let mut w55: f64;
+    let mut w56: f64;
+    let mut w57: f64;
+    let mut w58: f64;
+    let mut w59: f64;
+    let mut w60: f64;
+    let mut w61: f64;
+    let mut w62: f64;
+    let mut w63: f64;
+    let mut w64: f64;
+    let mut w65: f64;
+    let mut w66: f64;
+    let mut w67: f64;
+    let mut w68: f64;
+    let mut w69: f64;
+    let mut w70: f64;
+    let mut w71: f64;
+    let mut w72: f64;
+    let mut w73: f64;
+    w10 = cos_q_1 * q_dot_1;
+    w11 = sin_q_2 * w10;
+    w13 = cos_q_2 * q_dot_2;
+    w14 = sin_q_1 * w13;
+    w11 = w11 + w14;
+    w14 = sin_q_1 * q_dot_1;
+    w15 = cos_q_2 * w14;
+    w16 = sin_q_2 * q_dot_2;
+    w17 = cos_q_1 * w16;
+    w15 = w15 + w17;
+    w11 = w11 + w15;
+    w15 = cos_q_3 * w11;
+    w17 = sin_q_1 * sin_q_2;
+    w18 = cos_q_1 * cos_q_2;
+    w17 = w17 - w18;
+    w19 = sin_q_3 * q_dot_3;
+    w20 = w17 * w19;
+    w15 = w15 - w20;
+    w20 = cos_q_1 * w13;
+    w21 = sin_q_2 * w14;
+    w20 = w20 - w21;
+    w21 = cos_q_2 * w10;
+    w22 = sin_q_1 * w16;
+    w21 = w21 - w22;
+    w20 = w20 + w21;
+    w21 = sin_q_3 * w20;
+    w22 = cos_q_1 * sin_q_2;
+    w23 = sin_q_1 * cos_q_2;
+    w22 = w22 + w23;
+    w23 = cos_q_3 * q_dot_3;
+    w24 = w22 * w23;
+    w21 = w21 + w24;
+    w15 = w15 + w21;
+    w21 = 0.09465 * w15;
+    w25 = 0.425 * w10;
+    w27 = 0.39225 * w20;
+    w27 = w25 + w27;
+    w21 = w21 - w27;
+    w20 = cos_q_3 * w20;
+    w31 = w22 * w19;
+    w20 = w20 - w31;
+    w11 = sin_q_3 * w11;
+    w31 = w17 * w23;
+    w11 = w11 + w31;
+    w20 = w20 - w11;
+    w11 = sin_q_4 * w20;
+    w31 = w22 * cos_q_3;
+    w32 = w17 * sin_q_3;
+    w31 = w31 - w32;
+    w33 = cos_q_4 * q_dot_4;
+    w34 = w31 * w33;
+    w11 = w11 + w34;
+    w34 = 0.0823 * w11;
+    w34 = w21 - w34;
+    w20 = cos_q_4 * w20;
+    w38 = sin_q_4 * q_dot_4;
+    w39 = w31 * w38;
+    w20 = w20 - w39;
+    w39 = cos_q_5 * w20;
+    w40 = w31 * cos_q_4;
+    w42 = sin_q_5 * q_dot_5;
+    w43 = w40 * w42;
+    w39 = w39 - w43;
+    w43 = sin_q_5 * w15;
+    w17 = w17 * cos_q_3;
+    w44 = w22 * sin_q_3;
+    w17 = w17 + w44;
+    w44 = cos_q_5 * q_dot_5;
+    w45 = w17 * w44;
+    w43 = w43 + w45;
+    w39 = w39 - w43;
+    w39 = params_10 * w39;
+    w20 = sin_q_5 * w20;
+    w45 = w40 * w44;
+    w20 = w20 + w45;
+    w45 = cos_q_5 * w15;
+    w46 = w17 * w42;
+    w45 = w45 - w46;
+    w20 = w20 + w45;
+    w20 = params_11 * w20;
+    w39 = w39 - w20;
+    w45 = params_12 * w11;
+    w39 = w39 - w45;
+    w34 = w34 + w39;
+    w39 = cos_q_0 * w34;
+    w46 = 0.425 * sin_q_1;
+    w46 = 0.089159 - w46;
+    w22 = 0.39225 * w22;
+    w22 = w46 - w22;
+    w47 = 0.09465 * w17;
+    w47 = w22 + w47;
+    w31 = w31 * sin_q_4;
+    w48 = 0.0823 * w31;
+    w48 = w47 - w48;
+    w49 = w40 * cos_q_5;
+    w50 = w17 * sin_q_5;
+    w49 = w49 - w50;
+    w49 = w49 * params_10;
+    w40 = w40 * sin_q_5;
+    w50 = w17 * cos_q_5;
+    w40 = w40 + w50;
+    w40 = w40 * params_11;
+    w49 = w49 - w40;
+    w40 = w31 * params_12;
+    w49 = w49 - w40;
+    w48 = w48 + w49;
+    w45 = w48 - 0.089159;
+    w40 = sin_q_0 * q_dot_0;
+    w50 = w45 * w40;
+    w39 = w39 - w50;
+    w39 = q_dot_1 * w39;
+    w50 = cos_q_0 * q_dot_0;
+    w51 = cos_q_1 * w50;
+    w52 = sin_q_0 * w14;
+    w51 = w51 - w52;
+    w52 = 0.425 * w51;
+    w54 = (-0.1197) * w40;
+    w52 = w52 - w54;
+    w55 = 0.13585 * w40;
+    w52 = w52 - w55;
+    w56 = cos_q_2 * w51;
+    w57 = sin_q_0 * cos_q_1;
+    w58 = w57 * w16;
+    w56 = w56 - w58;
+    w58 = sin_q_1 * w50;
+    w59 = sin_q_0 * w10;
+    w58 = w58 + w59;
+    w59 = sin_q_2 * w58;
+    w60 = sin_q_0 * sin_q_1;
+    w61 = w60 * w13;
+    w59 = w59 + w61;
+    w56 = w56 - w59;
+    w59 = 0.39225 * w56;
+    w59 = w52 + w59;
+    w62 = 0.093 * w40;
+    w62 = w59 - w62;
+    w58 = cos_q_2 * w58;
+    w63 = w60 * w16;
+    w58 = w58 - w63;
+    w51 = sin_q_2 * w51;
+    w63 = w57 * w13;
+    w51 = w51 + w63;
+    w58 = w58 + w51;
+    w51 = cos_q_3 * w58;
+    w63 = w60 * cos_q_2;
+    w64 = w57 * sin_q_2;
+    w63 = w63 + w64;
+    w64 = w63 * w19;
+    w51 = w51 - w64;
+    w64 = sin_q_3 * w56;
+    w65 = w57 * cos_q_2;
+    w60 = w60 * sin_q_2;
+    w65 = w65 - w60;
+    w60 = w65 * w23;
+    w64 = w64 + w60;
+    w51 = w51 + w64;
+    w64 = 0.09465 * w51;
+    w64 = w62 - w64;
+    w60 = cos_q_4 * w40;
+    w66 = cos_q_0 * w38;
+    w60 = w60 + w66;
+    w58 = sin_q_3 * w58;
+    w66 = w63 * w23;
+    w58 = w58 + w66;
+    w56 = cos_q_3 * w56;
+    w66 = w65 * w19;
+    w56 = w56 - w66;
+    w58 = w58 - w56;
+    w56 = sin_q_4 * w58;
+    w66 = w63 * sin_q_3;
+    w67 = w65 * cos_q_3;
+    w66 = w66 - w67;
+    w67 = w66 * w33;
+    w56 = w56 + w67;
+    w60 = w60 + w56;
+    w56 = 0.0823 * w60;
+    w56 = w64 - w56;
+    w58 = cos_q_4 * w58;
+    w67 = w66 * w38;
+    w58 = w58 - w67;
+    w67 = cos_q_0 * w33;
+    w68 = sin_q_4 * w40;
+    w67 = w67 - w68;
+    w58 = w58 + w67;
+    w67 = cos_q_5 * w58;
+    w68 = w66 * cos_q_4;
+    w69 = cos_q_0 * sin_q_4;
+    w68 = w68 + w69;
+    w69 = w68 * w42;
+    w67 = w67 - w69;
+    w69 = sin_q_5 * w51;
+    w63 = w63 * cos_q_3;
+    w70 = w65 * sin_q_3;
+    w63 = w63 + w70;
+    w70 = w63 * w44;
+    w69 = w69 + w70;
+    w67 = w67 + w69;
+    w67 = params_10 * w67;
+    w58 = sin_q_5 * w58;
+    w69 = w68 * w44;
+    w58 = w58 + w69;
+    w69 = cos_q_5 * w51;
+    w70 = w63 * w42;
+    w69 = w69 - w70;
+    w58 = w58 - w69;
+    w58 = params_11 * w58;
+    w67 = w67 - w58;
+    w58 = params_12 * w60;
+    w67 = w67 - w58;
+    w56 = w56 + w67;
+    w67 = q_dot_0 * w56;
+    w39 = w39 - w67;
+    w25 = w34 + w25;
+    w67 = cos_q_0 * w25;
+    w46 = w48 - w46;
+    w58 = w46 * w40;
+    w67 = w67 - w58;
+    w67 = q_dot_2 * w67;
+    w39 = w39 + w67;
+    w27 = w34 + w27;
+    w67 = cos_q_0 * w27;
+    w22 = w48 - w22;
+    w58 = w22 * w40;
+    w67 = w67 - w58;
+    w67 = q_dot_3 * w67;
+    w39 = w39 + w67;
+    w67 = w22 * w51;
+    w58 = w63 * w27;
+    w67 = w67 + w58;
+    w58 = 0.13585 * cos_q_0;
+    w69 = (-0.1197) * cos_q_0;
+    w57 = 0.425 * w57;
+    w69 = w69 + w57;
+    w69 = w58 + w69;
+    w65 = 0.39225 * w65;
+    w65 = w69 + w65;
+    w57 = 0.093 * cos_q_0;
+    w57 = w65 + w57;
+    w70 = 0.09465 * w63;
+    w70 = w57 - w70;
+    w71 = cos_q_0 * cos_q_4;
+    w66 = w66 * sin_q_4;
+    w71 = w71 - w66;
+    w66 = 0.0823 * w71;
+    w66 = w70 + w66;
+    w72 = w68 * cos_q_5;
+    w73 = w63 * sin_q_5;
+    w72 = w72 + w73;
+    w72 = w72 * params_10;
+    w68 = w68 * sin_q_5;
+    w73 = w63 * cos_q_5;
+    w68 = w68 - w73;
+    w68 = w68 * params_11;
+    w72 = w72 - w68;
+    w68 = w71 * params_12;
+    w72 = w72 + w68;
+    w66 = w66 + w72;
+    w57 = w66 - w57;
+    w72 = w57 * w15;
+    w62 = w56 - w62;
+    w68 = w17 * w62;
+    w72 = w72 + w68;
+    w67 = w67 + w72;
+    w67 = q_dot_4 * w67;
+    w39 = w39 - w67;
+    w21 = w34 - w21;
+    w67 = w71 * w21;
+    w48 = w48 - w47;
+    w47 = w48 * w60;
+    w67 = w67 - w47;
+    w70 = w66 - w70;
+    w47 = w70 * w11;
+    w64 = w56 - w64;
+    w72 = w31 * w64;
+    w47 = w47 + w72;
+    w67 = w67 + w47;
+    w67 = q_dot_5 * w67;
+    w39 = w39 + w67;
+    bias[0] = w39;
+    w10 = cos_q_0 * w10;
+    w39 = sin_q_1 * w40;
+    w10 = w10 - w39;
+    w39 = cos_q_2 * w10;
+    w8 = cos_q_0 * sin_q_1;
+    w67 = w8 * w16;
+    w39 = w39 - w67;
+    w67 = cos_q_0 * cos_q_1;
+    w47 = w67 * w13;
+    w9 = cos_q_1 * w40;
+    w14 = cos_q_0 * w14;
+    w9 = w9 + w14;
+    w14 = sin_q_2 * w9;
+    w47 = w47 - w14;
+    w39 = w39 + w47;
+    w47 = sin_q_3 * w39;
+    w14 = w8 * cos_q_2;
+    w72 = w67 * sin_q_2;
+    w14 = w14 + w72;
+    w72 = w14 * w23;
+    w47 = w47 + w72;
+    w72 = cos_q_2 * w9;
+    w16 = w67 * w16;
+    w72 = w72 + w16;
+    w10 = sin_q_2 * w10;
+    w13 = w8 * w13;
+    w10 = w10 + w13;
+    w72 = w72 + w10;
+    w10 = cos_q_3 * w72;
+    w6 = w67 * cos_q_2;
+    w8 = w8 * sin_q_2;
+    w6 = w6 - w8;
+    w8 = w6 * w19;
+    w10 = w10 + w8;
+    w47 = w47 + w10;
+    w10 = cos_q_4 * w47;
+    w8 = w14 * sin_q_3;
+    w7 = w6 * cos_q_3;
+    w8 = w8 - w7;
+    w7 = w8 * w38;
+    w10 = w10 - w7;
+    w7 = sin_q_4 * w50;
+    w13 = sin_q_0 * w33;
+    w7 = w7 + w13;
+    w10 = w10 - w7;
+    w7 = cos_q_5 * w10;
+    w13 = w8 * cos_q_4;
+    w16 = sin_q_0 * sin_q_4;
+    w13 = w13 - w16;
+    w16 = w13 * w42;
+    w7 = w7 - w16;
+    w39 = cos_q_3 * w39;
+    w19 = w14 * w19;
+    w39 = w39 - w19;
+    w23 = w6 * w23;
+    w19 = sin_q_3 * w72;
+    w23 = w23 - w19;
+    w39 = w39 + w23;
+    w23 = sin_q_5 * w39;
+    w14 = w14 * cos_q_3;
+    w4 = w6 * sin_q_3;
+    w14 = w14 + w4;
+    w4 = w14 * w44;
+    w23 = w23 + w4;
+    w7 = w7 + w23;
+    w7 = params_10 * w7;
+    w10 = sin_q_5 * w10;
+    w44 = w13 * w44;
+    w10 = w10 + w44;
+    w44 = cos_q_5 * w39;
+    w42 = w14 * w42;
+    w44 = w44 - w42;
+    w10 = w10 - w44;
+    w10 = params_11 * w10;
+    w7 = w7 - w10;
+    w47 = sin_q_4 * w47;
+    w33 = w8 * w33;
+    w47 = w47 + w33;
+    w33 = cos_q_4 * w50;
+    w38 = sin_q_0 * w38;
+    w33 = w33 - w38;
+    w47 = w47 + w33;
+    w33 = params_12 * w47;
+    w7 = w7 - w33;
+    w9 = 0.425 * w9;
+    w33 = (-0.1197) * w50;
+    w9 = w9 + w33;
+    w33 = 0.13585 * w50;
+    w9 = w9 + w33;
+    w72 = 0.39225 * w72;
+    w72 = w9 + w72;
+    w38 = 0.093 * w50;
+    w38 = w72 + w38;
+    w10 = 0.09465 * w39;
+    w10 = w38 + w10;
+    w44 = 0.0823 * w47;
+    w44 = w10 + w44;
+    w7 = w7 - w44;
+    w49 = q_dot_0 * w7;
+    w45 = w45 * w50;
+    w34 = sin_q_0 * w34;
+    w45 = w45 + w34;
+    w45 = q_dot_1 * w45;
+    w49 = w49 + w45;
+    w46 = w46 * w50;
+    w25 = sin_q_0 * w25;
+    w46 = w46 + w25;
+    w46 = q_dot_2 * w46;
+    w49 = w49 + w46;
+    w46 = w22 * w50;
+    w25 = sin_q_0 * w27;
+    w46 = w46 + w25;
+    w46 = q_dot_3 * w46;
+    w49 = w49 + w46;
+    w24 = 0.425 * w67;
+    w53 = (-0.1197) * sin_q_0;
+    w24 = w24 - w53;
+    w54 = 0.13585 * sin_q_0;
+    w24 = w24 - w54;
+    w26 = 0.39225 * w6;
+    w26 = w24 + w26;
+    w61 = 0.093 * sin_q_0;
+    w61 = w26 - w61;
+    w3 = 0.09465 * w14;
+    w3 = w61 - w3;
+    w8 = w8 * sin_q_4;
+    w29 = sin_q_0 * cos_q_4;
+    w8 = w8 + w29;
+    w28 = 0.0823 * w8;
+    w28 = w3 - w28;
+    w29 = w13 * cos_q_5;
+    w30 = w14 * sin_q_5;
+    w29 = w29 + w30;
+    w29 = w29 * params_10;
+    w13 = w13 * sin_q_5;
+    w37 = w14 * cos_q_5;
+    w13 = w13 - w37;
+    w13 = w13 * params_11;
+    w29 = w29 - w13;
+    w20 = w8 * params_12;
+    w29 = w29 - w20;
+    w28 = w28 + w29;
+    w61 = w28 - w61;
+    w15 = w61 * w15;
+    w38 = w7 + w38;
+    w17 = w17 * w38;
+    w15 = w15 + w17;
+    w22 = w22 * w39;
+    w27 = w14 * w27;
+    w22 = w22 + w27;
+    w15 = w15 + w22;
+    w15 = q_dot_4 * w15;
+    w49 = w49 + w15;
+    w48 = w48 * w47;
+    w21 = w8 * w21;
+    w48 = w48 + w21;
+    w3 = w28 - w3;
+    w11 = w3 * w11;
+    w10 = w7 + w10;
+    w31 = w31 * w10;
+    w11 = w11 + w31;
+    w48 = w48 - w11;
+    w48 = q_dot_5 * w48;
+    w49 = w49 + w48;
+    bias[1] = w49;
+    w61 = w61 * w51;
+    w63 = w63 * w38;
+    w61 = w61 + w63;
+    w57 = w57 * w39;
+    w14 = w14 * w62;
+    w57 = w57 + w14;
+    w61 = w61 - w57;
+    w32 = q_dot_4 * w61;
+    w58 = w66 - w58;
+    w58 = w58 * w50;
+    w55 = w56 + w55;
+    w55 = sin_q_0 * w55;
+    w58 = w58 + w55;
+    w33 = w7 + w33;
+    w33 = cos_q_0 * w33;
+    w54 = w28 + w54;
+    w54 = w54 * w40;
+    w33 = w33 - w54;
+    w58 = w58 + w33;
+    w0 = q_dot_1 * w58;
+    w69 = w66 - w69;
+    w69 = w69 * w50;
+    w52 = w56 - w52;
+    w52 = sin_q_0 * w52;
+    w69 = w69 + w52;
+    w9 = w7 + w9;
+    w9 = cos_q_0 * w9;
+    w24 = w28 - w24;
+    w24 = w24 * w40;
+    w9 = w9 - w24;
+    w69 = w69 + w9;
+    w12 = q_dot_2 * w69;
+    w0 = w0 + w12;
+    w66 = w66 - w65;
+    w66 = w66 * w50;
+    w56 = w56 - w59;
+    w1 = sin_q_0 * w56;
+    w66 = w66 + w1;
+    w7 = w7 + w72;
+    w2 = cos_q_0 * w7;
+    w28 = w28 - w26;
+    w28 = w28 * w40;
+    w2 = w2 - w28;
+    w66 = w66 + w2;
+    w18 = q_dot_3 * w66;
+    w0 = w0 + w18;
+    w32 = w32 - w0;
+    w70 = w70 * w47;
+    w8 = w8 * w64;
+    w70 = w70 + w8;
+    w71 = w71 * w10;
+    w3 = w3 * w60;
+    w71 = w71 - w3;
+    w70 = w70 + w71;
+    w41 = q_dot_5 * w70;
+    w32 = w32 - w41;
+    bias[2] = w32;
+    bias
 }

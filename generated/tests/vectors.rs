@@ -318,6 +318,33 @@ mod arm2 {
                 ));
                 (vec![("gradient", rows(&gradient))], kappa)
             }
+            "tip_acceleration_sensitivity" => {
+                let d_tip_ddot_du = m::tip_acceleration_sensitivity(&input(i, "params"));
+                let kappa = 1.0;
+                (vec![("d_tip_ddot_du", rows(&d_tip_ddot_du))], kappa)
+            }
+            "tip_acceleration_control_confidence" => {
+                let pi_u = m::tip_acceleration_control_confidence(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                );
+                let kappa = 1.0;
+                (vec![("pi_u", rows(&pi_u))], kappa)
+            }
+            "tip_acceleration_logdet_gradient" => {
+                let gradient = m::tip_acceleration_logdet_gradient(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                );
+                let kappa = condition(&m::tip_acceleration_control_confidence(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                ));
+                (vec![("gradient", rows(&gradient))], kappa)
+            }
             "tip" => {
                 let (position, jacobian) = m::tip(&input(i, "q"), &input(i, "params"));
                 let kappa = 1.0;
@@ -326,13 +353,18 @@ mod arm2 {
                     kappa,
                 )
             }
+            "tip_bias" => {
+                let bias = m::tip_bias(&input(i, "q"), &input(i, "q_dot"), &input(i, "params"));
+                let kappa = 1.0;
+                (vec![("bias", rows(&bias))], kappa)
+            }
             _ => return None,
         })
     }
 
     #[test]
     fn functions_match_casadi_vectors() {
-        check("arm2", 20, evaluate);
+        check("arm2", 24, evaluate);
     }
 }
 
@@ -531,6 +563,33 @@ mod arm2_exact {
                 ));
                 (vec![("gradient", rows(&gradient))], kappa)
             }
+            "tip_acceleration_sensitivity" => {
+                let d_tip_ddot_du = m::tip_acceleration_sensitivity(&input(i, "params"));
+                let kappa = 1.0;
+                (vec![("d_tip_ddot_du", rows(&d_tip_ddot_du))], kappa)
+            }
+            "tip_acceleration_control_confidence" => {
+                let pi_u = m::tip_acceleration_control_confidence(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                );
+                let kappa = 1.0;
+                (vec![("pi_u", rows(&pi_u))], kappa)
+            }
+            "tip_acceleration_logdet_gradient" => {
+                let gradient = m::tip_acceleration_logdet_gradient(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                );
+                let kappa = condition(&m::tip_acceleration_control_confidence(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                ));
+                (vec![("gradient", rows(&gradient))], kappa)
+            }
             "tip" => {
                 let (position, jacobian) = m::tip(&input(i, "q"), &input(i, "params"));
                 let kappa = 1.0;
@@ -539,13 +598,18 @@ mod arm2_exact {
                     kappa,
                 )
             }
+            "tip_bias" => {
+                let bias = m::tip_bias(&input(i, "q"), &input(i, "q_dot"), &input(i, "params"));
+                let kappa = 1.0;
+                (vec![("bias", rows(&bias))], kappa)
+            }
             _ => return None,
         })
     }
 
     #[test]
     fn functions_match_casadi_vectors() {
-        check("arm2_exact", 20, evaluate);
+        check("arm2_exact", 24, evaluate);
     }
 }
 
@@ -744,6 +808,33 @@ mod arm2_payload {
                 ));
                 (vec![("gradient", rows(&gradient))], kappa)
             }
+            "tip_acceleration_sensitivity" => {
+                let d_tip_ddot_du = m::tip_acceleration_sensitivity(&input(i, "params"));
+                let kappa = 1.0;
+                (vec![("d_tip_ddot_du", rows(&d_tip_ddot_du))], kappa)
+            }
+            "tip_acceleration_control_confidence" => {
+                let pi_u = m::tip_acceleration_control_confidence(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                );
+                let kappa = 1.0;
+                (vec![("pi_u", rows(&pi_u))], kappa)
+            }
+            "tip_acceleration_logdet_gradient" => {
+                let gradient = m::tip_acceleration_logdet_gradient(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                );
+                let kappa = condition(&m::tip_acceleration_control_confidence(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                ));
+                (vec![("gradient", rows(&gradient))], kappa)
+            }
             "tip" => {
                 let (position, jacobian) = m::tip(&input(i, "q"), &input(i, "params"));
                 let kappa = 1.0;
@@ -752,13 +843,18 @@ mod arm2_payload {
                     kappa,
                 )
             }
+            "tip_bias" => {
+                let bias = m::tip_bias(&input(i, "q"), &input(i, "q_dot"), &input(i, "params"));
+                let kappa = 1.0;
+                (vec![("bias", rows(&bias))], kappa)
+            }
             _ => return None,
         })
     }
 
     #[test]
     fn functions_match_casadi_vectors() {
-        check("arm2_payload", 20, evaluate);
+        check("arm2_payload", 24, evaluate);
     }
 }
 
@@ -957,6 +1053,33 @@ mod arm3 {
                 ));
                 (vec![("gradient", rows(&gradient))], kappa)
             }
+            "tip_acceleration_sensitivity" => {
+                let d_tip_ddot_du = m::tip_acceleration_sensitivity(&input(i, "params"));
+                let kappa = 1.0;
+                (vec![("d_tip_ddot_du", rows(&d_tip_ddot_du))], kappa)
+            }
+            "tip_acceleration_control_confidence" => {
+                let pi_u = m::tip_acceleration_control_confidence(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                );
+                let kappa = 1.0;
+                (vec![("pi_u", rows(&pi_u))], kappa)
+            }
+            "tip_acceleration_logdet_gradient" => {
+                let gradient = m::tip_acceleration_logdet_gradient(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                );
+                let kappa = condition(&m::tip_acceleration_control_confidence(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                ));
+                (vec![("gradient", rows(&gradient))], kappa)
+            }
             "tip" => {
                 let (position, jacobian) = m::tip(&input(i, "q"), &input(i, "params"));
                 let kappa = 1.0;
@@ -965,13 +1088,18 @@ mod arm3 {
                     kappa,
                 )
             }
+            "tip_bias" => {
+                let bias = m::tip_bias(&input(i, "q"), &input(i, "q_dot"), &input(i, "params"));
+                let kappa = 1.0;
+                (vec![("bias", rows(&bias))], kappa)
+            }
             _ => return None,
         })
     }
 
     #[test]
     fn functions_match_casadi_vectors() {
-        check("arm3", 20, evaluate);
+        check("arm3", 24, evaluate);
     }
 }
 
@@ -1170,6 +1298,33 @@ mod msd {
                 ));
                 (vec![("gradient", rows(&gradient))], kappa)
             }
+            "tip_acceleration_sensitivity" => {
+                let d_tip_ddot_du = m::tip_acceleration_sensitivity(&input(i, "params"));
+                let kappa = 1.0;
+                (vec![("d_tip_ddot_du", rows(&d_tip_ddot_du))], kappa)
+            }
+            "tip_acceleration_control_confidence" => {
+                let pi_u = m::tip_acceleration_control_confidence(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                );
+                let kappa = 1.0;
+                (vec![("pi_u", rows(&pi_u))], kappa)
+            }
+            "tip_acceleration_logdet_gradient" => {
+                let gradient = m::tip_acceleration_logdet_gradient(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                );
+                let kappa = condition(&m::tip_acceleration_control_confidence(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                ));
+                (vec![("gradient", rows(&gradient))], kappa)
+            }
             "tip" => {
                 let (position, jacobian) = m::tip(&input(i, "q"), &input(i, "params"));
                 let kappa = 1.0;
@@ -1178,13 +1333,18 @@ mod msd {
                     kappa,
                 )
             }
+            "tip_bias" => {
+                let bias = m::tip_bias(&input(i, "q"), &input(i, "q_dot"), &input(i, "params"));
+                let kappa = 1.0;
+                (vec![("bias", rows(&bias))], kappa)
+            }
             _ => return None,
         })
     }
 
     #[test]
     fn functions_match_casadi_vectors() {
-        check("msd", 20, evaluate);
+        check("msd", 24, evaluate);
     }
 }
 
@@ -1383,6 +1543,33 @@ mod panda {
                 ));
                 (vec![("gradient", rows(&gradient))], kappa)
             }
+            "tip_acceleration_sensitivity" => {
+                let d_tip_ddot_du = m::tip_acceleration_sensitivity(&input(i, "params"));
+                let kappa = 1.0;
+                (vec![("d_tip_ddot_du", rows(&d_tip_ddot_du))], kappa)
+            }
+            "tip_acceleration_control_confidence" => {
+                let pi_u = m::tip_acceleration_control_confidence(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                );
+                let kappa = 1.0;
+                (vec![("pi_u", rows(&pi_u))], kappa)
+            }
+            "tip_acceleration_logdet_gradient" => {
+                let gradient = m::tip_acceleration_logdet_gradient(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                );
+                let kappa = condition(&m::tip_acceleration_control_confidence(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                ));
+                (vec![("gradient", rows(&gradient))], kappa)
+            }
             "rigid_body_dynamics" => {
                 let x_dot =
                     m::rigid_body_dynamics(&input(i, "x"), &input(i, "u"), &input(i, "params"));
@@ -1397,13 +1584,18 @@ mod panda {
                     kappa,
                 )
             }
+            "tip_bias" => {
+                let bias = m::tip_bias(&input(i, "q"), &input(i, "q_dot"), &input(i, "params"));
+                let kappa = 1.0;
+                (vec![("bias", rows(&bias))], kappa)
+            }
             _ => return None,
         })
     }
 
     #[test]
     fn functions_match_casadi_vectors() {
-        check("panda", 21, evaluate);
+        check("panda", 25, evaluate);
     }
 }
 
@@ -1602,6 +1794,33 @@ mod ur5 {
                 ));
                 (vec![("gradient", rows(&gradient))], kappa)
             }
+            "tip_acceleration_sensitivity" => {
+                let d_tip_ddot_du = m::tip_acceleration_sensitivity(&input(i, "params"));
+                let kappa = 1.0;
+                (vec![("d_tip_ddot_du", rows(&d_tip_ddot_du))], kappa)
+            }
+            "tip_acceleration_control_confidence" => {
+                let pi_u = m::tip_acceleration_control_confidence(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                );
+                let kappa = 1.0;
+                (vec![("pi_u", rows(&pi_u))], kappa)
+            }
+            "tip_acceleration_logdet_gradient" => {
+                let gradient = m::tip_acceleration_logdet_gradient(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                );
+                let kappa = condition(&m::tip_acceleration_control_confidence(
+                    &input(i, "params"),
+                    &input(i, "p_tip_ddot"),
+                    &input(i, "p_u"),
+                ));
+                (vec![("gradient", rows(&gradient))], kappa)
+            }
             "rigid_body_dynamics" => {
                 let x_dot =
                     m::rigid_body_dynamics(&input(i, "x"), &input(i, "u"), &input(i, "params"));
@@ -1616,12 +1835,17 @@ mod ur5 {
                     kappa,
                 )
             }
+            "tip_bias" => {
+                let bias = m::tip_bias(&input(i, "q"), &input(i, "q_dot"), &input(i, "params"));
+                let kappa = 1.0;
+                (vec![("bias", rows(&bias))], kappa)
+            }
             _ => return None,
         })
     }
 
     #[test]
     fn functions_match_casadi_vectors() {
-        check("ur5", 21, evaluate);
+        check("ur5", 25, evaluate);
     }
 }

@@ -123,11 +123,13 @@ pub fn dynamics<'py>(
 }
 
 /// The tool's tip (tool-centre point) y(q) in the robot's base frame and its Jacobian
-/// J = ∂y/∂q, for one joint configuration or a batch.
+/// J = ∂y/∂q, for one joint configuration or a batch; with joint velocities ``q_dot``, also the
+/// tip's acceleration at zero joint acceleration J̇(q, q̇) q̇, so that ÿ = J q̈ + J̇ q̇.
 ///
 /// For the URDF arms (``panda``, ``ur5``) the tip is the tool's ``tool_tip_x/y/z`` offset in the
 /// flange frame, carried through the arm's forward kinematics; J is the linear part of
-/// Pinocchio's ``computeFrameJacobian`` at that frame in ``LOCAL_WORLD_ALIGNED``.
+/// Pinocchio's ``computeFrameJacobian`` at that frame in ``LOCAL_WORLD_ALIGNED``, and J̇ q̇ the
+/// linear part of its ``getFrameClassicalAcceleration`` at zero joint acceleration.
 ///
 /// Args:
 ///     model: a generated model's name with a tip (``toolconf.models()[m]["has_tip"]``).
@@ -135,22 +137,25 @@ pub fn dynamics<'py>(
 ///         obeying the model's rule; a URDF tool may leave out its trailing products of inertia
 ///         and tip (zero).
 ///     q: the joint positions, 1-D (one configuration) or 2-D (one per row).
+///     q_dot: optional joint velocities, of q's shape.
 ///
 /// Returns:
 ///     dict: ``position`` of shape (3,) (m) and ``jacobian`` of shape (3, n) for 1-D arguments,
-///     else (k, 3) and (k, 3, n).
+///     else (k, 3) and (k, 3, n); with ``q_dot``, ``bias`` (J̇ q̇, m/s²) of ``position``'s shape.
 ///
 /// Raises:
 ///     ValueError: an unknown model or one without a tip, shapes that do not fit, a tool outside
-///         the model's rule (naming the parameter and the row), a non-finite q.
+///         the model's rule (naming the parameter and the row), a non-finite q or q_dot.
 ///     TypeError: an argument of booleans, complex numbers or text.
 ///     MemoryError: a batch that does not fit in memory.
 #[pyfunction]
+#[pyo3(signature = (model, params, q, q_dot=None))]
 pub fn tip<'py>(
     py: Python<'py>,
     model: &str,
     params: &Bound<'py, PyAny>,
     q: &Bound<'py, PyAny>,
+    q_dot: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = model_kind(model).map_err(|f| f.into_pyerr(py))?;
     if !kind.has_tip() {
@@ -162,6 +167,17 @@ pub fn tip<'py>(
     let (n, np) = (kind.dof(), kind.parameter_names().len());
     let (p_shape, p_data) = crate::arrays::tool_params(kind, params)?;
     let (q_shape, q_data) = crate::arrays::float_argument("q", q)?;
+    let rates = q_dot
+        .map(|v| crate::arrays::float_argument("q_dot", v))
+        .transpose()?;
+    if let Some((shape, _)) = &rates {
+        if *shape != q_shape {
+            return Err(Failure::Input(format!(
+                "q_dot of shape {shape:?}: it must have q's shape {q_shape:?}"
+            ))
+            .into_pyerr(py));
+        }
+    }
     let out = detached(py, || {
         let (p, kp) = rows("params", &p_shape, &p_data, np, kind, "tool parameters")?;
         let (qs, kq) = rows("q", &q_shape, &q_data, n, kind, "joint positions")?;
@@ -177,30 +193,41 @@ pub fn tip<'py>(
         let what = format!("tips of {count} configurations");
         let mut position = crate::arrays::zeros(count.saturating_mul(3), &what)?;
         let mut jacobian = crate::arrays::zeros(count.saturating_mul(3 * n), &what)?;
-        let q_rows = Rows {
-            shared: qs.shared && kp.is_none(),
-            ..qs
-        };
-        kind.model()
-            .tip(count, &p, &q_rows, &mut position, &mut jacobian)
+        // A 1-D q (or q_dot) is one configuration shared by every tool.
+        let model = kind.model();
+        model
+            .tip(count, &p, &qs, &mut position, &mut jacobian)
             .map_err(|e| batch_failure(e, &what))?;
-        Ok((position, jacobian, k))
+        let bias = match &rates {
+            None => None,
+            Some((shape, data)) => {
+                let (v, _) = rows("q_dot", shape, data, n, kind, "joint velocities")?;
+                let mut bias = crate::arrays::zeros(count.saturating_mul(3), &what)?;
+                model
+                    .tip_bias(count, &p, &qs, &v, &mut bias)
+                    .map_err(|e| batch_failure(e, &what))?;
+                Some(bias)
+            }
+        };
+        Ok((position, jacobian, bias, k))
     })?;
-    let (position, jacobian, k) = out;
-    let (position, jacobian) = (
-        PyArray1::from_vec(py, position),
-        PyArray1::from_vec(py, jacobian),
-    );
+    let (position, jacobian, bias, k) = out;
     let dict = PyDict::new(py);
+    let vector = |v: Vec<f64>| -> PyResult<Bound<'py, PyAny>> {
+        let a = PyArray1::from_vec(py, v);
+        Ok(match k {
+            None => a.into_any(),
+            Some(k) => a.reshape([k, 3])?.into_any(),
+        })
+    };
+    dict.set_item("position", vector(position)?)?;
+    let jacobian = PyArray1::from_vec(py, jacobian);
     match k {
-        None => {
-            dict.set_item("position", position)?;
-            dict.set_item("jacobian", jacobian.reshape([3, n])?)?;
-        }
-        Some(k) => {
-            dict.set_item("position", position.reshape([k, 3])?)?;
-            dict.set_item("jacobian", jacobian.reshape([k, 3, n])?)?;
-        }
+        None => dict.set_item("jacobian", jacobian.reshape([3, n])?)?,
+        Some(k) => dict.set_item("jacobian", jacobian.reshape([k, 3, n])?)?,
+    }
+    if let Some(bias) = bias {
+        dict.set_item("bias", vector(bias)?)?;
     }
     Ok(dict)
 }

@@ -15,6 +15,7 @@ import toolconf.dask as tdask
 ROOT = Path(__file__).resolve().parents[2]
 TOUCH = str(ROOT / "examples/tasks/panda_touch_point.toml")
 DRAW = str(ROOT / "examples/tasks/panda_draw_line.toml")
+PUSH = str(ROOT / "examples/tasks/panda_push_off.toml")
 PANDA_TOOLS = ROOT / "examples/tools/panda_tools.csv"
 # A 0.8 kg tool, its tip 25 cm out along the flange axis (flange frame).
 TOOL = [0.8, 0.0, 0.0, 0.05, 3e-3, 3e-3, 1.5e-3, 0.0, 0.0, 0.0, 0.0, 0.0, 0.25]
@@ -32,6 +33,18 @@ def test_an_episodes_tip_is_the_tips_forward_kinematics_and_reaches_the_goal():
     d = np.linalg.norm(e["tip"] - goal, axis=1)
     assert e["progress"] == pytest.approx(1 - d[-1] / d[0], rel=1e-12)
     assert e["progress"] > 0.8
+
+
+def test_a_tip_acceleration_episodes_series_is_j_q_ddot_plus_the_bias():
+    """ÿ along a tip acceleration episode is J(q) q̈ + J̇ q̇ from toolconf.tip at the episode's
+    states (q̈ the plant's, as recorded), and the episode reads it: its tip first accelerates
+    along the goal's x."""
+    e = toolconf.simulate("panda", TOOL, PUSH)
+    assert e["tip_ddot"].shape == (101, 3) and e["progress"] is None
+    y = toolconf.tip("panda", np.array(TOOL), e["theta"], e["theta_dot"])
+    expected = np.einsum("kij,kj->ki", y["jacobian"], e["theta_ddot"]) + y["bias"]
+    np.testing.assert_allclose(e["tip_ddot"], expected, rtol=1e-12, atol=1e-15)
+    assert e["tip_ddot"][10, 0] > 0.05 and abs(e["tip_ddot"][10, 1]) < 1e-3
 
 
 def test_a_joint_task_has_no_tip_series_and_no_progress_off_position():

@@ -15,8 +15,9 @@ The runtime is Rust (the ``toolconf`` crate); this package exposes it over NumPy
 * ``design(model, task, design)``: ``toolconf design --json``, which tool to build.
 * ``dynamics(model, params, state, control)``: a robot's own rigid-body dynamics
   Ẋ = [q̇; q̈] (U the joint torques), for one state or a batch.
-* ``tip(model, params, q)``: the tool's tip in the base frame and its Jacobian (3 × n), for one
-  joint configuration or a batch.
+* ``tip(model, params, q, q_dot=None)``: the tool's tip in the base frame and its Jacobian
+  (3 × n), for one joint configuration or a batch; with ``q_dot``, also J̇ q̇ (``bias``), so that
+  the tip's acceleration is J q̈ + J̇ q̇.
 * ``tool_from_urdf(urdf, root, tip, opening=..., flange=...)``: ``toolconf tool --urdf``, a
   tool's tools-file row (mass, centre of mass, full inertia, tip in the flange frame) from its
   own URDF, as a dict.

@@ -58,14 +58,16 @@ def dynamics(model: str, params: Params, state: npt.ArrayLike, control: npt.Arra
     (state size,) when every argument is 1-D, else (k, state size). Raises ``ValueError`` for bad
     input."""
 
-class Tip(TypedDict):
+class Tip(TypedDict, total=False):
     position: npt.NDArray[np.float64]
     jacobian: npt.NDArray[np.float64]
+    bias: npt.NDArray[np.float64]
 
-def tip(model: str, params: Params, q: npt.ArrayLike) -> Tip:
+def tip(model: str, params: Params, q: npt.ArrayLike, q_dot: Optional[npt.ArrayLike] = None) -> Tip:
     """The tool's tip y(q) in the base frame (m) and its Jacobian dy/dq: ``position`` (3,) and
-    ``jacobian`` (3, n) for 1-D arguments, else (k, 3) and (k, 3, n). Raises ``ValueError`` for a
-    model without a tip or bad input."""
+    ``jacobian`` (3, n) for 1-D arguments, else (k, 3) and (k, 3, n); with ``q_dot`` (q's shape),
+    also ``bias`` = J̇(q, q̇) q̇ (m/s², ``position``'s shape), so that ÿ = J q̈ + J̇ q̇. Raises
+    ``ValueError`` for a model without a tip or bad input."""
 
 ToolRow = TypedDict(
     "ToolRow",

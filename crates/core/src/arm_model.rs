@@ -82,6 +82,13 @@ pub trait ArmModel<const N: usize, const NX: usize, const NP: usize, const NZ: u
         q: &SVector<f64, N>,
         p: &SVector<f64, NP>,
     ) -> Option<(SVector<f64, 3>, SMatrix<f64, 3, N>)>;
+    /// The tip's acceleration at zero joint acceleration, J̇(q, q̇) q̇ (base frame, m/s²;
+    /// `generated::tip_bias::<name>`), so that ÿ = J(q) q̈ + J̇ q̇; `None` without a tip.
+    fn tip_bias(
+        q: &SVector<f64, N>,
+        q_dot: &SVector<f64, N>,
+        p: &SVector<f64, NP>,
+    ) -> Option<SVector<f64, 3>>;
     /// A = ∂f/∂X at the equilibrium.
     fn state_matrix(p: &SVector<f64, NP>) -> SMatrix<f64, NX, NX>;
     /// B = ∂f/∂U at the equilibrium.
@@ -181,6 +188,15 @@ macro_rules! arm_model {
                 p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
             ) -> Option<(SVector<f64, 3>, SMatrix<f64, 3, { generated::$module::DOF }>)> {
                 generated::tip::$module(q, p)
+            }
+
+            #[inline]
+            fn tip_bias(
+                q: &SVector<f64, { generated::$module::DOF }>,
+                q_dot: &SVector<f64, { generated::$module::DOF }>,
+                p: &SVector<f64, { generated::$module::PARAMETER_COUNT }>,
+            ) -> Option<SVector<f64, 3>> {
+                generated::tip_bias::$module(q, q_dot, p)
             }
 
             #[inline]

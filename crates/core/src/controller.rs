@@ -29,12 +29,15 @@ pub fn observe<const N: usize, const NX: usize>(
 
 /// The tool tip's kinematics at the measured joint positions q: y(q) in the base frame and
 /// J(q) = ∂y/∂q (the generated `tip::<model>`), of which a tip task uses the first `dim`
-/// components ([`crate::ArmModel::TIP_DIM`]).
+/// components ([`crate::ArmModel::TIP_DIM`]), and, where the task reads the tip's acceleration,
+/// J̇(q, q̇) q̇ (the generated `tip_bias::<model>`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TipKinematics<const N: usize> {
     pub position: SVector<f64, 3>,
     pub jacobian: SMatrix<f64, 3, N>,
     pub dim: usize,
+    /// J̇ q̇, the tip's acceleration at q̈ = 0: `None` unless asked for ([`Self::with_bias`]).
+    pub bias: Option<SVector<f64, 3>>,
 }
 
 impl<const N: usize> TipKinematics<N> {
@@ -52,6 +55,24 @@ impl<const N: usize> TipKinematics<N> {
             position,
             jacobian,
             dim: M::TIP_DIM,
+            bias: None,
+        })
+    }
+
+    /// The same with J̇(q, q̇) q̇ at joint rates `q_dot` (`None` for a model without a tip).
+    #[inline]
+    pub fn with_bias<M, const NX: usize, const NP: usize, const NZ: usize>(
+        self,
+        q: &SVector<f64, N>,
+        q_dot: &SVector<f64, N>,
+        p: &SVector<f64, NP>,
+    ) -> Option<Self>
+    where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
+        M::tip_bias(q, q_dot, p).map(|bias| Self {
+            bias: Some(bias),
+            ..self
         })
     }
 
@@ -76,7 +97,9 @@ impl<const N: usize> TipKinematics<N> {
 }
 
 /// [`observe`], and the terms read from the tool's tip at the same instant: y = y(q) (the
-/// generated forward kinematics, not its linearisation) and ẏ = J(q) q̇, each padded.
+/// generated forward kinematics, not its linearisation), ẏ = J(q) q̇ and, where `tip` has its
+/// bias, ÿ = J(q) q̈ + J̇ q̇ (q̈ the plant's, from Ẋ), each padded. Without the bias ÿ is zero,
+/// as every term the task does not read.
 #[inline]
 pub fn observe_with_tip<const N: usize, const NX: usize>(
     x: &SVector<f64, NX>,
@@ -87,14 +110,33 @@ pub fn observe_with_tip<const N: usize, const NX: usize>(
     let mut observed = observe(x, x_dot, u);
     for term in Term::ALL {
         if let Read::Tip { order } = term.read() {
-            observed[term.index()] = match order {
-                0 => tip.pad(&tip.position),
-                // The derivation emits orders 0 and 1 (y, ẏ) only (derive/tasks.toml).
-                _ => tip.pad(&(tip.jacobian * x.fixed_rows::<N>(N))),
+            observed[term.index()] = match (order, tip.bias) {
+                (0, _) => tip.pad(&tip.position),
+                (1, _) => tip.pad(&(tip.jacobian * x.fixed_rows::<N>(N))),
+                // The derivation's orders stop at 2 (derive/tasks.toml).
+                (_, Some(bias)) => tip.pad(&(tip.jacobian * x_dot.fixed_rows::<N>(N) + bias)),
+                (_, None) => SVector::zeros(),
             };
         }
     }
     observed
+}
+
+/// What observing a tool's tip needs on a tip task ([`tip_parameters`]): the tool's
+/// parameters, for y(q; p), and whether the task reads the tip's acceleration, for which each
+/// observation also evaluates J̇ q̇.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TipObserver<const NP: usize> {
+    pub params: SVector<f64, NP>,
+    pub acceleration: bool,
+}
+
+/// Whether the task's controller reads the tip's acceleration ÿ (a term [`Read::Tip`] of order
+/// 2, which needs J̇ q̇).
+pub fn reads_tip_acceleration(kind: crate::TaskKind) -> bool {
+    Term::ALL
+        .iter()
+        .any(|&t| kind.uses(t) && matches!(t.read(), Read::Tip { order: 2.. }))
 }
 
 /// What observing a tool's tip on model `M` needs: on a task that reads the tip
@@ -103,7 +145,7 @@ pub fn observe_with_tip<const N: usize, const NX: usize>(
 pub fn tip_parameters<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
     p: &SVector<f64, NP>,
     kind: crate::TaskKind,
-) -> Result<Option<SVector<f64, NP>>, Error>
+) -> Result<Option<TipObserver<NP>>, Error>
 where
     M: ArmModel<N, NX, NP, NZ>,
 {
@@ -111,29 +153,51 @@ where
         return Ok(None);
     }
     let q_e = M::equilibrium_state().fixed_rows::<N>(0).into_owned();
+    let acceleration = reads_tip_acceleration(kind);
+    let bias = !acceleration || M::tip_bias(&q_e, &SVector::zeros(), p).is_some();
     match M::tip(&q_e, p) {
-        Some(_) => Ok(Some(*p)),
-        None => Err(Error::NoTip {
+        Some(_) if bias => Ok(Some(TipObserver {
+            params: *p,
+            acceleration,
+        })),
+        _ => Err(Error::NoTip {
             kind,
             model: M::NAME,
         }),
     }
 }
 
-/// [`observe_with_tip`] of the tool with parameters `tip` ([`tip_parameters`]), or
-/// [`observe`] on a joint-space task (`None`).
+/// The tip's kinematics at state `x` for [`observe_with_tip`]: J̇ q̇ too where the task reads ÿ.
+#[inline]
+pub fn tip_kinematics<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    x: &SVector<f64, NX>,
+    tip: &TipObserver<NP>,
+) -> Option<TipKinematics<N>>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let q = x.fixed_rows::<N>(0).into_owned();
+    let kinematics = TipKinematics::of::<M, NX, NP, NZ>(&q, &tip.params)?;
+    if !tip.acceleration {
+        return Some(kinematics);
+    }
+    let q_dot = x.fixed_rows::<N>(N).into_owned();
+    kinematics.with_bias::<M, NX, NP, NZ>(&q, &q_dot, &tip.params)
+}
+
+/// [`observe_with_tip`] of the tool `tip` ([`tip_parameters`]), or [`observe`] on a
+/// joint-space task (`None`).
 #[inline]
 pub fn observe_tool<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
     x: &SVector<f64, NX>,
     x_dot: &SVector<f64, NX>,
     u: &SVector<f64, N>,
-    tip: Option<&SVector<f64, NP>>,
+    tip: Option<&TipObserver<NP>>,
 ) -> ObservationN<N>
 where
     M: ArmModel<N, NX, NP, NZ>,
 {
-    let q = x.fixed_rows::<N>(0).into_owned();
-    match tip.and_then(|p| TipKinematics::of::<M, NX, NP, NZ>(&q, p)) {
+    match tip.and_then(|t| tip_kinematics::<M, N, NX, NP, NZ>(x, t)) {
         Some(tip) => observe_with_tip(x, x_dot, u, &tip),
         None => observe(x, x_dot, u),
     }
@@ -225,18 +289,25 @@ impl<const N: usize> ActiveInferenceN<N> {
 
     /// The spectral radius of I − period·γ Σ K ∂(term)/∂U over the terms that follow U within
     /// a tick: B's block for a term read from Ẋ (θ̈: the lower N rows of the plant's input matrix
-    /// `b`), I for U itself. It is how much one [`Self::tick`] multiplies a torque error by,
-    /// linearised where B was taken. Below 1 the ticks settle as the continuous controller does;
-    /// at 1 or above they oscillate without decaying or diverge, and the control rate must be
-    /// raised. Light distal links make ∂θ̈/∂U large (~3/(m₂l₂²) for the paper's arm), and task
-    /// 3's P^θ̈ = 10 ten times the others'.
-    pub fn tick_contraction<const NX: usize>(&self, b: &SMatrix<f64, NX, N>, period: f64) -> f64 {
+    /// `b`), the tip's padded Jacobian `tip_jacobian` times it for the tip's acceleration
+    /// (ÿ = J q̈ + J̇ q̇), I for U itself. It is how much one [`Self::tick`] multiplies a torque
+    /// error by, linearised where B and J were taken. Below 1 the ticks settle as the continuous
+    /// controller does; at 1 or above they oscillate without decaying or diverge, and the control
+    /// rate must be raised. Light distal links make ∂θ̈/∂U large (~3/(m₂l₂²) for the paper's
+    /// arm), and task 3's P^θ̈ = 10 ten times the others'.
+    pub fn tick_contraction<const NX: usize>(
+        &self,
+        b: &SMatrix<f64, NX, N>,
+        tip_jacobian: &SMatrix<f64, N, N>,
+        period: f64,
+    ) -> f64 {
         let g = self.learning_rate * period;
         let instantaneous = sum(Term::ALL.iter().filter_map(|&term| {
             let k = self.gain[term.index()];
             match term.read() {
-                Read::State { .. } | Read::Tip { .. } => None,
+                Read::State { .. } | Read::Tip { order: 0 | 1 } => None,
                 Read::StateRate { block } => Some(k * b.fixed_rows::<N>(block * N)),
+                Read::Tip { .. } => Some(k * tip_jacobian * b.fixed_rows::<N>(N)),
                 Read::Control => Some(k),
             }
         }));

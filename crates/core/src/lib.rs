@@ -49,8 +49,8 @@ pub use toolconf_generated as generated;
 pub use arm_model::*;
 pub use confidence::{control_confidence, logdet_of, ControlConfidenceN, ValidatedTaskN};
 pub use controller::{
-    control_of, observe, observe_tool, observe_with_tip, tip_parameters, ActiveInferenceN,
-    ObservationN, TipKinematics,
+    control_of, observe, observe_tool, observe_with_tip, reads_tip_acceleration, tip_kinematics,
+    tip_parameters, ActiveInferenceN, ObservationN, TipKinematics, TipObserver,
 };
 pub use error::{Error, PrecisionKeys, PrecisionProblem};
 pub use generated::{Read, TaskKind, Term, TERMS};

@@ -114,15 +114,19 @@ pub const TIP_POSITION: Range = Range::closed(-10.0, 10.0, "m");
 /// The tool tip's velocity, a goal ẏ_g: |ẏ| ≤ 10 m/s in each component, several times an
 /// industrial arm's rated tool speed (the Panda's 2 m/s, the UR5's ≈ 1 m/s).
 pub const TIP_VELOCITY: Range = Range::closed(-10.0, 10.0, "m/s");
+/// The tool tip's acceleration, a goal ÿ_g: |ÿ| ≤ 100 m/s² in each component, ten times the
+/// gravity an arm lifts against and above the Panda's rated 13 m/s² Cartesian acceleration.
+pub const TIP_ACCELERATION: Range = Range::closed(-100.0, 100.0, "m/s²");
 
 /// The ranges a goal may be checked against, by the name `derive/tasks.toml` gives a term's
 /// `goal_range` (and `toolconf.ranges()` its key).
-pub const GOAL_RANGES: [(&str, Range); 5] = [
+pub const GOAL_RANGES: [(&str, Range); 6] = [
     ("joint_angle", JOINT_ANGLE),
     ("joint_rate", JOINT_RATE),
     ("joint_acceleration", JOINT_ACCELERATION),
     ("tip_position", TIP_POSITION),
     ("tip_velocity", TIP_VELOCITY),
+    ("tip_acceleration", TIP_ACCELERATION),
 ];
 
 /// The range a goal of `term` must lie in; `None` for a term without a goal (the control's).

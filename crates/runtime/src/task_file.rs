@@ -2,9 +2,10 @@
 //!
 //! ```toml
 //! kind = "position"              # position | velocity | acceleration: the paper's three task structures;
-//!                                # tip_position | tip_velocity: on the tool's tip (goal keys tip, tip_dot:
-//!                                # the tip's components in the base frame, m and m/s, 3 for a URDF arm,
-//!                                # 2 for a planar one; a scalar precision weighs those components alone)
+//!                                # tip_position | tip_velocity | tip_acceleration: on the tool's tip (goal
+//!                                # keys tip, tip_dot, tip_ddot: the tip's components in the base frame,
+//!                                # m, m/s and m/s², 3 for a URDF arm, 2 for a planar one; a scalar
+//!                                # precision weighs those components alone)
 //! description = "reach 45°"      # optional, shown in reports
 //! [goal]                         # optional, each key defaulting to the model's paper goal
 //! theta = [0.7853981633974483, 0.0]

@@ -74,6 +74,7 @@ pub struct RegistryModel<'a> {
     /// The body of `generated::tip::<name>`: `Some(..)` of the model's `tip` function, or `None`
     /// for a model whose description gives no tip.
     pub tip_body: String,
+    pub tip_bias_body: String,
     pub has_tip: bool,
     /// The tasks the model offers, as `TaskKind` variants (`TaskKind::Position`).
     pub task_variants: Vec<String>,
@@ -180,6 +181,7 @@ fn registry_model(ir: &Ir) -> Result<RegistryModel<'_>, RenderError> {
         tool_rule: tool_rule_view(m)?,
         rigid_body: rigid_body(&ir.functions),
         tip_body: tip_body(&m.name, &ir.functions),
+        tip_bias_body: tip_bias_body(&m.name, &ir.functions),
         has_tip: ir.functions.iter().any(|f| f.name == "tip"),
         task_variants: ir
             .tasks
@@ -195,6 +197,15 @@ fn tip_body(name: &str, functions: &[Function]) -> String {
         format!("Some(crate::{name}::tip(q, params))")
     } else {
         "let _ = (q, params);\n        None".to_string()
+    }
+}
+
+/// `generated::tip_bias::<name>`'s body: the model's `tip_bias` (J̇ q̇) where it has one.
+fn tip_bias_body(name: &str, functions: &[Function]) -> String {
+    if functions.iter().any(|f| f.name == "tip_bias") {
+        format!("Some(crate::{name}::tip_bias(q, q_dot, params))")
+    } else {
+        "let _ = (q, q_dot, params);\n        None".to_string()
     }
 }
 

@@ -75,7 +75,7 @@
 
 #![no_std]
 
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 use toolconf_core::{ActiveInferenceN, ArmModel, ControlConfidenceN, Error, TaskN, ToolN};
 
 pub use toolconf_core::{Arm2, Arm2Tool, Arm3, Arm3Tool, TaskKind};
@@ -106,8 +106,9 @@ where
     torque: SVector<f64, N>,
     period: f64,
     /// On a task on the tool's tip, the tool's parameters: each tick then reads the tip's
-    /// y(q) and J(q) q̇ from the generated forward kinematics (`None`: a joint-space task).
-    tip: Option<SVector<f64, NP>>,
+    /// y(q), J(q) q̇ and, for its acceleration, J(q) q̈ + J̇ q̇ from the generated forward
+    /// kinematics (`None`: a joint-space task).
+    tip: Option<toolconf_core::TipObserver<NP>>,
 }
 
 /// The paper's arm (`arm2`).
@@ -146,7 +147,12 @@ where
         let controller = ActiveInferenceN::new(tool, task, learning_rate)?;
         let period = 1.0 / rate_hz;
         let b = M::input_matrix(&tool.params());
-        let contraction = controller.tick_contraction(&b, period);
+        // The tip's Jacobian at the equilibrium, where B is taken (zero without a tip: then no
+        // term reads the tip's acceleration).
+        let q_e = M::equilibrium_state().fixed_rows::<N>(0).into_owned();
+        let j = toolconf_core::TipKinematics::of::<M, NX, NP, NZ>(&q_e, &tool.params())
+            .map_or_else(SMatrix::zeros, |t| t.padded_jacobian());
+        let contraction = controller.tick_contraction(&b, &j, period);
         if !(contraction.is_finite() && contraction < 1.0) {
             return Err(Error::InvalidOption {
                 name: "control rate [Hz] (too low for this tool and task: each tick would not shrink a torque error; raise it)",

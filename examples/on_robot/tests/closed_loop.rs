@@ -274,3 +274,40 @@ fn a_tick_on_a_tip_task_reads_the_tips_closed_form() {
         );
     }
 }
+
+/// On the tip acceleration task a tick with a measured θ̈ reads ÿ = J q̈ + J̇ q̇ from the arm's
+/// closed form (ÿ = Σ l_i θ̈_i (−sin θ_i, cos θ_i) − l_i θ̇_i² (cos θ_i, sin θ_i), angles absolute),
+/// not the generated tip and its bias.
+#[test]
+fn a_tick_on_the_tip_acceleration_task_reads_the_tips_closed_form() {
+    let p = [0.3, 0.4, 0.5, 0.2];
+    let tool = Arm2Tool::new(p).unwrap();
+    let task = Arm2::paper_task(TaskKind::TipAcceleration);
+    let mut controller = Arm2Controller::new(&tool, &task, 1.0, [0.1; 2], 1000.0).unwrap();
+    let x = nalgebra::Vector4::new(-1.4, -1.9, 0.3, -0.2);
+    let q_ddot = [2.5, -4.0];
+    let torque = controller
+        .tick_with_acceleration(&x.into(), &q_ddot)
+        .unwrap()
+        .torque;
+
+    let l = [p[2], p[3]];
+    let y_ddot = (0..2).fold(nalgebra::Vector2::zeros(), |a, i| {
+        let (s, c, w) = (x[i].sin(), x[i].cos(), x[2 + i]);
+        a + nalgebra::Vector2::new(-s, c) * (l[i] * q_ddot[i])
+            - nalgebra::Vector2::new(c, s) * (l[i] * w * w)
+    });
+    let s = tool.sensitivities(TaskKind::TipAcceleration);
+    let k = s.of(Term::TipDdot).unwrap().transpose() * task.precision[Term::TipDdot.index()];
+    let u = nalgebra::Vector2::new(0.1, 0.1);
+    let gradient = k * (y_ddot - task.goal[Term::TipDdot.index()])
+        + task.precision[Term::U.index()] * u;
+    let expected = u - gradient * 1e-3;
+    for i in 0..2 {
+        let scale = expected[i].abs().max(1.0);
+        assert!(
+            (torque[i] - expected[i]).abs() <= 1e-12 * scale,
+            "{torque:?} vs {expected}"
+        );
+    }
+}

@@ -10,7 +10,10 @@ use crate::integrate::{
     solve_grid_with_jacobian, uniform_grid, IntegrationError, Method, Options as IntegratorOptions,
 };
 use crate::Error;
-use toolconf_core::{observe_tool, reads_tip, tip_parameters, ObservationN, TipKinematics};
+use toolconf_core::{
+    observe_tool, reads_tip, tip_parameters, ObservationN, TipKinematics,
+    TipObserver,
+};
 
 /// A grid state whose magnitude passes this is a diverging simulation, not a result.
 pub(crate) const DIVERGENCE_BOUND: f64 = crate::validate::STATE_BOUND;
@@ -40,8 +43,9 @@ where
     pub controller: ActiveInferenceN<N>,
     perturbation: SVector<f64, N>,
     /// On a task that reads the tool's tip, the tool's parameters for y(q; p): then every
-    /// right-hand side evaluates y(q), J(q) ([`tip_parameters`]).
-    tip: Option<SVector<f64, NP>>,
+    /// right-hand side evaluates y(q), J(q), and J̇ q̇ on a tip acceleration task
+    /// ([`tip_parameters`]).
+    tip: Option<TipObserver<NP>>,
 }
 
 impl<P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>
@@ -153,8 +157,14 @@ where
                 Read::StateRate { .. } | Read::Tip { .. } => {}
             }
         }
-        if let Some(p) = &self.tip {
-            subtract_tip_gains::<P, N, NX, NP, NZ>(p, &x, &gains, &mut du_dx);
+        if let Some(tip) = &self.tip {
+            // ÿ reads the plant's q̈ = f(X, U + ΔT), its lower rows.
+            let q_ddot = tip.acceleration.then(|| {
+                let f = P::dynamics_with(&x, &(u + self.perturbation), &self.dynamics);
+                f.fixed_rows::<N>(N).into_owned()
+            });
+            let plant = (&f_x, &f_u, q_ddot);
+            subtract_tip_gains::<P, N, NX, NP, NZ>(tip, &x, plant, &gains, &mut du_dx, &mut du_du);
         }
         j.fixed_view_mut::<N, NX>(NX, 0).copy_from(&du_dx);
         j.fixed_view_mut::<N, N>(NX, NX).copy_from(&du_du);
@@ -162,53 +172,115 @@ where
     }
 }
 
-/// The tip terms' part of ∂U̇/∂X for the tool with parameters `p`: y = y(q) has ∂y/∂q = J;
+/// The tip terms' part of ∂U̇/∂X and ∂U̇/∂U for the tool `tip`: y = y(q) has ∂y/∂q = J;
 /// ẏ = J(q) q̇ has ∂ẏ/∂q̇ = J and ∂ẏ/∂q = J̇ = Σ_k ∂J/∂q_k q̇_k (column k of ∂(J q̇)/∂q is
 /// Σ_j ∂²y/∂q_k∂q_j q̇_j, and the Hessian of y is symmetric), the directional derivative of J
-/// along q̇, taken here by a central difference of the generated J (the tip's second derivatives
-/// are not generated). Its step h·|q̇|∞ = 1e-5 rad leaves an error ~1e-10 relative: this matrix
-/// only steers the stiff integrator's Newton-like stages, whose error control does not depend on
-/// it being exact, while the right-hand side itself is exact.
+/// along q̇; ÿ = J(q) q̈ + J̇ q̇ with q̈ = f(X, U) has J times f's lower rows, plus ∂(J a +
+/// J̇ q̇)/∂q at a = q̈ held, plus ∂(J̇ q̇)/∂q̇. The tip's second derivatives are not generated:
+/// they are central differences of the generated J and J̇ q̇, with steps of 1e-5 rad in q (an
+/// error ~1e-10 relative) and exact in q̇ (J̇ q̇ is quadratic in q̇). This matrix steers the stiff
+/// integrator's stages; the right-hand side itself is exact.
 fn subtract_tip_gains<P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
-    p: &SVector<f64, NP>,
+    tip: &TipObserver<NP>,
     x: &SVector<f64, NX>,
+    (f_x, f_u, q_ddot): (&SMatrix<f64, NX, NX>, &SMatrix<f64, NX, N>, Option<SVector<f64, N>>),
     gains: &[SMatrix<f64, N, N>; TERMS],
     du_dx: &mut SMatrix<f64, N, NX>,
+    du_du: &mut SMatrix<f64, N, N>,
 ) where
     P: ArmModel<N, NX, NP, NZ>,
 {
-    let jacobian =
-        |q: &SVector<f64, N>| TipKinematics::of::<P, NX, NP, NZ>(q, p).map(|t| t.padded_jacobian());
+    let p = &tip.params;
     let q = x.fixed_rows::<N>(0).into_owned();
     let q_dot = x.fixed_rows::<N>(N).into_owned();
-    let Some(j) = jacobian(&q) else {
+    let Some(j) = TipKinematics::of::<P, NX, NP, NZ>(&q, p).map(|t| t.padded_jacobian()) else {
         return;
     };
-    // At rest J̇ = 0; otherwise the step h that moves q by 1e-5 rad at most.
-    let speed = q_dot.amax();
-    let step = (speed > 0.0).then(|| 1e-5 / speed);
-    let j_dot = step
-        .and_then(|h| {
-            let (ahead, behind) = (jacobian(&(q + q_dot * h))?, jacobian(&(q - q_dot * h))?);
-            Some((ahead - behind) / (2.0 * h))
-        })
-        .unwrap_or_else(SMatrix::zeros);
+    let j_dot = jacobian_rate::<P, N, NX, NP, NZ>(p, &q, &q_dot);
     for term in Term::ALL {
         let k = gains[term.index()];
-        match term.read() {
-            Read::Tip { order: 0 } => {
+        match (term.read(), q_ddot) {
+            (Read::Tip { order: 0 }, _) => {
                 let mut positions = du_dx.fixed_view_mut::<N, N>(0, 0);
                 positions -= k * j;
             }
-            Read::Tip { .. } => {
+            (Read::Tip { order: 1 }, _) => {
                 let mut rates = du_dx.fixed_view_mut::<N, N>(0, N);
                 rates -= k * j;
                 let mut positions = du_dx.fixed_view_mut::<N, N>(0, 0);
                 positions -= k * j_dot;
             }
+            (Read::Tip { .. }, Some(a)) => {
+                let kj = k * j;
+                *du_dx -= kj * f_x.fixed_rows::<N>(N);
+                *du_du -= kj * f_u.fixed_rows::<N>(N);
+                let (d_q, d_q_dot) = acceleration_geometry::<P, N, NX, NP, NZ>(p, &q, &q_dot, &a);
+                let mut positions = du_dx.fixed_view_mut::<N, N>(0, 0);
+                positions -= k * d_q;
+                let mut rates = du_dx.fixed_view_mut::<N, N>(0, N);
+                rates -= k * d_q_dot;
+            }
             _ => {}
         }
     }
+}
+
+/// J̇ = ∂(J q̇)/∂q, padded: a central difference of the generated J along q̇ (zero at rest),
+/// its step moving q by 1e-5 rad at most.
+fn jacobian_rate<P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    p: &SVector<f64, NP>,
+    q: &SVector<f64, N>,
+    q_dot: &SVector<f64, N>,
+) -> SMatrix<f64, N, N>
+where
+    P: ArmModel<N, NX, NP, NZ>,
+{
+    let jacobian =
+        |q: &SVector<f64, N>| TipKinematics::of::<P, NX, NP, NZ>(q, p).map(|t| t.padded_jacobian());
+    let speed = q_dot.amax();
+    let step = (speed > 0.0).then(|| 1e-5 / speed);
+    step.and_then(|h| {
+        let (ahead, behind) = (jacobian(&(q + q_dot * h))?, jacobian(&(q - q_dot * h))?);
+        Some((ahead - behind) / (2.0 * h))
+    })
+    .unwrap_or_else(SMatrix::zeros)
+}
+
+/// The geometric part of ∂ÿ/∂X, padded: ∂(J(q) a + J̇ q̇)/∂q at the joint acceleration `a` held,
+/// by central differences of 1e-5 rad per joint, and ∂(J̇ q̇)/∂q̇, by central differences that are
+/// exact up to rounding (J̇ q̇ is a quadratic form in q̇).
+fn acceleration_geometry<P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    p: &SVector<f64, NP>,
+    q: &SVector<f64, N>,
+    q_dot: &SVector<f64, N>,
+    a: &SVector<f64, N>,
+) -> (SMatrix<f64, N, N>, SMatrix<f64, N, N>)
+where
+    P: ArmModel<N, NX, NP, NZ>,
+{
+    let tip = |q: &SVector<f64, N>, q_dot: &SVector<f64, N>| {
+        let t = TipKinematics::of::<P, NX, NP, NZ>(q, p)?.with_bias::<P, NX, NP, NZ>(q, q_dot, p)?;
+        Some((t.pad(&(t.jacobian * a)), t.pad(&t.bias?)))
+    };
+    let difference = |column: &dyn Fn(usize, f64) -> Option<SVector<f64, N>>, h: f64| {
+        let mut d = SMatrix::<f64, N, N>::zeros();
+        for k in 0..N {
+            if let (Some(ahead), Some(behind)) = (column(k, h), column(k, -h)) {
+                d.set_column(k, &((ahead - behind) / (2.0 * h)));
+            }
+        }
+        d
+    };
+    let unit = |k: usize, h: f64| SVector::<f64, N>::from_fn(|i, _| if i == k { h } else { 0.0 });
+    let d_q = difference(
+        &|k, h| tip(&(q + unit(k, h)), q_dot).map(|(ja, bias)| ja + bias),
+        1e-5,
+    );
+    let d_q_dot = difference(
+        &|k, h| tip(q, &(q_dot + unit(k, h))).map(|(_, bias)| bias),
+        q_dot.amax().max(1.0),
+    );
+    (d_q, d_q_dot)
 }
 
 /// Options of one episode for N joints ([`crate::closed_loop::EpisodeOptions`] for the paper's
@@ -525,8 +597,10 @@ where
     let mut integrator = options.integrator;
     // Auto switches only on acceleration-control tasks (θ̈ feedback makes them stiff); elsewhere
     // it stays DP5 so the paper's ode45 runs keep their numbers (see EpisodeOptions::integrator).
-    let fed_back_through_the_plant =
-        matches!(task.kind.error_term().read(), Read::StateRate { .. });
+    let fed_back_through_the_plant = matches!(
+        task.kind.error_term().read(),
+        Read::StateRate { .. } | Read::Tip { order: 2.. }
+    );
     if integrator.method == Method::Auto && !fed_back_through_the_plant {
         integrator.method = Method::Explicit;
     }

@@ -184,6 +184,44 @@ where
                 Ok(())
             })
     }
+
+    fn tip_bias(
+        &self,
+        k: usize,
+        params: &Rows,
+        q: &Rows,
+        q_dot: &Rows,
+        bias: &mut [f64],
+    ) -> Result<(), BatchError> {
+        let tools = tool_rows::<M, N, NX, NP, NZ>(k, params)?;
+        let named = [("joint position", q), ("joint velocity", q_dot)];
+        for (what, rows) in named {
+            if let Some(v) = rows.data.iter().find(|v| !v.is_finite()) {
+                return Err(BatchError::Input(format!("{what} {v} is not finite")));
+            }
+        }
+        bias.par_chunks_exact_mut(3)
+            .with_min_len(MIN_STATES_PER_THREAD)
+            .enumerate()
+            .try_for_each(|(i, row)| {
+                let tool = &tools[if params.shared { 0 } else { i }];
+                let qi = SVector::<f64, N>::from_column_slice(q.row(i));
+                let vi = SVector::<f64, N>::from_column_slice(q_dot.row(i));
+                let Some(b) = M::tip_bias(&qi, &vi, &tool.params()) else {
+                    return Err(BatchError::Input(format!(
+                        "model {} has no tip (its description gives none)",
+                        M::NAME
+                    )));
+                };
+                if !b.iter().all(|v| v.is_finite()) {
+                    return Err(BatchError::Input(format!(
+                        "state {i}: the tip's acceleration is not finite there (|q| or |q_dot| too large)"
+                    )));
+                }
+                row.copy_from_slice(b.as_slice());
+                Ok(())
+            })
+    }
 }
 
 /// The tools of a batch's `params` rows (one shared by every row, or one per row), each checked

@@ -86,6 +86,18 @@ pub trait Model: Send + Sync {
         position: &mut [f64],
         jacobian: &mut [f64],
     ) -> Result<(), BatchError>;
+
+    /// The tip's acceleration at zero joint acceleration, J̇(q, q̇) q̇ (base frame, m/s²), of `k`
+    /// rows of joint positions and rates into `bias` (k × 3), so that ÿ = J q̈ + J̇ q̇; `params`
+    /// one row shared by every state or one per state. An error for a model without a tip.
+    fn tip_bias(
+        &self,
+        k: usize,
+        params: &Rows,
+        q: &Rows,
+        q_dot: &Rows,
+        bias: &mut [f64],
+    ) -> Result<(), BatchError>;
 }
 
 /// A task bound to one model ([`Model::bind`]): every method takes a tool as its parameters in
