@@ -508,11 +508,15 @@ fn trajectory_figure(dir: &Path, input: &ReportInput) -> Result<Vec<Block>, Repr
         Block::Heading(2, "The best and the worst tools over time".into()),
         Block::p(format!(
             "The task variable {var} of the {} best (solid, blue) and {} worst (dashed, red) \
-             tools by {}, one panel per joint; the grey dashed line is the goal. A good tool \
+             tools by {}, one panel per {}; the grey dashed line is the goal. A good tool \
              gets to the goal quickly and stays there.",
             best.len(),
             worst.len(),
-            objective_words(input.objective)
+            objective_words(input.objective),
+            match input.spec.kind.error_term().read() {
+                Read::Tip { .. } => "component of the tip in the base frame",
+                _ => "joint",
+            }
         )),
         Block::Figure {
             file: TRAJECTORY_SVG.into(),
