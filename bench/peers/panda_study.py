@@ -43,6 +43,10 @@ DOC = ROOT / "docs" / "urdf.md"
 BEGIN, END = "<!-- impedance-study:begin (written by bench/peers/panda_study.py) -->", "<!-- impedance-study:end -->"
 RTOL, ATOL = 1e-8, 1e-10
 ROBOT = "panda"
+# The study measured the paper's task formulas (derive/tasks.toml's own, E = [I; I] on position),
+# before toolconf made the static gain the URDF arms' position formulation (docs/urdf.md, "The
+# static gain"); urdf_loop's default is toolconf's, so the study names the paper's.
+PAPER = "paper"
 
 
 def random_tools(count: int, seed: int = 2023) -> list[list[float]]:
@@ -70,7 +74,7 @@ def physical(kind: str) -> Task:
     0.05 rad from q^e on joints 1, 2, 4, 6 (K delta = 30 N m, 7.5 N m: within 87 and 12 N m).
     Velocity: joint 7 at 0.04 rad/s (0.2 rad in 5 s, K_7 * 0.2 = 10 N m within its 12),
     sigma_theta_dot = 0.01 rad/s, the rest as for position. U0 = 0: the set point holds the arm."""
-    t = Task.paper(ROBOT, kind)
+    t = Task.paper(ROBOT, kind, PAPER)
     n = len(t.goal["theta"])
     d = description(ROBOT)
     t.precision["u"] = np.diag(1.0 / (0.1 * rated_torques()) ** 2)
@@ -101,7 +105,7 @@ def episode(job):
     if isinstance(precisions, tuple):
         task = velocity_precisions(*precisions)
     else:
-        task = Task.paper(ROBOT, kind) if precisions == "paper" else physical(kind)
+        task = Task.paper(ROBOT, kind, PAPER) if precisions == "paper" else physical(kind)
     loop = ClosedLoop(ROBOT, tool, task, k_scale, d_scale)
     out = {"logdet": loop.logdet, "mass": tool[0]}
     try:
