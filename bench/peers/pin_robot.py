@@ -37,7 +37,8 @@ class Description:
 
 
 def description(name: str) -> Description:
-    path = MODELS / f"{name}.toml"
+    """A model of derive/models by name, or a description of kind urdf by its path (*.toml)."""
+    path = Path(name) if name.endswith(".toml") else MODELS / f"{name}.toml"
     with path.open("rb") as f:
         d = tomllib.load(f)
     env = {"__builtins__": {}, "pi": math.pi}

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Peer comparison: toolconf vs SciPy solve_ivp(RK45) vs CasADi cvodes on the same 100 tools;
-# with --urdf, the Panda against SciPy solve_ivp with Pinocchio's aba (bench/peers/urdf_peers.py).
+# with --urdf, the Panda against SciPy solve_ivp with Pinocchio's aba (bench/peers/urdf_peers.py);
+# with --sweep, a URDF robot's results against its impedance gains (bench/peers/impedance_sweep.py).
 # Creates bench/peers/.venv from requirements.txt on first use, builds toolconf (release) and the
 # peer_timing example, and writes docs/performance.md (extra arguments go to compare.py).
 set -euo pipefail
@@ -13,6 +14,11 @@ if [[ ! -x "$venv/bin/python" || "$here/requirements.txt" -nt "$venv/bin/python"
   touch "$venv/bin/python"
 fi
 cd "$root"
+if [[ "${1:-}" == "--sweep" ]]; then
+  # How a URDF robot's results depend on its impedance gains (impedance_sweep.py).
+  shift
+  exec "$venv/bin/python" "$here/impedance_sweep.py" "$@"
+fi
 if [[ "${1:-}" == "--urdf" ]]; then
   # The URDF arms: SciPy solve_ivp with Pinocchio's aba in the right-hand side (urdf_peers.py).
   shift

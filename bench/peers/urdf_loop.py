@@ -72,7 +72,8 @@ def task_definitions() -> dict:
 
 @lru_cache(maxsize=None)
 def model_description(robot: str):
-    return load_model(MODELS / f"{robot}.toml")
+    """A model of derive/models by name, or a description of kind urdf by its path (*.toml)."""
+    return load_model(Path(robot) if robot.endswith(".toml") else MODELS / f"{robot}.toml")
 
 
 def terms() -> list:
@@ -332,11 +333,12 @@ class ClosedLoop:
         """Task error, int F dt, int J dt on the grid, as toolconf computes them (J's summands in
         tasks.toml's cost_order)."""
         n, t = self.n, self.task
-        task_error, f_values, j_values = 0.0, [], []
+        task_error, f_values, j_values, distances = 0.0, [], [], []
         for z in states:
             value = self.observe(z[:n], z[n:2 * n], z[2 * n:])
             e = value[t.error] - t.goal[t.error]
             task_error += float(e @ t.precision[t.error] @ e)
+            distances.append(float(np.linalg.norm(e)))
             j = 0.0
             for term in t.cost_order:
                 if term in t.terms:
@@ -345,5 +347,8 @@ class ClosedLoop:
             j_values.append(0.5 * j)
             f_values.append(0.5 * j - 0.5 * self.logdet)
         trapz = lambda v: float(np.sum(0.5 * np.diff(grid) * (np.array(v[1:]) + np.array(v[:-1]))))  # noqa: E731
+        # Progress 1 - e(T)/e(0) on a position task (joint or tip), as toolconf's Metrics::progress.
+        position = t.error in ("theta", "tip") and distances[0] > 0.0
         return {"task_error": task_error, "free_energy": trapz(f_values), "cost_j": trapz(j_values),
-                "logdet": float(self.logdet), "rhs_evals": self.evals}
+                "logdet": float(self.logdet), "rhs_evals": self.evals,
+                "progress": 1.0 - distances[-1] / distances[0] if position else None}
