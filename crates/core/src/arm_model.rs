@@ -257,10 +257,27 @@ macro_rules! arm_model {
     };
 }
 
+/// [`TaskN::paper`](crate::TaskN) for the paper's arm, where the generated crate has it (`arm2`):
+/// a crate generated from other models alone (a model library of `make model`) has no such task.
+macro_rules! paper_arm {
+    (Arm2) => {
+        impl TaskN<2> {
+            /// The paper's task `kind` for its arm, with the published goals and precisions
+            /// ("Implementation details"; [`ArmModel::paper_task`] of [`crate::Arm2`]; another
+            /// model's is its own `paper_task`).
+            pub fn paper(kind: TaskKind) -> Self {
+                crate::Arm2::paper_task(kind)
+            }
+        }
+    };
+    ($other:ident) => {};
+}
+
 /// One marker type, its [`ArmModel`] implementation and its tool alias per generated model.
 macro_rules! arm_models {
     ($(($marker:ident, $module:ident, $tool:ident, $name:literal, $title:literal)),* $(,)?) => {
         $(
+            paper_arm!($marker);
             arm_model!(
                 #[doc = concat!($title, " (`toolconf_generated::", $name, "`).")]
                 $marker => $module

@@ -6,7 +6,8 @@
 //! ln|Π^U| ([`control_confidence`], eq. control_conf), and the active-inference controller
 //! ([`ActiveInferenceN`]: U̇ = −γ ∂F/∂U, eq. U_dot_deriv, the free energy F, the cost J and the
 //! task error) with [`ActiveInferenceN::tick`], one control period on a robot: measured state →
-//! U̇ → the next torque.
+//! U̇ → the next torque, and [`ArmController`], the on-robot controller ticking at a fixed rate
+//! (`examples/on_robot`; the C ABI of a model library, crates/cabi, ticks through it).
 //!
 //! ```text
 //! generated/       toolconf-generated  no_std   the derived code: models, tasks, registry
@@ -33,6 +34,7 @@
 #[cfg(feature = "std")]
 extern crate std;
 
+mod arm_controller;
 mod arm_model;
 mod confidence;
 mod controller;
@@ -46,6 +48,7 @@ pub mod validate;
 /// The generated crate this one is built on (`generated/`).
 pub use toolconf_generated as generated;
 
+pub use arm_controller::{ArmController, Command, RATE_HZ};
 pub use arm_model::*;
 pub use confidence::{control_confidence, logdet_of, ControlConfidenceN, ValidatedTaskN};
 pub use controller::{

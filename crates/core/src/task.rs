@@ -6,7 +6,7 @@ use crate::generated;
 use crate::generated::{Read, TaskKind, Term, TERMS};
 use crate::{Error, PrecisionProblem};
 
-use super::{ArmModel, ValidatedTaskN};
+use super::ValidatedTaskN;
 
 /// A task for N joints: a goal and a prior precision for every free-energy term
 /// (eq. free_energy), indexed by [`Term::index`]: θ^g, θ̇^g, θ̈^g and P^θ, P^θ̇, P^θ̈, P^U for the
@@ -14,7 +14,7 @@ use super::{ArmModel, ValidatedTaskN};
 /// task 3 θ and θ̇); the goal of the control's own term is zero (η^U = 0).
 ///
 /// A term read from the tool's tip ([`Read::Tip`]: y, ẏ) has the tip's `d` components
-/// ([`ArmModel::TIP_DIM`]: 3, 2 for a planar arm), stored padded in the N slots: its goal in the
+/// ([`crate::ArmModel::TIP_DIM`]: 3, 2 for a planar arm), stored padded in the N slots: its goal in the
 /// first d rows and zeros after, its precision in the upper-left d × d block and zeros elsewhere
 /// (as its generated sensitivity J ∂θ/∂U has zero rows after the d-th; derive/tasks.toml, `J`).
 /// Every sum the controller and Π^U form is then the same for joint and tip terms, on the stack,
@@ -99,15 +99,6 @@ impl<const N: usize> TaskN<N> {
             });
         }
         Ok(())
-    }
-}
-
-impl TaskN<2> {
-    /// The paper's task `kind` for its arm, with the published goals and precisions
-    /// ("Implementation details"; [`ArmModel::paper_task`] of [`crate::Arm2`]; another model's is
-    /// its own `paper_task`).
-    pub fn paper(kind: TaskKind) -> Self {
-        crate::Arm2::paper_task(kind)
     }
 }
 
