@@ -99,6 +99,42 @@ fn what_a_robot_links_has_nothing_heavy() {
 }
 
 #[test]
+fn the_c_abi_is_on_the_core_alone_without_its_std_feature() {
+    let direct = tree("crates/cabi/Cargo.toml", &["-e", "normal", "--depth", "1"]);
+    let expected: BTreeSet<String> = ["toolconf-cabi", "toolconf-core", "nalgebra", "sha2"]
+        .map(String::from)
+        .into();
+    assert_eq!(direct, expected);
+    let all = tree("crates/cabi/Cargo.toml", &["-e", "normal"]);
+    for heavy in HEAVY.iter().chain(&["toolconf", "toolconf-files"]) {
+        assert!(!all.contains(*heavy), "{heavy} in the C ABI's tree {all:?}");
+    }
+    // ln|Π^U| through the C ABI is the on-robot controller's (the libm crate's), not the std
+    // runtime's: a model library's ticks are that controller's, bit for bit.
+    let out = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args([
+            "tree",
+            "--manifest-path",
+            "crates/cabi/Cargo.toml",
+            "-e",
+            "normal",
+        ])
+        .args(["--prefix", "none", "--format", "{p} features=[{f}]"])
+        .output()
+        .expect("run cargo tree");
+    let text = String::from_utf8_lossy(&out.stdout);
+    let core: Vec<&str> = text
+        .lines()
+        .filter(|l| l.starts_with("toolconf-core "))
+        .collect();
+    assert!(
+        !core.is_empty() && core.iter().all(|l| l.ends_with("features=[]")),
+        "{text}"
+    );
+}
+
+#[test]
 fn the_runtime_and_the_python_package_have_no_command_line_plots_or_progress_bars() {
     for manifest in ["crates/runtime/Cargo.toml", "python/Cargo.toml"] {
         let normal = tree(manifest, &["-e", "normal"]);

@@ -12,7 +12,8 @@
 //! [`crate_path`] places in the crate (Rust sources under `src/`); a template under
 //! `templates/registry/`, at `<path>.tera`, renders once over all models to `<path>` in the crate:
 //! that folder is laid out as the crate (`Cargo.toml`, `src/lib.rs` with the model registry,
-//! `src/tasks.rs`, `tests/vectors.rs`, ...). Rust output goes through rustfmt so that the
+//! `src/tasks.rs`, `tests/vectors.rs`, ...). The templates under `templates/cabi/` render once
+//! for one model into the crate of a model library around it (`make model`: [`cabi`]). Rust output goes through rustfmt so that the
 //! checked-in code is exactly what `make derive` produces; [`check_crate`] compares a crate
 //! folder with what its IR renders to (`make render` writes it).
 
@@ -22,6 +23,7 @@ use std::process::{Command, Stdio};
 
 use tera::{Context, Tera};
 
+pub mod cabi;
 mod check;
 pub mod functions;
 pub mod ir;
@@ -84,7 +86,7 @@ pub fn crate_path(file_name: &str) -> PathBuf {
 }
 
 /// A Tera engine over the templates, with no HTML escaping (the outputs are Rust and Markdown).
-fn engine(templates: &[(String, String)]) -> Result<Tera, RenderError> {
+pub(crate) fn engine(templates: &[(String, String)]) -> Result<Tera, RenderError> {
     let mut tera = Tera::default();
     tera.autoescape_on(vec![]);
     tera.add_raw_templates(templates.iter().map(|(n, t)| (n.as_str(), t.as_str())))
@@ -93,7 +95,7 @@ fn engine(templates: &[(String, String)]) -> Result<Tera, RenderError> {
 }
 
 /// Renders one template to `file_name`; a `.rs` file goes through rustfmt.
-fn render_one(
+pub(crate) fn render_one(
     tera: &Tera,
     template: &str,
     context: &Context,

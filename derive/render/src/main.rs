@@ -12,7 +12,12 @@
 //! `--check-crate-out OUT --repository DIR [--input LABEL PATH]...` checks, before anything is
 //! derived, that OUT may become the crate; `--install-crate STAGING --out OUT --repository DIR
 //! [--input LABEL PATH]...` checks again, writes the ownership manifest into the crate made in
-//! STAGING and moves it into place. A refusal is one line, status 2; a failure to write, status 1.
+//! STAGING and moves it into place; `--command NAME` names another command as the folder's maker
+//! (`make model`: a folder of one command is not the other's to replace). A refusal is one line, status 2; a failure to write, status 1.
+//!
+//! `make model`'s library crate: `IR.json --model-library DIR --repository REPO [--templates
+//! templates]` renders templates/cabi/ for the one model into DIR (its generated crate, rendered
+//! as usual, goes into DIR/generated), on the repository REPO's toolconf-cabi.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -20,6 +25,7 @@ use std::process::ExitCode;
 use toolconf_files::file::create_folder;
 use toolconf_files::folder::{CrateFolder, FolderError};
 use toolconf_files::{write_atomically, WriteError};
+use toolconf_render::cabi::{render_library, LibraryPackage};
 use toolconf_render::{check_crate, crate_irs, render_crate, CrateFile, Package, RenderError};
 
 /// Writes one rendered file whole, or leaves what was there (toolconf_files' rule).
@@ -49,6 +55,9 @@ struct Args {
     crate_rule: Option<CrateRule>,
     repository: Option<PathBuf>,
     inputs: Vec<(String, PathBuf)>,
+    model_library: Option<PathBuf>,
+    /// The command the folder rule names as the folder's maker (`make crate`, `make model`).
+    command: String,
 }
 
 /// The value after `flag`, which the folder rule cannot do without.
@@ -68,6 +77,8 @@ fn parse(args: &[String]) -> Result<Args, String> {
         crate_rule: None,
         repository: None,
         inputs: Vec::new(),
+        model_library: None,
+        command: "make crate".into(),
     };
     let mut it = args.iter();
     while let Some(arg) = it.next() {
@@ -91,6 +102,8 @@ fn parse(args: &[String]) -> Result<Args, String> {
                 a.crate_rule = Some(CrateRule::Install(value(&mut it, arg)?.into()));
             }
             "--repository" => a.repository = Some(value(&mut it, arg)?.into()),
+            "--model-library" => a.model_library = Some(value(&mut it, arg)?.into()),
+            "--command" => a.command = value(&mut it, arg)?.clone(),
             "--input" => {
                 let label = value(&mut it, arg)?.clone();
                 let path = value(&mut it, "--input LABEL")?.into();
@@ -102,6 +115,9 @@ fn parse(args: &[String]) -> Result<Args, String> {
     if matches!(a.crate_rule, Some(CrateRule::Install(_))) && !a.out_given {
         return Err("--install-crate needs --out OUT".into());
     }
+    if a.model_library.is_some() && (a.irs.len() != 1 || a.repository.is_none()) {
+        return Err("--model-library DIR needs one IR and --repository REPO".into());
+    }
     Ok(a)
 }
 
@@ -111,7 +127,7 @@ fn crate_folder(a: &Args, rule: &CrateRule) -> Result<(), FolderError> {
         CrateRule::Check(out) => out,
         CrateRule::Install(_) => &a.out,
     };
-    let mut folder = CrateFolder::new("OUT", out, "make crate")?;
+    let mut folder = CrateFolder::new("OUT", out, &a.command)?;
     if let Some(repository) = &a.repository {
         folder.repository(repository);
     }
@@ -124,8 +140,26 @@ fn crate_folder(a: &Args, rule: &CrateRule) -> Result<(), FolderError> {
     }
 }
 
+/// `--model-library DIR`: the library's crate around the one model.
+fn run_model_library(a: &Args, dir: &Path) -> Result<(), RenderError> {
+    let ir = toolconf_render::read_ir(&a.irs[0])?;
+    let repository = a.repository.as_deref().unwrap_or(Path::new("."));
+    let repository = std::path::absolute(repository).map_err(|source| RenderError::Io {
+        path: repository.into(),
+        source,
+    })?;
+    let package = LibraryPackage::for_model(&ir.model.name, &repository);
+    for file in render_library(&ir, &a.templates.join("cabi"), &package)? {
+        write(dir, &file)?;
+    }
+    Ok(())
+}
+
 /// Renders; with `--check`, the differences found (none when the folder is up to date).
 fn run(a: &Args) -> Result<Vec<String>, RenderError> {
+    if let Some(dir) = &a.model_library {
+        return run_model_library(a, dir).map(|()| Vec::new());
+    }
     let irs = if a.from_crate && a.irs.is_empty() {
         crate_irs(&a.out)?
     } else {
@@ -175,7 +209,7 @@ fn main() -> ExitCode {
     };
     if args.is_empty() || args.iter().any(|a| a == "--help" || a == "-h") {
         eprintln!(
-            "usage: toolconf-render [IR.json...] [--crate DIR] [--templates DIR] [--out DIR] [--crate-name NAME] [--standalone] [--check]\n       toolconf-render --check-crate-out OUT --repository DIR [--input LABEL PATH]...\n       toolconf-render --install-crate STAGING --out OUT --repository DIR [--input LABEL PATH]..."
+            "usage: toolconf-render [IR.json...] [--crate DIR] [--templates DIR] [--out DIR] [--crate-name NAME] [--standalone] [--check]\n       toolconf-render IR.json --model-library DIR --repository REPO [--templates DIR]\n       toolconf-render --check-crate-out OUT --repository DIR [--command NAME] [--input LABEL PATH]...\n       toolconf-render --install-crate STAGING --out OUT --repository DIR [--command NAME] [--input LABEL PATH]..."
         );
         return ExitCode::from(2);
     }

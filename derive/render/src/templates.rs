@@ -7,7 +7,7 @@ use crate::ir::Ir;
 use crate::RenderError;
 
 /// Loads every `*.tera` file of a folder, in name order, then those of its sub-folders but
-/// `registry/` as `<folder>/<file>` ([`load_variants`]): macros a template imports and per-model
+/// the [`TREES`] as `<folder>/<file>` ([`load_variants`]): macros a template imports and per-model
 /// variants of the top-level templates (`urdf/`).
 pub fn load_templates(dir: &Path) -> Result<Vec<(String, String)>, RenderError> {
     let mut all = load_folder(dir)?;
@@ -89,7 +89,11 @@ pub fn variant<'a>(ir: &Ir, name: &'a str, templates: &'a [(String, String)]) ->
         .unwrap_or(name)
 }
 
-/// Every `*.tera` file in the sub-folders of `dir` other than `registry/`, named
+/// The sub-folders of the templates that are trees laid out as a crate, rendered once over all
+/// models (`registry/`) or for a model library (`cabi/`), not per-model variants.
+pub const TREES: [&str; 2] = ["registry", "cabi"];
+
+/// Every `*.tera` file in the sub-folders of `dir` other than the [`TREES`], named
 /// `<folder>/<file>`.
 fn load_variants(dir: &Path) -> Result<Vec<(String, String)>, RenderError> {
     let io = |source| RenderError::Io {
@@ -99,7 +103,11 @@ fn load_variants(dir: &Path) -> Result<Vec<(String, String)>, RenderError> {
     let mut folders: Vec<PathBuf> = std::fs::read_dir(dir)
         .map_err(io)?
         .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.is_dir() && p.file_name().is_some_and(|n| n != "registry"))
+        .filter(|p| {
+            p.is_dir()
+                && p.file_name()
+                    .is_some_and(|n| !TREES.iter().any(|t| n == *t))
+        })
         .collect();
     folders.sort();
     let mut out = Vec::new();

@@ -1,0 +1,1018 @@
+//! The checks a model library's own test runs on its exports (templates/cabi/tests/abi.rs.tera;
+//! this crate's tests run them on built-in models): [`bit_identity`] calls every export through
+//! its function pointer ([`Exports`]) on random inputs and compares each number with the direct
+//! Rust call's by `f64::to_bits`; [`hostile`] gives every export NULL pointers, unknown tasks,
+//! NaN and infinite inputs, invalid tools and options, and foreign handles, and expects a
+//! status each time, the outputs untouched.
+//!
+//! They panic with the export, the case and the entry that differ.
+
+use core::ffi::{c_char, CStr};
+
+use nalgebra::{SMatrix, SVector};
+use toolconf_core::{
+    control_confidence, ArmController, ArmModel, Error, TaskKind, TaskN, Term, ToolN, TERMS,
+};
+
+use crate::imp::Controller;
+use crate::{status, Exports};
+
+/// SplitMix64: a small, documented generator, so that a failing case can be replayed from its
+/// seed.
+#[derive(Debug, Clone)]
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Self {
+        Self(seed)
+    }
+
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [lo, hi).
+    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        let unit = (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        lo + (hi - lo) * unit
+    }
+}
+
+fn same(what: &str, case: usize, got: &[f64], want: &[f64]) {
+    assert_eq!(got.len(), want.len(), "{what}, case {case}: length");
+    for (i, (g, w)) in got.iter().zip(want).enumerate() {
+        assert!(
+            g.to_bits() == w.to_bits(),
+            "{what}, case {case}, entry {i}: the C ABI gives {g:e} ({:#018x}), the direct call {w:e} ({:#018x})",
+            g.to_bits(),
+            w.to_bits()
+        );
+    }
+}
+
+/// [`same`], and how many numbers it compared.
+fn counted(what: &str, case: usize, got: &[f64], want: &[f64]) -> usize {
+    same(what, case, got, want);
+    got.len()
+}
+
+fn ok(what: &str, e: &Exports, code: i32) {
+    assert!(
+        code == status::OK,
+        "{what}: status {code} ({}): {}",
+        c_str(e, (e.status_name)(code)),
+        c_str(e, (e.last_error)())
+    );
+}
+
+fn c_str(_: &Exports, p: *const c_char) -> String {
+    if p.is_null() {
+        return "(null)".into();
+    }
+    // SAFETY: the library's strings are NUL-terminated and live while it is loaded.
+    unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
+}
+
+/// A random tool from the model's sampling box.
+fn random_tool<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    rng: &mut Rng,
+) -> SVector<f64, NP>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    SVector::from_fn(|i, _| {
+        let (lo, hi) = M::TOOL_RULE.sample[i];
+        rng.uniform(lo, hi)
+    })
+}
+
+/// A random state about the equilibrium (q within ±1 rad, q̇ within ±2 rad/s).
+fn random_state<const NX: usize>(rng: &mut Rng, around: &SVector<f64, NX>) -> SVector<f64, NX> {
+    SVector::from_fn(|i, _| {
+        let spread = if i < NX / 2 { 1.0 } else { 2.0 };
+        around[i] + rng.uniform(-spread, spread)
+    })
+}
+
+/// Random symmetric positive definite precisions, one N × N per term.
+fn random_precisions<const N: usize>(rng: &mut Rng) -> [SMatrix<f64, N, N>; TERMS] {
+    core::array::from_fn(|_| {
+        let a = SMatrix::<f64, N, N>::from_fn(|_, _| rng.uniform(-1.0, 1.0));
+        let d =
+            SMatrix::<f64, N, N>::from_diagonal(&SVector::from_fn(|_, _| rng.uniform(0.5, 100.0)));
+        a * a.transpose() + d
+    })
+}
+
+fn flat<const R: usize, const C: usize>(blocks: &[SMatrix<f64, R, C>]) -> Vec<f64> {
+    blocks.iter().flat_map(|m| m.as_slice().to_vec()).collect()
+}
+
+/// What the direct call's error is as a status (imp.rs's mapping).
+fn status_of(e: &Error) -> i32 {
+    match e {
+        Error::InvalidParameter { .. }
+        | Error::ParameterOutOfDomain { .. }
+        | Error::ToolConstraint { .. } => status::INVALID_TOOL,
+        Error::InvalidGoal { .. }
+        | Error::InvalidPrecision { .. }
+        | Error::ConfidenceRank { .. } => status::INVALID_TASK,
+        Error::InvalidOption { .. } => status::INVALID_OPTION,
+        Error::NotPositiveDefinite { .. } | Error::IllConditioned { .. } => {
+            status::NOT_POSITIVE_DEFINITE
+        }
+        Error::NoTip { .. } => status::NO_TIP,
+    }
+}
+
+/// Every export through `e` against the direct Rust call, on `cases` random inputs from
+/// `seed`: bit for bit. Returns how many numbers were compared.
+pub fn bit_identity<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    e: &Exports,
+    cases: usize,
+    seed: u64,
+) -> usize
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let mut compared = 0;
+    assert_eq!((e.abi_version)(), crate::ABI_VERSION);
+    assert_eq!(c_str(e, (e.tasks_fingerprint)()), crate::fingerprint::hex());
+    check_info::<M, N, NX, NP, NZ>(e);
+    let mut rng = Rng::new(seed);
+    let x_e = M::equilibrium_state();
+    for case in 0..cases {
+        let p = random_tool::<M, N, NX, NP, NZ>(&mut rng);
+        let x = random_state(&mut rng, &x_e);
+        let u = SVector::<f64, N>::from_fn(|_, _| rng.uniform(-5.0, 5.0));
+        let mut x_dot = [0.0; NX];
+        // SAFETY (every call below): each pointer points to the documented number of values.
+        ok("dynamics", e, unsafe {
+            (e.dynamics)(x.as_ptr(), u.as_ptr(), p.as_ptr(), x_dot.as_mut_ptr())
+        });
+        compared += counted("dynamics", case, &x_dot, M::dynamics(&x, &u, &p).as_slice());
+        let (mut f_x, mut f_u) = (vec![0.0; NX * NX], vec![0.0; NX * N]);
+        ok("dynamics_jacobian", e, unsafe {
+            (e.dynamics_jacobian)(
+                x.as_ptr(),
+                u.as_ptr(),
+                p.as_ptr(),
+                f_x.as_mut_ptr(),
+                f_u.as_mut_ptr(),
+            )
+        });
+        let (a, b) = M::dynamics_jacobian(&x, &u, &p);
+        compared += counted("dynamics_jacobian (f_x)", case, &f_x, a.as_slice());
+        compared += counted("dynamics_jacobian (f_u)", case, &f_u, b.as_slice());
+        ok("rigid_body_dynamics", e, unsafe {
+            (e.rigid_body_dynamics)(x.as_ptr(), u.as_ptr(), p.as_ptr(), x_dot.as_mut_ptr())
+        });
+        compared += counted(
+            "rigid_body_dynamics",
+            case,
+            &x_dot,
+            M::rigid_body_dynamics(&x, &u, &p).as_slice(),
+        );
+        let q = x.fixed_rows::<N>(0).into_owned();
+        let (mut y, mut j) = ([0.0; 3], vec![0.0; 3 * N]);
+        let code = unsafe { (e.tip)(q.as_ptr(), p.as_ptr(), y.as_mut_ptr(), j.as_mut_ptr()) };
+        match M::tip(&q, &p) {
+            Some((y0, j0)) => {
+                ok("tip", e, code);
+                compared += counted("tip (position)", case, &y, y0.as_slice());
+                compared += counted("tip (jacobian)", case, &j, j0.as_slice());
+            }
+            None => assert_eq!(code, status::NO_TIP, "tip of a model without one"),
+        }
+        let mut a_e = vec![0.0; NX * NX];
+        ok("state_matrix", e, unsafe {
+            (e.state_matrix)(p.as_ptr(), a_e.as_mut_ptr())
+        });
+        compared += counted("state_matrix", case, &a_e, M::state_matrix(&p).as_slice());
+        let mut b_e = vec![0.0; NX * N];
+        ok("input_matrix", e, unsafe {
+            (e.input_matrix)(p.as_ptr(), b_e.as_mut_ptr())
+        });
+        compared += counted("input_matrix", case, &b_e, M::input_matrix(&p).as_slice());
+        let precision = random_precisions::<N>(&mut rng);
+        let pf = flat(&precision);
+        for (index, kind) in TaskKind::ALL.into_iter().enumerate() {
+            let t = index as u32;
+            let name = kind.name();
+            let (mut goals, mut precisions) = (vec![0.0; TERMS * N], vec![0.0; TERMS * N * N]);
+            ok("task_defaults", e, unsafe {
+                (e.task_defaults)(t, goals.as_mut_ptr(), precisions.as_mut_ptr())
+            });
+            let paper = M::paper_task(kind);
+            compared += counted(
+                &format!("task_defaults {name} (goals)"),
+                case,
+                &goals,
+                &flat(&paper.goal),
+            );
+            compared += counted(
+                &format!("task_defaults {name} (precisions)"),
+                case,
+                &precisions,
+                &flat(&paper.precision),
+            );
+            let (mut s, mut used) = (vec![f64::NAN; TERMS * N * N], [7_i32; TERMS]);
+            ok("sensitivities", e, unsafe {
+                (e.sensitivities)(t, p.as_ptr(), s.as_mut_ptr(), used.as_mut_ptr())
+            });
+            let direct = M::sensitivities(kind, &p);
+            for term in Term::ALL {
+                let i = term.index();
+                let want = direct.d_du[i].unwrap_or_else(SMatrix::zeros);
+                compared += counted(
+                    &format!("sensitivities {name} {}", term.name()),
+                    case,
+                    &s[i * N * N..(i + 1) * N * N],
+                    want.as_slice(),
+                );
+                assert_eq!(
+                    used[i],
+                    i32::from(direct.d_du[i].is_some()),
+                    "sensitivities {name}: used[{i}]"
+                );
+            }
+            let task = TaskN {
+                kind,
+                goal: [SVector::zeros(); TERMS],
+                precision,
+            };
+            let mut pi = vec![0.0; N * N];
+            ok("pi_u", e, unsafe {
+                (e.pi_u)(t, p.as_ptr(), pf.as_ptr(), pi.as_mut_ptr())
+            });
+            compared += counted(
+                &format!("pi_u {name}"),
+                case,
+                &pi,
+                M::pi_u(&task, &p).as_slice(),
+            );
+            let mut grad = vec![0.0; NP];
+            ok("logdet_gradient", e, unsafe {
+                (e.logdet_gradient)(t, p.as_ptr(), pf.as_ptr(), grad.as_mut_ptr())
+            });
+            compared += counted(
+                &format!("logdet_gradient {name}"),
+                case,
+                &grad,
+                M::logdet_gradient(&task, &p).as_slice(),
+            );
+            // The validated paths on the model's own task: the same status, and the same bits.
+            let tool = ToolN::<M, N, NX, NP, NZ>::new(p.into());
+            let (mut pi_c, mut logdet) = (vec![0.0; N * N], 0.0);
+            let code = unsafe {
+                (e.control_confidence)(
+                    t,
+                    p.as_ptr(),
+                    goals.as_ptr(),
+                    precisions.as_ptr(),
+                    pi_c.as_mut_ptr(),
+                    &mut logdet,
+                )
+            };
+            match tool
+                .as_ref()
+                .map_err(status_of)
+                .and_then(|tool| control_confidence(tool, &paper).map_err(|e| status_of(&e)))
+            {
+                Ok(c) => {
+                    ok("control_confidence", e, code);
+                    compared += counted(
+                        &format!("control_confidence {name} (pi_u)"),
+                        case,
+                        &pi_c,
+                        c.pi_u.as_slice(),
+                    );
+                    compared += counted(
+                        &format!("control_confidence {name} (logdet)"),
+                        case,
+                        &[logdet],
+                        &[c.logdet],
+                    );
+                }
+                Err(want) => assert_eq!(
+                    code,
+                    want,
+                    "control_confidence {name}: {}",
+                    c_str(e, (e.last_error)())
+                ),
+            }
+            compared += controller::<M, N, NX, NP, NZ>(
+                e,
+                &mut rng,
+                case,
+                &p,
+                t,
+                &goals,
+                &precisions,
+                &paper,
+            );
+        }
+    }
+    compared
+}
+
+/// A controller through the C ABI against [`ArmController`] directly: the same creation
+/// status, then a few ticks on random measurements, bit for bit.
+#[allow(clippy::too_many_arguments)]
+fn controller<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    e: &Exports,
+    rng: &mut Rng,
+    case: usize,
+    p: &SVector<f64, NP>,
+    t: u32,
+    goals: &[f64],
+    precisions: &[f64],
+    task: &TaskN<N>,
+) -> usize
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let name = task.kind.name();
+    let u0 = [0.1; N];
+    let mut handle: *mut Controller = core::ptr::null_mut();
+    let code = unsafe {
+        (e.controller_create)(
+            p.as_ptr(),
+            t,
+            goals.as_ptr(),
+            precisions.as_ptr(),
+            1.0,
+            u0.as_ptr(),
+            1000.0,
+            &mut handle,
+        )
+    };
+    let direct = ToolN::<M, N, NX, NP, NZ>::new((*p).into())
+        .and_then(|tool| ArmController::<M, N, NX, NP, NZ>::new(&tool, task, 1.0, u0, 1000.0));
+    let mut direct = match direct {
+        Ok(c) => {
+            ok("controller_create", e, code);
+            c
+        }
+        Err(err) => {
+            assert_eq!(
+                code,
+                status_of(&err),
+                "controller_create {name}: {}",
+                c_str(e, (e.last_error)())
+            );
+            assert!(handle.is_null());
+            return 0;
+        }
+    };
+    let mut compared = 0;
+    let mut pi = vec![0.0; N * N];
+    ok("controller_pi_u", e, unsafe {
+        (e.controller_pi_u)(handle, pi.as_mut_ptr())
+    });
+    same(
+        &format!("controller_pi_u {name}"),
+        case,
+        &pi,
+        direct.control_confidence().pi_u.as_slice(),
+    );
+    let x_e = M::equilibrium_state();
+    for tick in 0..4 {
+        let x = random_state(rng, &x_e) * 0.1 + x_e * 0.9;
+        let state: [f64; NX] = x.into();
+        let (mut torque, mut confidence) = ([0.0; N], 0.0);
+        let what = format!("controller_tick {name} #{tick}");
+        let (code, want) = if tick % 2 == 0 {
+            let c = unsafe {
+                (e.controller_tick)(handle, state.as_ptr(), torque.as_mut_ptr(), &mut confidence)
+            };
+            (c, direct.tick(&state))
+        } else {
+            let acc = [rng.uniform(-1.0, 1.0); N];
+            let c = unsafe {
+                (e.controller_tick_with_acceleration)(
+                    handle,
+                    state.as_ptr(),
+                    acc.as_ptr(),
+                    torque.as_mut_ptr(),
+                    &mut confidence,
+                )
+            };
+            (c, direct.tick_with_acceleration(&state, &acc))
+        };
+        match want {
+            Ok(command) => {
+                ok(&what, e, code);
+                same(&what, case, &torque, &command.torque);
+                same(&what, case, &[confidence], &[command.confidence]);
+                compared += N + 1;
+            }
+            Err(err) => assert_eq!(code, status_of(&err), "{what}"),
+        }
+    }
+    ok("controller_destroy", e, unsafe {
+        (e.controller_destroy)(handle)
+    });
+    compared
+}
+
+/// The metadata equals the generated `ModelInfo`, entry for entry.
+fn check_info<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(e: &Exports)
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let g = crate::info::generated(M::NAME).expect("the model's generated ModelInfo");
+    let i = (e.model_info)();
+    assert!(!i.is_null(), "model_info is NULL");
+    // SAFETY: the library's metadata lives while it is loaded; the counts are its own.
+    let i = unsafe { &*i };
+    let s = |p: *const c_char| c_str(e, p);
+    let strings = |p: *const *const c_char, n: usize| -> Vec<String> {
+        (0..n).map(|k| s(unsafe { *p.add(k) })).collect()
+    };
+    let numbers =
+        |p: *const f64, n: usize| -> Vec<f64> { (0..n).map(|k| unsafe { *p.add(k) }).collect() };
+    assert_eq!(i.abi_version, crate::ABI_VERSION);
+    assert_eq!(
+        (s(i.name), s(i.title), s(i.description)),
+        (g.name.into(), g.title.into(), g.description.into())
+    );
+    assert_eq!(
+        (i.dof, i.state_dim, i.parameter_count, i.tip_dim),
+        (N, NX, NP, g.tip_dim)
+    );
+    assert_eq!((g.dof, g.state_dim), (N, NX));
+    assert_eq!(i.has_tip != 0, g.has_tip);
+    assert_eq!(strings(i.parameter_names, NP), g.parameter_names);
+    assert_eq!(strings(i.parameter_units, NP), g.parameter_units);
+    assert_eq!(strings(i.state_names, NX), g.state_names);
+    assert_eq!(strings(i.control_names, N), g.control_names);
+    for (k, d) in g.domains.iter().enumerate() {
+        let c = unsafe { *i.domains.add(k) };
+        same("domains", k, &[c.lo, c.hi], &[d.lo, d.hi]);
+        assert_eq!(
+            (c.lo_open != 0, c.hi_open != 0, s(c.rule)),
+            (d.lo_open, d.hi_open, d.rule.into())
+        );
+    }
+    assert_eq!(i.constraint_count, g.constraints.len());
+    for (k, c) in g.constraints.iter().enumerate() {
+        let got = unsafe { *i.constraints.add(k) };
+        same(
+            "constraints",
+            k,
+            &numbers(got.coefficients, NP),
+            c.coefficients,
+        );
+        assert_eq!(s(got.rule), c.rule);
+    }
+    same(
+        "sample_lo",
+        0,
+        &numbers(i.sample_lo, NP),
+        &g.sample.iter().map(|s| s.0).collect::<Vec<_>>(),
+    );
+    same(
+        "sample_hi",
+        0,
+        &numbers(i.sample_hi, NP),
+        &g.sample.iter().map(|s| s.1).collect::<Vec<_>>(),
+    );
+    for (k, d) in g.defaults.iter().enumerate() {
+        let (has, value) = unsafe { (*i.has_default.add(k), *i.defaults.add(k)) };
+        assert_eq!(has != 0, d.is_some());
+        if let Some(v) = d {
+            same("defaults", k, &[value], &[*v]);
+        }
+    }
+    assert_eq!(i.has_inertia != 0, g.inertia.is_some());
+    if let Some(r) = g.inertia {
+        assert_eq!(i.inertia.moments.map(|v| v as usize), r.moments);
+        assert_eq!(i.inertia.products.map(|v| v as usize), r.products);
+        same("inertia slack", 0, &[i.inertia.slack], &[r.slack]);
+        assert_eq!(s(i.inertia.rule), r.rule);
+    }
+    same(
+        "equilibrium_state",
+        0,
+        &numbers(i.equilibrium_state, NX),
+        g.equilibrium_state,
+    );
+    same(
+        "equilibrium_control",
+        0,
+        &numbers(i.equilibrium_control, N),
+        g.equilibrium_control,
+    );
+    assert_eq!(i.task_count, TaskKind::ALL.len());
+    assert_eq!(
+        strings(i.task_names, i.task_count),
+        TaskKind::ALL.map(|k| k.name())
+    );
+    for (k, kind) in TaskKind::ALL.iter().enumerate() {
+        assert_eq!(
+            unsafe { *i.task_offered.add(k) } != 0,
+            g.tasks.contains(kind)
+        );
+    }
+    assert_eq!(i.term_count, TERMS);
+    assert_eq!(strings(i.term_names, TERMS), Term::NAMES);
+    assert_eq!(s(i.tasks_fingerprint), crate::fingerprint::hex());
+}
+
+/// Hostile input to every export: each is a status, never a crash, and leaves its outputs as
+/// they were. Returns how many calls were made.
+pub fn hostile<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    e: &Exports,
+) -> usize
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let mut calls = 0;
+    let mut expect = |what: &str, code: i32, want: i32| {
+        calls += 1;
+        assert_eq!(
+            code,
+            want,
+            "{what}: status {code}, expected {want} ({}); message: {}",
+            c_str(e, (e.status_name)(want)),
+            c_str(e, (e.last_error)())
+        );
+        if want != status::OK {
+            assert!(!c_str(e, (e.last_error)()).is_empty(), "{what}: no message");
+        }
+    };
+    let null = core::ptr::null::<f64>();
+    let null_mut = core::ptr::null_mut::<f64>();
+    let x = M::equilibrium_state();
+    let u = SVector::<f64, N>::zeros();
+    let p = SVector::<f64, NP>::from_fn(|i, _| {
+        let (lo, hi) = M::TOOL_RULE.sample[i];
+        0.5 * (lo + hi)
+    });
+    const SENTINEL: f64 = 12345.0;
+    // Room for the largest output of any export.
+    let room = (NX * NX).max(TERMS * N * N);
+    let mut buf = vec![SENTINEL; room];
+    let mut buf2 = vec![SENTINEL; room];
+    let untouched = |b: &[f64]| b.iter().all(|v| *v == SENTINEL);
+    unsafe {
+        expect(
+            "dynamics(x NULL)",
+            (e.dynamics)(null, u.as_ptr(), p.as_ptr(), buf.as_mut_ptr()),
+            status::NULL_POINTER,
+        );
+        expect(
+            "dynamics(u NULL)",
+            (e.dynamics)(x.as_ptr(), null, p.as_ptr(), buf.as_mut_ptr()),
+            status::NULL_POINTER,
+        );
+        expect(
+            "dynamics(params NULL)",
+            (e.dynamics)(x.as_ptr(), u.as_ptr(), null, buf.as_mut_ptr()),
+            status::NULL_POINTER,
+        );
+        expect(
+            "dynamics(x_dot NULL)",
+            (e.dynamics)(x.as_ptr(), u.as_ptr(), p.as_ptr(), null_mut),
+            status::NULL_POINTER,
+        );
+        let mut bad = x;
+        bad[NX - 1] = f64::NAN;
+        expect(
+            "dynamics(x NaN)",
+            (e.dynamics)(bad.as_ptr(), u.as_ptr(), p.as_ptr(), buf.as_mut_ptr()),
+            status::NOT_FINITE,
+        );
+        assert!(c_str(e, (e.last_error)()).contains(&format!("x[{}]", NX - 1)));
+        let mut bad_p = p;
+        bad_p[0] = f64::INFINITY;
+        expect(
+            "dynamics(params inf)",
+            (e.dynamics)(x.as_ptr(), u.as_ptr(), bad_p.as_ptr(), buf.as_mut_ptr()),
+            status::NOT_FINITE,
+        );
+        expect(
+            "dynamics_jacobian(f_u NULL)",
+            (e.dynamics_jacobian)(
+                x.as_ptr(),
+                u.as_ptr(),
+                p.as_ptr(),
+                buf.as_mut_ptr(),
+                null_mut,
+            ),
+            status::NULL_POINTER,
+        );
+        expect(
+            "dynamics_jacobian(u -inf)",
+            (e.dynamics_jacobian)(
+                x.as_ptr(),
+                [f64::NEG_INFINITY; N].as_ptr(),
+                p.as_ptr(),
+                buf.as_mut_ptr(),
+                buf2.as_mut_ptr(),
+            ),
+            status::NOT_FINITE,
+        );
+        expect(
+            "rigid_body_dynamics(x NULL)",
+            (e.rigid_body_dynamics)(null, u.as_ptr(), p.as_ptr(), buf.as_mut_ptr()),
+            status::NULL_POINTER,
+        );
+        expect(
+            "tip(q NULL)",
+            (e.tip)(null, p.as_ptr(), buf.as_mut_ptr(), buf2.as_mut_ptr()),
+            status::NULL_POINTER,
+        );
+        expect(
+            "tip(jacobian NULL)",
+            (e.tip)(x.as_ptr(), p.as_ptr(), buf.as_mut_ptr(), null_mut),
+            status::NULL_POINTER,
+        );
+        expect(
+            "state_matrix(params NULL)",
+            (e.state_matrix)(null, buf.as_mut_ptr()),
+            status::NULL_POINTER,
+        );
+        expect(
+            "state_matrix(a NULL)",
+            (e.state_matrix)(p.as_ptr(), null_mut),
+            status::NULL_POINTER,
+        );
+        expect(
+            "input_matrix(params NaN)",
+            (e.input_matrix)(bad_p.as_ptr(), buf.as_mut_ptr()),
+            status::NOT_FINITE,
+        );
+        expect(
+            "check_tool(NULL)",
+            (e.check_tool)(null),
+            status::NULL_POINTER,
+        );
+        expect(
+            "check_tool(inf)",
+            (e.check_tool)(bad_p.as_ptr()),
+            status::NOT_FINITE,
+        );
+        assert!(
+            untouched(&buf) && untouched(&buf2),
+            "an output was written by a failing call"
+        );
+
+        let tasks = TaskKind::ALL.len() as u32;
+        let mut goals = vec![0.0; TERMS * N];
+        let mut prec = vec![0.0; TERMS * N * N];
+        for t in [tasks, tasks + 1, u32::MAX] {
+            expect(
+                "task_defaults(unknown task)",
+                (e.task_defaults)(t, goals.as_mut_ptr(), prec.as_mut_ptr()),
+                status::UNKNOWN_TASK,
+            );
+            expect(
+                "sensitivities(unknown task)",
+                (e.sensitivities)(t, p.as_ptr(), prec.as_mut_ptr(), core::ptr::null_mut()),
+                status::UNKNOWN_TASK,
+            );
+            expect(
+                "pi_u(unknown task)",
+                (e.pi_u)(t, p.as_ptr(), prec.as_ptr(), buf.as_mut_ptr()),
+                status::UNKNOWN_TASK,
+            );
+            expect(
+                "logdet_gradient(unknown task)",
+                (e.logdet_gradient)(t, p.as_ptr(), prec.as_ptr(), buf.as_mut_ptr()),
+                status::UNKNOWN_TASK,
+            );
+        }
+        assert!(untouched(&buf));
+        expect(
+            "task_defaults(goals NULL)",
+            (e.task_defaults)(0, null_mut, prec.as_mut_ptr()),
+            status::NULL_POINTER,
+        );
+        expect(
+            "task_defaults",
+            (e.task_defaults)(0, goals.as_mut_ptr(), prec.as_mut_ptr()),
+            status::OK,
+        );
+        expect(
+            "sensitivities(used NULL is allowed)",
+            (e.sensitivities)(0, p.as_ptr(), buf.as_mut_ptr(), core::ptr::null_mut()),
+            status::OK,
+        );
+        expect(
+            "sensitivities(out NULL)",
+            (e.sensitivities)(0, p.as_ptr(), null_mut, core::ptr::null_mut()),
+            status::NULL_POINTER,
+        );
+        expect(
+            "pi_u(precisions NULL)",
+            (e.pi_u)(0, p.as_ptr(), null, buf.as_mut_ptr()),
+            status::NULL_POINTER,
+        );
+        let mut bad_prec = prec.clone();
+        bad_prec[TERMS * N * N - 1] = f64::NAN;
+        expect(
+            "pi_u(precision NaN)",
+            (e.pi_u)(0, p.as_ptr(), bad_prec.as_ptr(), buf.as_mut_ptr()),
+            status::NOT_FINITE,
+        );
+        assert!(c_str(e, (e.last_error)()).contains(&format!("precisions[{}]", TERMS * N * N - 1)));
+        expect(
+            "logdet_gradient(gradient NULL)",
+            (e.logdet_gradient)(0, p.as_ptr(), prec.as_ptr(), null_mut),
+            status::NULL_POINTER,
+        );
+        let mut logdet = SENTINEL;
+        expect(
+            "control_confidence(logdet NULL)",
+            (e.control_confidence)(
+                0,
+                p.as_ptr(),
+                goals.as_ptr(),
+                prec.as_ptr(),
+                buf2.as_mut_ptr(),
+                null_mut,
+            ),
+            status::NULL_POINTER,
+        );
+        let zero_prec = vec![0.0; TERMS * N * N];
+        expect(
+            "control_confidence(all precisions zero)",
+            (e.control_confidence)(
+                0,
+                p.as_ptr(),
+                goals.as_ptr(),
+                zero_prec.as_ptr(),
+                buf2.as_mut_ptr(),
+                &mut logdet,
+            ),
+            status::INVALID_TASK,
+        );
+        let mut bad_goals = goals.clone();
+        bad_goals[0] = 1e300;
+        expect(
+            "control_confidence(goal out of range)",
+            (e.control_confidence)(
+                0,
+                p.as_ptr(),
+                bad_goals.as_ptr(),
+                prec.as_ptr(),
+                buf2.as_mut_ptr(),
+                &mut logdet,
+            ),
+            status::INVALID_TASK,
+        );
+        assert!(logdet == SENTINEL && untouched(&buf2));
+
+        // An invalid tool: the first parameter's domain broken.
+        let d = M::TOOL_RULE.domains[0];
+        let mut invalid = p;
+        invalid[0] = if d.lo.is_finite() {
+            d.lo - 1.0
+        } else {
+            d.hi + 1.0
+        };
+        expect(
+            "check_tool(invalid)",
+            (e.check_tool)(invalid.as_ptr()),
+            status::INVALID_TOOL,
+        );
+        expect(
+            "check_tool(valid)",
+            (e.check_tool)(p.as_ptr()),
+            if ToolN::<M, N, NX, NP, NZ>::new(p.into()).is_ok() {
+                status::OK
+            } else {
+                status::INVALID_TOOL
+            },
+        );
+
+        let u0 = [0.1; N];
+        let mut h: *mut Controller = core::ptr::null_mut();
+        let create = |params: *const f64,
+                      t: u32,
+                      g: *const f64,
+                      pr: *const f64,
+                      lr: f64,
+                      u0: *const f64,
+                      rate: f64,
+                      h: *mut *mut Controller| {
+            (e.controller_create)(params, t, g, pr, lr, u0, rate, h)
+        };
+        expect(
+            "controller_create(out NULL)",
+            create(
+                p.as_ptr(),
+                0,
+                goals.as_ptr(),
+                prec.as_ptr(),
+                1.0,
+                u0.as_ptr(),
+                1000.0,
+                core::ptr::null_mut(),
+            ),
+            status::NULL_POINTER,
+        );
+        expect(
+            "controller_create(unknown task)",
+            create(
+                p.as_ptr(),
+                tasks,
+                goals.as_ptr(),
+                prec.as_ptr(),
+                1.0,
+                u0.as_ptr(),
+                1000.0,
+                &mut h,
+            ),
+            status::UNKNOWN_TASK,
+        );
+        expect(
+            "controller_create(invalid tool)",
+            create(
+                invalid.as_ptr(),
+                0,
+                goals.as_ptr(),
+                prec.as_ptr(),
+                1.0,
+                u0.as_ptr(),
+                1000.0,
+                &mut h,
+            ),
+            status::INVALID_TOOL,
+        );
+        expect(
+            "controller_create(learning rate NaN)",
+            create(
+                p.as_ptr(),
+                0,
+                goals.as_ptr(),
+                prec.as_ptr(),
+                f64::NAN,
+                u0.as_ptr(),
+                1000.0,
+                &mut h,
+            ),
+            status::NOT_FINITE,
+        );
+        expect(
+            "controller_create(learning rate -1)",
+            create(
+                p.as_ptr(),
+                0,
+                goals.as_ptr(),
+                prec.as_ptr(),
+                -1.0,
+                u0.as_ptr(),
+                1000.0,
+                &mut h,
+            ),
+            status::INVALID_OPTION,
+        );
+        expect(
+            "controller_create(rate 0)",
+            create(
+                p.as_ptr(),
+                0,
+                goals.as_ptr(),
+                prec.as_ptr(),
+                1.0,
+                u0.as_ptr(),
+                0.0,
+                &mut h,
+            ),
+            status::INVALID_OPTION,
+        );
+        expect(
+            "controller_create(initial torque NULL)",
+            create(
+                p.as_ptr(),
+                0,
+                goals.as_ptr(),
+                prec.as_ptr(),
+                1.0,
+                null,
+                1000.0,
+                &mut h,
+            ),
+            status::NULL_POINTER,
+        );
+        assert!(h.is_null(), "a failed create wrote a handle");
+        expect(
+            "controller_destroy(NULL)",
+            (e.controller_destroy)(core::ptr::null_mut()),
+            status::OK,
+        );
+        let foreign = crate::imp::foreign_handle();
+        let (mut torque, mut conf) = ([SENTINEL; N], SENTINEL);
+        expect(
+            "controller_tick(NULL)",
+            (e.controller_tick)(
+                core::ptr::null_mut(),
+                x.as_ptr(),
+                torque.as_mut_ptr(),
+                &mut conf,
+            ),
+            status::NULL_POINTER,
+        );
+        expect(
+            "controller_tick(foreign handle)",
+            (e.controller_tick)(foreign, x.as_ptr(), torque.as_mut_ptr(), &mut conf),
+            status::BAD_HANDLE,
+        );
+        expect(
+            "controller_destroy(foreign handle)",
+            (e.controller_destroy)(foreign),
+            status::BAD_HANDLE,
+        );
+        expect(
+            "controller_pi_u(foreign handle)",
+            (e.controller_pi_u)(foreign, buf.as_mut_ptr()),
+            status::BAD_HANDLE,
+        );
+        // A live controller: bad measurements are statuses and leave it as it was.
+        let task = M::paper_task(TaskKind::ALL[0]);
+        let direct = ToolN::<M, N, NX, NP, NZ>::new(p.into())
+            .and_then(|tool| ArmController::<M, N, NX, NP, NZ>::new(&tool, &task, 1.0, u0, 1000.0));
+        if let Ok(mut direct) = direct {
+            expect(
+                "controller_create",
+                create(
+                    p.as_ptr(),
+                    0,
+                    goals.as_ptr(),
+                    prec.as_ptr(),
+                    1.0,
+                    u0.as_ptr(),
+                    1000.0,
+                    &mut h,
+                ),
+                status::OK,
+            );
+            let mut nan_state = x;
+            nan_state[0] = f64::NAN;
+            expect(
+                "controller_tick(state NaN)",
+                (e.controller_tick)(h, nan_state.as_ptr(), torque.as_mut_ptr(), &mut conf),
+                status::NOT_FINITE,
+            );
+            expect(
+                "controller_tick(state NULL)",
+                (e.controller_tick)(h, null, torque.as_mut_ptr(), &mut conf),
+                status::NULL_POINTER,
+            );
+            expect(
+                "controller_tick(torque NULL)",
+                (e.controller_tick)(h, x.as_ptr(), null_mut, &mut conf),
+                status::NULL_POINTER,
+            );
+            expect(
+                "controller_tick_with_acceleration(acceleration NULL)",
+                (e.controller_tick_with_acceleration)(
+                    h,
+                    x.as_ptr(),
+                    null,
+                    torque.as_mut_ptr(),
+                    &mut conf,
+                ),
+                status::NULL_POINTER,
+            );
+            expect(
+                "controller_tick_with_acceleration(acceleration inf)",
+                (e.controller_tick_with_acceleration)(
+                    h,
+                    x.as_ptr(),
+                    [f64::INFINITY; N].as_ptr(),
+                    torque.as_mut_ptr(),
+                    &mut conf,
+                ),
+                status::NOT_FINITE,
+            );
+            assert!(torque.iter().all(|v| *v == SENTINEL) && conf == SENTINEL);
+            expect(
+                "controller_tick",
+                (e.controller_tick)(h, x.as_ptr(), torque.as_mut_ptr(), &mut conf),
+                status::OK,
+            );
+            let want = direct.tick(&x.into()).expect("the direct tick");
+            same(
+                "controller_tick after refused ticks",
+                0,
+                &torque,
+                &want.torque,
+            );
+            expect("controller_destroy", (e.controller_destroy)(h), status::OK);
+        }
+        assert_eq!(
+            c_str(e, (e.status_name)(status::BAD_HANDLE)),
+            "TOOLCONF_BAD_HANDLE"
+        );
+        assert_eq!(c_str(e, (e.status_name)(-7)), "TOOLCONF_UNKNOWN_STATUS");
+    }
+    calls
+}
