@@ -6,7 +6,7 @@ PY_DEV := $(VENV)/.python-dev-installed
 # Deterministic derivation: the same inputs give byte-identical generated files.
 export PYTHONHASHSEED := 0
 
-.PHONY: run test derive render drift-check venv clean-venv bench python-test crate on-robot-test
+.PHONY: run test derive render drift-check venv clean-venv bench python-test crate model on-robot-test
 
 ## make run: build in release mode and reproduce the paper's Results (results/report.md).
 run:
@@ -75,6 +75,15 @@ render:
 crate: $(PY)
 	@if [ -z "$(MODELS)" ] || [ -z "$(OUT)" ]; then echo "usage: make crate MODELS=<folder of model descriptions> OUT=<folder> [TASKS=<file>] [NAME=<crate>]" >&2; exit 2; fi
 	$(PY) derive/make_crate.py --models "$(MODELS)" --out "$(OUT)" $(if $(TASKS),--tasks "$(TASKS)") $(if $(NAME),--name "$(NAME)")
+
+## make model DESC=<description> OUT=<folder> [TASKS=<file>]: validate, derive and build ONE model into a
+## shared library with toolconf's C ABI in OUT (libtoolconf_model_<model>.so, toolconf_model.h, and the
+## crate they came from), showing each step; `make model IR=generated/<model>.json OUT=<folder>` renders
+## and compiles a model derived before. Nothing in the repository changes (derive/make_model.py,
+## docs/c-abi.md).
+model: $(PY)
+	@if [ -z "$(OUT)" ] || { [ -z "$(DESC)" ] && [ -z "$(IR)" ]; }; then echo "make model: usage: make model DESC=<description> OUT=<folder> [TASKS=<file>], or IR=<model.json> OUT=<folder>" >&2; exit 2; fi
+	@$(PY) derive/make_model.py $(if $(DESC),--desc "$(DESC)") $(if $(IR),--ir "$(IR)") --out "$(OUT)" $(if $(TASKS),--tasks "$(TASKS)")
 
 ## make drift-check: derive into a temporary folder, twice: as this CPU does, and with numpy's
 ## optional kernels (AVX-512, AVX2, ...) and glibc's AVX/FMA variants switched off; fail, naming

@@ -19,6 +19,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
+from toolconf_derive import progress  # noqa: E402
 from toolconf_derive.crosscheck import DerivationMismatch  # noqa: E402
 from toolconf_derive.description import load_model, load_tasks  # noqa: E402
 from toolconf_derive.errors import DescriptionError  # noqa: E402
@@ -80,7 +81,11 @@ def run() -> int:
     ap.add_argument("--vectors", type=int, default=100, help="test vectors per function (default 100)")
     ap.add_argument("--command", default="make derive",
                     help="the command the generated files name as their maker (default: make derive)")
+    ap.add_argument("--progress", action="store_true",
+                    help="report each step as it finishes on stderr (toolconf_derive/progress.py; make model)")
     args = ap.parse_args()
+    if args.progress:
+        progress.enable(sys.stderr)
     root = HERE.parent
     if args.out is not None and args.out.suffix != ".json":
         print(f"derive: --out {args.out}: the IR's file name must end in .json", file=sys.stderr)

@@ -108,6 +108,13 @@ def inputs(models: Path, found: list[Path], tasks: Path) -> list[tuple[str, Path
     descriptions, the URDFs they name (resolved as the derivation resolves them) and the task
     file."""
     files = [(f"MODELS={models}", models)] + [(f"description {p}", p) for p in found] + [(f"TASKS={tasks}", tasks)]
+    return files + urdf_inputs(found)
+
+
+def urdf_inputs(found: list[Path]) -> list[tuple[str, Path]]:
+    """The URDFs the descriptions name, resolved as the derivation resolves them (beside the
+    description), each labelled for the folder rule's messages."""
+    files = []
     for path in found:
         try:
             urdf = read_toml(path).get("urdf", {})
@@ -154,11 +161,12 @@ def render(folder: Path, name: str) -> int:
                     "--crate-name", name, "--standalone", stdout=subprocess.DEVNULL).returncode
 
 
-def folder_rule(args: list[str], files: list[tuple[str, Path]]) -> None:
+def folder_rule(args: list[str], files: list[tuple[str, Path]], command: str = COMMAND) -> None:
     """The rule for OUT (crates/files/src/folder.rs, through the renderer), with every input of
-    the run; its refusal is raised as Refused, its failure to write as Failed. Paths go absolute
-    but unresolved: the renderer runs in the repository and resolves them as the rule says."""
-    args = [*args, "--repository", str(ROOT)]
+    the run, for a folder `command` makes (make crate's or make model's); its refusal is raised as
+    Refused, its failure to write as Failed. Paths go absolute but unresolved: the renderer runs
+    in the repository and resolves them as the rule says."""
+    args = [*args, "--repository", str(ROOT), "--command", command]
     for label, path in files:
         args += ["--input", label, str(Path.cwd() / path)]
     r = renderer(*args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, errors="replace")
@@ -176,13 +184,13 @@ def folder_rule(args: list[str], files: list[tuple[str, Path]]) -> None:
 INTERRUPTS = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
 
 
-def install(tmp: Path, out: Path, files: list[tuple[str, Path]]) -> None:
+def install(tmp: Path, out: Path, files: list[tuple[str, Path]], command: str = COMMAND) -> None:
     """Moves the finished crate into place by the rule, which checks OUT again, writes the
     ownership manifest and swaps the crates with the interrupts blocked. They wait here too until
     it is done: this process ending would end the renderer half-way."""
     mask = signal.pthread_sigmask(signal.SIG_BLOCK, INTERRUPTS)
     try:
-        folder_rule(["--install-crate", str(tmp), "--out", str(out)], files)
+        folder_rule(["--install-crate", str(tmp), "--out", str(out)], files, command)
     finally:
         signal.pthread_sigmask(signal.SIG_SETMASK, mask)
 

@@ -16,7 +16,7 @@ from pathlib import Path
 DERIVE = Path(__file__).resolve().parent.parent
 PACKAGE = DERIVE / "toolconf_derive"
 # The modules below the description readers: they import nothing of the package.
-LEAVES = ("errors", "expression", "quantities")
+LEAVES = ("errors", "expression", "quantities", "progress")
 # The README's picture of the layers ("The pipeline"), top to bottom: a module imports only from
 # the rows below its own.
 LAYERS = (
@@ -28,7 +28,8 @@ LAYERS = (
     ("urdf_description",),
     ("urdf",),
     ("files",),
-    ("errors", "quantities", "expression", "exact", "planar_chain", "cost", "crosscheck", "ir_types", "rust_printer"),
+    ("errors", "quantities", "expression", "exact", "planar_chain", "cost", "crosscheck", "ir_types", "rust_printer",
+     "progress"),
 )
 
 

@@ -9,6 +9,7 @@ import numpy as np
 import sympy as sp
 
 from . import ir_types as irt
+from . import progress
 from .cost import cost, total
 from .crosscheck import check_against_casadi
 from .description import name_keys, rust_constant
@@ -234,6 +235,7 @@ def test_vectors(fn: Function, d: Derivation, count: int) -> list[dict]:
     samples = [{a.name: a.sample(rng) for a in fn.args} for _ in range(count)]
     reference = [[o.to_numpy() for o in fn.casadi(v)] for v in samples]
     check_against_casadi(fn, d, samples, reference)
+    progress.step("checking", f"{fn.name}: SymPy = CasADi at {count} points")
     return [
         {
             "inputs": {name: [float(x) for x in np.asarray(val).reshape(-1)] for name, val in v.items()},
@@ -269,13 +271,18 @@ def _formulation(task) -> irt.Formulation:
     return irt.Formulation(name=task.formulation, doc=doc, chosen_by=task.chosen_by)
 
 
+def _reported(f: irt.Function) -> irt.Function:
+    progress.step("deriving", f"{f.name}: code")
+    return f
+
+
 def model_ir(d: Derivation, functions: list[Function], generator: irt.Generator, report: irt.ClosedFormReport,
              vectors: int) -> irt.Ir:
     """The IR; `vectors` is the number of test vectors per function, which live in their own file."""
     printer = RustPrinter()
     return model_document(d.model, [printer(v) for v in d.x_e], [printer(v) for v in d.u_e],
-                          [t.task for t in d.tasks], [function_ir(fn, d) for fn in functions], generator, report,
-                          vectors)
+                          [t.task for t in d.tasks], [_reported(function_ir(fn, d)) for fn in functions], generator,
+                          report, vectors)
 
 
 def model_document(m, x_e: list[str], u_e: list[str], tasks: list, functions: list[irt.Function],

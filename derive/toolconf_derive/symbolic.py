@@ -14,6 +14,7 @@ import sympy as sp
 from .planar_chain import sympy_chain
 from .planar_chain import tip as planar_tip
 from .description import Model, Task, model_tasks, sensitivity, task_formula
+from . import progress
 from .errors import DescriptionError
 from .expression import ExpressionError, sympy_expression
 
@@ -167,6 +168,7 @@ def derive(model: Model, tasks: list[Task]) -> Derivation:
                                "the forces (gravity among them) are not balanced at q^e with U^e; choose q^e where "
                                "they are, or U^e that feeds them forward")
 
+    progress.step("deriving", "equations of motion")
     a = tidy_matrix(f_x.subs(at_e))
     b = tidy_matrix(f_u.subs(at_e))
     if any(e.has(sp.zoo, sp.nan, sp.oo, -sp.oo) for e in list(a) + list(b)):
@@ -180,9 +182,12 @@ def derive(model: Model, tasks: list[Task]) -> Derivation:
     tip_bias = tidy_matrix((tip_jacobian * sp.Matrix(q_dot)).jacobian(q) * sp.Matrix(q_dot))
     j = padded_jacobian(tip_jacobian, dict(zip(q, x_e[:model.dof])), model.tip_dim, model.dof)
     ns = task_namespace(a, b, j, model.dof, lambda m: tidy_matrix(m.inv()))
+    progress.step("deriving", "linearisation, tip and task namespace")
     derived_tasks = [derive_task(task, ns, model.dof) for task in tasks]
+    progress.step("deriving", f"tasks' sensitivities and control confidence ({len(tasks)} tasks)")
     for t in derived_tasks:
         t.logdet_gradient = logdet_gradient(t.confidence, params)
+        progress.step("deriving", f"{t.task.name}: d ln|Pi^U| / dp")
     return Derivation(model, params, consts, q, q_dot, u, q_ddot, f, f_x, f_u, x_e, u_e, a, b, derived_tasks, lagrangian,
                       tip, tip_jacobian, tip_bias)
 

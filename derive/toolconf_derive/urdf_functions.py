@@ -15,6 +15,7 @@ import mpmath
 import numpy as np
 
 from . import ir_types as irt
+from . import progress
 from .description import Model, model_tasks, sensitivity
 from .errors import DescriptionError
 from .exact import ExactFunction
@@ -198,6 +199,7 @@ def test_vectors(fn: SeqFunction, count: int) -> list[dict]:
         })
     fn.stats["agreement"] = worst
     fn.stats["check_seconds"] = time.perf_counter() - started
+    progress.step("checking", f"{fn.name}: code graph = reference graph (50 digits) at {count} points")
     return vectors
 
 
@@ -396,11 +398,15 @@ def urdf_documents(model: Model, tasks, generator: irt.Generator, vectors: int, 
     # Not exactly zero: the graphs' constants were folded in double while they were built.
     if not float(np.max(np.abs(residual))) <= EQUILIBRIUM_RESIDUAL:
         raise DescriptionError(model.path, "equilibrium", not_an_equilibrium(model.chain, residual.ravel()))
+    progress.step("deriving", f"chain of {model.dof} joints: RNEA, CRBA and ABA graphs, equilibrium")
     for name, mass, com, sides in REPORT_TOOLS:
         singular_joints(dv, report_tool(mass, com, sides), name)
     functions = build_functions(dv)
+    progress.step("deriving", f"{len(functions)} function graphs")
     document = vectors_document(model, functions, generator, vectors, schema)
     irs = [function_ir(fn) for fn in functions]
+    # Each is an instruction sequence of its graph already: milliseconds, one line for all.
+    progress.step("deriving", f"code of the {len(irs)} functions (instruction sequences of their graphs)")
     x_e = [float_literal(v) for v in dv.x_e]
     u_e = [float_literal(v) for v in dv.u_e]
     ir = model_document(model, x_e, u_e, tasks, irs, generator, report_data(dv, functions), vectors,
