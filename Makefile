@@ -6,7 +6,7 @@ PY_DEV := $(VENV)/.python-dev-installed
 # Deterministic derivation: the same inputs give byte-identical generated files.
 export PYTHONHASHSEED := 0
 
-.PHONY: run test derive render drift-check venv clean-venv bench python-test crate model on-robot-test
+.PHONY: run test derive render drift-check venv clean-venv bench python-test crate model on-robot-test c-example-test
 
 ## make run: build in release mode and reproduce the paper's Results (results/report.md).
 run:
@@ -28,6 +28,7 @@ test: drift-check $(PY_DEV)
 	$(PY) -m unittest discover --start-directory derive/tests
 	cargo test --workspace --quiet
 	$(MAKE) --no-print-directory on-robot-test
+	$(MAKE) --no-print-directory c-example-test
 	$(PYTHON_BUILD)
 	$(PYTHON_TESTS)
 
@@ -35,6 +36,12 @@ test: drift-check $(PY_DEV)
 ## workspace, as a robot's firmware would build it).
 on-robot-test:
 	cargo test --quiet --manifest-path examples/on_robot/Cargo.toml
+
+## make c-example-test: the C example controller (examples/c_controller/main.c) on the Panda's model library,
+## built by make model from the committed IR into a temporary folder, prints the Rust on-robot controller's
+## torque and confidence, bit for bit (examples/on_robot/tests/panda_tick.rs).
+c-example-test: $(PY)
+	@$(MAKE) --no-print-directory -C examples/c_controller check PY=$(abspath $(PY))
 
 ## make python-test: builds the Python package (python/, `import toolconf`) into derive/.venv
 ## with maturin (debug profile, in the workspace's target/, so the crate is not built twice),
