@@ -139,7 +139,7 @@ pub fn bit_identity<M, const N: usize, const NX: usize, const NP: usize, const N
 where
     M: ArmModel<N, NX, NP, NZ>,
 {
-    let mut compared = 0;
+    let (mut compared, mut ticks) = (0, 0);
     assert_eq!((e.abi_version)(), crate::ABI_VERSION);
     assert_eq!(c_str(e, (e.tasks_fingerprint)()), crate::fingerprint::hex());
     check_info::<M, N, NX, NP, NZ>(e);
@@ -187,6 +187,17 @@ where
                 compared += counted("tip (jacobian)", case, &j, j0.as_slice());
             }
             None => assert_eq!(code, status::NO_TIP, "tip of a model without one"),
+        }
+        let q_dot = x.fixed_rows::<N>(N).into_owned();
+        let mut bias = [0.0; 3];
+        let code =
+            unsafe { (e.tip_bias)(q.as_ptr(), q_dot.as_ptr(), p.as_ptr(), bias.as_mut_ptr()) };
+        match M::tip_bias(&q, &q_dot, &p) {
+            Some(b) => {
+                ok("tip_bias", e, code);
+                compared += counted("tip_bias", case, &bias, b.as_slice());
+            }
+            None => assert_eq!(code, status::NO_TIP, "tip_bias of a model without a tip"),
         }
         let mut a_e = vec![0.0; NX * NX];
         ok("state_matrix", e, unsafe {
@@ -305,7 +316,7 @@ where
                     c_str(e, (e.last_error)())
                 ),
             }
-            compared += controller::<M, N, NX, NP, NZ>(
+            ticks += controller::<M, N, NX, NP, NZ>(
                 e,
                 &mut rng,
                 case,
@@ -317,7 +328,12 @@ where
             );
         }
     }
-    compared
+    // The ticks must have been compared at all: some tool and task must make a controller.
+    assert!(
+        ticks > 0,
+        "no controller of {cases} random tools on any task could be made"
+    );
+    compared + ticks
 }
 
 /// A controller through the C ABI against [`ArmController`] directly: the same creation
@@ -632,6 +648,21 @@ where
             "tip(jacobian NULL)",
             (e.tip)(x.as_ptr(), p.as_ptr(), buf.as_mut_ptr(), null_mut),
             status::NULL_POINTER,
+        );
+        expect(
+            "tip_bias(q_dot NULL)",
+            (e.tip_bias)(x.as_ptr(), null, p.as_ptr(), buf.as_mut_ptr()),
+            status::NULL_POINTER,
+        );
+        expect(
+            "tip_bias(q_dot NaN)",
+            (e.tip_bias)(
+                x.as_ptr(),
+                [f64::NAN; N].as_ptr(),
+                p.as_ptr(),
+                buf.as_mut_ptr(),
+            ),
+            status::NOT_FINITE,
         );
         expect(
             "state_matrix(params NULL)",

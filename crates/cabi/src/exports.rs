@@ -22,6 +22,7 @@ pub struct Exports {
     pub rigid_body_dynamics:
         unsafe extern "C" fn(*const f64, *const f64, *const f64, *mut f64) -> i32,
     pub tip: unsafe extern "C" fn(*const f64, *const f64, *mut f64, *mut f64) -> i32,
+    pub tip_bias: unsafe extern "C" fn(*const f64, *const f64, *const f64, *mut f64) -> i32,
     pub state_matrix: unsafe extern "C" fn(*const f64, *mut f64) -> i32,
     pub input_matrix: unsafe extern "C" fn(*const f64, *mut f64) -> i32,
     pub task_defaults: unsafe extern "C" fn(u32, *mut f64, *mut f64) -> i32,
@@ -51,7 +52,7 @@ pub struct Exports {
 
 /// Every export's C name, in the order of [`Exports`]' fields: what a loader looks up, and what
 /// the header declares (a test compares the header with this list).
-pub const SYMBOLS: [&str; 22] = [
+pub const SYMBOLS: [&str; 23] = [
     "toolconf_abi_version",
     "toolconf_tasks_fingerprint",
     "toolconf_model_info",
@@ -62,6 +63,7 @@ pub const SYMBOLS: [&str; 22] = [
     "toolconf_dynamics_jacobian",
     "toolconf_rigid_body_dynamics",
     "toolconf_tip",
+    "toolconf_tip_bias",
     "toolconf_state_matrix",
     "toolconf_input_matrix",
     "toolconf_task_defaults",

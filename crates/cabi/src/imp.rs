@@ -326,6 +326,38 @@ where
     })
 }
 
+/// `toolconf_tip_bias`: J̇(q, q̇) q̇, the tip's acceleration at q̈ = 0 (ÿ = J q̈ + J̇ q̇).
+pub unsafe fn tip_bias<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    q: *const f64,
+    q_dot: *const f64,
+    params: *const f64,
+    bias: *mut f64,
+) -> i32
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    const F: &str = "toolconf_tip_bias";
+    guard(F, || {
+        let q = vector::<N>(q, F, "q")?;
+        let q_dot = vector::<N>(q_dot, F, "q_dot")?;
+        let p = vector::<NP>(params, F, "params")?;
+        let dst = out(bias, F, "bias")?;
+        match M::tip_bias(&q, &q_dot, &p) {
+            Some(b) => {
+                write(dst, b.as_slice());
+                Ok(())
+            }
+            None => Err(fail(
+                status::NO_TIP,
+                format_args!(
+                    "{F}: model {} has no tip (its description gives no [tip])",
+                    M::NAME
+                ),
+            )),
+        }
+    })
+}
+
 /// `toolconf_state_matrix`.
 pub unsafe fn state_matrix<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
     params: *const f64,

@@ -163,6 +163,17 @@ macro_rules! export_model {
             $crate::imp::tip::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(q, params, position, jacobian)
         }
 
+        /// The tip's acceleration at q̈ = 0, J̇(q, q̇) q̇ (3).
+        #[no_mangle]
+        pub unsafe extern "C" fn toolconf_tip_bias(
+            q: *const f64,
+            q_dot: *const f64,
+            params: *const f64,
+            bias: *mut f64,
+        ) -> i32 {
+            $crate::imp::tip_bias::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(q, q_dot, params, bias)
+        }
+
         /// A = ∂f/∂X at the equilibrium.
         #[no_mangle]
         pub unsafe extern "C" fn toolconf_state_matrix(params: *const f64, a: *mut f64) -> i32 {
@@ -301,6 +312,7 @@ macro_rules! export_model {
             dynamics_jacobian: toolconf_dynamics_jacobian,
             rigid_body_dynamics: toolconf_rigid_body_dynamics,
             tip: toolconf_tip,
+            tip_bias: toolconf_tip_bias,
             state_matrix: toolconf_state_matrix,
             input_matrix: toolconf_input_matrix,
             task_defaults: toolconf_task_defaults,

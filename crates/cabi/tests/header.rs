@@ -44,7 +44,7 @@ macro_rules! layout {
 
 /// The C type of each export, as the Rust signature in `Exports` says (by hand: the compiler
 /// then checks the header against it).
-const SIGNATURES: [(&str, &str); 22] = [
+const SIGNATURES: [(&str, &str); 23] = [
     ("toolconf_abi_version", "uint32_t (*)(void)"),
     ("toolconf_tasks_fingerprint", "const char *(*)(void)"),
     ("toolconf_model_info", "const toolconf_metadata *(*)(void)"),
@@ -55,6 +55,7 @@ const SIGNATURES: [(&str, &str); 22] = [
     ("toolconf_dynamics_jacobian", "int32_t (*)(const double *, const double *, const double *, double *, double *)"),
     ("toolconf_rigid_body_dynamics", "int32_t (*)(const double *, const double *, const double *, double *)"),
     ("toolconf_tip", "int32_t (*)(const double *, const double *, double *, double *)"),
+    ("toolconf_tip_bias", "int32_t (*)(const double *, const double *, const double *, double *)"),
     ("toolconf_state_matrix", "int32_t (*)(const double *, double *)"),
     ("toolconf_input_matrix", "int32_t (*)(const double *, double *)"),
     ("toolconf_task_defaults", "int32_t (*)(uint32_t, double *, double *)"),
