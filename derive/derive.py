@@ -81,6 +81,8 @@ def run() -> int:
     ap.add_argument("--vectors", type=int, default=100, help="test vectors per function (default 100)")
     ap.add_argument("--command", default="make derive",
                     help="the command the generated files name as their maker (default: make derive)")
+    ap.add_argument("--jobs", type=int, default=1,
+                    help="processes checking a URDF model's functions (default 1; make model: every core)")
     ap.add_argument("--progress", action="store_true",
                     help="report each step as it finishes on stderr (toolconf_derive/progress.py; make model)")
     args = ap.parse_args()
@@ -94,6 +96,9 @@ def run() -> int:
     if not folder.is_dir():
         flag = f"--out {args.out}" if args.out is not None else f"--out-dir {args.out_dir}"
         print(f"derive: {flag}: the folder {folder} does not exist", file=sys.stderr)
+        return 2
+    if args.jobs < 1:
+        print(f"derive: --jobs {args.jobs}: need at least one process", file=sys.stderr)
         return 2
     if args.vectors < 1:
         print(f"derive: --vectors {args.vectors}: need at least one test vector per function", file=sys.stderr)
@@ -118,7 +123,8 @@ def run() -> int:
             # CasADi SX, not SymPy (derive/toolconf_derive/urdf_model.py); each test vector is
             # checked in 50-digit arithmetic on two graphs of thousands of instructions, so fewer.
             generator.derive = "derive/derive.py (CasADi SX: RNEA/CRBA/LDL^T, checked against ABA)"
-            ir, vectors = urdf_documents(model, tasks, generator, min(args.vectors, URDF_VECTORS), IR_SCHEMA)
+            ir, vectors = urdf_documents(model, tasks, generator, min(args.vectors, URDF_VECTORS), IR_SCHEMA,
+                                        args.jobs)
         else:
             d = derive(model, tasks)
             functions = build_functions(d, CasadiModel(model))

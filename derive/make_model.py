@@ -116,7 +116,8 @@ def derive(desc: Path, tasks: Path, folder: Path, clock: Clock) -> None:
     """derive.py for the one description into `folder`, its steps shown as they finish; its own
     one-line errors are passed on with its status."""
     cmd = [sys.executable, str(ROOT / "derive" / "derive.py"), str(Path.cwd() / desc), "--tasks",
-           str(Path.cwd() / tasks), "--out-dir", str(folder), "--command", COMMAND, "--progress"]
+           str(Path.cwd() / tasks), "--out-dir", str(folder), "--command", COMMAND, "--progress",
+           "--jobs", str(os.cpu_count() or 1)]
     process = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                errors="replace")
     try:

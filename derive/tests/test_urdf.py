@@ -262,6 +262,28 @@ def _raw_dynamics(dyn: ChainDynamics, tool=None):
     return tuple((lambda *a, f=f: f(*a[:-1], inertial(a[-1]))) for f in fns)
 
 
+class CheckedOnSeveralProcesses(unittest.TestCase):
+    """make model checks a URDF model's functions on every core (derive.py --jobs): the IR and the
+    test vectors are the same bytes as one process writes, and a bad --jobs is one line."""
+
+    def test_jobs_write_the_same_bytes(self):
+        tmp = Path(self.enterContext(tempfile.TemporaryDirectory()))
+        (tmp / "robot.urdf").write_text(_robot(*GOOD))
+        (tmp / "three.toml").write_text(MODEL.format(file="robot.urdf", k1="50.0"))
+        written = {}
+        for jobs in (1, 3):
+            out = tmp / f"jobs{jobs}"
+            out.mkdir()
+            r = subprocess.run([sys.executable, str(DERIVE), str(tmp / "three.toml"), "--out", str(out / "three.json"),
+                                "--vectors", "2", "--jobs", str(jobs)], capture_output=True, text=True)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            written[jobs] = [(out / n).read_bytes() for n in ("three.json", "three.vectors.json")]
+        self.assertEqual(written[1], written[3])
+        r = subprocess.run([sys.executable, str(DERIVE), str(tmp / "three.toml"), "--out", str(tmp / "x.json"),
+                            "--jobs", "0"], capture_output=True, text=True)
+        self.assertEqual((r.returncode, r.stderr.strip()), (2, "derive: --jobs 0: need at least one process"))
+
+
 class PlanarRods(unittest.TestCase):
     """(a) The URDF route on two uniform rods is arm2_exact after q1 = theta1, q2 = theta2 - theta1."""
 

@@ -8,6 +8,7 @@ per-tool coefficients (the last body's inertia with the tool, and K q^e + g(q^e;
 
 from __future__ import annotations
 
+import multiprocessing
 import time
 
 import casadi as ca
@@ -173,7 +174,7 @@ def _code_values(fn: SeqFunction, v: dict) -> list[np.ndarray]:
     return values
 
 
-def test_vectors(fn: SeqFunction, count: int) -> list[dict]:
+def test_vectors(fn: SeqFunction, count: int, report: bool = True) -> list[dict]:
     """`count` random valid inputs and the reference outputs, after checking that the code graph
     gives the same values (both exactly; normwise relative AGREEMENT per output, the gradient
     relative to max(scale, 1) as the Rust test does). A disagreement stops the derivation."""
@@ -199,7 +200,8 @@ def test_vectors(fn: SeqFunction, count: int) -> list[dict]:
         })
     fn.stats["agreement"] = worst
     fn.stats["check_seconds"] = time.perf_counter() - started
-    progress.step("checking", f"{fn.name}: code graph = reference graph (50 digits) at {count} points")
+    if report:
+        progress.step("checking", f"{fn.name}: code graph = reference graph (50 digits) at {count} points")
     return vectors
 
 
@@ -266,14 +268,48 @@ def function_ir(fn: SeqFunction) -> irt.Function:
 
 
 def vectors_document(model: Model, functions: list[SeqFunction], generator: irt.Generator, count: int,
-                     schema: int) -> dict:
+                     schema: int, jobs: int = 1) -> dict:
     return {
         "schema": schema,
         "generator": generator,
         "model": model.name,
         "tolerance": "max|rust - casadi| <= 1e-12 max|casadi| per output (the generated crate's tests/vectors.rs)",
-        "functions": [{"name": fn.name, "vectors": test_vectors(fn, count)} for fn in functions],
+        "functions": [{"name": fn.name, "vectors": v} for fn, v in zip(functions, all_vectors(functions, count, jobs))],
     }
+
+
+# The functions the forked workers of all_vectors check (inherited from the parent at the fork:
+# their graphs and reference closures are not picklable, and need not be).
+_FORKED: list[SeqFunction] = []
+
+
+def _forked_vectors(job: tuple[int, int]) -> tuple[list[dict], float, float]:
+    fn = _FORKED[job[0]]
+    vectors = test_vectors(fn, job[1], report=False)
+    return vectors, fn.stats["agreement"], fn.stats["check_seconds"]
+
+
+def all_vectors(functions: list[SeqFunction], count: int, jobs: int) -> list[list[dict]]:
+    """test_vectors of every function, on `jobs` forked processes where more than one is asked
+    for (make model, one model on every core; make derive runs models side by side instead). Each
+    function draws its samples from its own seeded generator and its check is the same whichever
+    process runs it, so the vectors and the IR are the same bytes; results come back in order."""
+    jobs = min(jobs, len(functions))
+    if jobs <= 1 or "fork" not in multiprocessing.get_all_start_methods():
+        return [test_vectors(fn, count) for fn in functions]
+    global _FORKED
+    _FORKED = functions
+    out = []
+    try:
+        with multiprocessing.get_context("fork").Pool(jobs) as pool:
+            for fn, (vectors, worst, seconds) in zip(functions, pool.imap(_forked_vectors,
+                                                                           [(i, count) for i in range(len(functions))])):
+                fn.stats["agreement"], fn.stats["check_seconds"] = worst, seconds
+                progress.step("checking", f"{fn.name}: code graph = reference graph (50 digits) at {count} points")
+                out.append(vectors)
+    finally:
+        _FORKED = []
+    return out
 
 
 # |f(X^e, U^e)| (rad/s^2) accepted as zero: the reference graph's rounding of its folded constants.
@@ -390,8 +426,9 @@ def not_an_equilibrium(chain, residual) -> str:
             f"{cause}")
 
 
-def urdf_documents(model: Model, tasks, generator: irt.Generator, vectors: int, schema: int) -> tuple[irt.Ir, dict]:
-    """The IR and the test vectors of a URDF model."""
+def urdf_documents(model: Model, tasks, generator: irt.Generator, vectors: int, schema: int,
+                   jobs: int = 1) -> tuple[irt.Ir, dict]:
+    """The IR and the test vectors of a URDF model, its functions checked on `jobs` processes."""
     tasks = model_tasks(model, tasks)
     dv = UrdfDerivation(model, model.chain, tasks)
     residual = dv.reference_dynamics(dv.x_e, dv.u_e, report_tool(*REPORT_TOOLS[1][1:]))[0].to_numpy()
@@ -403,7 +440,7 @@ def urdf_documents(model: Model, tasks, generator: irt.Generator, vectors: int, 
         singular_joints(dv, report_tool(mass, com, sides), name)
     functions = build_functions(dv)
     progress.step("deriving", f"{len(functions)} function graphs")
-    document = vectors_document(model, functions, generator, vectors, schema)
+    document = vectors_document(model, functions, generator, vectors, schema, jobs)
     irs = [function_ir(fn) for fn in functions]
     # Each is an instruction sequence of its graph already: milliseconds, one line for all.
     progress.step("deriving", f"code of the {len(irs)} functions (instruction sequences of their graphs)")
