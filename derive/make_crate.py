@@ -230,27 +230,34 @@ def main() -> int:
     ap.add_argument("--tasks", type=Path, default=TASKS, help="task definitions (default derive/tasks.toml)")
     ap.add_argument("--name", help="the crate's package name (default: OUT's folder name)")
     args = ap.parse_args()
-    # A terminated or hung-up run cleans up as an interrupted one does (the temporary folder
-    # goes, the old crate stays), and ends with the shell's status for the signal.
+    return run_reported("make crate", args.out, lambda: make_crate(args.models, args.out, args.tasks, args.name))
+
+
+def run_reported(command: str, out: Path, body) -> int:
+    """`body()`'s status, every way it can end as one line on stderr naming `command`: a refusal
+    (status 2), a failure (1), an interrupt (130, nothing changed), an OSError naming a path, and
+    anything unforeseen (1, never a traceback). A terminated or hung-up run cleans up as an
+    interrupted one does (the temporary folder goes, the old OUT stays), and ends with the shell's
+    status for the signal."""
     for sig in (signal.SIGTERM, signal.SIGHUP):
         signal.signal(sig, lambda number, _: sys.exit(128 + number))
     try:
-        return make_crate(args.models, args.out, args.tasks, args.name)
+        return body()
     except Refused as err:
-        print(f"make crate: {err}", file=sys.stderr)
+        print(f"{command}: {err}", file=sys.stderr)
         return 2
     except Failed as err:
-        print(f"make crate: {err}", file=sys.stderr)
+        print(f"{command}: {err}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
-        print("make crate: interrupted; nothing changed", file=sys.stderr)
+        print(f"{command}: interrupted; nothing changed", file=sys.stderr)
         return 130
     except OSError as err:
-        print(f"make crate: {os_error(err, args.out)}", file=sys.stderr)
+        print(f"{command}: {os_error(err, out)}", file=sys.stderr)
         return 1
     except Exception as err:  # noqa: BLE001 - the last resort: one line, never a traceback
         reason = " ".join(str(err).split()) or "no message"
-        print(f"make crate: error: {type(err).__name__}: {reason[:300]}", file=sys.stderr)
+        print(f"{command}: error: {type(err).__name__}: {reason[:300]}", file=sys.stderr)
         return 1
 
 

@@ -42,7 +42,6 @@ import argparse
 import json
 import os
 import shutil
-import signal
 import subprocess
 import sys
 import tempfile
@@ -50,7 +49,7 @@ import time
 from pathlib import Path
 
 import make_crate
-from make_crate import Failed, Refused, folder_rule, install, os_error, renderer, urdf_inputs
+from make_crate import Failed, Refused, folder_rule, install, renderer, urdf_inputs
 from toolconf_derive.description import check_tasks, load_model, load_tasks
 from toolconf_derive.errors import DescriptionError
 
@@ -285,28 +284,7 @@ def main() -> int:
     if args.ir is not None and args.tasks is not None:
         ap.error("TASKS= goes with DESC=: an IR was derived with its task definitions")
     tasks = args.tasks if args.tasks is not None else TASKS
-    # A terminated or hung-up run cleans up as an interrupted one does (the temporary folder
-    # goes, the old OUT stays), and ends with the shell's status for the signal.
-    for sig in (signal.SIGTERM, signal.SIGHUP):
-        signal.signal(sig, lambda number, _: sys.exit(128 + number))
-    try:
-        return make_model(args.desc, args.ir, args.out, tasks)
-    except Refused as err:
-        print(f"{COMMAND}: {err}", file=sys.stderr)
-        return 2
-    except Failed as err:
-        print(f"{COMMAND}: {err}", file=sys.stderr)
-        return 1
-    except KeyboardInterrupt:
-        print(f"{COMMAND}: interrupted; nothing changed", file=sys.stderr)
-        return 130
-    except OSError as err:
-        print(f"{COMMAND}: {os_error(err, args.out)}", file=sys.stderr)
-        return 1
-    except Exception as err:  # noqa: BLE001 - the last resort: one line, never a traceback
-        reason = " ".join(str(err).split()) or "no message"
-        print(f"{COMMAND}: error: {type(err).__name__}: {reason[:300]}", file=sys.stderr)
-        return 1
+    return make_crate.run_reported(COMMAND, args.out, lambda: make_model(args.desc, args.ir, args.out, tasks))
 
 
 if __name__ == "__main__":

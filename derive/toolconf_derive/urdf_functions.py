@@ -174,7 +174,7 @@ def _code_values(fn: SeqFunction, v: dict) -> list[np.ndarray]:
     return values
 
 
-def test_vectors(fn: SeqFunction, count: int, report: bool = True) -> list[dict]:
+def test_vectors(fn: SeqFunction, count: int) -> list[dict]:
     """`count` random valid inputs and the reference outputs, after checking that the code graph
     gives the same values (both exactly; normwise relative AGREEMENT per output, the gradient
     relative to max(scale, 1) as the Rust test does). A disagreement stops the derivation."""
@@ -200,8 +200,6 @@ def test_vectors(fn: SeqFunction, count: int, report: bool = True) -> list[dict]
         })
     fn.stats["agreement"] = worst
     fn.stats["check_seconds"] = time.perf_counter() - started
-    if report:
-        progress.step("checking", f"{fn.name}: code graph = reference graph (50 digits) at {count} points")
     return vectors
 
 
@@ -285,7 +283,7 @@ _FORKED: list[SeqFunction] = []
 
 def _forked_vectors(job: tuple[int, int]) -> tuple[list[dict], float, float]:
     fn = _FORKED[job[0]]
-    vectors = test_vectors(fn, job[1], report=False)
+    vectors = test_vectors(fn, job[1])
     return vectors, fn.stats["agreement"], fn.stats["check_seconds"]
 
 
@@ -295,21 +293,29 @@ def all_vectors(functions: list[SeqFunction], count: int, jobs: int) -> list[lis
     function draws its samples from its own seeded generator and its check is the same whichever
     process runs it, so the vectors and the IR are the same bytes; results come back in order."""
     jobs = min(jobs, len(functions))
+    out = []
+    for fn, vectors in zip(functions, _vectors_in_order(functions, count, jobs)):
+        progress.step("checking", f"{fn.name}: code graph = reference graph (50 digits) at {count} points")
+        out.append(vectors)
+    return out
+
+
+def _vectors_in_order(functions: list[SeqFunction], count: int, jobs: int):
+    """Each function's test vectors as it is checked: here, or on `jobs` forked processes, their
+    stats copied back."""
     if jobs <= 1 or "fork" not in multiprocessing.get_all_start_methods():
-        return [test_vectors(fn, count) for fn in functions]
+        yield from (test_vectors(fn, count) for fn in functions)
+        return
     global _FORKED
     _FORKED = functions
-    out = []
     try:
         with multiprocessing.get_context("fork").Pool(jobs) as pool:
-            for fn, (vectors, worst, seconds) in zip(functions, pool.imap(_forked_vectors,
-                                                                           [(i, count) for i in range(len(functions))])):
+            results = pool.imap(_forked_vectors, [(i, count) for i in range(len(functions))])
+            for fn, (vectors, worst, seconds) in zip(functions, results):
                 fn.stats["agreement"], fn.stats["check_seconds"] = worst, seconds
-                progress.step("checking", f"{fn.name}: code graph = reference graph (50 digits) at {count} points")
-                out.append(vectors)
+                yield vectors
     finally:
         _FORKED = []
-    return out
 
 
 # |f(X^e, U^e)| (rad/s^2) accepted as zero: the reference graph's rounding of its folded constants.

@@ -131,14 +131,6 @@ pub struct TipObserver<const NP: usize> {
     pub acceleration: bool,
 }
 
-/// Whether the task's controller reads the tip's acceleration ÿ (a term [`Read::Tip`] of order
-/// 2, which needs J̇ q̇).
-pub fn reads_tip_acceleration(kind: crate::TaskKind) -> bool {
-    Term::ALL
-        .iter()
-        .any(|&t| kind.uses(t) && matches!(t.read(), Read::Tip { order: 2.. }))
-}
-
 /// What observing a tool's tip on model `M` needs: on a task that reads the tip
 /// ([`crate::reads_tip`]), the tool's parameters `p`, for y(q; p); `None` on a joint-space task,
 /// which never evaluates the tip. A tip task on a model without a tip is [`Error::NoTip`].
@@ -153,7 +145,7 @@ where
         return Ok(None);
     }
     let q_e = M::equilibrium_state().fixed_rows::<N>(0).into_owned();
-    let acceleration = reads_tip_acceleration(kind);
+    let acceleration = crate::reads_tip_acceleration(kind);
     let bias = !acceleration || M::tip_bias(&q_e, &SVector::zeros(), p).is_some();
     match M::tip(&q_e, p) {
         Some(_) if bias => Ok(Some(TipObserver {

@@ -52,12 +52,12 @@ pub use arm_controller::{ArmController, Command, RATE_HZ};
 pub use arm_model::*;
 pub use confidence::{control_confidence, logdet_of, ControlConfidenceN, ValidatedTaskN};
 pub use controller::{
-    control_of, observe, observe_tool, observe_with_tip, reads_tip_acceleration, tip_kinematics,
+    control_of, observe, observe_tool, observe_with_tip, tip_kinematics,
     tip_parameters, ActiveInferenceN, ObservationN, TipKinematics, TipObserver,
 };
 pub use error::{Error, PrecisionKeys, PrecisionProblem};
 pub use generated::{Read, TaskKind, Term, TERMS};
-pub use task::{reads_tip, term_components, term_identity, TaskN};
+pub use task::{reads_tip, reads_tip_acceleration, term_components, term_identity, TaskN};
 pub use tool::{SensitivitiesN, ToolN};
 
 /// ln x: the platform's with the `std` feature (glibc's on Linux), else the `libm` crate's.

@@ -125,6 +125,14 @@ pub fn reads_tip(kind: TaskKind) -> bool {
         .any(|t| matches!(t.read(), Read::Tip { .. }))
 }
 
+/// Whether the task's controller reads the tip's acceleration ÿ (a term [`Read::Tip`] of order
+/// 2, which needs J̇ q̇).
+pub fn reads_tip_acceleration(kind: TaskKind) -> bool {
+    kind.terms()
+        .iter()
+        .any(|t| matches!(t.read(), Read::Tip { order: 2.. }))
+}
+
 /// The rank of a symmetric positive semi-definite matrix: the pivots of a Cholesky
 /// factorisation with diagonal pivoting above 1e-12 of the largest entry (on the stack: no
 /// allocation).

@@ -196,9 +196,12 @@ fn subtract_tip_gains<P, const N: usize, const NX: usize, const NP: usize, const
     let Some(j) = TipKinematics::of::<P, NX, NP, NZ>(&q, p).map(|t| t.padded_jacobian()) else {
         return;
     };
-    let j_dot = jacobian_rate::<P, N, NX, NP, NZ>(p, &q, &q_dot);
     for term in Term::ALL {
         let k = gains[term.index()];
+        // A term the task does not use has no gain: no difference quotient to take for it.
+        if k.iter().all(|v| *v == 0.0) {
+            continue;
+        }
         match (term.read(), q_ddot) {
             (Read::Tip { order: 0 }, _) => {
                 let mut positions = du_dx.fixed_view_mut::<N, N>(0, 0);
@@ -208,7 +211,7 @@ fn subtract_tip_gains<P, const N: usize, const NX: usize, const NP: usize, const
                 let mut rates = du_dx.fixed_view_mut::<N, N>(0, N);
                 rates -= k * j;
                 let mut positions = du_dx.fixed_view_mut::<N, N>(0, 0);
-                positions -= k * j_dot;
+                positions -= k * jacobian_rate::<P, N, NX, NP, NZ>(p, &q, &q_dot);
             }
             (Read::Tip { .. }, Some(a)) => {
                 let kj = k * j;
