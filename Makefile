@@ -6,7 +6,7 @@ PY_DEV := $(VENV)/.python-dev-installed
 # Deterministic derivation: the same inputs give byte-identical generated files.
 export PYTHONHASHSEED := 0
 
-.PHONY: run test derive render drift-check venv clean-venv bench python-test crate model on-robot-test c-example-test
+.PHONY: run test derive render drift-check venv clean-venv bench python-test crate model on-robot-test c-example-test loaded-models-test
 
 ## make run: build in release mode and reproduce the paper's Results (results/report.md).
 run:
@@ -31,6 +31,7 @@ test: drift-check $(PY_DEV)
 	$(MAKE) --no-print-directory c-example-test
 	$(PYTHON_BUILD)
 	$(PYTHON_TESTS)
+	$(MAKE) --no-print-directory loaded-models-test
 
 ## make on-robot-test: the on-robot controller's own tests (examples/on_robot, a crate outside the
 ## workspace, as a robot's firmware would build it).
@@ -42,6 +43,23 @@ on-robot-test:
 ## torque and confidence, bit for bit (examples/on_robot/tests/panda_tick.rs).
 c-example-test: $(PY)
 	@$(MAKE) --no-print-directory -C examples/c_controller check PY=$(abspath $(PY))
+
+## make loaded-models-test: models loaded at run time. Builds every model of the repository into a model
+## library (make model IR=generated/<model>.json) and the UFactory xArm7, which the repository does not ship,
+## from its unedited URDF (make model DESC=examples/robots/xarm7.toml), into a temporary folder; then checks
+## that each loaded library gives its built-in model's numbers bit for bit in every operation and subcommand
+## (tests/loaded_models.rs), in Python and on Dask's workers (python/loaded_tests/), and the xArm7's
+## dynamics against Pinocchio's aba. Needs the Python package installed (make python-test does it).
+loaded-models-test: $(PY_DEV)
+	@d=$$(mktemp -d) && trap 'rm -rf "$$d"' EXIT && \
+	for ir in generated/*.json; do \
+	  case $$ir in *.vectors.json) continue;; esac; m=$$(basename $$ir .json); \
+	  $(PY) derive/make_model.py --ir $$ir --out $$d/$$m 2>$$d/$$m.log >/dev/null || { cat $$d/$$m.log; exit 1; }; \
+	done && \
+	$(PY) derive/make_model.py --desc examples/robots/xarm7.toml --out $$d/xarm7 2>$$d/xarm7.log >/dev/null || { cat $$d/xarm7.log; exit 1; }; \
+	echo "loaded-models-test: $$(ls -d $$d/*/ | wc -l) model libraries built" && \
+	TOOLCONF_TEST_LIBRARIES=$$d cargo test --quiet --test loaded_models -- --include-ignored && \
+	TOOLCONF_TEST_LIBRARIES=$$d $(PY) -m pytest -q python/loaded_tests
 
 ## make python-test: builds the Python package (python/, `import toolconf`) into derive/.venv
 ## with maturin (debug profile, in the workspace's target/, so the crate is not built twice),

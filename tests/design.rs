@@ -47,7 +47,7 @@ fn central_difference(tasks: &ModelTasks, model: ModelKind, p: &[f64], j: usize)
 
 #[test]
 fn gradient_agrees_with_finite_differences_for_every_model_and_task() {
-    for model in ModelKind::ALL {
+    for model in ModelKind::all() {
         for kind in [
             TaskKind::Position,
             TaskKind::Velocity,

@@ -249,7 +249,7 @@ fn check_task(text: &str) -> Result<(), TestCaseError> {
         Ok(spec) => {
             // Every model binds the task or says why, naming the file and key.
             let tasks = ModelTasks::new(&spec);
-            for model in ModelKind::ALL {
+            for model in ModelKind::all() {
                 if let Err(e) = tasks.check(model) {
                     one_line(&e.to_string(), "fuzz.toml")?;
                     prop_assert!(e.place.starts_with("key "), "{e}");

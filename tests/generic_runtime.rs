@@ -197,8 +197,11 @@ fn arm3_goals_extend_the_two_link_ones() {
     assert_eq!(v.goal[Term::ThetaDot.index()].as_slice(), &[0.0, 0.0, 2.0]);
     let a = Arm3::paper_task(TaskKind::Acceleration);
     assert_eq!(a.goal[Term::ThetaDdot.index()].as_slice(), &[0.0, 0.0, 0.1]);
-    assert_eq!(Arm3::NAME, "arm3");
-    assert_eq!(Arm3::PARAMETER_NAMES, ["m1", "m2", "m3", "l1", "l2", "l3"]);
+    assert_eq!(Arm3::name(), "arm3");
+    assert_eq!(
+        *Arm3::parameter_names(),
+        ["m1", "m2", "m3", "l1", "l2", "l3"]
+    );
 }
 
 #[test]

@@ -106,7 +106,7 @@ where
 {
     let extreme_x = SVector::<f64, NX>::repeat(STATE_BOUND);
     let extreme_u = SVector::<f64, N>::repeat(STATE_BOUND);
-    let rule = &M::TOOL_RULE;
+    let rule = &M::tool_rule();
     let positive: Vec<usize> = (0..NP).filter(|&j| rule.domains[j].is_positive()).collect();
     let well_conditioned = |p: &[f64; NP]| positive.iter().all(|&j| (1e-2..=1e2).contains(&p[j]));
     // A tip task's sensitivity J ∂θ/∂U carries the tip's lever arm, linear in the lengths, into

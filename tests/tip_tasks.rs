@@ -31,9 +31,13 @@ fn tip_tasks() -> Vec<TaskKind> {
         .filter(|k| reads_tip(*k))
         .collect();
     assert!(
-        [TaskKind::TipPosition, TaskKind::TipVelocity, TaskKind::TipAcceleration]
-            .iter()
-            .all(|k| kinds.contains(k)),
+        [
+            TaskKind::TipPosition,
+            TaskKind::TipVelocity,
+            TaskKind::TipAcceleration
+        ]
+        .iter()
+        .all(|k| kinds.contains(k)),
         "{kinds:?}"
     );
     kinds
@@ -157,20 +161,34 @@ fn the_tips_acceleration_is_the_rate_of_its_velocity_along_the_flow() {
         let rate = (velocity(&(z + z_dot * h)) - velocity(&(z - z_dot * h))) / (2.0 * h);
         let acceleration = observed[Term::TipDdot.index()];
         let error = (acceleration - rate).amax() / acceleration.amax().max(1.0);
-        assert!(error < 1e-7, "{label}: ÿ {acceleration} vs dẏ/dt {rate}: {error:e}");
-        assert!(acceleration.amax() > 1e-3, "{label}: a trivial state {acceleration}");
+        assert!(
+            error < 1e-7,
+            "{label}: ÿ {acceleration} vs dẏ/dt {rate}: {error:e}"
+        );
+        assert!(
+            acceleration.amax() > 1e-3,
+            "{label}: a trivial state {acceleration}"
+        );
     }
     let kind = TaskKind::TipAcceleration;
     for tip in [[0.0, 0.0, 0.1], [0.05, -0.02, 0.37]] {
         let tool = panda_tool(tip);
         let task = Panda::paper_task(kind);
         let system = ClosedLoopN::<Panda, 7, 14, 13, 21>::new(&tool, &task, 1.0, 0.3).unwrap();
-        check(&system, &moving_state::<7, 14, 21>(&Panda::equilibrium_state()), "panda");
+        check(
+            &system,
+            &moving_state::<7, 14, 21>(&Panda::equilibrium_state()),
+            "panda",
+        );
     }
     let tool = Arm2Tool::new([0.3, 0.4, 0.5, 0.2]).unwrap();
-    let system = ClosedLoopN::<Arm2, 2, 4, 4, 6>::new(&tool, &Arm2::paper_task(kind), 1.0, -0.4)
-        .unwrap();
-    check(&system, &moving_state::<2, 4, 6>(&Arm2::equilibrium_state()), "arm2");
+    let system =
+        ClosedLoopN::<Arm2, 2, 4, 4, 6>::new(&tool, &Arm2::paper_task(kind), 1.0, -0.4).unwrap();
+    check(
+        &system,
+        &moving_state::<2, 4, 6>(&Arm2::equilibrium_state()),
+        "arm2",
+    );
 }
 
 /// The generated J̇ q̇ against the generated y alone: d²/ds² y(q + s q̇) at s = 0 is q̇ᵀ∇²y q̇ =
@@ -200,7 +218,11 @@ fn the_generated_tip_bias_is_the_tips_second_derivative_along_q_dot() {
             let second = (y(h) - y(0.0) * 2.0 + y(-h)) / (h * h);
             let bias = M::tip_bias(&q, &v, p).unwrap();
             let error = (bias - second).amax() / bias.amax().max(1.0);
-            assert!(error < 1e-6, "{}: J̇q̇ {bias} vs {second}: {error:e}", M::NAME);
+            assert!(
+                error < 1e-6,
+                "{}: J̇q̇ {bias} vs {second}: {error:e}",
+                M::name()
+            );
         }
     }
     check::<Panda, 7, 14, 13, 21>(&panda_tool([0.05, -0.02, 0.37]).params(), 1);
@@ -210,7 +232,7 @@ fn the_generated_tip_bias_is_the_tips_second_derivative_along_q_dot() {
     check::<Ur5, 6, 12, 13, 18>(&ur5, 2);
     check::<Arm2, 2, 4, 4, 6>(&SVector::from([0.3, 0.4, 0.5, 0.2]), 3);
     let arm3 = SVector::from_fn(|i, _| 0.3 + 0.1 * i as f64);
-    check::<Arm3, 3, 6, { Arm3::PARAMETER_NAMES.len() }, 9>(&arm3, 4);
+    check::<Arm3, 3, 6, { toolconf::generated::arm3::PARAMETER_COUNT }, 9>(&arm3, 4);
 }
 
 /// The derivation writes ∂y/∂U = J ∂θ/∂U (J at q^e, its first TIP_DIM rows): the generated
@@ -222,9 +244,24 @@ fn the_tip_sensitivities_are_the_tip_jacobian_times_the_joints() {
         let q_e = Panda::equilibrium_state().fixed_rows::<7>(0).into_owned();
         let (_, j) = Panda::tip(&q_e, &tool.params()).unwrap();
         let pairs = [
-            (TaskKind::Position, TaskKind::TipPosition, Term::Theta, Term::Tip),
-            (TaskKind::Position, TaskKind::TipPosition, Term::ThetaDot, Term::TipDot),
-            (TaskKind::Acceleration, TaskKind::TipAcceleration, Term::ThetaDdot, Term::TipDdot),
+            (
+                TaskKind::Position,
+                TaskKind::TipPosition,
+                Term::Theta,
+                Term::Tip,
+            ),
+            (
+                TaskKind::Position,
+                TaskKind::TipPosition,
+                Term::ThetaDot,
+                Term::TipDot,
+            ),
+            (
+                TaskKind::Acceleration,
+                TaskKind::TipAcceleration,
+                Term::ThetaDdot,
+                Term::TipDdot,
+            ),
         ];
         for (joint_task, tip_task, joint, tip_term) in pairs {
             let joints = tool.sensitivities(joint_task);
@@ -261,7 +298,7 @@ fn task_files_give_tip_goals_with_the_tips_components() {
         3e4,
         "σ⁻² on the tip's three components only: {p}"
     );
-    assert_eq!(term_components(Term::Tip, 7, Panda::TIP_DIM), 3);
+    assert_eq!(term_components(Term::Tip, 7, Panda::tip_dim()), 3);
 
     let e = TaskSpec::parse(
         "kind = \"tip_position\"\n[goal]\ntip = [0.5, 0.0]\n",

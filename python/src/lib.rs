@@ -50,6 +50,7 @@ fn _toolconf(m: &Bound<'_, PyModule>) -> PyResult<()> {
         PyErr::warn(m.py(), &category, &std::ffi::CString::new(note)?, 1)?;
     }
     m.add_function(wrap_pyfunction!(models::models, m)?)?;
+    m.add_function(wrap_pyfunction!(models::load_model, m)?)?;
     m.add_function(wrap_pyfunction!(models::ranges, m)?)?;
     m.add_function(wrap_pyfunction!(models::terms, m)?)?;
     m.add_function(wrap_pyfunction!(confidence::confidence, m)?)?;

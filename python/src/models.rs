@@ -21,7 +21,7 @@ pub fn model_kind(name: &str) -> Result<ModelKind, Failure> {
 #[pyfunction]
 pub fn models(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let out = PyDict::new(py);
-    for kind in ModelKind::ALL {
+    for kind in ModelKind::all() {
         let entry = PyDict::new(py);
         entry.set_item("title", kind.title())?;
         entry.set_item("dof", kind.dof())?;
@@ -74,4 +74,27 @@ pub fn ranges(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
         out.set_item(name, entry)?;
     }
     Ok(out)
+}
+
+/// Loads a model library built by ``make model`` (its ``OUT`` folder, or the
+/// ``libtoolconf_model_<model>.so`` in it) next to the built-in models, and returns the name
+/// every function then takes it by: the library's own, or ``name``. No rebuild of toolconf and
+/// no reinstall of this package. Loading the same file under the same name again returns the
+/// same name. The library is native code that runs with the interpreter's privileges: load only
+/// libraries you built (docs/c-abi.md).
+///
+/// Raises:
+///     ValueError: one line naming the file and what is wrong: not a library, a C ABI or task
+///         list other than this toolconf's, a missing symbol, a name taken by another model, a
+///         size (joints, tool parameters) this toolconf does not run, or too many loaded.
+#[pyfunction]
+#[pyo3(signature = (path, name = None))]
+pub fn load_model(
+    py: Python<'_>,
+    path: std::path::PathBuf,
+    name: Option<String>,
+) -> PyResult<String> {
+    py.detach(|| toolconf::loaded::load(&path, name.as_deref()))
+        .map(|kind| kind.name().to_string())
+        .map_err(|e| Failure::Input(e.to_string()).into_pyerr(py))
 }

@@ -61,7 +61,7 @@ impl Outcome {
 /// The parameter columns of the models present, in the models' order (as the CLI's CSV).
 fn parameter_columns<'a>(tools: impl Iterator<Item = &'a ToolRow> + Clone) -> Vec<&'static str> {
     let mut columns = Vec::new();
-    for model in ModelKind::ALL {
+    for model in ModelKind::all() {
         if tools.clone().any(|t| t.tool.model() == model) {
             for p in model.parameter_names() {
                 if !columns.contains(p) {

@@ -21,7 +21,12 @@ The runtime is Rust (the ``toolconf`` crate); this package exposes it over NumPy
 * ``tool_from_urdf(urdf, root, tip, opening=..., flange=...)``: ``toolconf tool --urdf``, a
   tool's tools-file row (mass, centre of mass, full inertia, tip in the flange frame) from its
   own URDF, as a dict.
-* ``models()``: the generated models, their parameter names, equilibria and valid tools.
+* ``models()``: the models (generated and loaded), their parameter names, equilibria and valid
+  tools.
+* ``load_model(path, name=None)``: a model library built by ``make model`` (a robot the
+  repository does not ship), loaded next to the built-in models with no rebuild; every function
+  here, and ``toolconf.dask``'s workers, then take it by name. ``TOOLCONF_MODEL_PATH``
+  (``:``-separated, ``NAME=PATH`` entries allowed) loads libraries at import.
 * ``toolconf.dask`` (``pip install "./python[dask]"``): ``rank`` and ``simulate_batch`` on a
   Dask cluster, with the same results.
 * ``ranges()``: the valid range of every number the package and the command line take.
@@ -61,6 +66,7 @@ __all__ = [
     "confidence",
     "design",
     "dynamics",
+    "load_model",
     "models",
     "ranges",
     "rank",
@@ -70,6 +76,47 @@ __all__ = [
     "tip",
     "tool_from_urdf",
 ]
+
+
+# (path, name) of every library load_model loaded, in order: what toolconf.dask's workers load
+# before they run anything.
+_LOADED: list = []
+
+
+def load_model(path: Union[str, "os.PathLike[str]"], name: Optional[str] = None) -> str:
+    """Loads a model library built by ``make model`` and returns the name every function takes
+    it by (the library's own, or ``name``): see ``toolconf._toolconf.load_model``. The library is
+    native code run with this interpreter's privileges: load only libraries you built.
+
+    Raises:
+        ValueError: one line naming the file and what is wrong with it.
+        TypeError: ``path`` is not a str or path-like, or ``name`` not a str.
+    """
+    loaded = _toolconf.load_model(path, name)
+    entry = (os.fspath(path), name)
+    if entry not in _LOADED:
+        _LOADED.append(entry)
+    return loaded
+
+
+def _ensure_loaded(entries) -> None:
+    """On a Dask worker: loads the client's libraries (a no-op for those already loaded)."""
+    for path, name in entries:
+        load_model(path, name)
+
+
+def _load_environment() -> None:
+    for entry in os.environ.get("TOOLCONF_MODEL_PATH", "").split(":"):
+        if not entry.strip():
+            continue
+        name, sep, path = entry.partition("=")
+        if sep and name and "/" not in name:
+            load_model(path, name)
+        else:
+            load_model(entry)
+
+
+_load_environment()
 
 
 if TYPE_CHECKING:

@@ -52,6 +52,11 @@ def models() -> dict[str, ModelInfo]:
     """The generated models: ``{name: {"title", "dof", "parameters", "equilibrium", "domains"}}``
     in registry order."""
 
+def load_model(path: Union[str, "os.PathLike[str]"], name: Optional[str] = None) -> str:
+    """Loads a model library built by ``make model`` (its OUT folder or the .so) next to the
+    built-in models and returns the name every function takes it by. Raises ``ValueError``
+    naming the file and what is wrong with it."""
+
 def dynamics(model: str, params: Params, state: npt.ArrayLike, control: npt.ArrayLike) -> npt.NDArray[np.float64]:
     """The robot's own rigid-body dynamics Ẋ = [q̇; q̈], M(q) q̈ + C(q, q̇) q̇ + g(q) = U with U the
     joint torques (for ``panda`` and ``ur5`` without the joint impedance of their plant): shape

@@ -24,6 +24,10 @@ and a bad row raises the same ``ValueError`` (the first bad row in row order).
 Workers run each block's episodes on rayon's threads: set ``RAYON_NUM_THREADS`` in the workers'
 environment to their share of the cores (``LocalCluster(..., env={"RAYON_NUM_THREADS": "1"})``
 with one thread per worker), or the processes of one machine compete for its cores.
+
+A model library loaded on the client (``toolconf.load_model``) is loaded on each worker before
+its first block, from the same path: on a cluster of several machines, that path must reach the
+same library on every one of them (a shared file system, or the same build at the same place).
 """
 
 import math
@@ -33,7 +37,7 @@ from typing import TYPE_CHECKING, Any, Literal, Optional
 
 import numpy as np
 
-from . import _toolconf
+from . import _LOADED, _ensure_loaded, _toolconf
 from ._tables import DATAFRAME_SOURCE, frame_columns
 
 if TYPE_CHECKING:
@@ -70,7 +74,8 @@ def _partition_length(frame) -> int:
     return len(frame)
 
 
-def _screen_partition(frame, task, first_row, screen, skip_bad_rows):
+def _screen_partition(frame, task, first_row, screen, skip_bad_rows, loaded):
+    _ensure_loaded(loaded)
     return _toolconf._screen_block(frame_columns(frame), task, first_row, screen,
                                    skip_bad_rows, DATAFRAME_SOURCE)
 
@@ -79,15 +84,18 @@ def _counts(block):
     return {key: value for key, value in block.items() if key != "kept"}
 
 
-def _episodes(block, task, objective, method):
+def _episodes(block, task, objective, method, loaded):
+    _ensure_loaded(loaded)
     return _toolconf._episodes(block, task, objective, method)
 
 
-def _kept_episodes(screened, task, objective, method):
+def _kept_episodes(screened, task, objective, method, loaded):
+    _ensure_loaded(loaded)
     return _toolconf._episodes(screened["kept"], task, objective, method)
 
 
-def _batch(model, params, task, perturbations, method, first_tool, episode_options):
+def _batch(model, params, task, perturbations, method, first_tool, episode_options, loaded):
+    _ensure_loaded(loaded)
     # The private twin of toolconf.simulate_batch: it also reads a task file sent as text.
     return _toolconf._simulate_batch(model, params, task, perturbations, method, first_tool,
                                      **episode_options)
@@ -170,6 +178,7 @@ def rank(
                          "(dask.dataframe.from_pandas(frame, npartitions=...)); toolconf.rank "
                          "takes a pandas DataFrame")
     client = _client(client)
+    loaded = tuple(_LOADED)
     given = task
     task = _toolconf._portable_task(task, screen, objective, method)
     parts = ddf.to_delayed()
@@ -181,7 +190,7 @@ def rank(
         return local_rank(ddf._meta, given, screen, objective, skip_bad_rows, method)
     first_rows = np.concatenate([[1], 1 + np.cumsum(lengths)[:-1]]).tolist()
     screened = client.compute([
-        delayed(_screen_partition)(p, task, first, screen, skip_bad_rows)
+        delayed(_screen_partition)(p, task, first, screen, skip_bad_rows, loaded)
         for p, first in zip(parts, first_rows)
     ])
     if screen is None:
@@ -194,13 +203,13 @@ def rank(
             warnings.warn(warning, UserWarning, stacklevel=2)
     if screen is None:
         _toolconf._merge_screens(counts, task, None, DATAFRAME_SOURCE)
-        simulated = [client.submit(_kept_episodes, s, task, objective, method) for s in screened]
+        simulated = [client.submit(_kept_episodes, s, task, objective, method, loaded) for s in screened]
     else:
         kept = _toolconf._merge_screens(counts, task, screen, DATAFRAME_SOURCE)
         n = len(kept["row"])
         per_block = episodes_per_task or max(1, math.ceil(n / (4 * _threads(client))))
         simulated = [
-            client.submit(_episodes, _slice(kept, a, b), task, objective, method)
+            client.submit(_episodes, _slice(kept, a, b), task, objective, method, loaded)
             for a, b in _blocks(n, per_block)
         ]
     return pandas.DataFrame(_toolconf._rank_table(client.gather(simulated)))
@@ -253,6 +262,7 @@ def simulate_batch(
     """
     tools_per_task = _per_block("tools_per_task", tools_per_task)
     client = _client(client)
+    loaded = tuple(_LOADED)
     task = _toolconf._portable_task(task, None, "free-energy", method)
     blocks, shape, dtype = _param_blocks(client, params, tools_per_task)
     # Everything but the tools' values is checked here, before the cluster runs anything: on
@@ -271,7 +281,7 @@ def simulate_batch(
     futures, first = [], 0
     for block, rows in blocks:
         futures.append(client.submit(_batch, model, block, task, perturbations, method, first,
-                                     episode_options))
+                                     episode_options, loaded))
         first += rows
     parts = _in_order(client, futures)
     return {key: (sum((p[key] for p in parts), []) if key == "error"

@@ -46,6 +46,12 @@ use toolconf::{Arm, TaskKind};
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Load a model library (the OUT folder of `make model`, or its .so) next to the built-in
+    /// models, NAME=PATH to load it under another name; repeatable. TOOLCONF_MODEL_PATH
+    /// (':'-separated) loads more. The library is native code run with your privileges: load
+    /// only libraries you built (docs/c-abi.md).
+    #[arg(long = "model-path", global = true, value_name = "PATH")]
+    model_path: Vec<String>,
 }
 
 #[derive(Subcommand)]
@@ -98,6 +104,11 @@ pub(crate) fn parse_task(s: &str) -> Result<TaskKind, String> {
 }
 
 pub fn run() -> ExitCode {
+    // Before the arguments are parsed: their model names may be a loaded library's.
+    if let Err(e) = load_model_libraries() {
+        errln!("toolconf: error: {e}");
+        return ExitCode::from(2);
+    }
     let cli = match parse() {
         Ok(cli) => cli,
         Err(code) => return code,
@@ -169,6 +180,39 @@ fn parse() -> Result<Cli, ExitCode> {
             Err(ExitCode::from(2))
         }
     }
+}
+
+/// Loads the model libraries `TOOLCONF_MODEL_PATH` names, then those of every `--model-path`
+/// (found by a scan of the arguments ahead of clap, which parses model names with the models
+/// there are), in order.
+fn load_model_libraries() -> Result<(), String> {
+    toolconf::loaded::load_environment().map_err(|e| e.to_string())?;
+    let mut args = std::env::args_os().skip(1);
+    while let Some(arg) = args.next() {
+        if arg == "--" {
+            break;
+        }
+        let value = if arg == "--model-path" {
+            match args.next() {
+                Some(v) => v,
+                // clap names the missing value.
+                None => break,
+            }
+        } else {
+            match arg.to_str().and_then(|a| a.strip_prefix("--model-path=")) {
+                Some(v) => v.into(),
+                None => continue,
+            }
+        };
+        let value = value.to_str().ok_or_else(|| {
+            format!(
+                "--model-path {}: is not valid UTF-8",
+                Clip(&value.to_string_lossy())
+            )
+        })?;
+        toolconf::loaded::load_entry(value).map_err(|e| format!("--model-path: {e}"))?;
+    }
+    Ok(())
 }
 
 /// The most characters of clap's message the one line keeps (it may repeat a long value).

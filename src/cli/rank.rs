@@ -112,7 +112,7 @@ fn progress(total: usize) -> ProgressBar {
 /// The parameter columns of the models present, in the models' order.
 fn parameter_columns(candidates: &[Candidate]) -> Vec<&'static str> {
     let mut columns = Vec::new();
-    for model in ModelKind::ALL {
+    for model in ModelKind::all() {
         if candidates.iter().any(|c| c.row.tool.model() == model) {
             for p in model.parameter_names() {
                 if !columns.contains(p) {

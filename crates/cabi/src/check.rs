@@ -85,7 +85,7 @@ where
     M: ArmModel<N, NX, NP, NZ>,
 {
     SVector::from_fn(|i, _| {
-        let (lo, hi) = M::TOOL_RULE.sample[i];
+        let (lo, hi) = M::tool_rule().sample[i];
         rng.uniform(lo, hi)
     })
 }
@@ -441,7 +441,7 @@ fn check_info<M, const N: usize, const NX: usize, const NP: usize, const NZ: usi
 where
     M: ArmModel<N, NX, NP, NZ>,
 {
-    let g = crate::info::generated(M::NAME).expect("the model's generated ModelInfo");
+    let g = crate::info::generated(M::name()).expect("the model's generated ModelInfo");
     let i = (e.model_info)();
     assert!(!i.is_null(), "model_info is NULL");
     // SAFETY: the library's metadata lives while it is loaded; the counts are its own.
@@ -567,7 +567,7 @@ where
     let x = M::equilibrium_state();
     let u = SVector::<f64, N>::zeros();
     let p = SVector::<f64, NP>::from_fn(|i, _| {
-        let (lo, hi) = M::TOOL_RULE.sample[i];
+        let (lo, hi) = M::tool_rule().sample[i];
         0.5 * (lo + hi)
     });
     const SENTINEL: f64 = 12345.0;
@@ -801,7 +801,7 @@ where
         assert!(logdet == SENTINEL && untouched(&buf2));
 
         // An invalid tool: the first parameter's domain broken.
-        let d = M::TOOL_RULE.domains[0];
+        let d = M::tool_rule().domains[0];
         let mut invalid = p;
         invalid[0] = if d.lo.is_finite() {
             d.lo - 1.0

@@ -167,14 +167,14 @@ pub fn task<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize
 where
     M: ArmModel<N, NX, NP, NZ>,
 {
-    let offered = crate::info::generated(M::NAME).map_or(&[][..], |g| g.tasks);
+    let offered = crate::info::generated(M::name()).map_or(&[][..], |g| g.tasks);
     match TaskKind::ALL.get(index as usize) {
         Some(kind) if offered.contains(kind) => Ok(*kind),
         _ => Err(fail(
             status::UNKNOWN_TASK,
             format_args!(
                 "{function}: task {index} is not one of model {}'s {} tasks (0 to {})",
-                M::NAME,
+                M::name(),
                 TaskKind::ALL.len(),
                 TaskKind::ALL.len().saturating_sub(1)
             ),
@@ -319,7 +319,7 @@ where
                 status::NO_TIP,
                 format_args!(
                     "{F}: model {} has no tip (its description gives no [tip])",
-                    M::NAME
+                    M::name()
                 ),
             )),
         }
@@ -351,7 +351,7 @@ where
                 status::NO_TIP,
                 format_args!(
                     "{F}: model {} has no tip (its description gives no [tip])",
-                    M::NAME
+                    M::name()
                 ),
             )),
         }

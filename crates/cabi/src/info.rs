@@ -160,13 +160,13 @@ impl Builder {
     }
 }
 
-/// Builds the metadata of model `M` from its generated `ModelInfo` (the one named `M::NAME`).
+/// Builds the metadata of model `M` from its generated `ModelInfo` (the one named `M::name()`).
 pub fn build<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>() -> InfoStorage
 where
     M: ArmModel<N, NX, NP, NZ>,
 {
-    let g =
-        generated(M::NAME).unwrap_or_else(|| panic!("no generated ModelInfo named {}", M::NAME));
+    let g = generated(M::name())
+        .unwrap_or_else(|| panic!("no generated ModelInfo named {}", M::name()));
     let mut b = Builder {
         strings: Vec::new(),
         lists: Vec::new(),

@@ -15,20 +15,22 @@ use super::{SensitivitiesN, TaskN, ToolN};
 pub trait ArmModel<const N: usize, const NX: usize, const NP: usize, const NZ: usize>:
     Copy + Debug + Default + Send + Sync + 'static
 {
-    /// The model's name (`generated::<name>`).
-    const NAME: &'static str;
+    /// The model's name (`generated::<name>`; a loaded model library's own, or the name it was
+    /// loaded under). Functions rather than constants, so that a model whose metadata is known
+    /// only at run time (a library loaded by toolconf's runtime) implements the trait too.
+    fn name() -> &'static str;
     /// The tool parameters in the order every function takes them.
-    const PARAMETER_NAMES: [&'static str; NP];
+    fn parameter_names() -> &'static [&'static str; NP];
     /// The equilibrium state X^e the model is linearised at.
-    const EQUILIBRIUM_STATE: [f64; NX];
+    fn equilibrium_state() -> SVector<f64, NX>;
     /// The equilibrium torque U^e.
-    const EQUILIBRIUM_CONTROL: [f64; N];
+    fn equilibrium_control() -> SVector<f64, N>;
     /// How many components of the tip a tip task uses (3; 2 for a planar arm, in its plane;
     /// the description's `[tip] components`): see [`TaskN`] for how they are stored.
-    const TIP_DIM: usize;
+    fn tip_dim() -> usize;
     /// Which tools are valid (each parameter's domain, constraints across them) and the box
     /// random tools are drawn from: the model description's, `generated::validity::<name>`.
-    const TOOL_RULE: generated::validity::ToolRule<NP>;
+    fn tool_rule() -> &'static generated::validity::ToolRule<NP>;
 
     /// The parameter-only factors of [`ArmModel::dynamics`], computed once per tool.
     type DynamicsCoefficients: Copy + Debug + Send + Sync;
@@ -103,11 +105,6 @@ pub trait ArmModel<const N: usize, const NX: usize, const NP: usize, const NZ: u
     /// The model's paper-style task: its own goals (`derive/models/<name>.toml`) and the
     /// paper's precisions (`derive/tasks.toml`).
     fn paper_task(kind: TaskKind) -> TaskN<N>;
-
-    /// X^e as a vector.
-    fn equilibrium_state() -> SVector<f64, NX> {
-        SVector::from(Self::EQUILIBRIUM_STATE)
-    }
 }
 
 /// Implements [`ArmModel`] for a marker type by forwarding to `toolconf_generated::$module`.
@@ -125,16 +122,37 @@ macro_rules! arm_model {
                 { generated::$module::STATE_DIM + generated::$module::DOF },
             > for $marker
         {
-            const NAME: &'static str = generated::$module::NAME;
-            const PARAMETER_NAMES: [&'static str; generated::$module::PARAMETER_COUNT] =
-                generated::$module::PARAMETER_NAMES;
-            const EQUILIBRIUM_STATE: [f64; generated::$module::STATE_DIM] =
-                generated::$module::EQUILIBRIUM_STATE;
-            const EQUILIBRIUM_CONTROL: [f64; generated::$module::DOF] =
-                generated::$module::EQUILIBRIUM_CONTROL;
-            const TIP_DIM: usize = generated::$module::TIP_DIM;
-            const TOOL_RULE: generated::validity::ToolRule<{ generated::$module::PARAMETER_COUNT }> =
-                generated::validity::$module::RULE;
+            #[inline]
+            fn name() -> &'static str {
+                generated::$module::NAME
+            }
+
+            #[inline]
+            fn parameter_names() -> &'static [&'static str; generated::$module::PARAMETER_COUNT] {
+                &generated::$module::PARAMETER_NAMES
+            }
+
+            #[inline]
+            fn equilibrium_state() -> SVector<f64, { generated::$module::STATE_DIM }> {
+                SVector::from(generated::$module::EQUILIBRIUM_STATE)
+            }
+
+            #[inline]
+            fn equilibrium_control() -> SVector<f64, { generated::$module::DOF }> {
+                SVector::from(generated::$module::EQUILIBRIUM_CONTROL)
+            }
+
+            #[inline]
+            fn tip_dim() -> usize {
+                generated::$module::TIP_DIM
+            }
+
+            #[inline]
+            fn tool_rule(
+            ) -> &'static generated::validity::ToolRule<{ generated::$module::PARAMETER_COUNT }> {
+                &generated::validity::$module::RULE
+            }
+
             type DynamicsCoefficients = generated::$module::DynamicsCoefficients;
             type JacobianCoefficients = generated::$module::DynamicsJacobianCoefficients;
 

@@ -29,7 +29,7 @@ pub fn observe<const N: usize, const NX: usize>(
 
 /// The tool tip's kinematics at the measured joint positions q: y(q) in the base frame and
 /// J(q) = ∂y/∂q (the generated `tip::<model>`), of which a tip task uses the first `dim`
-/// components ([`crate::ArmModel::TIP_DIM`]), and, where the task reads the tip's acceleration,
+/// components ([`crate::ArmModel::tip_dim`]), and, where the task reads the tip's acceleration,
 /// J̇(q, q̇) q̇ (the generated `tip_bias::<model>`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TipKinematics<const N: usize> {
@@ -54,7 +54,7 @@ impl<const N: usize> TipKinematics<N> {
         M::tip(q, p).map(|(position, jacobian)| Self {
             position,
             jacobian,
-            dim: M::TIP_DIM,
+            dim: M::tip_dim(),
             bias: None,
         })
     }
@@ -154,7 +154,7 @@ where
         })),
         _ => Err(Error::NoTip {
             kind,
-            model: M::NAME,
+            model: M::name(),
         }),
     }
 }

@@ -52,8 +52,8 @@ pub use arm_controller::{ArmController, Command, RATE_HZ};
 pub use arm_model::*;
 pub use confidence::{control_confidence, logdet_of, ControlConfidenceN, ValidatedTaskN};
 pub use controller::{
-    control_of, observe, observe_tool, observe_with_tip, tip_kinematics,
-    tip_parameters, ActiveInferenceN, ObservationN, TipKinematics, TipObserver,
+    control_of, observe, observe_tool, observe_with_tip, tip_kinematics, tip_parameters,
+    ActiveInferenceN, ObservationN, TipKinematics, TipObserver,
 };
 pub use error::{Error, PrecisionKeys, PrecisionProblem};
 pub use generated::{Read, TaskKind, Term, TERMS};

@@ -14,7 +14,7 @@ use super::ValidatedTaskN;
 /// task 3 θ and θ̇); the goal of the control's own term is zero (η^U = 0).
 ///
 /// A term read from the tool's tip ([`Read::Tip`]: y, ẏ) has the tip's `d` components
-/// ([`crate::ArmModel::TIP_DIM`]: 3, 2 for a planar arm), stored padded in the N slots: its goal in the
+/// ([`crate::ArmModel::tip_dim`]: 3, 2 for a planar arm), stored padded in the N slots: its goal in the
 /// first d rows and zeros after, its precision in the upper-left d × d block and zeros elsewhere
 /// (as its generated sensitivity J ∂θ/∂U has zero rows after the d-th; derive/tasks.toml, `J`).
 /// Every sum the controller and Π^U form is then the same for joint and tip terms, on the stack,

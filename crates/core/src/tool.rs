@@ -20,7 +20,7 @@ use super::ArmModel;
 /// 1–2, [I O](A²∂X/∂U + AB) = I in task 3). The formulas are `derive/tasks.toml`'s.
 pub type SensitivitiesN<const N: usize> = generated::TaskSensitivities<N>;
 
-/// One tool of model `M`: its parameters, valid by the model's rule ([`ArmModel::TOOL_RULE`])
+/// One tool of model `M`: its parameters, valid by the model's rule ([`ArmModel::tool_rule`])
 /// and within [`crate::validate::TOOL_PARAMETER`].
 ///
 /// The parameters are private so that every `ToolN` has passed [`ToolN::new`].
@@ -54,8 +54,8 @@ impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> ToolN
 where
     M: ArmModel<N, NX, NP, NZ>,
 {
-    /// Validates and builds a tool from its parameters in [`ArmModel::PARAMETER_NAMES`] order,
-    /// against the model's rule ([`ArmModel::TOOL_RULE`], from its description through the
+    /// Validates and builds a tool from its parameters in [`ArmModel::parameter_names`] order,
+    /// against the model's rule ([`ArmModel::tool_rule`], from its description through the
     /// generated `validity` module): a value outside its parameter's domain is an
     /// [`Error::InvalidParameter`] naming it (domain "> 0": NaN, ±∞, values ≤ 0, and values
     /// outside [`crate::validate::TOOL_PARAMETER`], where the generated arithmetic is not known
@@ -63,10 +63,10 @@ where
     /// derivation keeps within ±1e6), a broken constraint across the parameters an
     /// [`Error::ToolConstraint`]. No allocation: tools are checked in bulk.
     pub fn new(params: [f64; NP]) -> Result<Self, Error> {
-        let rule = &M::TOOL_RULE;
+        let rule = &M::tool_rule();
         // A "> 0" domain within TOOL_PARAMETER first: that also refuses NaN, ±∞ and values ≤ 0,
         // so a domain the rule finds broken below is always another kind.
-        let named = M::PARAMETER_NAMES
+        let named = M::parameter_names()
             .into_iter()
             .zip(params)
             .zip(&rule.domains);
@@ -79,7 +79,7 @@ where
             Ok(()) => {}
             Err(Violation::Domain { index, value }) => {
                 return Err(Error::ParameterOutOfDomain {
-                    name: M::PARAMETER_NAMES[index],
+                    name: M::parameter_names()[index],
                     value,
                     domain: rule.domains[index].rule,
                 });
@@ -109,12 +109,12 @@ where
 
     /// The model's name.
     pub fn model_name(&self) -> &'static str {
-        M::NAME
+        M::name()
     }
 
     /// (name, value) of every parameter, in order.
     pub fn named_parameters(&self) -> [(&'static str, f64); NP] {
-        core::array::from_fn(|i| (M::PARAMETER_NAMES[i], self.params[i]))
+        core::array::from_fn(|i| (M::parameter_names()[i], self.params[i]))
     }
 
     /// Ẋ = f(X, U; p).
@@ -161,7 +161,7 @@ where
     M: ArmModel<N, NX, NP, NZ>,
 {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}({self})", M::NAME)
+        write!(f, "{}({self})", M::name())
     }
 }
 

@@ -37,6 +37,7 @@ pub mod error;
 pub use toolconf_generated as generated;
 pub use toolconf_generated::for_each_model;
 pub mod integrate;
+pub mod loaded;
 pub mod model;
 pub mod mpc;
 /// Result files, by the one rule the command line, the reports and `make crate` share: the crate

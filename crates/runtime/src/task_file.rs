@@ -390,9 +390,9 @@ impl TaskSpec {
             let Some(given) = &self.precision[term.index()] else {
                 continue;
             };
-            let d = term_components(term, N, M::TIP_DIM);
+            let d = term_components(term, N, M::tip_dim());
             task.precision[term.index()] = match given {
-                PrecisionSpec::Scalar(s) => term_identity::<N>(term, M::TIP_DIM) * *s,
+                PrecisionSpec::Scalar(s) => term_identity::<N>(term, M::tip_dim()) * *s,
                 PrecisionSpec::Matrix(rows) => {
                     if rows.len() != d {
                         return Err(self.error(
@@ -400,7 +400,7 @@ impl TaskSpec {
                             format!(
                                 "a {0}×{0} matrix, but {term} of model {1} has {d} components",
                                 rows.len(),
-                                M::NAME
+                                M::name()
                             ),
                         ));
                     }
@@ -451,7 +451,7 @@ impl TaskSpec {
     }
 
     /// A goal of `term` for model `M`: N values for a joint term, the tip's
-    /// [`ArmModel::TIP_DIM`] for a tip term, padded with zeros ([`TaskN`]).
+    /// [`ArmModel::tip_dim`] for a tip term, padded with zeros ([`TaskN`]).
     fn term_vector<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
         &self,
         term: Term,
@@ -464,7 +464,7 @@ impl TaskSpec {
         if !matches!(term.read(), crate::generated::Read::Tip { .. }) {
             return self.vector::<M, N, NX, NP, NZ>(key, v);
         }
-        let d = term_components(term, N, M::TIP_DIM);
+        let d = term_components(term, N, M::tip_dim());
         if v.len() != d {
             return Err(self.error(
                 key,
@@ -472,7 +472,7 @@ impl TaskSpec {
                     "{} values {}, but the tip of model {} has {d} components ({})",
                     v.len(),
                     ShortList(v),
-                    M::NAME,
+                    M::name(),
                     crate::registry::AXES[..d.min(3)].join(", ")
                 ),
             ));
@@ -495,7 +495,7 @@ impl TaskSpec {
                     "{} values {}, but model {} has {N} joints",
                     v.len(),
                     ShortList(v),
-                    M::NAME
+                    M::name()
                 ),
             ));
         }

@@ -213,7 +213,7 @@ impl UrdfTool {
 /// The generated models whose tool is a URDF tool at a flange (their parameters are the row's
 /// `tool_mass`, ...: `panda`, `ur5`).
 pub fn flange_models() -> Vec<&'static str> {
-    crate::registry::ModelKind::ALL
+    crate::registry::ModelKind::all()
         .iter()
         .filter(|m| m.parameter_names().contains(&"tool_mass"))
         .map(|m| m.name())

@@ -227,14 +227,14 @@ fn csv_error(e: &csv::Error) -> (Option<u64>, String) {
 fn known_key(key: &str) -> bool {
     key == "name"
         || key == "model"
-        || ModelKind::ALL
+        || ModelKind::all()
             .iter()
             .any(|m| m.parameter_names().contains(&key))
 }
 
 fn known_keys() -> String {
     let mut keys = vec!["name", "model"];
-    for m in ModelKind::ALL {
+    for m in ModelKind::all() {
         for p in m.parameter_names() {
             if !keys.contains(p) {
                 keys.push(p);
@@ -244,12 +244,12 @@ fn known_keys() -> String {
     keys.join(", ")
 }
 
-/// Every model's parameter keys, each once, in [`ModelKind::ALL`] order.
+/// Every model's parameter keys, each once, in [`ModelKind::all`] order.
 fn parameter_keys() -> &'static [&'static str] {
     static KEYS: std::sync::OnceLock<Vec<&'static str>> = std::sync::OnceLock::new();
     KEYS.get_or_init(|| {
         let mut keys = Vec::new();
-        for m in ModelKind::ALL {
+        for m in ModelKind::all() {
             for &p in m.parameter_names() {
                 if !keys.contains(&p) {
                     keys.push(p);

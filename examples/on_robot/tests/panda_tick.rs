@@ -36,7 +36,7 @@ fn one_tick_of_the_c_example() {
     let task = Panda::paper_task(TaskKind::Position);
     let mut controller = PandaController::new(&tool, &task, 1.0, [0.1; 7], 1000.0).unwrap();
     // The equilibrium, joint i 0.01·(i+1) rad off it and moving at 0.05·(i−3) rad/s.
-    let x_e = Panda::EQUILIBRIUM_STATE;
+    let x_e = Panda::equilibrium_state();
     let mut state = [0.0; 14];
     for i in 0..7 {
         state[i] = x_e[i] + 0.01 * (i + 1) as f64;

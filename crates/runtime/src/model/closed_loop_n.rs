@@ -11,8 +11,7 @@ use crate::integrate::{
 };
 use crate::Error;
 use toolconf_core::{
-    observe_tool, reads_tip, tip_parameters, ObservationN, TipKinematics,
-    TipObserver,
+    observe_tool, reads_tip, tip_parameters, ObservationN, TipKinematics, TipObserver,
 };
 
 /// A grid state whose magnitude passes this is a diverging simulation, not a result.
@@ -183,7 +182,11 @@ where
 fn subtract_tip_gains<P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
     tip: &TipObserver<NP>,
     x: &SVector<f64, NX>,
-    (f_x, f_u, q_ddot): (&SMatrix<f64, NX, NX>, &SMatrix<f64, NX, N>, Option<SVector<f64, N>>),
+    (f_x, f_u, q_ddot): (
+        &SMatrix<f64, NX, NX>,
+        &SMatrix<f64, NX, N>,
+        Option<SVector<f64, N>>,
+    ),
     gains: &[SMatrix<f64, N, N>; TERMS],
     du_dx: &mut SMatrix<f64, N, NX>,
     du_du: &mut SMatrix<f64, N, N>,
@@ -262,7 +265,8 @@ where
     P: ArmModel<N, NX, NP, NZ>,
 {
     let tip = |q: &SVector<f64, N>, q_dot: &SVector<f64, N>| {
-        let t = TipKinematics::of::<P, NX, NP, NZ>(q, p)?.with_bias::<P, NX, NP, NZ>(q, q_dot, p)?;
+        let t =
+            TipKinematics::of::<P, NX, NP, NZ>(q, p)?.with_bias::<P, NX, NP, NZ>(q, q_dot, p)?;
         Some((t.pad(&(t.jacobian * a)), t.pad(&t.bias?)))
     };
     let difference = |column: &dyn Fn(usize, f64) -> Option<SVector<f64, N>>, h: f64| {
@@ -548,7 +552,7 @@ where
     P: ArmModel<N, NX, NP, NZ>,
 {
     run_episode::<M, P, N, NX, NP, NZ>(tool, task, options)
-        .map_err(|f| ModelSimulationError::named(f, || format!("{}({tool})", M::NAME)))
+        .map_err(|f| ModelSimulationError::named(f, || format!("{}({tool})", M::name())))
 }
 
 /// The episode: the closed loop integrated on the output grid, the metrics accumulated (and the
@@ -581,7 +585,7 @@ where
 
     let mut trajectory = options.record_trajectory.then(|| TrajectoryN {
         t: Vec::with_capacity(grid.len()),
-        tip_dim: reads_tip(task.kind).then_some(P::TIP_DIM),
+        tip_dim: reads_tip(task.kind).then_some(P::tip_dim()),
         ..TrajectoryN::default()
     });
     let mut task_error = 0.0;

@@ -163,7 +163,7 @@ where
     P: ArmModel<N, NX, NP, NZ>,
 {
     run::<M, P, N, NX, NP, NZ>(tool, task, options, mpc_options)
-        .map_err(|f| MpcSimulationError::named(f, || format!("{}({tool})", M::NAME)))
+        .map_err(|f| MpcSimulationError::named(f, || format!("{}({tool})", M::name())))
 }
 
 fn run<M, P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(

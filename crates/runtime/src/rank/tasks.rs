@@ -18,6 +18,8 @@ pub use crate::registry::{AnyEpisode, Linearisation, TaskTrace, TrajectoryTable}
 pub struct ModelTasks {
     pub kind: TaskKind,
     bound: Vec<Result<Arc<dyn BoundTask>, TaskFileError>>,
+    /// What a model registered after the task was bound (a library loaded meanwhile) gets.
+    late: TaskFileError,
 }
 
 /// `spec` bound to `model`: its goals and precisions checked against the model, then its
@@ -45,11 +47,18 @@ impl ModelTasks {
         Self {
             kind: spec.kind,
             bound: models().iter().map(|m| bind(*m, spec)).collect(),
+            late: spec.error(
+                "model",
+                "the model was loaded after this task was read: read the task again".into(),
+            ),
         }
     }
 
     fn bound(&self, model: ModelKind) -> Result<&dyn BoundTask, &TaskFileError> {
-        self.bound[model.index()].as_deref()
+        match self.bound.get(model.index()) {
+            Some(bound) => bound.as_deref(),
+            None => Err(&self.late),
+        }
     }
 
     /// The bound task of `tool`'s model, or the error saying why the task does not fit it.

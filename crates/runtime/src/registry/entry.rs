@@ -29,9 +29,10 @@ const MIN_TOOLS_PER_THREAD: usize = 256;
 /// Below this many states a batch of rigid-body dynamics runs on one thread.
 const MIN_STATES_PER_THREAD: usize = 512;
 
-/// Model `M` as a [`Model`]: `index` is its place in the generated registry.
-pub(super) struct Generated<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> {
-    index: usize,
+/// Model `M` as a [`Model`], with its metadata: a generated model's entry of
+/// `generated::MODELS`, or a loaded model library's (`crate::loaded`).
+pub(crate) struct Generated<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> {
+    info: &'static ModelInfo,
     model: PhantomData<M>,
 }
 
@@ -40,9 +41,9 @@ impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>
 where
     M: ArmModel<N, NX, NP, NZ>,
 {
-    pub(super) const fn new() -> Self {
+    pub(crate) const fn new(info: &'static ModelInfo) -> Self {
         Self {
-            index: super::registry_index(M::NAME),
+            info,
             model: PhantomData,
         }
     }
@@ -56,9 +57,9 @@ where
     M: ArmModel<N, NX, NP, NZ>,
 {
     let params: [f64; NP] = params.try_into().map_err(|_| Error::ParameterCount {
-        model: M::NAME,
+        model: M::name(),
         expected: NP,
-        names: M::PARAMETER_NAMES.join(","),
+        names: M::parameter_names().join(","),
         found: params.len(),
     })?;
     Ok(ToolN::new(params)?)
@@ -70,7 +71,7 @@ where
     M: ArmModel<N, NX, NP, NZ>,
 {
     fn info(&self) -> &'static ModelInfo {
-        &generated::MODELS[self.index]
+        self.info
     }
 
     fn check_tool(&self, params: &[f64]) -> Result<(), Error> {
@@ -166,7 +167,7 @@ where
                 let Some((y, j)) = tool.tip(&qi) else {
                     return Err(BatchError::Input(format!(
                         "model {} has no tip (its description gives none)",
-                        M::NAME
+                        M::name()
                     )));
                 };
                 if !(y.iter().chain(j.iter()).all(|v| v.is_finite())) {
@@ -210,7 +211,7 @@ where
                 let Some(b) = M::tip_bias(&qi, &vi, &tool.params()) else {
                     return Err(BatchError::Input(format!(
                         "model {} has no tip (its description gives none)",
-                        M::NAME
+                        M::name()
                     )));
                 };
                 if !b.iter().all(|v| v.is_finite()) {
@@ -339,7 +340,7 @@ where
             .into_iter()
             .filter_map(|term| {
                 // A tip term's sensitivity J ∂θ/∂U: its first TIP_DIM rows (the rest are padding).
-                let own = toolconf_core::term_components(term, N, M::TIP_DIM);
+                let own = toolconf_core::term_components(term, N, M::tip_dim());
                 s.of(term).map(|m| {
                     (
                         term.sensitivity_name(),
@@ -464,7 +465,7 @@ where
     }
     // A term the task does not use has no sensitivity (the command line leaves it out too).
     let used = Term::ALL.map(|t| t.has_sensitivity() && kind.uses(t));
-    let mut out = allocate(k, N, NX, used, M::TIP_DIM)?;
+    let mut out = allocate(k, N, NX, used, M::tip_dim())?;
     let chunk = (CHUNK_BYTES / std::mem::size_of::<Result<One<N, NX>, Error>>()).max(1);
     for (c, tools) in params.chunks(chunk * NP).enumerate() {
         let mut results: Vec<Result<One<N, NX>, Error>> = room(tools.len() / NP, tools.len() / NP)?;

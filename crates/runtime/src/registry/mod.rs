@@ -16,12 +16,13 @@
 //! * [`AnyTool`] is a validated tool of any model: its [`ModelKind`] and its parameters, stored
 //!   inline (no allocation per tool).
 
-mod entry;
+pub(crate) mod entry;
 mod results;
 
 use std::fmt;
 use std::str::FromStr;
-use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, OnceLock};
 
 use crate::closed_loop::EpisodeOptions;
 use crate::generated;
@@ -147,7 +148,7 @@ macro_rules! registry {
                 { generated::$module::STATE_DIM },
                 { generated::$module::PARAMETER_COUNT },
                 { generated::$module::STATE_DIM + generated::$module::DOF },
-            >::new(),
+            >::new(&generated::MODELS[registry_index($name)]),
         )*];
 
         /// Handles of the generated models by their marker names (`ModelKind::Arm2`).
@@ -163,9 +164,35 @@ macro_rules! registry {
 
 crate::for_each_model!(registry);
 
-/// Every model, in registry order: the one place that lists them.
-pub fn models() -> &'static [&'static dyn Model] {
-    &MODELS
+/// The most models one process loads at run time ([`crate::loaded`]).
+pub const MAX_LOADED: usize = 64;
+
+/// The models registered at run time (loaded model libraries), after the generated ones: a
+/// slot is filled once, then [`LOADED_COUNT`] counts it, so a reader that sees the count sees
+/// the model.
+static LOADED: [OnceLock<&'static dyn Model>; MAX_LOADED] = [const { OnceLock::new() }; MAX_LOADED];
+static LOADED_COUNT: AtomicUsize = AtomicUsize::new(0);
+static REGISTERING: Mutex<()> = Mutex::new(());
+
+/// Registers a model made at run time after every model there is; its handle.
+pub(crate) fn register(model: &'static dyn Model) -> Result<ModelKind, String> {
+    let _one_at_a_time = REGISTERING.lock().unwrap_or_else(|p| p.into_inner());
+    let i = LOADED_COUNT.load(Ordering::Acquire);
+    if i >= MAX_LOADED {
+        return Err(format!(
+            "{MAX_LOADED} models are loaded already, the most one process holds"
+        ));
+    }
+    if LOADED[i].set(model).is_err() {
+        return Err("the registry's slot was filled meanwhile".into());
+    }
+    LOADED_COUNT.store(i + 1, Ordering::Release);
+    Ok(ModelKind((MODELS.len() + i) as u16))
+}
+
+/// Every model, in registry order: the generated ones, then those loaded at run time.
+pub fn models() -> Vec<&'static dyn Model> {
+    ModelKind::all().into_iter().map(ModelKind::model).collect()
 }
 
 /// A model by name (case and surrounding blanks ignored), or the error naming the models there
@@ -206,8 +233,14 @@ const fn const_eq(a: &str, b: &str) -> bool {
 }
 
 impl ModelKind {
+    /// Every model: the generated ones ([`ModelKind::BUILT_IN`]), then those loaded at run time.
+    pub fn all() -> Vec<ModelKind> {
+        let count = MODELS.len() + LOADED_COUNT.load(Ordering::Acquire);
+        (0..count).map(|i| ModelKind(i as u16)).collect()
+    }
+
     /// Every generated model, in registry order.
-    pub const ALL: [ModelKind; generated::MODEL_NAMES.len()] = {
+    pub const BUILT_IN: [ModelKind; generated::MODEL_NAMES.len()] = {
         let mut all = [ModelKind(0); generated::MODEL_NAMES.len()];
         let mut i = 0;
         while i < all.len() {
@@ -220,19 +253,28 @@ impl ModelKind {
     /// The paper's 2-link arm (`arm2`): the model where none is named (a tools file without a
     /// `model` column, `select` without `--models`), whose tools the typed 2-link API
     /// ([`crate::Arm`], [`crate::closed_loop::Plant`]) runs.
-    pub const PAPER_ARM: ModelKind =
-        ModelKind::builtin(<crate::model::Arm2 as ArmModel<2, 4, 4, 6>>::NAME);
+    pub const PAPER_ARM: ModelKind = ModelKind::builtin(generated::arm2::NAME);
 
     const fn builtin(name: &str) -> Self {
         ModelKind(registry_index(name) as u16)
     }
 
-    /// The handle of the model `M` implements.
+    /// The handle of the model `M` implements (registered: every generated model is, and a
+    /// loaded one from its loading on).
     pub fn of<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>() -> Self
     where
         M: ArmModel<N, NX, NP, NZ>,
     {
-        Self::builtin(M::NAME)
+        let name = M::name();
+        Self::all()
+            .into_iter()
+            .find(|k| k.name() == name)
+            .expect("a model's marker is used only once the model is registered")
+    }
+
+    /// Whether the model was loaded at run time (a model library), not generated.
+    pub fn is_loaded(self) -> bool {
+        self.index() >= MODELS.len()
     }
 
     /// Its place in [`models`].
@@ -242,11 +284,16 @@ impl ModelKind {
 
     /// The model's operations.
     pub fn model(self) -> &'static dyn Model {
-        models()[self.index()]
+        match MODELS.get(self.index()) {
+            Some(model) => *model,
+            None => *LOADED[self.index() - MODELS.len()]
+                .get()
+                .expect("a handle is made only for a registered model"),
+        }
     }
 
     pub fn info(self) -> &'static ModelInfo {
-        &generated::MODELS[self.index()]
+        self.model().info()
     }
 
     /// The generated module's name.
@@ -348,16 +395,17 @@ impl FromStr for ModelKind {
 
     fn from_str(s: &str) -> Result<Self, String> {
         let s = s.trim().to_ascii_lowercase();
-        ModelKind::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| {
-                format!(
-                    "unknown model '{}': expected one of {}",
-                    crate::display::Clip(&s),
-                    generated::MODEL_NAMES.join(", ")
-                )
-            })
+        let all = ModelKind::all();
+        all.iter().copied().find(|m| m.name() == s).ok_or_else(|| {
+            let names: Vec<&str> = all.iter().map(|m| m.name()).collect();
+            format!(
+                "unknown model '{}': expected one of {} (or a model library loaded with \
+                 --model-path, {} or toolconf.load_model)",
+                crate::display::Clip(&s),
+                names.join(", "),
+                crate::loaded::ENVIRONMENT
+            )
+        })
     }
 }
 
@@ -408,7 +456,7 @@ impl AnyTool {
     where
         M: ArmModel<N, NX, NP, NZ>,
     {
-        if self.model.name() != M::NAME {
+        if self.model.name() != M::name() {
             return None;
         }
         ToolN::new(self.parameters().try_into().ok()?).ok()
@@ -458,7 +506,7 @@ mod tests {
     #[test]
     fn registry_order_is_the_generated_one() {
         assert_eq!(models().len(), generated::MODEL_NAMES.len());
-        for (i, kind) in ModelKind::ALL.into_iter().enumerate() {
+        for (i, kind) in ModelKind::BUILT_IN.into_iter().enumerate() {
             assert_eq!(kind.index(), i);
             assert_eq!(models()[i].info().name, generated::MODEL_NAMES[i]);
             assert_eq!(kind.name(), generated::MODEL_NAMES[i]);

@@ -1,0 +1,476 @@
+//! Models loaded at run time (crates/runtime/src/loaded/, `--model-path`,
+//! `TOOLCONF_MODEL_PATH`): refusals of what is not a model library, each one line and status 2;
+//! and, with the libraries `make loaded-models-test` builds (every model of the repository,
+//! `make model IR=generated/<model>.json`), the loaded models equal the built-in ones bit for
+//! bit through every operation of the registry and every subcommand.
+//!
+//! The tests that need the libraries are ignored by plain `cargo test`: `make
+//! loaded-models-test` (part of `make test`) builds them into a temporary folder and runs them
+//! with `TOOLCONF_TEST_LIBRARIES` naming it. Without it they fail, never pass.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use toolconf::closed_loop::EpisodeOptions;
+use toolconf::loaded;
+use toolconf::registry::{ModelKind, Rows};
+use toolconf::task_file::TaskSpec;
+
+const BIN: &str = env!("CARGO_BIN_EXE_toolconf");
+
+/// The folder of model libraries, one sub-folder per model (`<folder>/<model>/`).
+fn libraries() -> PathBuf {
+    match std::env::var_os("TOOLCONF_TEST_LIBRARIES") {
+        Some(p) => PathBuf::from(p),
+        None => panic!("TOOLCONF_TEST_LIBRARIES is not set: run `make loaded-models-test`"),
+    }
+}
+
+/// Valid tools of `model`, drawn from its sample box (each checked by its rule).
+fn tools(model: ModelKind, count: usize, seed: u64) -> Vec<Vec<f64>> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut out = Vec::new();
+    for _ in 0..10_000 {
+        let p: Vec<f64> = model
+            .sample_box()
+            .iter()
+            .map(|&(lo, hi)| {
+                if lo == hi {
+                    lo
+                } else {
+                    rng.random_range(lo..hi)
+                }
+            })
+            .collect();
+        if model.model().check_tool(&p).is_ok() {
+            out.push(p);
+        }
+        if out.len() == count {
+            return out;
+        }
+    }
+    panic!("{model}: no {count} valid tools in 10 000 draws");
+}
+
+/// `value`'s Debug text with the loaded model's name as the built-in one's: equal texts are
+/// equal bits (Rust prints every f64 so that it reads back to the same bits; -0.0 and NaN
+/// print as themselves).
+fn text(value: impl std::fmt::Debug, loaded: ModelKind, builtin: ModelKind) -> String {
+    format!("{value:?}").replace(loaded.name(), builtin.name())
+}
+
+/// Compares one operation on both models, counting the comparisons.
+struct Same {
+    builtin: ModelKind,
+    loaded: ModelKind,
+    compared: usize,
+}
+
+impl Same {
+    fn check(&mut self, what: &str, b: impl std::fmt::Debug, l: impl std::fmt::Debug) {
+        let (b, l) = (
+            text(b, self.builtin, self.builtin),
+            text(l, self.loaded, self.builtin),
+        );
+        assert_eq!(b, l, "{}: {what}: the loaded model differs", self.builtin);
+        self.compared += 1;
+    }
+}
+
+/// Every operation of the registry ([`toolconf::registry::Model`], [`toolconf::registry::
+/// BoundTask`]) on the built-in model and on its library, loaded as `<model>_loaded`.
+fn compare(builtin: ModelKind, library: &Path) -> usize {
+    let name = format!("{}_loaded", builtin.name());
+    let loaded = loaded::load(library, Some(&name)).unwrap_or_else(|e| panic!("{e}"));
+    assert!(loaded.is_loaded() && !builtin.is_loaded());
+    assert_eq!(loaded.name(), name);
+    let (bi, li) = (builtin.info(), loaded.info());
+    let mut same = Same {
+        builtin,
+        loaded,
+        compared: 0,
+    };
+    let mut info = li.clone();
+    info.name = bi.name;
+    same.check("metadata", bi, &info);
+    let tools = tools(builtin, 6, 7);
+    let (b, l) = (builtin.model(), loaded.model());
+    for kind in bi.tasks {
+        let spec = TaskSpec::builtin(*kind);
+        let (bt, lt) = (b.bind(&spec).unwrap(), l.bind(&spec).unwrap());
+        for p in &tools {
+            let what = format!("{kind:?} {p:?}");
+            same.check(&what, bt.logdet(p), lt.logdet(p));
+            same.check(&what, bt.logdet_and_gradient(p), lt.logdet_and_gradient(p));
+            same.check(&what, bt.linearisation(p), lt.linearisation(p));
+            same.check(&what, bt.simulate(p), lt.simulate(p));
+            same.check(&what, bt.trace(p), lt.trace(p));
+            let common = EpisodeOptions::default();
+            same.check(
+                &what,
+                b.paper_evaluation(p, *kind, &common),
+                l.paper_evaluation(p, *kind, &common),
+            );
+        }
+        let flat: Vec<f64> = tools.concat();
+        same.check("confidences", bt.confidences(&flat), lt.confidences(&flat));
+    }
+    // The robot's own dynamics and the tip at random states, one tool per state.
+    let (n, k) = (builtin.dof(), tools.len());
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let mut random =
+        |len: usize| -> Vec<f64> { (0..len).map(|_| rng.random_range(-1.5..1.5)).collect() };
+    let (x, u) = (random(k * 2 * n), random(k * n));
+    let params = tools.concat();
+    fn rows(data: &[f64], width: usize) -> Rows<'_> {
+        Rows {
+            data,
+            width,
+            shared: false,
+        }
+    }
+    let run = |m: ModelKind| {
+        let mut f = vec![0.0; k * 2 * n];
+        let r = m.model().rigid_body_dynamics(
+            k,
+            &rows(&params, params.len() / k),
+            &rows(&x, 2 * n),
+            &rows(&u, n),
+            &mut f,
+        );
+        let (mut y, mut j, mut bias) = (vec![0.0; k * 3], vec![0.0; k * 3 * n], vec![0.0; k * 3]);
+        let q: Vec<f64> = x.chunks(2 * n).flat_map(|s| s[..n].to_vec()).collect();
+        let q_dot: Vec<f64> = x.chunks(2 * n).flat_map(|s| s[n..].to_vec()).collect();
+        let t = m.model().tip(
+            k,
+            &rows(&params, params.len() / k),
+            &rows(&q, n),
+            &mut y,
+            &mut j,
+        );
+        let tb = m.model().tip_bias(
+            k,
+            &rows(&params, params.len() / k),
+            &rows(&q, n),
+            &rows(&q_dot, n),
+            &mut bias,
+        );
+        format!("{r:?} {f:?} {t:?} {y:?} {j:?} {tb:?} {bias:?}")
+    };
+    same.check("dynamics and tip", run(builtin), run(loaded));
+    same.compared
+}
+
+#[test]
+#[ignore = "needs the model libraries: make loaded-models-test"]
+fn every_model_loaded_equals_built_in_bit_for_bit() {
+    let folder = libraries();
+    let mut total = 0;
+    for builtin in ModelKind::BUILT_IN {
+        let compared = compare(builtin, &folder.join(builtin.name()));
+        eprintln!("{builtin}: {compared} results equal, bit for bit");
+        total += compared;
+    }
+    // Loading again is the same model; under a name taken, a refusal naming it.
+    let panda = folder.join("panda");
+    let again = loaded::load(&panda, Some("panda_loaded")).unwrap();
+    assert_eq!(again.name(), "panda_loaded");
+    let taken = loaded::load(&panda, None).unwrap_err().to_string();
+    assert!(taken.contains("'panda' is already built in"), "{taken}");
+    let again = loaded::load(&folder.join("ur5"), Some("panda_loaded"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        again.contains("'panda_loaded' is already loaded from"),
+        "{again}"
+    );
+    let bad = loaded::load(&panda, Some("Bad Name"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        bad.contains("the model name 'bad name' is not one"),
+        "{bad}"
+    );
+    eprintln!(
+        "{total} comparisons over {} models",
+        ModelKind::BUILT_IN.len()
+    );
+}
+
+/// The JSON of a subcommand's run with the timings taken out.
+fn json(args: &[&str], env: Option<(&str, &str)>) -> serde_json::Value {
+    let mut command = Command::new(BIN);
+    command.args(args).env_remove(loaded::ENVIRONMENT);
+    if let Some((k, v)) = env {
+        command.env(k, v);
+    }
+    let out = command.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut value: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    strip(&mut value);
+    value
+}
+
+/// Removes what differs between two runs of the same work: timings and file names.
+fn strip(value: &mut serde_json::Value) {
+    match value {
+        serde_json::Value::Object(map) => {
+            map.retain(|k, _| !k.contains("timing") && !k.ends_with("_file") && k != "elapsed_s");
+            map.values_mut().for_each(strip);
+        }
+        serde_json::Value::Array(items) => items.iter_mut().for_each(strip),
+        serde_json::Value::String(s) => *s = s.replace("panda_lib", "panda"),
+        _ => {}
+    }
+}
+
+#[test]
+#[ignore = "needs the model libraries: make loaded-models-test"]
+fn every_subcommand_runs_a_loaded_model_as_the_built_in_one() {
+    let library = libraries().join("panda");
+    let path = format!("panda_lib={}", library.display());
+    let dir = tempfile::tempdir().unwrap();
+    let tools = dir.path().join("tools.csv");
+    let text = std::fs::read_to_string("examples/tools/panda_tools.csv").unwrap();
+    std::fs::write(&tools, text.replace(",panda,", ",panda_lib,")).unwrap();
+    let tools = tools.to_str().unwrap();
+    let params = "0.5,0.01,0,0.08,0.002,0.002,0.001,0,0,0,0,0,0.16";
+    let design = dir.path().join("design.toml");
+    let design_text = std::fs::read_to_string("examples/design/panda_tool.toml").unwrap();
+    std::fs::write(&design, design_text).unwrap();
+    let design = design.to_str().unwrap();
+    let runs: [(Vec<&str>, Vec<&str>); 5] = [
+        (
+            vec![
+                "rank",
+                "--tools",
+                "examples/tools/panda_tools.csv",
+                "--json",
+            ],
+            vec!["rank", "--tools", tools, "--json"],
+        ),
+        (
+            vec!["simulate", "--model", "panda", "--params", params, "--json"],
+            vec![
+                "simulate",
+                "--model",
+                "panda_lib",
+                "--params",
+                params,
+                "--json",
+            ],
+        ),
+        (
+            vec![
+                "confidence",
+                "--model",
+                "panda",
+                "--params",
+                params,
+                "--json",
+            ],
+            vec![
+                "confidence",
+                "--model",
+                "panda_lib",
+                "--params",
+                params,
+                "--json",
+            ],
+        ),
+        (
+            vec![
+                "select", "--models", "panda", "--tools", "12", "--seed", "3", "--json",
+            ],
+            vec![
+                "select",
+                "--models",
+                "panda_lib",
+                "--tools",
+                "12",
+                "--seed",
+                "3",
+                "--json",
+            ],
+        ),
+        (
+            vec!["design", "--model", "panda", "--design", design, "--json"],
+            vec![
+                "design",
+                "--model",
+                "panda_lib",
+                "--design",
+                design,
+                "--json",
+            ],
+        ),
+    ];
+    for task in [
+        "examples/tasks/panda_touch_point.toml",
+        "examples/tasks/panda_push_off.toml",
+    ] {
+        for (builtin, with_library) in &runs {
+            if builtin[0] == "select" && task.ends_with("push_off.toml") {
+                continue;
+            }
+            // `rank` and `design` take a task file as --task; the others as --task-file.
+            let flag = match builtin[0] {
+                "rank" | "design" => "--task",
+                _ => "--task-file",
+            };
+            let task_args = [flag, task];
+            let b: Vec<&str> = builtin.iter().copied().chain(task_args).collect();
+            let l: Vec<&str> = with_library.iter().copied().chain(task_args).collect();
+            let expected = json(&b, None);
+            let by_flag: Vec<&str> = ["--model-path", path.as_str()]
+                .into_iter()
+                .chain(l.iter().copied())
+                .collect();
+            assert_eq!(json(&by_flag, None), expected, "{l:?} with --model-path");
+            let by_environment = json(&l, Some((loaded::ENVIRONMENT, &path)));
+            assert_eq!(
+                by_environment,
+                expected,
+                "{l:?} with {}",
+                loaded::ENVIRONMENT
+            );
+        }
+    }
+}
+
+/// Runs the command line with `--model-path entry` and returns (status, stderr).
+fn refused(entry: &str) -> (i32, String) {
+    let out = Command::new(BIN)
+        .args(["--model-path", entry, "confidence", "--model", "arm2"])
+        .args(["--params", "1,1,1,1", "--task", "position"])
+        .env_remove(loaded::ENVIRONMENT)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// A shared library compiled from `source` by the C compiler (`cc`, as make test needs).
+fn c_library(dir: &Path, name: &str, source: &str) -> PathBuf {
+    let c = dir.join(format!("{name}.c"));
+    std::fs::write(&c, source).unwrap();
+    let so = dir.join(format!("lib{name}.so"));
+    let status = Command::new("cc")
+        .args(["-shared", "-fPIC", "-o"])
+        .arg(&so)
+        .arg(&c)
+        .status()
+        .expect("cc (make test needs a C compiler)");
+    assert!(status.success());
+    so
+}
+
+#[test]
+fn what_is_not_a_model_library_is_one_line_and_status_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let text = d.join("notes.txt");
+    std::fs::write(&text, "not a library").unwrap();
+    let empty = d.join("empty");
+    std::fs::create_dir(&empty).unwrap();
+    let no_symbols = c_library(d, "plain", "int toolconf_something_else = 1;\n");
+    let other_version = c_library(
+        d,
+        "future",
+        "unsigned toolconf_abi_version(void) { return 99; }\n",
+    );
+    let half = c_library(
+        d,
+        "half",
+        "unsigned toolconf_abi_version(void) { return 1; }\n",
+    );
+    let truncated = d.join("libtruncated.so");
+    std::fs::write(&truncated, &std::fs::read(&half).unwrap()[..300]).unwrap();
+    let cases: [(String, &str); 9] = [
+        (d.join("missing").display().to_string(), "cannot read"),
+        (empty.display().to_string(), "holds no model library"),
+        (text.display().to_string(), "is not a shared library"),
+        ("/dev/null".into(), "is not a file or a folder"),
+        (
+            no_symbols.display().to_string(),
+            "no symbol toolconf_abi_version",
+        ),
+        (other_version.display().to_string(), "C ABI is version 99"),
+        (
+            half.display().to_string(),
+            "no symbol toolconf_tasks_fingerprint",
+        ),
+        (truncated.display().to_string(), "cannot be loaded"),
+        (format!("Bad Name={}", half.display()), "no symbol"),
+    ];
+    for (entry, why) in cases {
+        let (code, stderr) = refused(&entry);
+        assert_eq!(code, 2, "{entry}: {stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{entry}: {stderr}");
+        assert!(
+            stderr.starts_with("toolconf: error: --model-path: model library ")
+                && stderr.contains(why),
+            "{entry}: expected '{why}': {stderr}"
+        );
+        // The same refusal through the library, and from the environment variable.
+        let e = loaded::load_entry(&entry).unwrap_err().to_string();
+        assert!(e.contains(why), "{e}");
+        let out = Command::new(BIN)
+            .args([
+                "confidence",
+                "--model",
+                "arm2",
+                "--params",
+                "1,1,1,1",
+                "--task",
+                "position",
+            ])
+            .env(loaded::ENVIRONMENT, &entry)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2));
+        assert!(String::from_utf8_lossy(&out.stderr).contains(why));
+    }
+    // An unknown model still names the models there are, and how to load one.
+    let out = Command::new(BIN)
+        .args([
+            "confidence",
+            "--model",
+            "xarm7",
+            "--params",
+            "1",
+            "--task",
+            "position",
+        ])
+        .env_remove(loaded::ENVIRONMENT)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr.contains("unknown model 'xarm7'") && stderr.contains("--model-path"),
+        "{stderr}"
+    );
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::test_runner::Config::with_cases(
+        std::env::var("TOOLCONF_FUZZ_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(256)
+    ))]
+    /// Any text as a `--model-path` entry: a refusal in one line, never a panic.
+    #[test]
+    fn any_entry_is_loaded_or_refused_in_one_line(entry in "\\PC{0,40}") {
+        if let Err(e) = loaded::load_entry(&entry) {
+            let line = e.to_string();
+            proptest::prop_assert!(!line.contains('\n'), "{line}");
+        }
+    }
+}
