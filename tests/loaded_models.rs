@@ -245,88 +245,47 @@ fn every_subcommand_runs_a_loaded_model_as_the_built_in_one() {
     let design_text = std::fs::read_to_string("examples/design/panda_tool.toml").unwrap();
     std::fs::write(&design, design_text).unwrap();
     let design = design.to_str().unwrap();
-    let runs: [(Vec<&str>, Vec<&str>); 5] = [
-        (
-            vec![
-                "rank",
-                "--tools",
-                "examples/tools/panda_tools.csv",
-                "--json",
-            ],
-            vec!["rank", "--tools", tools, "--json"],
-        ),
-        (
-            vec!["simulate", "--model", "panda", "--params", params, "--json"],
-            vec![
-                "simulate",
-                "--model",
-                "panda_lib",
-                "--params",
-                params,
-                "--json",
-            ],
-        ),
-        (
-            vec![
-                "confidence",
-                "--model",
-                "panda",
-                "--params",
-                params,
-                "--json",
-            ],
-            vec![
-                "confidence",
-                "--model",
-                "panda_lib",
-                "--params",
-                params,
-                "--json",
-            ],
-        ),
-        (
-            vec![
-                "select", "--models", "panda", "--tools", "12", "--seed", "3", "--json",
-            ],
-            vec![
-                "select",
-                "--models",
-                "panda_lib",
-                "--tools",
-                "12",
-                "--seed",
-                "3",
-                "--json",
-            ],
-        ),
-        (
-            vec!["design", "--model", "panda", "--design", design, "--json"],
-            vec![
-                "design",
-                "--model",
-                "panda_lib",
-                "--design",
-                design,
-                "--json",
-            ],
-        ),
+    let runs: [Vec<&str>; 5] = [
+        vec!["rank", "--tools", "examples/tools/panda_tools.csv"],
+        vec!["simulate", "--model", "panda", "--params", params],
+        vec!["confidence", "--model", "panda", "--params", params],
+        vec![
+            "select", "--models", "panda", "--tools", "12", "--seed", "3",
+        ],
+        vec!["design", "--model", "panda", "--design", design],
     ];
+    // The same run on the library: its model's name, its tools file.
+    let on_library = |args: &[&str]| -> Vec<String> {
+        args.iter()
+            .map(|a| match *a {
+                "panda" => "panda_lib",
+                "examples/tools/panda_tools.csv" => tools,
+                a => a,
+            })
+            .map(String::from)
+            .collect()
+    };
     for task in [
         "examples/tasks/panda_touch_point.toml",
         "examples/tasks/panda_push_off.toml",
     ] {
-        for (builtin, with_library) in &runs {
+        for builtin in &runs {
             if builtin[0] == "select" && task.ends_with("push_off.toml") {
                 continue;
             }
+            let with_library = on_library(builtin);
             // `rank` and `design` take a task file as --task; the others as --task-file.
             let flag = match builtin[0] {
                 "rank" | "design" => "--task",
                 _ => "--task-file",
             };
-            let task_args = [flag, task];
+            let task_args = [flag, task, "--json"];
             let b: Vec<&str> = builtin.iter().copied().chain(task_args).collect();
-            let l: Vec<&str> = with_library.iter().copied().chain(task_args).collect();
+            let l: Vec<&str> = with_library
+                .iter()
+                .map(String::as_str)
+                .chain(task_args)
+                .collect();
             let expected = json(&b, None);
             let by_flag: Vec<&str> = ["--model-path", path.as_str()]
                 .into_iter()

@@ -40,6 +40,9 @@ pub(crate) struct Table<const N: usize, const NX: usize, const NP: usize> {
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
 pub struct Loaded<const N: usize, const NP: usize, const S: usize>;
 
+/// `toolconf_dynamics` and `toolconf_rigid_body_dynamics`: (X, U, params) in, Ẋ out.
+type XDot = unsafe extern "C" fn(*const f64, *const f64, *const f64, *mut f64) -> i32;
+
 /// The index of `kind` in the C ABI (`TaskKind::ALL`, the same list by the fingerprint).
 fn task_index(kind: TaskKind) -> u32 {
     TaskKind::ALL
@@ -138,8 +141,10 @@ impl<const N: usize, const NX: usize, const NP: usize> Table<N, NX, NP> {
         }
     }
 
-    fn dynamics(
+    /// Ẋ by one of the two exports of that shape (the plant's dynamics, or the rigid body's).
+    fn x_dot(
         &self,
+        export: XDot,
         x: &SVector<f64, NX>,
         u: &SVector<f64, N>,
         p: &SVector<f64, NP>,
@@ -147,9 +152,7 @@ impl<const N: usize, const NX: usize, const NP: usize> Table<N, NX, NP> {
         let mut out = SVector::<f64, NX>::zeros();
         // SAFETY: every pointer points to as many doubles as the ABI says (the sizes are the
         // library's, checked at loading); the library stays loaded for the process's life.
-        let code = unsafe {
-            (self.exports.dynamics)(x.as_ptr(), u.as_ptr(), p.as_ptr(), out.as_mut_ptr())
-        };
+        let code = unsafe { export(x.as_ptr(), u.as_ptr(), p.as_ptr(), out.as_mut_ptr()) };
         checked(code, out)
     }
 
@@ -163,7 +166,7 @@ impl<const N: usize, const NX: usize, const NP: usize> Table<N, NX, NP> {
             SMatrix::<f64, NX, NX>::zeros(),
             SMatrix::<f64, NX, N>::zeros(),
         );
-        // SAFETY: as in `dynamics`.
+        // SAFETY: as in `x_dot`.
         let code = unsafe {
             (self.exports.dynamics_jacobian)(
                 x.as_ptr(),
@@ -176,27 +179,13 @@ impl<const N: usize, const NX: usize, const NP: usize> Table<N, NX, NP> {
         (checked(code, a), checked(code, b))
     }
 
-    fn rigid_body_dynamics(
-        &self,
-        x: &SVector<f64, NX>,
-        u: &SVector<f64, N>,
-        p: &SVector<f64, NP>,
-    ) -> SVector<f64, NX> {
-        let mut out = SVector::<f64, NX>::zeros();
-        // SAFETY: as in `dynamics`.
-        let code = unsafe {
-            (self.exports.rigid_body_dynamics)(x.as_ptr(), u.as_ptr(), p.as_ptr(), out.as_mut_ptr())
-        };
-        checked(code, out)
-    }
-
     fn tip(
         &self,
         q: &SVector<f64, N>,
         p: &SVector<f64, NP>,
     ) -> Option<(SVector<f64, 3>, SMatrix<f64, 3, N>)> {
         let (mut y, mut j) = (SVector::<f64, 3>::zeros(), SMatrix::<f64, 3, N>::zeros());
-        // SAFETY: as in `dynamics`.
+        // SAFETY: as in `x_dot`.
         let code =
             unsafe { (self.exports.tip)(q.as_ptr(), p.as_ptr(), y.as_mut_ptr(), j.as_mut_ptr()) };
         match code {
@@ -212,7 +201,7 @@ impl<const N: usize, const NX: usize, const NP: usize> Table<N, NX, NP> {
         p: &SVector<f64, NP>,
     ) -> Option<SVector<f64, 3>> {
         let mut b = SVector::<f64, 3>::zeros();
-        // SAFETY: as in `dynamics`.
+        // SAFETY: as in `x_dot`.
         let code = unsafe {
             (self.exports.tip_bias)(q.as_ptr(), q_dot.as_ptr(), p.as_ptr(), b.as_mut_ptr())
         };
@@ -224,14 +213,14 @@ impl<const N: usize, const NX: usize, const NP: usize> Table<N, NX, NP> {
 
     fn state_matrix(&self, p: &SVector<f64, NP>) -> SMatrix<f64, NX, NX> {
         let mut a = SMatrix::<f64, NX, NX>::zeros();
-        // SAFETY: as in `dynamics`.
+        // SAFETY: as in `x_dot`.
         let code = unsafe { (self.exports.state_matrix)(p.as_ptr(), a.as_mut_ptr()) };
         checked(code, a)
     }
 
     fn input_matrix(&self, p: &SVector<f64, NP>) -> SMatrix<f64, NX, N> {
         let mut b = SMatrix::<f64, NX, N>::zeros();
-        // SAFETY: as in `dynamics`.
+        // SAFETY: as in `x_dot`.
         let code = unsafe { (self.exports.input_matrix)(p.as_ptr(), b.as_mut_ptr()) };
         checked(code, b)
     }
@@ -336,7 +325,8 @@ macro_rules! loaded_model {
                 u: &SVector<f64, $n>,
                 p: &Self::DynamicsCoefficients,
             ) -> SVector<f64, $nx> {
-                Self::table().dynamics(x, u, p)
+                let t = Self::table();
+                t.x_dot(t.exports.dynamics, x, u, p)
             }
             #[inline]
             fn dynamics_jacobian_with(
@@ -351,7 +341,8 @@ macro_rules! loaded_model {
                 u: &SVector<f64, $n>,
                 p: &SVector<f64, $np>,
             ) -> SVector<f64, $nx> {
-                Self::table().rigid_body_dynamics(x, u, p)
+                let t = Self::table();
+                t.x_dot(t.exports.rigid_body_dynamics, x, u, p)
             }
             fn tip(
                 q: &SVector<f64, $n>,
