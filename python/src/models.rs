@@ -11,7 +11,7 @@ pub fn model_kind(name: &str) -> Result<ModelKind, Failure> {
     name.parse().map_err(Failure::Input)
 }
 
-/// The generated models: ``{name: {"title": str, "dof": int, "parameters": [str, ...],
+/// The models, generated then loaded (``load_model``): ``{name: {"title": str, "dof": int, "parameters": [str, ...],
 /// "equilibrium": {"q", "q_dot", "u"}, "domains": {...}}}`` in registry order. ``parameters`` is
 /// the order ``confidence`` and ``simulate`` take a tool's parameters in (masses in kg, lengths
 /// in m, ...); ``dof`` is the number of joints (torques); ``equilibrium`` the state and torque

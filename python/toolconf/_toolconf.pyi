@@ -49,8 +49,8 @@ class SimulationError(RuntimeError):
     """Why, in words."""
 
 def models() -> dict[str, ModelInfo]:
-    """The generated models: ``{name: {"title", "dof", "parameters", "equilibrium", "domains"}}``
-    in registry order."""
+    """The models, generated then loaded (``load_model``): ``{name: {"title", "dof", "parameters",
+    "equilibrium", "domains"}}`` in registry order."""
 
 def load_model(path: Union[str, "os.PathLike[str]"], name: Optional[str] = None) -> str:
     """Loads a model library built by ``make model`` (its OUT folder or the .so) next to the
