@@ -92,9 +92,9 @@ fn compare(builtin: ModelKind, library: &Path) -> usize {
         loaded,
         compared: 0,
     };
-    let mut info = li.clone();
+    let mut info = *li;
     info.name = bi.name;
-    same.check("metadata", bi, &info);
+    same.check("metadata", bi, info);
     let tools = tools(builtin, 6, 7);
     let (b, l) = (builtin.model(), loaded.model());
     for kind in bi.tasks {
@@ -395,8 +395,14 @@ fn what_is_not_a_model_library_is_one_line_and_status_2() {
             .env(loaded::ENVIRONMENT, &entry)
             .output()
             .unwrap();
-        assert_eq!(out.status.code(), Some(2));
-        assert!(String::from_utf8_lossy(&out.stderr).contains(why));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{stderr}");
+        assert!(
+            stderr.starts_with("toolconf: error: TOOLCONF_MODEL_PATH: model library ")
+                && stderr.contains(why)
+                && stderr.lines().count() == 1,
+            "{stderr}"
+        );
     }
     // An unknown model still names the models there are, and how to load one.
     let out = Command::new(BIN)

@@ -189,3 +189,19 @@ def test_the_xarm7_ranks_tools_with_no_rebuild():
     ranked = toolconf.rank(frame.assign(model=name), "tip_acceleration")
     assert len(ranked) == len(frame) and set(ranked["model"]) == {name}
     assert np.isfinite(ranked["free_energy"]).all()
+
+
+def test_toolconf_model_path_loads_at_import_and_names_itself_when_refused(tmp_path):
+    import subprocess
+
+    code = "import toolconf; print(sorted(toolconf.models()))"
+    env = {**os.environ, "TOOLCONF_MODEL_PATH": f"arm2_env={LIBRARIES / 'arm2'}::{LIBRARIES / 'xarm7'}"}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    assert "'arm2_env'" in out.stdout and "'xarm7'" in out.stdout
+    bad = tmp_path / "notes.txt"
+    bad.write_text("not a library")
+    env["TOOLCONF_MODEL_PATH"] = str(bad)
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert out.returncode == 1
+    assert f"ValueError: TOOLCONF_MODEL_PATH: model library {bad}: is not a shared library" in out.stderr

@@ -107,14 +107,19 @@ def _ensure_loaded(entries) -> None:
 
 
 def _load_environment() -> None:
+    """Loads TOOLCONF_MODEL_PATH's libraries (``:``-separated, ``NAME=PATH`` entries allowed), as
+    the command line does; a refusal names the variable."""
     for entry in os.environ.get("TOOLCONF_MODEL_PATH", "").split(":"):
         if not entry.strip():
             continue
         name, sep, path = entry.partition("=")
-        if sep and name and "/" not in name:
-            load_model(path, name)
-        else:
-            load_model(entry)
+        try:
+            if sep and name and "/" not in name:
+                load_model(path, name)
+            else:
+                load_model(entry)
+        except ValueError as e:
+            raise ValueError(f"TOOLCONF_MODEL_PATH: {e}") from None
 
 
 _load_environment()

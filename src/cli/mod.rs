@@ -186,7 +186,8 @@ fn parse() -> Result<Cli, ExitCode> {
 /// (found by a scan of the arguments ahead of clap, which parses model names with the models
 /// there are), in order.
 fn load_model_libraries() -> Result<(), String> {
-    toolconf::loaded::load_environment().map_err(|e| e.to_string())?;
+    toolconf::loaded::load_environment()
+        .map_err(|e| format!("{}: {e}", toolconf::loaded::ENVIRONMENT))?;
     let mut args = std::env::args_os().skip(1);
     while let Some(arg) = args.next() {
         if arg == "--" {
