@@ -21,10 +21,12 @@ bench:
 	cargo bench --manifest-path examples/on_robot/bench/Cargo.toml
 
 ## make test: the whole suite: `make derive` reproduces generated/ byte for byte (on this CPU and
-## on an imitated older one), the derivation's own tests, the crate's, then the Python package's.
+## on an imitated older one), the renderer in release (what make crate and make model run, built
+## before their tests time them), the derivation's own tests, the crate's, then the Python package's.
 ## The fuzzers of every parser run in it with bounded case counts (TOOLCONF_FUZZ_CASES raises
 ## them: README "Bad input"), and so does the sweep of hostile inputs (tests/hostile.rs).
 test: drift-check $(PY_DEV)
+	cargo build --release --quiet -p toolconf-render
 	$(PY) -m unittest discover --start-directory derive/tests
 	cargo test --workspace --quiet
 	$(MAKE) --no-print-directory on-robot-test
