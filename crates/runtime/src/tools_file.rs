@@ -244,20 +244,26 @@ fn known_keys() -> String {
     keys.join(", ")
 }
 
-/// Every model's parameter keys, each once, in [`ModelKind::all`] order.
+/// Every model's parameter keys, each once, in [`ModelKind::all`] order; built again when a
+/// model has been loaded since (at most [`crate::registry::MAX_LOADED`] times: each list is kept
+/// for the life of the process, as the models are).
 fn parameter_keys() -> &'static [&'static str] {
-    static KEYS: std::sync::OnceLock<Vec<&'static str>> = std::sync::OnceLock::new();
-    KEYS.get_or_init(|| {
+    static KEYS: std::sync::Mutex<(usize, &'static [&'static str])> =
+        std::sync::Mutex::new((0, &[]));
+    let models = ModelKind::all();
+    let mut cached = KEYS.lock().unwrap_or_else(|p| p.into_inner());
+    if cached.0 != models.len() {
         let mut keys = Vec::new();
-        for m in ModelKind::all() {
+        for m in &models {
             for &p in m.parameter_names() {
                 if !keys.contains(&p) {
                     keys.push(p);
                 }
             }
         }
-        keys
-    })
+        *cached = (models.len(), keys.leak());
+    }
+    cached.1
 }
 
 /// The parameter keys among `has`, in [`parameter_keys`] order.
