@@ -88,44 +88,7 @@ pub fn load(path: &Path, name: Option<&str>) -> Result<ModelKind, LoadError> {
     }
     let (handle, library) = open(&canonical).map_err(&fail)?;
     let metadata = metadata::read(&library.exports, name).map_err(&fail)?;
-    if let Some(other) = ModelKind::all()
-        .into_iter()
-        .find(|k| k.name() == metadata.name)
-    {
-        let whose = match loaded.iter().find(|(_, _, k)| *k == other) {
-            Some((p, _, _)) => format!(
-                "loaded from {}",
-                crate::display::ClipPath(&p.display().to_string())
-            ),
-            None => "built in".to_string(),
-        };
-        return Err(fail(format!(
-            "a model named '{}' is already {whose}: load this one under another name \
-             (NAME=PATH on the command line and in {ENVIRONMENT}, name= in Python)",
-            metadata.name
-        )));
-    }
-    let size = (metadata.dof, metadata.parameter_count());
-    if !SIZES.contains(&size) {
-        return Err(fail(format!(
-            "{} joints and {} tool parameters: this toolconf runs loaded models of the sizes \
-             (joints, parameters) {}",
-            size.0,
-            size.1,
-            SIZES
-                .iter()
-                .map(|(n, p)| format!("({n}, {p})"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        )));
-    }
-    if !table::slot_free(size) {
-        return Err(fail(format!(
-            "{SLOTS} models of {} joints and {} tool parameters are loaded already, the most one \
-             process holds",
-            size.0, size.1
-        )));
-    }
+    room_for(&metadata, &loaded).map_err(&fail)?;
     let model = match table::install(&library, metadata.leak()) {
         Some(Some(Ok(model))) => model,
         Some(Some(Err(e))) => return Err(fail(e)),
@@ -136,6 +99,48 @@ pub fn load(path: &Path, name: Option<&str>) -> Result<ModelKind, LoadError> {
     std::mem::forget(handle);
     loaded.push((canonical, asked, kind));
     Ok(kind)
+}
+
+/// Whether the model `metadata` describes can be registered: its name free, its size one the
+/// runtime was compiled for ([`SIZES`]), a slot of that size free.
+fn room_for(
+    metadata: &metadata::Metadata,
+    loaded: &[(PathBuf, Option<String>, ModelKind)],
+) -> Result<(), String> {
+    let all = ModelKind::all();
+    if let Some(other) = all.into_iter().find(|k| k.name() == metadata.name) {
+        let whose = match loaded.iter().find(|(_, _, k)| *k == other) {
+            Some((p, _, _)) => format!(
+                "loaded from {}",
+                crate::display::ClipPath(&p.display().to_string())
+            ),
+            None => "built in".to_string(),
+        };
+        return Err(format!(
+            "a model named '{}' is already {whose}: load this one under another name \
+             (NAME=PATH on the command line and in {ENVIRONMENT}, name= in Python)",
+            metadata.name
+        ));
+    }
+    let size = (metadata.dof, metadata.parameter_count());
+    if !SIZES.contains(&size) {
+        let sizes: Vec<String> = SIZES.iter().map(|(n, p)| format!("({n}, {p})")).collect();
+        return Err(format!(
+            "{} joints and {} tool parameters: this toolconf runs loaded models of the sizes \
+             (joints, parameters) {}",
+            size.0,
+            size.1,
+            sizes.join(", ")
+        ));
+    }
+    if !table::slot_free(size) {
+        return Err(format!(
+            "{SLOTS} models of {} joints and {} tool parameters are loaded already, the most one \
+             process holds",
+            size.0, size.1
+        ));
+    }
+    Ok(())
 }
 
 /// Loads one entry of `--model-path` or [`ENVIRONMENT`]: `PATH`, or `NAME=PATH`.
