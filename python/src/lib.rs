@@ -51,6 +51,7 @@ fn _toolconf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     }
     m.add_function(wrap_pyfunction!(models::models, m)?)?;
     m.add_function(wrap_pyfunction!(models::load_model, m)?)?;
+    m.add_function(wrap_pyfunction!(models::model_path_entries, m)?)?;
     m.add_function(wrap_pyfunction!(models::ranges, m)?)?;
     m.add_function(wrap_pyfunction!(models::terms, m)?)?;
     m.add_function(wrap_pyfunction!(confidence::confidence, m)?)?;

@@ -98,3 +98,12 @@ pub fn load_model(
         .map(|kind| kind.name().to_string())
         .map_err(|e| Failure::Input(e.to_string()).into_pyerr(py))
 }
+
+/// ``TOOLCONF_MODEL_PATH``'s entries as ``[(path, name or None), ...]``, read by the command
+/// line's rule (``toolconf::loaded::environment_entries``): what ``import toolconf`` loads.
+#[pyfunction]
+#[pyo3(name = "_model_path_entries")]
+pub fn model_path_entries(py: Python<'_>) -> PyResult<Vec<(String, Option<String>)>> {
+    toolconf::loaded::environment_entries()
+        .map_err(|e| Failure::Input(e.to_string()).into_pyerr(py))
+}

@@ -107,19 +107,13 @@ def _ensure_loaded(entries) -> None:
 
 
 def _load_environment() -> None:
-    """Loads TOOLCONF_MODEL_PATH's libraries (``:``-separated, ``NAME=PATH`` entries allowed), as
-    the command line does; a refusal names the variable."""
-    for entry in os.environ.get("TOOLCONF_MODEL_PATH", "").split(":"):
-        if not entry.strip():
-            continue
-        name, sep, path = entry.partition("=")
-        try:
-            if sep and name and "/" not in name:
-                load_model(path, name)
-            else:
-                load_model(entry)
-        except ValueError as e:
-            raise ValueError(f"TOOLCONF_MODEL_PATH: {e}") from None
+    """Loads TOOLCONF_MODEL_PATH's libraries, its entries read by the command line's rule
+    (``:``-separated, ``NAME=PATH`` allowed); a refusal names the variable."""
+    try:
+        for path, name in _toolconf._model_path_entries():
+            load_model(path, name)
+    except ValueError as e:
+        raise ValueError(f"TOOLCONF_MODEL_PATH: {e}") from None
 
 
 _load_environment()

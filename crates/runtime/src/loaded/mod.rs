@@ -27,7 +27,6 @@ use std::io::Read as _;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use toolconf_cabi::exports::SYMBOLS;
 use toolconf_cabi::{Exports, ABI_VERSION};
 
 use crate::registry::{self, ModelKind};
@@ -89,11 +88,7 @@ pub fn load(path: &Path, name: Option<&str>) -> Result<ModelKind, LoadError> {
     let (handle, library) = open(&canonical).map_err(&fail)?;
     let metadata = metadata::read(&library.exports, name).map_err(&fail)?;
     room_for(&metadata, &loaded).map_err(&fail)?;
-    let model = match table::install(&library, metadata.leak()) {
-        Some(Some(Ok(model))) => model,
-        Some(Some(Err(e))) => return Err(fail(e)),
-        _ => return Err(fail("no slot for its size (checked above)".into())),
-    };
+    let model = table::install(&library, metadata.leak()).map_err(&fail)?;
     let kind = registry::register(model).map_err(fail)?;
     // The library stays loaded: its functions back a 'static model.
     std::mem::forget(handle);
@@ -143,32 +138,47 @@ fn room_for(
     Ok(())
 }
 
-/// Loads one entry of `--model-path` or [`ENVIRONMENT`]: `PATH`, or `NAME=PATH`.
-pub fn load_entry(entry: &str) -> Result<ModelKind, LoadError> {
+/// One entry of `--model-path` or [`ENVIRONMENT`] as (path, name): `PATH`, or `NAME=PATH` (a
+/// name has no `/`, so a path with `=` in a folder's name stays a path).
+pub fn parse_entry(entry: &str) -> (&str, Option<&str>) {
     match entry.split_once('=') {
-        Some((name, path)) if !name.is_empty() && !name.contains('/') => {
-            load(Path::new(path), Some(name))
-        }
-        _ => load(Path::new(entry), None),
+        Some((name, path)) if !name.is_empty() && !name.contains('/') => (path, Some(name)),
+        _ => (entry, None),
     }
 }
 
-/// Loads every entry of [`ENVIRONMENT`] (`:`-separated, empty entries skipped), in order.
+/// Loads one entry of `--model-path` or [`ENVIRONMENT`] ([`parse_entry`]).
+pub fn load_entry(entry: &str) -> Result<ModelKind, LoadError> {
+    let (path, name) = parse_entry(entry);
+    load(Path::new(path), name)
+}
+
+/// The entries of [`ENVIRONMENT`] (`:`-separated, empty entries skipped), in order, each as
+/// [`parse_entry`] reads it; none when it is not set.
+pub fn environment_entries() -> Result<Vec<(String, Option<String>)>, LoadError> {
+    let Some(value) = std::env::var_os(ENVIRONMENT) else {
+        return Ok(Vec::new());
+    };
+    let value = value.to_str().ok_or_else(|| LoadError {
+        path: crate::display::ClipPath(&value.to_string_lossy()).to_string(),
+        reason: "is not valid UTF-8".into(),
+    })?;
+    Ok(value
+        .split(':')
+        .filter(|e| !e.trim().is_empty())
+        .map(|e| {
+            let (path, name) = parse_entry(e);
+            (path.to_string(), name.map(str::to_string))
+        })
+        .collect())
+}
+
+/// Loads every entry of [`ENVIRONMENT`], in order.
 pub fn load_environment() -> Result<Vec<ModelKind>, LoadError> {
-    match std::env::var_os(ENVIRONMENT) {
-        None => Ok(Vec::new()),
-        Some(value) => {
-            let value = value.to_str().ok_or_else(|| LoadError {
-                path: ENVIRONMENT.into(),
-                reason: "is not valid UTF-8".into(),
-            })?;
-            value
-                .split(':')
-                .filter(|e| !e.trim().is_empty())
-                .map(load_entry)
-                .collect()
-        }
-    }
+    environment_entries()?
+        .iter()
+        .map(|(path, name)| load(Path::new(path), name.as_deref()))
+        .collect()
 }
 
 /// The library file `path` names: `path` itself if it is a file, the one
@@ -270,15 +280,13 @@ fn is_mach_o(magic: [u8; 4]) -> bool {
 fn exports(handle: &libloading::Library) -> Result<Exports, String> {
     macro_rules! symbols {
         ($($field:ident),* $(,)?) => {{
-            let mut names = SYMBOLS.iter();
             Exports {
                 $($field: {
-                    let name = names.next().copied().unwrap_or("");
-                    debug_assert_eq!(name, concat!("toolconf_", stringify!($field)));
-                    let c = format!("{name}\0");
+                    // The C name is the field's (exports.rs: `toolconf_<field>`).
+                    let name = concat!("toolconf_", stringify!($field));
                     // SAFETY: the symbol's type is the one the ABI gives it ([`Exports`]); the
                     // pointer is used only while the library is loaded.
-                    *unsafe { handle.get(c.as_bytes()) }
+                    *unsafe { handle.get(concat!("toolconf_", stringify!($field), "\0").as_bytes()) }
                         .map_err(|_| format!("is not a whole toolconf model library: it has no symbol {name}"))?
                 },)*
             }

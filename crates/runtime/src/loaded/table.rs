@@ -382,32 +382,29 @@ macro_rules! loaded_model {
 /// Slots per size: how many libraries of the same sizes one process can load.
 pub const SLOTS: usize = 2;
 
-/// `Loaded<N, S>` as a [`Model`] in the first free slot of `slots`, its table built from
-/// `library`; `None` when both slots are taken.
+/// `Loaded<N, NP, S>` as a [`Model`] in the first free slot of `slots`, its table built from
+/// `library`.
 fn install_in<const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
     slots: &'static [OnceLock<Table<N, NX, NP>>; SLOTS],
     library: &Library,
     info: &'static ModelInfo,
-) -> Option<Result<&'static dyn Model, String>>
+) -> Result<&'static dyn Model, String>
 where
     Loaded<N, NP, 0>: ArmModel<N, NX, NP, NZ>,
     Loaded<N, NP, 1>: ArmModel<N, NX, NP, NZ>,
 {
-    let slot = slots.iter().position(|s| s.get().is_none())?;
-    let table = match Table::build(library, info) {
-        Ok(table) => table,
-        Err(e) => return Some(Err(e)),
-    };
-    if slots[slot].set(table).is_err() {
-        return Some(Err(
-            "the slot was filled meanwhile (loads are serialised)".into()
-        ));
+    let slot = slots
+        .iter()
+        .position(|s| s.get().is_none())
+        .ok_or("every slot of its size is taken")?;
+    if slots[slot].set(Table::build(library, info)?).is_err() {
+        return Err("the slot was filled meanwhile (loads are serialised)".into());
     }
     let model: Box<dyn Model> = match slot {
         0 => Box::new(Generated::<Loaded<N, NP, 0>, N, NX, NP, NZ>::new(info)),
         _ => Box::new(Generated::<Loaded<N, NP, 1>, N, NX, NP, NZ>::new(info)),
     };
-    Some(Ok(Box::leak(model)))
+    Ok(Box::leak(model))
 }
 
 /// The marker types of every size in [`SIZES`], and [`install`] over them.
@@ -429,15 +426,15 @@ macro_rules! loaded_sizes {
             }
         }
 
-        /// The loaded `library` as a [`Model`], in a free slot of its size: `None` for a size
-        /// not in [`SIZES`], `Some(None)` when its slots are taken.
+        /// The loaded `library` as a [`Model`], in a free slot of its size (the loader checked
+        /// both first: [`slot_free`]).
         pub(crate) fn install(
             library: &Library,
             info: &'static ModelInfo,
-        ) -> Option<Option<Result<&'static dyn Model, String>>> {
+        ) -> Result<&'static dyn Model, String> {
             match (info.dof, info.parameter_names.len()) {
-                $(($n, $np) => Some(install_in::<$n, $nx, $np, $nz>(&$slots, library, info)),)*
-                _ => None,
+                $(($n, $np) => install_in::<$n, $nx, $np, $nz>(&$slots, library, info),)*
+                _ => Err("a size this toolconf was not compiled for".into()),
             }
         }
     };
