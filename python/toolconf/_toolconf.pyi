@@ -57,6 +57,10 @@ def load_model(path: Union[str, "os.PathLike[str]"], name: Optional[str] = None)
     built-in models and returns the name every function takes it by. Raises ``ValueError``
     naming the file and what is wrong with it."""
 
+def _model_path_entries() -> list[tuple[str, Optional[str]]]:
+    """TOOLCONF_MODEL_PATH's entries as ``[(path, name or None), ...]``, read by the command
+    line's rule: what ``import toolconf`` loads."""
+
 def dynamics(model: str, params: Params, state: npt.ArrayLike, control: npt.ArrayLike) -> npt.NDArray[np.float64]:
     """The robot's own rigid-body dynamics Ẋ = [q̇; q̈], M(q) q̈ + C(q, q̇) q̇ + g(q) = U with U the
     joint torques (for ``panda`` and ``ur5`` without the joint impedance of their plant): shape
