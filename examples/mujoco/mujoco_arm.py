@@ -29,10 +29,10 @@ MuJoCo keeps a body's inertia as principal moments and a frame. Given a full ten
 (`fullinertia`, which its URDF reader sets for every <inertia>), it diagonalises it with a
 Jacobi iteration (mju_eig3) that stops short of double precision: the tensor it keeps differs
 from the file's by up to 4.6e-7 relative (the Panda's links and the catalogue's tools), which
-moved q̈ by up to 1.6e-6 relative to toolconf's, 10⁶ times the two derivations' rounding. So `principal_inertia` diagonalises each tensor with LAPACK (numpy's
-eigh) and hands MuJoCo the moments and the frame instead: the tensor MuJoCo keeps
-(`body_inertia`, recomposed by `inertia_tensor`) is then the file's to 1e-16, and q̈ toolconf's to
-rounding (test_mujoco.py).
+moved q̈ by up to 1.6e-6 relative to toolconf's, 10⁸ times the two derivations' rounding.
+So `principal_inertia` diagonalises each tensor with LAPACK (numpy's eigh) and hands MuJoCo the
+moments and the frame instead: the tensor MuJoCo keeps (`body_inertia`, recomposed by
+`inertia_tensor`) is then the file's to 9e-16, and q̈ toolconf's to rounding (test_mujoco.py).
 
 The gravity feed-forward g(q^e) is a constant torque, computed once by MuJoCo from its own model
 of arm and tool (`gravity_torque`), as a robot computes it from its own.
