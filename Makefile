@@ -6,7 +6,7 @@ PY_DEV := $(VENV)/.python-dev-installed
 # Deterministic derivation: the same inputs give byte-identical generated files.
 export PYTHONHASHSEED := 0
 
-.PHONY: run test derive render drift-check venv clean-venv bench python-test crate model on-robot-test c-example-test loaded-models-test
+.PHONY: run test derive render drift-check venv clean-venv bench python-test crate model on-robot-test c-example-test loaded-models-test mujoco-test
 
 ## make run: build in release mode and reproduce the paper's Results (results/report.md).
 run:
@@ -34,6 +34,7 @@ test: drift-check $(PY_DEV)
 	$(PYTHON_BUILD)
 	$(PYTHON_TESTS)
 	$(MAKE) --no-print-directory loaded-models-test
+	$(MAKE) --no-print-directory mujoco-test
 
 ## make on-robot-test: the on-robot controller's own tests (examples/on_robot, a crate outside the
 ## workspace, as a robot's firmware would build it).
@@ -62,6 +63,25 @@ loaded-models-test: $(PY_DEV)
 	echo "loaded-models-test: $$(ls -d $$d/*/ | wc -l) model libraries built" && \
 	TOOLCONF_TEST_LIBRARIES=$$d cargo test --quiet --test loaded_models -- --include-ignored && \
 	TOOLCONF_TEST_LIBRARIES=$$d $(PY) -m pytest -q python/loaded_tests
+
+## make mujoco-test: the on-robot controller on MuJoCo (examples/mujoco/, docs/mujoco.md). Installs the example's
+## pinned requirements (examples/mujoco/requirements.txt) into derive/.venv, builds the Panda's model library from
+## the committed IR into a temporary folder, checks MuJoCo's plant against the library's open loop, then runs the
+## example's comparison (compare.py) of the catalogue's touch task against toolconf simulate and asserts its bounds
+## and ranking (examples/mujoco/test_mujoco.py). Where mujoco cannot be installed, one line says so and it is skipped.
+MUJOCO_INSTALLED := $(VENV)/.mujoco-installed
+mujoco-test: $(PY_DEV)
+	@d=$$(mktemp -d) && trap 'rm -rf "$$d"' EXIT && \
+	if ! $(MAKE) --no-print-directory $(MUJOCO_INSTALLED) >$$d/install.log 2>&1; then \
+	  echo "mujoco-test: skipped: mujoco cannot be installed here: $$(grep -m 1 -i 'error' $$d/install.log || tail -n 1 $$d/install.log)"; \
+	  exit 0; \
+	fi && \
+	$(PY) derive/make_model.py --ir generated/panda.json --out $$d/panda 2>$$d/panda.log >/dev/null || { cat $$d/panda.log; exit 1; }; \
+	TOOLCONF_MUJOCO_LIBRARY=$$d/panda $(PY) -m pytest -q examples/mujoco
+
+$(MUJOCO_INSTALLED): examples/mujoco/requirements.txt $(PY)
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r examples/mujoco/requirements.txt
+	touch $@
 
 ## make python-test: builds the Python package (python/, `import toolconf`) into derive/.venv
 ## with maturin (debug profile, in the workspace's target/, so the crate is not built twice),
