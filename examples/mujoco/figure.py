@@ -15,13 +15,13 @@ import numpy as np  # noqa: E402
 def _paths(ax, results: list[dict], goal: np.ndarray, colours) -> None:
     for result, colour in zip(results, colours):
         tc, mj = result["runs"]["toolconf"].tip, result["runs"]["mujoco"].tip
-        ax.plot(tc[:, 0], tc[:, 2], "-", color=colour, lw=1.2)
+        ax.plot(tc[:, 0], tc[:, 2], "-", color=colour, lw=1.2, label=result["tool"].name)
         ax.plot(mj[::4, 0], mj[::4, 2], "o", color=colour, ms=2.5, mfc="none")
     ax.plot(goal[0], goal[2], "k*", ms=10, label="goal")
     ax.plot([], [], "k-", label="toolconf simulate (continuous)")
     ax.plot([], [], "ko", mfc="none", ms=3, label="MuJoCo, 1 kHz ticks (every 4th sample)")
-    ax.set(xlabel="tip x [m] (base frame)", ylabel="tip z [m]", title="(a) the tips' paths")
-    ax.legend(fontsize=7, loc="best")
+    ax.set(xlabel="tip x [m] (base frame)", ylabel="tip z [m]", title="(a) the tips' paths, 5 s")
+    ax.legend(fontsize=6, loc="upper right", ncol=2)
 
 
 def _deviation(ax, results: list[dict], colours) -> None:
@@ -60,11 +60,11 @@ def draw(results: list[dict], rows: list[dict], goal: np.ndarray, path: Path) ->
     _paths(axes[0, 0], results, goal, colours)
     _deviation(axes[0, 1], results, colours)
     _metric(axes[1, 0], rows, "task_error",
-            "(c) task error Σ(y−y^g)ᵀP(y−y^g) (relative difference, ≤ bound)", True)
+            "(c) task error; above: Δ relative, ≤ its bound", True)
     _metric(axes[1, 1], rows, "free_energy",
-            "(d) ∫F dt, tools by toolconf's ranking (relative difference, ≤ bound)", True)
+            "(d) ∫F dt, by toolconf's ranking; above: Δ relative, ≤ its bound", True)
     fig.suptitle("The Panda's catalogue touching a point: toolconf simulate against the C ABI's "
                  "controller ticking at 1 kHz on MuJoCo", fontsize=11)
     fig.tight_layout()
-    fig.savefig(path, dpi=110, format="png")
+    fig.savefig(path, dpi=90, format="png")
     plt.close(fig)
