@@ -35,6 +35,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -46,7 +47,7 @@ sys.path.insert(0, str(HERE))
 import figure  # noqa: E402
 from episode import Run, Task, mujoco_episode, read_task, simulate  # noqa: E402
 from model_library import LibraryError, ModelLibrary  # noqa: E402
-from mujoco_arm import Description, read_description  # noqa: E402
+from mujoco_arm import Description, arm_spec, read_description  # noqa: E402
 
 REPO = HERE.parents[1]
 # The least ratio D₁/D₂ accepted as first-order behaviour (2 in the limit h → 0).
@@ -78,11 +79,19 @@ def catalogue(toolconf: Path, tools: Path, task: Path, library: ModelLibrary) ->
     done = subprocess.run([str(toolconf), "rank", "--tools", str(tools), "--task", str(task),
                            "--json"], capture_output=True, text=True)
     if done.returncode != 0:
-        raise RuntimeError(f"toolconf rank --tools {tools}: {done.stderr.strip()}")
-    rows = sorted(json.loads(done.stdout)["tools"], key=lambda t: t["row"])
-    return [Tool(row=t["row"], name=t["name"] or f"row {t['row']}", params=t["parameters"],
-                 vector=library.params([t["parameters"][n] for n in library.parameter_names]))
-            for t in rows]
+        # toolconf's one line: status 2 is bad input (the file, row and value named).
+        error = ValueError if done.returncode == 2 else RuntimeError
+        raise error(done.stderr.strip().removeprefix("toolconf: error: "))
+    out = []
+    for t in sorted(json.loads(done.stdout)["tools"], key=lambda t: t["row"]):
+        name = t["name"] or f"row {t['row']}"
+        if t.get("error"):
+            print(f"compare.py: {tools}: {name}: not compared: toolconf's episode failed: "
+                  f"{t['error']}", file=sys.stderr)
+            continue
+        vector = library.params([t["parameters"][n] for n in library.parameter_names])
+        out.append(Tool(row=t["row"], name=name, params=t["parameters"], vector=vector))
+    return out
 
 
 def _quantities(run: Run) -> dict:
@@ -176,15 +185,22 @@ def summary(result: dict, library: ModelLibrary, task: Task) -> dict:
 
 
 def compare_all(library: ModelLibrary, description: Description, toolconf: Path, tools: Path,
-                task: Task) -> tuple[list[dict], list[dict]]:
-    """Every tool's comparison, and its summary rows ordered by toolconf's ∫F (best first)."""
-    results = []
+                task: Task) -> tuple[list[dict], list[dict], int]:
+    """Every tool's comparison, its summary rows ordered by toolconf's ∫F (best first), and how
+    many tools could not be compared."""
+    results, failed = [], 0
     with tempfile.TemporaryDirectory(prefix="toolconf-mujoco-") as workdir:
         for tool in catalogue(toolconf, tools, task.path, library):
             print(f"compare: {tool.name}", file=sys.stderr, flush=True)
-            results.append(compare_tool(library, description, toolconf, tool, task, Path(workdir)))
+            try:
+                results.append(compare_tool(library, description, toolconf, tool, task,
+                                            Path(workdir)))
+            except (LibraryError, RuntimeError) as e:
+                # One tool's failure is reported, and the others are compared.
+                print(f"compare.py: {tool.name}: not compared: {e}", file=sys.stderr)
+                failed += 1
     rows = {r["name"]: r for r in (summary(x, library, task) for x in results)}
-    return results, [rows[name] for name in ranking(results, "toolconf")]
+    return results, [rows[name] for name in ranking(results, "toolconf")], failed
 
 
 def table(rows: list[dict], mujoco_ranking: list[str]) -> str:
@@ -280,16 +296,25 @@ def main(argv=None) -> int:
     parser.add_argument("--toolconf", type=Path, help="the toolconf binary (default: cargo build)")
     args = parser.parse_args(argv)
     try:
+        if args.out.exists() and not args.out.is_dir():
+            raise ValueError(f"--out {args.out}: exists and is not a folder")
         description = read_description(args.description)
         with tempfile.TemporaryDirectory(prefix="toolconf-mujoco-lib-") as scratch:
             folder = args.library or build_library(
-                REPO / "generated" / f"{args.description.stem}.json", Path(scratch))
+                REPO / "generated" / f"{description.name}.json", Path(scratch))
             library = ModelLibrary(folder)
+            if library.name != description.name:
+                raise ValueError(f"--library {folder}: the model {library.name}, not the "
+                                 f"description's {description.name}")
+            # The URDF as MuJoCo loads it, checked once before any tool.
+            arm_spec(description, library.equilibrium_state[:library.dof], "RK4", 1e-3).compile()
             task = read_task(args.task, library)
             toolconf = args.toolconf or build_toolconf()
-            results, rows = compare_all(library, description, toolconf, args.tools, task)
+            results, rows, failed = compare_all(library, description, toolconf, args.tools, task)
+            if not results:
+                raise RuntimeError(f"{args.tools}: no tool could be compared")
             write_outputs(args.out, results, rows, task, library)
-    except (OSError, ValueError, LibraryError) as e:
+    except (OSError, ValueError, TypeError, LibraryError, ET.ParseError) as e:
         print(f"compare.py: {e}", file=sys.stderr)
         return 2
     except (RuntimeError, subprocess.CalledProcessError) as e:
@@ -297,7 +322,7 @@ def main(argv=None) -> int:
         return 1
     print(table(rows, ranking(results, "mujoco")))
     print(f"compare.py: wrote {args.out}/comparison.json, comparison.csv, comparison.png")
-    return 0
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":

@@ -49,11 +49,21 @@ class Task:
     kind: str = "tip_position"
 
 
-def _block(value, size: int, dof: int, where: str) -> np.ndarray:
+def _numbers(value, where: str) -> np.ndarray:
+    """`value` as finite float64s, or a ValueError naming where it was read."""
+    try:
+        array = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{where} = {value!r}: not a number or list of numbers") from None
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{where} = {value!r}: not finite")
+    return array
+
+
+def _block(value: np.ndarray, size: int, dof: int, where: str) -> np.ndarray:
     """A precision as a dof × dof block: a number is value·I on the term's `size` components,
     a matrix its size × size block; zeros elsewhere."""
     out = np.zeros((dof, dof))
-    value = np.asarray(value, dtype=np.float64)
     if value.ndim == 0:
         out[:size, :size] = float(value) * np.eye(size)
     elif value.shape == (size, size):
@@ -64,32 +74,41 @@ def _block(value, size: int, dof: int, where: str) -> np.ndarray:
 
 
 def read_task(path: str | Path, library: ModelLibrary) -> Task:
-    """A task file of kind tip_position (goal, precision of tip, tip_dot and u, episode)."""
+    """A task file of kind tip_position (goal, precision of tip, tip_dot and u, episode); its
+    values' ranges are toolconf's to check (compare.py runs `toolconf rank` on it first)."""
     path = Path(path)
-    with open(path, "rb") as f:
-        spec = tomllib.load(f)
+    try:
+        spec = tomllib.loads(path.read_bytes().decode("utf-8"))
+    except (UnicodeDecodeError, tomllib.TOMLDecodeError) as e:
+        raise ValueError(f"{path}: not a TOML task file: {e}") from None
     if spec.get("kind") != "tip_position":
         raise ValueError(f"{path}: kind = {spec.get('kind')!r}: this example runs tip_position tasks")
     n, terms = library.dof, library.term_names
-    goals = np.zeros((len(terms), n))
-    precisions = np.zeros((len(terms), n, n))
+    goals, precisions = np.zeros((len(terms), n)), np.zeros((len(terms), n, n))
+    given_goals, given_precisions = dict(spec.get("goal", {})), dict(spec.get("precision", {}))
     for name in TIP_TERMS:
-        size = library.tip_dim if name.startswith("tip") else n
-        goal = spec.get("goal", {}).get(name, [0.0] * size)
-        if len(goal) != size:
-            raise ValueError(f"{path}: goal.{name}: {len(goal)} values, not {size}")
-        goals[terms.index(name), :size] = goal
-        if name not in spec.get("precision", {}):
+        size, i = (library.tip_dim if name.startswith("tip") else n), terms.index(name)
+        goal = _numbers(given_goals.get(name, [0.0] * size), f"{path}: goal.{name}")
+        if goal.shape != (size,):
+            raise ValueError(f"{path}: goal.{name}: {goal.size} values, not {size}")
+        goals[i, :size] = goal
+        if name not in given_precisions:
             raise ValueError(f"{path}: precision.{name}: missing (this example takes it given)")
-        precisions[terms.index(name)] = _block(spec["precision"][name], size, n,
-                                               f"{path}: precision.{name}")
-    episode = {**DEFAULT_EPISODE, **spec.get("episode", {})}
-    if float(episode.get("perturbation", 0.0)) != 0.0:
+        where = f"{path}: precision.{name}"
+        precisions[i] = _block(_numbers(given_precisions[name], where), size, n, where)
+    episode = {**DEFAULT_EPISODE, **dict(spec.get("episode", {}))}
+    number = {k: _numbers(episode.get(k, 0.0), f"{path}: episode.{k}")
+              for k in ("t_end", "dt", "learning_rate", "initial_torque", "perturbation")}
+    if number["perturbation"].any():
         raise ValueError(f"{path}: episode.perturbation: this example runs without one")
-    u0 = np.broadcast_to(np.asarray(episode["initial_torque"], dtype=np.float64), (n,)).copy()
-    return Task(path=path, goals=goals, precisions=precisions, t_end=float(episode["t_end"]),
-                dt=float(episode["dt"]), learning_rate=float(episode["learning_rate"]),
-                initial_torque=u0)
+    try:
+        u0 = np.broadcast_to(number["initial_torque"], (n,)).copy()
+        t_end, dt, rate = (float(number[k]) for k in ("t_end", "dt", "learning_rate"))
+    except (ValueError, TypeError):
+        raise ValueError(f"{path}: episode: t_end, dt and learning_rate numbers, initial_torque "
+                         f"a number or {n} numbers") from None
+    return Task(path=path, goals=goals, precisions=precisions, t_end=t_end, dt=dt,
+                learning_rate=rate, initial_torque=u0)
 
 
 @dataclass
@@ -162,8 +181,20 @@ def mujoco_episode(library: ModelLibrary, description: Description, tool: dict,
             data.qfrc_applied[:] = feed_forward + u
             mujoco.mj_step(model, data, nstep=substeps)
         logdet = controller.confidence
+    _check_warnings(data, rate_hz, substeps)
     run = Run(**{k: np.array(v) for k, v in out.items()}, logdet=logdet)
     return measure(run, task, library)
+
+
+def _check_warnings(data: mujoco.MjData, rate_hz: float, substeps: int) -> None:
+    """MuJoCo answers a diverging state (a NaN or huge q, q̇ or q̈) by resetting the data to the
+    model's rest pose with a warning and going on: such an episode is not a result."""
+    for warning in (mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
+                    mujoco.mjtWarning.mjWARN_BADQACC):
+        if data.warning[warning].number:
+            raise RuntimeError(f"MuJoCo's simulation diverged ({warning.name}, at "
+                               f"t = {data.warning[warning].lastinfo} steps; {rate_hz} Hz, "
+                               f"{substeps} steps per tick)")
 
 
 def simulate(toolconf: Path, library: ModelLibrary, params: np.ndarray, task: Task,

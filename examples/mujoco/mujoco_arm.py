@@ -55,6 +55,7 @@ TOOL_BODY, TIP_SITE = "toolconf_tool", "toolconf_tip"
 @dataclass(frozen=True)
 class Description:
     """What MuJoCo needs of a toolconf model description of kind `urdf`."""
+    name: str
     urdf: Path
     base: str
     flange: str
@@ -67,25 +68,39 @@ def read_description(path: str | Path) -> Description:
     """The [urdf] and [impedance] tables of a model description (derive/models/*.toml); the
     URDF is relative to the description's folder, as for toolconf."""
     path = Path(path)
-    with open(path, "rb") as f:
-        d = tomllib.load(f)
+    try:
+        d = tomllib.loads(path.read_bytes().decode("utf-8"))
+    except (UnicodeDecodeError, tomllib.TOMLDecodeError) as e:
+        raise ValueError(f"{path}: not a TOML model description: {e}") from None
+    kind = d.get("dynamics", {}).get("kind") if isinstance(d.get("dynamics"), dict) else None
+    if kind != "urdf":
+        raise ValueError(f"{path}: dynamics.kind = {kind!r}: not a URDF arm's description")
     try:
         urdf, impedance = d["urdf"], d["impedance"]
-        if d["dynamics"]["kind"] != "urdf":
-            raise ValueError(f"{path}: dynamics.kind = {d['dynamics']['kind']!r}: not a URDF arm")
-        return Description(urdf=path.parent / urdf["file"], base=urdf["base"],
-                           flange=urdf["flange"],
-                           gravity=tuple(float(g) for g in urdf["gravity"]),
+        gravity = tuple(float(g) for g in urdf["gravity"])
+        if len(gravity) != 3:
+            raise ValueError(f"urdf.gravity: {len(gravity)} components, not 3")
+        return Description(name=str(d["model"]["name"]), urdf=path.parent / urdf["file"],
+                           base=str(urdf["base"]), flange=str(urdf["flange"]), gravity=gravity,
                            stiffness=tuple(float(k) for k in impedance["stiffness"]),
                            damping=tuple(float(c) for c in impedance["damping"]))
     except KeyError as e:
         raise ValueError(f"{path}: no key {e.args[0]!r}: not a URDF arm's description") from None
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"{path}: [model], [urdf] or [impedance]: {e}") from None
+
+
+def _ends(joint) -> tuple[str, str]:
+    """A joint's (parent, child) links."""
+    parent, child = joint.find("parent"), joint.find("child")
+    if parent is None or child is None:
+        raise ValueError(f"joint {joint.get('name')!r}: no <parent> or <child>")
+    return parent.get("link"), child.get("link")
 
 
 def _chain(root, base: str, flange: str) -> set[str]:
     """The links from `base` down to `flange` (the flange's path up to the base)."""
-    parent_of = {j.find("child").get("link"): j.find("parent").get("link")
-                 for j in root.findall("joint")}
+    parent_of = {child: parent for parent, child in map(_ends, root.findall("joint"))}
     chain, link = [flange], flange
     while link != base:
         if link not in parent_of:
@@ -110,7 +125,7 @@ def strip_urdf(text: str, base: str, flange: str) -> str:
             raise ValueError(f"link {link.get('name')!r}: its <inertial> frame is rotated "
                              f"(rpy {origin.get('rpy')}): not handled by this example")
     for joint in root.findall("joint"):
-        if joint.find("child").get("link") not in keep or joint.find("parent").get("link") not in keep:
+        if not set(_ends(joint)) <= keep:
             root.remove(joint)
             continue
         for element in joint.findall("dynamics") + joint.findall("safety_controller"):
@@ -122,8 +137,12 @@ def strip_urdf(text: str, base: str, flange: str) -> str:
 
 def arm_spec(description: Description, q_e, integrator: str, timestep: float) -> mujoco.MjSpec:
     """Step 2: the stripped URDF as a MuJoCo spec with toolconf's plant's options (above)."""
-    text = strip_urdf(description.urdf.read_text(), description.base, description.flange)
-    spec = mujoco.MjSpec.from_string(text)
+    try:
+        text = strip_urdf(description.urdf.read_bytes().decode("utf-8"), description.base,
+                          description.flange)
+        spec = mujoco.MjSpec.from_string(text)
+    except (UnicodeDecodeError, ET.ParseError, ValueError) as e:
+        raise ValueError(f"{description.urdf}: {e}") from None
     spec.compiler.fusestatic = False
     spec.option.gravity = description.gravity
     spec.option.timestep = timestep
