@@ -156,6 +156,9 @@ def mujoco_episode(library: ModelLibrary, description: Description, tool: dict,
     if not math.isclose(ticks_per_sample, task.dt * rate_hz, rel_tol=1e-9) or ticks_per_sample < 1:
         raise ValueError(f"the output step {task.dt} s is not a whole number of ticks at {rate_hz} Hz")
     samples = round(task.t_end / task.dt)
+    if not math.isclose(samples * task.dt, task.t_end, rel_tol=1e-9):
+        raise ValueError(f"{task.path}: episode.t_end = {task.t_end} s is not a whole number of "
+                         f"dt = {task.dt} s (this example samples both engines alike)")
     q_e = library.equilibrium_state[:library.dof]
     model = arm_model(description, q_e, tool, integrator, 1.0 / (rate_hz * substeps))
     data = mujoco.MjData(model)
