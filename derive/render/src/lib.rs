@@ -25,8 +25,11 @@ use tera::{Context, Tera};
 
 pub mod cabi;
 mod check;
+pub mod code;
+pub mod escape;
 pub mod functions;
 pub mod ir;
+pub mod ir_check;
 pub mod model_view;
 pub mod registry;
 pub mod tasks;
@@ -47,6 +50,13 @@ pub enum RenderError {
     },
     #[error(transparent)]
     Write(#[from] toolconf_files::WriteError),
+    /// An IR that is not one this renderer renders (bad input): its file, key and why.
+    #[error("{}: {}{problem}", path.display(), if key.is_empty() { String::new() } else { format!("{key}: ") })]
+    Refused {
+        path: PathBuf,
+        key: String,
+        problem: String,
+    },
     #[error("{path} is not an IR this renderer reads: {source}")]
     Json {
         path: PathBuf,
@@ -66,6 +76,17 @@ pub enum RenderError {
     Task(String),
     #[error("rustfmt failed: {0}")]
     Rustfmt(String),
+}
+
+impl RenderError {
+    /// Whether the error is the input's (an IR that cannot be rendered, status 2) rather than a
+    /// failure to render or write one that can (status 1).
+    pub fn is_refusal(&self) -> bool {
+        matches!(
+            self,
+            RenderError::Refused { .. } | RenderError::Json { .. } | RenderError::Schema { .. }
+        )
+    }
 }
 
 /// One rendered file: its name (relative to the output folder) and contents.
