@@ -1,7 +1,7 @@
 """Every free-text field of a model description and of a task file (titles, sources, units, docs,
-LaTeX, equations' names, the printed matrices' and the tip's sources, a URDF's file, base and
-flange; a task's title and doc, a term's symbol, LaTeX, doc, label and unit, a remark's text, a
-formulation's doc) with any text Hypothesis draws: read back exactly as written when it is one
+LaTeX, equations' names, the printed matrices', the tip's, a URDF arm's, its impedance's and its
+tool rule's sources; a task's title and doc, a term's symbol, LaTeX, doc, label and unit, a
+remark's text, a formulation's doc) with any text Hypothesis draws: read back exactly as written when it is one
 line of text (a paragraph field: lines), and otherwise (a control character, a line break, a
 Unicode line or paragraph separator, a bidirectional control, a byte-order mark) refused with one
 line naming the file and the key. The renderer's side, that no accepted text reaches generated
@@ -107,7 +107,44 @@ TASK_FIELDS = {
     'title = "Task 1 (position control)"': ("task[0].title", lambda ts: ts[0].title, False),
     'doc = "Reach and hold a goal configuration of the joints (zero goal velocity and acceleration)."':
         ("task[0].doc", lambda ts: ts[0].doc, True),
+    'text = """The paper takes': ("task[1].remarks[0].text", lambda ts: ts[1].remarks[0].text, True),
+    'doc = """The stabilised plant': ("task[0].formulations.static_gain.doc",
+                                      lambda ts: ts[0].formulations["static_gain"].doc, True),
 }
+
+# A URDF arm's own text fields (three joints: its tip has three components).
+URDF = """<?xml version="1.0"?><robot name="three">
+<link name="base"/><link name="flange"/>""" + "".join(
+    f'<link name="l{i}"><inertial><origin xyz="0 0 0.1"/><mass value="1"/>'
+    f'<inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+    f'<joint name="j{i}" type="revolute"><parent link="{"base" if i == 0 else f"l{i - 1}"}"/><child link="l{i}"/>'
+    f'<origin xyz="0 0 0.2"/><axis xyz="{"0 0 1" if i == 0 else "0 1 0"}"/>'
+    f'<limit lower="-3" upper="3" effort="10" velocity="1"/></joint>' for i in range(3)) + \
+    '<joint name="fix" type="fixed"><parent link="l2"/><child link="flange"/></joint></robot>'
+URDF_MODEL = """
+[model]
+name = "three"
+dof = 3
+[dynamics]
+kind = "urdf"
+[urdf]
+file = "three.urdf"
+base = "base"
+flange = "flange"
+gravity = [0.0, 0.0, -9.81]
+source = @urdf_source@
+[impedance]
+stiffness = [50.0, 50.0, 50.0]
+damping = [5.0, 5.0, 5.0]
+source = @impedance_source@
+[tool]
+source = @tool_source@
+[equilibrium]
+q = ["0", "0.3", "0.2"]
+q_dot = ["0", "0", "0"]
+u = ["0", "0", "0"]
+"""
+URDF_FIELDS = {"urdf_source": "urdf.source", "impedance_source": "impedance.source", "tool_source": "tool.source"}
 
 TEXT = st.text(alphabet=st.one_of(
     st.characters(codec="utf-8"),
@@ -126,6 +163,16 @@ def toml_string(text: str) -> str:
         else:
             out.append(c)
     return '"' + "".join(out) + '"'
+
+
+def replace_value(text: str, start: str, value: str) -> str:
+    """`text` with the value of the assignment that starts with `start` (one line, or a
+    triple-quoted string over lines) replaced by `value`."""
+    i = text.index(start)
+    name = start.split(" = ")[0]
+    j = i + len(name) + 3
+    end = text.index('"""', j + 3) + 3 if text.startswith('"""', j) else text.index("\n", j)
+    return text[:i] + f"{name} = {value}" + text[end:]
 
 
 def model_text(field: str, value: str) -> str:
@@ -168,13 +215,35 @@ class TextFields(unittest.TestCase):
     def test_a_task_text_field_is_read_exactly_or_refused_naming_its_key(self, original: str, value: str):
         key, kept, paragraph = TASK_FIELDS[original]
         self.assertIn(original, TASKS)
-        name = original.split(" = ")[0]
-        tasks, err, path = self.read(TASKS.replace(original, f"{name} = {toml_string(value)}", 1), load_tasks)
+        tasks, err, path = self.read(replace_value(TASKS, original, toml_string(value)), load_tasks)
         if refused_character(value, paragraph) is not None:
             self.refused_naming(err, path, key, value)
             return
         self.assertIsNone(err, f"{key} = {value!r}: {err}")
         self.assertEqual(kept(tasks), " ".join(value.split()) if paragraph else value)
+
+    @settings(max_examples=max(1, CASES // 4), deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @given(st.sampled_from(sorted(URDF_FIELDS)), TEXT)
+    def test_a_urdf_arms_text_field_is_read_or_refused_naming_its_key(self, field: str, value: str):
+        text = URDF_MODEL
+        for name in URDF_FIELDS:
+            text = text.replace(f"@{name}@", toml_string(value) if name == field else '"x"')
+        with tempfile.TemporaryDirectory() as tmp:
+            (Path(tmp) / "three.urdf").write_text(URDF)
+            path = Path(tmp) / "three.toml"
+            path.write_text(text, encoding="utf-8")
+            try:
+                model, err = load_model(path), None
+            except DescriptionError as caught:
+                model, err = None, caught
+        if refused_character(value) is not None:
+            self.refused_naming(err, path, URDF_FIELDS[field], value)
+            return
+        self.assertIsNone(err, f"{field} = {value!r}: {err}")
+        if field == "impedance_source":
+            self.assertEqual(model.impedance_source, value)
+        if field == "tool_source":
+            self.assertEqual(model.tool_rule["source"], value)
 
     def test_a_paragraph_may_have_lines_and_is_one_line_where_it_is_shown(self):
         doc = next(k for k in TASK_FIELDS if k.startswith('doc = "Reach'))

@@ -545,7 +545,7 @@ def _task(path: Path, t: Table, all_terms: tuple[TermDef, ...], cost_order: tupl
     for r in t.tables("remarks", REMARK_KEYS):
         if r.get("term") not in used:
             raise DescriptionError(path, r.sub("term"), f"'{r.get('term')}' is not a term with a sensitivity in this task")
-        remarks.append(Remark(**r.raw))
+        remarks.append(Remark(term=r.get("term"), alternative=r.get("alternative"), text=" ".join(r.get("text").split())))
     _check_identifier(t.get("name"), path, t.sub("name"))
     # A paragraph's lines are one line wherever it is shown (the IR's text is one line).
     return Task(name=t.get("name"), index=t.get("index"), title=t.get("title", ""), doc=" ".join(t.get("doc", "").split()),
