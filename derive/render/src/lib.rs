@@ -3,7 +3,9 @@
 //! toolconf-generated; or a crate of a user's own with `make crate`).
 //!
 //! The IR is read into types ([`ir`]: an unknown key, a missing one or a value of the wrong kind
-//! stops the render, naming the file, line and column). Every decision about the Rust and the
+//! stops the render, naming the file, line and column), and each field checked for its kind
+//! ([`ir_check`]: text of one line, names, file names, code in [`code`]'s grammar): an IR is data,
+//! whoever wrote it. Text reaches the templates only escaped for where it goes ([`escape`]). Every decision about the Rust and the
 //! reports written (names, signatures, bodies, counts, wording) is made here, in the views the
 //! templates see ([`model_view`], [`functions`], [`tasks`], [`tool_rule`], [`registry`]); the
 //! templates only loop over them.
