@@ -115,13 +115,29 @@ derive: $(PY)
 render:
 	cargo run --quiet -p toolconf-render -- --crate generated
 
+# make crate's and make model's arguments are data, whatever they hold (a quote, `$(...)`, a
+# backtick, a newline): each reaches the script as typed, in the environment (make's $(value),
+# which expands nothing), never through a shell command line; and they are not exported as make
+# exports a command line's variables (expanded, which would run a `$(shell ...)` in one). The
+# script starts with SIGINT blocked (GNU env's --block-signal, where env has it) until its first
+# lines have installed their handler: an interrupt while Python starts waits for it, and is one
+# line, never a traceback.
+MAKE_ARGUMENTS := MODELS OUT TASKS NAME DESC IR
+BLOCK_SIGINT := $(shell env --block-signal=INT true 2>/dev/null && echo env --block-signal=INT)
+unexport $(MAKE_ARGUMENTS)
+crate model: export TOOLCONF_MAKE_MODELS = $(value MODELS)
+crate model: export TOOLCONF_MAKE_OUT = $(value OUT)
+crate model: export TOOLCONF_MAKE_TASKS = $(value TASKS)
+crate model: export TOOLCONF_MAKE_NAME = $(value NAME)
+crate model: export TOOLCONF_MAKE_DESC = $(value DESC)
+crate model: export TOOLCONF_MAKE_IR = $(value IR)
+
 ## make crate MODELS=<folder> OUT=<folder> [TASKS=<file>] [NAME=<crate>]: derive the model descriptions in
 ## MODELS (with derive/tasks.toml, or TASKS) into a standalone no_std crate at OUT, with its own
 ## test against the CasADi vectors (cargo test --manifest-path OUT/Cargo.toml); nothing in the
 ## repository changes (derive/make_crate.py).
 crate: $(PY)
-	@if [ -z "$(MODELS)" ] || [ -z "$(OUT)" ]; then echo "usage: make crate MODELS=<folder of model descriptions> OUT=<folder> [TASKS=<file>] [NAME=<crate>]" >&2; exit 2; fi
-	$(PY) derive/make_crate.py --models "$(MODELS)" --out "$(OUT)" $(if $(TASKS),--tasks "$(TASKS)") $(if $(NAME),--name "$(NAME)")
+	@exec $(BLOCK_SIGINT) $(PY) derive/make_crate.py --from-make
 
 ## make model DESC=<description> OUT=<folder> [TASKS=<file>]: validate, derive and build ONE model into a
 ## shared library with toolconf's C ABI in OUT (libtoolconf_model_<model>.so, toolconf_model.h, and the
@@ -129,8 +145,7 @@ crate: $(PY)
 ## and compiles a model derived before. Nothing in the repository changes (derive/make_model.py,
 ## docs/c-abi.md).
 model: $(PY)
-	@if [ -z "$(OUT)" ] || { [ -z "$(DESC)" ] && [ -z "$(IR)" ]; }; then echo "make model: usage: make model DESC=<description> OUT=<folder> [TASKS=<file>], or IR=<model.json> OUT=<folder>" >&2; exit 2; fi
-	@$(PY) derive/make_model.py $(if $(DESC),--desc "$(DESC)") $(if $(IR),--ir "$(IR)") --out "$(OUT)" $(if $(TASKS),--tasks "$(TASKS)")
+	@exec $(BLOCK_SIGINT) $(PY) derive/make_model.py --from-make
 
 ## make drift-check: derive into a temporary folder, twice: as this CPU does, and with numpy's
 ## optional kernels (AVX-512, AVX2, ...) and glibc's AVX/FMA variants switched off; fail, naming

@@ -10,11 +10,17 @@ beside it the CasADi test vectors (<name>.vectors.json for --out <name>.json).
 
 from __future__ import annotations
 
-import argparse
-import json
+import signal
 import sys
-import warnings
-from pathlib import Path
+
+# An interrupt is no error: the run ends quietly with the shell's status for it (make model, which
+# runs this, says it in one line), even while the modules below load.
+signal.signal(signal.SIGINT, lambda *_: sys.exit(130))
+
+import argparse  # noqa: E402
+import json  # noqa: E402
+import warnings  # noqa: E402
+from pathlib import Path  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
@@ -23,6 +29,7 @@ from toolconf_derive import progress  # noqa: E402
 from toolconf_derive.crosscheck import DerivationMismatch  # noqa: E402
 from toolconf_derive.description import load_model, load_tasks  # noqa: E402
 from toolconf_derive.errors import DescriptionError  # noqa: E402
+from toolconf_derive.files import text_problem  # noqa: E402
 from toolconf_derive.functions import build_functions  # noqa: E402
 from toolconf_derive.exact import ExactEvaluationError  # noqa: E402
 from toolconf_derive.ir import IR_SCHEMA, model_ir, vectors_document  # noqa: E402
@@ -103,6 +110,12 @@ def run() -> int:
     if args.vectors < 1:
         print(f"derive: --vectors {args.vectors}: need at least one test vector per function", file=sys.stderr)
         return 2
+    for flag, path in (("model", args.model), ("--tasks", args.tasks)):
+        # The paths are named in the generated files: one line of text.
+        problem = text_problem(str(path))
+        if problem:
+            print(f"derive: {flag} {str(path)!r}: {problem}", file=sys.stderr)
+            return 2
     try:
         model = load_model(args.model)
         out = args.out if args.out is not None else args.out_dir / f"{model.name}.json"

@@ -26,25 +26,43 @@ target/ (which the new crate keeps): only then is it replaced. OUT may not be a 
 inside the repository, or hold the descriptions, their URDFs or the task file, and the crate gets
 the permissions of any folder the user makes (0777 less the umask). Nothing in the repository
 changes (the derivation runs in place, the renderer builds into target/). Bad input is one line
-naming the file, key or value, status 2.
+naming the file, key or value, status 2. make hands the arguments over in the environment, as
+typed (`--from-make`: make_arguments), never through a shell; a path holding a newline or another
+control character is refused (check_arguments).
 """
 
 from __future__ import annotations
 
-import argparse
-import os
-import re
-import shutil
 import signal
-import subprocess
 import sys
-import tempfile
-from concurrent.futures import ThreadPoolExecutor
-from pathlib import Path
 
-from toolconf_derive.description import RUST_KEYWORDS, load_tasks
-from toolconf_derive.errors import DescriptionError
-from toolconf_derive.files import read_toml
+
+def _interrupted_while_starting(*_) -> None:
+    """Ctrl-C while the derivation's modules load, before the run has started: one line and the
+    shell's status for an interrupt, no traceback."""
+    print("make crate: interrupted; nothing changed", file=sys.stderr)
+    raise SystemExit(130)
+
+
+# First, before the imports that take a second: an interrupt during them is the line above. make
+# starts this with SIGINT blocked (the Makefile): one that came while Python started is delivered
+# here, to the handler.
+if __name__ == "__main__":
+    signal.signal(signal.SIGINT, _interrupted_while_starting)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+import argparse  # noqa: E402
+import os  # noqa: E402
+import re  # noqa: E402
+import shutil  # noqa: E402
+import subprocess  # noqa: E402
+import tempfile  # noqa: E402
+from concurrent.futures import ThreadPoolExecutor  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+from toolconf_derive.description import RUST_KEYWORDS, load_tasks  # noqa: E402
+from toolconf_derive.errors import DescriptionError  # noqa: E402
+from toolconf_derive.files import read_toml, refused_character  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 TASKS = ROOT / "derive" / "tasks.toml"
@@ -204,6 +222,7 @@ def install(tmp: Path, out: Path, files: list[tuple[str, Path]], command: str = 
 
 
 def make_crate(models: Path, out: Path, tasks: Path, name: str | None) -> int:
+    check_arguments(COMMAND, [("MODELS", models), ("OUT", out), ("TASKS", tasks), ("NAME", name)])
     out = Path(os.path.abspath(out))  # the crate is named after the name given, links and all
     package = crate_name(out, name)
     found = descriptions(models)
@@ -231,13 +250,54 @@ def make_crate(models: Path, out: Path, tasks: Path, name: str | None) -> int:
     return 0
 
 
+# make's arguments, as the Makefile hands them over: each variable's text as typed (make's
+# `$(value ...)`), in the environment under this prefix, never through a shell command line.
+MAKE_PREFIX = "TOOLCONF_MAKE_"
+
+
+def make_arguments(names: list[tuple[str, str]]) -> list[str] | None:
+    """With the only argument `--from-make` (the Makefile's targets): the options of the make
+    variables given, `--out=<OUT as typed>`, from the environment; else None (sys.argv's)."""
+    if sys.argv[1:] != ["--from-make"]:
+        return None
+    return [f"{flag}={os.environ[MAKE_PREFIX + name]}" for name, flag in names
+            if os.environ.get(MAKE_PREFIX + name)]
+
+
+def check_arguments(command: str, given: list[tuple[str, Path | str | None]]) -> None:
+    """Each path or name given is one line of text: a line break or another control character in
+    one is refused, naming the argument (it would reach messages, file names and generated
+    files)."""
+    for label, value in given:
+        if value is None:
+            continue
+        c = refused_character(str(value))
+        if c is not None:
+            text = str(value)
+            shown = repr(text if len(text) <= 100 else text[:100] + "…")
+            raise Refused(f"{label}={shown}: holds U+{ord(c):04X} (a control character or line break) at character "
+                          f"{text.index(c) + 1}; give a path of one line")
+
+
+class Arguments(argparse.ArgumentParser):
+    """Argument errors as one line and status 2, as every other refusal."""
+
+    def error(self, message: str):
+        print(f"{COMMAND}: {message} (usage: make crate MODELS=<folder of model descriptions> OUT=<folder> "
+              "[TASKS=<file>] [NAME=<crate>])", file=sys.stderr)
+        raise SystemExit(2)
+
+
 def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    argv = make_arguments([("MODELS", "--models"), ("OUT", "--out"), ("TASKS", "--tasks"), ("NAME", "--name")])
+    ap = Arguments(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--models", type=Path, required=True, help="folder of model descriptions (*.toml)")
     ap.add_argument("--out", type=Path, required=True, help="the crate's folder (new, empty, or made by this)")
     ap.add_argument("--tasks", type=Path, default=TASKS, help="task definitions (default derive/tasks.toml)")
     ap.add_argument("--name", help="the crate's package name (default: OUT's folder name)")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
+    # From here an interrupt is the run's: run_reported says it and the old OUT stays.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     return run_reported("make crate", args.out, lambda: make_crate(args.models, args.out, args.tasks, args.name))
 
 

@@ -21,15 +21,20 @@ the step's own: reading and validating, deriving (the equations, then each funct
 checking (each function's test vectors against its reference), rendering, compiling. The last
 line, on stdout, names what was made.
 
-The description and the task file are read and checked before anything else (a mistake is one
-line naming the file, the key and the value, status 2), as are the arguments. OUT follows make
+The arguments, the description and the task file (or the IR, by the renderer's whole check:
+its text, names, file names and code) are read and checked before anything else (a mistake is
+one line naming the file, the key and the value, status 2). make hands the arguments over in the
+environment, as typed (`--from-make`: make_crate.make_arguments), never through a shell; a path
+holding a newline or another control character is refused. OUT follows make
 crate's rule (crates/files/src/folder.rs, asked through the renderer: derive/make_crate.py): it
 must not exist, be empty, or be a folder make model made whose files are all as it wrote them
 (cargo's Cargo.lock and target/ aside); it may not be a symbolic link, lie inside the repository,
 or hold an input. Everything is made in a temporary folder beside OUT and moved into place at the
 end, so a failure or an interrupt leaves the old OUT as it was. Nothing in the repository
 changes: the renderer and the library build into the repository's target/ (ignored by git; the
-library's build under target/make-model/, or $CARGO_TARGET_DIR/make-model).
+library's build under target/make-model/, or $CARGO_TARGET_DIR/make-model). That build folder is
+shared by every run, so that the dependencies are built once; runs at once take turns to build
+and install their library (build_lock), the later one saying that it waits.
 
 The library's crate builds on the repository it was made from (toolconf-cabi and toolconf-core
 by path, the model's generated crate in place of the repository's by cargo's [patch]), so that
@@ -38,24 +43,49 @@ its exports run the very code the command line and the on-robot controller run.
 
 from __future__ import annotations
 
-import argparse
-import json
-import os
-import shutil
-import subprocess
+import signal
 import sys
-import tempfile
-import time
-from pathlib import Path
 
-import make_crate
-from make_crate import Failed, Refused, folder_rule, install, renderer, urdf_inputs
-from toolconf_derive.description import check_tasks, load_model, load_tasks
-from toolconf_derive.errors import DescriptionError
+COMMAND = "make model"
+
+
+def _interrupted_while_starting(*_) -> None:
+    """Ctrl-C while the derivation's modules load, before the run has started: one line and the
+    shell's status for an interrupt, no traceback."""
+    print(f"{COMMAND}: interrupted; nothing changed", file=sys.stderr)
+    raise SystemExit(130)
+
+
+# First, before the imports that take a second: an interrupt during them is the line above. make
+# starts this with SIGINT blocked (the Makefile): one that came while Python started is delivered
+# here, to the handler.
+signal.signal(signal.SIGINT, _interrupted_while_starting)
+signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+import argparse  # noqa: E402
+import fcntl  # noqa: E402
+import json  # noqa: E402
+import os  # noqa: E402
+import re  # noqa: E402
+import shutil  # noqa: E402
+import stat  # noqa: E402
+import subprocess  # noqa: E402
+import tempfile  # noqa: E402
+import time  # noqa: E402
+from contextlib import contextmanager  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import make_crate  # noqa: E402
+from make_crate import Failed, Refused, check_arguments, folder_rule, install, make_arguments, renderer, urdf_inputs  # noqa: E402
+from toolconf_derive.description import MAX_NAME, RUST_NAME, check_tasks, load_model, load_tasks  # noqa: E402
+from toolconf_derive.errors import DescriptionError  # noqa: E402
+from toolconf_derive.files import read_text  # noqa: E402
 
 ROOT = make_crate.ROOT
 TASKS = make_crate.TASKS
-COMMAND = "make model"
+# The largest IR read: derive/render/src/ir.rs's MAX_IR_BYTES (the Panda's is 5.5 MB).
+MAX_IR_BYTES = 128 << 20
+VECTORS_FILE = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*\.vectors\.json", re.ASCII)
 
 
 class Clock:
@@ -92,23 +122,59 @@ def read_description(desc: Path, tasks: Path):
 
 
 def read_ir(ir: Path) -> tuple[str, Path]:
-    """A committed IR's model name and its test vectors beside it (`<name>.vectors.json`): the
-    renderer checks the rest."""
-    if not ir.is_file():
-        what = "does not exist" if not ir.exists() else "is not a file"
-        raise Refused(f"IR={ir}: {what}")
+    """A committed IR's model name and its test vectors beside it (`<name>.vectors.json`), read
+    bounded (MAX_IR_BYTES) from a regular file; the renderer checks the rest (check_ir)."""
+    if not os.path.lexists(ir):
+        raise Refused(f"IR={ir}: does not exist")
     if not ir.name.endswith(".json") or ir.name.endswith(".vectors.json"):
         raise Refused(f"IR={ir}: not a model's IR (<model>.json, as make derive writes them into generated/)")
     try:
-        with ir.open(encoding="utf-8") as f:
-            document = json.load(f)
+        document = json.loads(read_text(ir, MAX_IR_BYTES, "a model's IR"))
         name = document["model"]["name"]
-        vectors = ir.parent / document["test_vectors"]["file"]
-    except (OSError, ValueError, KeyError, TypeError) as err:
+        file = document["test_vectors"]["file"]
+    except DescriptionError as err:
+        raise Refused(f"IR={err}") from err
+    except (ValueError, KeyError, TypeError, RecursionError) as err:
         raise Refused(f"IR={ir}: not a model's IR ({type(err).__name__}: {' '.join(str(err).split())[:200]})") from err
-    if not isinstance(name, str) or not vectors.is_file():
-        raise Refused(f"IR={ir}: its test vectors {vectors} are not beside it")
+    if not isinstance(name, str) or not RUST_NAME.fullmatch(name) or len(name) > MAX_NAME:
+        raise Refused(f"IR={ir}: model.name: {shown(name)} is not a model's name (a lower-case ASCII letter, then "
+                      f"letters, digits or _, at most {MAX_NAME})")
+    # A file beside the IR, by name: no folder, no link (a path out of the IR's folder, or a
+    # link to one, would copy a file from elsewhere into OUT).
+    if not isinstance(file, str) or not VECTORS_FILE.fullmatch(file):
+        raise Refused(f"IR={ir}: test_vectors.file: {shown(file)} is not the name of a file beside the IR "
+                      "(<model>.vectors.json; no folder)")
+    vectors = ir.parent / file
+    try:
+        mode = os.lstat(vectors).st_mode
+    except OSError:
+        raise Refused(f"IR={ir}: its test vectors {vectors} are not beside it") from None
+    if not stat.S_ISREG(mode):
+        what = "a symbolic link" if stat.S_ISLNK(mode) else "not a regular file"
+        raise Refused(f"IR={ir}: its test vectors {vectors} are {what}, not a file beside it")
+    if os.lstat(vectors).st_size > MAX_IR_BYTES:
+        raise Refused(f"IR={ir}: its test vectors {vectors} are larger than {MAX_IR_BYTES >> 20} MiB")
     return name, vectors
+
+
+def shown(value) -> str:
+    """A value quoted in a message: one line, at most 100 characters."""
+    text = repr(value)
+    return text if len(text) <= 100 else f"{text[:100]}… ({len(text)} characters)"
+
+
+def check_ir(ir: Path) -> None:
+    """The renderer's whole check of the IR (its shape, and each field of its kind: text, names,
+    file names, code), before anything is made: its one line, status 2."""
+    r = renderer("--check-ir", str(Path.cwd() / ir), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                 errors="replace")
+    if r.returncode == 0:
+        return
+    last = (r.stderr.strip().splitlines() or [""])[-1].removeprefix("toolconf-render: ")
+    if r.returncode == 2:
+        raise Refused(f"IR={last}")
+    sys.stderr.write(r.stderr)
+    raise Failed(f"the renderer could not check IR={ir} (status {r.returncode})")
 
 
 def derive(desc: Path, tasks: Path, folder: Path, clock: Clock) -> None:
@@ -166,6 +232,25 @@ def target_dir() -> Path:
     dependencies' builds are shared by every make model run)."""
     base = os.environ.get("CARGO_TARGET_DIR")
     return (Path(base) if base else ROOT / "target") / "make-model"
+
+
+@contextmanager
+def build_lock():
+    """The one make model run at a time that builds in target_dir() and installs its OUT: two
+    runs at once (to one OUT or to two) would otherwise overwrite or clean each other's library
+    there. The dependencies' builds stay shared; a second run waits, saying so, and a run that
+    ends releases the lock with its process."""
+    folder = target_dir()
+    folder.mkdir(parents=True, exist_ok=True)
+    lock = folder / ".make-model.lock"
+    with open(lock, "a") as f:
+        try:
+            fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            print(f"{COMMAND}: waiting for another make model run to finish building in {folder} (it holds {lock})",
+                  file=sys.stderr, flush=True)
+            fcntl.flock(f, fcntl.LOCK_EX)
+        yield
 
 
 def compile_library(staging: Path, clock: Clock) -> Path:
@@ -226,6 +311,7 @@ def build_renderer() -> float:
 
 def make_model(desc: Path | None, ir: Path | None, out: Path, tasks: Path) -> int:
     clock = Clock()
+    check_arguments(COMMAND, [("DESC", desc), ("IR", ir), ("OUT", out), ("TASKS", tasks)])
     out = Path(os.path.abspath(out))
     # Everything is checked (the input, then OUT) before the first line of progress.
     if desc is not None:
@@ -239,6 +325,8 @@ def make_model(desc: Path | None, ir: Path | None, out: Path, tasks: Path) -> in
         files = [(f"IR={ir}", ir), (f"the test vectors of IR={ir}", vectors)]
         read = f"{ir} (model {name}), derived before: no derivation; OUT={out}: may be made"
     built = build_renderer()
+    if ir is not None:
+        check_ir(ir)
     folder_rule(["--check-crate-out", str(out)], files, COMMAND)
     if built > 2:
         read += f" (toolconf-render built first: {built:.0f} s)"
@@ -256,8 +344,9 @@ def make_model(desc: Path | None, ir: Path | None, out: Path, tasks: Path) -> in
             shutil.copyfile(ir, ir_file)
             shutil.copyfile(vectors, generated / vectors.name)
         render(ir_file, staging, clock)
-        library = compile_library(staging, clock)
-        install(staging, out, files, COMMAND)
+        with build_lock():
+            library = compile_library(staging, clock)
+            install(staging, out, files, COMMAND)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     print(f"{COMMAND}: {out}: {library.name} and toolconf_model.h (model {name}, C ABI of crates/cabi) in "
@@ -276,16 +365,20 @@ class Arguments(argparse.ArgumentParser):
 
 
 def main() -> int:
+    # make's arguments come in the environment, as typed (the Makefile's `model` target).
+    argv = make_arguments([("DESC", "--desc"), ("IR", "--ir"), ("OUT", "--out"), ("TASKS", "--tasks")])
     ap = Arguments(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     source = ap.add_mutually_exclusive_group(required=True)
     source.add_argument("--desc", type=Path, help="the model description (TOML)")
     source.add_argument("--ir", type=Path, help="a model's IR derived before (generated/<model>.json)")
     ap.add_argument("--out", type=Path, required=True, help="the library's folder (new, empty, or made by this)")
     ap.add_argument("--tasks", type=Path, default=None, help="task definitions (default derive/tasks.toml)")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     if args.ir is not None and args.tasks is not None:
         ap.error("TASKS= goes with DESC=: an IR was derived with its task definitions")
     tasks = args.tasks if args.tasks is not None else TASKS
+    # From here an interrupt is the run's: run_reported says it and the old OUT stays.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     return make_crate.run_reported(COMMAND, args.out, lambda: make_model(args.desc, args.ir, args.out, tasks))
 
 

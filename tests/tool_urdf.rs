@@ -212,7 +212,7 @@ fn bad_input_is_status_2_and_one_line_naming_it() {
         (String::new(), with(&[]), vec!["x.urdf: not a well-formed XML file"]),
         (deep, with(&[]), vec!["x.urdf: not a well-formed XML file"]),
         (chain, vec!["--urdf", "x.urdf", "--root", "l0", "--tip", "l49999"], vec!["merge to an inertia", "is not positive definite"]),
-        (panda.clone(), vec!["--urdf", "/dev/zero", "--root", "a", "--tip", "b"], vec!["/dev/zero: is larger than 8388608 bytes (8 MiB)"]),
+        (panda.clone(), vec!["--urdf", "/dev/zero", "--root", "a", "--tip", "b"], vec!["/dev/zero: is a device, not a URDF file"]),
         (panda.clone(), vec!["--urdf", "missing.urdf", "--root", "a", "--tip", "b"], vec!["missing.urdf: cannot read the URDF file"]),
         (panda.clone(), vec!["--urdf", ".", "--root", "a", "--tip", "b"], vec![".: is a folder, not a URDF file"]),
         (panda.clone(), with(&["--opening", "0", "--out", "/"]), vec!["--out /"]),

@@ -105,7 +105,7 @@ URDF = """<?xml version="1.0"?><robot name="fuzz">
 <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>
 <link name="flange"/>
 <joint name="j1" type="revolute"><parent link="base"/><child link="a"/><origin xyz="0 0 0" rpy="0 0 0"/>
-<axis xyz="0 0 1"/></joint>
+<axis xyz="0 0 1"/><limit lower="-4" upper="4" effort="10" velocity="1"/></joint>
 <joint name="fix" type="fixed"><parent link="a"/><child link="flange"/><origin xyz="0 0 0.2" rpy="0 0 0"/></joint>
 </robot>"""
 URDF_TOKENS = ["<", ">", "/>", "</", '"', "=", " ", "link", "joint", "inertial", "mass", "value", "origin", "xyz",

@@ -38,11 +38,11 @@ URDF = """<?xml version="1.0"?><robot name="test">
 <inertia ixx="0.002" ixy="0" ixz="0" iyy="0.002" iyz="0" izz="0.002"/></inertial></link>
 <link name="flange"/>
 <joint name="j1" type="revolute"><parent link="base"/><child link="a"/><origin xyz="{xyz}" rpy="0 0 0"/>
-<axis xyz="0 0 1"/></joint>
+<axis xyz="0 0 1"/><limit lower="-4" upper="4" effort="10" velocity="1"/></joint>
 <joint name="j2" type="revolute"><parent link="a"/><child link="b"/><origin xyz="0 0 0.2" rpy="0 0 0"/>
-<axis xyz="0 1 0"/></joint>
+<axis xyz="0 1 0"/><limit lower="-4" upper="4" effort="10" velocity="1"/></joint>
 <joint name="j3" type="revolute"><parent link="b"/><child link="c"/><origin xyz="0 0 0.2" rpy="0 0 0"/>
-<axis xyz="1 0 0"/></joint>
+<axis xyz="1 0 0"/><limit lower="-4" upper="4" effort="10" velocity="1"/></joint>
 <joint name="fix" type="fixed"><parent link="c"/><child link="flange"/><origin xyz="0 0 0.1" rpy="0 0 0"/></joint>
 </robot>"""
 URDF_MODEL = """

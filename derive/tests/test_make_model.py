@@ -6,6 +6,7 @@ interrupted run keeps the old library (part of make test)."""
 from __future__ import annotations
 
 import ctypes
+import json
 import os
 import re
 import shutil
@@ -131,7 +132,142 @@ class MakeModel(unittest.TestCase):
         self.assert_refused(self.run_make_model("--desc", str(inside / "p.toml"), "--out", str(inside)), "DESC=",
                             kept=kept)
 
+    def run_make(self, *args: str) -> subprocess.CompletedProcess:
+        return subprocess.run(["make", "--no-print-directory", "-s", *args], cwd=ROOT, capture_output=True, text=True)
+
+    def own_lines(self, r: subprocess.CompletedProcess, command: str = "make model") -> list[str]:
+        """stderr's lines but make's own (`make: *** [...] Error 2`), each checked to be the command's."""
+        lines = [line for line in r.stderr.splitlines() if not line.startswith("make: *** ")]
+        for line in lines:
+            self.assertTrue(line.startswith(f"{command}: "), r.stderr)
+        return lines
+
+    def test_make_arguments_are_data_never_shell_code(self):
+        # Backticks, $(...), make's own $(shell ...), quotes and a newline in DESC, IR, OUT, TASKS
+        # (and make crate's MODELS, NAME): nothing runs, each is one line, status 2.
+        marker = self.base / "ran"
+        code = [f"`touch {marker}1`", f"$(touch {marker}2)", f'"; touch {marker}3; "', f"$(shell touch {marker}4)",
+                f"$$(touch {marker}5)", f"'; touch {marker}6; '"]
+        out = self.base / "out"
+        for c in code:
+            for args in ([f"DESC={self.base}/{c}x.toml", f"OUT={out}"], [f"IR={self.base}/{c}.json", f"OUT={out}"],
+                         [f"DESC={self.desc}", f"OUT={self.base}/{c}"], [f"DESC={self.desc}", f"TASKS={c}", f"OUT={out}"]):
+                r = self.run_make("model", *args)
+                self.assertEqual(r.returncode, 2, r.stderr)
+                self.assertEqual(len(self.own_lines(r)), 1, r.stderr)
+            r = self.run_make("crate", f"MODELS={self.base}/{c}", f"OUT={out}", f"NAME={c}")
+            self.assertEqual(r.returncode, 2, r.stderr)
+            self.assertEqual(len(self.own_lines(r, "make crate")), 1, r.stderr)
+        self.assertEqual(sorted(p.name for p in self.base.iterdir()), ["my_pendulum.toml"])
+        r = self.run_make("model", f"DESC={self.desc}", f"OUT={self.base}/a\nb")
+        self.assertEqual(self.own_lines(r), [f"make model: OUT='{self.base}/a\\nb': holds U+000A (a control "
+                                             f"character or line break) at character {len(str(self.base)) + 3}; give "
+                                             "a path of one line"])
+        self.assertEqual(sorted(p.name for p in self.base.iterdir()), ["my_pendulum.toml"])
+
+    def test_an_ir_is_read_bounded_and_its_vectors_only_from_beside_it(self):
+        out = str(self.base / "out")
+        huge = self.base / "huge.json"
+        with open(huge, "wb") as f:
+            f.truncate(2 << 30)  # 2 GiB, sparse
+        self.assert_refused(self.run_make_model("--ir", str(huge), "--out", out), f"IR={huge}", "larger than",
+                            kept=files_under(self.base))
+        huge.unlink()
+        ir = json.loads((ROOT / "generated" / "msd.json").read_text())
+        here = self.base / "msd.json"
+
+        def refused(edit, *words, vectors: str | None = None):
+            document = json.loads(json.dumps(ir))
+            edit(document)
+            here.write_text(json.dumps(document))
+            if vectors is not None:
+                (self.base / "msd.vectors.json").symlink_to(vectors)
+            self.assert_refused(self.run_make_model("--ir", str(here), "--out", out), f"IR={here}", *words,
+                                kept=files_under(self.base))
+            for p in self.base.iterdir():
+                if p.name.startswith("msd"):
+                    p.unlink()
+
+        for file in ("../../../../etc/hostname", "/etc/hostname", "sub/msd.vectors.json", ".vectors.json"):
+            refused(lambda d, f=file: d["test_vectors"].update(file=f), "test_vectors.file", "not the name of a file")
+        # The right name, but a link out of the folder.
+        refused(lambda d: None, "symbolic link", vectors="/etc/hostname")
+        for name in ("../../evil", "a" * 300, "Evil"):
+            refused(lambda d, n=name: d["model"].update(name=n), "model.name")
+        # The rest is the renderer's check, before anything is made: a line break in a title, code
+        # in a closed form, each one line naming the key.
+        shutil.copy(ROOT / "generated" / "msd.vectors.json", self.base / "msd.vectors.json")
+        for edit, key in ((lambda d: d["model"].update(title="a\nb"), "model.title"),
+                          (lambda d: d["functions"][0]["temporaries"].append({"name": "x", "rust": "{ abort() }"}),
+                           "functions[0].temporaries")):
+            document = json.loads(json.dumps(ir))
+            edit(document)
+            here.write_text(json.dumps(document))
+            self.assert_refused(self.run_make_model("--ir", str(here), "--out", out), f"IR={here}", key,
+                                kept=files_under(self.base))
+
+    def test_a_long_name_or_a_tip_that_is_code_is_refused_before_anything_is_derived(self):
+        out = str(self.base / "out")
+        text = PENDULUM.read_text()
+        for edit, key in ((text.replace('name = "pendulum"', f'name = "{"p" * 300}"'), "model.name"),
+                          (text.replace('"l*sin(theta)"', '"__import__(\'os\').system(\'x\')"'), "tip.position[1]")):
+            self.desc.write_text(edit)
+            r = self.run_make_model("--desc", str(self.desc), "--out", out)
+            self.assert_refused(r, "my_pendulum.toml", key)
+
+    def test_an_interrupt_while_make_model_starts_is_one_line(self):
+        # Ctrl-C (SIGINT to make's process group, as a terminal sends it) at times within the first
+        # 0.1 s: never a traceback, at most one line of make model's, the shell's status for it.
+        for delay in (0.0, 0.01, 0.02, 0.04, 0.06, 0.08, 0.1):
+            run = subprocess.Popen(["make", "--no-print-directory", "-s", "model", f"DESC={self.desc}",
+                                    f"OUT={self.base / 'out'}"], cwd=ROOT, stderr=subprocess.PIPE, text=True,
+                                   start_new_session=True)
+            time.sleep(delay)
+            os.killpg(run.pid, signal.SIGINT)
+            stderr = run.communicate(timeout=300)[1]
+            self.assertNotIn("Traceback", stderr)
+            ours = [line for line in stderr.splitlines() if not line.startswith("make: *** ")]
+            self.assertLessEqual(len(ours), 1, stderr)
+            self.assertIn(run.returncode, (-signal.SIGINT, 2, 130), stderr)
+            if ours:
+                self.assertEqual(ours, ["make model: interrupted; nothing changed"], stderr)
+            self.assertEqual(sorted(p.name for p in self.base.iterdir()), ["my_pendulum.toml"])
+
+    def test_two_runs_at_once_each_make_their_library(self):
+        # Three runs at once, two of them to one OUT: each ends well and its library is whole; the
+        # build folder is shared (the dependencies built once) and taken in turn.
+        ir = ROOT / "generated" / "msd.json"
+        outs = [self.base / "one", self.base / "two", self.base / "two"]
+        runs = [subprocess.Popen([*MAKE_MODEL, "--ir", str(ir), "--out", str(out)], cwd=self.base,
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for out in outs]
+        results = [(run.communicate(timeout=900)[1], run.returncode) for run in runs]
+        results = [(status, stderr) for stderr, status in results]
+        for status, stderr in results:
+            self.assertEqual(status, 0, stderr)
+            self.assertNotIn("Traceback", stderr)
+        self.assertTrue(any("waiting for another make model run" in stderr for _, stderr in results), results)
+        for out in outs:
+            library = out / "libtoolconf_model_msd.so"
+            lib = ctypes.CDLL(str(library))
+            lib.toolconf_abi_version.restype = ctypes.c_uint32
+            self.assertEqual(lib.toolconf_abi_version(), 1)
+        self.assertEqual(sorted(p.name for p in self.base.iterdir()), ["my_pendulum.toml", "one", "two"])
+
     def test_a_description_becomes_a_library_that_loads_and_computes_with_each_step_shown(self):
+        # Its text fields hold what would be code if pasted into the Rust: a unit that closes its
+        # literal and adds a constructor writing a canary file, a title that closes a C comment,
+        # an indented doctest, fences, quotes and a trigraph. They are text: the library builds,
+        # loads, and the canary never appears.
+        canary = self.base / "canary"
+        unit = (f'kg", "", ""]; #[used] #[link_section = ".init_array"] static INIT: extern "C" fn() = init; '
+                f'extern "C" fn init() {{ let _ = std::fs::write("{canary}", ""); }} const _X: [&str; 3] = ["')
+        text = PENDULUM.read_text().replace('unit = "kg"', f"unit = {json.dumps(unit)}", 1)
+        for old, new in (('title = "Uniform rod pendulum driven at its pivot"', 'title = "*/ #define X 1 /* ??/"'),
+                         ('doc = "mass of the rod"', f'doc = "    std::fs::write(\\"{canary}\\", \\"\\"); //"'),
+                         ('equations = ["moment balance at the pivot"]', 'equations = ["```", "~~~ rust"]')):
+            self.assertIn(old, text)
+            text = text.replace(old, new, 1)
+        self.desc.write_text(text)
         before = git_status()
         out = self.base / "pendulum-lib"
         r = self.run_make_model("--desc", str(self.desc), "--out", str(out))
@@ -183,6 +319,10 @@ class MakeModel(unittest.TestCase):
         lib.toolconf_last_error.restype = ctypes.c_char_p
         self.assertIn(b"x is a null pointer", lib.toolconf_last_error())
         self.assertEqual(lib.toolconf_pi_u(99, p, p, x_dot), 2)  # TOOLCONF_UNKNOWN_TASK
+        self.assertFalse(canary.exists())
+        self.assertIn(f"pub const PARAMETER_UNITS: [&str; 2] = [{json.dumps(unit)}, \"m\",",
+                      (out / "generated" / "src" / "pendulum.rs").read_text())
+        self.assertIn(" * * / #define X 1 / * ??/.\n", header)
         if before is not None:
             self.assertEqual(git_status(), before)
 

@@ -56,6 +56,9 @@ def _inertial(mass, com=(0.0, 0.0, 0.0), moments=(0.01, 0.01, 0.01), rpy="0 0 0"
 
 
 def _joint(name, kind, parent, child, xyz="0 0 0", rpy="0 0 0", axis="0 0 1", extra=""):
+    # A revolute or prismatic joint has a <limit> (the URDF specification's rule): a wide one.
+    if kind in ("revolute", "prismatic") and "<limit" not in extra:
+        extra += '<limit lower="-4" upper="4" effort="10" velocity="1"/>'
     return (f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
             f'<origin xyz="{xyz}" rpy="{rpy}"/><axis xyz="{axis}"/>{extra}</joint>')
 
@@ -123,9 +126,11 @@ class Refusals(unittest.TestCase):
         self.assertEqual(r.returncode, 0, r.stderr)
 
     def test_floating_planar_and_unknown_joints(self):
-        for kind in ("floating", "planar", "ball"):
+        for kind in ("floating", "planar"):
             urdf = _robot(*GOOD).replace('name="j2" type="revolute"', f'name="j2" type="{kind}"')
             self.stops(urdf, "joint 'j2'", f"type '{kind}' is not supported")
+        urdf = _robot(*GOOD).replace('name="j2" type="revolute"', 'name="j2" type="ball"')
+        self.stops(urdf, "joint 'j2'", "type 'ball' is not a URDF joint type")
 
     def test_mimic_joint(self):
         urdf = _robot(*GOOD).replace('<axis xyz="0 1 0"/>', '<axis xyz="0 1 0"/><mimic joint="j1"/>')
@@ -179,10 +184,14 @@ class Refusals(unittest.TestCase):
         self.stops(urdf, "link 'b'", "violate the triangle inequality")
 
     def test_flange_not_below_the_base_and_undefined_links(self):
-        urdf = _robot(*GOOD, _link("elsewhere"))
-        self.stops(urdf.replace('name="flange"/>', 'name="flange"/>', 1).replace(
-            _joint("fix", "fixed", "c", "flange", "0 0 0.2"), _joint("fix", "fixed", "elsewhere", "flange")),
-            "link 'flange'", "is not below the base")
+        # The flange above the base: the one root.
+        urdf = _robot(*GOOD).replace(_joint("fix", "fixed", "c", "flange", "0 0 0.2"),
+                                     _joint("fix", "fixed", "flange", "base"))
+        self.stops(urdf, "link 'flange'", "is not below the base")
+        # Under a second root: not a URDF (its links are one tree).
+        urdf = _robot(*GOOD, _link("elsewhere")).replace(_joint("fix", "fixed", "c", "flange", "0 0 0.2"),
+                                                         _joint("fix", "fixed", "elsewhere", "flange"))
+        self.stops(urdf, "2 root links ('base', 'elsewhere')", "one tree with one root")
         self.stops(_robot(*GOOD).replace('<child link="flange"/>', '<child link="nowhere"/>'),
                    "joint 'fix'", "its child link 'nowhere' is not defined")
 
@@ -770,10 +779,10 @@ class HowAUrdfIsRead(PinocchioCheck, unittest.TestCase):
         self.assertEqual(r.stderr.splitlines(), [
             f"derive: {model}: equilibrium.q[1]: '2.5' = 2.5 is outside joint 'joint2''s limits [-2.059, 2.0944] "
             f"({urdf} <limit lower upper>)"])
-        # A continuous joint has no limits; a limit's absent side is no bound.
+        # A limit's absent side is 0, as the URDF specification has it.
         text = _xarm_urdf().replace('lower="-2.059" ', "")
-        urdf, model = self.files(text, "xarm.urdf", XARM_MODEL.format(q2="-2.5"))
-        self.assertEqual(load_model(model).chain.limits[1], (None, 2.0944))
+        urdf, model = self.files(text, "xarm.urdf", XARM_MODEL.format(q2="0.5"))
+        self.assertEqual(load_model(model).chain.limits[1], (0.0, 2.0944))
 
     def test_an_equilibrium_failure_names_the_joints_and_the_cause(self):
         # With the former entry snapping let through, gravity fed forward by the code (RNEA) and

@@ -206,6 +206,10 @@ RESERVED_MODEL_NAMES = ("lib", "mod", "powi", "rigid_body", "tasks", "trig", "va
 MODULE_CONSTANTS = ("NAME", "DOF", "STATE_DIM", "TIP_DIM", "PARAMETER_COUNT", "PARAMETER_NAMES",
                     "PARAMETER_UNITS", "STATE_NAMES", "CONTROL_NAMES", "EQUILIBRIUM_STATE", "EQUILIBRIUM_CONTROL")
 RUST_NAME = re.compile(r"[a-z][a-z0-9_]*")
+# The longest name a description gives: a model's name is part of its library's file name
+# (`libtoolconf_model_<name>.so`) and of cargo's artefacts beside it, which a file system limits to
+# 255 bytes (derive/render/src/escape.rs's MAX_NAME, which the renderer checks an IR against).
+MAX_NAME = 64
 # Every edition's strict and reserved keywords (the Rust Reference, "Keywords"), which no
 # generated `let`, `fn` or `mod` may be named.
 RUST_KEYWORDS = frozenset((
@@ -219,19 +223,19 @@ TOOL_FILE_COLUMNS = ("name", "model")
 
 # The keys each table may have, as serde's deny_unknown_fields: a misspelt key is an error, not a
 # silently ignored setting. (name, type, required); types are checked by _TYPES.
-NAMED = (("name", "string", True), ("latex", "string", False), ("unit", "string", False), ("doc", "string", False))
+NAMED = (("name", "string", True), ("latex", "text", False), ("unit", "text", False), ("doc", "text", False))
 MODEL_KEYS = {
-    "model": (("name", "string", True), ("title", "string", False), ("source", "string", False),
+    "model": (("name", "string", True), ("title", "text", False), ("source", "text", False),
               ("dof", "integer", True)),
-    "constant": (("value", "number", True), ("latex", "string", False), ("unit", "string", False),
-                 ("doc", "string", False)),
+    "constant": (("value", "number", True), ("latex", "text", False), ("unit", "text", False),
+                 ("doc", "text", False)),
     "coordinates": (("q", "tables", True), ("q_dot", "tables", True), ("u", "tables", True)),
-    "dynamics": (("kind", "string", True), ("equations", "strings", False), ("q_ddot", "strings", False),
+    "dynamics": (("kind", "string", True), ("equations", "texts", False), ("q_ddot", "strings", False),
                  ("links", "tables", False), ("gravity", "string", False), ("payload", "string", False)),
     "link": (("mass", "string", True), ("length", "string", True)),
     "equilibrium": (("q", "values", True), ("q_dot", "values", True), ("u", "values", True)),
-    "printed": (("where", "string", False), ("A", "matrix", False), ("B", "matrix", False)),
-    "tip": (("position", "strings", True), ("components", "integer", False), ("source", "string", False)),
+    "printed": (("where", "text", False), ("A", "matrix", False), ("B", "matrix", False)),
+    "tip": (("position", "strings", True), ("components", "integer", False), ("source", "text", False)),
     **URDF_KEYS,
 }
 # The dynamics kinds, and the tip dimension TIP_DIM of those whose tip is not described: a URDF
@@ -247,15 +251,15 @@ TOP_KEYS = (("model", "table", True), ("parameters", "tables", False), ("constan
             ("goals", "table", False), ("printed", "table", False), ("urdf", "table", False),
             ("impedance", "table", False), ("tool", "table", False), ("tip", "table", False),
             ("formulation", "table", False))
-TASK_KEYS = (("name", "string", True), ("index", "integer", True), ("title", "string", False),
-             ("doc", "string", False), ("terms", "strings", True), ("error", "string", True),
+TASK_KEYS = (("name", "string", True), ("index", "integer", True), ("title", "text", False),
+             ("doc", "paragraph", False), ("terms", "strings", True), ("error", "string", True),
              ("sensitivity", "table", True),
              ("defaults", "table", False), ("remarks", "tables", False), ("formulations", "table", False))
-FORMULATION_KEYS = (("doc", "string", True), ("default_for", "strings", False), ("sensitivity", "table", True))
+FORMULATION_KEYS = (("doc", "paragraph", True), ("default_for", "strings", False), ("sensitivity", "table", True))
 DEFAULTS_KEYS = (("precision", "table", True),)
-REMARK_KEYS = (("term", "string", True), ("alternative", "string", True), ("text", "string", True))
-TERM_KEYS = (("name", "string", True), ("symbol", "string", True), ("latex", "string", True),
-             ("doc", "string", True), ("label", "string", True), ("unit", "string", True), ("read", "string", True),
+REMARK_KEYS = (("term", "string", True), ("alternative", "string", True), ("text", "paragraph", True))
+TERM_KEYS = (("name", "string", True), ("symbol", "text", True), ("latex", "text", True),
+             ("doc", "text", True), ("label", "text", True), ("unit", "text", True), ("read", "string", True),
              ("goal_range", "string", False))
 # How a term's value is read, as tasks.toml writes it (white space aside): (source, block); for
 # the tip, block is the order of the derivative (y, y_dot = J(q) q_dot, then
@@ -383,6 +387,9 @@ def _check_identifier(name: str, path: Path, key: str) -> None:
     if not RUST_NAME.fullmatch(name):
         raise DescriptionError(path, key, f"'{name}' must be a lower-case ASCII name: a letter, then letters, "
                                           "digits or _ (it becomes a Rust name)")
+    if len(name) > MAX_NAME:
+        raise DescriptionError(path, key, f"is longer than {MAX_NAME} characters ({len(name)}, '{name[:20]}…'): it "
+                                          "becomes a Rust name and part of file names")
     if name in RUST_KEYWORDS:
         raise DescriptionError(path, key, f"'{name}' is a Rust keyword (the name becomes a Rust name); rename it")
 
@@ -538,9 +545,10 @@ def _task(path: Path, t: Table, all_terms: tuple[TermDef, ...], cost_order: tupl
     for r in t.tables("remarks", REMARK_KEYS):
         if r.get("term") not in used:
             raise DescriptionError(path, r.sub("term"), f"'{r.get('term')}' is not a term with a sensitivity in this task")
-        remarks.append(Remark(**r.raw))
+        remarks.append(Remark(term=r.get("term"), alternative=r.get("alternative"), text=" ".join(r.get("text").split())))
     _check_identifier(t.get("name"), path, t.sub("name"))
-    return Task(name=t.get("name"), index=t.get("index"), title=t.get("title", ""), doc=t.get("doc", ""),
+    # A paragraph's lines are one line wherever it is shown (the IR's text is one line).
+    return Task(name=t.get("name"), index=t.get("index"), title=t.get("title", ""), doc=" ".join(t.get("doc", "").split()),
                 terms=terms, error=t.get("error"), sensitivity=dict(sens.raw), remarks=remarks,
                 default_precision={k: float(v) for k, v in precision.raw.items()}, path=path, key=t.key,
                 all_terms=all_terms, cost_order=cost_order, formulations=_formulations(path, t, used))
@@ -709,6 +717,14 @@ def _validate_expressions(m: Model) -> None:
     if m.dynamics_kind == "explicit":
         for i, text in enumerate(m.q_ddot):
             expression(m.path, f"dynamics.q_ddot[{i}]", text, names)
+    # The tip depends on the joint positions, the parameters and the constants only.
+    tip_names = {n.name for n in m.parameters + m.constants + m.q}
+    for i, text in enumerate(m.tip or []):
+        extra = sorted(_names_used(expression(m.path, f"tip.position[{i}]", text, names).tree) - tip_names)
+        if extra:
+            raise DescriptionError(m.path, f"tip.position[{i}]", f"'{text}' uses {', '.join(extra)}: the tip depends "
+                                                                 "on the joint positions, the parameters and the "
+                                                                 "constants only")
     for label, texts in (("q", m.equilibrium_q), ("q_dot", m.equilibrium_q_dot), ("u", m.equilibrium_u)):
         for i, text in enumerate(texts):
             v = value(m.path, f"equilibrium.{label}[{i}]", text)
@@ -727,6 +743,18 @@ def _validate_expressions(m: Model) -> None:
         for i, row in enumerate(matrix or []):
             for j, text in enumerate(row):
                 expression(m.path, f"printed.{label}[{i}][{j}]", text, printed_names)
+
+
+def _names_used(node) -> set[str]:
+    """The names an expression's tree reads (not its functions)."""
+    out, pending = set(), [node]
+    while pending:
+        n = pending.pop()
+        if n.kind == "name" and n.value is None:  # pi is a number
+            out.add(n.text)
+        pending.extend(n.args)
+        pending.extend(operand for _, operand in n.rest)
+    return out
 
 
 def _within_limits(m: Model, i: int, text: str, v: float) -> None:

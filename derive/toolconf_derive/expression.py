@@ -43,8 +43,11 @@ MAX_NUMBER_CHARACTERS = 100
 SCALAR_FUNCTIONS = {"sin": 1, "cos": 1, "sqrt": 1}
 SCALAR_CONSTANTS = {"pi": math.pi}
 
+# ASCII only (re.ASCII): Python's \d also matches other scripts' digits (Arabic-Indic, mathematical
+# bold), which float() then reads as numbers, and \s other spaces; a description's numbers and
+# spaces are ASCII.
 TOKEN = re.compile(r"(?P<space>\s+)|(?P<number>(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)"
-                   r"|(?P<name>[A-Za-z_][A-Za-z0-9_]*)|(?P<op>\*\*|[-+*/@(),])")
+                   r"|(?P<name>[A-Za-z_][A-Za-z0-9_]*)|(?P<op>\*\*|[-+*/@(),])", re.ASCII)
 
 
 class ExpressionError(ValueError):
@@ -388,7 +391,7 @@ def parse(text: str, names, functions: dict[str, int] | None = None, constants: 
 
 def python_number(text: str):
     """A number as Python's eval reads it: an int, or a float where it has a point or exponent."""
-    return int(text) if text.isdigit() else float(text)
+    return int(text) if text.isascii() and text.isdigit() else float(text)
 
 
 def sympy_number(rational: bool):
@@ -396,7 +399,7 @@ def sympy_number(rational: bool):
     import sympy as sp
 
     def number(text: str):
-        if text.isdigit():
+        if text.isascii() and text.isdigit():
             return sp.Integer(text)
         return sp.Rational(text) if rational else sp.Float(text)
     return number

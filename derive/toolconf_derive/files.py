@@ -9,9 +9,40 @@ import math
 import os
 import stat
 import tomllib
+import unicodedata
 from pathlib import Path
 
 from .errors import DescriptionError
+
+
+# Characters no text field may hold besides the control characters (Unicode category Cc: C0, DEL,
+# C1, the newline among them): the line and paragraph separators, the bidirectional controls
+# (which rustc refuses in literals and comments) and the byte-order mark. The renderer's IR reader
+# refuses the same (derive/render/src/escape.rs, `refused`).
+REFUSED = frozenset("\u2028\u2029\u061c\u200e\u200f\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069\ufeff")
+
+
+def refused_character(text: str, paragraph: bool = False) -> str | None:
+    """The first character of `text` no text field may hold (a newline is allowed in a
+    `paragraph`, a field of several lines), or None."""
+    for c in text:
+        if c == "\n" and paragraph:
+            continue
+        if c in REFUSED or unicodedata.category(c) == "Cc":
+            return c
+    return None
+
+
+def text_problem(value: str, paragraph: bool = False) -> str | None:
+    """Why `value` cannot be a text field (one line, or lines for a `paragraph`), or None."""
+    c = refused_character(value, paragraph)
+    if c is None:
+        return None
+    what = ("a line break" if c in "\n\r\u2028\u2029\x85" else
+            "a control character" if unicodedata.category(c) == "Cc" else "an invisible formatting character")
+    lines = "several lines (a newline is allowed)" if paragraph else "one line"
+    return (f"holds U+{ord(c):04X} ({what}) at character {value.index(c) + 1}: a text field is {lines} of "
+            "text with no control character")
 
 
 def _is_matrix(v) -> bool:
@@ -20,6 +51,10 @@ def _is_matrix(v) -> bool:
 
 _TYPES = {
     "string": ("a string", lambda v: isinstance(v, str)),
+    # Free text (a title, a unit, a doc): one line; a paragraph may have several; texts, one each.
+    "text": ("a string", lambda v: isinstance(v, str)),
+    "paragraph": ("a string", lambda v: isinstance(v, str)),
+    "texts": ("an array of strings", lambda v: isinstance(v, list) and all(isinstance(x, str) for x in v)),
     "integer": ("an integer", lambda v: isinstance(v, int) and not isinstance(v, bool)),
     "number": ("a number", lambda v: isinstance(v, (int, float)) and not isinstance(v, bool)),
     "table": ("a table", lambda v: isinstance(v, dict)),
@@ -55,6 +90,13 @@ class Table:
             name, ok = _TYPES[kind]
             if not ok(raw[k]):
                 raise DescriptionError(path, self.sub(k), f"must be {name}, got {raw[k]!r}")
+            if kind in ("text", "paragraph", "texts"):
+                items = raw[k] if kind == "texts" else [raw[k]]
+                for i, item in enumerate(items):
+                    problem = text_problem(item, paragraph=kind == "paragraph")
+                    if problem:
+                        key = self.sub(k) + (f"[{i}]" if kind == "texts" else "")
+                        raise DescriptionError(path, key, problem)
         self.raw = raw
 
     def sub(self, k: str) -> str:

@@ -13,7 +13,8 @@ from .description import MODEL_KEYS, NAMED, TOP_KEYS
 from .urdf_description import COM_BOUND, SAMPLE, URDF_KEYS
 
 _NAMED = {
-    "name": (None, "identifier (letters, digits, `_`; not a Rust or Python keyword): the tools-file column, "
+    "name": (None, "name (a lower-case ASCII letter, then letters, digits, `_`; at most 64; not a Rust or Python "
+                   "keyword): the tools-file column, "
                    "the Python dict key, the name in every message"),
     "latex": ("the name", "how the report typesets it"),
     "unit": ('""', "SI unit, shown in reports and docs"),
@@ -94,7 +95,8 @@ MEANING = {
     ("(top level)", "tool"): ("the defaults below", "`[tool]`: kind `urdf` only"),
     ("(top level)", "tip"): ("none", "`[tip]`: required for kind `explicit`, refused for the other kinds "
                                      "(they have their tip)"),
-    ("model", "name"): (None, "identifier of the model: `--model NAME`, the generated module and file names"),
+    ("model", "name"): (None, "name of the model (as a parameter's `name`): `--model NAME`, the generated module "
+                              "and file names"),
     ("model", "title"): ('""', "one line for reports and `toolconf models`"),
     ("model", "source"): ('""', "where the equations come from"),
     ("model", "dof"): (None, "number of joints n (for `urdf`, checked against the chain)"),
@@ -162,6 +164,16 @@ def description_reference() -> str:
              "Every table refuses a key it does not list here, naming the file and the key; every "
              "expression is parsed (numbers, names, `+ - * / **`, `sin`, `cos`, `sqrt`, `pi`), never "
              "evaluated. \"required\" means the file is refused without it.",
+             "",
+             "A `text` (`texts`: an array of them) is free text of one line: any character but the control "
+             "characters (tab and newline among them), the Unicode line and paragraph separators, the "
+             "bidirectional controls and the byte-order mark, each refused naming the file and the key (a "
+             "task file's `paragraph`, a task's `doc`, a remark's `text`, a formulation's `doc`, may have "
+             "newlines, and is shown as one line). Text is data: it reaches the generated code only escaped "
+             "for where it goes (derive/render/src/escape.rs), as a Rust string literal, one line of a "
+             "comment (runs of spaces made one and a run of three backticks or tildes escaped, so that no "
+             "Markdown code block forms for rustdoc to run), a C comment of `toolconf_model.h` (`*/` broken "
+             "up) or a TOML string. Numbers are ASCII decimals (no other script's digits).",
              ""]
     for table, keys, applies, what in SECTIONS:
         lines += [f"## `{table}`" if table != "(top level)" else "## Top level", "",

@@ -6,8 +6,8 @@ Only the kinematic and inertial data are read (xml.etree through defusedxml: URD
 plain XML, and entity declarations, which no URDF needs, are refused).
 Refused, each with one line naming the file, the joint or link and the reason (a
 DescriptionError, status 2 from derive.py): floating, planar and mimic joints (and any unknown
-type) between the base and the flange; a moving side branch (below); a link with two parents (a
-loop); a body carried by a moving joint without an <inertial>, or with mass <= 0; an inertia that
+type) between the base and the flange; a moving side branch (below); a link with two parents, a
+loop or a second root anywhere in the file; a revolute or prismatic joint without <limit>; a body carried by a moving joint without an <inertial>, or with mass <= 0; an inertia that
 is not positive definite or whose principal moments violate the triangle inequality; a rotation
 that is not orthonormal (below); a number outside its physical range (MAX_MASS, MAX_INERTIA,
 MAX_LENGTH, MAX_ANGLE) or more than MAX_LINKS links.
@@ -24,10 +24,16 @@ How a URDF is read (one rule; docs/urdf.md, "How a URDF is read"):
   matrix that is no rotation, and the derivation then failed far from the cause (an equilibrium
   residual of 1e-9). Every rotation built from the file is checked orthonormal to
   ORTHONORMAL (1e-12) and refused otherwise, naming the joint or link and the deviation.
-- Joint limits: the <limit lower upper> of each revolute or prismatic joint of the chain is kept
-  (`UrdfChain.limits`; an absent attribute is no bound, continuous joints have none), and an
-  equilibrium q^e outside it is refused by description.py, naming equilibrium.q[i], the joint,
-  the value and the limits. Effort and velocity limits are not read.
+- Joint limits: every revolute or prismatic joint of the file has a <limit> (the URDF
+  specification's rule, urdfdom's and the tool reader's), whose absent lower or upper is 0; those
+  of the chain are kept (`UrdfChain.limits`; continuous joints have none), and an equilibrium q^e
+  outside them is refused by description.py, naming equilibrium.q[i], the joint, the value and
+  the limits. Effort and velocity limits are not read.
+- The file's shape, as the tool reader (crates/runtime/src/tool_urdf.rs) reads every URDF: each
+  joint of a URDF type naming two defined links, no link with two parents, the links one tree
+  (one root, no loop anywhere, on the chain or off it); numbers ASCII decimals between XML's
+  blanks (no other script's digits). The two readers are tested on one corpus of files
+  (tests/fixtures/urdf/).
 - <dynamics damping friction>: not read into the plant, whose joint damping is the description's
   [impedance]; the chain's joints with a non-zero value are listed (`UrdfChain.ignored_dynamics`)
   and derive.py says on stderr, once per derivation, that they are ignored.
@@ -46,6 +52,7 @@ never in libm.
 from __future__ import annotations
 
 import math
+import re
 import xml.etree.ElementTree as ET
 
 import defusedxml.ElementTree as SafeET
@@ -56,7 +63,7 @@ from pathlib import Path
 import mpmath
 
 from .errors import DescriptionError
-from .files import read_text
+from .files import read_text, text_problem
 
 DIGITS = 50
 # An rpy angle within SNAP (rad) of a multiple of pi/2 is that multiple (the module docs).
@@ -64,6 +71,14 @@ SNAP = mpmath.mpf("1e-9")
 # A rotation built from the file whose R^T R is further than this from I is refused.
 ORTHONORMAL = mpmath.mpf("1e-12")
 SUPPORTED = ("revolute", "continuous", "prismatic", "fixed")
+# Every joint type of the URDF specification (the others are refused on the chain).
+URDF_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+# A number of the file: ASCII decimal as the tool reader (crates/runtime/src/tool_urdf.rs) and
+# Rust's f64 parser read it, between XML's blanks (space, tab, CR, LF); no other script's
+# digits, no `_`.
+NUMBER = re.compile(r"[+-]?(?:(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|inf|infinity|nan)",
+                    re.ASCII | re.IGNORECASE)
+BLANKS = re.compile(r"[ \t\r\n]+")
 # Bounds on what is read: the Panda's URDF is 15 KB; the derivation's graphs grow as n^2 (M) to
 # n^3 (the Jacobian's solves) and a 7-joint arm already emits 2 MB of Rust.
 MAX_BYTES = 4 * 1024 * 1024
@@ -132,13 +147,11 @@ class _Inertial:
 def _floats(path: Path, where: str, text: str | None, n: int, default: str, bound: float,
             unit: str = "") -> list[mpmath.mpf]:
     """`n` numbers, each within +-`bound` (its physical range, in `unit`)."""
-    words = (text if text is not None else default).split()
-    try:
-        values = [float(w) for w in words]
-    except ValueError:
-        values = []
+    words = [w for w in BLANKS.split(text if text is not None else default) if w]
+    values = [float(w) for w in words] if all(NUMBER.fullmatch(w) for w in words) else []
     if len(values) != n or not all(mpmath.isfinite(v) for v in values):
-        raise DescriptionError(path, where, f"'{text}' is not {n} finite numbers")
+        what = "a finite number" if n == 1 else f"{n} finite numbers"
+        raise DescriptionError(path, where, f"'{text}' is not {what} (ASCII decimals)")
     if any(abs(v) > bound for v in values):
         raise DescriptionError(path, where, f"'{text}' is outside [-{bound:g}, {bound:g}]{' ' + unit if unit else ''}")
     return [mpmath.mpf(v) for v in values]
@@ -279,6 +292,9 @@ class _Tree:
         if root.tag != "robot":
             raise DescriptionError(path, "", f"the root element is <{root.tag}>, not <robot>")
         self.robot = root.get("name", "")
+        problem = text_problem(self.robot)
+        if problem:
+            raise DescriptionError(path, "robot name", problem)
         if len(root.findall("link")) > MAX_LINKS:
             raise DescriptionError(path, "", f"{len(root.findall('link'))} links; a URDF the derivation reads has at "
                                              f"most {MAX_LINKS}")
@@ -312,6 +328,28 @@ class _Tree:
             self.joints[name] = joint
             self.parent_joint[child] = joint
             self.child_joints[parent].append(joint)
+            _check_joint(path, joint)
+        self._check_tree()
+
+    def _check_tree(self) -> None:
+        """The links form one tree (URDF's rule, as urdfdom and the tool reader have it): no loop
+        anywhere, one root link, every link below it."""
+        done: set[str] = set()
+        for start in self.links:
+            walked, link = [], start
+            while link not in done and link in self.parent_joint:
+                if link in walked:
+                    joint = self.parent_joint[walked[-1]]
+                    raise DescriptionError(self.path, f"joint '{joint.get('name')}'",
+                                           f"leads back to link '{link}': the links form a loop")
+                walked.append(link)
+                link = self.parent_joint[link].find("parent").get("link")
+            done.update(walked)
+        roots = [name for name in self.links if name not in self.parent_joint]
+        if len(roots) != 1:
+            shown = ", ".join(f"'{r}'" for r in roots[:4]) + (", ..." if len(roots) > 4 else "")
+            raise DescriptionError(self.path, "", f"{len(roots)} root links ({shown}): a URDF's links form one "
+                                                  "tree with one root")
 
     def path_to(self, base: str, flange: str) -> list:
         """The joints from `base` down to `flange`, in order."""
@@ -380,26 +418,30 @@ def _base_side_branches(tree: _Tree, link: str, on_path: set[str], flange: str) 
         _base_side_branches(tree, child, on_path, flange)
 
 
+def _check_joint(path: Path, joint) -> None:
+    """What the URDF specification requires of every joint of the file, as the tool reader
+    requires it: a known type, and a <limit> on a revolute or prismatic joint whose bounds
+    (absent: 0) are numbers."""
+    name, kind = joint.get("name"), joint.get("type")
+    if kind not in URDF_TYPES:
+        raise DescriptionError(path, f"joint '{name}'", f"type '{kind}' is not a URDF joint type "
+                                                       f"({', '.join(URDF_TYPES)})")
+    element = joint.find("limit")
+    if element is None and kind in ("revolute", "prismatic"):
+        raise DescriptionError(path, f"joint '{name}'", f"is {kind} and has no <limit> (the URDF specification "
+                                                       "requires one)")
+    if element is not None:
+        _limits(path, joint)
+
+
 def _limits(path: Path, joint) -> tuple:
-    """A revolute or prismatic joint's <limit> (lower, upper) as doubles, None for an absent one
-    (a continuous joint has none)."""
+    """A revolute or prismatic joint's <limit> (lower, upper) as doubles, an absent side 0 (the
+    URDF specification's default); (None, None) for a continuous joint."""
     element = joint.find("limit")
     if joint.get("type") not in ("revolute", "prismatic") or element is None:
         return (None, None)
-    out = []
-    for side in ("lower", "upper"):
-        text = element.get(side)
-        if text is None:
-            out.append(None)
-            continue
-        try:
-            v = float(text)
-        except ValueError:
-            v = math.nan
-        if math.isnan(v):
-            raise DescriptionError(path, f"joint '{joint.get('name')}' limit {side}", f"'{text}' is not a number")
-        out.append(v if math.isfinite(v) else None)
-    return tuple(out)
+    return tuple(float(_floats(path, f"joint '{joint.get('name')}' limit {side}", element.get(side), 1, "0",
+                               math.inf)[0]) for side in ("lower", "upper"))
 
 
 def _dynamics_given(joint) -> bool:
@@ -408,10 +450,8 @@ def _dynamics_given(joint) -> bool:
     if element is None:
         return False
     for attribute in ("damping", "friction"):
-        try:
-            if float(element.get(attribute, "0")) != 0:
-                return True
-        except ValueError:
+        text = element.get(attribute, "0").strip(" \t\r\n")
+        if not NUMBER.fullmatch(text) or float(text) != 0:
             return True
     return False
 

@@ -17,10 +17,10 @@ from .urdf import read_chain
 
 # The keys of a URDF arm's own tables (description.py's MODEL_KEYS for the rest).
 URDF_KEYS = {
-    "urdf": (("file", "string", True), ("base", "string", True), ("flange", "string", True),
-             ("gravity", "numbers", True), ("source", "string", False)),
-    "impedance": (("stiffness", "numbers", True), ("damping", "numbers", True), ("source", "string", False)),
-    "tool": (("com_bound", "number", False), ("sample", "table", False), ("source", "string", False)),
+    "urdf": (("file", "text", True), ("base", "text", True), ("flange", "text", True),
+             ("gravity", "numbers", True), ("source", "text", False)),
+    "impedance": (("stiffness", "numbers", True), ("damping", "numbers", True), ("source", "text", False)),
+    "tool": (("com_bound", "number", False), ("sample", "table", False), ("source", "text", False)),
 }
 # A URDF arm's gravity (m/s^2) and joint impedance gains (N m/rad, N m s/rad): physical ranges.
 MAX_GRAVITY = 1e3

@@ -4,7 +4,8 @@
 //! whole, and only over a new path or a regular file ([`file`]); no output that is an input or
 //! another output of the same run ([`run_files`]); an interrupted run keeps the old files
 //! ([`partial`]); a generated folder replaced only while it holds only what was written into it
-//! ([`folder`]).
+//! ([`folder`]). A file a user names is read whole and bounded, never blocking on a FIFO
+//! ([`input`]).
 //!
 //! The lowest layer for file output, on no other toolconf crate: the runtime re-exports it as
 //! `toolconf::output`, and the renderer (`derive/render`, which `make crate` runs) uses it too.
@@ -12,6 +13,7 @@
 pub mod csv;
 pub mod file;
 pub mod folder;
+pub mod input;
 pub mod partial;
 pub mod run_files;
 

@@ -8,8 +8,9 @@
 //! for that joint, else `opening` (`--opening VALUE`) for every one-axis joint that is not a
 //! `<mimic>`; a mimic joint follows `multiplier · value + offset` of the joint it mimics (the
 //! Franka Hand's `panda_finger_joint2` mimics `panda_finger_joint1`). A held position outside
-//! a revolute or prismatic joint's `<limit lower upper>` is refused; a floating or planar joint
-//! below the root is refused (it has no one position).
+//! a revolute or prismatic joint's `<limit lower upper>` (an absent bound 0, the URDF
+//! specification's default) is refused; a floating or planar joint below the root is refused (it
+//! has no one position).
 //!
 //! **Frames and conventions** (the URDF specification's, as urdfdom and Pinocchio read it). A
 //! joint places its child link at `parent · origin(xyz, rpy) · motion(q)`, the motion a rotation
@@ -28,10 +29,14 @@
 //! (smallest principal moment above 1e-12 of the largest) and its principal moments obeying the
 //! triangle inequality (each at most the sum of the other two, within 1e-9 of their sum, the
 //! slack printed decimals need). Anything else, and every flaw of the file (not XML, no
-//! `<robot>`, a link or joint named twice, a link with two parents, a loop, a joint naming a link
-//! that is not there, a number that is not one or not finite, an `xyz` or `rpy` of other than
-//! three numbers, a negative mass), is one line naming the file, the line of the element, the
-//! link or joint and the value ([`UrdfToolError`]).
+//! `<robot>`, a link or joint named twice, a link with two parents, a loop or a second root
+//! link anywhere in the file, a revolute or prismatic joint without `<limit>`, a joint naming a
+//! link that is not there, a number that is not an ASCII decimal or not finite, an `xyz` or
+//! `rpy` of other than three numbers, a negative mass), is one line naming the file, the line of
+//! the element, the link or joint and the value ([`UrdfToolError`]). The file rules are the
+//! derivation's reader's too (derive/toolconf_derive/urdf.py): both are tested on one corpus,
+//! tests/fixtures/urdf/ (tests/urdf_corpus.rs, derive/tests/test_urdf_corpus.py). The file is
+//! opened without blocking and must be a regular file (a FIFO with no writer is refused).
 //!
 //! **Why roxmltree.** The XML is read with `roxmltree` (a small, widely used read-only XML tree
 //! with no dependencies but memchr, already the runtime's): it keeps every node's byte range, so
@@ -44,7 +49,6 @@
 
 use std::collections::{HashMap, HashSet};
 use std::fmt;
-use std::io::Read;
 use std::path::Path;
 
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
@@ -264,21 +268,17 @@ pub fn tool_from_urdf_file(path: &Path, request: &Request) -> Result<UrdfTool, U
         line: None,
         message,
     };
-    if std::fs::metadata(path).is_ok_and(|m| m.is_dir()) {
-        return Err(fail("is a folder, not a URDF file".into()));
-    }
-    let handle =
-        std::fs::File::open(path).map_err(|e| fail(format!("cannot read the URDF file: {e}")))?;
-    let mut bytes = Vec::new();
-    handle
-        .take(MAX_URDF_BYTES + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| fail(format!("cannot read the URDF file: {e}")))?;
-    if bytes.len() as u64 > MAX_URDF_BYTES {
-        return Err(fail(format!(
+    // Opened without blocking and required to be a regular file: a FIFO with no writer is
+    // refused, not waited on.
+    let bytes = toolconf_files::input::read_regular(path, MAX_URDF_BYTES).map_err(|e| match e {
+        toolconf_files::input::InputError::NotAFile(what) => {
+            fail(format!("is {what}, not a URDF file"))
+        }
+        toolconf_files::input::InputError::TooLarge(_) => fail(format!(
             "is larger than {MAX_URDF_BYTES} bytes (8 MiB), more than any tool's URDF needs"
-        )));
-    }
+        )),
+        toolconf_files::input::InputError::Io(e) => fail(format!("cannot read the URDF file: {e}")),
+    })?;
     let text = String::from_utf8(bytes).map_err(|e| {
         fail(format!(
             "is not UTF-8 text (an invalid byte at offset {})",
@@ -521,7 +521,7 @@ fn number(
         });
     };
     let tag = node.tag_name().name();
-    match text.trim().parse::<f64>() {
+    match text.trim_matches(xml_blank).parse::<f64>() {
         Ok(v) if v.is_finite() => Ok(v),
         Ok(_) => Err(cx.at(
             node,
@@ -532,6 +532,12 @@ fn number(
             format!("{owner}<{tag}> {attr} = '{}' is not a number", Clip(text)),
         )),
     }
+}
+
+/// XML's blanks (space, tab, CR, LF), which alone separate and surround a URDF's numbers: no
+/// other space (U+00A0, ...), as the derivation's reader (derive/toolconf_derive/urdf.py) has it.
+fn xml_blank(c: char) -> bool {
+    matches!(c, ' ' | '\t' | '\r' | '\n')
 }
 
 /// Three finite numbers separated by blanks, `default` when the attribute is absent.
@@ -546,7 +552,7 @@ fn triple(
         return Ok(Vector3::from(default));
     };
     let tag = node.tag_name().name();
-    let words: Vec<&str> = text.split_whitespace().collect();
+    let words: Vec<&str> = text.split(xml_blank).filter(|w| !w.is_empty()).collect();
     if words.len() != 3 {
         return Err(cx.at(
             node,
@@ -681,7 +687,63 @@ impl<'a, 'input> Robot<'a, 'input> {
             robot.joint_index.insert(name, index);
             robot.joints.push(joint);
         }
+        robot.check_tree(cx)?;
         Ok(robot)
+    }
+
+    /// The links form one tree, as the URDF specification (and urdfdom, and the derivation's
+    /// reader) has them: no loop anywhere in the file, one root link.
+    fn check_tree(&self, cx: &Cx) -> Result<(), UrdfToolError> {
+        // Each link is walked up from once: `walk[l]` is 1 + the start of the walk that reached it.
+        let mut done = vec![false; self.links.len()];
+        let mut walk = vec![0usize; self.links.len()];
+        for start in 0..self.links.len() {
+            let mut walked: Vec<usize> = Vec::new();
+            let mut link = start;
+            while !done[link] {
+                let Some(j) = self.parent_joint[link] else {
+                    break;
+                };
+                if walk[link] == start + 1 {
+                    let last = walked[walked.len() - 1];
+                    let joint = &self.joints[self.parent_joint[last].expect("walked up")];
+                    return Err(cx.at(
+                        joint.node,
+                        format!(
+                            "joint '{}' leads back to link '{}': the links form a loop",
+                            Clip(joint.name),
+                            Clip(self.links[link].name)
+                        ),
+                    ));
+                }
+                walk[link] = start + 1;
+                walked.push(link);
+                link = self.joints[j].parent;
+            }
+            for l in walked {
+                done[l] = true;
+            }
+        }
+        let roots: Vec<&str> = (0..self.links.len())
+            .filter(|&l| self.parent_joint[l].is_none())
+            .map(|l| self.links[l].name)
+            .collect();
+        if roots.len() != 1 {
+            let mut shown: Vec<String> = roots
+                .iter()
+                .take(4)
+                .map(|r| format!("'{}'", Clip(r)))
+                .collect();
+            if roots.len() > 4 {
+                shown.push("...".into());
+            }
+            return Err(cx.whole(format!(
+                "{} root links ({}): a URDF's links form one tree with one root",
+                roots.len(),
+                shown.join(", ")
+            )));
+        }
+        Ok(())
     }
 
     fn read_joint(
@@ -758,6 +820,16 @@ impl<'a, 'input> Robot<'a, 'input> {
             }
         };
         let limit = match only_child(cx, node, owner, "limit")? {
+            // The URDF specification's rule (urdfdom's, the derivation reader's).
+            None if matches!(kind, Kind::Revolute | Kind::Prismatic) => {
+                return Err(cx.at(
+                    node,
+                    format!(
+                        "{owner}is {} and has no <limit> (the URDF specification requires one)",
+                        kind.name()
+                    ),
+                ))
+            }
             None => None,
             // urdfdom's defaults for absent bounds.
             Some(element) => Some((

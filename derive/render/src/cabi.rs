@@ -14,6 +14,7 @@ use serde::Serialize;
 use sha2::{Digest, Sha256};
 
 use crate::check::CrateFile;
+use crate::escape::{c_comment, toml_string};
 use crate::ir::{Ir, Source};
 use crate::tasks::{camel_case, string_literal};
 use crate::{engine, load_template_tree, render_one, RenderError};
@@ -63,7 +64,8 @@ pub struct LibraryModelView {
     /// toolconf-core's marker type (`Panda`).
     pub marker: String,
     pub title_literal: String,
-    /// The title on one comment line (no `*/` in it).
+    /// The title and the description's path, each one line of a comment, Rust's, TOML's or the
+    /// header's C block comment ([`c_comment`]).
     pub title_comment: String,
     pub description: String,
     pub dof: usize,
@@ -137,21 +139,6 @@ pub fn sha256_hex(text: &str) -> String {
         .collect()
 }
 
-/// A TOML basic string of `text`.
-fn toml_string(text: &str) -> String {
-    let mut s = String::from("\"");
-    for c in text.chars() {
-        match c {
-            '"' => s += "\\\"",
-            '\\' => s += "\\\\",
-            c if (c as u32) < 0x20 || c as u32 == 0x7f => s += &format!("\\u{:04X}", c as u32),
-            c => s.push(c),
-        }
-    }
-    s.push('"');
-    s
-}
-
 /// `file://` and the absolute path `path`, percent-encoded as Cargo reads a source URL.
 fn file_url(path: &Path) -> String {
     let mut url = String::from("file://");
@@ -194,8 +181,8 @@ pub fn library_context(ir: &Ir, package: &LibraryPackage) -> Result<LibraryConte
             name: m.name.clone(),
             marker: camel_case(&m.name),
             title_literal: string_literal(&m.title),
-            title_comment: m.title.replace("*/", "* /"),
-            description: ir.generator.model.clone(),
+            title_comment: c_comment(&m.title),
+            description: c_comment(&ir.generator.model),
             dof: m.dof,
             state_dim: m.state_dim,
             parameter_count: m.parameters.len(),
@@ -206,7 +193,7 @@ pub fn library_context(ir: &Ir, package: &LibraryPackage) -> Result<LibraryConte
                 .enumerate()
                 .map(|(index, p)| ParameterView {
                     name: p.name.clone(),
-                    unit: p.unit.replace("*/", "* /"),
+                    unit: c_comment(&p.unit),
                     index,
                     macro_name: p.name.to_uppercase(),
                 })

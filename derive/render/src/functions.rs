@@ -8,8 +8,11 @@
 //! one struct: the first function's, which the second names by a type alias.
 
 use serde::Serialize;
+use serde_json::Value;
 
-use crate::ir::{Arg, Coefficients, Cost, Function, Output, Step};
+use crate::escape::comment;
+use crate::ir::{Coefficients, Cost, Function, Output, Step};
+use crate::model_view::comment_all;
 use crate::tasks::binding_pattern;
 use crate::RenderError;
 
@@ -30,7 +33,8 @@ pub struct Assignment {
 /// An output's declaration, `let binding = <rust_type>::zeros();`, then its entries' assignments.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct OutputView<'a> {
-    pub doc: &'a str,
+    /// Its doc, one line of a comment.
+    pub doc: String,
     pub binding: String,
     pub rust_type: &'a str,
     pub assignments: Vec<Assignment>,
@@ -85,12 +89,13 @@ pub struct CoefficientsView<'a> {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FunctionView<'a> {
     pub name: &'a str,
-    pub doc: &'a str,
+    /// Its doc, equation and arguments ([`comment_all`]), each one line of its doc comment.
+    pub doc: String,
     /// Paragraphs the doc comment adds after `doc` (a task's formulation, for its sensitivity
-    /// function).
+    /// function), each one line.
     pub notes: Vec<String>,
-    pub equation: &'a str,
-    pub args: &'a [Arg],
+    pub equation: String,
+    pub args: Value,
     /// The doc comment's lines on the cost per call.
     pub cost_doc: Vec<String>,
     /// The public function's parameters, `x: &SVector<f64, 4>` (`_x` where the body does not
@@ -135,7 +140,9 @@ pub fn function_views<'a>(
                 .and_then(|c| defined.iter().copied().find(|(_, d)| same_factors(d, c)));
             let own = notes.iter().find(|(name, _)| *name == f.name);
             let mut view = function_view(f, shared)?;
-            view.notes = own.map_or_else(Vec::new, |(_, lines)| lines.clone());
+            view.notes = own.map_or_else(Vec::new, |(_, lines)| {
+                lines.iter().map(|l| comment(l)).collect()
+            });
             if let (Some(c), None) = (&f.coefficients, shared) {
                 defined.push((&f.name, c));
             }
@@ -178,10 +185,10 @@ fn function_view<'a>(
     let Some(c) = &f.coefficients else {
         return Ok(FunctionView {
             name: &f.name,
-            doc: &f.doc,
+            doc: comment(&f.doc),
             notes: Vec::new(),
-            equation: &f.equation,
-            args: &f.args,
+            equation: comment(&f.equation),
+            args: comment_all(&f.args),
             cost_doc: vec![format!("Cost per call: {}.", ops_text(&f.cost))],
             signature: f
                 .args
@@ -240,10 +247,10 @@ fn function_view<'a>(
     ];
     Ok(FunctionView {
         name: &f.name,
-        doc: &f.doc,
+        doc: comment(&f.doc),
         notes: Vec::new(),
-        equation: &f.equation,
-        args: &f.args,
+        equation: comment(&f.equation),
+        args: comment_all(&f.args),
         cost_doc,
         signature: f
             .args
@@ -372,7 +379,7 @@ fn body_view(f: &Function, result: String) -> Result<BodyView<'_>, RenderError> 
                     format!("mut {}", o.name)
                 };
                 Ok(OutputView {
-                    doc: &o.doc,
+                    doc: comment(&o.doc),
                     binding,
                     rust_type: &o.rust_type,
                     assignments,
@@ -394,7 +401,7 @@ fn body_view(f: &Function, result: String) -> Result<BodyView<'_>, RenderError> 
             .outputs
             .iter()
             .map(|o| OutputView {
-                doc: &o.doc,
+                doc: comment(&o.doc),
                 // An output the steps never write (a sensitivity that is zero by structure,
                 // the static gain's ∂θ̇/∂U) stays immutable.
                 binding: if o.entries.is_empty() {

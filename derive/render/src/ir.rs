@@ -605,13 +605,38 @@ impl<R> Ir<R> {
     }
 }
 
-/// Reads and checks an IR file.
+/// The largest IR read: the Panda's is 5.5 MB, and a derivation's code grows as the cube of the
+/// joints (at most 12: derive/toolconf_derive/urdf.py); a larger file is no IR of a model.
+pub const MAX_IR_BYTES: u64 = 128 << 20;
+
+/// Reads and checks an IR file: a regular file of at most [`MAX_IR_BYTES`], UTF-8 JSON of the
+/// types here, every field of its kind ([`crate::ir_check`]).
 pub fn read_ir(path: &Path) -> Result<Ir, RenderError> {
-    let text = std::fs::read_to_string(path).map_err(|source| RenderError::Io {
+    let refused = |key: &str, problem: String| RenderError::Refused {
         path: path.into(),
-        source,
+        key: key.into(),
+        problem,
+    };
+    let bytes = toolconf_files::input::read_regular(path, MAX_IR_BYTES).map_err(|e| match e {
+        toolconf_files::input::InputError::TooLarge(limit) => refused(
+            "",
+            format!(
+                "larger than {}, more than any model's IR (the Panda's is 5.5 MB)",
+                toolconf_files::input::bytes(limit)
+            ),
+        ),
+        e => refused("", e.to_string()),
     })?;
-    parse_ir(&text).map_err(|e| match e {
+    let text = String::from_utf8(bytes).map_err(|e| {
+        refused(
+            "",
+            format!(
+                "not UTF-8 text (an invalid byte at offset {})",
+                e.utf8_error().valid_up_to()
+            ),
+        )
+    })?;
+    let ir = parse_ir(&text).map_err(|e| match e {
         ParseError::Json(source) => RenderError::Json {
             path: path.into(),
             source,
@@ -621,6 +646,24 @@ pub fn read_ir(path: &Path) -> Result<Ir, RenderError> {
             found,
             expected: IR_SCHEMA,
         },
+    })?;
+    let value: serde_json::Value =
+        serde_json::from_str(&text).map_err(|source| RenderError::Json {
+            path: path.into(),
+            source,
+        })?;
+    crate::ir_check::check_text(&value)
+        .and_then(|()| crate::ir_check::check_ir(&ir))
+        .map_err(|r| refused(&r.key, r.problem))?;
+    Ok(ir)
+}
+
+/// The IR in `text` with the shape of these types, its fields not checked ([`read_ir`] checks
+/// them): what the tests of the escaping render past the reader.
+pub fn parse_shape(text: &str) -> Result<Ir, String> {
+    parse_ir(text).map_err(|e| match e {
+        ParseError::Json(e) => e.to_string(),
+        ParseError::Schema(s) => format!("schema {s:?}"),
     })
 }
 

@@ -3,7 +3,9 @@
 //! toolconf-generated; or a crate of a user's own with `make crate`).
 //!
 //! The IR is read into types ([`ir`]: an unknown key, a missing one or a value of the wrong kind
-//! stops the render, naming the file, line and column). Every decision about the Rust and the
+//! stops the render, naming the file, line and column), and each field checked for its kind
+//! ([`ir_check`]: text of one line, names, file names, code in [`code`]'s grammar): an IR is data,
+//! whoever wrote it. Text reaches the templates only escaped for where it goes ([`escape`]). Every decision about the Rust and the
 //! reports written (names, signatures, bodies, counts, wording) is made here, in the views the
 //! templates see ([`model_view`], [`functions`], [`tasks`], [`tool_rule`], [`registry`]); the
 //! templates only loop over them.
@@ -25,8 +27,11 @@ use tera::{Context, Tera};
 
 pub mod cabi;
 mod check;
+pub mod code;
+pub mod escape;
 pub mod functions;
 pub mod ir;
+pub mod ir_check;
 pub mod model_view;
 pub mod registry;
 pub mod tasks;
@@ -47,6 +52,13 @@ pub enum RenderError {
     },
     #[error(transparent)]
     Write(#[from] toolconf_files::WriteError),
+    /// An IR that is not one this renderer renders (bad input): its file, key and why.
+    #[error("{}: {}{problem}", path.display(), if key.is_empty() { String::new() } else { format!("{key}: ") })]
+    Refused {
+        path: PathBuf,
+        key: String,
+        problem: String,
+    },
     #[error("{path} is not an IR this renderer reads: {source}")]
     Json {
         path: PathBuf,
@@ -66,6 +78,17 @@ pub enum RenderError {
     Task(String),
     #[error("rustfmt failed: {0}")]
     Rustfmt(String),
+}
+
+impl RenderError {
+    /// Whether the error is the input's (an IR that cannot be rendered, status 2) rather than a
+    /// failure to render or write one that can (status 1).
+    pub fn is_refusal(&self) -> bool {
+        matches!(
+            self,
+            RenderError::Refused { .. } | RenderError::Json { .. } | RenderError::Schema { .. }
+        )
+    }
 }
 
 /// One rendered file: its name (relative to the output folder) and contents.

@@ -15,6 +15,10 @@
 //! STAGING and moves it into place; `--command NAME` names another command as the folder's maker
 //! (`make model`: a folder of one command is not the other's to replace). A refusal is one line, status 2; a failure to write, status 1.
 //!
+//! `--check-ir IR.json...` reads and checks each IR (its shape, and each field of its kind:
+//! text, names, file names, code) and renders nothing: `make model IR=...` asks it before
+//! anything else, so that a bad IR is one line, status 2.
+//!
 //! `make model`'s library crate: `IR.json --model-library DIR --repository REPO [--templates
 //! templates]` renders templates/cabi/ for the one model into DIR (its generated crate, rendered
 //! as usual, goes into DIR/generated), on the repository REPO's toolconf-cabi.
@@ -56,6 +60,7 @@ struct Args {
     repository: Option<PathBuf>,
     inputs: Vec<(String, PathBuf)>,
     model_library: Option<PathBuf>,
+    check_ir: bool,
     /// The command the folder rule names as the folder's maker (`make crate`, `make model`).
     command: String,
 }
@@ -78,6 +83,7 @@ fn parse(args: &[String]) -> Result<Args, String> {
         repository: None,
         inputs: Vec::new(),
         model_library: None,
+        check_ir: false,
         command: "make crate".into(),
     };
     let mut it = args.iter();
@@ -95,6 +101,7 @@ fn parse(args: &[String]) -> Result<Args, String> {
             "--crate-name" => a.package.name = it.next().cloned().unwrap_or(a.package.name),
             "--standalone" => a.package.standalone = true,
             "--check" => a.check = true,
+            "--check-ir" => a.check_ir = true,
             "--check-crate-out" => {
                 a.crate_rule = Some(CrateRule::Check(value(&mut it, arg)?.into()));
             }
@@ -160,6 +167,12 @@ fn run(a: &Args) -> Result<Vec<String>, RenderError> {
     if let Some(dir) = &a.model_library {
         return run_model_library(a, dir).map(|()| Vec::new());
     }
+    if a.check_ir {
+        for ir in &a.irs {
+            toolconf_render::read_ir(ir)?;
+        }
+        return Ok(Vec::new());
+    }
     let irs = if a.from_crate && a.irs.is_empty() {
         crate_irs(&a.out)?
     } else {
@@ -209,7 +222,7 @@ fn main() -> ExitCode {
     };
     if args.is_empty() || args.iter().any(|a| a == "--help" || a == "-h") {
         eprintln!(
-            "usage: toolconf-render [IR.json...] [--crate DIR] [--templates DIR] [--out DIR] [--crate-name NAME] [--standalone] [--check]\n       toolconf-render IR.json --model-library DIR --repository REPO [--templates DIR]\n       toolconf-render --check-crate-out OUT --repository DIR [--command NAME] [--input LABEL PATH]...\n       toolconf-render --install-crate STAGING --out OUT --repository DIR [--command NAME] [--input LABEL PATH]..."
+            "usage: toolconf-render [IR.json...] [--crate DIR] [--templates DIR] [--out DIR] [--crate-name NAME] [--standalone] [--check]\n       toolconf-render --check-ir IR.json...\n       toolconf-render IR.json --model-library DIR --repository REPO [--templates DIR]\n       toolconf-render --check-crate-out OUT --repository DIR [--command NAME] [--input LABEL PATH]...\n       toolconf-render --install-crate STAGING --out OUT --repository DIR [--command NAME] [--input LABEL PATH]..."
         );
         return ExitCode::from(2);
     }
@@ -243,7 +256,7 @@ fn main() -> ExitCode {
         }
         Err(e) => {
             eprintln!("toolconf-render: {e}");
-            ExitCode::FAILURE
+            ExitCode::from(if e.is_refusal() { 2 } else { 1 })
         }
     }
 }

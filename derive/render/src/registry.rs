@@ -4,6 +4,7 @@
 
 use serde::Serialize;
 
+use crate::escape::comment;
 use crate::ir::{Function, Ir, Task};
 use crate::tasks::{
     binding_pattern, camel_case, cost_order, string_literal, task_choices, task_list, term_views,
@@ -58,12 +59,13 @@ pub struct VectorTestView<'a> {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct RegistryModel<'a> {
     pub name: &'a str,
-    pub title: &'a str,
+    /// The title, one line of a comment ([`comment`]), and as a Rust string literal.
+    pub title: String,
     pub title_literal: String,
     pub marker: String,
     pub tool: String,
-    /// The model description it was derived from.
-    pub description: &'a str,
+    /// The model description it was derived from, one line of a comment.
+    pub description: String,
     /// `description` as a Rust string literal.
     pub description_literal: String,
     pub parameter_count: usize,
@@ -86,7 +88,8 @@ pub struct PackageView {
     /// The crate's name as Rust code names it (`toolconf_generated`).
     pub lib: String,
     pub standalone: bool,
-    /// The command and the task definitions every model was derived by.
+    /// The command and the task definitions every model was derived by, and the models'
+    /// descriptions, each one line of a comment.
     pub command: String,
     pub tasks: String,
     /// The models' descriptions and names, `, `-separated.
@@ -119,6 +122,12 @@ pub fn registry_context<'a>(
     irs: &'a [Ir],
     package: &Package,
 ) -> Result<RegistryContext<'a>, RenderError> {
+    if !crate_name(&package.name) {
+        return Err(RenderError::Template(format!(
+            "{:?} is not a crate name (an ASCII letter, then letters, digits, - or _)",
+            package.name
+        )));
+    }
     let models = irs
         .iter()
         .map(registry_model)
@@ -150,9 +159,11 @@ pub fn registry_context<'a>(
             name: package.name.clone(),
             lib: package.name.replace('-', "_"),
             standalone: package.standalone,
-            command: shared_generator(irs, "command", |ir| &ir.generator.command)?,
-            tasks: shared_generator(irs, "tasks", |ir| &ir.generator.tasks)?,
-            descriptions: list(models.iter().map(|m| m.description).collect()),
+            command: comment(&shared_generator(irs, "command", |ir| {
+                &ir.generator.command
+            })?),
+            tasks: comment(&shared_generator(irs, "tasks", |ir| &ir.generator.tasks)?),
+            descriptions: list(models.iter().map(|m| m.description.as_str()).collect()),
             model_names: list(models.iter().map(|m| m.name).collect()),
         },
         models,
@@ -165,11 +176,11 @@ fn registry_model(ir: &Ir) -> Result<RegistryModel<'_>, RenderError> {
     let marker = camel_case(&m.name);
     Ok(RegistryModel {
         name: &m.name,
-        title: &m.title,
+        title: comment(&m.title),
         title_literal: string_literal(&m.title),
         tool: format!("{marker}Tool"),
         marker,
-        description: &ir.generator.model,
+        description: comment(&ir.generator.model),
         description_literal: string_literal(&ir.generator.model),
         parameter_count: m.parameters.len(),
         functions: ir
@@ -189,6 +200,15 @@ fn registry_model(ir: &Ir) -> Result<RegistryModel<'_>, RenderError> {
             .map(|t| format!("TaskKind::{}", camel_case(&t.name)))
             .collect(),
     })
+}
+
+/// A Cargo package name (make crate's rule: derive/make_crate.py's crate_name).
+fn crate_name(name: &str) -> bool {
+    name.len() <= 64
+        && name.bytes().next().is_some_and(|b| b.is_ascii_alphabetic())
+        && name
+            .bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b == b'-' || b == b'_')
 }
 
 /// `generated::tip::<name>`'s body: the model's `tip` (position and Jacobian) where it has one.

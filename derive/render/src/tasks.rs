@@ -9,6 +9,7 @@
 
 use serde::Serialize;
 
+use crate::escape::comment;
 use crate::ir::{ChosenBy, Formulation, Ir, Source, Task, Term};
 use crate::RenderError;
 
@@ -24,9 +25,9 @@ pub fn camel_case(name: &str) -> String {
         .collect()
 }
 
-/// A Rust string literal of `text` (quotes and backslashes escaped).
+/// A Rust string literal of `text` ([`crate::escape::rust_string`]).
 pub fn string_literal(text: &str) -> String {
-    format!("{text:?}")
+    crate::escape::rust_string(text)
 }
 
 /// The runtime's `Term` variant of a term named `name` (`Term::ThetaDot`).
@@ -57,7 +58,8 @@ pub struct TermView<'a> {
     pub variant: String,
     pub index: usize,
     pub symbol_literal: String,
-    pub doc: &'a str,
+    /// Its doc, one line of a comment; as a Rust string literal.
+    pub doc: String,
     pub doc_literal: String,
     pub label_literal: String,
     pub unit_literal: String,
@@ -101,7 +103,7 @@ fn term_view((index, t): (usize, &Term)) -> TermView<'_> {
         variant: camel_case(&t.name),
         index,
         symbol_literal: string_literal(&t.symbol),
-        doc: &t.doc,
+        doc: comment(&t.doc),
         doc_literal: string_literal(&t.doc),
         label_literal: string_literal(&t.label),
         unit_literal: string_literal(&t.unit),
@@ -135,8 +137,9 @@ pub fn cost_order(ir: &Ir) -> Result<Vec<String>, RenderError> {
 pub struct TaskView<'a> {
     pub name: &'a str,
     pub index: u8,
-    pub title: &'a str,
-    pub doc: &'a str,
+    /// Its title and doc, each one line of a comment.
+    pub title: String,
+    pub doc: String,
     /// The task's terms' names, and how many.
     pub terms: Vec<&'a str>,
     pub term_count: usize,
@@ -258,8 +261,8 @@ pub fn task_view<'a>(task: &'a Task, terms: &'a [Term]) -> Result<TaskView<'a>, 
     Ok(TaskView {
         name,
         index: task.index,
-        title: &task.title,
-        doc: &task.doc,
+        title: comment(&task.title),
+        doc: comment(&task.doc),
         terms: task.terms.iter().map(String::as_str).collect(),
         term_count: task.terms.len(),
         goals: task
@@ -318,8 +321,11 @@ pub fn task_view<'a>(task: &'a Task, terms: &'a [Term]) -> Result<TaskView<'a>, 
         error_variant: variant(&task.error),
         title_literal: string_literal(&task.title),
         doc_literal: string_literal(&task.doc),
-        formulation: formulation_text(&task.formulation),
-        sensitivity_notes: sensitivity_notes(&task.formulation),
+        formulation: comment(&formulation_text(&task.formulation)),
+        sensitivity_notes: sensitivity_notes(&task.formulation)
+            .iter()
+            .map(|n| comment(n))
+            .collect(),
     })
 }
 

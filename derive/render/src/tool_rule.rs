@@ -5,6 +5,7 @@
 
 use serde::Serialize;
 
+use crate::escape::comment;
 use crate::ir::{Domain, Inertia, Model, Parameter, ToolRule};
 use crate::tasks::string_literal;
 use crate::RenderError;
@@ -120,7 +121,7 @@ pub fn tool_rule_view(model: &Model) -> Result<ToolRuleView, RenderError> {
         .iter()
         .map(|c| ConstraintView {
             coefficients: c.coefficients.iter().copied().map(rust_f64).collect(),
-            text: c.text.clone(),
+            text: comment(&c.text),
             rule: string_literal(&c.text),
         })
         .collect();
@@ -153,7 +154,7 @@ pub fn tool_rule_view(model: &Model) -> Result<ToolRuleView, RenderError> {
         sample,
         defaults,
         inertia,
-        inertia_text,
+        inertia_text: inertia_text.as_deref().map(comment),
     })
 }
 
@@ -216,7 +217,7 @@ fn domain_view(d: &Domain, name: &str, unit: &str, sample: String) -> DomainView
         lo_open,
         hi_open,
         rule: string_literal(&words),
-        words,
+        words: comment(&words),
         sample,
     }
 }
