@@ -603,3 +603,59 @@ fn a_fifo_nothing_reads_is_refused_at_once_and_stays_a_fifo() {
     }
     assert!(!dir.join("r/report.html").exists());
 }
+
+/// An input that is a FIFO with no writer reads as empty at once (one line, status 2), never
+/// waits for a writer; a pipe with one (`--task <(...)`) is read as a file.
+#[cfg(unix)]
+#[test]
+fn an_input_fifo_with_no_writer_is_one_line_at_once() {
+    use std::process::Stdio;
+    let dir = scratch("input-fifo");
+    let drawer = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/tools/drawer.csv");
+    for (fifo, args) in [
+        (
+            "t.csv",
+            vec!["rank", "--tools", "t.csv", "--task", "position"],
+        ),
+        (
+            "t.json",
+            vec!["rank", "--tools", "t.json", "--task", "position"],
+        ),
+        (
+            "task.toml",
+            vec!["rank", "--tools", drawer, "--task", "task.toml"],
+        ),
+        (
+            "tf.toml",
+            vec![
+                "confidence",
+                "--arm",
+                "0.3,0.4,0.5,0.2",
+                "--task-file",
+                "tf.toml",
+            ],
+        ),
+        (
+            "d.toml",
+            vec!["design", "--task", "velocity", "--design", "d.toml"],
+        ),
+    ] {
+        let path = std::ffi::CString::new(dir.join(fifo).to_str().unwrap()).unwrap();
+        // SAFETY: a NUL-terminated path.
+        assert_eq!(unsafe { libc::mkfifo(path.as_ptr(), 0o644) }, 0);
+        let mut child = Command::new(env!("CARGO_BIN_EXE_toolconf"))
+            .args(&args)
+            .current_dir(&dir)
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let status = wait_bounded(&mut child, std::time::Duration::from_secs(60));
+        let mut stderr = String::new();
+        std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut stderr).unwrap();
+        assert_eq!(status.code(), Some(2), "{fifo}: {stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(stderr.contains(fifo), "{stderr}");
+    }
+}

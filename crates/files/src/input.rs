@@ -86,6 +86,47 @@ pub fn open_regular(path: &Path) -> Result<File, InputError> {
     Ok(file)
 }
 
+/// Opens a file a user names as input that may also be a pipe or FIFO (`--task <(...)`):
+/// without blocking on a FIFO that has no writer (it then reads as empty, at once), refusing a
+/// folder, a device or a socket; a pipe's reads block again once it is open.
+pub fn open_stream(path: &Path) -> Result<File, InputError> {
+    match open_regular(path) {
+        Err(InputError::NotAFile("a FIFO")) => open_fifo(path),
+        other => other,
+    }
+}
+
+#[cfg(unix)]
+fn open_fifo(path: &Path) -> Result<File, InputError> {
+    use std::os::unix::fs::OpenOptionsExt;
+    use std::os::unix::io::AsRawFd;
+    let file = OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NONBLOCK)
+        .open(path)
+        .map_err(InputError::Io)?;
+    // What was opened is what was checked: a FIFO replaced by another file in between is refused.
+    if !std::os::unix::fs::FileTypeExt::is_fifo(
+        &file.metadata().map_err(InputError::Io)?.file_type(),
+    ) {
+        return Err(InputError::NotAFile("not a regular file"));
+    }
+    // SAFETY: fcntl on a descriptor this function owns, with integer flags only.
+    let flags = unsafe { libc::fcntl(file.as_raw_fd(), libc::F_GETFL) };
+    // SAFETY: as above.
+    if flags < 0
+        || unsafe { libc::fcntl(file.as_raw_fd(), libc::F_SETFL, flags & !libc::O_NONBLOCK) } < 0
+    {
+        return Err(InputError::Io(io::Error::last_os_error()));
+    }
+    Ok(file)
+}
+
+#[cfg(not(unix))]
+fn open_fifo(_path: &Path) -> Result<File, InputError> {
+    Err(InputError::NotAFile("a FIFO"))
+}
+
 /// The bytes of the regular file at `path`, at most `limit` of them ([`open_regular`]).
 pub fn read_regular(path: &Path, limit: u64) -> Result<Vec<u8>, InputError> {
     let file = open_regular(path)?;

@@ -23,10 +23,11 @@ pub const MAX_TEXT_FILE_BYTES: u64 = 1 << 20;
 /// ("task file"), which says what is wrong: a folder, a missing or unreadable file, a file too
 /// large, or one that is not UTF-8.
 pub fn read_text_file(path: &Path, what: &str) -> Result<String, String> {
-    if std::fs::metadata(path).is_ok_and(|m| m.is_dir()) {
-        return Err(format!("is a folder, not a {what}"));
-    }
-    let file = std::fs::File::open(path).map_err(|e| format!("cannot read the {what}: {e}"))?;
+    let file = toolconf_files::input::open_stream(path).map_err(|e| match e {
+        toolconf_files::input::InputError::NotAFile(kind) => format!("is {kind}, not a {what}"),
+        toolconf_files::input::InputError::Io(e) => format!("cannot read the {what}: {e}"),
+        e => e.to_string(),
+    })?;
     let mut bytes = Vec::new();
     file.take(MAX_TEXT_FILE_BYTES + 1)
         .read_to_end(&mut bytes)

@@ -21,7 +21,6 @@
 //! whether it stops the read or is skipped. A column given twice in a CSV header, or a key twice
 //! in a JSON tool, is refused.
 
-use std::fs::File;
 use std::io::{BufReader, Read};
 use std::path::Path;
 
@@ -96,10 +95,15 @@ pub fn read_tools(
         message,
         row_level: false,
     };
-    let file = File::open(path).map_err(|e| fatal(format!("cannot open the tools file: {e}")))?;
-    if file.metadata().is_ok_and(|m| m.is_dir()) {
-        return Err(fatal("is a folder, not a tools file".into()));
-    }
+    let file = toolconf_files::input::open_stream(path).map_err(|e| match e {
+        toolconf_files::input::InputError::NotAFile(kind) => {
+            fatal(format!("is {kind}, not a tools file"))
+        }
+        toolconf_files::input::InputError::Io(e) => {
+            fatal(format!("cannot open the tools file: {e}"))
+        }
+        e => fatal(e.to_string()),
+    })?;
     let is_json = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"));
