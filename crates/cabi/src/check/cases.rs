@@ -96,6 +96,35 @@ where
     h
 }
 
+/// A new controller of model `M` made through library `e`'s `toolconf_controller_create` (NULL
+/// if the model has none to make).
+pub fn controller_through<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    e: &Exports,
+) -> *mut Controller
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let mut h = core::ptr::null_mut();
+    if let Some((p, t, rate)) = controllable::<M, N, NX, NP, NZ>() {
+        let task = M::paper_task(TaskKind::ALL[t as usize]);
+        let (g, pr) = (flat(&task.goal), flat(&task.precision));
+        // SAFETY: the arrays hold the model's sizes.
+        unsafe {
+            (e.controller_create)(
+                p.as_ptr(),
+                t,
+                g.as_ptr(),
+                pr.as_ptr(),
+                1.0,
+                [0.1; N].as_ptr(),
+                rate,
+                &mut h,
+            )
+        };
+    }
+    h
+}
+
 /// The cases of the controller's exports: γ and U0 out of range, handles that are not live.
 #[allow(clippy::type_complexity)]
 fn controller_cases<'a, M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
@@ -492,27 +521,7 @@ where
         );
     }
     calls += fuzzed;
-    let own = || {
-        let mut h = core::ptr::null_mut();
-        if let Some((p, t, rate)) = controllable::<M, N, NX, NP, NZ>() {
-            let task = M::paper_task(TaskKind::ALL[t as usize]);
-            let (g, pr) = (flat(&task.goal), flat(&task.precision));
-            // SAFETY: the arrays hold the model's sizes.
-            unsafe {
-                (e.controller_create)(
-                    p.as_ptr(),
-                    t,
-                    g.as_ptr(),
-                    pr.as_ptr(),
-                    1.0,
-                    [0.1; N].as_ptr(),
-                    rate,
-                    &mut h,
-                )
-            };
-        }
-        h
-    };
+    let own = || controller_through::<M, N, NX, NP, NZ>(e);
     let state: Vec<f64> = M::equilibrium_state().as_slice().to_vec();
     calls + fuzz_threads(e, &own, &state, N, 4, fuzz_cases(3000) / 8)
 }
