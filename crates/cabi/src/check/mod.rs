@@ -22,6 +22,7 @@ use toolconf_core::{ArmModel, TERMS};
 mod bits;
 pub mod cases;
 pub mod fuzz;
+pub mod table;
 
 pub use bits::bit_identity;
 pub use cases::hostile;
