@@ -92,8 +92,7 @@ static ALLOW: AtomicUsize = AtomicUsize::new(0);
 
 #[test]
 fn out_of_memory_in_create_is_a_status() {
-    let mut refused = 0;
-    for allowed in 0..16 {
+    for (refused, allowed) in (0..16).enumerate() {
         ALLOW.store(allowed, Ordering::SeqCst);
         let live = handles::live();
         let mut h = 7 as *mut Controller;
@@ -115,7 +114,6 @@ fn out_of_memory_in_create_is_a_status() {
         assert!(toolconf_cabi::status::last_error().contains("out of memory"));
         assert_eq!(h as usize, 7, "a failed create wrote a handle");
         assert_eq!(handles::live(), live, "a failed create registered a handle");
-        refused += 1;
     }
     panic!("create never succeeded with 16 allocations");
 }

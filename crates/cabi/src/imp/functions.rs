@@ -28,13 +28,17 @@ where
     })
 }
 
+/// X, U and p: the inputs of the dynamics.
+type Xup<const N: usize, const NX: usize, const NP: usize> =
+    (SVector<f64, NX>, SVector<f64, N>, SVector<f64, NP>);
+
 /// (X, U, p) from C: the inputs of the dynamics.
 unsafe fn x_u_p<const N: usize, const NX: usize, const NP: usize>(
     x: *const f64,
     u: *const f64,
     params: *const f64,
     function: &str,
-) -> Result<(SVector<f64, NX>, SVector<f64, N>, SVector<f64, NP>), Failure> {
+) -> Result<Xup<N, NX, NP>, Failure> {
     Ok((
         vector::<NX>(x, function, "x")?,
         vector::<N>(u, function, "u")?,
