@@ -158,6 +158,14 @@ where
             }
         }
         .map_err(|e| core_error(&e, f))?;
+        // The core refuses a torque that is not finite; ln|Π^U| was checked at creation.
+        kept_finite(
+            f,
+            &[
+                ("torque", &command.torque),
+                ("confidence", &[command.confidence]),
+            ],
+        )?;
         write(torque, &command.torque);
         confidence.write_unaligned(command.confidence);
         Ok(())
@@ -188,8 +196,24 @@ where
             ],
         )?;
         handles::with(controller, F, |c: &mut ArmController<M, N, NX, NP, NZ>| {
-            write(pi_u, c.control_confidence().pi_u.as_slice());
+            let pi = c.control_confidence().pi_u;
+            kept_finite(F, &[("pi_u", pi.as_slice())])?;
+            write(pi_u, pi.as_slice());
             Ok(())
         })
     })
+}
+
+/// Step 6 for what a controller keeps: finite by its construction, so a value that is not is a
+/// bug ([`crate::status::INTERNAL`]), never written.
+fn kept_finite(function: &str, results: &[(&str, &[f64])]) -> Result<(), Failure> {
+    for (what, values) in results {
+        if let Some((i, v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(crate::status::fail(
+                crate::status::INTERNAL,
+                format_args!("{function}: {what}[{i}] = {v}: the controller holds a number that is not finite"),
+            ));
+        }
+    }
+    Ok(())
 }
