@@ -14,10 +14,11 @@ run:
 	./target/release/toolconf reproduce --out results/
 
 ## make bench: criterion benchmarks (Π^U per tool, closed-loop RHS, episodes, a batch of 1000, populations of 2000 tools, the Panda's joint and tip episodes,
-## the default reproduce, the on-robot controller's tick); reports in target/criterion/ and
-## examples/on_robot/bench/target/criterion/. Peers: bench/peers/run.sh.
+## the default reproduce, the on-robot controller's tick, directly and through the C ABI); reports in
+## target/criterion/ and examples/on_robot/bench/target/criterion/. Peers: bench/peers/run.sh.
 bench:
 	cargo bench --bench confidence --bench episode --bench stiff --bench reproduce --bench population --bench urdf_episode
+	cargo bench -p toolconf-cabi --bench tick
 	cargo bench --manifest-path examples/on_robot/bench/Cargo.toml
 
 ## make test: the whole suite: `make derive` reproduces generated/ byte for byte (on this CPU and

@@ -190,9 +190,18 @@ fn every_model_loaded_equals_built_in_bit_for_bit() {
         .unwrap_err()
         .to_string();
     assert!(
-        bad.contains("the model name 'bad name' is not one"),
+        bad.contains("the model name 'Bad Name' is not one"),
         "{bad}"
     );
+    // A name in capitals is refused as given, never lower-cased into another model's name.
+    let upper = loaded::load(&panda, Some("Panda_C"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        upper.contains("the model name 'Panda_C' is not one") && upper.contains("('panda_c' is)"),
+        "{upper}"
+    );
+    assert!(!ModelKind::all().iter().any(|k| k.name() == "panda_c"));
     eprintln!(
         "{total} comparisons over {} models",
         ModelKind::BUILT_IN.len()
@@ -346,11 +355,11 @@ fn what_is_not_a_model_library_is_one_line_and_status_2() {
         "future",
         "unsigned toolconf_abi_version(void) { return 99; }\n",
     );
-    let half = c_library(
-        d,
-        "half",
-        "unsigned toolconf_abi_version(void) { return 1; }\n",
+    let version = format!(
+        "unsigned toolconf_abi_version(void) {{ return {}; }}\n",
+        toolconf_cabi::ABI_VERSION
     );
+    let half = c_library(d, "half", &version);
     let truncated = d.join("libtruncated.so");
     std::fs::write(&truncated, &std::fs::read(&half).unwrap()[..300]).unwrap();
     let cases: [(String, &str); 9] = [
@@ -367,7 +376,7 @@ fn what_is_not_a_model_library_is_one_line_and_status_2() {
             half.display().to_string(),
             "no symbol toolconf_tasks_fingerprint",
         ),
-        (truncated.display().to_string(), "cannot be loaded"),
+        (truncated.display().to_string(), "is truncated or damaged"),
         (format!("Bad Name={}", half.display()), "no symbol"),
     ];
     for (entry, why) in cases {
@@ -424,6 +433,167 @@ fn what_is_not_a_model_library_is_one_line_and_status_2() {
         stderr.contains("unknown model 'xarm7'") && stderr.contains("--model-path"),
         "{stderr}"
     );
+}
+
+/// (offset, size in the file) of every program header of a 64-bit little-endian ELF file, read
+/// by hand from its header (e_phoff at 0x20, e_phentsize at 0x36, e_phnum at 0x38; p_offset at
+/// +8, p_filesz at +32 of each entry): independent of the reader the loader uses.
+fn segments(elf: &[u8]) -> Vec<(usize, usize)> {
+    let word = |at: usize, n: usize| -> usize {
+        elf[at..at + n]
+            .iter()
+            .rev()
+            .fold(0usize, |v, b| (v << 8) | usize::from(*b))
+    };
+    let (phoff, phentsize, phnum) = (word(0x20, 8), word(0x36, 2), word(0x38, 2));
+    (0..phnum)
+        .map(|i| {
+            let at = phoff + i * phentsize;
+            (word(at + 8, 8), word(at + 32, 8))
+        })
+        .collect()
+}
+
+/// Where to cut `bytes` for the truncation tests: at every program header's start and end and
+/// one byte short of its end, in the ELF header, and at a few lengths drawn from a seed.
+fn cuts(bytes: &[u8], seed: u64) -> Vec<usize> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut cuts: Vec<usize> = segments(bytes)
+        .into_iter()
+        .flat_map(|(offset, size)| [offset, offset + size, (offset + size).saturating_sub(1)])
+        .chain([1, 5, 63, 64, 300])
+        .chain((0..5).map(|_| rng.random_range(1..bytes.len())))
+        .filter(|c| (1..bytes.len()).contains(c))
+        .collect();
+    cuts.sort_unstable();
+    cuts.dedup();
+    cuts
+}
+
+/// The library `whole` cut at each of [`cuts`] into `dir`: each is refused in one line naming
+/// the file, status 2, by `--model-path` and `TOOLCONF_MODEL_PATH`, and in this process;
+/// never a crash (the command line's status would be 135, SIGBUS, and this test would die).
+fn truncations_are_refused(whole: &Path, dir: &Path, seed: u64) -> usize {
+    let bytes = std::fs::read(whole).unwrap();
+    let cuts = cuts(&bytes, seed);
+    for (i, cut) in cuts.iter().enumerate() {
+        let t = dir.join(format!("t{i}.so"));
+        std::fs::write(&t, &bytes[..*cut]).unwrap();
+        let entry = t.display().to_string();
+        let (code, stderr) = refused(&entry);
+        let why = ["is truncated or damaged", "is not a shared library"];
+        assert!(
+            code == 2
+                && stderr.lines().count() == 1
+                && stderr.contains(&format!("model library {entry}: "))
+                && why.iter().any(|w| stderr.contains(w)),
+            "cut at {cut} of {}: status {code}: {stderr}",
+            bytes.len()
+        );
+        let out = Command::new(BIN)
+            .args(["confidence", "--model", "arm2", "--params", "1,1,1,1"])
+            .args(["--task", "position"])
+            .env(loaded::ENVIRONMENT, &entry)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            out.status.code() == Some(2) && stderr.lines().count() == 1,
+            "{loaded_env} cut at {cut}: {:?}: {stderr}",
+            out.status,
+            loaded_env = loaded::ENVIRONMENT
+        );
+        let e = loaded::load_entry(&entry).unwrap_err().to_string();
+        assert!(why.iter().any(|w| e.contains(w)), "{e}");
+    }
+    cuts.len()
+}
+
+#[test]
+fn a_truncated_library_is_one_line_and_status_2_never_a_crash() {
+    let dir = tempfile::tempdir().unwrap();
+    // Data enough for a segment of its own beyond the first pages.
+    let source = format!(
+        "unsigned toolconf_abi_version(void) {{ return {}; }}\nint table[8192] = {{1}};\n",
+        toolconf_cabi::ABI_VERSION
+    );
+    let whole = c_library(dir.path(), "whole", &source);
+    let cut = truncations_are_refused(&whole, dir.path(), 1);
+    assert!(cut >= 10, "{cut} cuts");
+    // The whole library gets past the headers to its symbols.
+    let (code, stderr) = refused(&whole.display().to_string());
+    assert!(
+        code == 2 && stderr.contains("no symbol toolconf_tasks_fingerprint"),
+        "{stderr}"
+    );
+}
+
+/// The library file in `make model`'s folder `dir`.
+fn library_in(dir: &Path) -> PathBuf {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|x| x == "so"))
+        .expect("a library in the folder")
+}
+
+#[test]
+#[ignore = "needs the model libraries: make loaded-models-test"]
+fn a_truncated_model_library_is_one_line_and_status_2_never_a_crash() {
+    let dir = tempfile::tempdir().unwrap();
+    let panda = library_in(&libraries().join("panda"));
+    let cut = truncations_are_refused(&panda, dir.path(), 2);
+    // `head -c 300000`, the cut that killed the process with SIGBUS before the check.
+    let bytes = std::fs::read(&panda).unwrap();
+    let t = dir.path().join("head.so");
+    std::fs::write(&t, &bytes[..300_000]).unwrap();
+    let (code, stderr) = refused(&t.display().to_string());
+    assert!(
+        code == 2 && stderr.contains("is truncated or damaged"),
+        "{stderr}"
+    );
+    eprintln!(
+        "{} bytes cut at {} places, each refused",
+        bytes.len(),
+        cut + 1
+    );
+}
+
+/// Each library's C ABI fuzzed ([`toolconf_cabi::check::fuzz`]) with another library's
+/// controllers as the foreign handles, and controllers ticked from several threads at once:
+/// the libraries `make model` built, as a C program would call them.
+#[test]
+#[ignore = "needs the model libraries: make loaded-models-test"]
+fn each_librarys_c_abi_refuses_the_others_handles_under_fuzzing() {
+    use toolconf_cabi::check::{self, cases::controller_through, Foreign};
+    use toolconf_cabi::toolconf_core::{Arm2, Arm3, ArmModel as _};
+    let folder = libraries();
+    let arm2 = loaded::open_exports(&folder.join("arm2")).unwrap();
+    let arm3 = loaded::open_exports(&folder.join("arm3")).unwrap();
+    let cases = check::fuzz_cases(3000);
+    // SAFETY (both destroys): any handle value is checked.
+    let (create3, destroy3) = (
+        || controller_through::<Arm3, 3, 6, 6, 9>(&arm3),
+        |h| unsafe { (arm3.controller_destroy)(h) },
+    );
+    let foreign = Foreign {
+        create: &create3,
+        destroy: &destroy3,
+    };
+    let (calls, seen) = check::fuzz::<Arm2, 2, 4, 4, 6>(&arm2, &foreign, cases, 3);
+    assert!(calls >= cases && seen[toolconf_cabi::status::BAD_HANDLE as usize] > 0);
+    let (create2, destroy2) = (
+        || controller_through::<Arm2, 2, 4, 4, 6>(&arm2),
+        |h| unsafe { (arm2.controller_destroy)(h) },
+    );
+    let foreign = Foreign {
+        create: &create2,
+        destroy: &destroy2,
+    };
+    check::fuzz::<Arm3, 3, 6, 6, 9>(&arm3, &foreign, cases, 4);
+    let state = Arm2::equilibrium_state();
+    let own = || controller_through::<Arm2, 2, 4, 4, 6>(&arm2);
+    check::fuzz_threads(&arm2, &own, state.as_slice(), 2, 4, cases / 8);
 }
 
 proptest::proptest! {

@@ -303,7 +303,8 @@ class MakeModel(unittest.TestCase):
         # Loaded by a program (ctypes here): the version, the metadata and one function.
         lib = ctypes.CDLL(str(library))
         lib.toolconf_abi_version.restype = ctypes.c_uint32
-        self.assertEqual(lib.toolconf_abi_version(), 1)
+        version = int(re.search(r"#define TOOLCONF_ABI_VERSION (\d+)u", header).group(1))
+        self.assertEqual(lib.toolconf_abi_version(), version)
         lib.toolconf_tasks_fingerprint.restype = ctypes.c_char_p
         fingerprint = re.search(r'#define TOOLCONF_TASKS_FINGERPRINT "([0-9a-f]{64})"', header).group(1)
         self.assertEqual(lib.toolconf_tasks_fingerprint().decode(), fingerprint)

@@ -129,8 +129,15 @@ int main(void) {
     double ignored_confidence;
     int32_t status = toolconf_controller_tick(controller, broken, ignored, &ignored_confidence);
     printf("a NaN measurement: %s (%s)\n", toolconf_status_name(status), toolconf_last_error());
-    toolconf_controller_destroy(controller);
-    if (status != TOOLCONF_NOT_FINITE) {
+    if (status != TOOLCONF_NOT_FINITE || toolconf_controller_destroy(controller) != TOOLCONF_OK) {
+        return 1;
+    }
+    /* The handle is checked: ticking or destroying it again is a status, not freed memory. */
+    int32_t again = toolconf_controller_tick(controller, state, ignored, &ignored_confidence);
+    printf("a tick after destroy: %s\n", toolconf_status_name(again));
+    int32_t twice = toolconf_controller_destroy(controller);
+    printf("a second destroy: %s\n", toolconf_status_name(twice));
+    if (again != TOOLCONF_BAD_HANDLE || twice != TOOLCONF_BAD_HANDLE) {
         return 1;
     }
 

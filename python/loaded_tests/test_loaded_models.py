@@ -205,3 +205,57 @@ def test_toolconf_model_path_loads_at_import_and_names_itself_when_refused(tmp_p
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
     assert out.returncode == 1
     assert f"ValueError: TOOLCONF_MODEL_PATH: model library {bad}: is not a shared library" in out.stderr
+
+
+def test_a_relative_path_is_resolved_at_load_so_workers_elsewhere_find_it(loaded, dask_client, monkeypatch):
+    import toolconf.dask
+
+    # The mass-spring-damper's size has a slot left beside msd_loaded.
+    monkeypatch.chdir(LIBRARIES)
+    assert toolconf.load_model("msd", "msd_relative") == "msd_relative"
+    monkeypatch.undo()
+    # Recorded for the workers as the file it named, whatever folder they run in.
+    assert (str(LIBRARIES / "msd"), "msd_relative") in toolconf._LOADED
+    assert all(cwd != str(LIBRARIES) for cwd in dask_client.run(os.getcwd).values())
+    params = tools("msd", 6, 4)
+    same(toolconf.simulate_batch("msd", params, "position"),
+         toolconf.dask.simulate_batch("msd_relative", params, "position", client=dask_client),
+         "dask simulate_batch")
+
+
+def test_a_name_in_capitals_is_refused_not_lower_cased(loaded):
+    with pytest.raises(ValueError, match=r"the model name 'Arm2_Caps' is not one.*\('arm2_caps' is\)"):
+        toolconf.load_model(LIBRARIES / "arm2", "Arm2_Caps")
+    assert "arm2_caps" not in toolconf.models()
+
+
+def _segments(elf):
+    """(offset, size in the file) of every program header of a 64-bit little-endian ELF file."""
+    import struct
+
+    phoff, = struct.unpack_from("<Q", elf, 0x20)
+    phentsize, phnum = struct.unpack_from("<HH", elf, 0x36)
+    return [(struct.unpack_from("<Q", elf, phoff + i * phentsize + 8)[0],
+             struct.unpack_from("<Q", elf, phoff + i * phentsize + 32)[0]) for i in range(phnum)]
+
+
+def test_a_truncated_library_is_a_value_error_never_a_crash(tmp_path):
+    import subprocess
+
+    whole = next((LIBRARIES / "panda").glob("libtoolconf_model_*.so")).read_bytes()
+    cuts = {300_000, len(whole) // 2, len(whole) - 1}
+    cuts |= {c for offset, size in _segments(whole) for c in (offset, offset + size) if 0 < c < len(whole)}
+    for cut in sorted(cuts):
+        t = tmp_path / f"t{cut}.so"
+        t.write_bytes(whole[:cut])
+        # In other interpreters: a SIGBUS there fails the test instead of killing pytest.
+        out = subprocess.run([sys.executable, "-c", f"import toolconf; toolconf.load_model({str(t)!r})"],
+                             capture_output=True, text=True)
+        assert out.returncode == 1, (cut, out.returncode, out.stderr)
+        assert out.stderr.splitlines()[-1].startswith(f"ValueError: model library {t}: is truncated or damaged"), \
+            out.stderr
+        env = {**os.environ, "TOOLCONF_MODEL_PATH": str(t)}
+        out = subprocess.run([sys.executable, "-c", "import toolconf"], env=env, capture_output=True, text=True)
+        assert out.returncode == 1, (cut, out.returncode, out.stderr)
+        assert out.stderr.splitlines()[-1].startswith(
+            f"ValueError: TOOLCONF_MODEL_PATH: model library {t}: is truncated or damaged"), out.stderr

@@ -92,7 +92,9 @@ def load_model(path: Union[str, "os.PathLike[str]"], name: Optional[str] = None)
         ValueError: one line naming the file and what is wrong with it.
         TypeError: ``path`` is not a str or path-like, or ``name`` not a str.
     """
-    path = os.path.expanduser(os.fspath(path))
+    # Resolved once, here: the path recorded for toolconf.dask's workers must not depend on
+    # the folder a worker was started in.
+    path = os.path.abspath(os.path.expanduser(os.fspath(path)))
     loaded = _toolconf.load_model(path, name)
     entry = (path, name)
     if entry not in _LOADED:

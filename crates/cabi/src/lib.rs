@@ -18,21 +18,27 @@
 //!   `derive/tasks.toml`, in its order (`Term::ALL`): goals `TERMS × N`, precisions and
 //!   sensitivities `TERMS × N × N`, a tip term padded to N as toolconf-core's `TaskN` does.
 //! * **Status, never a crash.** Every function returns an `int32_t` [`status`]: 0, or why not
-//!   (a null pointer, an unknown task, a non-finite input, ...), with a message for the calling
-//!   thread in `toolconf_last_error()`. Outputs are written only on success. A panic is caught
-//!   at the boundary ([`status::INTERNAL`]); nothing unwinds into C, nothing aborts.
+//!   (a null pointer, an unknown task, a non-finite input, ...), the arguments checked in one
+//!   order ([`imp`]), with a message for the calling thread in `toolconf_last_error()`. Outputs
+//!   are written only on success, and only finite numbers. A panic is caught at the boundary
+//!   ([`status::INTERNAL`]); nothing unwinds into C; an allocation that fails is
+//!   [`status::OUT_OF_MEMORY`].
+//! * **Checked handles.** A controller handle is a key of the library's registry of live
+//!   controllers ([`handles`]): a destroyed, foreign or forged one is
+//!   [`status::BAD_HANDLE`], and nothing is read through it.
 //! * **The same numbers.** Each function calls the generated function (through toolconf-core's
 //!   [`toolconf_core::ArmModel`]) the Rust code calls, and copies; [`check::bit_identity`]
 //!   compares every export through its function pointer with the direct call, bit for bit.
 //!
-//! Nothing here allocates per call but the controller's creation (one `Box`) and the metadata,
-//! built once on first use.
+//! Nothing here allocates per call but the controller's creation (its box and room in the
+//! registry, both fallible) and the metadata, built once on first use.
 
 use core::ffi::c_char;
 
 pub mod check;
 pub mod exports;
 pub mod fingerprint;
+pub mod handles;
 pub mod imp;
 pub mod info;
 pub mod status;
@@ -44,8 +50,9 @@ pub use info::{Constraint, Domain, InertiaRule, ModelInfo};
 pub use toolconf_core;
 
 /// The version of the C ABI: `toolconf_abi_version()`. A loader refuses a library whose version
-/// is not the one it was built for.
-pub const ABI_VERSION: u32 = 1;
+/// is not the one it was built for. 2: controller handles are keys of the library's registry
+/// (checked, never reused), results are checked finite, and `TOOLCONF_OUT_OF_MEMORY` is new.
+pub const ABI_VERSION: u32 = 2;
 
 /// `toolconf_abi_version()`.
 pub extern "C" fn abi_version() -> u32 {
@@ -273,7 +280,7 @@ macro_rules! export_model {
             torque: *mut f64,
             confidence: *mut f64,
         ) -> i32 {
-            $crate::imp::controller_tick::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(controller, state, ::core::ptr::null(), torque, confidence)
+            $crate::imp::controller_tick::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(controller, state, torque, confidence)
         }
 
         /// One tick with the joint accelerations measured too.
@@ -285,10 +292,7 @@ macro_rules! export_model {
             torque: *mut f64,
             confidence: *mut f64,
         ) -> i32 {
-            if acceleration.is_null() {
-                return $crate::imp::null_acceleration();
-            }
-            $crate::imp::controller_tick::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(controller, state, acceleration, torque, confidence)
+            $crate::imp::controller_tick_with_acceleration::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(controller, state, acceleration, torque, confidence)
         }
 
         /// The controller's Π^U (N × N).

@@ -13,27 +13,33 @@ pub const OK: i32 = 0;
 pub const NULL_POINTER: i32 = 1;
 /// The task index is not one of the model's tasks (`task_count` of the metadata).
 pub const UNKNOWN_TASK: i32 = 2;
-/// An input is NaN or infinite.
+/// An input is NaN or infinite, or a result would be (inputs too large for the model's
+/// arithmetic): the message names the array and index.
 pub const NOT_FINITE: i32 = 3;
-/// The tool's parameters break the model's rule (a domain, a constraint, the inertia rule).
+/// The tool's parameters break the model's rule (a domain, a constraint, the inertia rule):
+/// checked where documented, and the cause named wherever a result is not finite.
 pub const INVALID_TOOL: i32 = 4;
 /// A goal outside its range, a precision that is not symmetric positive semi-definite, or
 /// precisions that leave Π^U singular for every tool.
 pub const INVALID_TASK: i32 = 5;
-/// A learning rate, control rate or initial torque out of range, a control rate too low for
-/// the ticks to settle, or a measurement that drives the torque out of range.
+/// A learning rate, control rate or initial torque out of range, a learning rate and control
+/// rate with which the ticks would not settle (the message says which to change), or a
+/// measurement that drives the torque out of range.
 pub const INVALID_OPTION: i32 = 6;
 /// Π^U is not positive definite for this tool, or too ill-conditioned for ln|Π^U|.
 pub const NOT_POSITIVE_DEFINITE: i32 = 7;
 /// A task on the tool's tip, for a model whose description gives no tip.
 pub const NO_TIP: i32 = 8;
-/// The controller handle is not a live controller of this library.
+/// The controller handle is not a live controller of this library and model: destroyed,
+/// another library's or model's, or never a handle (crate::handles).
 pub const BAD_HANDLE: i32 = 9;
 /// An internal error (a panic, caught at the boundary): a bug, to be reported.
 pub const INTERNAL: i32 = 10;
+/// The allocator had no room for a new controller: nothing was created.
+pub const OUT_OF_MEMORY: i32 = 11;
 
 /// Every status by code: its C name.
-pub const NAMES: [&CStr; 11] = [
+pub const NAMES: [&CStr; 12] = [
     c"TOOLCONF_OK",
     c"TOOLCONF_NULL_POINTER",
     c"TOOLCONF_UNKNOWN_TASK",
@@ -45,6 +51,7 @@ pub const NAMES: [&CStr; 11] = [
     c"TOOLCONF_NO_TIP",
     c"TOOLCONF_BAD_HANDLE",
     c"TOOLCONF_INTERNAL",
+    c"TOOLCONF_OUT_OF_MEMORY",
 ];
 
 /// A status code's C name, `"TOOLCONF_UNKNOWN_STATUS"` for any other number.
@@ -146,6 +153,7 @@ mod tests {
         assert_eq!(name(OK), c"TOOLCONF_OK");
         assert_eq!(name(INTERNAL), c"TOOLCONF_INTERNAL");
         assert_eq!(name(-1), c"TOOLCONF_UNKNOWN_STATUS");
-        assert_eq!(name(11), c"TOOLCONF_UNKNOWN_STATUS");
+        assert_eq!(name(OUT_OF_MEMORY), c"TOOLCONF_OUT_OF_MEMORY");
+        assert_eq!(name(12), c"TOOLCONF_UNKNOWN_STATUS");
     }
 }

@@ -7,6 +7,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
+use crate::validate::{Range, CONTROL_RATE, LEARNING_RATE, TORQUE};
 use crate::{ActiveInferenceN, ArmModel, ControlConfidenceN, Error, TaskKind, TaskN, ToolN};
 
 /// The control rate the loop runs at: 1 kHz.
@@ -46,9 +47,11 @@ where
     M: ArmModel<N, NX, NP, NZ>,
 {
     /// The controller of `tool` for `task` with learning rate γ, starting from
-    /// `initial_torque`, ticking at `rate_hz`. Errors for an invalid task or γ, a rate or torque
-    /// that is not finite and positive (finite), and a rate too low for the ticks to settle for
-    /// this tool and task (`examples/on_robot`'s docs).
+    /// `initial_torque`, ticking at `rate_hz`. Errors for an invalid task; a learning rate,
+    /// control rate or initial torque outside its range ([`crate::validate::LEARNING_RATE`],
+    /// [`crate::validate::CONTROL_RATE`], [`crate::validate::TORQUE`]); and a learning rate
+    /// and rate with which the ticks would not settle for this tool and task ([`unsettled`]
+    /// names which to change; `examples/on_robot`'s docs).
     pub fn new(
         tool: &ToolN<M, N, NX, NP, NZ>,
         task: &TaskN<N>,
@@ -56,17 +59,10 @@ where
         initial_torque: [f64; N],
         rate_hz: f64,
     ) -> Result<Self, Error> {
-        if !(rate_hz.is_finite() && rate_hz > 0.0) {
-            return Err(Error::InvalidOption {
-                name: "control rate [Hz]",
-                value: rate_hz,
-            });
-        }
-        if let Some(&value) = initial_torque.iter().find(|v| !v.is_finite()) {
-            return Err(Error::InvalidOption {
-                name: "initial torque U0",
-                value,
-            });
+        within("control rate [Hz]", rate_hz, CONTROL_RATE)?;
+        within("learning rate", learning_rate, LEARNING_RATE)?;
+        for value in initial_torque {
+            within("initial torque U0", value, TORQUE)?;
         }
         let controller = ActiveInferenceN::new(tool, task, learning_rate)?;
         let period = 1.0 / rate_hz;
@@ -78,10 +74,11 @@ where
             .map_or_else(SMatrix::zeros, |t| t.padded_jacobian());
         let contraction = controller.tick_contraction(&b, &j, period);
         if !(contraction.is_finite() && contraction < 1.0) {
-            return Err(Error::InvalidOption {
-                name: "control rate [Hz] (too low for this tool and task: each tick would not shrink a torque error; raise it)",
-                value: rate_hz,
-            });
+            return Err(unsettled(
+                &controller.tick_feedback(&b, &j),
+                learning_rate,
+                rate_hz,
+            ));
         }
         let tip = crate::tip_parameters::<M, N, NX, NP, NZ>(&tool.params(), task.kind)?;
         Ok(Self {
@@ -173,6 +170,47 @@ where
     }
 }
 
+/// `value` if it is in `range`, else the error naming `name` and the range.
+fn within(name: &'static str, value: f64, range: Range) -> Result<(), Error> {
+    if range.contains(value) {
+        Ok(())
+    } else {
+        Err(Error::OptionOutOfRange { name, value, range })
+    }
+}
+
+/// Why ticks with learning rate γ at `rate_hz` would not settle, given the tick's feedback
+/// `feedback` (ActiveInferenceN::tick_feedback): each tick multiplies a torque error by
+/// I − (γ/rate)·feedback, which must shrink it. The option named is the one to change:
+/// * no γ/rate shrinks it (a torque direction the task's precisions on U, θ̈ and ÿ leave
+///   without feedback): neither option helps;
+/// * γ/rate so small that the step is lost to rounding (I − ε·feedback rounds to I): γ;
+/// * γ so large that even the fastest rate ([`CONTROL_RATE`]'s bound) does not settle: γ;
+/// * otherwise, a faster rate settles: the rate.
+fn unsettled<const N: usize>(
+    feedback: &SMatrix<f64, N, N>,
+    learning_rate: f64,
+    rate_hz: f64,
+) -> Error {
+    let radius = crate::linalg::spectral_radius(feedback);
+    let contraction = |step: f64| {
+        crate::linalg::spectral_radius(&(SMatrix::<f64, N, N>::identity() - feedback * step))
+    };
+    // A step of a thousandth of the feedback's size shrinks every direction it reaches.
+    let reaches_all = radius > 0.0 && radius.is_finite() && contraction(1e-3 / radius) < 1.0;
+    let (name, value) = if !reaches_all {
+        ("control rate [Hz] (no rate makes the ticks settle for this tool and task: its precisions on U, θ̈ and the tip's acceleration leave a torque direction without feedback; give P^U weight)", rate_hz)
+    } else if learning_rate / rate_hz * radius < 1e-12 {
+        // A tick would change a torque error by less than 10⁻¹² of it: lost to rounding.
+        ("learning rate (too small for this tool and task at this control rate: a tick would not change the torque; raise it)", learning_rate)
+    } else if !(contraction(learning_rate / CONTROL_RATE.hi) < 1.0) {
+        ("learning rate (too large for this tool and task: the ticks would not settle at any control rate up to 1e6 Hz; lower it)", learning_rate)
+    } else {
+        ("control rate [Hz] (too low for this tool and task: each tick would not shrink a torque error; raise it)", rate_hz)
+    };
+    Error::InvalidOption { name, value }
+}
+
 /// A measurement as a vector, or the error naming its first non-finite value.
 #[inline]
 fn measured<const K: usize>(values: &[f64; K]) -> Result<SVector<f64, K>, Error> {
@@ -182,5 +220,100 @@ fn measured<const K: usize>(values: &[f64; K]) -> Result<SVector<f64, K>, Error>
             value,
         }),
         None => Ok(SVector::from(*values)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Arm2;
+
+    type Controller = ArmController<Arm2, 2, 4, 4, 6>;
+
+    /// The controller of the paper's first arm ([0.3, 0.4, 0.5, 0.2]), or a light one whose
+    /// ∂θ̈2/∂T2 ~ 3/(m2 l2²) = 375 s⁻² per N m, on `kind`.
+    fn made(
+        light: bool,
+        kind: TaskKind,
+        gamma: f64,
+        u0: f64,
+        rate: f64,
+    ) -> Result<Controller, Error> {
+        let p = if light {
+            [0.3, 0.2, 0.5, 0.2]
+        } else {
+            [0.3, 0.4, 0.5, 0.2]
+        };
+        let tool = ToolN::new(p).unwrap();
+        Controller::new(&tool, &Arm2::paper_task(kind), gamma, [u0; 2], rate)
+    }
+
+    fn named(e: Error) -> (&'static str, f64) {
+        match e {
+            Error::InvalidOption { name, value } | Error::OptionOutOfRange { name, value, .. } => {
+                (name, value)
+            }
+            other => panic!("not an option's error: {other}"),
+        }
+    }
+
+    #[test]
+    fn each_refused_option_is_named_as_itself() {
+        use TaskKind::{Acceleration, Position};
+        let cases: [(bool, TaskKind, f64, f64, f64, &str, f64); 8] = [
+            (false, Position, 1e300, 0.1, 1000.0, "learning rate", 1e300),
+            (
+                false,
+                Position,
+                1e-300,
+                0.1,
+                1000.0,
+                "learning rate (too small",
+                1e-300,
+            ),
+            (false, Position, -1.0, 0.1, 1000.0, "learning rate", -1.0),
+            (
+                false,
+                Position,
+                1.0,
+                1e300,
+                1000.0,
+                "initial torque U0",
+                1e300,
+            ),
+            (false, Position, 1.0, 0.1, 1e300, "control rate [Hz]", 1e300),
+            (false, Position, 1.0, 0.1, 0.0, "control rate [Hz]", 0.0),
+            // The light arm on task 3 needs a faster rate at γ = 1 ...
+            (
+                true,
+                Acceleration,
+                1.0,
+                0.1,
+                1000.0,
+                "control rate [Hz] (too low",
+                1000.0,
+            ),
+            // ... and no rate up to 1 MHz settles γ = 10⁶.
+            (
+                true,
+                Acceleration,
+                1e6,
+                0.1,
+                1000.0,
+                "learning rate (too large",
+                1e6,
+            ),
+        ];
+        for (light, kind, gamma, u0, rate, name, value) in cases {
+            let e = made(light, kind, gamma, u0, rate).unwrap_err();
+            let (got, v) = named(e);
+            assert!(
+                got.starts_with(name) && v == value,
+                "γ {gamma}, U0 {u0}, {rate} Hz: {e}"
+            );
+        }
+        assert!(made(false, TaskKind::Position, 1.0, 0.1, 1000.0).is_ok());
+        // The message's bound is the range's.
+        assert_eq!(CONTROL_RATE.hi, 1e6);
     }
 }

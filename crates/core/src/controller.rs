@@ -294,7 +294,18 @@ impl<const N: usize> ActiveInferenceN<N> {
         period: f64,
     ) -> f64 {
         let g = self.learning_rate * period;
-        let instantaneous = sum(Term::ALL.iter().filter_map(|&term| {
+        let step = SMatrix::<f64, N, N>::identity() - self.tick_feedback(b, tip_jacobian) * g;
+        crate::linalg::spectral_radius(&step)
+    }
+
+    /// Σ K ∂(term)/∂U over the terms that follow U within a tick ([`Self::tick_contraction`]
+    /// without γ and the period): how a tick feeds a torque error back, per unit of γ·period.
+    pub fn tick_feedback<const NX: usize>(
+        &self,
+        b: &SMatrix<f64, NX, N>,
+        tip_jacobian: &SMatrix<f64, N, N>,
+    ) -> SMatrix<f64, N, N> {
+        sum(Term::ALL.iter().filter_map(|&term| {
             let k = self.gain[term.index()];
             match term.read() {
                 Read::State { .. } | Read::Tip { order: 0 | 1 } => None,
@@ -302,9 +313,7 @@ impl<const N: usize> ActiveInferenceN<N> {
                 Read::Tip { .. } => Some(k * tip_jacobian * b.fixed_rows::<N>(N)),
                 Read::Control => Some(k),
             }
-        }));
-        let step = SMatrix::<f64, N, N>::identity() - instantaneous * g;
-        crate::linalg::spectral_radius(&step)
+        }))
     }
 
     /// The gains γ·K of U̇ = −γ ∂F/∂U by [`Term::index`] (γ·P^U for the control's term), for

@@ -45,6 +45,14 @@ pub enum Error {
     /// A numeric option outside its domain (the learning rate γ, the control period).
     #[error("invalid {name} = {}", Short(*value))]
     InvalidOption { name: &'static str, value: f64 },
+    /// A numeric option of the on-robot controller outside its documented range
+    /// ([`crate::validate`]: the learning rate, the control rate, the initial torque).
+    #[error("invalid {name} = {}: must be a number in {range}", Short(*value))]
+    OptionOutOfRange {
+        name: &'static str,
+        value: f64,
+        range: Range,
+    },
     /// Π^U that is not positive definite for one tool, so it is no precision and ln|Π^U| is
     /// undefined. (A task whose precisions leave Π^U singular for every tool is refused up
     /// front: [`Error::ConfidenceRank`].)

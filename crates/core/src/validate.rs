@@ -92,6 +92,16 @@ pub const PRECISION_ENTRY: Range = Range::closed(-1e6, 1e6, "");
 /// The episode's divergence bound: a state past it is a diverged simulation
 /// (the runtime's `DIVERGENCE_BOUND`).
 pub const STATE_BOUND: f64 = 1e6;
+/// Torques, the initial torque U0 and the perturbation ΔT: the divergence bound, over which
+/// the generated arithmetic is shown to stay finite (the runtime's `toolconf::validate`).
+pub const TORQUE: Range = Range::closed(-STATE_BOUND, STATE_BOUND, "N m");
+/// The controller's learning rate γ.
+pub const LEARNING_RATE: Range = Range::above(0.0, 1e6, "");
+/// The on-robot controller's control rate: up to 1 MHz, 25 times the fastest loop a robot's
+/// fieldbus runs (EtherCAT drives close their loops at up to 40 kHz; the Panda's and the
+/// UR5's controllers tick at 1 kHz and 500 Hz). A faster rate only makes each tick's step
+/// γ/rate smaller, until it is lost to rounding.
+pub const CONTROL_RATE: Range = Range::above(0.0, 1e6, "Hz");
 /// Joint angles, the initial θ₀ and the goal θ_g, in rad (m for a prismatic joint or the
 /// mass-spring-damper): |θ| ≤ 4π, two full turns either way of the zero pose. Every revolute
 /// joint of the shipped arms travels less (the UR5's ±2π is the widest), and the controller's

@@ -35,18 +35,14 @@
 use core::fmt;
 
 pub use toolconf_core::validate::{
-    goal_range, Range, JOINT_ACCELERATION, JOINT_ANGLE, JOINT_RATE, PRECISION_ENTRY, STATE_BOUND,
-    TOOL_PARAMETER,
+    goal_range, Range, JOINT_ACCELERATION, JOINT_ANGLE, JOINT_RATE, LEARNING_RATE, PRECISION_ENTRY,
+    STATE_BOUND, TOOL_PARAMETER, TORQUE,
 };
 
 /// Any state an episode reaches, the divergence bound: past it a simulation has diverged.
 /// Not an input of its own (starts are within [`JOINT_ANGLE`] and [`JOINT_RATE`]), but the
 /// box over which the generated code is shown to stay finite.
 pub const STATE: Range = Range::closed(-STATE_BOUND, STATE_BOUND, "");
-/// Torques: the initial torque U0 and the perturbation ΔT.
-pub const TORQUE: Range = Range::closed(-STATE_BOUND, STATE_BOUND, "N m");
-/// The controller's learning rate γ.
-pub const LEARNING_RATE: Range = Range::above(0.0, 1e6, "");
 /// The episode's end time.
 pub const T_END: Range = Range::above(0.0, 1e6, "s");
 /// The output step; also at most t_end, and the grid at most

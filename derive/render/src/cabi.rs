@@ -21,7 +21,7 @@ use crate::{engine, load_template_tree, render_one, RenderError};
 
 /// The version of the C ABI the templates declare: toolconf-cabi's `ABI_VERSION` (the
 /// library's test compares them).
-pub const ABI_VERSION: u32 = 1;
+pub const ABI_VERSION: u32 = 2;
 
 /// The library's crate: its package name, and the repository whose crates it builds on.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -148,10 +148,8 @@ pub(crate) fn read(exports: &Exports, name: Option<&str>) -> Result<Metadata, St
     }
     // SAFETY (every read below): the metadata's arrays hold the counts it gives.
     let own_name = unsafe { text(c.name, "name") }?;
-    let name = match name {
-        Some(n) => n.trim().to_ascii_lowercase(),
-        None => own_name,
-    };
+    // A name given is taken as given: refused if it is not one, never changed into one.
+    let name = name.map_or(own_name, str::to_string);
     check_name(&name)?;
     let task_names = unsafe { texts(c.task_names, c.task_count, "task_names") }?;
     let term_names = unsafe { texts(c.term_names, c.term_count, "term_names") }?;
@@ -234,8 +232,14 @@ fn check_name(name: &str) -> Result<(), String> {
     if ok {
         Ok(())
     } else {
+        let lower = name.to_ascii_lowercase();
+        let hint = match lower != name && check_name(&lower).is_ok() {
+            true => format!(" ('{lower}' is)"),
+            false => String::new(),
+        };
         Err(format!(
-            "the model name '{}' is not one: 1 to 64 of a-z, 0-9 and _, starting with a letter",
+            "the model name '{}' is not one: 1 to 64 of a-z, 0-9 and _, starting with a \
+             letter{hint}",
             crate::display::Clip(name)
         ))
     }

@@ -18,12 +18,12 @@
 //!   out `'static` models); loading the same file under the same name again returns the model
 //!   loaded before.
 
+mod elf;
 mod metadata;
 mod table;
 
 use std::ffi::CStr;
 use std::fmt;
-use std::io::Read as _;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
@@ -94,6 +94,21 @@ pub fn load(path: &Path, name: Option<&str>) -> Result<ModelKind, LoadError> {
     std::mem::forget(handle);
     loaded.push((canonical, asked, kind));
     Ok(kind)
+}
+
+/// The exports of the model library at `path` (as [`load`] takes it), checked as [`load`]
+/// checks them but not registered as a model: for a program that calls a library's C ABI
+/// itself (tests/loaded_models.rs fuzzes libraries with each other's controllers). The
+/// library stays loaded.
+pub fn open_exports(path: &Path) -> Result<Exports, LoadError> {
+    let fail = |reason: String| LoadError {
+        path: crate::display::ClipPath(&path.display().to_string()).to_string(),
+        reason,
+    };
+    let file = library_file(path).map_err(&fail)?;
+    let (handle, library) = open(&file).map_err(&fail)?;
+    std::mem::forget(handle);
+    Ok(library.exports)
 }
 
 /// Whether the model `metadata` describes can be registered: its name free, its size one the
@@ -217,28 +232,78 @@ fn library_file(path: &Path) -> Result<PathBuf, String> {
     }
 }
 
-/// Opens `file` and reads its exports: the ABI version first, then every symbol, then the task
+/// Opens `file` once, checks it through that descriptor (a regular file, a shared library of
+/// this system whose headers fit in it: [`elf::check`]), has the dynamic loader map the very
+/// file it checked (`/proc/self/fd/<n>`, not the path again, which may meanwhile name another
+/// file), and reads its exports: the ABI version first, then every symbol, then the task
 /// list's fingerprint.
+///
+/// What remains: a file changed in place after the check (truncated, or overwritten by `cp`)
+/// can still fault while or after it is mapped, as any shared library can; `make model`
+/// replaces a library by renaming a new file over it, which leaves a loaded one intact.
 fn open(file: &Path) -> Result<(libloading::Library, Library), String> {
-    let mut magic = [0u8; 4];
-    let read = std::fs::File::open(file)
-        .and_then(|f| f.take(4).read(&mut magic))
+    use std::os::unix::fs::OpenOptionsExt;
+    let f = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NONBLOCK)
+        .open(file)
         .map_err(|e| format!("cannot read: {e}"))?;
-    if read < 4 || (magic != *b"\x7fELF" && !is_mach_o(magic)) {
+    let meta = f.metadata().map_err(|e| format!("cannot read: {e}"))?;
+    if !meta.is_file() {
+        return Err("is not a file or a folder (a device, a pipe or a socket)".into());
+    }
+    let mut ident = [0u8; 6];
+    let read = std::os::unix::fs::FileExt::read_at(&f, &mut ident, 0)
+        .map_err(|e| format!("cannot read: {e}"))?;
+    let magic = [ident[0], ident[1], ident[2], ident[3]];
+    if read >= 6 && magic == *b"\x7fELF" {
+        elf::check(&f, meta.len(), &ident)?;
+    } else if read < 4 || !is_mach_o(magic) {
         return Err(
             "is not a shared library (no ELF or Mach-O header): make model writes \
                     libtoolconf_model_<model>.so"
                 .into(),
         );
+    } else if !cfg!(target_vendor = "apple") {
+        return Err("is a Mach-O library (macOS): this system loads ELF libraries".into());
     }
+    let handle = dlopen(f, file)?;
+    let exports = checked_exports(&handle)?;
+    Ok((handle, Library { exports }))
+}
+
+/// Has the dynamic loader map the file open as `f`, by its descriptor where /proc gives one.
+/// Once the loader has taken it, the descriptor is never closed, whether the library is then
+/// registered or refused: the loader keeps `/proc/self/fd/<n>` among the names of what it
+/// loaded (as an alias of an already loaded library, when it is the same file), and would
+/// answer a later file opened under the same number with that library.
+fn dlopen(f: std::fs::File, file: &Path) -> Result<libloading::Library, String> {
+    use std::os::fd::{AsRawFd, IntoRawFd};
+    let by_fd = PathBuf::from(format!("/proc/self/fd/{}", f.as_raw_fd()));
+    let target = match by_fd.exists() {
+        true => by_fd.clone(),
+        false => file.to_path_buf(),
+    };
     // SAFETY: opening a library runs its initialisers: a model library is trusted native code
     // (the module's documentation).
-    let handle = unsafe { libloading::Library::new(file) }.map_err(|e| {
+    let handle = unsafe { libloading::Library::new(&target) }.map_err(|e| {
+        let message = e
+            .to_string()
+            .replace(&*by_fd.to_string_lossy(), &file.to_string_lossy());
         format!(
             "cannot be loaded: {}",
-            crate::display::ClipMessage(&e.to_string())
+            crate::display::ClipMessage(&message)
         )
     })?;
+    if target == by_fd {
+        let _never_closed = f.into_raw_fd();
+    }
+    Ok(handle)
+}
+
+/// The exports of an opened library: the ABI version first, then every symbol, then the
+/// task list's fingerprint.
+fn checked_exports(handle: &libloading::Library) -> Result<Exports, String> {
     // SAFETY: the symbol's type is the ABI's; the value is copied while `handle` is alive, and
     // `handle` outlives every use (it is never closed once the model is registered).
     let version = unsafe { handle.get::<extern "C" fn() -> u32>(b"toolconf_abi_version\0") }
@@ -252,7 +317,7 @@ fn open(file: &Path) -> Result<(libloading::Library, Library), String> {
              it with make model from this toolconf"
         ));
     }
-    let exports = exports(&handle)?;
+    let exports = exports(handle)?;
     // SAFETY: the function returns a NUL-terminated string owned by the library.
     let theirs = unsafe { c_text((exports.tasks_fingerprint)()) };
     let ours = toolconf_cabi::fingerprint::hex();
@@ -266,7 +331,7 @@ fn open(file: &Path) -> Result<(libloading::Library, Library), String> {
             &ours[..16]
         ));
     }
-    Ok((handle, Library { exports }))
+    Ok(exports)
 }
 
 fn is_mach_o(magic: [u8; 4]) -> bool {
