@@ -15,7 +15,7 @@ run:
 
 ## make bench: criterion benchmarks (Π^U per tool, closed-loop RHS, episodes, a batch of 1000, populations of 2000 tools, the Panda's joint and tip episodes,
 ## the default reproduce, the on-robot controller's tick); reports in target/criterion/ and
-## examples/on_robot/bench/target/criterion/. Peers: bench/peers/run.sh.
+## examples/on_robot/bench/target/criterion/. Peers: benches/peers/run.sh.
 bench:
 	cargo bench --bench confidence --bench episode --bench stiff --bench reproduce --bench population --bench urdf_episode
 	cargo bench --manifest-path examples/on_robot/bench/Cargo.toml
