@@ -15,7 +15,7 @@ run:
 
 ## make bench: criterion benchmarks (Π^U per tool, closed-loop RHS, episodes, a batch of 1000, populations of 2000 tools, the Panda's joint and tip episodes,
 ## the default reproduce, the on-robot controller's tick, directly and through the C ABI); reports in
-## target/criterion/ and examples/on_robot/bench/target/criterion/. Peers: bench/peers/run.sh.
+## target/criterion/ and examples/on_robot/bench/target/criterion/. Peers: benches/peers/run.sh.
 bench:
 	cargo bench --bench confidence --bench episode --bench stiff --bench reproduce --bench population --bench urdf_episode
 	cargo bench -p toolconf-cabi --bench tick
@@ -53,7 +53,8 @@ c-example-test: $(PY)
 ## from its unedited URDF (make model DESC=examples/robots/xarm7.toml), into a temporary folder; then checks
 ## that each loaded library gives its built-in model's numbers bit for bit in every operation and subcommand
 ## (tests/loaded_models.rs), in Python and on Dask's workers (python/loaded_tests/), and the xArm7's
-## dynamics against Pinocchio's aba. Needs the Python package installed (make python-test does it).
+## dynamics against Pinocchio's aba; and runs the examples that load a library (examples/load_model.rs,
+## examples/python/load_model.py) on the Panda's. Needs the Python package installed (make python-test does it).
 loaded-models-test: $(PY_DEV)
 	@d=$$(mktemp -d) && trap 'rm -rf "$$d"' EXIT && \
 	for ir in generated/*.json; do \
@@ -63,6 +64,7 @@ loaded-models-test: $(PY_DEV)
 	$(PY) derive/make_model.py --desc examples/robots/xarm7.toml --out $$d/xarm7 2>$$d/xarm7.log >/dev/null || { cat $$d/xarm7.log; exit 1; }; \
 	echo "loaded-models-test: $$(ls -d $$d/*/ | wc -l) model libraries built" && \
 	TOOLCONF_TEST_LIBRARIES=$$d cargo test --quiet --test loaded_models -- --include-ignored && \
+	TOOLCONF_TEST_LIBRARIES=$$d cargo test --quiet --test examples -- --ignored && \
 	TOOLCONF_TEST_LIBRARIES=$$d $(PY) -m pytest -q python/loaded_tests
 
 ## make mujoco-test: the on-robot controller on MuJoCo (examples/mujoco/, docs/mujoco.md). Installs the example's

@@ -3,7 +3,7 @@
 //! `Method::Fast` (the default of select, rank and reproduce) side by side. Criterion's
 //! throughput is per tool, so its "elem/s" is tools per second and the time per element the mean
 //! time per tool. The percentiles and the accuracy against a tight reference are
-//! `bench/population.sh` (`examples/population.rs`).
+//! `benches/population.sh` (`benches/timing/population.rs`).
 //!
 //! `cargo bench --bench population`.
 

@@ -9,7 +9,7 @@
 //! joint tasks take 0.36–0.41 ms).
 //!
 //! `cargo bench --bench urdf_episode`; goals: an episode ≤ 2 ms, ≥ 100× SciPy's
-//! `solve_ivp` with Pinocchio's `aba` on the same loop (bench/peers/urdf_peers.py, which times the
+//! `solve_ivp` with Pinocchio's `aba` on the same loop (benches/peers/urdf_peers.py, which times the
 //! peers and toolconf on one population side by side, mean and percentiles).
 
 use std::hint::black_box;

@@ -5,8 +5,8 @@
 //! own, beyond 1e-4 of ∫J (`ode45` itself is off by up to ≈ 1e-3 at rtol 1e-3, see
 //! docs/performance.md); identical results whatever the number of threads.
 //!
-//! The full 2000-tool check (`draw_tools(2000, 1)`) is `bench/population.sh`
-//! (`examples/population.rs`); here 60 tools per task keep the debug build to seconds.
+//! The full 2000-tool check (`draw_tools(2000, 1)`) is `benches/population.sh`
+//! (`benches/timing/population.rs`); here 60 tools per task keep the debug build to seconds.
 
 use toolconf::closed_loop::{simulate, EpisodeOptions, Metrics, Plant};
 use toolconf::integrate::Method;

@@ -77,8 +77,8 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
 
 /// [`sin_cos`] of W angles at once, lane by lane the same bits: the usual path is straight-line
 /// code over the lanes, which the compiler vectorises (SIMD across tools,
-/// `examples/lanes.rs`); if any lane needs more of the reduction (an angle next to a multiple of
-/// π/2, or out of range) every lane takes [`sin_cos`].
+/// `benches/timing/lanes.rs`); if any lane needs more of the reduction (an angle next to a
+/// multiple of π/2, or out of range) every lane takes [`sin_cos`].
 #[inline(always)]
 pub fn sin_cos_lanes<const W: usize>(x: [f64; W]) -> ([f64; W], [f64; W]) {
     let (mut n, mut hi, mut w, mut r) = ([0.0; W], [0.0; W], [0.0; W], [0.0; W]);

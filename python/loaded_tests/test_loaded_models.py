@@ -25,7 +25,7 @@ import toolconf
 import pinocchio as pin
 
 REPO = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(REPO / "bench" / "peers"))
+sys.path.insert(0, str(REPO / "benches" / "peers"))
 import pin_robot  # noqa: E402
 
 LIBRARIES = Path(os.environ["TOOLCONF_TEST_LIBRARIES"])

@@ -15,14 +15,14 @@ import toolconf
 import pinocchio as pin  # in derive/requirements.txt: make test installs it; a missing pin fails here
 
 REPO = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(REPO / "bench" / "peers"))
+sys.path.insert(0, str(REPO / "benches" / "peers"))
 import pin_robot  # noqa: E402
 # Normwise relative, per state: the issue's bound.
 TOLERANCE = 1e-10
 
 
 def pinocchio_model(name, tool):
-    """The robot's URDF cut at its flange with the tool a fixed link there (bench/peers/pin_robot.py,
+    """The robot's URDF cut at its flange with the tool a fixed link there (benches/peers/pin_robot.py,
     which builds it from the URDF file and the description alone)."""
     return pin_robot.model_with_tool(name, tool)
 

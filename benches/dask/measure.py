@@ -1,6 +1,6 @@
 """toolconf on one process against toolconf.dask on a 2-worker LocalCluster of this machine.
 
-Run by bench/dask/run.sh (a release wheel in its own venv). Every number is a median of
+Run by benches/dask/run.sh (a release wheel in its own venv). Every number is a median of
 ``--repeat`` runs, in one run of this script, on the same data:
 
 * rank, screen stage: N arm2 tools (a DataFrame; a dask DataFrame of P partitions persisted

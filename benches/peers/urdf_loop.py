@@ -25,7 +25,7 @@ task's weighted error over every grid point, t = 0 included; int F dt and int J 
 trapezoidal rule). The impedance can be scaled (`stiffness_scale`, `damping_scale`) for the study
 in docs/urdf.md; at 1 it is the description's.
 
-Checked against toolconf (examples/model_timing.rs) on the Panda, the first 5 tools of
+Checked against toolconf (benches/timing/model_timing.rs) on the Panda, the first 5 tools of
 urdf_peers.py's population (boxes with tips) per task, both integrated tightly (toolconf's
 `explicit` DP5 and this loop in SciPy's DOP853, rtol 1e-10, atol 1e-12; `urdf_peers.py --check`
 repeats it): the largest relative difference of ln|Pi^U| and of the task error, 2026-12-05:
@@ -38,7 +38,7 @@ repeats it): the largest relative difference of ln|Pi^U| and of the task error, 
 
 (tip_position's ln|Pi^U| is 8e-4 to 1.2e-3 on these tools: its differences are 8e-16 absolute at most.)
 
-Needs numpy, scipy and pin (bench/peers/requirements.txt), and derive/toolconf_derive (no
+Needs numpy, scipy and pin (benches/peers/requirements.txt), and derive/toolconf_derive (no
 SymPy: the description and task readers and the expression grammar).
 """
 

@@ -1,4 +1,4 @@
-//! Times toolconf's episodes on one thread for `bench/peers/compare.py`.
+//! Times toolconf's episodes on one thread for `benches/peers/compare.py`.
 //!
 //! Reads tools as JSON on stdin — the output of `toolconf select --json` (its `tools[].arm`), or a
 //! list of `{"m1", "m2", "l1", "l2"}` objects, or a list of `[m1, m2, l1, l2]` — and runs every

@@ -10,7 +10,7 @@ paper's claim is rho < 0: more confident tools do the task better), its 95 % int
 over the tools, the span of ln|Pi^U|, rho of the tip's length (tool_tip_z) against each, and the
 progress (median and minimum) on position tasks.
 
-    python3 bench/tip_confidence.py [N=1000] [SEED=7]
+    python3 benches/tip_confidence.py [N=1000] [SEED=7]
 
 Spearman's rho is the Pearson correlation of the ranks (ties broken by order: the metrics are
 continuous); no SciPy needed.

@@ -9,7 +9,7 @@ The population: `--tools` random physical Panda tools (solid boxes, panda_study.
 seed 2023), each with its tip at the centre of the box's far face along the flange z,
 (com_x, com_y, com_z + c/2), c the box's side along z (from its inertia: c^2 = 6 (ixx + iyy -
 izz) / m), written to a temporary tools file (with tool_tip_x/y/z, products of inertia zero) that
-toolconf's `examples/model_timing.rs` times on one thread (median of `--repeat` runs per tool, the
+toolconf's `benches/timing/model_timing.rs` times on one thread (median of `--repeat` runs per tool, the
 default `fast` method, what `toolconf rank` runs). SciPy is timed with time.perf_counter around
 `solve_ivp` only (model building, gains and metrics outside), once per tool; `aba` as the median
 over `--calls` calls per tool at a random state. Per task: mean and p50/p90/p99 of the per-tool
@@ -23,7 +23,7 @@ Before timing, each task is checked on the first `--check` tools with both integ
 through a copy of the task file with them in its [episode]): the largest relative difference of
 ln|Pi^U| and of the task error, a table of its own.
 
-    bench/peers/run.sh --urdf [--tools 100] [--tasks position,velocity,...] [--check 5] [--write]
+    benches/peers/run.sh --urdf [--tools 100] [--tasks position,velocity,...] [--check 5] [--write]
 
 `--tools-for TASK=N` times task TASK (as written in --tasks) on the first N tools only.
 --write puts the tables into docs/performance.md between the `peers-urdf` markers.
@@ -52,7 +52,7 @@ from urdf_loop import ClosedLoop, Task  # noqa: E402
 
 MODEL_TIMING = ROOT / "target" / "release" / "examples" / "model_timing"
 DOC = ROOT / "docs" / "performance.md"
-BEGIN, END = "<!-- peers-urdf:begin (written by bench/peers/urdf_peers.py) -->", "<!-- peers-urdf:end -->"
+BEGIN, END = "<!-- peers-urdf:begin (written by benches/peers/urdf_peers.py) -->", "<!-- peers-urdf:end -->"
 ROBOT = "panda"
 TASKS = ("position", "velocity", "examples/tasks/panda_wrist_turn.toml", "examples/tasks/panda_touch_point.toml",
          "examples/tasks/panda_draw_line.toml", "examples/tasks/panda_push_off.toml")
@@ -169,10 +169,10 @@ def report(args, results, aba, checks) -> str:
     lines = [f"{dt.date.today().isoformat()}, {platform.processor() or platform.machine()}, one thread each; "
              f"{args.tools} random Panda tools (solid boxes 0.05-3 kg, seed 2023, the tip at the centre of the "
              f"box's far face along the flange z{fewer}); SciPy {scipy.__version__}, "
-             f"Pinocchio {pin.__version__}, numpy {np.__version__}. toolconf: `examples/model_timing.rs`, method "
+             f"Pinocchio {pin.__version__}, numpy {np.__version__}. toolconf: `benches/timing/model_timing.rs`, method "
              f"`fast`, median of {args.repeat} runs per tool; SciPy: `solve_ivp(RK45, rtol=1e-3, atol=1e-6)` with "
              "`pin.aba` in the right-hand side (and Pinocchio's frame kinematics on a tip task), once per tool "
-             "(bench/peers/urdf_loop.py: the same loop and formulation). The tight reference of the task error: "
+             "(benches/peers/urdf_loop.py: the same loop and formulation). The tight reference of the task error: "
              f"toolconf's `explicit` DP5 at rtol {CHECK_RTOL:g}, atol {CHECK_ATOL:g}, which the same loop in SciPy's "
              "DOP853 at those tolerances matches (the second table).", ""]
     lines += ["| per tool | mean | p50 | p90 | p99 |", "| --- | ---: | ---: | ---: | ---: |"]

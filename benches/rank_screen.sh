@@ -4,7 +4,7 @@
 # draw_tools draws them, from Python's random.Random(SEED), six decimals), then runs
 # `toolconf rank --screen K --json` (release) on each task and prints both stages' wall time and
 # throughput, with the load average before and after each run. Nothing is written into docs/.
-#   bench/rank_screen.sh [N=1000000] [K=1000] [TASKS=position,velocity] [THREADS=1] [SEED=1]
+#   benches/rank_screen.sh [N=1000000] [K=1000] [TASKS=position,velocity] [THREADS=1] [SEED=1]
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"

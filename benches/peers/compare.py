@@ -11,14 +11,14 @@ sensitivities from derive/tasks.toml via toolconf_derive.numeric.CasadiModel (Ca
 B, the task formulas in 50-digit arithmetic), so no model equation is typed twice.
 
 toolconf's metrics come from `toolconf select --json` (task error, RHS evaluations), its timing
-from `examples/peer_timing.rs` (one thread, median of repeated runs per tool). Peers are timed
+from `benches/timing/peer_timing.rs` (one thread, median of repeated runs per tool). Peers are timed
 with time.perf_counter around the integration call only (model building, sensitivities and the
 task error are outside the timing).
 
 Writes the tables into docs/performance.md between the `peers` markers (the rest of the file is
-left alone) and prints them. Run through bench/peers/run.sh, which creates the environment.
+left alone) and prints them. Run through benches/peers/run.sh, which creates the environment.
 
-`--population` instead times the population that `bench/population.sh` ranks,
+`--population` instead times the population that `benches/population.sh` ranks,
 `toolconf select --task position --tools 2000 --seed 1 --json` (`draw_tools(2000, 1)`), on one
 thread: per task the mean over tools and p50/p90/p99/max of the per-tool time of SciPy RK45,
 CasADi cvodes, toolconf `--method explicit` (ode45-faithful DP5) and toolconf `--method fast`
@@ -55,8 +55,8 @@ from toolconf_derive.numeric import CasadiModel  # noqa: E402
 TOOLCONF = ROOT / "target" / "release" / "toolconf"
 PEER_TIMING = ROOT / "target" / "release" / "examples" / "peer_timing"
 DOC = ROOT / "docs" / "performance.md"
-BEGIN, END = "<!-- peers:begin (written by bench/peers/compare.py) -->", "<!-- peers:end -->"
-POP_BEGIN = "<!-- peers-population:begin (written by bench/peers/compare.py --population) -->"
+BEGIN, END = "<!-- peers:begin (written by benches/peers/compare.py) -->", "<!-- peers:end -->"
+POP_BEGIN = "<!-- peers-population:begin (written by benches/peers/compare.py --population) -->"
 POP_END = "<!-- peers-population:end -->"
 
 T_END, DT = 5.0, 0.05
@@ -361,7 +361,7 @@ def load_average() -> str:
 
 
 def quantile(sorted_values: list[float], q: float) -> float:
-    """examples/population.rs's: the element at round((n - 1) q)."""
+    """benches/timing/population.rs's: the element at round((n - 1) q)."""
     return sorted_values[round((len(sorted_values) - 1) * q)]
 
 
@@ -428,7 +428,7 @@ def commit() -> str:
 
 
 def render_population(results: dict, args, n_tools: int) -> str:
-    cmd = "bench/peers/run.sh" + "".join(" " + shlex.quote(a) for a in sys.argv[1:])
+    cmd = "benches/peers/run.sh" + "".join(" " + shlex.quote(a) for a in sys.argv[1:])
     out = [
         POP_BEGIN,
         "",
@@ -436,15 +436,15 @@ def render_population(results: dict, args, n_tools: int) -> str:
         "",
         f"Command: `{cmd}` (from the repository root). Tools: `toolconf select --task position "
         f"--tools {n_tools} --seed {args.seed} --json` (`draw_tools({n_tools}, {args.seed})`, the population "
-        "of `bench/population.sh`), every episode as in the tables above (rtol 1e-3, atol 1e-6, "
+        "of `benches/population.sh`), every episode as in the tables above (rtol 1e-3, atol 1e-6, "
         "101 output points). On a subsample (stride N > 1: tools 0, N, 2N, … of the population, "
         "the same tools for every row) the means are over the subsample. Time per tool on one "
         f"thread: SciPy RK45 {f'the median of {args.repeat} runs' if args.repeat > 1 else 'one run'} per tool, "
         f"cvodes the median of 3 runs, toolconf the median of "
-        f"{args.toolconf_repeat} runs per tool (`examples/peer_timing.rs --method`) in 4 passes, "
+        f"{args.toolconf_repeat} runs per tool (`benches/timing/peer_timing.rs --method`) in 4 passes, "
         "two before and two after the peers, the methods in turn (median over passes). Columns: mean "
         "over tools of the per-tool time, its percentiles (the element at round((n − 1) q) of the "
-        "sorted times, as `examples/population.rs`), mean RHS (and Jacobian) evaluations per tool "
+        "sorted times, as `benches/timing/population.rs`), mean RHS (and Jacobian) evaluations per tool "
         "(counted as in the tables above), the mean time over toolconf `fast`'s mean on the same "
         "tools, and the task error's relative difference from toolconf `explicit` (median / max).",
         "",
@@ -503,7 +503,7 @@ def versions() -> str:
 
 
 def render(results: dict, tight: dict, args) -> str:
-    cmd = "bench/peers/run.sh" + "".join(" " + shlex.quote(a) for a in sys.argv[1:])
+    cmd = "benches/peers/run.sh" + "".join(" " + shlex.quote(a) for a in sys.argv[1:])
     out = [
         BEGIN,
         "",
@@ -517,7 +517,7 @@ def render(results: dict, tight: dict, args) -> str:
            "(DP5 with ode45's step control on tasks 1 and 2; see `crates/runtime/src/integrate` for task 3)"
            if args.method == "auto" else f"`--method {args.method}`")
         + ". Times are per episode on one thread: "
-        f"toolconf the median of {args.toolconf_repeat} runs per tool (`examples/peer_timing.rs`), in "
+        f"toolconf the median of {args.toolconf_repeat} runs per tool (`benches/timing/peer_timing.rs`), in "
         "4 passes spread over the run (median over passes), the "
         f"peers the median of {args.repeat} runs per tool (1 for SciPy on task 3) around the "
         "integration call only; the table gives the median over tools. RHS = closed-loop right-hand-side "

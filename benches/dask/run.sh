@@ -1,15 +1,15 @@
 #!/usr/bin/env bash
 # toolconf.rank and toolconf.simulate_batch on one process against toolconf.dask on a
 # distributed.LocalCluster of 2 worker processes (1 thread, RAYON_NUM_THREADS=1 each) on this
-# machine, in one run (bench/dask/measure.py): throughput of both, the cluster's overhead per
-# partition and per task. Builds a release wheel into bench/dask/.venv (with the pinned
+# machine, in one run (benches/dask/measure.py): throughput of both, the cluster's overhead per
+# partition and per task. Builds a release wheel into benches/dask/.venv (with the pinned
 # python/requirements-dev.txt), so nothing touches derive/.venv; prints a table and one JSON
 # line. Nothing is written into docs/.
-#   bench/dask/run.sh [--quick]
+#   benches/dask/run.sh [--quick]
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 cd "$root"
-venv="$root/bench/dask/.venv"
+venv="$root/benches/dask/.venv"
 [[ -x "$venv/bin/python" ]] || python3 -m venv "$venv"
 "$venv/bin/pip" install --quiet --disable-pip-version-check -r python/requirements-dev.txt
 rm -rf target/bench-dask-wheel
@@ -17,5 +17,5 @@ rm -rf target/bench-dask-wheel
   --interpreter "$venv/bin/python" --out target/bench-dask-wheel
 "$venv/bin/pip" install --quiet --disable-pip-version-check --force-reinstall --no-deps \
   target/bench-dask-wheel/toolconf-*.whl
-cd bench/dask   # not the repository root: the wheel's toolconf, not python/toolconf
+cd benches/dask   # not the repository root: the wheel's toolconf, not python/toolconf
 "$venv/bin/python" measure.py "$@"

@@ -22,12 +22,13 @@ use toolconf::model::{Arm2, ArmModel, ClosedLoopN, TaskN};
 use toolconf::select::draw_tools;
 use toolconf::{Task, TaskKind};
 
+/// One f64 per lane, each lane a tool: what a SIMD register of W doubles holds.
 #[derive(Clone, Copy, Debug)]
-struct L<const W: usize>([f64; W]);
+struct PerLane<const W: usize>([f64; W]);
 
 macro_rules! lane_op {
     ($tr:ident, $f:ident, $op:tt) => {
-        impl<const W: usize> $tr for L<W> {
+        impl<const W: usize> $tr for PerLane<W> {
             type Output = Self;
             #[inline(always)]
             fn $f(self, o: Self) -> Self {
@@ -35,10 +36,10 @@ macro_rules! lane_op {
                 for i in 0..W {
                     r[i] = self.0[i] $op o.0[i];
                 }
-                L(r)
+                PerLane(r)
             }
         }
-        impl<const W: usize> $tr<f64> for L<W> {
+        impl<const W: usize> $tr<f64> for PerLane<W> {
             type Output = Self;
             #[inline(always)]
             fn $f(self, o: f64) -> Self {
@@ -46,7 +47,7 @@ macro_rules! lane_op {
                 for i in 0..W {
                     r[i] = self.0[i] $op o;
                 }
-                L(r)
+                PerLane(r)
             }
         }
     };
@@ -56,22 +57,22 @@ lane_op!(Sub, sub, -);
 lane_op!(Mul, mul, *);
 lane_op!(Div, div, /);
 
-impl<const W: usize> Neg for L<W> {
+impl<const W: usize> Neg for PerLane<W> {
     type Output = Self;
     #[inline(always)]
     fn neg(self) -> Self {
-        L(self.0.map(|x| -x))
+        PerLane(self.0.map(|x| -x))
     }
 }
 
-impl<const W: usize> L<W> {
+impl<const W: usize> PerLane<W> {
     #[inline(always)]
     fn splat(x: f64) -> Self {
-        L([x; W])
+        PerLane([x; W])
     }
     #[inline(always)]
     fn map(self, f: impl Fn(f64) -> f64) -> Self {
-        L(self.0.map(f))
+        PerLane(self.0.map(f))
     }
     #[inline(always)]
     fn select(mask: [bool; W], a: Self, b: Self) -> Self {
@@ -81,26 +82,26 @@ impl<const W: usize> L<W> {
                 r[i] = a.0[i];
             }
         }
-        L(r)
+        PerLane(r)
     }
 }
 
 #[inline(always)]
-fn sin_cos<const W: usize>(x: L<W>) -> (L<W>, L<W>) {
+fn sin_cos<const W: usize>(x: PerLane<W>) -> (PerLane<W>, PerLane<W>) {
     let (s, c) = toolconf::generated::trig::sin_cos_lanes(x.0);
-    (L(s), L(c))
+    (PerLane(s), PerLane(c))
 }
 
 /// One lane per tool: the plant's coefficients and the controller's gains γK_θ, γK_θ̇, γK_θ̈, γP^U
 /// (row-major 2 × 2) and goals.
 #[derive(Clone, Copy)]
 struct Loop<const W: usize> {
-    k: [L<W>; 8],
-    gains: [[L<W>; 4]; 4],
-    goals: [[L<W>; 2]; 3],
+    k: [PerLane<W>; 8],
+    gains: [[PerLane<W>; 4]; 4],
+    goals: [[PerLane<W>; 2]; 3],
 }
 
-type Z<const W: usize> = [L<W>; 6];
+type Z<const W: usize> = [PerLane<W>; 6];
 
 #[inline(always)]
 fn rhs<const W: usize>(p: &Loop<W>, z: &Z<W>) -> Z<W> {
@@ -122,7 +123,9 @@ fn rhs<const W: usize>(p: &Loop<W>, z: &Z<W>) -> Z<W> {
         [a1 - p.goals[2][0], a2 - p.goals[2][1]],
         [u1, u2],
     ];
-    let mv = |m: &[L<W>; 4], v: &[L<W>; 2]| [m[0] * v[0] + m[1] * v[1], m[2] * v[0] + m[3] * v[1]];
+    let mv = |m: &[PerLane<W>; 4], v: &[PerLane<W>; 2]| {
+        [m[0] * v[0] + m[1] * v[1], m[2] * v[0] + m[3] * v[1]]
+    };
     let [g0, g1, g2, g3] = [
         mv(&p.gains[0], &e[0]),
         mv(&p.gains[1], &e[1]),
@@ -171,7 +174,7 @@ const E: [f64; 7] = [
 ];
 
 #[inline(always)]
-fn combine<const W: usize>(y: &Z<W>, k: &[Z<W>], a: &[f64], h: L<W>) -> Z<W> {
+fn combine<const W: usize>(y: &Z<W>, k: &[Z<W>], a: &[f64], h: PerLane<W>) -> Z<W> {
     let mut out = *y;
     for c in 0..6 {
         let mut s = k[0][c] * a[0];
@@ -195,8 +198,8 @@ struct Lanes<const W: usize> {
     p: Loop<W>,
     y: Z<W>,
     k1: Z<W>,
-    t: L<W>,
-    h: L<W>,
+    t: PerLane<W>,
+    h: PerLane<W>,
     tool: [usize; W],
     rhs: [usize; W],
 }
@@ -229,16 +232,16 @@ fn load<const W: usize>(lanes: &mut Lanes<W>, lane: usize, src: &Loop<1>, tool: 
 fn run_lanes<const W: usize>(loops: &[Loop<1>], z0: &Z<1>) -> Vec<([f64; 6], usize)> {
     let mut out = vec![([0.0; 6], 0); loops.len()];
     let zero = Loop {
-        k: [L::splat(0.0); 8],
-        gains: [[L::splat(0.0); 4]; 4],
-        goals: [[L::splat(0.0); 2]; 3],
+        k: [PerLane::splat(0.0); 8],
+        gains: [[PerLane::splat(0.0); 4]; 4],
+        goals: [[PerLane::splat(0.0); 2]; 3],
     };
     let mut lanes = Lanes {
         p: zero,
-        y: [L::splat(0.0); 6],
-        k1: [L::splat(0.0); 6],
-        t: L::splat(T_END),
-        h: L::splat(0.01),
+        y: [PerLane::splat(0.0); 6],
+        k1: [PerLane::splat(0.0); 6],
+        t: PerLane::splat(T_END),
+        h: PerLane::splat(0.01),
         tool: [usize::MAX; W],
         rhs: [0; W],
     };
@@ -252,7 +255,7 @@ fn run_lanes<const W: usize>(loops: &[Loop<1>], z0: &Z<1>) -> Vec<([f64; 6], usi
     lanes.k1 = rhs(&lanes.p, &lanes.y);
     let threshold = ATOL / RTOL;
     while active.iter().any(|&a| a) {
-        let t_new = L(std::array::from_fn(|i| {
+        let t_new = PerLane(std::array::from_fn(|i| {
             (lanes.t.0[i] + lanes.h.0[i]).min(T_END)
         }));
         let h = t_new - lanes.t;
@@ -266,17 +269,17 @@ fn run_lanes<const W: usize>(loops: &[Loop<1>], z0: &Z<1>) -> Vec<([f64; 6], usi
         let y_new = combine(&y, &[k1, k2, k3, k4, k5, k6], &B, h);
         let k7 = rhs(&lanes.p, &y_new);
         let ks = [k1, k2, k3, k4, k5, k6, k7];
-        let mut err = L::<W>::splat(0.0);
+        let mut err = PerLane::<W>::splat(0.0);
         for c in 0..6 {
             let mut ek = ks[0][c] * E[0];
             for j in 2..7 {
                 ek = ek + ks[j][c] * E[j];
             }
-            let scale = L(std::array::from_fn(|i| {
+            let scale = PerLane(std::array::from_fn(|i| {
                 y[c].0[i].abs().max(y_new[c].0[i].abs()).max(threshold)
             }));
             let r = (ek * h / scale).map(f64::abs);
-            err = L(std::array::from_fn(|i| err.0[i].max(r.0[i])));
+            err = PerLane(std::array::from_fn(|i| err.0[i].max(r.0[i])));
         }
         let mut accept = [false; W];
         let mut fac = [0.0; W];
@@ -288,11 +291,11 @@ fn run_lanes<const W: usize>(loops: &[Loop<1>], z0: &Z<1>) -> Vec<([f64; 6], usi
             lanes.rhs[i] += 6;
         }
         for c in 0..6 {
-            lanes.y[c] = L::select(accept, y_new[c], y[c]);
-            lanes.k1[c] = L::select(accept, k7[c], k1[c]);
+            lanes.y[c] = PerLane::select(accept, y_new[c], y[c]);
+            lanes.k1[c] = PerLane::select(accept, k7[c], k1[c]);
         }
-        lanes.t = L::select(accept, t_new, lanes.t);
-        lanes.h = L(std::array::from_fn(|i| (h.0[i] * fac[i]).min(H_MAX)));
+        lanes.t = PerLane::select(accept, t_new, lanes.t);
+        lanes.h = PerLane(std::array::from_fn(|i| (h.0[i] * fac[i]).min(H_MAX)));
         let mut refilled = false;
         for lane in 0..W {
             if active[lane] && lanes.t.0[lane] >= T_END {
@@ -336,16 +339,16 @@ fn lane_loop(arm: &toolconf::Arm, task: &TaskN<2>) -> (Loop<1>, ClosedLoopN<Arm2
     let gains = cl.controller.scaled_gains();
     let m = |g: &nalgebra::Matrix2<f64>| {
         [
-            L([g[(0, 0)]]),
-            L([g[(0, 1)]]),
-            L([g[(1, 0)]]),
-            L([g[(1, 1)]]),
+            PerLane([g[(0, 0)]]),
+            PerLane([g[(0, 1)]]),
+            PerLane([g[(1, 0)]]),
+            PerLane([g[(1, 1)]]),
         ]
     };
     let t = &cl.controller.task;
-    let v = |g: &SVector<f64, 2>| [L([g[0]]), L([g[1]])];
+    let v = |g: &SVector<f64, 2>| [PerLane([g[0]]), PerLane([g[1]])];
     let p = Loop {
-        k: coeff.k.map(|k| L([k])),
+        k: coeff.k.map(|k| PerLane([k])),
         gains: [m(&gains[0]), m(&gains[1]), m(&gains[2]), m(&gains[3])],
         // The goals of the terms read from X and Ẋ, in term order (the control's is zero).
         goals: std::array::from_fn(|i| v(&t.goal[i])),
@@ -378,11 +381,11 @@ fn main() {
         let pairs: Vec<_> = arms.iter().map(|a| lane_loop(a, &task)).collect();
         let loops: Vec<Loop<1>> = pairs.iter().map(|p| p.0).collect();
         let x0 = Arm2::equilibrium_state();
-        let z0: Z<1> = [x0[0], x0[1], x0[2], x0[3], 0.1, 0.1].map(|v| L([v]));
+        let z0: Z<1> = [x0[0], x0[1], x0[2], x0[3], 0.1, 0.1].map(|v| PerLane([v]));
         // The width-1 right-hand side is the library's, bit for bit.
         for (p, cl) in pairs.iter().take(50) {
             let z = SVector::<f64, 6>::from_column_slice(&[-1.3, -1.9, 0.4, -0.7, 0.3, -0.2]);
-            let ours = rhs(p, &std::array::from_fn(|c| L([z[c]])));
+            let ours = rhs(p, &std::array::from_fn(|c| PerLane([z[c]])));
             let lib = cl.rhs(&z);
             for c in 0..6 {
                 assert_eq!(

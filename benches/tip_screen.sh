@@ -6,7 +6,7 @@
 # of inertia, the tip within 5 cm of the axis and 5-40 cm out; Python's random.Random(SEED), six
 # significant digits), then runs `toolconf rank --screen K --json` (release) on the task and
 # prints the confidence stage's wall time and throughput, with the load average around the run.
-#   bench/tip_screen.sh [N=1000000] [K=100] [TASK=examples/tasks/panda_touch_point.toml] [THREADS=2] [SEED=1]
+#   benches/tip_screen.sh [N=1000000] [K=100] [TASK=examples/tasks/panda_touch_point.toml] [THREADS=2] [SEED=1]
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$root"

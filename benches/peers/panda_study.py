@@ -17,7 +17,7 @@ Settings: the impedance K scaled by s with D by sqrt(s) (the damping ratio kept)
 the paper's precisions against precisions in physical units (below), the paper's goals against
 goals within the Panda's rated torques.
 
-    bench/peers/.venv/bin/python bench/peers/panda_study.py [--tools 200] [--workers 2] [--sweep impedance|precision] [--write]
+    benches/peers/.venv/bin/python benches/peers/panda_study.py [--tools 200] [--workers 2] [--sweep impedance|precision] [--write]
 
 --write puts the table into docs/urdf.md between the `impedance-study` (or `precision-study`) markers.
 --sweep precision varies the wrist turn's precisions (sigma_theta_dot, P^theta_ddot, sigma_U) at
@@ -40,7 +40,7 @@ from pin_robot import ROOT, description, model_with_tool  # noqa: E402
 from urdf_loop import ClosedLoop, Task  # noqa: E402
 
 DOC = ROOT / "docs" / "urdf.md"
-BEGIN, END = "<!-- impedance-study:begin (written by bench/peers/panda_study.py) -->", "<!-- impedance-study:end -->"
+BEGIN, END = "<!-- impedance-study:begin (written by benches/peers/panda_study.py) -->", "<!-- impedance-study:end -->"
 RTOL, ATOL = 1e-8, 1e-10
 ROBOT = "panda"
 # The study measured the paper's task formulas (derive/tasks.toml's own, E = [I; I] on position),

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Peer comparison: toolconf vs SciPy solve_ivp(RK45) vs CasADi cvodes on the same 100 tools;
-# with --urdf, the Panda against SciPy solve_ivp with Pinocchio's aba (bench/peers/urdf_peers.py);
-# with --sweep, a URDF robot's results against its impedance gains (bench/peers/impedance_sweep.py).
-# Creates bench/peers/.venv from requirements.txt on first use, builds toolconf (release) and the
+# with --urdf, the Panda against SciPy solve_ivp with Pinocchio's aba (benches/peers/urdf_peers.py);
+# with --sweep, a URDF robot's results against its impedance gains (benches/peers/impedance_sweep.py).
+# Creates benches/peers/.venv from requirements.txt on first use, builds toolconf (release) and the
 # peer_timing example, and writes docs/performance.md (extra arguments go to compare.py).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"

@@ -1,4 +1,4 @@
-//! Times toolconf's episodes of any model's tools on one thread, for bench/peers/urdf_peers.py.
+//! Times toolconf's episodes of any model's tools on one thread, for benches/peers/urdf_peers.py.
 //!
 //! Reads a tools file (`toolconf rank`'s CSV or JSON: examples/tools/panda_tools.csv, or one the
 //! peer script writes) and a task (a built-in name or a task file), and runs every tool's episode

@@ -11,7 +11,7 @@ prints the spread of ln|Pi^U| across the tools, Spearman's rho between ln|Pi^U| 
 error, the progress of a position task (1 - e(T)/e(0), e the distance to the goal) and how many
 episodes failed.
 
-    bench/peers/run.sh --sweep --model panda --tools examples/tools/panda_tools.csv \\
+    benches/peers/run.sh --sweep --model panda --tools examples/tools/panda_tools.csv \\
         --task examples/tasks/panda_touch_point.toml [--scales 0.3,1,3] [--damping-only]
 
 --model is a model of derive/models or the path of a description of kind urdf.
