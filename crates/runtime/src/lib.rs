@@ -45,6 +45,7 @@ pub mod mpc;
 pub use toolconf_files as output;
 pub mod rank;
 pub mod registry;
+pub mod robot_scales;
 pub mod select;
 pub mod stats;
 pub mod task;
