@@ -30,6 +30,7 @@ pub mod confidence;
 pub mod design;
 pub mod display;
 pub mod error;
+pub mod evaluation;
 /// The code `make derive` writes into `generated/` (the crate toolconf-generated): one module
 /// per model (see `generated/<model>.md` for each derivation report), the tasks and the
 /// registry [`for_each_model!`]. Nobody edits these files: change a model description or the
