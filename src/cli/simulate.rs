@@ -228,7 +228,9 @@ fn two_link_task(
         return Ok(task);
     };
     let q0 = options.x0.fixed_rows::<2>(0).into_owned();
-    Ok(toolconf::task_file::at_initial_tip(&task, &offset, arm, &q0)?)
+    Ok(toolconf::task_file::at_initial_tip(
+        &task, &offset, arm, &q0,
+    )?)
 }
 
 /// One episode of the task file's task: the generic 2-link runtime, which takes the file's

@@ -33,6 +33,7 @@
 //! The three claims' rules are stated in [`verdict`], before any number is computed.
 
 pub mod analysis;
+pub mod check;
 pub mod highlight;
 mod plan;
 mod population;
@@ -44,6 +45,7 @@ pub mod trials;
 pub mod verdict;
 
 pub use analysis::{barely_moved, Statistics};
+pub use check::{ConfidenceCheck, VALIDATION_TOOLS};
 pub use highlight::{Highlight, HighlightRun};
 pub use plan::{check_population, Plan, MAX_COUNT, MAX_TOOLS};
 pub use population::{parse_box, sample_box, Population};
@@ -154,6 +156,16 @@ pub fn finish(
 }
 
 impl Evaluation {
+    /// "panda, tip_position (panda_touch_point.toml)": the figures' titles.
+    pub fn task_title(&self) -> String {
+        let s = &self.setup.spec;
+        let file = std::path::Path::new(&s.file)
+            .file_name()
+            .map(|f| format!(" ({})", f.to_string_lossy()))
+            .unwrap_or_default();
+        format!("{}, {}{file}", self.setup.model, s.kind)
+    }
+
     /// Whether the task reads the tool's tip.
     pub fn reads_tip(&self) -> bool {
         toolconf_core::reads_tip(self.setup.spec.kind)
@@ -196,11 +208,9 @@ impl Evaluation {
             .collect();
         let s = &self.setup;
         let (episodes, rhs_evals) = self.work();
-        json!({
+        let mut v = json!({
             "model": s.model.name(),
             "task": s.spec.kind,
-            "task_file": (!s.spec.file.is_empty()).then_some(&s.spec.file),
-            "description": s.spec.description,
             "goal": s.spec.tip_goal.kind_name(),
             "goal_description": s.spec.tip_goal.describe(),
             "perturbation": s.perturbation.values,
@@ -211,9 +221,16 @@ impl Evaluation {
             "seed": self.seed,
             "plan": self.plan,
             "verdicts": verdicts,
-            "barely_moved": self.barely_moved,
+            "notes": self.barely_moved.iter().collect::<Vec<_>>(),
             "episodes": episodes,
             "rhs_evals": rhs_evals,
-        })
+        });
+        if !s.spec.file.is_empty() {
+            v["task_file"] = json!(s.spec.file);
+        }
+        if let Some(d) = &s.spec.description {
+            v["description"] = json!(d);
+        }
+        v
     }
 }

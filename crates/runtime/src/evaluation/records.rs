@@ -226,3 +226,43 @@ impl ToolRecord {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A record read back from its wire text is the record, to the last bit (NaN-free numbers,
+    /// a missing progress, failed runs and an empty sweep included).
+    #[test]
+    fn a_record_travels_exactly() {
+        let n = |x: f64| Numbers {
+            task_error: x,
+            free_energy: x / 3.0,
+            cost_j: -x * 1e-300,
+            progress: (x > 1.0).then_some(x.sqrt()),
+            rhs_evals: 12345,
+        };
+        let record = ToolRecord {
+            index: 7,
+            logdet: Ok(-7.912606123456789),
+            base: Ok(n(0.1 + 0.2)),
+            perturbed: Err("simulation of panda(…) diverged".into()),
+            sweep: vec![Ok(n(2.0f64.sqrt())), Err("x".into()), Ok(n(5e-324))],
+        };
+        let back = ToolRecord::from_wire(&record.to_wire()).unwrap();
+        assert_eq!(back, record);
+        let bits = |r: &Run| {
+            r.as_ref()
+                .map(|n| (n.task_error.to_bits(), n.cost_j.to_bits()))
+                .ok()
+        };
+        assert_eq!(bits(&back.base), bits(&record.base));
+        let plain = ToolRecord {
+            logdet: Err("no Π^U".into()),
+            sweep: vec![],
+            ..record
+        };
+        assert_eq!(ToolRecord::from_wire(&plain.to_wire()).unwrap(), plain);
+        assert!(ToolRecord::from_wire("{}").is_err());
+    }
+}

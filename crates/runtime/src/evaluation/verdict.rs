@@ -89,14 +89,33 @@ impl Correlation {
         }
     }
 
+    /// "ρ = −0.41 [−0.49, −0.32]" (a figure's title), or "ρ undefined".
+    pub fn describe_short(&self) -> String {
+        match (&self.rho, &self.ci) {
+            (Ok(r), Ok(ci)) => format!(
+                "ρ = {} [{}, {}]",
+                signed(*r),
+                signed(ci.low),
+                signed(ci.high)
+            ),
+            (Ok(r), Err(_)) => format!("ρ = {}", signed(*r)),
+            (Err(_), _) => "ρ undefined".into(),
+        }
+    }
+
+    /// `rho`, `ci` ([low, high]), `n`, `level`; `why_undefined` instead of what is undefined
+    /// (no key is ever null).
     pub fn json(&self) -> Value {
-        json!({
-            "rho": self.rho.as_ref().ok(),
-            "ci": self.ci.as_ref().ok().map(|c| [c.low, c.high]),
-            "n": self.n,
-            "level": self.level,
-            "why_undefined": self.ci.as_ref().err(),
-        })
+        let mut v = json!({ "n": self.n, "level": self.level });
+        match &self.rho {
+            Ok(r) => v["rho"] = json!(r),
+            Err(e) => v["why_undefined"] = json!(e),
+        }
+        match &self.ci {
+            Ok(c) => v["ci"] = json!([c.low, c.high]),
+            Err(e) => v["why_undefined"] = json!(e),
+        }
+        v
     }
 }
 
@@ -182,17 +201,22 @@ impl Paired {
         }
     }
 
+    /// `mean_difference`, `wilcoxon_p`, `t_p`, `n`, `ties`, `dropped`; `why_undefined` instead
+    /// of a test that is undefined (no key is ever null).
     pub fn json(&self) -> Value {
-        let t = self.test.as_ref().ok();
-        json!({
-            "mean_difference": self.mean_difference,
-            "wilcoxon_p": t.map(|t| t.wilcoxon_p_value),
-            "t_p": t.map(|t| t.t_p_value),
-            "n": self.n,
-            "ties": self.ties,
-            "dropped": self.dropped,
-            "why_undefined": self.test.as_ref().err().filter(|_| !self.identical()),
-        })
+        let mut v = json!({ "n": self.n, "ties": self.ties, "dropped": self.dropped });
+        if let Some(d) = self.mean_difference {
+            v["mean_difference"] = json!(d);
+        }
+        match &self.test {
+            Ok(t) => {
+                v["wilcoxon_p"] = json!(t.wilcoxon_p_value);
+                v["t_p"] = json!(t.t_p_value);
+            }
+            Err(_) if self.identical() => v["identical"] = json!(true),
+            Err(e) => v["why_undefined"] = json!(e),
+        }
+        v
     }
 }
 

@@ -118,6 +118,18 @@ pub fn default_precision(term: Term, rated: &RatedTorques, tip_dim: usize) -> Op
     Some(vec![1.0 / (sigma * sigma); tip_dim])
 }
 
+/// The default precision of `term` on a URDF arm's tip task file, in words (for reports).
+pub fn default_words(term: Term) -> Option<String> {
+    let sigma = match term {
+        Term::U => format!("{TORQUE_SHARE_PERCENT} % of each joint's rated torque"),
+        Term::Tip => format!("{} mm", TIP_SIGMA * 1e3),
+        Term::TipDot => format!("{} mm/s", TIP_DOT_SIGMA * 1e3),
+        Term::TipDdot => format!("{} m/s²", TIP_DDOT_SIGMA),
+        _ => return None,
+    };
+    Some(format!("1/σ² with σ = {sigma}"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
