@@ -101,6 +101,7 @@ fn cases() -> Vec<Case> {
     let design = repo("examples/design/reach_and_budget.toml");
     let d = drawer.as_str();
     let panda_tools = repo("examples/tools/panda_tools.csv");
+    let panda_touch = repo("examples/tasks/panda_touch_point.toml");
     let panda_task = std::fs::read_to_string(repo("examples/tasks/panda_wrist_turn.toml")).unwrap();
     let long_name = "n".repeat(70_000);
     let v = vec![
@@ -238,6 +239,21 @@ fn cases() -> Vec<Case> {
         case("an unknown flag", &["simulate", "--arm", ARM, "--task", "position", "--torque", "3"], 2, &["unexpected argument '--torque'"]),
         case("an unknown task", &["select", "--task", "sideways"], 2, &["unknown task 'sideways'"]),
         case("a long bad --arm", &["confidence", "--arm", &"9,".repeat(50_000), "--task", "position"], 2, &["invalid value '9,9,", "…"]),
+        // 9. The evaluation on a model (reproduce --model): bad input is one line naming the
+        // flag or key, before any episode.
+        case("reproduce, an unknown model", &["reproduce", "--model", "kuka", "--task", "tip_position", "--out", "out"], 2, &["unknown model 'kuka'"]),
+        case("reproduce, a task of another model", &["reproduce", "--model", "ur5", "--task-file", &panda_touch, "--sample", "5", "--out", "out"], 2, &["panda_touch_point.toml, key precision.u", "model ur5 has 6 components"]),
+        case("reproduce, a population of 0", &["reproduce", "--model", "panda", "--task", "tip_position", "--sample", "0", "--out", "out"], 2, &["--sample 0: no tools"]),
+        case("reproduce, a population of 10⁹", &["reproduce", "--model", "panda", "--task", "tip_position", "--sample", "1000000000", "--out", "out"], 2, &["--sample 1000000000", "more than the 1000000"]),
+        case("reproduce, a box the model lacks", &["reproduce", "--model", "panda", "--task", "tip_position", "--sample", "5", "--box", "tool_lenght=0.1:0.2", "--out", "out"], 2, &["--box tool_lenght", "no parameter 'tool_lenght'"]),
+        case("reproduce, a relative goal on a joint task", &["reproduce", "--model", "panda", "--task-file", "joint.toml", "--sample", "5", "--out", "out"], 2, &["joint.toml, key goal.tip_offset", "a position task has no such goal"])
+            .file("joint.toml", "kind = \"position\"\n[goal]\ntip_offset = [0.05, 0.0, 0.0]\n"),
+        case("reproduce, --task without --model", &["reproduce", "--task", "tip_position", "--out", "out"], 2, &["--task is for an evaluation on a model"]),
+        case("reproduce, --only with --model", &["reproduce", "--model", "panda", "--task", "tip_position", "--only", "fig2", "--out", "out"], 2, &["'--model <MODEL>' cannot be used with '--only <ONLY>'"]),
+        case("reproduce, trials of one tool", &["reproduce", "--model", "panda", "--task", "tip_position", "--trial-tools", "1", "--out", "out"], 2, &["--trial-tools: 1 must be a count in [2, 100000]"]),
+        case("reproduce, a tools file of another model", &["reproduce", "--model", "ur5", "--task", "tip_position", "--tools", &panda_tools, "--out", "out"], 2, &["panda_tools.csv, tool 1", "a panda tool, but the evaluation is of model ur5"]),
+        case("reproduce, a zero ΔT", &["reproduce", "--model", "panda", "--task-file", "still.toml", "--sample", "5", "--out", "out"], 2, &["still.toml, key episode.perturbation", "ΔT is 0 on every joint"])
+            .file("still.toml", "kind = \"tip_position\"\n[goal]\ntip_offset = [0.05, 0.0, 0.0]\n[episode]\nperturbation = 0.0\n"),
         // 8. Threads.
         case("RAYON_NUM_THREADS=5000", &["select", "--tools", "3", "--task", "velocity", "--json"], 0, &[])
             .env("RAYON_NUM_THREADS", "5000"),

@@ -8,3 +8,5 @@ _spec = importlib.util.spec_from_file_location(
 _tests = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(_tests)
 dask_client = _tests.dask_client
+cli = _tests.cli
+cli_json = _tests.cli_json

@@ -8,6 +8,8 @@
 //!   file or of columns in memory ([`tools`]).
 //! * [`batch`]: `simulate_batch`, the episodes of many tools under many perturbations.
 //! * [`design`]: `toolconf design --json` as a dict.
+//! * [`evaluate`]: `toolconf reproduce --model` (the paper's evaluation on any model, task and
+//!   population) as tables and verdicts, whole or in the steps `toolconf.dask` spreads.
 //! * [`dask_steps`]: the steps of `rank` that `toolconf.dask` spreads over a cluster.
 //! * [`dynamics`]: a robot's own rigid-body dynamics Ẋ = [q̇; q̈] for one state or a batch, and
 //!   its tool's tip with the tip's Jacobian (`tip`).
@@ -27,6 +29,7 @@ mod dask_steps;
 mod design;
 mod dynamics;
 mod errors;
+mod evaluate;
 mod integers;
 mod models;
 mod rank;
@@ -68,6 +71,11 @@ fn _toolconf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(dynamics::dynamics, m)?)?;
     m.add_function(wrap_pyfunction!(dynamics::tip, m)?)?;
     m.add_function(wrap_pyfunction!(tool_urdf::tool_from_urdf, m)?)?;
+    m.add_function(wrap_pyfunction!(evaluate::reproduce_plan, m)?)?;
+    m.add_function(wrap_pyfunction!(evaluate::reproduce_population, m)?)?;
+    m.add_function(wrap_pyfunction!(evaluate::reproduce_block, m)?)?;
+    m.add_function(wrap_pyfunction!(evaluate::reproduce_finish, m)?)?;
+    m.add_function(wrap_pyfunction!(evaluate::reproduce, m)?)?;
     m.add(
         "SimulationError",
         m.py().get_type::<errors::SimulationError>(),

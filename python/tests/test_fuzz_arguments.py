@@ -234,3 +234,17 @@ def test_dask_block_sizes(tools_per_task, episodes_per_task):
     call(tdask.simulate_batch, "arm2", np.full((2, 4), 0.3), SHORT,
          tools_per_task=tools_per_task, nan_with_error=True)
     call(tdask.rank, None, "position", episodes_per_task=episodes_per_task)
+
+
+@FUZZ
+@given(models, tasks, mostly(st.integers(1, 3)), mostly(st.integers(0, 2**64 - 1)),
+       mostly(st.one_of(st.none(), st.just({"m1": (0.2, 0.3)}))),
+       st.dictionaries(st.sampled_from(["trials", "trial_tools", "sweep_levels", "resamples", "grid_tools"]),
+                       st.one_of(integers, anything), max_size=2), methods)
+def test_reproduce(model, task, sample, seed, box, counts, method):
+    if isinstance(task, str):
+        task = {"kind": task, "episode": {"t_end": 0.2}}
+    # The default population (300 tools) checks nothing more here, and would only cost time.
+    sample = 2 if sample is None else sample
+    call(toolconf.reproduce, model, task, None, sample, seed=seed, box=box, quick=True,
+         method=method, may_fail=[RuntimeError], **counts)

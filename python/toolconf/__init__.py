@@ -13,6 +13,9 @@ The runtime is Rust (the ``toolconf`` crate); this package exposes it over NumPy
   file, a pandas DataFrame, a dict of 1-D arrays or a NumPy structured array; a DataFrame for a
   DataFrame, else a dict of columns.
 * ``design(model, task, design)``: ``toolconf design --json``, which tool to build.
+* ``reproduce(model, task, tools=... | sample=N)``: ``toolconf reproduce --model``, the
+  paper's evaluation (Figs. 2-7) on any model, task and tool population: its tables as
+  DataFrames and a verdict for each claim.
 * ``dynamics(model, params, state, control)``: a robot's own rigid-body dynamics
   Ẋ = [q̇; q̈] (U the joint torques), for one state or a batch.
 * ``tip(model, params, q, q_dot=None)``: the tool's tip in the base frame and its Jacobian
@@ -27,8 +30,8 @@ The runtime is Rust (the ``toolconf`` crate); this package exposes it over NumPy
   repository does not ship), loaded next to the built-in models with no rebuild; every function
   here, and ``toolconf.dask``'s workers, then take it by name. ``TOOLCONF_MODEL_PATH``
   (``:``-separated, ``NAME=PATH`` entries allowed) loads libraries at import.
-* ``toolconf.dask`` (``pip install "./python[dask]"``): ``rank`` and ``simulate_batch`` on a
-  Dask cluster, with the same results.
+* ``toolconf.dask`` (``pip install "./python[dask]"``): ``rank``, ``simulate_batch`` and
+  ``reproduce`` on a Dask cluster, with the same results.
 * ``ranges()``: the valid range of every number the package and the command line take.
 * ``terms()``: the free-energy terms, whose names key a task's goals and precisions.
 
@@ -70,6 +73,7 @@ __all__ = [
     "models",
     "ranges",
     "rank",
+    "reproduce",
     "simulate",
     "simulate_batch",
     "terms",
@@ -190,3 +194,122 @@ def rank(
 
         return pandas.DataFrame(table)
     return table
+
+
+# The counts of an evaluation, by their keyword arguments (the command line's --highlight-sample …).
+_COUNTS = ("highlight_sample", "sweep_tools", "sweep_levels", "grid_trials", "grid_tools", "trials",
+           "trial_tools", "resamples")
+
+
+def _evaluation(out, frames: bool) -> dict:
+    """The native evaluation as the package returns it: each table a DataFrame (a dict of
+    columns without pandas), ``verdicts`` and ``summary`` as dicts."""
+    import json
+
+    summary = json.loads(out["summary"])
+    result = {}
+    if frames:
+        import pandas
+
+        for name, columns in out["tables"].items():
+            result[name] = pandas.DataFrame(columns)
+    else:
+        result.update(out["tables"])
+    result["verdicts"] = {key: v["verdict"] for key, v in summary["verdicts"].items()}
+    result["summary"] = summary
+    return result
+
+
+def _wants_frames(frames: Optional[bool]) -> bool:
+    if frames is not None:
+        return bool(frames)
+    try:
+        import pandas  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def reproduce(
+    model: str,
+    task: "Task",
+    tools: Union[None, str, "os.PathLike[str]", "pandas.DataFrame", Mapping[str, Any], np.ndarray] = None,
+    sample: Optional[int] = None,
+    *,
+    seed: int = 0,
+    box: Optional[Mapping[str, tuple[float, float]]] = None,
+    quick: bool = False,
+    method: Literal["fast", "explicit", "auto", "stiff"] = "fast",
+    frames: Optional[bool] = None,
+    **counts: Optional[int],
+) -> dict:
+    """The paper's evaluation (its Figs. 2-7) of ``model`` on ``task``, as ``toolconf reproduce
+    --model`` runs it, with the same numbers: does control confidence predict the task error, and
+    the reliability under a torque perturbation ΔT, on this robot and task?
+
+    Every tool of the population runs without and with ΔT (the task file's ``[episode]
+    perturbation``, else −10 % of each joint's rated torque on a URDF arm, the paper's −0.8 N m
+    otherwise); the first ``sweep_tools`` also at every level of the sweep; the selection
+    experiments choose among tools of the same population. Episodes run on rayon's threads
+    without the GIL; results do not depend on the number of threads.
+
+    Args:
+        model: the model's name (``toolconf.models()``; a library loaded with ``load_model``).
+        task: a built-in task name, a task file's path, or a dict with a task file's keys.
+        tools: the population, as ``toolconf.rank`` takes tools (a tools file's path, a pandas
+            DataFrame, a dict of columns, a structured array), every one a tool of ``model``.
+        sample: or the population as this many random tools (1 … 10⁶) from the model's
+            sampling box, drawn as ``toolconf select --models MODEL --tools N --seed SEED``
+            draws them; 300 (the paper's Fig. 2) when neither is given.
+        seed: the sample's seed and the master seed of the trials and bootstraps.
+        box: with ``sample``, intervals replacing the sampling box's, ``{name: (lo, hi)}``.
+        quick: the reduced counts (for tests), instead of the paper's.
+        method: the integrator, as the command line's ``--method``.
+        frames: return pandas DataFrames (the default when pandas is installed) or dicts of
+            columns.
+        counts: ``highlight_sample`` (20), ``sweep_tools`` (100), ``sweep_levels`` (11),
+            ``grid_trials`` (25), ``grid_tools`` (5), ``trials`` (50), ``trial_tools`` (10),
+            ``resamples`` (2000): the paper's counts by default.
+
+    Returns:
+        dict: one entry per table of ``toolconf reproduce --model``'s CSVs
+        (``fig2_confidence_vs_error``, ``fig3_tools``, ``fig3_trajectories``,
+        ``fig4_perturbation_change``, ``fig5_perturbation_sweep``, ``fig6_selection_grid``,
+        ``fig7_benchmark``, ``fig7_choices``), each a DataFrame (or a dict of columns);
+        ``verdicts``, each claim's verdict (``"holds"``, ``"reversed"``, ``"no relation"`` or
+        ``"cannot be judged"``) by its key (``confidence_predicts_task_error``,
+        ``confidence_predicts_reliability``, ``free_energy_choices_less_sensitive``); and
+        ``summary``, the command line's ``--json`` object (the statistics, rules, ΔT, goal
+        kind, population, counts).
+
+    Raises:
+        ValueError: bad input, with the command line's message (an unknown model, a task of
+            another model, a population of 0 or more than 10⁶, a box naming a parameter the
+            model lacks, a relative goal on a joint task, a count out of range).
+        TypeError: a count or ``sample`` that is not an integer.
+        RuntimeError: every tool's episode failed.
+    """
+    native, source, frame = (None, None, False) if tools is None else native_tools(tools)
+    unknown = sorted(set(counts) - set(_COUNTS))
+    if unknown:
+        raise TypeError(f"reproduce() got an unexpected keyword argument '{unknown[0]}'")
+    plan = _toolconf._reproduce_plan(quick, counts)
+    boxes = _box_texts(box)
+    out = _toolconf._reproduce(model, task, native, sample, seed, boxes, plan, method, source)
+    return _evaluation(out, _wants_frames(frames) or frame)
+
+
+def _box_texts(box) -> list:
+    """``{name: (lo, hi)}`` as the command line's ``NAME=LO:HI`` texts."""
+    if box is None:
+        return []
+    if not isinstance(box, Mapping):
+        raise TypeError(f"box = {box!r:.60}: expected a dict of name: (lo, hi)")
+    texts = []
+    for name, bounds in box.items():
+        try:
+            lo, hi = (float(v) for v in bounds)
+        except (TypeError, ValueError):
+            raise ValueError(f"box {name}: expected (lo, hi), got {bounds!r:.60}") from None
+        texts.append(f"{name}={lo!r}:{hi!r}")
+    return texts

@@ -288,3 +288,65 @@ def _episodes(
 
 def _rank_table(blocks: list[Columns]) -> Columns:
     """Simulated blocks ranked into ``rank``'s table."""
+
+# The evaluation of `toolconf reproduce --model` (python/src/evaluate.rs): toolconf.reproduce
+# calls _reproduce; toolconf.dask.reproduce its three steps (population, blocks, finish).
+
+class Evaluation(TypedDict):
+    tables: dict[str, Columns]
+    summary: str
+
+class Population(TypedDict):
+    params: list[list[float]]
+    names: list[Optional[str]]
+    rows: list[int]
+    source: str
+    box: Optional[list[tuple[str, float, float]]]
+
+def _reproduce_plan(quick: bool, counts: Mapping[str, Optional[int]]) -> str:
+    """The evaluation's counts (the paper's, or the quick ones, with ``counts`` over them) as
+    JSON text; raises ``ValueError`` for a count out of range, ``TypeError`` for a non-integer."""
+
+def _reproduce_population(
+    model: str,
+    tools: Union[None, str, "os.PathLike[str]", ToolColumns] = None,
+    sample: Optional[int] = None,
+    seed: int = 0,
+    box: Sequence[str] = ...,
+    source: Optional[str] = None,
+) -> Population:
+    """The population: the tools' rows (all of ``model``), or ``sample`` random tools of it."""
+
+def _reproduce_block(
+    model: str,
+    task: PortableTask,
+    params: Sequence[Sequence[float]],
+    first: int,
+    plan: str,
+    method: str,
+) -> list[str]:
+    """A block of tools' records (confidence and episodes), numbers carried as their bits."""
+
+def _reproduce_finish(
+    model: str,
+    task: PortableTask,
+    population: Population,
+    records: list[str],
+    seed: int,
+    plan: str,
+    method: str,
+) -> Evaluation:
+    """The evaluation from its population and every tool's record: tables and summary."""
+
+def _reproduce(
+    model: str,
+    task: PortableTask,
+    tools: Union[None, str, "os.PathLike[str]", ToolColumns],
+    sample: Optional[int],
+    seed: int,
+    box: Sequence[str],
+    plan: str,
+    method: str,
+    source: Optional[str] = None,
+) -> Evaluation:
+    """The whole evaluation in one call (what ``toolconf.reproduce`` runs)."""

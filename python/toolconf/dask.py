@@ -1,5 +1,6 @@
-"""toolconf on a Dask cluster: ``rank`` and ``simulate_batch`` for studies one machine is too
-small for, with the same results as ``toolconf.rank`` and ``toolconf.simulate_batch``.
+"""toolconf on a Dask cluster: ``rank``, ``simulate_batch`` and ``reproduce`` for studies one
+machine is too small for, with the same results as ``toolconf.rank``,
+``toolconf.simulate_batch`` and ``toolconf.reproduce``.
 
 An optional extra (``pip install "./python[dask]"``: dask's dataframe and distributed). Both
 functions run on whatever cluster the ``distributed.Client`` given (or the current one) points
@@ -21,6 +22,11 @@ the native library's own code:
 So the result is ``toolconf.rank`` on the concatenated rows, row for row and digit for digit,
 and a bad row raises the same ``ValueError`` (the first bad row in row order).
 
+``reproduce(model, task, tools=... | sample=N)`` is ``toolconf.reproduce`` in three steps: the
+population drawn (or read) on the client, every tool's episodes in blocks of tools on the
+workers (each record's numbers travel as their bits), and the trials, statistics and verdicts
+on the client: the same tables and verdicts, number for number.
+
 Workers run each block's episodes on rayon's threads: set ``RAYON_NUM_THREADS`` in the workers'
 environment to their share of the cores (``LocalCluster(..., env={"RAYON_NUM_THREADS": "1"})``
 with one thread per worker), or the processes of one machine compete for its cores.
@@ -37,8 +43,8 @@ from typing import TYPE_CHECKING, Any, Literal, Optional
 
 import numpy as np
 
-from . import _LOADED, _ensure_loaded, _toolconf
-from ._tables import DATAFRAME_SOURCE, frame_columns
+from . import _COUNTS, _LOADED, _box_texts, _ensure_loaded, _evaluation, _toolconf, _wants_frames
+from ._tables import DATAFRAME_SOURCE, frame_columns, native_tools
 
 if TYPE_CHECKING:
     import dask.dataframe
@@ -47,7 +53,7 @@ if TYPE_CHECKING:
 
     from ._toolconf import Columns, Task
 
-__all__ = ["rank", "simulate_batch"]
+__all__ = ["rank", "reproduce", "simulate_batch"]
 
 
 def _client(client):
@@ -99,6 +105,11 @@ def _batch(model, params, task, perturbations, method, first_tool, episode_optio
     # The private twin of toolconf.simulate_batch: it also reads a task file sent as text.
     return _toolconf._simulate_batch(model, params, task, perturbations, method, first_tool,
                                      **episode_options)
+
+
+def _reproduce_block(model, task, params, first, plan, method, loaded):
+    _ensure_loaded(loaded)
+    return _toolconf._reproduce_block(model, task, params, first, plan, method)
 
 
 def _slice(block, start, stop):
@@ -307,3 +318,63 @@ def _param_blocks(client, params, tools_per_task):
     n = array.shape[0]
     per_block = tools_per_task or max(1, math.ceil(n / (4 * _threads(client))))
     return [(array[a:b], b - a) for a, b in _blocks(n, per_block)], array.shape, array.dtype
+
+
+def reproduce(
+    model: str,
+    task: "Task",
+    tools: Any = None,
+    sample: Optional[int] = None,
+    *,
+    seed: int = 0,
+    box: Optional[dict] = None,
+    quick: bool = False,
+    method: Literal["fast", "explicit", "auto", "stiff"] = "fast",
+    frames: Optional[bool] = None,
+    client: Optional["distributed.Client"] = None,
+    tools_per_task: Optional[int] = None,
+    **counts: Optional[int],
+) -> dict:
+    """``toolconf.reproduce`` on a Dask cluster: the population's episodes in blocks of tools on
+    the workers, the rest on the client. The result equals ``toolconf.reproduce(model, task,
+    tools, sample, ...)`` table for table and number for number.
+
+    Args:
+        model, task, tools, sample, seed, box, quick, method, frames, counts: as
+            ``toolconf.reproduce``; ``tools`` may also be a dask DataFrame (computed on the
+            client: a population is at most 10⁶ tools). A task file is read here and sent to
+            the workers as text.
+        client: the ``distributed.Client`` to run on (default: the current one).
+        tools_per_task: the tools of one block, an integer ≥ 1; by default about four blocks
+            per worker thread.
+
+    Returns:
+        dict: as ``toolconf.reproduce``.
+
+    Raises:
+        ValueError, TypeError, RuntimeError: as ``toolconf.reproduce``; a ``tools_per_task``
+            below 1 (ValueError) or not an integer (TypeError).
+    """
+    tools_per_task = _per_block("tools_per_task", tools_per_task)
+    unknown = sorted(set(counts) - set(_COUNTS))
+    if unknown:
+        raise TypeError(f"reproduce() got an unexpected keyword argument '{unknown[0]}'")
+    client = _client(client)
+    loaded = tuple(_LOADED)
+    if hasattr(tools, "to_delayed") and hasattr(tools, "compute"):
+        tools = tools.compute()
+    native, source, frame = (None, None, False) if tools is None else native_tools(tools)
+    plan = _toolconf._reproduce_plan(quick, counts)
+    task = _toolconf._portable_task(task, None, "free-energy", method)
+    population = _toolconf._reproduce_population(model, native, sample, seed, _box_texts(box), source)
+    # The task checked on the client, before the cluster runs anything.
+    _toolconf._reproduce_block(model, task, [], 0, plan, method)
+    params = population["params"]
+    per_block = tools_per_task or max(1, math.ceil(len(params) / (4 * _threads(client))))
+    futures = [
+        client.submit(_reproduce_block, model, task, params[a:b], a, plan, method, loaded)
+        for a, b in _blocks(len(params), per_block)
+    ]
+    records = [record for block in _in_order(client, futures) for record in block]
+    out = _toolconf._reproduce_finish(model, task, population, records, seed, plan, method)
+    return _evaluation(out, _wants_frames(frames) or frame)

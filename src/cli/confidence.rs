@@ -47,7 +47,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 
 fn run_arm(args: &Args, arm: &Arm, spec: &TaskSpec) -> Result<(), CliError> {
     let kind = spec.kind;
-    let task = spec.task::<Arm2, 2, 4, 4, 6>()?;
+    // Π^U does not depend on the goals, so a relative tip goal needs no tool here.
+    let (task, _) = spec.task_and_offset::<Arm2, 2, 4, 4, 6>()?;
     let confidence = control_confidence(arm, &task).map_err(toolconf::Error::from)?;
     let s = arm.sensitivities(kind);
     let a = arm.state_matrix();

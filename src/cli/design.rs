@@ -223,4 +223,7 @@ fn print_text(spec: &DesignSpec, r: &DesignResult, seconds: f64) {
             parameters_text(&spec.names, &c.params)
         );
     }
+    if let Some(note) = r.confidence_note() {
+        outln!("note: {note}");
+    }
 }

@@ -26,6 +26,7 @@ macro_rules! errln {
 mod confidence;
 mod design;
 mod episode_args;
+mod evaluate;
 mod output;
 mod rank;
 mod reproduce;
@@ -66,7 +67,8 @@ enum Command {
     Rank(rank::Args),
     /// Design a tool: maximise control confidence under bounds and linear constraints.
     Design(design::Args),
-    /// Run every experiment of the paper's Results section: CSVs, SVG figures, report.
+    /// Run every experiment of the paper's Results section (CSVs, SVG figures, report); with
+    /// --model, on any model, task and tools, with a verdict for each claim.
     Reproduce(reproduce::Args),
     /// A tool's row of a tools file from its own URDF: mass, centre of mass, inertia and tip
     /// in the flange frame.

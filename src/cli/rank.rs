@@ -10,10 +10,11 @@ use std::time::Instant;
 
 use serde_json::{json, Map, Value};
 use toolconf::display::Clip;
+use toolconf::evaluation::{barely_moved, ConfidenceCheck};
 use toolconf::output::csv::{Cell, CsvWriter};
 use toolconf::rank::{
-    ranking, screen_file, simulate_all_timed, Candidate, ConfidenceTiming, ModelTasks, RankedTool,
-    Screen, ScreenError, SimulationTiming, StageTimings,
+    ranking, screen_file_with_validation, simulate_all, simulate_all_timed, Candidate,
+    ConfidenceTiming, ModelTasks, RankedTool, Screen, ScreenError, SimulationTiming, StageTimings,
 };
 use toolconf::registry::ModelKind;
 use toolconf::select::Objective;
@@ -51,6 +52,12 @@ pub struct Args {
     /// Report a bad row on stderr and go on without it, instead of stopping.
     #[arg(long)]
     skip_bad_rows: bool,
+    /// With --screen: also simulate a uniform sample of N tools of the file, to check that
+    /// confidence predicts the task error among them (the output says so when it does not);
+    /// 0 for no check.
+    #[arg(long, default_value_t = toolconf::evaluation::VALIDATION_TOOLS as u64,
+          value_parser = clap::value_parser!(u64).range(0..=100_000))]
+    validation: u64,
     #[command(flatten)]
     method: super::episode_args::MethodArgs,
 }
@@ -91,11 +98,15 @@ pub(crate) fn task_spec(task: &str) -> Result<TaskSpec, CliError> {
 /// the number of rows skipped.
 fn screen_tools(args: &Args, tasks: &ModelTasks) -> Result<(Screen, usize), CliError> {
     let limit = args.screen.map(|k| k as usize);
-    screen_file(
+    let validation = match limit {
+        Some(_) => args.validation as usize,
+        None => 0,
+    };
+    screen_file_with_validation(
         &args.tools,
         tasks,
         &args.task,
-        limit,
+        (limit, validation),
         args.skip_bad_rows,
         |bad| errln!("toolconf: skipping {bad}"),
     )
@@ -273,6 +284,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         skipped,
         without_confidence: screen.without_confidence,
     };
+    let sample = screen.validation_sample();
     let candidates = screen.finish();
     let confidence = ConfidenceTiming {
         tools: counts.read,
@@ -290,10 +302,23 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         simulation,
     };
     let order = ranking(&results, objective);
+    let check = (!sample.is_empty()).then(|| confidence_check(sample, &results, &tasks));
+    let notes = notes(&spec, check.as_ref(), &results);
     if args.json {
-        print_json(args, &spec, objective, &counts, &results, &order, &timing);
+        let mut out = rank_json(args, &spec, objective, &counts, &results, &order, &timing);
+        if let Some(check) = &check {
+            out["confidence_check"] = check.json();
+        }
+        out["notes"] = json!(notes);
+        outln!(
+            "{}",
+            serde_json::to_string_pretty(&out).expect("finite numbers")
+        );
     } else {
         print_text(args, &spec, objective, &counts, &results, &order, &timing);
+        for note in &notes {
+            outln!("note: {note}");
+        }
     }
     if let Some(dir) = &args.report {
         let command: Vec<String> = std::env::args().collect();
@@ -309,6 +334,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             results: &results,
             order: &order,
             timing: Some(timing),
+            notes,
         };
         let files = write_report(dir, &input)?;
         if !args.json {
@@ -402,7 +428,50 @@ fn timing_text(t: &StageTimings) -> String {
     )
 }
 
-fn print_json(
+/// Claim (a) on the validation sample: its tools' task errors, from the ranking's episodes where
+/// the screen kept them, else simulated here.
+fn confidence_check(
+    sample: Vec<Candidate>,
+    results: &[RankedTool],
+    tasks: &ModelTasks,
+) -> ConfidenceCheck {
+    let sampled = sample.len();
+    let (known, extra): (Vec<Candidate>, Vec<Candidate>) = sample
+        .into_iter()
+        .partition(|c| results.iter().any(|r| r.row.row == c.row.row));
+    let episodes = extra.len();
+    let simulated = simulate_all(extra, tasks, |_| Ok::<(), ()>(())).unwrap_or_default();
+    let points: Vec<(f64, f64)> = known
+        .iter()
+        .filter_map(|c| results.iter().find(|r| r.row.row == c.row.row))
+        .chain(&simulated)
+        .filter_map(|r| {
+            Some((
+                *r.logdet.as_ref().ok()?,
+                r.episode.as_ref().ok()?.task_error,
+            ))
+        })
+        .collect();
+    ConfidenceCheck::compute(&points, sampled, episodes, "from the tools file")
+}
+
+/// What the output and the report add in words: confidence does not predict the task error
+/// (with a screen), or the task barely moved the tools.
+fn notes(spec: &TaskSpec, check: Option<&ConfidenceCheck>, results: &[RankedTool]) -> Vec<String> {
+    let consequence = "the screen keeps the most confident tools, which need not be the best \
+                       here; screen less, or not at all";
+    let progress: Vec<f64> = results
+        .iter()
+        .filter_map(|r| r.episode.as_ref().ok()?.progress)
+        .collect();
+    check
+        .and_then(|c| c.note(consequence))
+        .into_iter()
+        .chain(barely_moved(spec.kind, &progress))
+        .collect()
+}
+
+fn rank_json(
     args: &Args,
     spec: &TaskSpec,
     objective: Objective,
@@ -410,8 +479,8 @@ fn print_json(
     results: &[RankedTool],
     order: &[usize],
     timing: &StageTimings,
-) {
-    let out = json!({
+) -> Value {
+    json!({
         "task": spec.kind,
         "task_file": (!spec.file.is_empty()).then_some(&spec.file),
         "tools_file": args.tools,
@@ -428,11 +497,8 @@ fn print_json(
             .enumerate()
             .map(|(k, &i)| tool_json(k + 1, &results[i]))
             .collect::<Vec<_>>(),
-    });
-    outln!(
-        "{}",
-        serde_json::to_string_pretty(&out).expect("finite numbers")
-    );
+        "goal": spec.tip_goal.kind_name(),
+    })
 }
 
 fn print_text(

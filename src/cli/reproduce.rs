@@ -1,5 +1,6 @@
 //! `toolconf reproduce [--out DIR] [--seed S] [--quick] [--only IDS]`: every experiment of the
-//! paper's Results section, with CSVs, SVG figures and a report (Markdown and HTML).
+//! paper's Results section, with CSVs, SVG figures and a report (Markdown and HTML); with
+//! `--model`, the same experiments on any model, task and tool population ([`super::evaluate`]).
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -22,14 +23,26 @@ pub struct Args {
     #[arg(long)]
     quick: bool,
     /// Run only these experiments (comma-separated: fig2,fig3,fig4,fig5,fig6,fig7).
-    #[arg(long, value_delimiter = ',', value_parser = parse_experiment)]
+    #[arg(long, value_delimiter = ',', value_parser = parse_experiment, conflicts_with = "model")]
     only: Option<Vec<String>>,
     /// Also run the MPC baseline: J* in Fig. 7 and the active-inference-against-MPC section
     /// (about ten times the run time of the paper's experiments).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "model")]
     mpc: bool,
     #[command(flatten)]
     method: super::episode_args::MethodArgs,
+    #[command(flatten)]
+    model: super::evaluate::ModelArgs,
+}
+
+/// What the paper's reproduction and an evaluation with `--model` share.
+pub struct Common {
+    pub out: PathBuf,
+    pub seed: u64,
+    pub quick: bool,
+    pub method: toolconf::integrate::Method,
+    /// The command line, quoted in the report.
+    pub command: String,
 }
 
 fn parse_experiment(s: &str) -> Result<String, String> {
@@ -45,6 +58,29 @@ fn parse_experiment(s: &str) -> Result<String, String> {
 }
 
 pub fn run(args: &Args) -> Result<(), CliError> {
+    let method = toolconf::integrate::Method::from(args.method.method);
+    if let Some(model) = args.model.model {
+        let command: Vec<String> = std::env::args().collect();
+        let common = Common {
+            out: args.out.clone(),
+            seed: args.seed,
+            quick: args.quick,
+            method,
+            command: command.join(" "),
+        };
+        return super::evaluate::run(&args.model, model, &common);
+    }
+    if let Some(flag) = args.model.stray_flag() {
+        return Err(CliError::Usage(format!(
+            "{flag} is for an evaluation on a model: give --model too (without it, reproduce \
+             runs the paper's own experiments)"
+        )));
+    }
+    paper(args, method)
+}
+
+/// The paper's Results section on its planar arm, as before `--model` existed.
+fn paper(args: &Args, method: toolconf::integrate::Method) -> Result<(), CliError> {
     let mut command = format!(
         "toolconf reproduce --out {} --seed {}",
         args.out.display(),
@@ -59,7 +95,6 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if args.mpc {
         command.push_str(" --mpc");
     }
-    let method = toolconf::integrate::Method::from(args.method.method);
     if method != toolconf::integrate::Method::Fast {
         command.push_str(&format!(
             " --method {}",

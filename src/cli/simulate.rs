@@ -216,6 +216,23 @@ fn print_episode(args: &Args, mut out: Value, heading: &str, m: &Metrics) -> Res
     Ok(())
 }
 
+/// The task file's task for `arm`: a tip goal relative to the tool's tip resolved at the arm's
+/// own tip where the episode starts.
+fn two_link_task(
+    spec: &TaskSpec,
+    arm: &Arm,
+    options: &toolconf::model::EpisodeOptionsN<2, 4>,
+) -> Result<Task, CliError> {
+    let (task, offset) = spec.task_and_offset::<Arm2, 2, 4, 4, 6>()?;
+    let Some(offset) = offset else {
+        return Ok(task);
+    };
+    let q0 = options.x0.fixed_rows::<2>(0).into_owned();
+    Ok(toolconf::task_file::at_initial_tip(
+        &task, &offset, arm, &q0,
+    )?)
+}
+
 /// One episode of the task file's task: the generic 2-link runtime, which takes the file's
 /// initial state, initial torque and per-joint perturbation as they are.
 fn from_task_file(
@@ -225,8 +242,8 @@ fn from_task_file(
 ) -> Result<(Episode, Value), CliError> {
     args.episode.apply(&mut spec)?;
     spec.episode.method = Some(args.method.method.into());
-    let task = spec.task::<Arm2, 2, 4, 4, 6>()?;
     let mut options = spec.episode::<Arm2, 2, 4, 4, 6>()?;
+    let task = two_link_task(&spec, arm, &options)?;
     options.record_trajectory = args.csv.is_some();
     let episode = match Plant::from(args.episode.plant) {
         Plant::Paper => episode_on::<Arm2, Arm2, 2, 4, 4, 6>(arm, &task, &options)?,
@@ -249,8 +266,8 @@ fn run_mpc(args: &Args, arm: &Arm, mut spec: TaskSpec) -> Result<(), CliError> {
         ),
         Some(_) => {
             args.episode.apply(&mut spec)?;
-            let task = spec.task::<Arm2, 2, 4, 4, 6>()?;
             let mut o = spec.episode::<Arm2, 2, 4, 4, 6>()?;
+            let task = two_link_task(&spec, arm, &o)?;
             o.record_trajectory = args.csv.is_some();
             let why = "is not supported by the MPC baseline";
             (task, two_link_options(&o, why)?)

@@ -90,6 +90,9 @@ pub fn write_report(dir: &Path, input: &ReportInput) -> Result<Vec<PathBuf>, Rep
                 .collect(),
         ),
     ];
+    if let Some(note) = r.confidence_note() {
+        doc.insert(2, Block::p(format!("**Note: {note}.**")));
+    }
     let md = dir.join("report.md");
     let html = dir.join("report.html");
     let mut files = vec![md.clone(), html.clone()];

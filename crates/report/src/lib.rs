@@ -17,6 +17,7 @@ use toolconf::{
 };
 
 pub mod design;
+pub mod evaluation;
 pub mod experiments;
 pub mod progress;
 pub mod rank;

@@ -34,6 +34,9 @@ pub struct ReportInput<'a> {
     /// Both stages' wall times (stated under "Run time"; they vary from run to run, so the
     /// report is not compared byte for byte).
     pub timing: Option<StageTimings>,
+    /// Notes the output gives too: that confidence does not predict the task error among these
+    /// tools (with a screen), that the task barely moved the tools.
+    pub notes: Vec<String>,
 }
 
 /// How many tools the report lists, and how many of the best and worst it plots over time.
@@ -48,6 +51,9 @@ pub const REPORT_FILES: [&str; 4] = ["report.md", "report.html", CONFIDENCE_SVG,
 pub fn write_report(dir: &Path, input: &ReportInput) -> Result<Vec<PathBuf>, ReproduceError> {
     toolconf::output::file::create_folder(dir).map_err(ReproduceError::io(dir))?;
     let mut doc = introduction(input);
+    for note in &input.notes {
+        doc.push(Block::p(format!("**Note: {note}.**")));
+    }
     doc.extend(ranking_table(input));
     doc.extend(confidence_figure(dir, input)?);
     doc.extend(trajectory_figure(dir, input)?);
@@ -236,16 +242,43 @@ fn task_table(input: &ReportInput) -> Vec<Block> {
     let number = |v: Option<f64>| v.map(|v| v.to_string());
     let mut rows = vec![vec!["task kind".to_string(), spec.kind.to_string()]];
     let mut add = |name: &str, value: String| rows.push(vec![name.to_string(), value]);
+    // A tip task file's precisions left out come from the robot's own scales on a URDF arm.
+    let scaled = !spec.file.is_empty()
+        && spec
+            .kind
+            .terms()
+            .iter()
+            .any(|t| matches!(t.read(), Read::Tip { .. }));
+    let default_precision = |term: Term| match toolconf::robot_scales::default_words(term) {
+        Some(words) if scaled => {
+            format!("on a URDF arm {words} (the robot's own scale), else {paper}")
+        }
+        _ => paper.to_string(),
+    };
     for term in Term::ALL.into_iter().filter(|t| spec.kind.uses(*t)) {
         let i = term.index();
         if term.has_goal() {
             let name = format!("goal {} [{}]", term.symbol(), term.unit());
-            add(&name, given(vector(&spec.goal[i]), paper));
+            let value = match (&spec.tip_goal, term) {
+                (toolconf::task_file::TipGoal::Offset(_), Term::Tip) => spec.tip_goal.describe(),
+                (toolconf::task_file::TipGoal::Motion { .. }, Term::TipDot | Term::TipDdot) => {
+                    format!(
+                        "{} ({})",
+                        given(vector(&spec.goal[i]), paper),
+                        spec.tip_goal.describe()
+                    )
+                }
+                _ => given(vector(&spec.goal[i]), paper),
+            };
+            add(&name, value);
         }
         let name = format!("precision P^{}", term.symbol());
         add(
             &name,
-            given(spec.precision[i].as_ref().map(precision), paper),
+            given(
+                spec.precision[i].as_ref().map(precision),
+                &default_precision(term),
+            ),
         );
     }
     add(

@@ -30,6 +30,7 @@ pub mod confidence;
 pub mod design;
 pub mod display;
 pub mod error;
+pub mod evaluation;
 /// The code `make derive` writes into `generated/` (the crate toolconf-generated): one module
 /// per model (see `generated/<model>.md` for each derivation report), the tasks and the
 /// registry [`for_each_model!`]. Nobody edits these files: change a model description or the
@@ -45,6 +46,7 @@ pub mod mpc;
 pub use toolconf_files as output;
 pub mod rank;
 pub mod registry;
+pub mod robot_scales;
 pub mod select;
 pub mod stats;
 pub mod task;

@@ -45,6 +45,10 @@ use crate::validate::goal_range;
 use crate::{TaskKind, Term};
 use toolconf_core::{term_components, term_identity};
 
+mod tip_goal;
+pub use tip_goal::{at_initial_tip, TipGoal};
+use tip_goal::{RelativeKeys, RELATIVE_KEYS};
+
 /// A bad task file: the file, where in it (a key or a line), and what is wrong.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub struct TaskFileError {
@@ -114,9 +118,12 @@ pub struct TaskSpec {
     pub description: Option<String>,
     /// The goals the file gives, by [`Term::index`] (`None`: the model's paper goal).
     pub goal: [Option<Vec<f64>>; TERMS],
-    /// The precisions the file gives, by [`Term::index`] (`None`: the model's paper precision).
+    /// The precisions the file gives, by [`Term::index`] (`None`: the model's paper precision,
+    /// or on a tip task file the robot's own scales: [`crate::robot_scales`]).
     pub precision: [Option<PrecisionSpec>; TERMS],
     pub episode: EpisodeSpec,
+    /// Whether the tip goal is absolute or relative to each tool's own tip ([`TipGoal`]).
+    pub tip_goal: TipGoal,
 }
 
 #[derive(Deserialize)]
@@ -125,7 +132,7 @@ struct RawTask {
     kind: String,
     description: Option<String>,
     #[serde(default)]
-    goal: TermTable<Vec<f64>, true>,
+    goal: RawGoal,
     #[serde(default)]
     precision: TermTable<toml::Value, false>,
     #[serde(default)]
@@ -209,6 +216,113 @@ impl<'de> serde::de::Visitor<'de> for TermKey {
     }
 }
 
+/// `[goal]`: the terms' goals by name ([`Term::GOAL_NAMES`]) and the relative tip goal's keys
+/// ([`RELATIVE_KEYS`]); an unknown key is serde's "unknown field" error at its own line, listing
+/// both.
+#[derive(Default)]
+struct RawGoal {
+    terms: [Option<Vec<f64>>; TERMS],
+    relative: RelativeKeys,
+}
+
+/// Every key `[goal]` takes, for the message of an unknown one.
+fn goal_keys() -> &'static [&'static str] {
+    static KEYS: std::sync::OnceLock<Vec<&'static str>> = std::sync::OnceLock::new();
+    KEYS.get_or_init(|| {
+        Term::GOAL_NAMES
+            .iter()
+            .chain(&RELATIVE_KEYS)
+            .copied()
+            .collect()
+    })
+}
+
+impl<'de> Deserialize<'de> for RawGoal {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Keys;
+        impl<'de> serde::de::Visitor<'de> for Keys {
+            type Value = RawGoal;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("struct RawGoal")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                mut map: A,
+            ) -> Result<RawGoal, A::Error> {
+                let mut goal = RawGoal::default();
+                while let Some(key) = map.next_key_seed(GoalKey)? {
+                    goal.take(key, &mut map)?;
+                }
+                Ok(goal)
+            }
+        }
+        deserializer.deserialize_struct("RawGoal", goal_keys(), Keys)
+    }
+}
+
+impl RawGoal {
+    /// The value of `key`, refused if the key was given before.
+    fn take<'de, A: serde::de::MapAccess<'de>>(
+        &mut self,
+        key: GoalKeyName,
+        map: &mut A,
+    ) -> Result<(), A::Error> {
+        fn once<T, E: serde::de::Error>(
+            slot: &mut Option<T>,
+            v: T,
+            name: &'static str,
+        ) -> Result<(), E> {
+            if slot.is_some() {
+                return Err(E::duplicate_field(name));
+            }
+            *slot = Some(v);
+            Ok(())
+        }
+        let r = &mut self.relative;
+        match key {
+            GoalKeyName::Term(t) => once(&mut self.terms[t.index()], map.next_value()?, t.name()),
+            GoalKeyName::Relative(0) => once(&mut r.offset, map.next_value()?, RELATIVE_KEYS[0]),
+            GoalKeyName::Relative(1) => once(&mut r.direction, map.next_value()?, RELATIVE_KEYS[1]),
+            GoalKeyName::Relative(2) => once(&mut r.speed, map.next_value()?, RELATIVE_KEYS[2]),
+            GoalKeyName::Relative(_) => {
+                once(&mut r.acceleration, map.next_value()?, RELATIVE_KEYS[3])
+            }
+        }
+    }
+}
+
+/// A `[goal]` key: a term's goal or one of [`RELATIVE_KEYS`] (by its index).
+enum GoalKeyName {
+    Term(Term),
+    Relative(usize),
+}
+
+/// Reads a `[goal]` key, refusing an unknown one at its own line.
+struct GoalKey;
+
+impl<'de> serde::de::DeserializeSeed<'de> for GoalKey {
+    type Value = GoalKeyName;
+    fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<GoalKeyName, D::Error> {
+        d.deserialize_identifier(self)
+    }
+}
+
+impl<'de> serde::de::Visitor<'de> for GoalKey {
+    type Value = GoalKeyName;
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("field identifier")
+    }
+    fn visit_str<E: serde::de::Error>(self, key: &str) -> Result<GoalKeyName, E> {
+        if let Some(t) = Term::from_name(key).filter(|t| Term::GOAL_NAMES.contains(&t.name())) {
+            return Ok(GoalKeyName::Term(t));
+        }
+        match RELATIVE_KEYS.iter().position(|k| *k == key) {
+            Some(i) => Ok(GoalKeyName::Relative(i)),
+            None => Err(E::unknown_field(key, goal_keys())),
+        }
+    }
+}
+
 #[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 struct RawEpisode {
@@ -233,6 +347,7 @@ impl TaskSpec {
             goal: std::array::from_fn(|_| None),
             precision: std::array::from_fn(|_| None),
             episode: EpisodeSpec::default(),
+            tip_goal: TipGoal::Absolute,
         }
     }
 
@@ -289,11 +404,15 @@ impl TaskSpec {
                 .transpose()
         };
         let e = raw.episode;
+        let mut goal = raw.goal.terms;
+        let tip_goal =
+            tip_goal::resolve(kind, raw.goal.relative, &mut goal).map_err(|(k, m)| err(&k, m))?;
         let spec = TaskSpec {
             file: file.into(),
             kind,
             description: raw.description,
-            goal: raw.goal.values,
+            goal,
+            tip_goal,
             precision,
             episode: EpisodeSpec {
                 t_end: e.t_end,
@@ -372,10 +491,28 @@ impl TaskSpec {
     }
 
     /// The task for model `M`: the file's goals and precisions, the rest from `M`'s paper-style
-    /// task. Errors when a goal or precision has the wrong size for `M`.
+    /// task (on a tip task file for a URDF arm, from the robot's own scales:
+    /// [`crate::robot_scales`]). Errors when a goal or precision has the wrong size for `M`, and
+    /// for a tip goal relative to each tool's tip, which needs the tool
+    /// ([`TaskSpec::task_and_offset`]).
     pub fn task<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
         &self,
     ) -> Result<TaskN<N>, TaskFileError>
+    where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
+        match self.task_and_offset::<M, N, NX, NP, NZ>()? {
+            (task, None) => Ok(task),
+            (_, Some(_)) => Err(tip_goal::needs_absolute(&self.file)),
+        }
+    }
+
+    /// The task for model `M` and, for a `tip_offset` goal, the offset (padded as the task's tip
+    /// rows are): each tool's goal is then [`at_initial_tip`]. Until then the task's tip goal is
+    /// zero, which nothing but the episode reads (Π^U does not depend on goals).
+    pub fn task_and_offset<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+        &self,
+    ) -> Result<(TaskN<N>, Option<SVector<f64, N>>), TaskFileError>
     where
         M: ArmModel<N, NX, NP, NZ>,
     {
@@ -386,6 +523,16 @@ impl TaskSpec {
                     self.term_vector::<M, N, NX, NP, NZ>(term, &format!("goal.{term}"), v)?;
             }
         }
+        let offset = match &self.tip_goal {
+            TipGoal::Offset(v) => {
+                let offset =
+                    self.term_vector::<M, N, NX, NP, NZ>(Term::Tip, "goal.tip_offset", v)?;
+                task.goal[Term::Tip.index()] = SVector::zeros();
+                Some(offset)
+            }
+            _ => None,
+        };
+        self.robot_scale_precisions::<M, N, NX, NP, NZ>(&mut task)?;
         for term in Term::ALL {
             let Some(given) = &self.precision[term.index()] else {
                 continue;
@@ -410,7 +557,59 @@ impl TaskSpec {
         }
         task.validate()
             .map_err(|e| self.error("precision", e.to_string()))?;
-        Ok(task)
+        Ok((task, offset))
+    }
+
+    /// On a tip task file (not a built-in task) for a URDF arm, every precision the file leaves
+    /// out from the robot's own scales ([`crate::robot_scales`]); other models and built-in tasks
+    /// keep the paper's. A URDF arm whose rated torques cannot be read is an error naming the
+    /// first precision that would need them.
+    fn robot_scale_precisions<
+        M,
+        const N: usize,
+        const NX: usize,
+        const NP: usize,
+        const NZ: usize,
+    >(
+        &self,
+        task: &mut TaskN<N>,
+    ) -> Result<(), TaskFileError>
+    where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
+        let missing: Vec<Term> = Term::ALL
+            .into_iter()
+            .filter(|t| self.kind.uses(*t) && self.precision[t.index()].is_none())
+            .collect();
+        if self.file.is_empty() || !toolconf_core::reads_tip(self.kind) || missing.is_empty() {
+            return Ok(());
+        }
+        let rated = match crate::robot_scales::rated_torques_of(M::name()) {
+            Ok(Some(rated)) => rated,
+            Ok(None) => return Ok(()),
+            Err(why) => {
+                return Err(self.error(
+                    &format!("precision.{}", missing[0]),
+                    format!(
+                        "not given, and its default comes from the robot's rated torques, \
+                         which cannot be read ({why}): give precision.{} in the task",
+                        missing[0]
+                    ),
+                ))
+            }
+        };
+        for term in missing {
+            let Some(diagonal) = crate::robot_scales::default_precision(term, &rated, M::tip_dim())
+            else {
+                continue;
+            };
+            let mut p = SMatrix::<f64, N, N>::zeros();
+            for (i, v) in diagonal.iter().enumerate().take(N) {
+                p[(i, i)] = *v;
+            }
+            task.precision[term.index()] = p;
+        }
+        Ok(())
     }
 
     /// The episode options for model `M`: the file's `[episode]`, the rest the paper's.

@@ -18,6 +18,10 @@ pub enum Outcome {
     Partly,
     /// The statistics could not be computed (the reason is in the evidence).
     NotJudged,
+    /// The opposite of the claim, significantly (`reproduce --model`'s three-way rule).
+    Reversed,
+    /// Neither the claim nor its opposite (`reproduce --model`'s three-way rule).
+    NoRelation,
 }
 
 impl Outcome {
@@ -27,6 +31,18 @@ impl Outcome {
             Outcome::DoesNotHold => "does not hold",
             Outcome::Partly => "partly holds",
             Outcome::NotJudged => "cannot be judged",
+            Outcome::Reversed => "reversed",
+            Outcome::NoRelation => "no relation",
+        }
+    }
+
+    /// The HTML class of a verdict's paragraph (the style's colours: green, red, amber, grey).
+    pub fn css_class(self) -> &'static str {
+        match self {
+            Outcome::Holds => "holds",
+            Outcome::DoesNotHold | Outcome::Reversed => "does-not-hold",
+            Outcome::Partly => "partly-holds",
+            Outcome::NotJudged | Outcome::NoRelation => "cannot-be-judged",
         }
     }
 }
@@ -393,7 +409,7 @@ pub fn to_html(doc: &[Block]) -> String {
                 let _ = writeln!(
                     out,
                     "<p class=\"verdict {}\">{}</p>\n<p>Rule: {}</p>",
-                    v.outcome.words().replace(' ', "-"),
+                    v.outcome.css_class(),
                     inline(&verdict_line(v)),
                     inline(&v.rule)
                 );

@@ -14,6 +14,8 @@
 //! samples = 100000                    # random feasible tools the design is compared with
 //! simulate = 5                        # how many of the most confident of them are simulated
 //! perturbation = -0.8                 # ΔT [N m] for the sensitivity |Δ task error|
+//! validation = 100                    # random feasible tools simulated to check that confidence
+//!                                     # predicts the task error here (0: no check)
 //! ```
 //!
 //! Every mistake is a [`DesignError::Input`] naming the file and the key.
@@ -55,6 +57,9 @@ pub struct SearchSettings {
     pub samples: usize,
     pub simulate: usize,
     pub perturbation: f64,
+    /// The first this many random feasible tools are simulated to check claim (a) on the
+    /// design's feasible set ([`crate::evaluation::check`]).
+    pub validation: usize,
 }
 
 impl Default for SearchSettings {
@@ -65,6 +70,7 @@ impl Default for SearchSettings {
             samples: 100_000,
             simulate: 5,
             perturbation: -0.8,
+            validation: crate::evaluation::VALIDATION_TOOLS,
         }
     }
 }
@@ -105,6 +111,7 @@ struct RawSearch {
     samples: Option<usize>,
     simulate: Option<usize>,
     perturbation: Option<f64>,
+    validation: Option<usize>,
 }
 
 impl DesignSpec {
@@ -291,7 +298,11 @@ fn search_settings(raw: &RawSearch) -> Result<SearchSettings, (&'static str, Str
         samples: raw.samples.unwrap_or(d.samples),
         simulate: raw.simulate.unwrap_or(d.simulate),
         perturbation: raw.perturbation.unwrap_or(d.perturbation),
+        validation: raw.validation.unwrap_or(d.validation),
     };
+    if s.validation > 100_000 {
+        return Err(("validation", format!("{} is more than 10^5", s.validation)));
+    }
     if s.samples > 10_000_000 {
         return Err(("samples", format!("{} is more than 10^7", s.samples)));
     }

@@ -82,7 +82,7 @@ fn result_json(spec: &DesignSpec, r: &DesignResult) -> Value {
         random["best_logdet"] = Value::from(best.1);
     }
     let optimum = Polytope::new(spec).full(&o.x);
-    json!({
+    let mut v = json!({
         "objective": r.objective.name(),
         "params": named(&spec.names, &r.params),
         "logdet": r.logdet,
@@ -97,5 +97,11 @@ fn result_json(spec: &DesignSpec, r: &DesignResult) -> Value {
         "perturbation": spec.search.perturbation,
         "random": random,
         "verification": verification,
-    })
+        "notes": r.confidence_note().into_iter().collect::<Vec<_>>(),
+    });
+    // No check at all (no random feasible tool to sample) is a missing key, not a null.
+    if let Some(check) = &r.confidence_check {
+        v["confidence_check"] = check.json();
+    }
+    v
 }

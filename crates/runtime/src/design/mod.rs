@@ -164,6 +164,18 @@ pub struct DesignResult {
     pub random: RandomTools,
     /// The design first, then the most confident random tools.
     pub checks: Vec<ToolCheck>,
+    /// Claim (a) on the feasible set: does confidence predict the task error there?
+    pub confidence_check: Option<crate::evaluation::ConfidenceCheck>,
+}
+
+impl DesignResult {
+    /// The line `design` prints when confidence does not predict the task error here.
+    pub fn confidence_note(&self) -> Option<String> {
+        self.confidence_check.as_ref()?.note(
+            "the most confident design need not do the task best; compare by simulation \
+             (objective = \"free_energy\", or the verification's task errors)",
+        )
+    }
 }
 
 /// Designs a tool: the optimum, then the verification against random feasible tools.
@@ -199,8 +211,7 @@ pub fn design_with_progress(
         &polytope,
         setting.model,
         setting.tasks,
-        s.samples,
-        s.simulate,
+        (s.samples, s.simulate, s.validation),
         s.seed ^ 0x9e37_79b9_7f4a_7c15,
         sampling,
     );
@@ -210,6 +221,8 @@ pub fn design_with_progress(
     }
     let perturbed = ModelTasks::new(&verify::perturbed(setting.task, s.perturbation));
     let checks = verify::check_tools(&tools, setting.model, setting.tasks, &perturbed);
+    let confidence_check = (!random.sample.is_empty())
+        .then(|| verify::confidence_check(&polytope, setting.model, setting.tasks, &random.sample));
     Ok(DesignResult {
         objective: spec.objective,
         params: polytope.full(&x),
@@ -219,6 +232,7 @@ pub fn design_with_progress(
         free_energy_evaluations: evaluations,
         random,
         checks,
+        confidence_check,
     })
 }
 

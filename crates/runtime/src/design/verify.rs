@@ -37,6 +37,9 @@ pub struct RandomTools {
     pub drawn: u64,
     /// (free parameters, ln|Π^U|), most confident first (ties: the earlier draw).
     pub top: Vec<(Vec<f64>, f64)>,
+    /// The first feasible tools with a confidence, in draw order: a uniform sample of the
+    /// feasible set, simulated to check claim (a) there ([`crate::evaluation::check`]).
+    pub sample: Vec<(Vec<f64>, f64)>,
 }
 
 /// The most draws from the box the random comparison makes (about 2 s): a thin feasible set
@@ -59,13 +62,23 @@ pub fn random_tools(
     polytope: &Polytope,
     model: ModelKind,
     tasks: &ModelTasks,
-    n: usize,
-    keep: usize,
+    (n, keep, sample): (usize, usize, usize),
     seed: u64,
     progress: &mut dyn FnMut(&Sampling),
 ) -> RandomTools {
     let max_draws = (1000 * n.max(1) as u64).min(MAX_DRAWS);
-    random_tools_within(polytope, model, tasks, (n, keep), seed, max_draws, progress)
+    let mut r = random_tools_within(
+        polytope,
+        model,
+        tasks,
+        (n, keep.max(sample)),
+        seed,
+        max_draws,
+        progress,
+    );
+    r.top.truncate(keep.max(1));
+    r.sample.truncate(sample);
+    r
 }
 
 /// [`random_tools`] with at most `max_draws` draws; `(n, keep)` as there.
@@ -80,6 +93,7 @@ fn random_tools_within(
 ) -> RandomTools {
     let mut sampler = FeasibleSampler::new(polytope, seed);
     let mut top: Vec<(Vec<f64>, f64)> = Vec::with_capacity(keep + 1);
+    let mut sample: Vec<(Vec<f64>, f64)> = Vec::with_capacity(keep);
     let mut feasible = 0;
     let mut next_report = 0;
     while feasible < n {
@@ -104,6 +118,9 @@ fn random_tools_within(
         let Ok(logdet) = tasks.logdet(&tool) else {
             continue;
         };
+        if sample.len() < keep {
+            sample.push((x.clone(), logdet));
+        }
         let at = top.partition_point(|(_, v)| *v >= logdet);
         if at < keep.max(1) {
             top.insert(at, (x, logdet));
@@ -115,6 +132,7 @@ fn random_tools_within(
         feasible,
         drawn: sampler.drawn,
         top,
+        sample,
     }
 }
 
@@ -145,6 +163,29 @@ pub fn check_tools(
             simulated: simulate(model, params, nominal, under_perturbation),
         })
         .collect()
+}
+
+/// Claim (a) on the random feasible tools `sample` (free parameters, ln|Π^U|): each simulated
+/// on the task, in parallel.
+pub fn confidence_check(
+    polytope: &Polytope,
+    model: ModelKind,
+    tasks: &ModelTasks,
+    sample: &[(Vec<f64>, f64)],
+) -> crate::evaluation::ConfidenceCheck {
+    let points: Vec<(f64, f64)> = sample
+        .par_iter()
+        .filter_map(|(x, logdet)| {
+            let tool = AnyTool::new(model, &polytope.full(x)).ok()?;
+            Some((*logdet, tasks.simulate(&tool).ok()?.task_error))
+        })
+        .collect();
+    crate::evaluation::ConfidenceCheck::compute(
+        &points,
+        sample.len(),
+        sample.len(),
+        "from the design's feasible set",
+    )
 }
 
 fn simulate(

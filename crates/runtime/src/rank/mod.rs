@@ -14,8 +14,8 @@ mod screen;
 mod tasks;
 
 pub use screen::{
-    check_screened, screen_file, screen_rows, Candidate, EachRow, Screen, ScreenError,
-    ScreenedBlock,
+    check_screened, screen_file, screen_file_with_validation, screen_rows, Candidate, EachRow,
+    Screen, ScreenError, ScreenedBlock,
 };
 pub use tasks::{AnyEpisode, Linearisation, ModelTasks, TaskTrace, TrajectoryTable};
 

@@ -16,6 +16,29 @@ pub struct Candidate {
     pub logdet: Result<f64, Error>,
 }
 
+/// A candidate in the validation sample's heap (ordered by its key and row alone).
+struct SampledCandidate(Candidate);
+
+impl PartialEq for SampledCandidate {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl Eq for SampledCandidate {}
+
+impl PartialOrd for SampledCandidate {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for SampledCandidate {
+    fn cmp(&self, _: &Self) -> Ordering {
+        Ordering::Equal
+    }
+}
+
 /// A candidate in the screen's heap, ordered by confidence; on a tie the later row is less.
 struct Screened {
     logdet: f64,
@@ -50,6 +73,9 @@ pub struct Screen {
     limit: Option<usize>,
     heap: BinaryHeap<Reverse<Screened>>,
     all: Vec<Candidate>,
+    /// The validation sample's size ([`Screen::with_validation`]) and its tools, by key.
+    validation: usize,
+    sample: BinaryHeap<(u64, usize, SampledCandidate)>,
     /// Tools seen.
     pub read: usize,
     /// Tools whose Π^U is not positive definite (never kept by a screen), and the first reason.
@@ -64,13 +90,55 @@ impl Screen {
             limit,
             heap: BinaryHeap::new(),
             all: Vec::new(),
+            validation: 0,
+            sample: BinaryHeap::new(),
             read: 0,
             without_confidence: 0,
             first_confidence_error: None,
         }
     }
 
+    /// A screen that also keeps a uniform sample of `validation` tools with a confidence, the
+    /// rows whose [`sample_key`](crate::evaluation::check::sample_key) is smallest: what `rank
+    /// --screen` simulates alongside to check that confidence predicts the task error.
+    pub fn with_validation(limit: Option<usize>, validation: usize) -> Self {
+        Self {
+            validation,
+            ..Self::new(limit)
+        }
+    }
+
+    /// The validation sample, in row order.
+    pub fn validation_sample(&self) -> Vec<Candidate> {
+        let mut sample: Vec<Candidate> = self.sample.iter().map(|s| s.2 .0.clone()).collect();
+        sample.sort_by_key(|c| c.row.row);
+        sample
+    }
+
+    fn offer_to_sample(&mut self, candidate: &Candidate) {
+        if self.validation == 0 || candidate.logdet.is_err() {
+            return;
+        }
+        let row = candidate.row.row;
+        let entry = (
+            crate::evaluation::check::sample_key(row),
+            row,
+            SampledCandidate(candidate.clone()),
+        );
+        if self.sample.len() < self.validation {
+            self.sample.push(entry);
+        } else if self
+            .sample
+            .peek()
+            .is_some_and(|worst| (entry.0, entry.1) < (worst.0, worst.1))
+        {
+            self.sample.pop();
+            self.sample.push(entry);
+        }
+    }
+
     pub fn push(&mut self, candidate: Candidate) {
+        self.offer_to_sample(&candidate);
         self.read += 1;
         if let Err(e) = &candidate.logdet {
             self.without_confidence += 1;
@@ -197,9 +265,40 @@ pub fn screen_rows(
     tasks: &ModelTasks,
     limit: Option<usize>,
     skip_bad_rows: bool,
+    skipping: impl FnMut(&ToolFileError),
+) -> Result<(Screen, usize), ScreenError> {
+    let screen = Screen::new(limit);
+    screen_rows_into(screen, tools_file, read, tasks, skip_bad_rows, skipping)
+}
+
+/// [`screen_file`] into a [`Screen::with_validation`]: the kept tools, and a sample of
+/// `validation` tools of the whole file to check claim (a) on.
+pub fn screen_file_with_validation(
+    path: &Path,
+    tasks: &ModelTasks,
+    task: &str,
+    (limit, validation): (Option<usize>, usize),
+    skip_bad_rows: bool,
+    skipping: impl FnMut(&ToolFileError),
+) -> Result<(Screen, usize), ScreenError> {
+    let source = crate::display::ClipPath(&path.to_string_lossy()).to_string();
+    let read = |each: &mut EachRow| read_tools(path, each);
+    let screen = Screen::with_validation(limit, validation);
+    let (screen, skipped) =
+        screen_rows_into(screen, &source, read, tasks, skip_bad_rows, skipping)?;
+    check_screened(&screen, skipped, &source, task)?;
+    Ok((screen, skipped))
+}
+
+/// The rows `read` gives pushed into `screen`.
+fn screen_rows_into(
+    mut screen: Screen,
+    tools_file: &str,
+    read: impl FnOnce(&mut EachRow) -> Result<usize, ToolFileError>,
+    tasks: &ModelTasks,
+    skip_bad_rows: bool,
     mut skipping: impl FnMut(&ToolFileError),
 ) -> Result<(Screen, usize), ScreenError> {
-    let mut screen = Screen::new(limit);
     let mut skipped = 0;
     let mut misfit = None;
     let read = read(&mut |row| match row {

@@ -79,11 +79,12 @@ where
     }
 
     fn bind(&self, spec: &TaskSpec) -> Result<Arc<dyn BoundTask>, TaskFileError> {
-        let task = spec.task::<M, N, NX, NP, NZ>()?;
+        let (task, offset) = spec.task_and_offset::<M, N, NX, NP, NZ>()?;
         Ok(Arc::new(TaskOn::<M, N, NX, NP, NZ> {
             kind: spec.kind,
             validated: task.validated().map_err(Error::from),
             task,
+            offset,
             options: spec.episode::<M, N, NX, NP, NZ>(),
             model: PhantomData,
         }))
@@ -276,6 +277,9 @@ where
 struct TaskOn<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> {
     kind: TaskKind,
     task: TaskN<N>,
+    /// A tip goal relative to each tool's tip where the episode starts
+    /// ([`crate::task_file::TipGoal::Offset`]); `task`'s tip goal is then resolved per tool.
+    offset: Option<SVector<f64, N>>,
     validated: Result<ValidatedTaskN<N>, Error>,
     options: Result<EpisodeOptionsN<N, NX>, TaskFileError>,
     model: PhantomData<M>,
@@ -293,6 +297,19 @@ where
         self.options
             .as_ref()
             .map_err(|e| ModelSimulationError::Input(Error::Unsupported(e.to_string())))
+    }
+
+    /// The task `tool` runs: with a relative tip goal, resolved at the tool's own initial tip.
+    fn task_for(
+        &self,
+        tool: &ToolN<M, N, NX, NP, NZ>,
+    ) -> Result<std::borrow::Cow<'_, TaskN<N>>, ModelSimulationError> {
+        let Some(offset) = &self.offset else {
+            return Ok(std::borrow::Cow::Borrowed(&self.task));
+        };
+        let q0 = self.options()?.x0.fixed_rows::<N>(0).into_owned();
+        let task = crate::task_file::at_initial_tip(&self.task, offset, tool, &q0)?;
+        Ok(std::borrow::Cow::Owned(task))
     }
 
     fn recorded(&self) -> Result<EpisodeOptionsN<N, NX>, ModelSimulationError> {
@@ -365,7 +382,7 @@ where
 
     fn simulate(&self, params: &[f64]) -> Result<Metrics, ModelSimulationError> {
         let tool = tool::<M, N, NX, NP, NZ>(params)?;
-        simulate(&tool, &self.task, self.options()?)
+        simulate(&tool, &*self.task_for(&tool)?, self.options()?)
     }
 
     fn episode(&self, params: &[f64], record: bool) -> Result<AnyEpisode, ModelSimulationError> {
@@ -374,7 +391,7 @@ where
             record_trajectory: record,
             ..*self.options()?
         };
-        let e = episode(&tool, &self.task, &options)?;
+        let e = episode(&tool, &*self.task_for(&tool)?, &options)?;
         Ok(AnyEpisode {
             metrics: e.metrics,
             perturbation: options.total_perturbation().iter().copied().collect(),
@@ -384,7 +401,7 @@ where
 
     fn trace(&self, params: &[f64]) -> Result<TaskTrace, ModelSimulationError> {
         let tool = tool::<M, N, NX, NP, NZ>(params)?;
-        let task = &self.task;
+        let task = &*self.task_for(&tool)?;
         let tr = episode(&tool, task, &self.recorded()?)?
             .trajectory
             .expect("a recorded episode has a trajectory");
