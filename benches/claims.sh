@@ -5,7 +5,7 @@
 # paper's other counts. One row per run, each row's own command in its last column; every run's
 # CSVs, figures and report stay under OUT (default: a temporary folder, printed at the end).
 #
-#     bench/claims.sh [XARM7_LIBRARY [OUT]]
+#     benches/claims.sh [XARM7_LIBRARY [OUT]]
 #
 # Without XARM7_LIBRARY, the xArm7's library is built first (about 3 minutes on 2 idle cores:
 # derive/make_model.py, which needs `make venv`).
