@@ -154,7 +154,8 @@ def derive_all(runs: list[Run]) -> None:
         raise SystemExit(1)
     for run in runs:
         irs = [str(out) for _, out, _ in run.model_jobs()]
-        render = ["cargo", "run", "--quiet", "-p", "toolconf-render", "--", *irs,
+        # release, as make crate and make model build it: one renderer build serves all three.
+        render = ["cargo", "run", "--release", "--quiet", "-p", "toolconf-render", "--", *irs,
                   "--templates", str(ROOT / "templates"), "--out", str(run.generated)]
         if subprocess.run(render, cwd=ROOT, env=run.env).returncode:
             raise SystemExit(1)
