@@ -6,7 +6,7 @@
 //! * `random_100k`: ln|Π^U| of 10⁵ random feasible tools (what the design is compared with);
 //! * `gradient`: one ln|Π^U| and ∂ln|Π^U|/∂p through the dispatch the solver uses.
 //!
-//! `cargo bench --bench design`; the target: the confidence design well under a second.
+//! `cargo bench --bench design`; the target: the confidence design well under a second.
 
 use std::hint::black_box;
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 30's screening target: the control confidence of N Panda tools with tips (default 10⁶) on
+# The screening target: the control confidence of N Panda tools with tips (default 10⁶) on
 # a tip task, file reading included, on 2 threads. Writes target/tip_screen/panda_N.csv (N tools:
 # mass 0.1-3 kg, centre of mass within 5 cm of the flange axis and up to 20 cm out, the principal
 # moments of a solid box of 1-30 cm sides about it (so the triangle inequality holds), no products

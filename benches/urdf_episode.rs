@@ -5,7 +5,7 @@
 //!
 //! `panda_tip_episode`: one episode of the tip task a user runs (examples/tasks/
 //! panda_touch_point.toml, touching a point with the tool's tip, σ = 1 mm) per iteration,
-//! cycling through the same 50 tools, with `rank`'s default method; goal ≤ 1 ms (issue 30: the
+//! cycling through the same 50 tools, with `rank`'s default method; goal ≤ 1 ms (the
 //! joint tasks take 0.36–0.41 ms).
 //!
 //! `cargo bench --bench urdf_episode`; goals: an episode ≤ 2 ms, ≥ 100× SciPy's

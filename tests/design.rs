@@ -1,6 +1,6 @@
 //! `toolconf design`'s library: the derived gradient against finite differences and against a
 //! hand-derived closed form, a constrained optimum known in closed form, the paper's arm under
-//! the constraints against 10^5 random feasible tools, infeasibility and determinism.
+//! the stated constraints against 10^5 random feasible tools, infeasibility and determinism.
 
 use toolconf::design::file::DesignSpec;
 use toolconf::design::{confidence_optimum, design, DesignError, Setting};
@@ -227,7 +227,7 @@ fn an_unconverged_optimum_is_reported_as_such() {
     );
 }
 
-/// The acceptance case: the paper's arm, task 2, l1 + l2 ≥ 0.7, m1 + m2 ≤ 0.5.
+/// The acceptance case: the paper's arm, task 2, l1 + l2 ≥ 0.7, m1 + m2 ≤ 0.5.
 #[test]
 fn paper_arm_design_beats_the_best_of_100k_random_feasible_tools() {
     let s = spec(MINIMAL, ModelKind::Arm2);

@@ -1,4 +1,4 @@
-//! The hostile-input sweep: the examples of each class and more, against the binary
+//! The hostile-input sweep: the reported examples of each class and more, against the binary
 //! (the debug one in `cargo test`; the release one with
 //! `TOOLCONF_BIN=target/release/toolconf cargo test --release --test hostile`). Each case runs
 //! in a folder of its own, under a 2 GB address-space limit, and must end with its expected

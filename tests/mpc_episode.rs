@@ -176,7 +176,7 @@ fn observer_estimate_converges_to_the_perturbation_near_the_equilibrium() {
     }
 }
 
-/// The measurement behind `MpcOptions::default()`: the paper's three tasks on 30 random
+/// The measurement behind `MpcOptions::default()`: the paper's three tasks on 30 random
 /// tools (seed 1) with ΔT = 0 and −0.8 for the four (model, observer) combinations. Prints a
 /// table; run with `cargo test --release --test mpc_episode -- --ignored --nocapture`.
 #[test]

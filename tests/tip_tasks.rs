@@ -1,4 +1,4 @@
-//! Tasks on the tool's tip (issue 30) through the model-generic runtime: the controller observes
+//! Tasks on the tool's tip through the model-generic runtime: the controller observes
 //! the tip's forward kinematics y(q), ẏ = J(q) q̇ and ÿ = J(q) q̈ + J̇ q̇, not their
 //! linearisation, and ÿ is the time derivative of ẏ along the closed loop's flow; the generated
 //! J̇ q̇ is the second derivative of the generated y along q̇; the closed loop's
@@ -336,7 +336,7 @@ fn a_tip_position_episode_reaches_its_goal_on_every_catalogue_tool() {
             assert!(row.missing_tip().is_empty(), "{}", row.label());
             let m = tasks.simulate(&row.tool).unwrap();
             let progress = m.progress.unwrap();
-            // 0.8: the tip within a fifth of its starting distance after 5 s (issue 30).
+            // 0.8: the tip within a fifth of its starting distance after 5 s, the tip tasks' stated target.
             assert!(
                 progress >= 0.8,
                 "{task_file}, {}: progress {progress}",

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Does a joint position task reach its goal on a real arm? The paper's task-1 sensitivity against
-the stabilised plant's static gain, measured (issue "Tool use in task space", item 3).
+the stabilised plant's static gain, measured.
 
 For random physical tools (urdf_model._sample_tool, seeded) on a URDF model, or tools from the
 paper's box [0.1, 0.6]^k on the paper's arms (kinds explicit, planar_chain), the position task

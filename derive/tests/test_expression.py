@@ -51,7 +51,7 @@ ROOT = Path(__file__).resolve().parents[2]
 SECONDS = 2.0
 CANARY = Path(tempfile.gettempdir()) / "toolconf-expression-canary"
 PAYLOADS = {
-    # The example: attribute access and escaped string literals reaching __import__.
+    # The reported attack: attribute access and escaped string literals reaching __import__.
     "globals": '(1).__add__.__globals__["\\137\\137builtins\\137\\137"]["\\137\\137import\\137\\137"]'
                f'("\\157\\163").system("touch {CANARY}")',
     "class": "().__class__",

@@ -78,7 +78,7 @@ class Hostile(unittest.TestCase):
         self.canary = self.tmp / "canary"
 
     def payload(self) -> str:
-        """The issue's payload: attribute access and escaped strings to os.system, creating the canary."""
+        """The reported payload: attribute access and escaped strings to os.system, creating the canary."""
         return ('(1).__add__.__globals__[\\"\\\\137\\\\137builtins\\\\137\\\\137\\"][\\"\\\\137\\\\137import\\\\137\\\\137\\"]'
                 f'(\\"\\\\157\\\\163\\").system(\\"touch {self.canary}\\")')
 

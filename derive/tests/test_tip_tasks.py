@@ -1,4 +1,4 @@
-"""The tasks on the tool's tip (issue 30): tasks.toml's J and the tip sensitivities, checked against
+"""The tasks on the tool's tip: tasks.toml's J and the tip sensitivities, checked against
 what they mean rather than against the formulas that made them.
 
 - J is padded: its first TIP_DIM rows are the tip's Jacobian dy/dq at q^e, the others exactly

@@ -1,4 +1,4 @@
-"""Tasks on the tool's tip from Python (issue 30): simulate, rank, confidence and toolconf.dask take
+"""Tasks on the tool's tip from Python: simulate, rank, confidence and toolconf.dask take
 tip tasks; an episode's tip series are the tip's forward kinematics (toolconf.tip at the
 episode's joint angles); rank's progress column equals the command line's JSON; a tools table
 without tip columns is refused by a tip task, naming the row and the columns."""

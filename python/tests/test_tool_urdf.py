@@ -37,7 +37,8 @@ COLUMNS = [
     "tool_ixx", "tool_iyy", "tool_izz", "tool_ixy", "tool_ixz", "tool_iyz",
     "tool_tip_x", "tool_tip_y", "tool_tip_z",
 ]
-# Relative to each quantity's largest entry: the bound.
+# Relative to each quantity's largest entry: round-off of the frame changes, far below what a
+# misread origin or inertia moves.
 TOLERANCE = 1e-10
 
 

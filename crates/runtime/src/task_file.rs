@@ -926,7 +926,7 @@ mod tests {
     use super::*;
     use crate::model::{Arm2, Arm3};
 
-    const ISSUE_EXAMPLE: &str = r#"
+    const FORMAT_EXAMPLE: &str = r#"
 kind = "position"
 [goal]
 theta = [0.7853981633974483, 0.0]
@@ -942,8 +942,8 @@ perturbation = 0.0
 "#;
 
     #[test]
-    fn the_issue_example_parses_into_the_task_it_states() {
-        let spec = TaskSpec::parse(ISSUE_EXAMPLE, "t.toml").unwrap();
+    fn the_format_example_parses_into_the_task_it_states() {
+        let spec = TaskSpec::parse(FORMAT_EXAMPLE, "t.toml").unwrap();
         let task = spec.task::<Arm2, 2, 4, 4, 6>().unwrap();
         assert_eq!(
             *task.goal(Term::Theta),
@@ -964,7 +964,7 @@ perturbation = 0.0
 
     #[test]
     fn a_two_joint_goal_does_not_fit_three_joints() {
-        let spec = TaskSpec::parse(ISSUE_EXAMPLE, "t.toml").unwrap();
+        let spec = TaskSpec::parse(FORMAT_EXAMPLE, "t.toml").unwrap();
         let e = spec.task::<Arm3, 3, 6, 6, 9>().unwrap_err();
         assert_eq!(e.place, "key goal.theta");
         assert!(e.message.contains("model arm3 has 3 joints"), "{e}");
@@ -986,9 +986,9 @@ perturbation = 0.0
 
     #[test]
     fn a_table_is_checked_as_a_file_is_and_errors_name_the_key() {
-        let table: toml::Table = toml::from_str(ISSUE_EXAMPLE).unwrap();
+        let table: toml::Table = toml::from_str(FORMAT_EXAMPLE).unwrap();
         let from_table = TaskSpec::from_table(table, "task dict").unwrap();
-        let from_text = TaskSpec::parse(ISSUE_EXAMPLE, "task dict").unwrap();
+        let from_text = TaskSpec::parse(FORMAT_EXAMPLE, "task dict").unwrap();
         assert_eq!(from_table, from_text);
         let table: toml::Table =
             toml::from_str("kind = \"position\"\n[goal]\ntheta = 0.5\n").unwrap();

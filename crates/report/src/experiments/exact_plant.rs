@@ -1,4 +1,4 @@
-//! Issue-7 robustness check: the paper's experiments rerun with the *exact* Lagrangian 2-link arm
+//! Robustness check: the paper's experiments rerun with the *exact* Lagrangian 2-link arm
 //! as the plant, while the agent keeps the paper's model (its A, B, sensitivities and Π^U). The
 //! paper's generative process treats link 2 as if its pivot did not accelerate; do claims C1, C2
 //! and the Fig. 7 ranking survive when the world is the exact arm?

@@ -1,5 +1,5 @@
 //! The ∫F dt objective: minimise the free energy of a simulated episode over the feasible set,
-//! started from the confidence optimum (the "optionally minimise ∫F by simulation").
+//! started from the confidence optimum (the option asked for beside the confidence design: minimise ∫F by simulation).
 //!
 //! ∫F dt comes from an adaptive integrator, so it is only piecewise smooth in the parameters
 //! (its step sequence changes discretely) and has no derived gradient: a compass search, which

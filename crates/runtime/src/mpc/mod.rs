@@ -10,7 +10,7 @@
 //!
 //! # Models ([`MpcModel`])
 //!
-//! - [`MpcModel::Equilibrium`], the specification: the paper's linearisation
+//! - [`MpcModel::Equilibrium`], the baseline as first specified: the paper's linearisation
 //!   ẋ = A(x − X^e) + Bu at the hanging equilibrium (appendix "Generative model"), fixed.
 //! - [`MpcModel::Local`], successive linearisation: at every control step the generative
 //!   process f is linearised at the measured state x̄ and the torque ū the plant is believed to
@@ -153,7 +153,7 @@
 //!   filter, and a slower estimate means a longer uncompensated transient).
 //!
 //! Hence the default: [`MpcModel::Local`], observer on, L = 1 ([`MpcOptions::default`]); the
-//! issue's original linear MPC stays available as [`MpcOptions::original_linear`]
+//! original linear MPC baseline stays available as [`MpcOptions::original_linear`]
 //! (`--mpc-model equilibrium --disturbance-observer false` on the command line). On task 1 the
 //! default settles ≈ 0.03–0.05 rad from θ^g: that is J's own optimum (P^U = I prices the
 //! torque that holds the arm against gravity), not an offset.

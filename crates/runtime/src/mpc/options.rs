@@ -9,7 +9,7 @@ use crate::display::Short;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MpcModel {
     /// The paper's linearisation ẋ = A(x − X^e) + Bu at the hanging equilibrium, fixed for the
-    /// whole episode: the original linear MPC.
+    /// whole episode: the original linear MPC baseline.
     Equilibrium,
     /// Successive linearisation: at every control step the generative process is linearised
     /// at the measured state and the torque last applied (plus the disturbance estimate),
@@ -51,7 +51,7 @@ impl Default for MpcOptions {
 }
 
 impl MpcOptions {
-    /// The original linear MPC: the default timing and bound, the equilibrium model
+    /// The original linear MPC baseline: the default timing and bound, the equilibrium model
     /// and no disturbance observer.
     pub fn original_linear() -> Self {
         Self {
