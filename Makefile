@@ -6,7 +6,7 @@ PY_DEV := $(VENV)/.python-dev-installed
 # Deterministic derivation: the same inputs give byte-identical generated files.
 export PYTHONHASHSEED := 0
 
-.PHONY: run test derive render drift-check venv clean-venv bench python-test crate model on-robot-test c-example-test loaded-models-test mujoco-test
+.PHONY: run test check derive render drift-check venv clean-venv bench python-test crate model on-robot-test c-example-test loaded-models-test mujoco-test
 
 ## make run: build in release mode and reproduce the paper's Results (results/report.md).
 run:
@@ -22,20 +22,28 @@ bench:
 	cargo bench --manifest-path examples/on_robot/bench/Cargo.toml
 
 ## make test: the whole suite: `make derive` reproduces generated/ byte for byte (on this CPU and
-## on an imitated older one), the renderer in release (what make crate and make model run, built
-## before their tests time them), the derivation's own tests, the crate's, then the Python package's.
+## on an imitated older one; it builds the renderer in release, what make crate and make model run,
+## before their tests time them), the derivation's own tests, the crates', the Python package's, then
+## the tests that load a model library, on libraries built once for all of them
+## (scripts/model_libraries.sh: every committed model and the xArm7).
 ## The fuzzers of every parser run in it with bounded case counts (TOOLCONF_FUZZ_CASES raises
 ## them: README "Bad input"), and so does the sweep of hostile inputs (tests/hostile.rs).
 test: drift-check $(PY_DEV)
-	cargo build --release --quiet -p toolconf-render
 	$(PY) -m unittest discover --start-directory derive/tests
 	cargo test --workspace --quiet
 	$(MAKE) --no-print-directory on-robot-test
-	$(MAKE) --no-print-directory c-example-test
 	$(PYTHON_BUILD)
 	$(PYTHON_TESTS)
-	$(MAKE) --no-print-directory loaded-models-test
-	$(MAKE) --no-print-directory mujoco-test
+	@d=$$(mktemp -d) && trap 'rm -rf "$$d"' EXIT && scripts/model_libraries.sh $(PY) $$d && \
+	TOOLCONF_TEST_LIBRARIES=$$d $(MAKE) --no-print-directory c-example-test loaded-models-test mujoco-test
+
+## make check: the inner loop, after each edit (under 3 min warm): rustfmt over the workspace; clippy
+## (warnings are errors) and the unit tests of each package the working tree changes against main
+## (CHECK_BASE=<rev> for another base); each changed integration test file; the derivation's tests
+## named after each changed derive/ module (scripts/check.py). make test, the whole suite, before a merge.
+CHECK_BASE ?= main
+check:
+	@python3 scripts/check.py $(CHECK_BASE)
 
 ## make on-robot-test: the on-robot controller's own tests (examples/on_robot, a crate outside the
 ## workspace, as a robot's firmware would build it).
@@ -50,26 +58,23 @@ c-example-test: $(PY)
 
 ## make loaded-models-test: models loaded at run time. Builds every model of the repository into a model
 ## library (make model IR=generated/<model>.json) and the UFactory xArm7, which the repository does not ship,
-## from its unedited URDF (make model DESC=examples/robots/xarm7.toml), into a temporary folder; then checks
+## from its unedited URDF (make model DESC=examples/robots/xarm7.toml), into a temporary folder (or takes
+## those in $TOOLCONF_TEST_LIBRARIES, as make test gives them: scripts/model_libraries.sh); then checks
 ## that each loaded library gives its built-in model's numbers bit for bit in every operation and subcommand
 ## (tests/loaded_models.rs), in Python and on Dask's workers (python/loaded_tests/), and the xArm7's
 ## dynamics against Pinocchio's aba; and runs the examples that load a library (examples/load_model.rs,
 ## examples/python/load_model.py) on the Panda's. Needs the Python package installed (make python-test does it).
 loaded-models-test: $(PY_DEV)
 	@d=$$(mktemp -d) && trap 'rm -rf "$$d"' EXIT && \
-	for ir in generated/*.json; do \
-	  case $$ir in *.vectors.json) continue;; esac; m=$$(basename $$ir .json); \
-	  $(PY) derive/make_model.py --ir $$ir --out $$d/$$m 2>$$d/$$m.log >/dev/null || { cat $$d/$$m.log; exit 1; }; \
-	done && \
-	$(PY) derive/make_model.py --desc examples/robots/xarm7.toml --out $$d/xarm7 2>$$d/xarm7.log >/dev/null || { cat $$d/xarm7.log; exit 1; }; \
-	echo "loaded-models-test: $$(ls -d $$d/*/ | wc -l) model libraries built" && \
-	TOOLCONF_TEST_LIBRARIES=$$d cargo test --quiet --test loaded_models -- --include-ignored && \
-	TOOLCONF_TEST_LIBRARIES=$$d cargo test --quiet --test examples -- --ignored && \
-	TOOLCONF_TEST_LIBRARIES=$$d $(PY) -m pytest -q python/loaded_tests
+	if [ -z "$$TOOLCONF_TEST_LIBRARIES" ]; then scripts/model_libraries.sh $(PY) $$d && export TOOLCONF_TEST_LIBRARIES=$$d; fi && \
+	echo "loaded-models-test: $$(ls -d $$TOOLCONF_TEST_LIBRARIES/*/ | wc -l) model libraries" && \
+	cargo test --quiet --test loaded_models -- --include-ignored && \
+	cargo test --quiet --test examples -- --ignored && \
+	$(PY) -m pytest -q python/loaded_tests
 
 ## make mujoco-test: the on-robot controller on MuJoCo (examples/mujoco/, docs/mujoco.md). Installs the example's
 ## pinned requirements (examples/mujoco/requirements.txt) into derive/.venv, builds the Panda's model library from
-## the committed IR into a temporary folder, checks MuJoCo's plant against the library's open loop, then runs the
+## the committed IR into a temporary folder (or takes $TOOLCONF_TEST_LIBRARIES/panda), checks MuJoCo's plant against the library's open loop, then runs the
 ## example's comparison (compare.py) of the catalogue's touch task against toolconf simulate and asserts its bounds
 ## and ranking (examples/mujoco/test_mujoco.py). Where mujoco cannot be installed, one line says so and it is skipped.
 MUJOCO_INSTALLED := $(VENV)/.mujoco-installed
@@ -79,8 +84,8 @@ mujoco-test: $(PY_DEV)
 	  echo "mujoco-test: skipped: mujoco cannot be installed here: $$(grep -m 1 -i 'error' $$d/install.log || tail -n 1 $$d/install.log)"; \
 	  exit 0; \
 	fi && \
-	$(PY) derive/make_model.py --ir generated/panda.json --out $$d/panda 2>$$d/panda.log >/dev/null || { cat $$d/panda.log; exit 1; }; \
-	TOOLCONF_MUJOCO_LIBRARY=$$d/panda $(PY) -m pytest -q examples/mujoco
+	if [ -z "$$TOOLCONF_TEST_LIBRARIES" ]; then scripts/model_libraries.sh $(PY) $$d panda >/dev/null && export TOOLCONF_TEST_LIBRARIES=$$d; fi && \
+	TOOLCONF_MUJOCO_LIBRARY=$$TOOLCONF_TEST_LIBRARIES/panda $(PY) -m pytest -q examples/mujoco
 
 $(MUJOCO_INSTALLED): examples/mujoco/requirements.txt $(PY)
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r examples/mujoco/requirements.txt
