@@ -25,7 +25,7 @@ bench:
 ## on an imitated older one), the renderer in release (what make crate and make model run, built
 ## before their tests time them), the derivation's own tests, the crate's, then the Python package's.
 ## The fuzzers of every parser run in it with bounded case counts (TOOLCONF_FUZZ_CASES raises
-## them: README "Bad input"), and so does the sweep of hostile inputs (tests/hostile.rs).
+## them: docs/reference/errors.md), and so does the sweep of hostile inputs (tests/hostile.rs).
 test: drift-check $(PY_DEV)
 	cargo build --release --quiet -p toolconf-render
 	$(PY) -m unittest discover --start-directory derive/tests
@@ -67,7 +67,7 @@ loaded-models-test: $(PY_DEV)
 	TOOLCONF_TEST_LIBRARIES=$$d cargo test --quiet --test examples -- --ignored && \
 	TOOLCONF_TEST_LIBRARIES=$$d $(PY) -m pytest -q python/loaded_tests
 
-## make mujoco-test: the on-robot controller on MuJoCo (examples/mujoco/, docs/mujoco.md). Installs the example's
+## make mujoco-test: the on-robot controller on MuJoCo (examples/mujoco/, docs/tutorials/mujoco.md). Installs the example's
 ## pinned requirements (examples/mujoco/requirements.txt) into derive/.venv, builds the Panda's model library from
 ## the committed IR into a temporary folder, checks MuJoCo's plant against the library's open loop, then runs the
 ## example's comparison (compare.py) of the catalogue's touch task against toolconf simulate and asserts its bounds
@@ -146,7 +146,7 @@ crate: $(PY)
 ## shared library with toolconf's C ABI in OUT (libtoolconf_model_<model>.so, toolconf_model.h, and the
 ## crate they came from), showing each step; `make model IR=generated/<model>.json OUT=<folder>` renders
 ## and compiles a model derived before. Nothing in the repository changes (derive/make_model.py,
-## docs/c-abi.md).
+## docs/reference/c-abi.md).
 model: $(PY)
 	@exec $(BLOCK_SIGINT) $(PY) derive/make_model.py --from-make
 
