@@ -27,7 +27,7 @@ bench:
 ## the tests that load a model library, on libraries built once for all of them
 ## (scripts/model_libraries.sh: every committed model and the xArm7).
 ## The fuzzers of every parser run in it with bounded case counts (TOOLCONF_FUZZ_CASES raises
-## them: README "Bad input"), and so does the sweep of hostile inputs (tests/hostile.rs).
+## them: docs/reference/errors.md), and so does the sweep of hostile inputs (tests/hostile.rs).
 test: drift-check $(PY_DEV)
 	$(PY) -m unittest discover --start-directory derive/tests
 	cargo test --workspace --quiet
@@ -72,7 +72,7 @@ loaded-models-test: $(PY_DEV)
 	cargo test --quiet --test examples -- --ignored && \
 	$(PY) -m pytest -q python/loaded_tests
 
-## make mujoco-test: the on-robot controller on MuJoCo (examples/mujoco/, docs/mujoco.md). Installs the example's
+## make mujoco-test: the on-robot controller on MuJoCo (examples/mujoco/, docs/tutorials/mujoco.md). Installs the example's
 ## pinned requirements (examples/mujoco/requirements.txt) into derive/.venv, builds the Panda's model library from
 ## the committed IR into a temporary folder (or takes $TOOLCONF_TEST_LIBRARIES/panda), checks MuJoCo's plant against the library's open loop, then runs the
 ## example's comparison (compare.py) of the catalogue's touch task against toolconf simulate and asserts its bounds
@@ -151,7 +151,7 @@ crate: $(PY)
 ## shared library with toolconf's C ABI in OUT (libtoolconf_model_<model>.so, toolconf_model.h, and the
 ## crate they came from), showing each step; `make model IR=generated/<model>.json OUT=<folder>` renders
 ## and compiles a model derived before. Nothing in the repository changes (derive/make_model.py,
-## docs/c-abi.md).
+## docs/reference/c-abi.md).
 model: $(PY)
 	@exec $(BLOCK_SIGINT) $(PY) derive/make_model.py --from-make
 

@@ -1,5 +1,5 @@
 #!/bin/sh
-# The claims table of docs/evaluation.md: `toolconf reproduce --model` on the Panda, the UR5 and
+# The claims table of docs/tutorials/evaluate-your-robot.md: `toolconf reproduce --model` on the Panda, the UR5 and
 # the xArm7 (its library built from its unedited URDF by `make model`), every shipped tip task,
 # absolute and relative goals, 1000 random tools each (the model's sampling box, seed 7), the
 # paper's other counts. One row per run, each row's own command in its last column; every run's

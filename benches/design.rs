@@ -1,4 +1,4 @@
-//! `toolconf design`'s stages for the README's example (the paper's arm, task 2,
+//! `toolconf design`'s stages for the example of docs/tutorials/design-a-tool.md (the paper's arm, task 2,
 //! l1 + l2 ≥ 0.7, m1 + m2 ≤ 0.5):
 //!
 //! * `optimum`: the multi-start SQP on ln|Π^U| with the derived gradient (centre, 8 random

@@ -11,7 +11,7 @@ use toolconf::closed_loop::{simulate, ClosedLoop, EpisodeOptions, JointState, Pl
 use toolconf::select::{draw_tools, evaluate};
 use toolconf::{Arm, Task, TaskKind};
 
-/// The fixed arm of the README (m1, m2, l1, l2).
+/// The fixed arm of docs/tutorials/paper-arm.md (m1, m2, l1, l2).
 fn arm() -> Arm {
     Arm::new([0.3, 0.4, 0.5, 0.2]).unwrap()
 }
@@ -29,7 +29,7 @@ fn rhs(c: &mut Criterion) {
 
 /// 1000 evaluations, each on the previous one's result (z ← z + h·Ż, as a Runge–Kutta stage
 /// waits for the one before): the time per element is the latency of one RHS plus a stage
-/// combination, the floor of an episode's time per evaluation (docs/performance.md).
+/// combination, the floor of an episode's time per evaluation (docs/explanation/performance.md).
 fn rhs_chain(c: &mut Criterion) {
     let arm = arm();
     let mut group = c.benchmark_group("rhs_chain");

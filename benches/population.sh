@@ -4,7 +4,7 @@
 # methods alternating tool by tool), with mean/p50/p90/p99/max per tool, mean RHS, Jacobians and
 # LU factorisations, and the worst relative error and ranking swaps against an rtol-1e-10
 # reference. Prints the table and rewrites the "Population throughput" block of
-# docs/performance.md (date, machine, load average, commit). Arguments go to the example, e.g.
+# docs/explanation/performance-population.md (date, machine, load average, commit). Arguments go to the example, e.g.
 #   benches/population.sh --tools 500 --repeat 1      (a quick look; the default is 2000 tools, 3 rounds)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -35,12 +35,12 @@ BLOCK
 )"
 python3 - "$block" <<'PY'
 import re, sys
-path = "docs/performance.md"
+path = "docs/explanation/performance-population.md"
 text = open(path, encoding="utf-8").read()
 block = sys.argv[1]
 pattern = re.compile(r"<!-- population:begin.*?<!-- population:end -->", re.S)
 if not pattern.search(text):
-    sys.exit("docs/performance.md has no population:begin/end markers")
+    sys.exit("docs/explanation/performance-population.md has no population:begin/end markers")
 open(path, "w", encoding="utf-8").write(pattern.sub(lambda _: block, text))
 PY
-echo "docs/performance.md updated"
+echo "docs/explanation/performance-population.md updated"

@@ -14,7 +14,7 @@ OUT then holds the library (`libtoolconf_model_<model>.so`; `.dylib` on macOS), 
 `toolconf_model.h`, and the crate they were built from (Cargo.toml, src/, tests/ and generated/,
 the model's generated crate with its IR, report and CasADi vectors): `cargo test --workspace
 --manifest-path OUT/Cargo.toml` checks every export against the Rust functions, bit for bit, and
-the generated code against the vectors. docs/c-abi.md describes the ABI.
+the generated code against the vectors. docs/reference/c-abi.md describes the ABI.
 
 Progress goes to stderr, one line per step as it finishes, with the seconds since the start and
 the step's own: reading and validating, deriving (the equations, then each function's code),

@@ -38,7 +38,7 @@ MODELS = ROOT / "derive" / "models"
 GENERATED = ROOT / "generated"
 FIXTURES = ROOT / "tests" / "fixtures"
 # The description file's reference, written from the reader's key tables (reference.py).
-REFERENCE = ROOT / "docs" / "description.md"
+REFERENCE = ROOT / "docs" / "reference" / "description.md"
 # The renderer's fixture: a small model with few vectors, pinned by tests/render_snapshot.rs.
 FIXTURE_MODELS = [("pendulum", 3)]
 # glibc's x86 features whose ifunc variants (libm's sin, cos, exp, log, pow...) depend on them.

@@ -1,4 +1,4 @@
-//! `toolconf design` as a user runs it: the README's example, JSON keys, the report and sweep
+//! `toolconf design` as a user runs it: the example of docs/tutorials/design-a-tool.md, JSON keys, the report and sweep
 //! files, determinism across thread counts, and bad input as one line with exit status 2.
 
 use std::process::Command;

@@ -8,7 +8,7 @@
 //! (parameters in range, finite numbers) or one error line naming the file (and the line, tool
 //! or key where there is one), at most a few hundred characters whatever the input.
 //!
-//! Cases per parser: 256, or `TOOLCONF_FUZZ_CASES` (the long run, README "Bad input":
+//! Cases per parser: 256, or `TOOLCONF_FUZZ_CASES` (the long run, docs/reference/errors.md:
 //! `TOOLCONF_FUZZ_CASES=100000 cargo test --release --test fuzz_parsers`).
 
 use proptest::prelude::*;

@@ -1,4 +1,4 @@
-//! The layers as crates (README, "Crates"): each depends only on the ones below it, and the low
+//! The layers as crates (docs/explanation/pipeline.md, "Crates"): each depends only on the ones below it, and the low
 //! ones carry little. Checked with `cargo tree` on the manifests, as a user would look.
 
 use std::collections::BTreeSet;

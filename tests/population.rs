@@ -3,7 +3,7 @@
 //! (`Method::Explicit`) at the same default tolerances: every tool's task error within 1e-4
 //! relative and the same ranking by it; ∫F and ∫J no further from the reference than `ode45`'s
 //! own, beyond 1e-4 of ∫J (`ode45` itself is off by up to ≈ 1e-3 at rtol 1e-3, see
-//! docs/performance.md); identical results whatever the number of threads.
+//! docs/explanation/performance-population.md); identical results whatever the number of threads.
 //!
 //! The full 2000-tool check (`draw_tools(2000, 1)`) is `benches/population.sh`
 //! (`benches/timing/population.rs`); here 60 tools per task keep the debug build to seconds.

@@ -1,4 +1,4 @@
-//! `toolconf rank`, tool files and task files, as a user runs them: the README's example, the
+//! `toolconf rank`, tool files and task files, as a user runs them: the example of docs/tutorials/paper-arm.md, the
 //! paper's task written as a file against `simulate`, a custom task against an independent
 //! fine-step integration, determinism across thread counts, and every kind of bad input.
 

@@ -15,7 +15,7 @@ from `benches/timing/peer_timing.rs` (one thread, median of repeated runs per to
 with time.perf_counter around the integration call only (model building, sensitivities and the
 task error are outside the timing).
 
-Writes the tables into docs/performance.md between the `peers` markers (the rest of the file is
+Writes the tables into docs/explanation/performance-peers.md between the `peers` markers (the rest of the file is
 left alone) and prints them. Run through benches/peers/run.sh, which creates the environment.
 
 `--population` instead times the population that `benches/population.sh` ranks,
@@ -54,7 +54,7 @@ from toolconf_derive.numeric import CasadiModel  # noqa: E402
 
 TOOLCONF = ROOT / "target" / "release" / "toolconf"
 PEER_TIMING = ROOT / "target" / "release" / "examples" / "peer_timing"
-DOC = ROOT / "docs" / "performance.md"
+DOC = ROOT / "docs" / "explanation" / "performance-peers.md"
 BEGIN, END = "<!-- peers:begin (written by benches/peers/compare.py) -->", "<!-- peers:end -->"
 POP_BEGIN = "<!-- peers-population:begin (written by benches/peers/compare.py --population) -->"
 POP_END = "<!-- peers-population:end -->"
@@ -231,7 +231,7 @@ def main() -> None:
     ap.add_argument("--toolconf-repeat", type=int, default=21)
     ap.add_argument("--tight-tools", type=int, default=10,
                     help="tools for the agreement check at rtol 1e-8, atol 1e-10 (0: skip)")
-    ap.add_argument("--no-write", action="store_true", help="print only, leave docs/performance.md alone")
+    ap.add_argument("--no-write", action="store_true", help="print only, leave docs/explanation/performance-peers.md alone")
     ap.add_argument("--method", default="auto",
                     help="toolconf's integration method in the 100-tool tables (select and peer_timing)")
     ap.add_argument("--population", action="store_true",
@@ -572,7 +572,7 @@ def render(results: dict, tight: dict, args) -> str:
 
 
 def write_block(text: str, begin: str, end: str, after: str) -> None:
-    """Replaces the block between `begin` and `end` in docs/performance.md, or inserts it after
+    """Replaces the block between `begin` and `end` in docs/explanation/performance-peers.md, or inserts it after
     the line holding `after` (with a blank line before it)."""
     doc = DOC.read_text()
     if begin in doc and end in doc:

@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
 """How a URDF robot's results depend on its joint impedance: one tools file and one task, the
 impedance K scaled by s and D by sqrt(s) (the damping ratio kept) around the description's values,
-without re-deriving anything (docs/urdf.md, "Choosing impedance gains for a robot without vendor
+without re-deriving anything (docs/how-to/choose-impedance-gains.md, "Choose impedance gains for a robot without vendor
 values").
 
 Each episode is the closed loop of urdf_loop.py (Pinocchio's aba in the right-hand side,
 toolconf's controller, sensitivities and metrics; it agrees with `toolconf rank`, see
-docs/performance.md) integrated by SciPy's solve_ivp with the task's own tolerances. Per scale it
+docs/explanation/performance-peers.md) integrated by SciPy's solve_ivp with the task's own tolerances. Per scale it
 prints the spread of ln|Pi^U| across the tools, Spearman's rho between ln|Pi^U| and the task
 error, the progress of a position task (1 - e(T)/e(0), e the distance to the goal) and how many
 episodes failed.

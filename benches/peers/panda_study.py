@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """What drives the Panda's control confidence under joint impedance, and does it predict task
-error? The sweep behind docs/urdf.md, "Confidence and task error on the Panda".
+error? The sweep behind docs/explanation/static-gain.md, "Confidence and task error on the Panda".
 
 For random physical tools (solid boxes: 0.05-3 kg, centre of mass within 5 cm of the flange axis
 and up to 25 cm out, sides 1-30 cm; seeded) it takes ln|Pi^U| in closed form and simulates each
@@ -19,7 +19,7 @@ goals within the Panda's rated torques.
 
     benches/peers/.venv/bin/python benches/peers/panda_study.py [--tools 200] [--workers 2] [--sweep impedance|precision] [--write]
 
---write puts the table into docs/urdf.md between the `impedance-study` (or `precision-study`) markers.
+--write puts the table into docs/explanation/static-gain.md between the `impedance-study` (or `precision-study`) markers.
 --sweep precision varies the wrist turn's precisions (sigma_theta_dot, P^theta_ddot, sigma_U) at
 libfranka's K and D instead (velocity task only).
 """
@@ -39,12 +39,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from pin_robot import ROOT, description, model_with_tool  # noqa: E402
 from urdf_loop import ClosedLoop, Task  # noqa: E402
 
-DOC = ROOT / "docs" / "urdf.md"
+DOC = ROOT / "docs" / "explanation" / "static-gain.md"
 BEGIN, END = "<!-- impedance-study:begin (written by benches/peers/panda_study.py) -->", "<!-- impedance-study:end -->"
 RTOL, ATOL = 1e-8, 1e-10
 ROBOT = "panda"
 # The study measured the paper's task formulas (derive/tasks.toml's own, E = [I; I] on position),
-# before toolconf made the static gain the URDF arms' position formulation (docs/urdf.md, "The
+# before toolconf made the static gain the URDF arms' position formulation (docs/explanation/static-gain.md, "The
 # static gain"); urdf_loop's default is toolconf's, so the study names the paper's.
 PAPER = "paper"
 
@@ -222,7 +222,7 @@ def main() -> int:
     ap.add_argument("--sweep", choices=("impedance", "precision"), default="impedance",
                     help="impedance: K and D scaled, paper's vs physical precisions; precision: the wrist turn's "
                          "precisions varied at libfranka's K and D")
-    ap.add_argument("--write", action="store_true", help="write the table into docs/urdf.md")
+    ap.add_argument("--write", action="store_true", help="write the table into docs/explanation/static-gain.md")
     args = ap.parse_args()
     start = time.perf_counter()
     results = rows(random_tools(args.tools), args.workers, args.sweep)

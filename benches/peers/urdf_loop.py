@@ -23,7 +23,7 @@ on position and tip_position for the URDF arms), parsed by toolconf_derive's exp
 not eval. The metrics on the output grid as toolconf takes them (task error: the sum of the
 task's weighted error over every grid point, t = 0 included; int F dt and int J dt by the
 trapezoidal rule). The impedance can be scaled (`stiffness_scale`, `damping_scale`) for the study
-in docs/urdf.md; at 1 it is the description's.
+in docs/explanation/static-gain.md; at 1 it is the description's.
 
 Checked against toolconf (benches/timing/model_timing.rs) on the Panda, the first 5 tools of
 urdf_peers.py's population (boxes with tips) per task, both integrated tightly (toolconf's

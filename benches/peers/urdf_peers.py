@@ -26,7 +26,7 @@ ln|Pi^U| and of the task error, a table of its own.
     benches/peers/run.sh --urdf [--tools 100] [--tasks position,velocity,...] [--check 5] [--write]
 
 `--tools-for TASK=N` times task TASK (as written in --tasks) on the first N tools only.
---write puts the tables into docs/performance.md between the `peers-urdf` markers.
+--write puts the tables into docs/explanation/performance-peers.md between the `peers-urdf` markers.
 """
 
 from __future__ import annotations
@@ -51,7 +51,7 @@ from pin_robot import ROOT, model_with_tool  # noqa: E402
 from urdf_loop import ClosedLoop, Task  # noqa: E402
 
 MODEL_TIMING = ROOT / "target" / "release" / "examples" / "model_timing"
-DOC = ROOT / "docs" / "performance.md"
+DOC = ROOT / "docs" / "explanation" / "performance-peers.md"
 BEGIN, END = "<!-- peers-urdf:begin (written by benches/peers/urdf_peers.py) -->", "<!-- peers-urdf:end -->"
 ROBOT = "panda"
 TASKS = ("position", "velocity", "examples/tasks/panda_wrist_turn.toml", "examples/tasks/panda_touch_point.toml",

@@ -9,7 +9,7 @@
 //! The integrator is DP5 with ode45's error norm and a standard step controller, from t = 0 to
 //! 5 s with no dense output: the accuracy-limited and stability-limited work of an episode, which
 //! is what lanes would change. Run: `cargo run --release --example lanes [-- --tools N --task T]`.
-//! Measurements and conclusions: docs/performance.md, "Population throughput".
+//! Measurements and conclusions: docs/explanation/performance-population.md.
 
 #![allow(clippy::needless_range_loop)] // lane code indexes its lanes by design
 

@@ -1,5 +1,5 @@
 //! Ranking throughput on a population of tools, old and new integration paths side by side:
-//! `benches/population.sh` runs it and writes its table into `docs/performance.md`.
+//! `benches/population.sh` runs it and writes its table into `docs/explanation/performance-population.md`.
 //!
 //! For each task, every method ranks the same `--tools` tools drawn by `draw_tools(n, seed)` on
 //! one thread at the paper's defaults; the methods alternate tool by tool (each tool: one warm-up

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Re-derives the paper's eq. (DE_theta_2) from its own force and moment balances (appendix
 "Tool Dynamics": eqs. link1_moment, link2_force, acc_ang_lin) and prints what differs from the
-printed equation. See docs/paper-notes.md, section 4.
+printed equation. See docs/explanation/paper-notes.md, section 4.
 
     derive/.venv/bin/python derive/checks/arm2_newton_euler.py
 """

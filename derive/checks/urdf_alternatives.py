@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """How the generated right-hand side of a URDF arm is formulated: the measurement behind
-docs/urdf.md's choice. Emits four straight-line versions of the Panda's plant f(X, U; k) into a
+docs/explanation/derivation.md's choice. Emits four straight-line versions of the Panda's plant f(X, U; k) into a
 scratch crate and times them over a population of 1000 random states and tools (one thread):
 
 - crba_ldl: M(q) by CRBA, the bias by RNEA, an unrolled LDL^T solve (what make derive generates);

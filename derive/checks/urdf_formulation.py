@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Which plant should the controller of a real arm see? The numbers behind docs/urdf.md's choice.
+"""Which plant should the controller of a real arm see? The numbers behind docs/explanation/real-arms.md's choice.
 
 For 1000 random physical tools (urdf_model._sample_tool, seeded) on a URDF model, the three tasks'
 ln|Pi^U| with the default precisions under three formulations of the linearised plant at q^e:

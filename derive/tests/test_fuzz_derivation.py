@@ -8,7 +8,7 @@ go through derive.py itself.
     derive/.venv/bin/python -m unittest discover -s derive/tests -p 'test_fuzz_derivation.py'
     TOOLCONF_FUZZ_CASES=5000 derive/.venv/bin/python -m unittest discover -s derive/tests -p 'test_fuzz_derivation.py'
 
-(100 cases per reader by default; the second line is the long run, README "Bad input".)
+(100 cases per reader by default; the second line is the long run, docs/reference/errors.md.)
 """
 
 from __future__ import annotations

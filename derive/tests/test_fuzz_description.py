@@ -7,7 +7,7 @@ exception (derive.py would print a traceback instead of its one line and status 
     derive/.venv/bin/python -m unittest derive/tests/test_fuzz_description.py     (in make test)
     TOOLCONF_FUZZ_CASES=20000 derive/.venv/bin/python -m unittest derive/tests/test_fuzz_description.py
 
-(200 cases per reader by default; the second line is the long run, README "Bad input".)
+(200 cases per reader by default; the second line is the long run, docs/reference/errors.md.)
 """
 
 from __future__ import annotations

@@ -17,7 +17,7 @@ DERIVE = Path(__file__).resolve().parent.parent
 PACKAGE = DERIVE / "toolconf_derive"
 # The modules below the description readers: they import nothing of the package.
 LEAVES = ("errors", "expression", "quantities", "progress")
-# The README's picture of the layers ("The pipeline"), top to bottom: a module imports only from
+# The layers as docs/explanation/pipeline.md draws them ("The derivation's modules"), top to bottom: a module imports only from
 # the rows below its own.
 LAYERS = (
     ("urdf_functions",),

@@ -1,4 +1,4 @@
-"""docs/description.md is the reference of the description file: every key the reader accepts is
+"""docs/reference/description.md is the reference of the description file: every key the reader accepts is
 documented there, nothing it does not accept is, and the committed file is what reference.py
 writes (make derive rewrites it; the drift check names its first differing line)."""
 
@@ -24,8 +24,8 @@ class ReferenceTest(unittest.TestCase):
         self.assertEqual(undocumented(), [])
 
     def test_the_committed_reference_is_current(self):
-        committed = (ROOT / "docs" / "description.md").read_text()
-        self.assertEqual(committed, description_reference(), "run `make derive` and commit docs/description.md")
+        committed = (ROOT / "docs" / "reference" / "description.md").read_text()
+        self.assertEqual(committed, description_reference(), "run `make derive` and commit docs/reference/description.md")
 
     def test_every_key_the_shipped_descriptions_use_is_in_the_reference(self):
         tables = {t for t, _ in MEANING}
@@ -57,10 +57,10 @@ if __name__ == "__main__":
 
 
 class DocsExample(unittest.TestCase):
-    def test_the_urdf_docs_example_description_loads_as_written(self):
+    def test_the_urdf_arms_reference_example_description_loads_as_written(self):
         import re
         import tempfile
-        text = (ROOT / "docs" / "urdf.md").read_text()
+        text = (ROOT / "docs" / "reference" / "urdf-arms.md").read_text()
         block = re.search(r"## The description \(kind `urdf`\)\n\n```toml\n(.*?)```", text, re.S).group(1)
         with tempfile.TemporaryDirectory() as tmp:
             # The example sits where derive/models/ does, so its relative urdf.file resolves.

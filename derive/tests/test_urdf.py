@@ -673,7 +673,7 @@ def _orthonormality(rotation) -> float:
 
 
 class HowAUrdfIsRead(PinocchioCheck, unittest.TestCase):
-    """(d) urdf.py's rule ("How a URDF is read", docs/urdf.md): angles snapped to quarter turns
+    """(d) urdf.py's rule ("How a URDF is read", docs/reference/urdf-arms.md): angles snapped to quarter turns
     within 1e-9 rad and otherwise literal, as Pinocchio reads them; joint limits, <dynamics> and
     side branches."""
 

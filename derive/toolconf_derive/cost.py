@@ -7,7 +7,7 @@ counted once. The joints' `sin_cos` calls are counted apart (ir.joint_trigonomet
 count multiplies each kind by WEIGHTS, a rough relative latency on x86-64 (anything not listed
 costs 1); hoist.py uses it to decide whether per-tool coefficients pay. count_ops reads a square
 root as x**(1/2), one POW and one DIV, and a rational coefficient 3/4 as a DIV the compiler folds:
-the counts compare derivations, they do not time them (docs/performance.md does).
+the counts compare derivations, they do not time them (docs/explanation/performance.md does).
 """
 
 from __future__ import annotations

@@ -1,10 +1,10 @@
-"""docs/description.md, the reference of the model description file, written from the key tables
+"""docs/reference/description.md, the reference of the model description file, written from the key tables
 the reader enforces (description.py's TOP_KEYS and MODEL_KEYS, urdf_description.py's URDF_KEYS):
 which keys each table has, their type and whether they are required come from the same tuples that
 refuse a misspelt key, so the reference cannot list a key the reader does not know, or miss one.
 What a key means and its default are written here, once; `undocumented` names a key the tables
 have and MEANING lacks, and the test (derive/tests/test_reference.py) fails on it and on a stale
-docs/description.md. `make derive` rewrites the file.
+docs/reference/description.md. `make derive` rewrites the file.
 """
 
 from __future__ import annotations
@@ -57,8 +57,8 @@ SECTIONS = (
      "of the joints' slots (derive/tasks.toml, J)."),
     ("urdf", URDF_KEYS["urdf"], "kind `urdf` (required)", "The robot and its chain."),
     ("impedance", URDF_KEYS["impedance"], "kind `urdf` (required)",
-     "The joint impedance of the plant tau = U + K (q^e - q) - D q_dot + g(q^e) (docs/urdf.md): K and "
-     "D per joint, each in [0, 1e6]. Every confidence depends on them; docs/urdf.md says how to choose "
+     "The joint impedance of the plant tau = U + K (q^e - q) - D q_dot + g(q^e) (docs/explanation/real-arms.md): K and "
+     "D per joint, each in [0, 1e6]. Every confidence depends on them; docs/how-to/choose-impedance-gains.md says how to choose "
      "them."),
     ("tool", URDF_KEYS["tool"], "kind `urdf`", "Which tools are valid, and where random tools come from."),
 )
@@ -88,7 +88,7 @@ MEANING = {
                                                            "a name of the task's `[task.formulations]`; a task "
                                                            "not named takes the formulation whose `default_for` "
                                                            "lists the model's dynamics kind, else the paper's "
-                                                           "(docs/urdf.md, \"The static gain\")"),
+                                                           "(docs/explanation/static-gain.md)"),
     ("(top level)", "printed"): ("none", "`[printed]`"),
     ("(top level)", "urdf"): ("none", "`[urdf]`: required for kind `urdf`, refused otherwise"),
     ("(top level)", "impedance"): ("none", "`[impedance]`: required for kind `urdf`, refused otherwise"),
@@ -130,7 +130,7 @@ MEANING = {
     ("printed", "B"): ("none", "2n x n expressions"),
     ("urdf", "file"): (None, "the URDF, **relative to the folder of this description file** (the one rule: "
                              "`make derive`, `make crate` and derive/derive.py resolve it the same way); read "
-                             "as docs/urdf.md, \"How a URDF is read\", says"),
+                             "as docs/reference/urdf-arms.md, \"How a URDF is read\", says"),
     ("urdf", "base"): (None, "the link the chain starts from (fixed to the world)"),
     ("urdf", "flange"): (None, "the link the tool is fixed to; links beyond it are not read"),
     ("urdf", "gravity"): (None, "3 numbers, m/s^2 in the base frame, each within +-1e3"),

@@ -4,7 +4,7 @@ algorithm (CRBA), an LDL^T solve for the accelerations, and, independently, the 
 algorithm (ABA, Featherstone 2008, ch. 7) in 6-D spatial algebra.
 
 Why our own and not SymPy: expanding M(q) of a spatial chain symbolically takes 88 s for 5 joints
-and does not finish for 6 (docs/urdf.md); the recursive algorithms on SX stay linear (RNEA, ABA)
+and does not finish for 6 (docs/explanation/derivation.md); the recursive algorithms on SX stay linear (RNEA, ABA)
 or quadratic (CRBA) in the joints, and CasADi's expression graph is already single assignment.
 
 Conventions. Body i's frame is joint i's frame (URDF: the joint's origin in the parent link, then

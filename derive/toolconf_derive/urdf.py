@@ -12,7 +12,7 @@ is not positive definite or whose principal moments violate the triangle inequal
 that is not orthonormal (below); a number outside its physical range (MAX_MASS, MAX_INERTIA,
 MAX_LENGTH, MAX_ANGLE) or more than MAX_LINKS links.
 
-How a URDF is read (one rule; docs/urdf.md, "How a URDF is read"):
+How a URDF is read (one rule; docs/reference/urdf-arms.md, "How a URDF is read"):
 
 - Angles, as Pinocchio reads them. Each rpy angle within SNAP (1e-9 rad) of a multiple k pi/2 is
   taken as exactly k pi/2, so its sine and cosine are exactly 0 or +-1; any other angle is used

@@ -1,6 +1,6 @@
 """The derivation of a URDF arm with a tool at its flange (description kind `urdf`), on CasADi SX.
 
-The plant the active-inference controller sees (docs/urdf.md, "The task formulation for real
+The plant the active-inference controller sees (docs/explanation/real-arms.md, "The task formulation for real
 arms"): a torque-controlled arm under joint impedance about the equilibrium pose q^e, with the
 gravity of the arm and tool at q^e fed forward,
 

@@ -27,7 +27,7 @@
 #include "toolconf_model.h"
 
 /* The Franka Hand at the flange, as `toolconf tool --urdf ... --flange panda_link8` gives it
- * (README, "A tool from its own URDF"), in the order of TOOLCONF_PARAMETER_*. */
+ * (docs/how-to/tool-from-urdf.md), in the order of TOOLCONF_PARAMETER_*. */
 static const double FRANKA_HAND[TOOLCONF_PARAMETER_COUNT] = {
     0.76,
     -0.006791946714028682,

@@ -9,7 +9,7 @@ derive/.venv). It builds the Panda's model library from the committed IR into a 
 before) and the command line (`cargo build --bin toolconf`), then writes comparison.json, the
 per-tool table comparison.csv and the figure comparison.png into --out, and prints the table.
 
-What may differ, and by how much (docs/mujoco.md): each quantity Q (the task error, ∫F, the tip
+What may differ, and by how much (docs/tutorials/mujoco.md): each quantity Q (the task error, ∫F, the tip
 at each grid time) of the MuJoCo episode differs from the continuous closed loop's by the
 controller's discretisation (a tick every h, the torque held: first order in h), by MuJoCo's
 integration (RK4, steps of h/substeps) and toolconf's (its tolerances), and nothing else once the
@@ -56,7 +56,7 @@ REPO = HERE.parents[1]
 R_MIN = 1.7
 RATIO_RANGE = (R_MIN, 2.3)
 # The on-robot controller's rate (toolconf_core::RATE_HZ) and MuJoCo's steps per tick: RK4 at
-# h/4 = 0.25 ms (docs/mujoco.md, "The integrator").
+# h/4 = 0.25 ms (docs/tutorials/mujoco.md, "The integrator").
 RATE_HZ = 1000.0
 SUBSTEPS = 4
 # Two routes to the same double-precision number (MuJoCo's and toolconf's kinematics and

@@ -29,7 +29,7 @@ import numpy as np
 from model_library import ModelLibrary
 from mujoco_arm import TIP_SITE, Description, arm_model, gravity_torque
 
-# toolconf's defaults for a task file's [episode] (README, task files; `toolconf simulate --help`).
+# toolconf's defaults for a task file's [episode] (docs/reference/file-formats.md, "Task files"; `toolconf simulate --help`).
 DEFAULT_EPISODE = {"t_end": 5.0, "dt": 0.05, "learning_rate": 1.0, "initial_torque": 0.0}
 # The terms a tip_position task uses (derive/tasks.toml), the error term first.
 TIP_TERMS = ("tip", "tip_dot", "u")
@@ -38,7 +38,7 @@ TIP_TERMS = ("tip", "tip_dot", "u")
 @dataclass
 class Task:
     """A tip_position task file as the controller takes it: goals and precisions padded to the
-    model's joints (docs/c-abi.md, "Layout"), and the episode."""
+    model's joints (docs/reference/c-abi.md, "Layout"), and the episode."""
     path: Path
     goals: np.ndarray          # terms × dof
     precisions: np.ndarray     # terms × dof × dof

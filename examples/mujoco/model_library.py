@@ -1,6 +1,6 @@
 """A toolconf model library (`make model`) through its C ABI, with ctypes.
 
-The library is the one a C or C++ controller links (docs/c-abi.md, `toolconf_model.h` beside
+The library is the one a C or C++ controller links (docs/reference/c-abi.md, `toolconf_model.h` beside
 it): its metadata, the plant and the rigid-body dynamics, the tool tip's forward kinematics and
 the on-robot controller (create, tick, destroy). Arrays are flat doubles, matrices column-major,
 as the header says; every call's status is checked and a failure raised as `LibraryError` with

@@ -1,6 +1,6 @@
 """A toolconf URDF arm in MuJoCo: the same URDF the model was derived from, the same plant.
 
-toolconf's plant (docs/urdf.md, "The task formulation for real arms") is the rigid-body chain
+toolconf's plant (docs/explanation/real-arms.md, "The task formulation for real arms") is the rigid-body chain
 from the description's base to its flange with the tool fixed to the flange, under joint
 impedance about the equilibrium with the gravity there fed forward:
 

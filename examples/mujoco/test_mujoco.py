@@ -69,7 +69,7 @@ def tools(toolconf, library):
 
 @pytest.fixture(scope="module")
 def comparison(library_folder, toolconf, tmp_path_factory):
-    """The example's own command (docs/mujoco.md) on the catalogue and touch task, its
+    """The example's own command (docs/tutorials/mujoco.md) on the catalogue and touch task, its
     comparison.json read back."""
     out = tmp_path_factory.mktemp("comparison")
     status = compare.main(["--out", str(out), "--library", str(library_folder),

@@ -58,7 +58,7 @@ pub fn terms(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
         .collect()
 }
 
-/// Every documented valid range (``README.md``, "Bad input"): ``{name: {"low", "high",
+/// Every documented valid range (``docs/reference/errors.md``): ``{name: {"low", "high",
 /// "low_open", "unit"}}``, e.g. ``ranges()["tool_parameter"]`` is ``[1e-6, 1e6]``, the range of
 /// every tool parameter, where the generated arithmetic is known to stay finite. A value outside
 /// its range raises ``ValueError`` before any work starts.
@@ -81,7 +81,7 @@ pub fn ranges(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
 /// every function then takes it by: the library's own, or ``name``. No rebuild of toolconf and
 /// no reinstall of this package. Loading the same file under the same name again returns the
 /// same name. The library is native code that runs with the interpreter's privileges: load only
-/// libraries you built (docs/c-abi.md).
+/// libraries you built (docs/reference/c-abi.md).
 ///
 /// Raises:
 ///     ValueError: one line naming the file and what is wrong: not a library, a C ABI or task

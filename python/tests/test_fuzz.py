@@ -7,7 +7,7 @@ message of at most a few hundred characters: never a panic (pyo3's PanicExceptio
 exception.
 
 200 cases per test; ``TOOLCONF_FUZZ_CASES=20000 python -m pytest python/tests/test_fuzz.py`` is
-the long run (README "Bad input").
+the long run (docs/reference/errors.md).
 """
 
 import math

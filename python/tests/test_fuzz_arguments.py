@@ -12,7 +12,7 @@ a segfault) ends the run. test_fuzz.py fuzzes the values inside task dicts and t
 
 Episodes are kept short (t_end ≤ 0.2 s): the numbers drawn for the episode options are small or
 outside their ranges, never in the slow middle. ``TOOLCONF_FUZZ_CASES`` cases per test (100 by
-default, about 20 s in all; README "Bad input").
+default, about 20 s in all; docs/reference/errors.md).
 """
 
 import math

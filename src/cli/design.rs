@@ -25,7 +25,7 @@ pub struct Args {
     /// The task: a built-in name (position, velocity, acceleration or 1, 2, 3) or a task file.
     #[arg(long)]
     task: String,
-    /// The design file (TOML): bounds, constraints, fixed parameters, objective (see the README).
+    /// The design file (TOML): bounds, constraints, fixed parameters, objective (see docs/reference/file-formats.md).
     #[arg(long)]
     design: PathBuf,
     /// Print one JSON object instead of text.

@@ -17,7 +17,7 @@ pub struct TaskArgs {
     /// The task (from derive/tasks.toml).
     #[arg(long, help = format!("The task: {}", toolconf::task::task_choices()), value_parser = parse_task, required_unless_present = "task_file", conflicts_with = "task_file")]
     pub task: Option<TaskKind>,
-    /// A task file (TOML: kind, [goal], [precision], [episode]; see the README) instead of a
+    /// A task file (TOML: kind, [goal], [precision], [episode]; see docs/reference/file-formats.md) instead of a
     /// built-in task. Episode flags given on the command line override its [episode].
     #[arg(long)]
     pub task_file: Option<PathBuf>,

@@ -50,7 +50,7 @@ struct Cli {
     /// Load a model library (the OUT folder of `make model`, or its .so) next to the built-in
     /// models, NAME=PATH to load it under another name; repeatable. TOOLCONF_MODEL_PATH
     /// (':'-separated) loads more. The library is native code run with your privileges: load
-    /// only libraries you built (docs/c-abi.md).
+    /// only libraries you built (docs/reference/c-abi.md).
     #[arg(long = "model-path", global = true, value_name = "PATH")]
     model_path: Vec<String>,
 }

@@ -28,7 +28,7 @@ use super::output::{add_outcome, check_files, CliError, RunFiles};
 #[derive(clap::Args)]
 pub struct Args {
     /// The tools: a CSV or JSON file, one tool per row (columns name, model, and the model's
-    /// parameters, e.g. m1,m2,l1,l2; see the README).
+    /// parameters, e.g. m1,m2,l1,l2; see docs/reference/file-formats.md).
     #[arg(long)]
     tools: PathBuf,
     /// The task: a built-in name or a task file.

@@ -4,7 +4,7 @@
 //! `cdylib`) whose exports are this crate's: [`export_model!`] defines them in the library's own
 //! crate (templates/cabi/src/lib.rs.tera), for the model's marker type in toolconf-core and its
 //! module in the generated crate. The header `toolconf_model.h` beside the library
-//! (templates/cabi/toolconf_model.h.tera) declares the same functions and types; docs/c-abi.md
+//! (templates/cabi/toolconf_model.h.tera) declares the same functions and types; docs/reference/c-abi.md
 //! is the reference.
 //!
 //! * **Versioned.** [`ABI_VERSION`] (`toolconf_abi_version()`) is checked first by any loader;

@@ -18,7 +18,7 @@ pub struct ControlConfidenceN<const N: usize> {
 
 impl<const N: usize> ControlConfidenceN<N> {
     /// ln|Π^U|/N: the mean log precision per control channel, ln of the geometric mean of Π^U's
-    /// eigenvalues; the quantity comparable across models with different N (docs/mixed-tools.md).
+    /// eigenvalues; the quantity comparable across models with different N (docs/explanation/mixed-tools.md).
     pub fn logdet_per_joint(&self) -> f64 {
         self.logdet / N as f64
     }
@@ -45,7 +45,7 @@ where
 /// A task whose goals and precisions have been checked once ([`TaskN::validated`]): ranking many
 /// tools for one task then costs only the closed form and the log-determinant per tool, not the
 /// task's checks (about half of [`control_confidence`]'s time for the 2-link arm, see
-/// docs/performance.md).
+/// docs/explanation/performance.md).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ValidatedTaskN<const N: usize>(pub(super) TaskN<N>);
 

@@ -68,7 +68,7 @@ pub const CONSTRAINT_COEFFICIENT: Range = Range::closed(-1e6, 1e6, "");
 /// The constant side of a design constraint.
 pub const CONSTRAINT_BOUND: Range = Range::closed(-1e12, 1e12, "");
 
-/// Every documented range by its name (as `toolconf.ranges()` and the README give them).
+/// Every documented range by its name (as `toolconf.ranges()` and docs/reference/errors.md give them).
 pub const RANGES: [(&str, Range); 19] = [
     ("tool_parameter", TOOL_PARAMETER),
     ("precision_entry", PRECISION_ENTRY),

@@ -77,7 +77,7 @@
 
 // The controller itself is toolconf-core's (`toolconf_core::ArmController`), so that a model
 // library built by `make model` ticks through its C ABI with this very code
-// (`toolconf_controller_tick`, docs/c-abi.md); this crate is what a robot's firmware links.
+// (`toolconf_controller_tick`, docs/reference/c-abi.md); this crate is what a robot's firmware links.
 pub use toolconf_core::{Arm2, Arm2Tool, Arm3, Arm3Tool, Panda, PandaTool, TaskKind};
 pub use toolconf_core::{ArmController, Command, RATE_HZ};
 

@@ -7,7 +7,7 @@ use toolconf_core::ArmModel;
 use toolconf_on_robot::{Panda, PandaController, PandaTool, TaskKind};
 
 /// The Franka Hand at the flange, as `toolconf tool --urdf ... --flange panda_link8` gives it
-/// (README, "A tool from its own URDF"): main.c's `params`.
+/// (docs/how-to/tool-from-urdf.md): main.c's `params`.
 const FRANKA_HAND: [f64; 13] = [
     0.76,
     -0.006791946714028682,

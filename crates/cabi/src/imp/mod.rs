@@ -15,7 +15,7 @@
 //! # Safety
 //!
 //! Every `unsafe fn` here takes raw pointers from C: each non-NULL pointer must point to as many
-//! `double`s (or `int32_t`s) as the C ABI documents for it (docs/c-abi.md), readable or
+//! `double`s (or `int32_t`s) as the C ABI documents for it (docs/reference/c-abi.md), readable or
 //! writable; nothing else can be checked. Reads and writes are unaligned-tolerant. A
 //! controller handle is the exception: any value is checked ([`crate::handles`]).
 

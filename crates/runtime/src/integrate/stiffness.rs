@@ -15,7 +15,7 @@ const STABILITY_BOUND: f64 = 3.25;
 /// Steps at the boundary before the problem is declared stiff (`DOPRI5`: 15).
 const STIFF_STEPS: u32 = 15;
 /// Steps at the boundary before [`super::Method::Fast`] hands over to Rodas5P: chosen on
-/// `draw_tools(2000, 1)` by the work model of `docs/performance.md` (patience 3, 6, 10, 15:
+/// `draw_tools(2000, 1)` by the work model of `docs/explanation/performance-population.md` (patience 3, 6, 10, 15:
 /// task 1 favours the shorter, task 2 the longer; 10 is within 5 % of the best of both).
 pub(super) const FAST_STIFF_STEPS: u32 = 10;
 /// Consecutive steps inside the boundary that clear the count (`DOPRI5`: 6).

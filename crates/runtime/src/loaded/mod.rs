@@ -10,7 +10,7 @@
 //!   [`LoadError`] naming the file and what is wrong.
 //! * **Trusted as native code.** Opening a library runs its initialisers and every call runs
 //!   its code with the process's privileges: nothing here can make an untrusted library safe
-//!   (docs/c-abi.md, "What a loaded library is trusted with"). Load only libraries you built.
+//!   (docs/reference/c-abi.md, "What a loaded library is trusted with"). Load only libraries you built.
 //! * **The same numbers.** A loaded model runs the same const-generic runtime as a built-in one
 //!   ([`table::Loaded`]), and the library's functions are the same generated code: the
 //!   results are the built-in model's, bit for bit (tests/loaded_models.rs).

@@ -1,5 +1,5 @@
 //! Tool sets that mix models: a seeded draw, parallel evaluation, and choices by ∫F, ∫J, ln|Π^U|
-//! and the normalised confidence ln|Π^U|/n (docs/mixed-tools.md).
+//! and the normalised confidence ln|Π^U|/n (docs/explanation/mixed-tools.md).
 //!
 //! # The stream
 //!
@@ -181,7 +181,7 @@ pub enum MixedObjective {
     FreeEnergy,
     /// argmin ∫J dt.
     CostJ,
-    /// argmax ln|Π^U| (raw: favours more joints, see docs/mixed-tools.md).
+    /// argmax ln|Π^U| (raw: favours more joints, see docs/explanation/mixed-tools.md).
     Confidence,
     /// argmax ln|Π^U|/n, the per-joint (geometric-mean) confidence.
     NormalisedConfidence,
