@@ -72,9 +72,9 @@ def _kind(kind: str, schema: dict, defs: dict) -> str:
 
 def dataclass_of(name: str, schema: dict, defs: dict) -> type:
     """The dataclass of the struct `name` whose JSON Schema is `schema` (`defs`: the others, by
-    name, which its fields refer to): its properties in order,
-    one the schema does not require an `omitted()` field. Those must come after every written one,
-    as a dataclass's defaults must (the callers also build these by position)."""
+    name, which its fields refer to): its properties in order, one the schema does not require an
+    `omitted()` field. Those must come after every written one, as a dataclass's defaults must
+    (and the callers build these by position too)."""
     required = schema.get("required", [])
     fields, optional_seen = [], None
     for key, sub in schema["properties"].items():
@@ -87,7 +87,7 @@ def dataclass_of(name: str, schema: dict, defs: dict) -> type:
             optional_seen = key
             fields.append((key, annotation(sub, defs), omitted()))
     cls = dataclasses.make_dataclass(name, fields, namespace={"__doc__": schema.get("description")})
-    # make_dataclass would name its own module; annotations resolve in this one.
+    # make_dataclass would name another module; the annotations resolve in this one.
     cls.__module__ = __name__
     return cls
 
