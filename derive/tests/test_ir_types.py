@@ -1,15 +1,18 @@
-"""The IR's dataclasses (toolconf_derive/ir_types.py) mirror the renderer's structs
-(derive/render/src/ir.rs): the same structs, each with the same fields in the same order, the same
-ones optional (`Option` there, `| None` here) and the same ones left out of the JSON when None.
-The renderer refuses unknown and missing keys, so a difference would otherwise show only when an
-IR is rendered; this finds it without Rust."""
+"""The IR's dataclasses (toolconf_derive/ir_types.py) are built from derive/ir_schema.json, the JSON
+Schema the renderer prints of its structs (derive/render/src/ir.rs, whose tests/ir_schema.rs keeps
+the file what they describe). These check the building: every struct becomes a dataclass with its
+fields in order and the ones left out when None marked so; the fixture IR that the renderer's tests
+read goes through them byte for byte; and a schema that differs from the documents by a missing,
+an extra or a moved field is caught by that round trip. Without Rust."""
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import json
-import re
 import sys
+import types
+import typing
 import unittest
 from pathlib import Path
 
@@ -18,50 +21,46 @@ sys.path.insert(0, str(ROOT / "derive"))
 
 from toolconf_derive import ir_types  # noqa: E402
 
-RUST = ROOT / "derive" / "render" / "src" / "ir.rs"
-OMITTED = '#[serde(default, skip_serializing_if = "Option::is_none")]'
+FIXTURE = ROOT / "tests" / "fixtures" / "pendulum.json"
 
 
-def rust_structs(text: str) -> dict[str, list[tuple[str, bool, bool]]]:
-    """`pub struct`s of ir.rs: name -> [(field, optional, omitted when None)] in order."""
-    structs = {}
-    for m in re.finditer(r"^pub struct (\w+)(?:<[^>]*>)? \{\n(.*?)^\}", text, re.M | re.S):
-        fields, omitted = [], False
-        for line in m.group(2).splitlines():
-            line = line.strip()
-            if line == OMITTED:
-                omitted = True
-            f = re.fullmatch(r"pub (?:r#)?(\w+): (.+),", line)
-            if f:
-                fields.append((f.group(1), f.group(2).startswith("Option<"), omitted))
-                omitted = False
-        structs[m.group(1)] = fields
-    return structs
+def schema() -> dict:
+    return json.loads(ir_types.SCHEMA_FILE.read_text())
 
 
-def python_dataclasses() -> dict[str, list[tuple[str, bool, bool]]]:
-    out = {}
-    for name, cls in vars(ir_types).items():
-        if isinstance(cls, type) and dataclasses.is_dataclass(cls) and cls.__module__ == ir_types.__name__:
-            out[name] = [(f.name, str(f.type).endswith("| None"), bool(f.metadata.get("omit_none")))
-                         for f in dataclasses.fields(cls)]
-    return out
+def structs(s: dict) -> dict[str, dict]:
+    return {s["title"]: s} | {n: d for n, d in s["$defs"].items() if "properties" in d}
 
 
-class MirrorTest(unittest.TestCase):
-    def test_every_struct_has_its_dataclass_with_the_same_fields(self):
-        rust = rust_structs(RUST.read_text())
-        python = python_dataclasses()
-        self.assertGreater(len(rust), 30, "ir.rs's structs were not found")
-        self.assertEqual(sorted(rust), sorted(python))
-        for name in rust:
+class BuildTest(unittest.TestCase):
+    def test_every_struct_is_a_dataclass_with_its_fields_in_order(self):
+        found = structs(schema())
+        self.assertGreater(len(found), 30, "the schema's structs were not found")
+        for name, s in found.items():
             with self.subTest(struct=name):
-                self.assertEqual(rust[name], python[name])
+                cls = getattr(ir_types, name)
+                self.assertEqual([f.name for f in dataclasses.fields(cls)], list(s["properties"]))
+                self.assertEqual([f.name for f in dataclasses.fields(cls) if f.metadata.get("omit_none")],
+                                 [k for k in s["properties"] if k not in s["required"]])
+                self.assertIsInstance(typing.get_type_hints(cls), dict)  # every annotation resolves
 
-    def test_the_parser_sees_a_field_an_option_and_an_omitted_one(self):
-        text = ('pub struct A<R = B> {\n    pub x: u64,\n    pub r#struct: Option<String>,\n'
-                f'    {OMITTED}\n    pub y: Option<u64>,\n}}\n')
-        self.assertEqual(rust_structs(text), {"A": [("x", False, False), ("struct", True, False), ("y", True, True)]})
+    def test_the_fields_the_renderer_has_optional_are_so_here(self):
+        # Independent of the builder: what ir.rs says of these fields, read off it by hand.
+        hints = typing.get_type_hints(ir_types.Function)
+        self.assertEqual(hints["sequence"], ir_types.Sequence | None)
+        self.assertEqual(hints["cost"], ir_types.Cost)
+        self.assertEqual(typing.get_type_hints(ir_types.Ir)["report"], ir_types.ClosedFormReport | ir_types.UrdfReport)
+        self.assertEqual(typing.get_type_hints(ir_types.Cost)["kinds"], dict[str, int])
+        self.assertEqual(ir_types.IR_SCHEMA, json.loads(FIXTURE.read_text())["schema"])
+
+    def test_a_field_written_always_after_one_left_out_is_refused_naming_both(self):
+        s = {"properties": {"a": {"type": ["string", "null"]}, "b": {"type": "integer"}}, "required": ["b"]}
+        with self.assertRaisesRegex(ValueError, r"X: 'b' is written always but comes after 'a'"):
+            ir_types.dataclass_of("X", s, {})
+
+    def test_a_type_with_no_python_type_is_refused_naming_it(self):
+        with self.assertRaisesRegex(ValueError, "'tuple'"):
+            ir_types.annotation({"type": "tuple"}, {})
 
 
 class JsonTest(unittest.TestCase):
@@ -73,31 +72,64 @@ class JsonTest(unittest.TestCase):
                          {"reference": "0.35", "values": [{"name": "m", "value": "1.0"}], "closed": None})
 
     def test_the_fixture_ir_round_trips_through_the_dataclasses_byte_for_byte(self):
-        # Read back into the dataclasses by their own field lists, written again: the same bytes.
-        path = ROOT / "tests" / "fixtures" / "pendulum.json"
-        text = path.read_text()
-        ir = _load(ir_types.Ir, json.loads(text))
+        text = FIXTURE.read_text()
+        ir = _load(vars(ir_types), ir_types.Ir, json.loads(text))
         self.assertIsInstance(ir.report, ir_types.ClosedFormReport)
-        self.assertEqual(json.dumps(ir_types.as_json(ir), indent=1, ensure_ascii=False) + "\n", text)
+        self.assertEqual(_written(ir), text)
 
 
-def _load(cls, data):
-    """`data` (JSON) as dataclass `cls`, by the names its fields' annotations give."""
-    import typing
-    hints = typing.get_type_hints(cls, vars(ir_types))
-    kwargs = {}
-    for f in dataclasses.fields(cls):
-        if f.name in data:
-            kwargs[f.name] = _value(hints[f.name], data[f.name])
-    unknown = set(data) - {f.name for f in dataclasses.fields(cls)}
+class CaughtTest(unittest.TestCase):
+    """A schema that is not the documents' (a field the renderer no longer has, a new one, two
+    swapped) fails the round trip above: built from such a schema, the dataclasses refuse the
+    fixture or write it otherwise."""
+
+    def types_without(self, change) -> dict:
+        s = copy.deepcopy(schema())
+        change(s["$defs"]["Model"])
+        return ir_types.dataclasses_of(s)
+
+    def test_a_missing_field_is_caught(self):
+        def drop(model):
+            del model["properties"]["tip_dim"]
+            model["required"].remove("tip_dim")
+        built = self.types_without(drop)
+        with self.assertRaisesRegex(ValueError, r"Model: unknown keys \['tip_dim'\]"):
+            _load(built, built["Ir"], json.loads(FIXTURE.read_text()))
+
+    def test_an_extra_field_is_caught(self):
+        def add(model):
+            model["properties"] = {"degrees": {"type": "integer"}} | model["properties"]
+            model["required"].insert(0, "degrees")
+        built = self.types_without(add)
+        with self.assertRaisesRegex(TypeError, "degrees"):
+            _load(built, built["Ir"], json.loads(FIXTURE.read_text()))
+
+    def test_a_moved_field_is_caught(self):
+        def swap(model):
+            p = model["properties"]
+            order = ["state_dim", "dof"] + [k for k in p if k not in ("dof", "state_dim")]
+            model["properties"] = {k: p[k] for k in order}
+        built = self.types_without(swap)
+        text = FIXTURE.read_text()
+        self.assertNotEqual(_written(_load(built, built["Ir"], json.loads(text))), text)
+
+
+def _written(ir) -> str:
+    """As derive.py writes an IR."""
+    return json.dumps(ir_types.as_json(ir), indent=1, ensure_ascii=False) + "\n"
+
+
+def _load(names: dict, cls, data):
+    """`data` (JSON) as dataclass `cls`, by the classes `names` its fields' annotations name."""
+    hints = typing.get_type_hints(cls, names)
+    fields = {f.name for f in dataclasses.fields(cls)}
+    unknown = set(data) - fields
     if unknown:
         raise ValueError(f"{cls.__name__}: unknown keys {sorted(unknown)}")
-    return cls(**kwargs)
+    return cls(**{k: _value(names, hints[k], v) for k, v in data.items()})
 
 
-def _value(hint, data):
-    import types
-    import typing
+def _value(names: dict, hint, data):
     if data is None:
         return None
     origin = typing.get_origin(hint)
@@ -106,13 +138,13 @@ def _value(hint, data):
         if len(options) > 1:  # the report: the kind whose fields the data has
             for option in options:
                 if {f.name for f in dataclasses.fields(option)} == set(data):
-                    return _load(option, data)
+                    return _load(names, option, data)
             raise ValueError(f"no kind of {hint} has the keys {sorted(data)}")
-        return _value(options[0], data)
+        return _value(names, options[0], data)
     if origin is list:
-        return [_value(typing.get_args(hint)[0], d) for d in data]
+        return [_value(names, typing.get_args(hint)[0], d) for d in data]
     if dataclasses.is_dataclass(hint):
-        return _load(hint, data)
+        return _load(names, hint, data)
     return data
 
 

@@ -1,7 +1,7 @@
 """The intermediate representation: one JSON document per model that the Tera renderer turns into
 Rust and a report. It carries the CSE'd expressions (printed as Rust f64 code), the shapes, the
 docs, and the CasADi test vectors; the renderer needs nothing else. The document is built of
-ir_types' dataclasses, the mirror of the types the renderer reads it into (derive/render/src/ir.rs)."""
+ir_types' dataclasses, made from the types the renderer reads it into (derive/render/src/ir.rs)."""
 
 from __future__ import annotations
 
@@ -20,8 +20,8 @@ from .hoist import hoist
 from .rust_printer import RustPrinter, float_literal
 from .symbolic import Derivation
 
-# 4: each function carries its cost (cost.py); 6: the model's tip_dim, the tasks' formulation.
-IR_SCHEMA = 6
+# The renderer's, as derive/ir_schema.json gives it.
+IR_SCHEMA = irt.IR_SCHEMA
 
 
 def _rust_type(shape: tuple[int, int]) -> str:
@@ -285,6 +285,15 @@ def model_ir(d: Derivation, functions: list[Function], generator: irt.Generator,
                           report, vectors)
 
 
+def _tool_rule(rule: dict) -> irt.ToolRule:
+    """The rule urdf_description.tool_rule gives as a dict, as the IR's."""
+    inertia = rule.get("inertia")
+    return irt.ToolRule(domains=[irt.Domain(**d) for d in rule["domains"]],
+                        constraints=[irt.Constraint(**c) for c in rule["constraints"]],
+                        sample=rule["sample"], defaults=rule["defaults"],
+                        inertia=None if inertia is None else irt.Inertia(**inertia), source=rule["source"])
+
+
 def model_document(m, x_e: list[str], u_e: list[str], tasks: list, functions: list[irt.Function],
                    generator: irt.Generator, report: irt.ClosedFormReport | irt.UrdfReport, vectors: int,
                    templates: list[str] | None = None) -> irt.Ir:
@@ -309,7 +318,7 @@ def model_document(m, x_e: list[str], u_e: list[str], tasks: list, functions: li
             equilibrium=irt.Equilibrium(x=x_e, u=u_e),
             # Only where the description states one (a URDF tool): without it the renderer gives
             # every parameter the planar arms' rule (> 0, drawn from [0.1, 0.6]).
-            tool_rule=None if m.tool_rule is None else irt.ToolRule.of(m.tool_rule),
+            tool_rule=None if m.tool_rule is None else _tool_rule(m.tool_rule),
         ),
         terms=[irt.Term(t.name, t.symbol, t.latex, t.doc, t.label, t.unit, irt.TermRead(t.source, t.block), t.goal_range)
                for t in (tasks[0].all_terms if tasks else ())],

@@ -2,26 +2,31 @@
 //! types: a key this renderer does not know, a missing one or a value of the wrong kind is an error
 //! naming the file, the line and the column, before any template runs.
 //!
-//! Each struct here has a Python dataclass of the same name and fields in
-//! `derive/toolconf_derive/ir_types.py`, which is what writes these documents
-//! (`derive/tests/test_ir_types.py` holds the two lists of fields equal). A field that the Python side
-//! leaves out of the JSON when it has no value is `#[serde(default, skip_serializing_if = ...)]`
-//! here; every other field is always written, `null` where it has no value.
+//! These structs are where the IR's fields are written, once: the derivation's dataclasses
+//! (`derive/toolconf_derive/ir_types.py`) are built from their JSON Schema ([`crate::ir_schema`],
+//! committed as `derive/ir_schema.json`), with the same names, the fields in the same order (the
+//! order of the keys in the JSON) and their docs. A field left out of the JSON when it has no value
+//! is `#[serde(default, skip_serializing_if = "Option::is_none")]` here; every other field is
+//! always written, `null` where it has no value.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use crate::RenderError;
 
-/// The IR schema this renderer understands (`schema` in the JSON).
+/// The IR schema this renderer understands (`schema` in the JSON, which the derivation takes
+/// from `derive/ir_schema.json`). 4: each function carries its cost; 6: the model's `tip_dim`, the
+/// tasks' formulation.
 pub const IR_SCHEMA: u64 = 6;
 
 /// One model's IR. `R` is its report: [`ClosedFormReport`] for a model derived by SymPy,
 /// [`UrdfReport`] for a URDF arm (derived on CasADi SX).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
+#[schemars(rename = "Ir")]
 pub struct Ir<R = Report> {
     pub schema: u64,
     pub generator: Generator,
@@ -39,7 +44,7 @@ pub struct Ir<R = Report> {
 }
 
 /// A model's derivation report, which of the two kinds its IR carries.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, JsonSchema)]
 #[serde(untagged)]
 pub enum Report {
     ClosedForm(ClosedFormReport),
@@ -47,7 +52,7 @@ pub enum Report {
 }
 
 /// What made the IR, as the generated files name it.
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Generator {
     pub command: String,
@@ -59,7 +64,7 @@ pub struct Generator {
     pub render: String,
 }
 
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Model {
     pub name: String,
@@ -81,7 +86,7 @@ pub struct Model {
 }
 
 /// A tool parameter.
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Parameter {
     pub name: String,
@@ -91,7 +96,7 @@ pub struct Parameter {
 }
 
 /// A named constant of the model (gravity, ...), with its Rust constant's name.
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Constant {
     pub name: String,
@@ -102,7 +107,7 @@ pub struct Constant {
 }
 
 /// A state or control variable.
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Variable {
     pub name: String,
@@ -110,7 +115,7 @@ pub struct Variable {
 }
 
 /// X^e and U^e as Rust literals.
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Equilibrium {
     pub x: Vec<String>,
@@ -118,7 +123,7 @@ pub struct Equilibrium {
 }
 
 /// A description's rule for its tools (urdf_description.tool_rule).
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ToolRule {
     pub domains: Vec<Domain>,
@@ -135,7 +140,7 @@ pub struct ToolRule {
 /// The parameters that are a rigid body's inertia tensor about its centre of mass, by index (the
 /// moments xx, yy, zz, the products xy, xz, yz): positive definite, its eigenvalues obeying the
 /// triangle inequality to a relative `slack`.
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Inertia {
     pub moments: [usize; 3],
@@ -144,7 +149,7 @@ pub struct Inertia {
 }
 
 /// One parameter's domain; a missing bound is none.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Domain {
     pub lo: Option<f64>,
@@ -154,7 +159,7 @@ pub struct Domain {
 }
 
 /// c · p ≤ 0, and the rule in words.
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Constraint {
     pub coefficients: Vec<f64>,
@@ -162,7 +167,7 @@ pub struct Constraint {
 }
 
 /// A free-energy term (eq. free_energy) of `derive/tasks.toml`'s `[[term]]` list.
-#[derive(Debug, Clone, PartialEq, Eq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Term {
     pub name: String,
@@ -180,7 +185,7 @@ pub struct Term {
 
 /// Where a term's value is read: `block` (n rows) of the state X, of its rate Ẋ, or the control;
 /// for the tool's tip, `block` is the order of the derivative (0: y(q), 1: J(q) q̇).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TermRead {
     pub source: Source,
@@ -188,7 +193,7 @@ pub struct TermRead {
 }
 
 /// What a term is read from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Source {
     State,
@@ -205,7 +210,7 @@ impl Term {
 }
 
 /// A task of `derive/tasks.toml`, with this model's default goals and precisions.
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Task {
     pub name: String,
@@ -225,7 +230,7 @@ pub struct Task {
 
 /// Which formulation of its sensitivities a task has in this model: `paper` (the formulas of
 /// `derive/tasks.toml`'s task) or one of the task's named `[task.formulations]`, and why.
-#[derive(Debug, Clone, PartialEq, Eq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Formulation {
     pub name: String,
@@ -240,7 +245,7 @@ impl Formulation {
 }
 
 /// Why a task has its formulation in a model.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum ChosenBy {
     /// Nothing chose another: the paper's.
@@ -253,7 +258,7 @@ pub enum ChosenBy {
 
 /// A default goal, one Rust literal per joint (a goal at the tip: its TIP_DIM components, then
 /// zeros).
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Goal {
     pub term: String,
@@ -261,7 +266,7 @@ pub struct Goal {
 }
 
 /// A default precision P = value · I.
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Precision {
     pub term: String,
@@ -271,7 +276,7 @@ pub struct Precision {
 
 /// One generated function: a closed form (its CSE'd `temporaries` and each output entry's
 /// `rust`) or CasADi's instruction `sequence`, with optional per-tool `coefficients`.
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Function {
     pub name: String,
@@ -292,7 +297,7 @@ pub struct Function {
     pub sequence: Option<Sequence>,
 }
 
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Arg {
     pub name: String,
@@ -306,7 +311,7 @@ pub struct Arg {
 }
 
 /// The parameter-only factors of a function, computed once per tool (derive/toolconf_derive/hoist.py).
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Coefficients {
     pub r#struct: String,
@@ -320,7 +325,7 @@ pub struct Coefficients {
     pub args: Vec<CoefficientArg>,
 }
 
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CoefficientArg {
     pub name: String,
@@ -329,7 +334,7 @@ pub struct CoefficientArg {
 }
 
 /// Operation counts (derive/toolconf_derive/cost.py): `kinds` by count_ops' names, in name order.
-#[derive(Debug, Clone, PartialEq, Eq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Cost {
     pub ops: u64,
@@ -338,7 +343,7 @@ pub struct Cost {
     pub sin_cos: u64,
 }
 
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Output {
     pub name: String,
@@ -353,7 +358,7 @@ pub struct Output {
 
 /// A nonzero output entry; `rust` is its closed form (absent where an instruction sequence
 /// writes it).
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Entry {
     pub row: usize,
@@ -363,7 +368,7 @@ pub struct Entry {
 }
 
 /// `let name = rust;`
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Let {
     pub name: String,
@@ -371,7 +376,7 @@ pub struct Let {
 }
 
 /// `let name = access;`, an element of argument `arg`.
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Binding {
     pub name: String,
@@ -380,7 +385,7 @@ pub struct Binding {
 }
 
 /// `let (sin, cos) = crate::trig::sin_cos(angle);`, `_` for a side the body does not read.
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Trig {
     pub angle: String,
@@ -389,14 +394,14 @@ pub struct Trig {
 }
 
 /// CasADi's instructions on its work slots (derive/toolconf_derive/sequence.py).
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Sequence {
     pub slots: Vec<Slot>,
     pub steps: Vec<Step>,
 }
 
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Slot {
     pub name: String,
@@ -404,7 +409,7 @@ pub struct Slot {
 }
 
 /// `target = rust;`
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Step {
     pub target: String,
@@ -412,7 +417,7 @@ pub struct Step {
 }
 
 /// Where the test vectors are, and how many per function.
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TestVectors {
     pub file: String,
@@ -420,7 +425,7 @@ pub struct TestVectors {
 }
 
 /// The report of a model derived in closed form (derive/toolconf_derive/report.py).
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ClosedFormReport {
     pub printed_where: String,
@@ -435,7 +440,7 @@ pub struct ClosedFormReport {
     pub tasks: Vec<TaskReport>,
 }
 
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Equation {
     pub lhs: String,
@@ -443,7 +448,7 @@ pub struct Equation {
 }
 
 /// A derived matrix entry against the one the paper prints.
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Comparison {
     pub entry: String,
@@ -453,7 +458,7 @@ pub struct Comparison {
     pub difference: String,
 }
 
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TaskReport {
     pub name: String,
@@ -468,7 +473,7 @@ pub struct TaskReport {
     pub remarks: Vec<Remark>,
 }
 
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SensitivityReport {
     pub term: String,
@@ -478,7 +483,7 @@ pub struct SensitivityReport {
 }
 
 /// d ln|Π^U|/dp at the reference tool, and its closed form for a one-joint model.
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GradientReport {
     pub reference: String,
@@ -486,14 +491,14 @@ pub struct GradientReport {
     pub closed: Option<Vec<GradientClosedForm>>,
 }
 
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GradientValue {
     pub name: String,
     pub value: String,
 }
 
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct GradientClosedForm {
     pub name: String,
@@ -501,7 +506,7 @@ pub struct GradientClosedForm {
 }
 
 /// A task's note on an alternative reading of one of its sensitivities.
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Remark {
     pub what: String,
@@ -513,7 +518,7 @@ pub struct Remark {
 }
 
 /// The report of a URDF arm (derive/toolconf_derive/urdf_functions.py).
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct UrdfReport {
     pub urdf: String,
@@ -530,7 +535,7 @@ pub struct UrdfReport {
 }
 
 /// A body of the chain, its numbers as the report prints them.
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Body {
     pub joint: String,
@@ -542,7 +547,7 @@ pub struct Body {
 }
 
 /// One of the report's example tools.
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ReportTool {
     pub name: String,
@@ -552,7 +557,7 @@ pub struct ReportTool {
     pub logdets: Vec<Logdet>,
 }
 
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Logdet {
     pub task: String,
@@ -560,7 +565,7 @@ pub struct Logdet {
 }
 
 /// A generated function's cost and its agreement with the reference graph.
-#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CostRow {
     pub name: String,

@@ -32,6 +32,7 @@ pub mod escape;
 pub mod functions;
 pub mod ir;
 pub mod ir_check;
+pub mod ir_schema;
 pub mod model_view;
 pub mod registry;
 pub mod tasks;

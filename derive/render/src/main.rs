@@ -19,6 +19,9 @@
 //! text, names, file names, code) and renders nothing: `make model IR=...` asks it before
 //! anything else, so that a bad IR is one line, status 2.
 //!
+//! `--ir-schema` prints the JSON Schema of the IR this renderer reads, which the derivation builds
+//! its types from (`derive/ir_schema.json`: [`toolconf_render::ir_schema`]).
+//!
 //! `make model`'s library crate: `IR.json --model-library DIR --repository REPO [--templates
 //! templates]` renders templates/cabi/ for the one model into DIR (its generated crate, rendered
 //! as usual, goes into DIR/generated), on the repository REPO's toolconf-cabi.
@@ -61,6 +64,7 @@ struct Args {
     inputs: Vec<(String, PathBuf)>,
     model_library: Option<PathBuf>,
     check_ir: bool,
+    ir_schema: bool,
     /// The command the folder rule names as the folder's maker (`make crate`, `make model`).
     command: String,
 }
@@ -84,6 +88,7 @@ fn parse(args: &[String]) -> Result<Args, String> {
         inputs: Vec::new(),
         model_library: None,
         check_ir: false,
+        ir_schema: false,
         command: "make crate".into(),
     };
     let mut it = args.iter();
@@ -102,6 +107,7 @@ fn parse(args: &[String]) -> Result<Args, String> {
             "--standalone" => a.package.standalone = true,
             "--check" => a.check = true,
             "--check-ir" => a.check_ir = true,
+            "--ir-schema" => a.ir_schema = true,
             "--check-crate-out" => {
                 a.crate_rule = Some(CrateRule::Check(value(&mut it, arg)?.into()));
             }
@@ -200,6 +206,21 @@ fn run_crate_rule(a: &Args, rule: &CrateRule) -> ExitCode {
     }
 }
 
+/// `--ir-schema`: the IR's JSON Schema on standard output (status 1 if the types cannot be
+/// described, which is a fault of this renderer, not of any input).
+fn print_ir_schema() -> ExitCode {
+    match toolconf_render::ir_schema::ir_schema() {
+        Ok(text) => {
+            print!("{text}");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("toolconf-render: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
 /// The arguments, each of which must be UTF-8 (a path that is not cannot be told apart here).
 fn arguments() -> Result<Vec<String>, String> {
     std::env::args_os()
@@ -222,12 +243,15 @@ fn main() -> ExitCode {
     };
     if args.is_empty() || args.iter().any(|a| a == "--help" || a == "-h") {
         eprintln!(
-            "usage: toolconf-render [IR.json...] [--crate DIR] [--templates DIR] [--out DIR] [--crate-name NAME] [--standalone] [--check]\n       toolconf-render --check-ir IR.json...\n       toolconf-render IR.json --model-library DIR --repository REPO [--templates DIR]\n       toolconf-render --check-crate-out OUT --repository DIR [--command NAME] [--input LABEL PATH]...\n       toolconf-render --install-crate STAGING --out OUT --repository DIR [--command NAME] [--input LABEL PATH]..."
+            "usage: toolconf-render [IR.json...] [--crate DIR] [--templates DIR] [--out DIR] [--crate-name NAME] [--standalone] [--check]\n       toolconf-render --check-ir IR.json...\n       toolconf-render --ir-schema\n       toolconf-render IR.json --model-library DIR --repository REPO [--templates DIR]\n       toolconf-render --check-crate-out OUT --repository DIR [--command NAME] [--input LABEL PATH]...\n       toolconf-render --install-crate STAGING --out OUT --repository DIR [--command NAME] [--input LABEL PATH]..."
         );
         return ExitCode::from(2);
     }
     if let Some(rule) = &a.crate_rule {
         return run_crate_rule(&a, rule);
+    }
+    if a.ir_schema {
+        return print_ir_schema();
     }
     match run(&a) {
         Ok(problems) if problems.is_empty() => {
