@@ -547,11 +547,34 @@ fn sigterm_during_rank_csv_keeps_the_old_file_and_leaves_no_temporary() {
     assert_eq!(partials(&dir), Vec::<std::path::PathBuf>::new());
 }
 
+/// `args` run in `dir` with `fifo` made a FIFO there that no process reads: refused with
+/// status 2 and one line (returned), not blocked.
+#[cfg(unix)]
+fn refused_at_fifo(dir: &std::path::Path, fifo: &str, args: &[&str]) -> String {
+    use std::process::Stdio;
+    let path = std::ffi::CString::new(dir.join(fifo).to_str().unwrap()).unwrap();
+    // SAFETY: a NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(path.as_ptr(), 0o644) }, 0);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_toolconf"))
+        .args(args)
+        .current_dir(dir)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let status = wait_bounded(&mut child, std::time::Duration::from_secs(60));
+    let mut stderr = String::new();
+    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut stderr).unwrap();
+    assert_eq!(status.code(), Some(2), "{fifo}: {stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    stderr
+}
+
 #[cfg(unix)]
 #[test]
 fn a_fifo_nothing_reads_is_refused_at_once_and_stays_a_fifo() {
     use std::os::unix::fs::FileTypeExt;
-    use std::process::Stdio;
     let dir = scratch("fifo");
     std::fs::create_dir(dir.join("r")).unwrap();
     let drawer = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/tools/drawer.csv");
@@ -575,22 +598,7 @@ fn a_fifo_nothing_reads_is_refused_at_once_and_stays_a_fifo() {
             ],
         ),
     ] {
-        let path = std::ffi::CString::new(dir.join(fifo).to_str().unwrap()).unwrap();
-        // SAFETY: a NUL-terminated path.
-        assert_eq!(unsafe { libc::mkfifo(path.as_ptr(), 0o644) }, 0);
-        let mut child = Command::new(env!("CARGO_BIN_EXE_toolconf"))
-            .args(&args)
-            .current_dir(&dir)
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        let status = wait_bounded(&mut child, std::time::Duration::from_secs(60));
-        let mut stderr = String::new();
-        std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut stderr).unwrap();
-        assert_eq!(status.code(), Some(2), "{fifo}: {stderr}");
-        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        let stderr = refused_at_fifo(&dir, fifo, &args);
         let name = fifo.rsplit('/').next().unwrap();
         assert!(
             stderr.contains(name) && stderr.contains("a FIFO that no process reads"),
@@ -609,7 +617,6 @@ fn a_fifo_nothing_reads_is_refused_at_once_and_stays_a_fifo() {
 #[cfg(unix)]
 #[test]
 fn an_input_fifo_with_no_writer_is_one_line_at_once() {
-    use std::process::Stdio;
     let dir = scratch("input-fifo");
     let drawer = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/tools/drawer.csv");
     for (fifo, args) in [
@@ -640,22 +647,7 @@ fn an_input_fifo_with_no_writer_is_one_line_at_once() {
             vec!["design", "--task", "velocity", "--design", "d.toml"],
         ),
     ] {
-        let path = std::ffi::CString::new(dir.join(fifo).to_str().unwrap()).unwrap();
-        // SAFETY: a NUL-terminated path.
-        assert_eq!(unsafe { libc::mkfifo(path.as_ptr(), 0o644) }, 0);
-        let mut child = Command::new(env!("CARGO_BIN_EXE_toolconf"))
-            .args(&args)
-            .current_dir(&dir)
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        let status = wait_bounded(&mut child, std::time::Duration::from_secs(60));
-        let mut stderr = String::new();
-        std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut stderr).unwrap();
-        assert_eq!(status.code(), Some(2), "{fifo}: {stderr}");
-        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        let stderr = refused_at_fifo(&dir, fifo, &args);
         assert!(stderr.contains(fifo), "{stderr}");
     }
 }

@@ -110,27 +110,7 @@ fn an_evaluation_on_a_users_task_writes_every_file_figure_and_verdict() {
         );
     }
     let (first, second) = (files(&one), files(&two));
-    let mut names: Vec<&str> = toolconf_report::evaluation::FILES.to_vec();
-    names.sort_unstable();
-    assert_eq!(first.keys().map(String::as_str).collect::<Vec<_>>(), names);
-    for (name, bytes) in &first {
-        let text = std::str::from_utf8(bytes).unwrap();
-        assert!(!text.contains("NaN"), "{name} holds NaN");
-        if name.ends_with(".csv") {
-            for cell in text.lines().skip(1).flat_map(|l| l.split(',')) {
-                assert!(
-                    cell.parse::<f64>().map_or(true, f64::is_finite),
-                    "{name}: {cell}"
-                );
-            }
-        }
-        if !name.starts_with("report.") {
-            assert!(
-                bytes == &second[name],
-                "{name} differs between 1 and 2 threads"
-            );
-        }
-    }
+    every_file_finite_and_thread_independent(&first, &second);
     let svg = |f: &str| std::str::from_utf8(&first[f]).unwrap().to_string();
     // Every panel has its data: the tools' dots, the runs' lines, the grid's cells, the boxes.
     assert!(count(&svg("fig2_confidence_vs_error.svg"), "<circle") >= 24);
@@ -157,6 +137,35 @@ fn an_evaluation_on_a_users_task_writes_every_file_figure_and_verdict() {
     // The fig7 trials' rows and choices agree with each other.
     let choices = std::str::from_utf8(&first["fig7_choices.csv"]).unwrap();
     assert_eq!(choices.lines().count(), 1 + 6 * 3);
+}
+
+/// Exactly the evaluation's files, no NaN or infinite cell in any, and each but the reports
+/// the same with one and with two threads.
+fn every_file_finite_and_thread_independent(
+    first: &BTreeMap<String, Vec<u8>>,
+    second: &BTreeMap<String, Vec<u8>>,
+) {
+    let mut names: Vec<&str> = toolconf_report::evaluation::FILES.to_vec();
+    names.sort_unstable();
+    assert_eq!(first.keys().map(String::as_str).collect::<Vec<_>>(), names);
+    for (name, bytes) in first {
+        let text = std::str::from_utf8(bytes).unwrap();
+        assert!(!text.contains("NaN"), "{name} holds NaN");
+        if name.ends_with(".csv") {
+            for cell in text.lines().skip(1).flat_map(|l| l.split(',')) {
+                assert!(
+                    cell.parse::<f64>().map_or(true, f64::is_finite),
+                    "{name}: {cell}"
+                );
+            }
+        }
+        if !name.starts_with("report.") {
+            assert!(
+                bytes == &second[name],
+                "{name} differs between 1 and 2 threads"
+            );
+        }
+    }
 }
 
 /// `reproduce --model` without a sample draws `select --models`'s tools: the fig2 rows are
@@ -255,30 +264,29 @@ fn a_relative_tip_goal_starts_every_tool_at_the_same_distance() {
     assert!(hi - lo > 0.05, "the absolute point: {lo}..{hi} m");
 }
 
+/// `rank` of the Panda's catalogue on the task file `text` (in a fresh folder `name`), on two
+/// threads, with `extra` arguments.
+fn rank_panda_catalogue(name: &str, text: &str, extra: &[&str]) -> Output {
+    let task = fresh_dir(name).join("task.toml");
+    std::fs::write(&task, text).unwrap();
+    let tools = repo("examples/tools/panda_tools.csv");
+    let args = [
+        "rank",
+        "--tools",
+        tools.to_str().unwrap(),
+        "--task",
+        task.to_str().unwrap(),
+    ];
+    toolconf(&[&args[..], extra].concat(), 2)
+}
+
 /// A tip task file that states only its goal gets its precisions from the robot's own scales,
 /// and moves the Panda's catalogue towards the point (the paper's unit precisions would not:
 /// progress 0.0003).
 #[test]
 fn a_goal_only_tip_task_moves_the_panda_catalogue() {
-    let dir = fresh_dir("goal-only");
-    let task = dir.join("touch.toml");
-    std::fs::write(
-        &task,
-        "kind = \"tip_position\"\n[goal]\ntip = [0.36, 0.03, 0.39]\n",
-    )
-    .unwrap();
-    let tools = repo("examples/tools/panda_tools.csv");
-    let out = toolconf(
-        &[
-            "rank",
-            "--tools",
-            tools.to_str().unwrap(),
-            "--task",
-            task.to_str().unwrap(),
-            "--json",
-        ],
-        2,
-    );
+    let task = "kind = \"tip_position\"\n[goal]\ntip = [0.36, 0.03, 0.39]\n";
+    let out = rank_panda_catalogue("goal-only", task, &["--json"]);
     let json: Value = serde_json::from_slice(&out.stdout).unwrap();
     let mut progress: Vec<f64> = json["tools"]
         .as_array()
@@ -301,24 +309,8 @@ fn a_goal_only_tip_task_moves_the_panda_catalogue() {
 /// to raise.
 #[test]
 fn a_task_that_barely_moves_the_tools_says_which_precision_to_raise() {
-    let dir = fresh_dir("barely");
-    let task = dir.join("soft.toml");
-    std::fs::write(
-        &task,
-        "kind = \"tip_position\"\n[goal]\ntip = [0.36, 0.03, 0.39]\n[precision]\ntip = 100\ntip_dot = 50\nu = 1\n",
-    )
-    .unwrap();
-    let tools = repo("examples/tools/panda_tools.csv");
-    let out = toolconf(
-        &[
-            "rank",
-            "--tools",
-            tools.to_str().unwrap(),
-            "--task",
-            task.to_str().unwrap(),
-        ],
-        2,
-    );
+    let task = "kind = \"tip_position\"\n[goal]\ntip = [0.36, 0.03, 0.39]\n[precision]\ntip = 100\ntip_dot = 50\nu = 1\n";
+    let out = rank_panda_catalogue("barely", task, &[]);
     let text = String::from_utf8_lossy(&out.stdout);
     let note = text
         .lines()

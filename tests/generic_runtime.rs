@@ -205,7 +205,7 @@ fn arm3_goals_extend_the_two_link_ones() {
 }
 
 #[test]
-fn invalid_input_gives_typed_errors() {
+fn invalid_tool_parameters_give_typed_errors() {
     assert_eq!(
         Arm3Tool::new([0.3, -1.0, 0.2, 0.4, 0.35, 0.3]).unwrap_err(),
         model::Error::InvalidParameter {
@@ -243,7 +243,10 @@ fn invalid_input_gives_typed_errors() {
             ..
         }))
     ));
+}
 
+#[test]
+fn invalid_tasks_give_typed_errors() {
     let tool = Arm3Tool::new([0.3, 0.25, 0.2, 0.4, 0.35, 0.3]).unwrap();
     // All-zero precisions: Π^U = 0 for every tool, refused as such.
     let mut task = Arm3::paper_task(TaskKind::Acceleration);
@@ -290,6 +293,11 @@ fn invalid_input_gives_typed_errors() {
         control_confidence(&tool, &task),
         Err(model::Error::InvalidGoal { .. })
     ));
+}
+
+#[test]
+fn invalid_episode_options_give_typed_errors() {
+    let tool = Arm3Tool::new([0.3, 0.25, 0.2, 0.4, 0.35, 0.3]).unwrap();
     // Options and learning rate.
     let task = Arm3::paper_task(TaskKind::Position);
     let bad = EpisodeOptionsN {
@@ -494,7 +502,7 @@ fn cli_default_models_keep_the_two_link_output() {
 
 #[test]
 fn cli_mixed_selection_json_and_text() {
-    let out = toolconf(&[
+    let select = [
         "select",
         "--task",
         "velocity",
@@ -504,8 +512,8 @@ fn cli_mixed_selection_json_and_text() {
         "1",
         "--models",
         "arm2,arm3",
-        "--json",
-    ]);
+    ];
+    let out = toolconf(&[&select[..], &["--json"]].concat());
     assert!(
         out.status.success(),
         "{}",
@@ -532,17 +540,7 @@ fn cli_mixed_selection_json_and_text() {
     ] {
         assert!(v["choice"][key].is_u64(), "{key}");
     }
-    let text = toolconf(&[
-        "select",
-        "--task",
-        "velocity",
-        "--tools",
-        "5",
-        "--seed",
-        "1",
-        "--models",
-        "arm2,arm3",
-    ]);
+    let text = toolconf(&select);
     let text = String::from_utf8(text.stdout).unwrap();
     assert!(text.contains("arm3"));
     assert!(text.contains("chosen by normalised_confidence"));

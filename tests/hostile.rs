@@ -96,15 +96,42 @@ impl Case {
 
 const ARM: &str = "0.3,0.4,0.5,0.2";
 
+/// The files the cases name, from the repository.
+struct Fixtures {
+    drawer: String,
+    design: String,
+    panda_tools: String,
+    panda_touch: String,
+    panda_task: String,
+}
+
+/// Every case, by class of hostile input: tables of one row a case, each row on one line
+/// (`#[rustfmt::skip]` keeps them so).
 fn cases() -> Vec<Case> {
-    let drawer = repo("examples/tools/drawer.csv");
-    let design = repo("examples/design/reach_and_budget.toml");
-    let d = drawer.as_str();
-    let panda_tools = repo("examples/tools/panda_tools.csv");
-    let panda_touch = repo("examples/tasks/panda_touch_point.toml");
-    let panda_task = std::fs::read_to_string(repo("examples/tasks/panda_wrist_turn.toml")).unwrap();
+    let f = Fixtures {
+        drawer: repo("examples/tools/drawer.csv"),
+        design: repo("examples/design/reach_and_budget.toml"),
+        panda_tools: repo("examples/tools/panda_tools.csv"),
+        panda_touch: repo("examples/tasks/panda_touch_point.toml"),
+        panda_task: std::fs::read_to_string(repo("examples/tasks/panda_wrist_turn.toml")).unwrap(),
+    };
+    let groups = [
+        panics_and_reads(&f),
+        results_and_exit_codes(&f),
+        output_files(&f),
+        design_and_messages(&f),
+        evaluation_and_threads(&f),
+    ];
+    groups.into_iter().flatten().collect()
+}
+
+/// Panics and unbounded reads.
+#[rustfmt::skip]
+fn panics_and_reads(f: &Fixtures) -> Vec<Case> {
+    let d = f.drawer.as_str();
+    let design = f.design.as_str();
     let long_name = "n".repeat(70_000);
-    let v = vec![
+    vec![
         // 1. Panics: a long tool name, an unwritable stdout.
         case("long name, CSV", &["rank", "--tools", "long.csv", "--task", "position", "--screen", "1"], 0, &[])
             .file("long.csv", format!("name,m1,m2,l1,l2\n{long_name},0.3,0.4,0.5,0.2\n")),
@@ -114,7 +141,7 @@ fn cases() -> Vec<Case> {
         case("simulate > /dev/full", &["simulate", "--arm", ARM, "--task", "position", "--json"], 1, &["standard output"]).to_full(),
         case("select > /dev/full", &["select", "--tools", "2", "--task", "velocity"], 1, &["standard output"]).to_full(),
         case("rank > /dev/full", &["rank", "--tools", d, "--task", "position", "--screen", "1"], 1, &["standard output"]).to_full(),
-        case("design > /dev/full", &["design", "--task", "velocity", "--design", &design], 1, &["standard output"]).to_full(),
+        case("design > /dev/full", &["design", "--task", "velocity", "--design", design], 1, &["standard output"]).to_full(),
         case("--help > /dev/full", &["rank", "--help"], 1, &["standard output"]).to_full(),
         // 2. Unbounded reads.
         case("tools /dev/zero", &["rank", "--tools", "/dev/zero", "--task", "position"], 2, &["/dev/zero", "is a device, not a tools file"]),
@@ -128,6 +155,17 @@ fn cases() -> Vec<Case> {
             .file("wide.json", format!("[{{\"name\": \"{}\"}}]", "w".repeat(2 << 20))),
         case("deep JSON", &["rank", "--tools", "deep.json", "--task", "position"], 2, &["deep.json", "recursion limit"])
             .file("deep.json", format!("[{{\"name\": {}", "[".repeat(100_000))),
+    ]
+}
+
+/// Non-finite results, and the exit codes of bad options.
+#[rustfmt::skip]
+fn results_and_exit_codes(f: &Fixtures) -> Vec<Case> {
+    let d = f.drawer.as_str();
+    let design = f.design.as_str();
+    let panda_tools = f.panda_tools.as_str();
+    let panda_task = &f.panda_task;
+    vec![
         // 3. Non-finite results.
         case("arm 1e308", &["confidence", "--arm", "1e308,1e308,1e308,1e308", "--task", "velocity"], 2, &["m1 = 1e308", "[1e-6, 1e6]"]),
         case("arm at the range's edge", &["confidence", "--arm", "1e-6,1e-6,1e-6,1e6", "--task", "velocity", "--json"], 1, &["ill-conditioned"]),
@@ -137,7 +175,7 @@ fn cases() -> Vec<Case> {
         case("goal 1e300", &["simulate", "--arm", ARM, "--task-file", "g.toml"], 2, &["g.toml", "key goal.theta", "1e300"])
             .file("g.toml", "kind = \"position\"\n[goal]\ntheta = [1e300, 0.0]\n"),
         // Starts and goals a joint can have: an angle of 1e6 rad cost 10⁶ step attempts a tool.
-        case("Panda initial_theta 1e6", &["rank", "--tools", &panda_tools, "--task", "far.toml"], 2, &["far.toml", "key episode.initial_theta", "1e6 must be a number in [-4π, 4π] rad"])
+        case("Panda initial_theta 1e6", &["rank", "--tools", panda_tools, "--task", "far.toml"], 2, &["far.toml", "key episode.initial_theta", "1e6 must be a number in [-4π, 4π] rad"])
             .file("far.toml", format!("{}initial_theta = [1e6, 0.0, 0.0, -1.5, 0.0, 1.5, 0.8]\n", panda_task)),
         case("goal rate 1e3", &["simulate", "--arm", ARM, "--task-file", "fast.toml"], 2, &["fast.toml", "key goal.theta_dot", "[-100, 100] rad/s"])
             .file("fast.toml", "kind = \"velocity\"\n[goal]\ntheta_dot = [0.0, 1e3]\n"),
@@ -163,7 +201,7 @@ fn cases() -> Vec<Case> {
             .file("zero.toml", "kind = \"acceleration\"\n[precision]\ntheta_ddot = 0.0\nu = 0.0\n"),
         case("rank zero precisions", &["rank", "--tools", d, "--task", "zero.toml"], 2, &["zero.toml", "key precision"])
             .file("zero.toml", "kind = \"velocity\"\n[precision]\ntheta_dot = 0.0\ntheta_ddot = 0.0\nu = 0.0\n"),
-        case("design zero precisions", &["design", "--task", "zero.toml", "--design", &design], 2, &["zero.toml", "key precision"])
+        case("design zero precisions", &["design", "--task", "zero.toml", "--design", design], 2, &["zero.toml", "key precision"])
             .file("zero.toml", "kind = \"acceleration\"\n[precision]\ntheta_ddot = 0.0\nu = 0.0\n"),
         case("every tool of select fails", &["select", "--tools", "2", "--task-file", "wild.toml"], 1, &["every one of the 2 tools failed"])
             .file("wild.toml", WILD),
@@ -172,6 +210,15 @@ fn cases() -> Vec<Case> {
             .file("three.csv", THREE),
         case("a simulation fails", &["simulate", "--arm", "0.3,0.4,0.25,0.2", "--task-file", "wild.toml"], 1, &["diverged at t = 0.01 s"])
             .file("wild.toml", WILD),
+    ]
+}
+
+/// Output files: folders, links, devices, an output that is an input.
+#[rustfmt::skip]
+fn output_files(f: &Fixtures) -> Vec<Case> {
+    let d = f.drawer.as_str();
+    let design = f.design.as_str();
+    vec![
         // 5. Output files.
         case("--csv a folder", &["simulate", "--arm", ARM, "--task", "position", "--csv", "out"], 2, &["--csv out: is a folder, not a file"]),
         case("rank --csv a folder", &["rank", "--tools", d, "--task", "position", "--csv", "out"], 2, &["is a folder"]),
@@ -209,7 +256,16 @@ fn cases() -> Vec<Case> {
         case("--csv /dev/null", &["simulate", "--arm", ARM, "--task", "position", "--csv", "/dev/null"], 0, &[]),
         case("--out a file", &["reproduce", "--quick", "--out", "file.txt"], 2, &["--out file.txt: is a file, not a folder"]).file("file.txt", ""),
         case("--report a file", &["rank", "--tools", d, "--task", "position", "--report", "file.txt"], 2, &["is a file, not a folder"]).file("file.txt", ""),
-        case("design --report a file", &["design", "--task", "velocity", "--design", &design, "--report", "file.txt"], 2, &["is a file, not a folder"]).file("file.txt", ""),
+        case("design --report a file", &["design", "--task", "velocity", "--design", design, "--report", "file.txt"], 2, &["is a file, not a folder"]).file("file.txt", ""),
+    ]
+}
+
+/// `design`, and the messages of bad input.
+#[rustfmt::skip]
+fn design_and_messages(f: &Fixtures) -> Vec<Case> {
+    let d = f.drawer.as_str();
+    let design = f.design.as_str();
+    vec![
         // 6. design.
         case("design, a thin feasible set", &["design", "--task", "velocity", "--design", "thin.toml", "--json"], 0, &[])
             .file("thin.toml", THIN),
@@ -217,7 +273,7 @@ fn cases() -> Vec<Case> {
             .file("wider.toml", WIDE.replace("1e-6", "1e-9").replace("1e6", "1e9")),
         case("design, huge coefficient", &["design", "--task", "velocity", "--design", "huge.toml"], 2, &["huge.toml, key constraints[0]", "coefficient of m1"])
             .file("huge.toml", format!("constraints = [\"1e300 m1 + l1 <= 1e300\"]\n{}", &WIDE[WIDE.find("[bounds]").unwrap()..])),
-        case("design, a sweep out of range", &["design", "--task", "velocity", "--design", &design, "--sweep", "m1 + m2 <= 1e20..1e21:3"], 2, &["--sweep", "constant side"]),
+        case("design, a sweep out of range", &["design", "--task", "velocity", "--design", design, "--sweep", "m1 + m2 <= 1e20..1e21:3"], 2, &["--sweep", "constant side"]),
         // 7. Messages.
         case("dt 5e-324", &["simulate", "--arm", ARM, "--task", "position", "--dt", "5e-324"], 2, &["--dt: 5e-324 must be"]),
         case("mpc period 1e-9", &["simulate", "--arm", ARM, "--task", "position", "--controller", "mpc", "--mpc-period", "1e-9"], 2, &["--mpc-period: 1e-9"]),
@@ -239,10 +295,19 @@ fn cases() -> Vec<Case> {
         case("an unknown flag", &["simulate", "--arm", ARM, "--task", "position", "--torque", "3"], 2, &["unexpected argument '--torque'"]),
         case("an unknown task", &["select", "--task", "sideways"], 2, &["unknown task 'sideways'"]),
         case("a long bad --arm", &["confidence", "--arm", &"9,".repeat(50_000), "--task", "position"], 2, &["invalid value '9,9,", "…"]),
+    ]
+}
+
+/// The evaluation on a model, and the thread count.
+#[rustfmt::skip]
+fn evaluation_and_threads(f: &Fixtures) -> Vec<Case> {
+    let panda_tools = f.panda_tools.as_str();
+    let panda_touch = f.panda_touch.as_str();
+    vec![
         // 9. The evaluation on a model (reproduce --model): bad input is one line naming the
         // flag or key, before any episode.
         case("reproduce, an unknown model", &["reproduce", "--model", "kuka", "--task", "tip_position", "--out", "out"], 2, &["unknown model 'kuka'"]),
-        case("reproduce, a task of another model", &["reproduce", "--model", "ur5", "--task-file", &panda_touch, "--sample", "5", "--out", "out"], 2, &["panda_touch_point.toml, key precision.u", "model ur5 has 6 components"]),
+        case("reproduce, a task of another model", &["reproduce", "--model", "ur5", "--task-file", panda_touch, "--sample", "5", "--out", "out"], 2, &["panda_touch_point.toml, key precision.u", "model ur5 has 6 components"]),
         case("reproduce, a population of 0", &["reproduce", "--model", "panda", "--task", "tip_position", "--sample", "0", "--out", "out"], 2, &["--sample 0: no tools"]),
         case("reproduce, a population of 10⁹", &["reproduce", "--model", "panda", "--task", "tip_position", "--sample", "1000000000", "--out", "out"], 2, &["--sample 1000000000", "more than the 1000000"]),
         case("reproduce, a box the model lacks", &["reproduce", "--model", "panda", "--task", "tip_position", "--sample", "5", "--box", "tool_lenght=0.1:0.2", "--out", "out"], 2, &["--box tool_lenght", "no parameter 'tool_lenght'"]),
@@ -251,14 +316,13 @@ fn cases() -> Vec<Case> {
         case("reproduce, --task without --model", &["reproduce", "--task", "tip_position", "--out", "out"], 2, &["--task is for an evaluation on a model"]),
         case("reproduce, --only with --model", &["reproduce", "--model", "panda", "--task", "tip_position", "--only", "fig2", "--out", "out"], 2, &["'--model <MODEL>' cannot be used with '--only <ONLY>'"]),
         case("reproduce, trials of one tool", &["reproduce", "--model", "panda", "--task", "tip_position", "--trial-tools", "1", "--out", "out"], 2, &["--trial-tools: 1 must be a count in [2, 100000]"]),
-        case("reproduce, a tools file of another model", &["reproduce", "--model", "ur5", "--task", "tip_position", "--tools", &panda_tools, "--out", "out"], 2, &["panda_tools.csv, tool 1", "a panda tool, but the evaluation is of model ur5"]),
+        case("reproduce, a tools file of another model", &["reproduce", "--model", "ur5", "--task", "tip_position", "--tools", panda_tools, "--out", "out"], 2, &["panda_tools.csv, tool 1", "a panda tool, but the evaluation is of model ur5"]),
         case("reproduce, a zero ΔT", &["reproduce", "--model", "panda", "--task-file", "still.toml", "--sample", "5", "--out", "out"], 2, &["still.toml, key episode.perturbation", "ΔT is 0 on every joint"])
             .file("still.toml", "kind = \"tip_position\"\n[goal]\ntip_offset = [0.05, 0.0, 0.0]\n[episode]\nperturbation = 0.0\n"),
         // 8. Threads.
         case("RAYON_NUM_THREADS=5000", &["select", "--tools", "3", "--task", "velocity", "--json"], 0, &[])
             .env("RAYON_NUM_THREADS", "5000"),
-    ];
-    v
+    ]
 }
 
 /// Torques at the edge of their range throw every arm past the divergence bound at t = 0.01 s.
@@ -347,21 +411,7 @@ fn check(c: &Case, dir: &Path, out: &Output) -> Result<(), String> {
         ));
     }
     if status != 0 {
-        let lines: Vec<&str> = stderr.lines().collect();
-        if lines.len() != 1 || !lines[0].starts_with("toolconf: error: ") {
-            return Err(format!("stderr is not one error line: {stderr:?}"));
-        }
-        if lines[0].chars().count() > 700 {
-            return Err(format!(
-                "an error line of {} characters",
-                lines[0].chars().count()
-            ));
-        }
-        for fragment in &c.says {
-            if !lines[0].contains(fragment) {
-                return Err(format!("stderr lacks {fragment:?}: {}", lines[0]));
-            }
-        }
+        one_error_line(c, &stderr)?;
     }
     for word in stdout.split(|ch: char| !ch.is_alphanumeric()) {
         if ["NaN", "nan", "inf", "Infinity"].contains(&word) {
@@ -373,6 +423,32 @@ fn check(c: &Case, dir: &Path, out: &Output) -> Result<(), String> {
             serde_json::from_str(&stdout).map_err(|e| format!("stdout is not JSON: {e}"))?;
         no_null_numbers(&v, "")?;
     }
+    files_unharmed(c, dir)
+}
+
+/// A failure's stderr: one line, `toolconf: error: `, not too long, holding the case's words.
+fn one_error_line(c: &Case, stderr: &str) -> Result<(), String> {
+    let lines: Vec<&str> = stderr.lines().collect();
+    if lines.len() != 1 || !lines[0].starts_with("toolconf: error: ") {
+        return Err(format!("stderr is not one error line: {stderr:?}"));
+    }
+    if lines[0].chars().count() > 700 {
+        return Err(format!(
+            "an error line of {} characters",
+            lines[0].chars().count()
+        ));
+    }
+    for fragment in &c.says {
+        if !lines[0].contains(fragment) {
+            return Err(format!("stderr lacks {fragment:?}: {}", lines[0]));
+        }
+    }
+    Ok(())
+}
+
+/// The case's files as they were, its links links, nothing created that should not be, no
+/// temporary file left, and the devices still devices.
+fn files_unharmed(c: &Case, dir: &Path) -> Result<(), String> {
     for (name, text) in &c.files {
         if std::fs::read(dir.join(name)).ok().as_ref() != Some(text) {
             return Err(format!("{name} changed"));

@@ -118,7 +118,15 @@ fn compare(builtin: ModelKind, library: &Path) -> usize {
         same.check("confidences", bt.confidences(&flat), lt.confidences(&flat));
     }
     // The robot's own dynamics and the tip at random states, one tool per state.
-    let (n, k) = (builtin.dof(), tools.len());
+    let run = |m: ModelKind| dynamics_and_tip(m, &tools);
+    same.check("dynamics and tip", run(builtin), run(loaded));
+    same.compared
+}
+
+/// Model `m`'s rigid-body dynamics, tip and tip bias for `tools` at random states (the same
+/// for every model of the same size), one tool per state, as text.
+fn dynamics_and_tip(m: ModelKind, tools: &[Vec<f64>]) -> String {
+    let (n, k) = (m.dof(), tools.len());
     let mut rng = ChaCha8Rng::seed_from_u64(11);
     let mut random =
         |len: usize| -> Vec<f64> { (0..len).map(|_| rng.random_range(-1.5..1.5)).collect() };
@@ -131,36 +139,32 @@ fn compare(builtin: ModelKind, library: &Path) -> usize {
             shared: false,
         }
     }
-    let run = |m: ModelKind| {
-        let mut f = vec![0.0; k * 2 * n];
-        let r = m.model().rigid_body_dynamics(
-            k,
-            &rows(&params, params.len() / k),
-            &rows(&x, 2 * n),
-            &rows(&u, n),
-            &mut f,
-        );
-        let (mut y, mut j, mut bias) = (vec![0.0; k * 3], vec![0.0; k * 3 * n], vec![0.0; k * 3]);
-        let q: Vec<f64> = x.chunks(2 * n).flat_map(|s| s[..n].to_vec()).collect();
-        let q_dot: Vec<f64> = x.chunks(2 * n).flat_map(|s| s[n..].to_vec()).collect();
-        let t = m.model().tip(
-            k,
-            &rows(&params, params.len() / k),
-            &rows(&q, n),
-            &mut y,
-            &mut j,
-        );
-        let tb = m.model().tip_bias(
-            k,
-            &rows(&params, params.len() / k),
-            &rows(&q, n),
-            &rows(&q_dot, n),
-            &mut bias,
-        );
-        format!("{r:?} {f:?} {t:?} {y:?} {j:?} {tb:?} {bias:?}")
-    };
-    same.check("dynamics and tip", run(builtin), run(loaded));
-    same.compared
+    let mut f = vec![0.0; k * 2 * n];
+    let r = m.model().rigid_body_dynamics(
+        k,
+        &rows(&params, params.len() / k),
+        &rows(&x, 2 * n),
+        &rows(&u, n),
+        &mut f,
+    );
+    let (mut y, mut j, mut bias) = (vec![0.0; k * 3], vec![0.0; k * 3 * n], vec![0.0; k * 3]);
+    let q: Vec<f64> = x.chunks(2 * n).flat_map(|s| s[..n].to_vec()).collect();
+    let q_dot: Vec<f64> = x.chunks(2 * n).flat_map(|s| s[n..].to_vec()).collect();
+    let t = m.model().tip(
+        k,
+        &rows(&params, params.len() / k),
+        &rows(&q, n),
+        &mut y,
+        &mut j,
+    );
+    let tb = m.model().tip_bias(
+        k,
+        &rows(&params, params.len() / k),
+        &rows(&q, n),
+        &rows(&q_dot, n),
+        &mut bias,
+    );
+    format!("{r:?} {f:?} {t:?} {y:?} {j:?} {tb:?} {bias:?}")
 }
 
 #[test]
@@ -341,6 +345,33 @@ fn c_library(dir: &Path, name: &str, source: &str) -> PathBuf {
     so
 }
 
+/// `entry`'s refusal (naming `why`) through the library, and from the environment variable.
+fn refused_elsewhere(entry: &str, why: &str) {
+    let e = loaded::load_entry(entry).unwrap_err().to_string();
+    assert!(e.contains(why), "{e}");
+    let out = Command::new(BIN)
+        .args([
+            "confidence",
+            "--model",
+            "arm2",
+            "--params",
+            "1,1,1,1",
+            "--task",
+            "position",
+        ])
+        .env(loaded::ENVIRONMENT, entry)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.starts_with("toolconf: error: TOOLCONF_MODEL_PATH: model library ")
+            && stderr.contains(why)
+            && stderr.lines().count() == 1,
+        "{stderr}"
+    );
+}
+
 #[test]
 fn what_is_not_a_model_library_is_one_line_and_status_2() {
     let dir = tempfile::tempdir().unwrap();
@@ -389,30 +420,12 @@ fn what_is_not_a_model_library_is_one_line_and_status_2() {
             "{entry}: expected '{why}': {stderr}"
         );
         // The same refusal through the library, and from the environment variable.
-        let e = loaded::load_entry(&entry).unwrap_err().to_string();
-        assert!(e.contains(why), "{e}");
-        let out = Command::new(BIN)
-            .args([
-                "confidence",
-                "--model",
-                "arm2",
-                "--params",
-                "1,1,1,1",
-                "--task",
-                "position",
-            ])
-            .env(loaded::ENVIRONMENT, &entry)
-            .output()
-            .unwrap();
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{stderr}");
-        assert!(
-            stderr.starts_with("toolconf: error: TOOLCONF_MODEL_PATH: model library ")
-                && stderr.contains(why)
-                && stderr.lines().count() == 1,
-            "{stderr}"
-        );
+        refused_elsewhere(&entry, why);
     }
+}
+
+#[test]
+fn an_unknown_model_names_the_models_and_how_to_load_one() {
     // An unknown model still names the models there are, and how to load one.
     let out = Command::new(BIN)
         .args([

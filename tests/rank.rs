@@ -631,96 +631,32 @@ fn assert_refused(dir: &Path, args: &[&str], expected: &[&str]) {
     );
 }
 
+/// Tools files `rank` refuses, and what its message names: (file, text, fragments).
+#[rustfmt::skip]
+const BAD_TOOLS_FILES: &[(&str, &str, &[&str])] = &[
+    ("missing.csv", "name,model,m1,m2,l1,l2\nok,arm2,0.3,0.4,0.5,0.2\nhole,arm2,0.3,,0.5,0.2\n", &["missing.csv", "line 3", "m2 is missing", "hole"]),
+    ("text.csv", "name,model,m1,m2,l1,l2\nw,arm2,0.3,heavy,0.5,0.2\n", &["text.csv", "line 2", "m2 = 'heavy' is not a number"]),
+    ("nan.csv", "name,model,m1,m2,l1,l2\nw,arm2,NaN,0.4,0.5,0.2\n", &["nan.csv", "line 2", "m1 = NaN must be a number in [1e-6, 1e6]"]),
+    ("zero.csv", "name,model,m1,m2,l1,l2\nw,arm2,0.3,0.4,0,0.2\n", &["zero.csv", "line 2", "l1 = 0 must be"]),
+    ("negative.csv", "name,model,m1,m2,l1,l2\nw,arm2,0.3,0.4,0.5,-0.2\n", &["negative.csv", "line 2", "l2 = -0.2"]),
+    ("model.csv", "name,model,m1,m2,l1,l2\nw,arm7,0.3,0.4,0.5,0.2\n", &["model.csv", "line 2", "unknown model 'arm7'"]),
+    ("no_m3.csv", "name,model,m1,m2,l1,l2\nw,arm3,0.3,0.4,0.5,0.2\n", &["no_m3.csv", "line 2", "m3 is missing", "arm3"]),
+    ("extra.csv", "name,model,m1,m2,m3,l1,l2\nw,arm2,0.3,0.4,0.1,0.5,0.2\n", &["extra.csv", "line 2", "m3 is given", "arm2"]),
+    ("column.csv", "name,mass1,m2,l1,l2\nw,0.3,0.4,0.5,0.2\n", &["column.csv", "line 1", "unknown column 'mass1'"]),
+    ("short.csv", "name,model,m1,m2,l1,l2\nw,arm2,0.3,0.4\n", &["short.csv", "line 2", "4 cells", "header 6"]),
+    ("empty.csv", "", &["empty.csv", "no tools"]),
+    ("header.csv", "name,model,m1,m2,l1,l2\n", &["header.csv", "no tools"]),
+    ("empty.json", "[]", &["empty.json", "no tools"]),
+    ("row.json", r#"[{"m1": 0.3, "m2": "a", "l1": 0.5, "l2": 0.2}]"#, &["row.json", "tool 1", "m2 = 'a' is not a number"]),
+    ("extra.json", r#"[{"name": "w", "model": "arm2", "m1": 0.3, "m2": 0.4, "m3": 0.1, "l1": 0.5, "l2": 0.2}]"#, &["extra.json", "tool 1", "m3 is given", "model arm2", "(tool 'w')"]),
+    ("key.json", r#"[{"m1": 0.3, "m2": 0.4, "l1": 0.5, "l2": 0.2, "colour": 1}]"#, &["key.json", "tool 1", "unknown key 'colour'"]),
+    ("object.json", r#"{"m1": 0.3}"#, &["object.json", "line 1", "not a JSON array"]),
+];
+
 #[test]
 fn every_bad_tools_file_is_refused_naming_file_line_and_value() {
     let dir = scratch("bad_tools");
-    let header = "name,model,m1,m2,l1,l2\n";
-    let cases: &[(&str, &str, &[&str])] = &[
-        (
-            "missing.csv",
-            "name,model,m1,m2,l1,l2\nok,arm2,0.3,0.4,0.5,0.2\nhole,arm2,0.3,,0.5,0.2\n",
-            &["missing.csv", "line 3", "m2 is missing", "hole"],
-        ),
-        (
-            "text.csv",
-            "name,model,m1,m2,l1,l2\nw,arm2,0.3,heavy,0.5,0.2\n",
-            &["text.csv", "line 2", "m2 = 'heavy' is not a number"],
-        ),
-        (
-            "nan.csv",
-            "name,model,m1,m2,l1,l2\nw,arm2,NaN,0.4,0.5,0.2\n",
-            &[
-                "nan.csv",
-                "line 2",
-                "m1 = NaN must be a number in [1e-6, 1e6]",
-            ],
-        ),
-        (
-            "zero.csv",
-            "name,model,m1,m2,l1,l2\nw,arm2,0.3,0.4,0,0.2\n",
-            &["zero.csv", "line 2", "l1 = 0 must be"],
-        ),
-        (
-            "negative.csv",
-            "name,model,m1,m2,l1,l2\nw,arm2,0.3,0.4,0.5,-0.2\n",
-            &["negative.csv", "line 2", "l2 = -0.2"],
-        ),
-        (
-            "model.csv",
-            "name,model,m1,m2,l1,l2\nw,arm7,0.3,0.4,0.5,0.2\n",
-            &["model.csv", "line 2", "unknown model 'arm7'"],
-        ),
-        (
-            "no_m3.csv",
-            "name,model,m1,m2,l1,l2\nw,arm3,0.3,0.4,0.5,0.2\n",
-            &["no_m3.csv", "line 2", "m3 is missing", "arm3"],
-        ),
-        (
-            "extra.csv",
-            "name,model,m1,m2,m3,l1,l2\nw,arm2,0.3,0.4,0.1,0.5,0.2\n",
-            &["extra.csv", "line 2", "m3 is given", "arm2"],
-        ),
-        (
-            "column.csv",
-            "name,mass1,m2,l1,l2\nw,0.3,0.4,0.5,0.2\n",
-            &["column.csv", "line 1", "unknown column 'mass1'"],
-        ),
-        (
-            "short.csv",
-            "name,model,m1,m2,l1,l2\nw,arm2,0.3,0.4\n",
-            &["short.csv", "line 2", "4 cells", "header 6"],
-        ),
-        ("empty.csv", "", &["empty.csv", "no tools"]),
-        ("header.csv", header, &["header.csv", "no tools"]),
-        ("empty.json", "[]", &["empty.json", "no tools"]),
-        (
-            "row.json",
-            r#"[{"m1": 0.3, "m2": "a", "l1": 0.5, "l2": 0.2}]"#,
-            &["row.json", "tool 1", "m2 = 'a' is not a number"],
-        ),
-        (
-            "extra.json",
-            r#"[{"name": "w", "model": "arm2", "m1": 0.3, "m2": 0.4, "m3": 0.1, "l1": 0.5, "l2": 0.2}]"#,
-            &[
-                "extra.json",
-                "tool 1",
-                "m3 is given",
-                "model arm2",
-                "(tool 'w')",
-            ],
-        ),
-        (
-            "key.json",
-            r#"[{"m1": 0.3, "m2": 0.4, "l1": 0.5, "l2": 0.2, "colour": 1}]"#,
-            &["key.json", "tool 1", "unknown key 'colour'"],
-        ),
-        (
-            "object.json",
-            r#"{"m1": 0.3}"#,
-            &["object.json", "line 1", "not a JSON array"],
-        ),
-    ];
-    for (file, text, expected) in cases {
+    for (file, text, expected) in BAD_TOOLS_FILES {
         let tools = write(&dir, file, text);
         assert_refused(
             &dir,
@@ -747,6 +683,27 @@ fn every_bad_tools_file_is_refused_naming_file_line_and_value() {
     );
 }
 
+/// Task files `rank` refuses, and what its message names: (file, text, fragments).
+#[rustfmt::skip]
+const BAD_TASK_FILES: &[(&str, &str, &[&str])] = &[
+    ("unknown.toml", "kind = \"position\"\ncolour = 3\n", &["unknown.toml", "line 2", "unknown field `colour`"]),
+    ("unknown_episode.toml", "kind = \"position\"\n[episode]\nt_stop = 3.0\n", &["unknown_episode.toml", "line 3", "t_stop"]),
+    ("kind.toml", "kind = \"grasp\"\n", &["kind.toml", "key kind", "'grasp'"]),
+    ("no_kind.toml", "[goal]\ntheta = [0.1, 0.2]\n", &["no_kind.toml", "kind"]),
+    ("shape.toml", "kind = \"position\"\n[precision]\ntheta = \"high\"\n", &["shape.toml", "key precision.theta", "\"high\""]),
+    ("goal_shape.toml", "kind = \"position\"\n[goal]\ntheta = 0.5\n", &["goal_shape.toml", "line 3"]),
+    ("ragged.toml", "kind = \"position\"\n[precision]\ntheta = [[1.0, 0.0], [0.0]]\n", &["ragged.toml", "key precision.theta", "square"]),
+    ("asym.toml", "kind = \"position\"\n[precision]\ntheta = [[80.0, 5.0], [1.0, 80.0]]\n", &["asym.toml", "key precision.theta", "not symmetric", "5"]),
+    ("indefinite.toml", "kind = \"position\"\n[precision]\ntheta = [[1.0, 3.0], [3.0, 1.0]]\n", &["indefinite.toml", "key precision.theta", "not positive semi-definite"]),
+    ("negative.toml", "kind = \"velocity\"\n[precision]\nu = -1.0\n", &["negative.toml", "key precision.u", "-1"]),
+    ("nan.toml", "kind = \"position\"\n[goal]\ntheta = [nan, 0.0]\n", &["nan.toml", "key goal.theta", "NaN"]),
+    ("unused.toml", "kind = \"velocity\"\n[goal]\ntheta = [0.1, 0.2]\n", &["unused.toml", "key goal.theta", "velocity task does not use it"]),
+    ("dt.toml", "kind = \"position\"\n[episode]\ndt = 0.0\n", &["dt.toml", "key episode.dt", "0 must be"]),
+    ("long.toml", "kind = \"position\"\n[episode]\nt_end = 1e5\n", &["long.toml", "key episode.t_end", "episode too long", "t_end = 100000 s"]),
+    ("far.toml", "kind = \"position\"\n[episode]\nt_end = 1e9\n", &["far.toml", "key episode.t_end", "1e9 must be a number in (0, 1e6] s"]),
+    ("joints.toml", "kind = \"position\"\n[episode]\nperturbation = [0.1, 0.2, 0.3]\n", &["joints.toml", "key episode.perturbation", "3 values", "2 joints"]),
+];
+
 #[test]
 fn every_bad_task_file_is_refused_naming_file_key_and_value() {
     let dir = scratch("bad_tasks");
@@ -755,111 +712,7 @@ fn every_bad_task_file_is_refused_naming_file_key_and_value() {
         "arm3.csv",
         "model,m1,m2,m3,l1,l2,l3\narm3,0.3,0.25,0.2,0.4,0.35,0.3\n",
     );
-    let cases: &[(&str, &str, &[&str])] = &[
-        (
-            "unknown.toml",
-            "kind = \"position\"\ncolour = 3\n",
-            &["unknown.toml", "line 2", "unknown field `colour`"],
-        ),
-        (
-            "unknown_episode.toml",
-            "kind = \"position\"\n[episode]\nt_stop = 3.0\n",
-            &["unknown_episode.toml", "line 3", "t_stop"],
-        ),
-        (
-            "kind.toml",
-            "kind = \"grasp\"\n",
-            &["kind.toml", "key kind", "'grasp'"],
-        ),
-        (
-            "no_kind.toml",
-            "[goal]\ntheta = [0.1, 0.2]\n",
-            &["no_kind.toml", "kind"],
-        ),
-        (
-            "shape.toml",
-            "kind = \"position\"\n[precision]\ntheta = \"high\"\n",
-            &["shape.toml", "key precision.theta", "\"high\""],
-        ),
-        (
-            "goal_shape.toml",
-            "kind = \"position\"\n[goal]\ntheta = 0.5\n",
-            &["goal_shape.toml", "line 3"],
-        ),
-        (
-            "ragged.toml",
-            "kind = \"position\"\n[precision]\ntheta = [[1.0, 0.0], [0.0]]\n",
-            &["ragged.toml", "key precision.theta", "square"],
-        ),
-        (
-            "asym.toml",
-            "kind = \"position\"\n[precision]\ntheta = [[80.0, 5.0], [1.0, 80.0]]\n",
-            &["asym.toml", "key precision.theta", "not symmetric", "5"],
-        ),
-        (
-            "indefinite.toml",
-            "kind = \"position\"\n[precision]\ntheta = [[1.0, 3.0], [3.0, 1.0]]\n",
-            &[
-                "indefinite.toml",
-                "key precision.theta",
-                "not positive semi-definite",
-            ],
-        ),
-        (
-            "negative.toml",
-            "kind = \"velocity\"\n[precision]\nu = -1.0\n",
-            &["negative.toml", "key precision.u", "-1"],
-        ),
-        (
-            "nan.toml",
-            "kind = \"position\"\n[goal]\ntheta = [nan, 0.0]\n",
-            &["nan.toml", "key goal.theta", "NaN"],
-        ),
-        (
-            "unused.toml",
-            "kind = \"velocity\"\n[goal]\ntheta = [0.1, 0.2]\n",
-            &[
-                "unused.toml",
-                "key goal.theta",
-                "velocity task does not use it",
-            ],
-        ),
-        (
-            "dt.toml",
-            "kind = \"position\"\n[episode]\ndt = 0.0\n",
-            &["dt.toml", "key episode.dt", "0 must be"],
-        ),
-        (
-            "long.toml",
-            "kind = \"position\"\n[episode]\nt_end = 1e5\n",
-            &[
-                "long.toml",
-                "key episode.t_end",
-                "episode too long",
-                "t_end = 100000 s",
-            ],
-        ),
-        (
-            "far.toml",
-            "kind = \"position\"\n[episode]\nt_end = 1e9\n",
-            &[
-                "far.toml",
-                "key episode.t_end",
-                "1e9 must be a number in (0, 1e6] s",
-            ],
-        ),
-        (
-            "joints.toml",
-            "kind = \"position\"\n[episode]\nperturbation = [0.1, 0.2, 0.3]\n",
-            &[
-                "joints.toml",
-                "key episode.perturbation",
-                "3 values",
-                "2 joints",
-            ],
-        ),
-    ];
-    for (file, text, expected) in cases {
+    for (file, text, expected) in BAD_TASK_FILES {
         let task = write(&dir, file, text);
         assert_refused(
             &dir,
@@ -908,7 +761,7 @@ fn every_bad_task_file_is_refused_naming_file_key_and_value() {
 }
 
 #[test]
-fn simulate_confidence_and_select_take_a_task_file() {
+fn simulate_and_confidence_take_a_task_file() {
     let p = json_of(&toolconf(&[
         "simulate",
         "--arm",
@@ -967,6 +820,10 @@ fn simulate_confidence_and_select_take_a_task_file() {
     ]));
     assert!(f(&shorter, "rhs_evals") < f(&full, "rhs_evals"));
     assert_eq!(full["perturb"], serde_json::json!([0.3, -0.2]));
+}
+
+#[test]
+fn select_takes_a_task_file_for_each_drawn_model() {
     let s = json_of(&toolconf(&[
         "select",
         "--task-file",
@@ -1008,6 +865,10 @@ fn simulate_confidence_and_select_take_a_task_file() {
     ]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("key goal.theta"));
+}
+
+#[test]
+fn a_task_file_that_does_not_fit_the_arm_is_refused() {
     // simulate's 2-link arm with a three-joint goal.
     let dir = scratch("simulate_file");
     let task = write(

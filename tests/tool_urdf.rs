@@ -72,25 +72,23 @@ fn parse(stdout: &str) -> (String, Vec<String>, Vec<String>) {
 fn the_franka_hand_row_parses_as_csv_with_the_documented_columns() {
     let dir = scratch("row");
     let panda = repo(PANDA);
-    let out = tool(
-        &dir,
-        &[
-            "--urdf",
-            &panda,
-            "--root",
-            "panda_hand",
-            "--tip",
-            "panda_hand_tcp",
-            "--opening",
-            "0.04",
-            "--flange",
-            "panda_link8",
-            "--model",
-            "panda",
-            "--name",
-            "Franka Hand, open",
-        ],
-    );
+    let hand: &[&str] = &[
+        "--urdf",
+        &panda,
+        "--root",
+        "panda_hand",
+        "--tip",
+        "panda_hand_tcp",
+        "--opening",
+        "0.04",
+        "--flange",
+        "panda_link8",
+        "--model",
+        "panda",
+        "--name",
+        "Franka Hand, open",
+    ];
+    let out = tool(&dir, hand);
     let stdout = String::from_utf8(out.stdout).unwrap();
     assert!(
         out.status.success(),
@@ -113,34 +111,19 @@ fn the_franka_hand_row_parses_as_csv_with_the_documented_columns() {
     assert_eq!(&v[10..], [0.0, 0.0, 0.1034]);
     // In panda_link8's frame (the hand turned -45° about z): ixx = iyy, com_x = -com_y.
     assert!((v[4] - v[5]).abs() < 1e-15 && (v[1] + v[2]).abs() < 1e-15);
-    // --out writes the same text, through the output rule; it refuses the URDF itself.
-    let out = tool(
-        &dir,
-        &[
-            "--urdf",
-            &panda,
-            "--root",
-            "panda_hand",
-            "--tip",
-            "panda_hand_tcp",
-            "--opening",
-            "0.04",
-            "--flange",
-            "panda_link8",
-            "--model",
-            "panda",
-            "--name",
-            "Franka Hand, open",
-            "--out",
-            "hand.csv",
-        ],
-    );
+    // --out writes the same text, through the output rule (it refuses the URDF itself: below).
+    let out = tool(&dir, &[hand, &["--out", "hand.csv"]].concat());
     assert!(out.status.success() && out.stdout.is_empty());
     assert_eq!(
         std::fs::read_to_string(dir.join("hand.csv")).unwrap(),
         stdout
     );
-    std::fs::copy(&panda, dir.join("copy.urdf")).unwrap();
+}
+
+#[test]
+fn out_never_overwrites_the_urdf_it_reads() {
+    let dir = scratch("row_over_urdf");
+    std::fs::copy(repo(PANDA), dir.join("copy.urdf")).unwrap();
     let before = std::fs::read(dir.join("copy.urdf")).unwrap();
     let out = tool(
         &dir,

@@ -296,35 +296,48 @@ fn run_lanes<const W: usize>(loops: &[Loop<1>], z0: &Z<1>) -> Vec<([f64; 6], usi
         }
         lanes.t = PerLane::select(accept, t_new, lanes.t);
         lanes.h = PerLane(std::array::from_fn(|i| (h.0[i] * fac[i]).min(H_MAX)));
-        let mut refilled = false;
-        for lane in 0..W {
-            if active[lane] && lanes.t.0[lane] >= T_END {
-                out[lanes.tool[lane]] =
-                    (std::array::from_fn(|c| lanes.y[c].0[lane]), lanes.rhs[lane]);
-                if next < loops.len() {
-                    load(&mut lanes, lane, &loops[next], next, z0);
-                    next += 1;
-                    refilled = true;
-                } else {
-                    active[lane] = false;
-                    lanes.t.0[lane] = T_END;
-                    lanes.h.0[lane] = 0.01;
-                }
+        refill(&mut lanes, &mut active, &mut next, loops, z0, &mut out);
+    }
+    out
+}
+
+/// Stores each lane that reached T_END into `out` and loads the next tool into it (or retires
+/// it when none is left).
+#[inline(always)]
+fn refill<const W: usize>(
+    lanes: &mut Lanes<W>,
+    active: &mut [bool; W],
+    next: &mut usize,
+    loops: &[Loop<1>],
+    z0: &Z<1>,
+    out: &mut [([f64; 6], usize)],
+) {
+    let mut refilled = false;
+    for lane in 0..W {
+        if active[lane] && lanes.t.0[lane] >= T_END {
+            out[lanes.tool[lane]] = (std::array::from_fn(|c| lanes.y[c].0[lane]), lanes.rhs[lane]);
+            if *next < loops.len() {
+                load(lanes, lane, &loops[*next], *next, z0);
+                *next += 1;
+                refilled = true;
+            } else {
+                active[lane] = false;
+                lanes.t.0[lane] = T_END;
+                lanes.h.0[lane] = 0.01;
             }
         }
-        if refilled {
-            // A refilled lane needs its own k1; the others keep theirs (FSAL), bit for bit.
-            let fresh = rhs(&lanes.p, &lanes.y);
-            for lane in 0..W {
-                if lanes.t.0[lane] == 0.0 && active[lane] {
-                    for c in 0..6 {
-                        lanes.k1[c].0[lane] = fresh[c].0[lane];
-                    }
+    }
+    if refilled {
+        // A refilled lane needs its own k1; the others keep theirs (FSAL), bit for bit.
+        let fresh = rhs(&lanes.p, &lanes.y);
+        for lane in 0..W {
+            if lanes.t.0[lane] == 0.0 && active[lane] {
+                for c in 0..6 {
+                    lanes.k1[c].0[lane] = fresh[c].0[lane];
                 }
             }
         }
     }
-    out
 }
 
 #[target_feature(enable = "avx2")]
@@ -356,7 +369,15 @@ fn lane_loop(arm: &toolconf::Arm, task: &TaskN<2>) -> (Loop<1>, ClosedLoopN<Arm2
     (p, cl)
 }
 
-fn main() {
+/// A way to run the lanes: its width, its build, and the run.
+type Variant<'a> = (
+    usize,
+    &'static str,
+    Box<dyn Fn(&[Loop<1>]) -> Vec<([f64; 6], usize)> + 'a>,
+);
+
+/// `--tools N`, `--task T` and `--rounds R`, with their defaults.
+fn arguments() -> (usize, Vec<TaskKind>, usize) {
     let mut tools_n = 2000;
     let mut kinds: Vec<TaskKind> = vec!["position".parse().unwrap(), "velocity".parse().unwrap()];
     let mut rounds = 5;
@@ -369,6 +390,11 @@ fn main() {
             other => panic!("unknown argument {other}"),
         }
     }
+    (tools_n, kinds, rounds)
+}
+
+fn main() {
+    let (tools_n, kinds, rounds) = arguments();
     let arms = draw_tools(tools_n, 1);
     println!(
         "{tools_n} tools (draw_tools({tools_n}, 1)), one thread, fastest of {rounds} rounds per 64-tool chunk, variants alternating; avx2 detected: {}",
@@ -382,67 +408,9 @@ fn main() {
         let loops: Vec<Loop<1>> = pairs.iter().map(|p| p.0).collect();
         let x0 = Arm2::equilibrium_state();
         let z0: Z<1> = [x0[0], x0[1], x0[2], x0[3], 0.1, 0.1].map(|v| PerLane([v]));
-        // The width-1 right-hand side is the library's, bit for bit.
-        for (p, cl) in pairs.iter().take(50) {
-            let z = SVector::<f64, 6>::from_column_slice(&[-1.3, -1.9, 0.4, -0.7, 0.3, -0.2]);
-            let ours = rhs(p, &std::array::from_fn(|c| PerLane([z[c]])));
-            let lib = cl.rhs(&z);
-            for c in 0..6 {
-                assert_eq!(
-                    ours[c].0[0].to_bits(),
-                    lib[c].to_bits(),
-                    "rhs component {c}"
-                );
-            }
-        }
-        type Variant<'a> = (
-            usize,
-            &'static str,
-            Box<dyn Fn(&[Loop<1>]) -> Vec<([f64; 6], usize)> + 'a>,
-        );
-        let mut variants: Vec<Variant> = vec![
-            (1, "baseline", Box::new(|l| run_lanes::<1>(l, &z0))),
-            (2, "baseline", Box::new(|l| run_lanes::<2>(l, &z0))),
-            (4, "baseline", Box::new(|l| run_lanes::<4>(l, &z0))),
-        ];
-        if is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2 (checked above).
-            variants.push((
-                1,
-                "avx2",
-                Box::new(|l| unsafe { run_lanes_avx2::<1>(l, &z0) }),
-            ));
-            variants.push((
-                4,
-                "avx2",
-                Box::new(|l| unsafe { run_lanes_avx2::<4>(l, &z0) }),
-            ));
-            variants.push((
-                8,
-                "avx2",
-                Box::new(|l| unsafe { run_lanes_avx2::<8>(l, &z0) }),
-            ));
-        }
-        // Chunks of 64 tools, the variants alternating chunk by chunk and round by round; each
-        // (variant, chunk) keeps its fastest round, which drops preemptions on a shared machine.
-        let mut best = vec![vec![f64::INFINITY; loops.len().div_ceil(64)]; variants.len()];
-        let mut outputs: Vec<Vec<([f64; 6], usize)>> = vec![Vec::new(); variants.len()];
-        for round in 0..rounds {
-            for (c, chunk) in loops.chunks(64).enumerate() {
-                for (v, (_, _, run)) in variants.iter().enumerate() {
-                    let s = Instant::now();
-                    let out = std::hint::black_box(run(std::hint::black_box(chunk)));
-                    best[v][c] = best[v][c].min(s.elapsed().as_secs_f64());
-                    if round == 0 {
-                        outputs[v].extend(out);
-                    }
-                }
-            }
-        }
-        let per_tool: Vec<f64> = best
-            .iter()
-            .map(|b| b.iter().sum::<f64>() * 1e6 / loops.len() as f64)
-            .collect();
+        same_rhs_as_the_library(&pairs);
+        let variants = variants(&z0);
+        let (per_tool, outputs) = measure(&variants, &loops, rounds);
         let base = &outputs[0];
         let mean_rhs = base.iter().map(|r| r.1).sum::<usize>() as f64 / base.len() as f64;
         for (v, (w, build, _)) in variants.iter().enumerate() {
@@ -460,4 +428,78 @@ fn main() {
             );
         }
     }
+}
+
+/// The width-1 right-hand side is the library's, bit for bit (on the first 50 tools).
+fn same_rhs_as_the_library(pairs: &[(Loop<1>, ClosedLoopN<Arm2, 2, 4, 4, 6>)]) {
+    for (p, cl) in pairs.iter().take(50) {
+        let z = SVector::<f64, 6>::from_column_slice(&[-1.3, -1.9, 0.4, -0.7, 0.3, -0.2]);
+        let ours = rhs(p, &std::array::from_fn(|c| PerLane([z[c]])));
+        let lib = cl.rhs(&z);
+        for c in 0..6 {
+            assert_eq!(
+                ours[c].0[0].to_bits(),
+                lib[c].to_bits(),
+                "rhs component {c}"
+            );
+        }
+    }
+}
+
+/// Widths 1, 2 and 4 for baseline x86-64, and 1, 4 and 8 for AVX2 where the CPU has it.
+fn variants(z0: &Z<1>) -> Vec<Variant<'_>> {
+    let mut variants: Vec<Variant> = vec![
+        (1, "baseline", Box::new(|l| run_lanes::<1>(l, z0))),
+        (2, "baseline", Box::new(|l| run_lanes::<2>(l, z0))),
+        (4, "baseline", Box::new(|l| run_lanes::<4>(l, z0))),
+    ];
+    if is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked above).
+        variants.push((
+            1,
+            "avx2",
+            Box::new(|l| unsafe { run_lanes_avx2::<1>(l, z0) }),
+        ));
+        variants.push((
+            4,
+            "avx2",
+            Box::new(|l| unsafe { run_lanes_avx2::<4>(l, z0) }),
+        ));
+        variants.push((
+            8,
+            "avx2",
+            Box::new(|l| unsafe { run_lanes_avx2::<8>(l, z0) }),
+        ));
+    }
+    variants
+}
+
+/// µs per tool of each variant, and its results (from the first round). Chunks of 64 tools,
+/// the variants alternating chunk by chunk and round by round; each (variant, chunk) keeps its
+/// fastest round, which drops preemptions on a shared machine.
+#[allow(clippy::type_complexity)]
+fn measure(
+    variants: &[Variant],
+    loops: &[Loop<1>],
+    rounds: usize,
+) -> (Vec<f64>, Vec<Vec<([f64; 6], usize)>>) {
+    let mut best = vec![vec![f64::INFINITY; loops.len().div_ceil(64)]; variants.len()];
+    let mut outputs: Vec<Vec<([f64; 6], usize)>> = vec![Vec::new(); variants.len()];
+    for round in 0..rounds {
+        for (c, chunk) in loops.chunks(64).enumerate() {
+            for (v, (_, _, run)) in variants.iter().enumerate() {
+                let s = Instant::now();
+                let out = std::hint::black_box(run(std::hint::black_box(chunk)));
+                best[v][c] = best[v][c].min(s.elapsed().as_secs_f64());
+                if round == 0 {
+                    outputs[v].extend(out);
+                }
+            }
+        }
+    }
+    let per_tool: Vec<f64> = best
+        .iter()
+        .map(|b| b.iter().sum::<f64>() * 1e6 / loops.len() as f64)
+        .collect();
+    (per_tool, outputs)
 }

@@ -9,8 +9,9 @@
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use toolconf_cabi::imp::Controller;
-use toolconf_cabi::toolconf_core::{ArmController, ArmModel, TaskKind, TERMS};
+use toolconf_cabi::bodies::Controller;
+use toolconf_cabi::check;
+use toolconf_cabi::toolconf_core::{ArmController, ArmModel, TaskKind};
 
 toolconf_cabi::export_model!(Arm2, arm2);
 use toolconf_cabi::toolconf_core::Arm2;
@@ -23,40 +24,9 @@ const LIVE: usize = 2000;
 fn tick(c: &mut Criterion) {
     let p = [0.3, 0.4, 0.5, 0.2];
     let task = Arm2::paper_task(TaskKind::Position);
-    let goals: Vec<f64> = task
-        .goal
-        .iter()
-        .flat_map(|g| g.as_slice().to_vec())
-        .collect();
-    let precisions: Vec<f64> = task
-        .precision
-        .iter()
-        .flat_map(|m| m.as_slice().to_vec())
-        .collect();
-    assert_eq!(precisions.len(), TERMS * 4);
-    let position = TaskKind::ALL
-        .iter()
-        .position(|k| *k == TaskKind::Position)
-        .unwrap() as u32;
+    let flat = check::flat_paper_task::<Arm2, 2, 4, 4, 6>(TaskKind::Position);
     let handles: Vec<*mut Controller> = (0..LIVE)
-        .map(|_| {
-            let mut h = core::ptr::null_mut();
-            // SAFETY: the arrays hold the model's sizes.
-            let code = unsafe {
-                toolconf_controller_create(
-                    p.as_ptr(),
-                    position,
-                    goals.as_ptr(),
-                    precisions.as_ptr(),
-                    1.0,
-                    [0.1; 2].as_ptr(),
-                    1000.0,
-                    &mut h,
-                )
-            };
-            assert_eq!(code, 0);
-            h
-        })
+        .map(|_| check::create_controller(&EXPORTS, &p, &flat, 1000.0))
         .collect();
     let tool = toolconf_cabi::toolconf_core::ToolN::new(p).unwrap();
     let mut direct =

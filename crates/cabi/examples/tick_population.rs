@@ -14,9 +14,9 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use toolconf_cabi::check::Rng;
-use toolconf_cabi::imp::Controller;
-use toolconf_cabi::toolconf_core::{ArmController, ArmModel, TaskKind, TaskN, ToolN, TERMS};
+use toolconf_cabi::bodies::Controller;
+use toolconf_cabi::check::{self, Rng};
+use toolconf_cabi::toolconf_core::{ArmController, ArmModel, TaskKind, TaskN, ToolN};
 
 toolconf_cabi::export_model!(Arm2, arm2);
 use toolconf_cabi::toolconf_core::Arm2;
@@ -61,73 +61,23 @@ fn main() {
     let ticks = args.next().unwrap_or(200);
     let rounds = args.next().unwrap_or(1);
     let task = Arm2::paper_task(TaskKind::Position);
-    let (mut goals, mut precisions) = (vec![0.0; TERMS * 2], vec![0.0; TERMS * 4]);
-    let position = TaskKind::ALL
-        .iter()
-        .position(|k| *k == TaskKind::Position)
-        .unwrap() as u32;
-    // SAFETY (every call): each pointer points to the documented number of values.
-    let code =
-        unsafe { (EXPORTS.task_defaults)(position, goals.as_mut_ptr(), precisions.as_mut_ptr()) };
-    assert_eq!(code, 0);
+    let flat = check::flat_paper_task::<Arm2, 2, 4, 4, 6>(TaskKind::Position);
     let mut population = population(tools, &task);
     let handles: Vec<*mut Controller> = population
         .iter()
-        .map(|(p, _)| {
-            let mut h = core::ptr::null_mut();
-            let code = unsafe {
-                (EXPORTS.controller_create)(
-                    p.as_ptr(),
-                    position,
-                    goals.as_ptr(),
-                    precisions.as_ptr(),
-                    1.0,
-                    [0.1; 2].as_ptr(),
-                    1000.0,
-                    &mut h,
-                )
-            };
-            assert_eq!(code, 0);
-            h
-        })
+        .map(|(p, _)| check::create_controller(&EXPORTS, p, &flat, 1000.0))
         .collect();
-    let xe = Arm2::equilibrium_state();
-    let state = |i: usize| {
-        let s = i as f64 * 1e-4;
-        [xe[0] + s, xe[1] - 0.5 * s, 0.1 + s, -0.2]
-    };
     let (mut direct_ns, mut abi_ns, mut ratio) = (Vec::new(), Vec::new(), Vec::new());
     let mut sink = 0.0;
     let pairs = (0..rounds).flat_map(|_| 0..handles.len());
     for k in pairs {
-        let (direct, handle) = (&mut population[k].1, &handles[k]);
-        let start = Instant::now();
-        for i in 0..ticks {
-            sink += direct
-                .tick(black_box(&state(i)))
-                .map_or(0.0, |c| c.torque[0]);
-        }
-        let d = start.elapsed().as_secs_f64() * 1e9 / ticks as f64;
-        let (mut torque, mut confidence) = ([0.0; 2], 0.0);
-        let start = Instant::now();
-        for i in 0..ticks {
-            let x = state(i);
-            let code = unsafe {
-                (EXPORTS.controller_tick)(
-                    black_box(*handle),
-                    x.as_ptr(),
-                    torque.as_mut_ptr(),
-                    &mut confidence,
-                )
-            };
-            sink += f64::from(code) + torque[0];
-        }
-        let a = start.elapsed().as_secs_f64() * 1e9 / ticks as f64;
+        let (d, a) = time_pair(&mut population[k].1, handles[k], ticks, &mut sink);
         direct_ns.push(d);
         abi_ns.push(a);
         ratio.push(a / d);
     }
     for h in handles {
+        // SAFETY: a live handle.
         assert_eq!(unsafe { (EXPORTS.controller_destroy)(h) }, 0);
     }
     println!(
@@ -137,4 +87,44 @@ fn main() {
     stats("C ABI (handle)", abi_ns);
     stats("ratio C ABI / direct", ratio);
     black_box(sink);
+}
+
+/// ns per tick of `ticks` ticks of one tool: directly, then through the C ABI's `handle` (the
+/// same controller); what they return is added to `sink`, so that no tick is optimised away.
+fn time_pair(
+    direct: &mut Direct,
+    handle: *mut Controller,
+    ticks: usize,
+    sink: &mut f64,
+) -> (f64, f64) {
+    // A measured state near the equilibrium, different at each tick.
+    let xe = Arm2::equilibrium_state();
+    let state = |i: usize| {
+        let s = i as f64 * 1e-4;
+        [xe[0] + s, xe[1] - 0.5 * s, 0.1 + s, -0.2]
+    };
+    let start = Instant::now();
+    for i in 0..ticks {
+        *sink += direct
+            .tick(black_box(&state(i)))
+            .map_or(0.0, |c| c.torque[0]);
+    }
+    let d = start.elapsed().as_secs_f64() * 1e9 / ticks as f64;
+    let (mut torque, mut confidence) = ([0.0; 2], 0.0);
+    let start = Instant::now();
+    for i in 0..ticks {
+        let x = state(i);
+        // SAFETY: a live handle; the arrays hold the model's sizes.
+        let code = unsafe {
+            (EXPORTS.controller_tick)(
+                black_box(handle),
+                x.as_ptr(),
+                torque.as_mut_ptr(),
+                &mut confidence,
+            )
+        };
+        *sink += f64::from(code) + torque[0];
+    }
+    let a = start.elapsed().as_secs_f64() * 1e9 / ticks as f64;
+    (d, a)
 }

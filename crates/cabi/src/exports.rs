@@ -4,7 +4,7 @@
 
 use core::ffi::c_char;
 
-use crate::imp::Controller;
+use crate::bodies::Controller;
 use crate::ModelInfo;
 
 /// The exports of one model library, by their C names without the `toolconf_` prefix.

@@ -34,7 +34,7 @@ use std::sync::{Mutex, PoisonError};
 
 use toolconf_core::{TaskKind, Term};
 
-use crate::imp::Controller;
+use crate::bodies::Controller;
 use crate::status::{self, fail, Failure};
 
 /// A live controller: its handle's value, its type, and its box.

@@ -160,6 +160,48 @@ impl Builder {
     }
 }
 
+impl Builder {
+    /// The tool's rule of `g` as C sees it: its domains, constraints and inertia rule (zeros
+    /// and an empty rule for a model without one).
+    fn tool_rule(&mut self, g: &Generated) -> (Vec<Domain>, Vec<Constraint>, InertiaRule) {
+        let domains: Vec<Domain> = g
+            .domains
+            .iter()
+            .map(|d| Domain {
+                lo: d.lo,
+                hi: d.hi,
+                lo_open: d.lo_open.into(),
+                hi_open: d.hi_open.into(),
+                rule: self.string(d.rule),
+            })
+            .collect();
+        let constraints: Vec<Constraint> = g
+            .constraints
+            .iter()
+            .map(|c| Constraint {
+                coefficients: self.numbers(c.coefficients.iter().copied()),
+                rule: self.string(c.rule),
+            })
+            .collect();
+        let index = |i: usize| u32::try_from(i).unwrap_or(u32::MAX);
+        let inertia = match g.inertia {
+            Some(r) => InertiaRule {
+                moments: r.moments.map(index),
+                products: r.products.map(index),
+                slack: r.slack,
+                rule: self.string(r.rule),
+            },
+            None => InertiaRule {
+                moments: [0; 3],
+                products: [0; 3],
+                slack: 0.0,
+                rule: self.string(""),
+            },
+        };
+        (domains, constraints, inertia)
+    }
+}
+
 /// Builds the metadata of model `M` from its generated `ModelInfo` (the one named `M::name()`).
 pub fn build<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>() -> InfoStorage
 where
@@ -173,40 +215,7 @@ where
         numbers: Vec::new(),
         flags: Vec::new(),
     };
-    let domains: Vec<Domain> = g
-        .domains
-        .iter()
-        .map(|d| Domain {
-            lo: d.lo,
-            hi: d.hi,
-            lo_open: d.lo_open.into(),
-            hi_open: d.hi_open.into(),
-            rule: b.string(d.rule),
-        })
-        .collect();
-    let constraints: Vec<Constraint> = g
-        .constraints
-        .iter()
-        .map(|c| Constraint {
-            coefficients: b.numbers(c.coefficients.iter().copied()),
-            rule: b.string(c.rule),
-        })
-        .collect();
-    let index = |i: usize| u32::try_from(i).unwrap_or(u32::MAX);
-    let inertia = match g.inertia {
-        Some(r) => InertiaRule {
-            moments: r.moments.map(index),
-            products: r.products.map(index),
-            slack: r.slack,
-            rule: b.string(r.rule),
-        },
-        None => InertiaRule {
-            moments: [0; 3],
-            products: [0; 3],
-            slack: 0.0,
-            rule: b.string(""),
-        },
-    };
+    let (domains, constraints, inertia) = b.tool_rule(g);
     let info = ModelInfo {
         abi_version: crate::ABI_VERSION,
         name: b.string(g.name),

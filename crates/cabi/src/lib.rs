@@ -19,7 +19,7 @@
 //!   sensitivities `TERMS × N × N`, a tip term padded to N as toolconf-core's `TaskN` does.
 //! * **Status, never a crash.** Every function returns an `int32_t` [`status`]: 0, or why not
 //!   (a null pointer, an unknown task, a non-finite input, ...), the arguments checked in one
-//!   order ([`imp`]), with a message for the calling thread in `toolconf_last_error()`. Outputs
+//!   order ([`bodies`]), with a message for the calling thread in `toolconf_last_error()`. Outputs
 //!   are written only on success, and only finite numbers. A panic is caught at the boundary
 //!   ([`status::INTERNAL`]); nothing unwinds into C; an allocation that fails is
 //!   [`status::OUT_OF_MEMORY`].
@@ -27,19 +27,21 @@
 //!   controllers ([`handles`]): a destroyed, foreign or forged one is
 //!   [`status::BAD_HANDLE`], and nothing is read through it.
 //! * **The same numbers.** Each function calls the generated function (through toolconf-core's
-//!   [`toolconf_core::ArmModel`]) the Rust code calls, and copies; [`check::bit_identity`]
-//!   compares every export through its function pointer with the direct call, bit for bit.
+//!   [`toolconf_core::ArmModel`]) the Rust code calls, and copies; `check::bit_identity` (the
+//!   feature `check`) compares every export through its function pointer with the direct
+//!   call, bit for bit.
 //!
 //! Nothing here allocates per call but the controller's creation (its box and room in the
 //! registry, both fallible) and the metadata, built once on first use.
 
 use core::ffi::c_char;
 
+pub mod bodies;
+#[cfg(feature = "check")]
 pub mod check;
 pub mod exports;
 pub mod fingerprint;
 pub mod handles;
-pub mod imp;
 pub mod info;
 pub mod status;
 
@@ -86,6 +88,13 @@ macro_rules! export_model {
         const TOOLCONF_NX: usize = $crate::toolconf_core::generated::$module::STATE_DIM;
         const TOOLCONF_NP: usize = $crate::toolconf_core::generated::$module::PARAMETER_COUNT;
         const TOOLCONF_NZ: usize = TOOLCONF_NX + TOOLCONF_N;
+        type ToolconfBodies = $crate::bodies::Bodies<
+            ToolconfModel,
+            TOOLCONF_N,
+            TOOLCONF_NX,
+            TOOLCONF_NP,
+            TOOLCONF_NZ,
+        >;
 
         /// The version of the C ABI (checked first).
         #[no_mangle]
@@ -104,7 +113,13 @@ macro_rules! export_model {
         pub extern "C" fn toolconf_model_info() -> *const $crate::ModelInfo {
             static INFO: ::std::sync::OnceLock<$crate::info::InfoStorage> =
                 ::std::sync::OnceLock::new();
-            $crate::info::model_info::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(&INFO)
+            $crate::info::model_info::<
+                ToolconfModel,
+                TOOLCONF_N,
+                TOOLCONF_NX,
+                TOOLCONF_NP,
+                TOOLCONF_NZ,
+            >(&INFO)
         }
 
         /// The calling thread's message for its last nonzero status.
@@ -122,7 +137,7 @@ macro_rules! export_model {
         /// Whether `params` is a valid tool by the model's rule.
         #[no_mangle]
         pub unsafe extern "C" fn toolconf_check_tool(params: *const f64) -> i32 {
-            $crate::imp::check_tool::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(params)
+            ToolconfBodies::check_tool(params)
         }
 
         /// Ẋ = f(X, U; p).
@@ -133,7 +148,7 @@ macro_rules! export_model {
             params: *const f64,
             x_dot: *mut f64,
         ) -> i32 {
-            $crate::imp::dynamics::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(x, u, params, x_dot)
+            ToolconfBodies::dynamics(x, u, params, x_dot)
         }
 
         /// (∂f/∂X, ∂f/∂U) at (X, U).
@@ -145,7 +160,7 @@ macro_rules! export_model {
             f_x: *mut f64,
             f_u: *mut f64,
         ) -> i32 {
-            $crate::imp::dynamics_jacobian::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(x, u, params, f_x, f_u)
+            ToolconfBodies::dynamics_jacobian(x, u, params, f_x, f_u)
         }
 
         /// The rigid-body dynamics alone, U the joint torques.
@@ -156,7 +171,7 @@ macro_rules! export_model {
             params: *const f64,
             x_dot: *mut f64,
         ) -> i32 {
-            $crate::imp::rigid_body_dynamics::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(x, u, params, x_dot)
+            ToolconfBodies::rigid_body_dynamics(x, u, params, x_dot)
         }
 
         /// The tool tip y(q) and its Jacobian ∂y/∂q (3 × N).
@@ -167,7 +182,7 @@ macro_rules! export_model {
             position: *mut f64,
             jacobian: *mut f64,
         ) -> i32 {
-            $crate::imp::tip::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(q, params, position, jacobian)
+            ToolconfBodies::tip(q, params, position, jacobian)
         }
 
         /// The tip's acceleration at q̈ = 0, J̇(q, q̇) q̇ (3).
@@ -178,19 +193,19 @@ macro_rules! export_model {
             params: *const f64,
             bias: *mut f64,
         ) -> i32 {
-            $crate::imp::tip_bias::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(q, q_dot, params, bias)
+            ToolconfBodies::tip_bias(q, q_dot, params, bias)
         }
 
         /// A = ∂f/∂X at the equilibrium.
         #[no_mangle]
         pub unsafe extern "C" fn toolconf_state_matrix(params: *const f64, a: *mut f64) -> i32 {
-            $crate::imp::state_matrix::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(params, a)
+            ToolconfBodies::state_matrix(params, a)
         }
 
         /// B = ∂f/∂U at the equilibrium.
         #[no_mangle]
         pub unsafe extern "C" fn toolconf_input_matrix(params: *const f64, b: *mut f64) -> i32 {
-            $crate::imp::input_matrix::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(params, b)
+            ToolconfBodies::input_matrix(params, b)
         }
 
         /// The model's default goals and precisions of a task.
@@ -200,7 +215,7 @@ macro_rules! export_model {
             goals: *mut f64,
             precisions: *mut f64,
         ) -> i32 {
-            $crate::imp::task_defaults::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(task, goals, precisions)
+            ToolconfBodies::task_defaults(task, goals, precisions)
         }
 
         /// A task's sensitivities ∂(term)/∂U.
@@ -211,7 +226,7 @@ macro_rules! export_model {
             sensitivities: *mut f64,
             used: *mut i32,
         ) -> i32 {
-            $crate::imp::sensitivities::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(task, params, sensitivities, used)
+            ToolconfBodies::sensitivities(task, params, sensitivities, used)
         }
 
         /// Π^U of a task for a tool, given the precisions (the closed form, unvalidated).
@@ -222,7 +237,7 @@ macro_rules! export_model {
             precisions: *const f64,
             pi_u: *mut f64,
         ) -> i32 {
-            $crate::imp::pi_u::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(task, params, precisions, pi_u)
+            ToolconfBodies::pi_u(task, params, precisions, pi_u)
         }
 
         /// ∂ln|Π^U|/∂p (the closed form, unvalidated).
@@ -233,7 +248,7 @@ macro_rules! export_model {
             precisions: *const f64,
             gradient: *mut f64,
         ) -> i32 {
-            $crate::imp::logdet_gradient::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(task, params, precisions, gradient)
+            ToolconfBodies::logdet_gradient(task, params, precisions, gradient)
         }
 
         /// Π^U and ln|Π^U| of a valid tool on a valid task.
@@ -246,7 +261,7 @@ macro_rules! export_model {
             pi_u: *mut f64,
             logdet: *mut f64,
         ) -> i32 {
-            $crate::imp::control_confidence::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(task, params, goals, precisions, pi_u, logdet)
+            ToolconfBodies::control_confidence(task, params, goals, precisions, pi_u, logdet)
         }
 
         /// A controller of a tool for a task (the on-robot controller), into `*controller`.
@@ -259,49 +274,64 @@ macro_rules! export_model {
             learning_rate: f64,
             initial_torque: *const f64,
             rate_hz: f64,
-            controller: *mut *mut $crate::imp::Controller,
+            controller: *mut *mut $crate::bodies::Controller,
         ) -> i32 {
-            $crate::imp::controller_create::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(params, task, goals, precisions, learning_rate, initial_torque, rate_hz, controller)
+            ToolconfBodies::controller_create(
+                params,
+                task,
+                goals,
+                precisions,
+                learning_rate,
+                initial_torque,
+                rate_hz,
+                controller,
+            )
         }
 
         /// Frees a controller (NULL: nothing).
         #[no_mangle]
         pub unsafe extern "C" fn toolconf_controller_destroy(
-            controller: *mut $crate::imp::Controller,
+            controller: *mut $crate::bodies::Controller,
         ) -> i32 {
-            $crate::imp::controller_destroy::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(controller)
+            ToolconfBodies::controller_destroy(controller)
         }
 
         /// One tick: the measured state in, the torque and ln|Π^U| out.
         #[no_mangle]
         pub unsafe extern "C" fn toolconf_controller_tick(
-            controller: *mut $crate::imp::Controller,
+            controller: *mut $crate::bodies::Controller,
             state: *const f64,
             torque: *mut f64,
             confidence: *mut f64,
         ) -> i32 {
-            $crate::imp::controller_tick::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(controller, state, torque, confidence)
+            ToolconfBodies::controller_tick(controller, state, torque, confidence)
         }
 
         /// One tick with the joint accelerations measured too.
         #[no_mangle]
         pub unsafe extern "C" fn toolconf_controller_tick_with_acceleration(
-            controller: *mut $crate::imp::Controller,
+            controller: *mut $crate::bodies::Controller,
             state: *const f64,
             acceleration: *const f64,
             torque: *mut f64,
             confidence: *mut f64,
         ) -> i32 {
-            $crate::imp::controller_tick_with_acceleration::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(controller, state, acceleration, torque, confidence)
+            ToolconfBodies::controller_tick_with_acceleration(
+                controller,
+                state,
+                acceleration,
+                torque,
+                confidence,
+            )
         }
 
         /// The controller's Π^U (N × N).
         #[no_mangle]
         pub unsafe extern "C" fn toolconf_controller_pi_u(
-            controller: *const $crate::imp::Controller,
+            controller: *const $crate::bodies::Controller,
             pi_u: *mut f64,
         ) -> i32 {
-            $crate::imp::controller_pi_u::<ToolconfModel, TOOLCONF_N, TOOLCONF_NX, TOOLCONF_NP, TOOLCONF_NZ>(controller, pi_u)
+            ToolconfBodies::controller_pi_u(controller, pi_u)
         }
 
         /// Every export as a table of function pointers (the library's own tests go through it).

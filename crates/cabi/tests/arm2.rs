@@ -9,8 +9,8 @@
 toolconf_cabi::export_model!(Arm2, arm2);
 
 use nalgebra::SVector;
+use toolconf_cabi::bodies::{Bodies, Controller};
 use toolconf_cabi::check::{self, Foreign};
-use toolconf_cabi::imp::{self, Controller};
 use toolconf_cabi::status;
 use toolconf_cabi::toolconf_core::{Arm2, Arm3, ArmModel};
 
@@ -33,7 +33,7 @@ fn hostile_input_is_a_status() {
 fn the_fuzzer_reaches_every_rule_with_another_models_handles() {
     let create = || check::cases::controller_of::<Arm3, 3, 6, 6, 9>();
     // SAFETY: any handle value is checked.
-    let destroy = |h: *mut Controller| unsafe { imp::controller_destroy::<Arm3, 3, 6, 6, 9>(h) };
+    let destroy = |h: *mut Controller| unsafe { Bodies::<Arm3, 3, 6, 6, 9>::controller_destroy(h) };
     let foreign = Foreign {
         create: &create,
         destroy: &destroy,

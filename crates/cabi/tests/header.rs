@@ -90,6 +90,12 @@ fn the_header_declares_this_crates_abi() {
         toolconf_cabi::ABI_VERSION
     )));
 
+    compiles(&h, &layouts_and_signatures());
+}
+
+/// A C file that asserts (with `_Static_assert`) each struct's layout and assigns each export
+/// to a pointer of its signature.
+fn layouts_and_signatures() -> String {
     let mut c = String::from("#include <stddef.h>\n#include \"toolconf_model.h\"\n");
     c += &layout!("toolconf_domain", Domain, [lo, hi, lo_open, hi_open, rule]);
     c += &layout!("toolconf_constraint", Constraint, [coefficients, rule]);
@@ -138,9 +144,14 @@ fn the_header_declares_this_crates_abi() {
         let pointer = signature.replacen("(*)", &format!("(*p_{symbol})"), 1);
         c += &format!("{pointer} = {symbol};\n");
     }
+    c
+}
+
+/// The header `h` compiles with `c` (the layouts) as C11, and alone as C++11.
+fn compiles(h: &str, c: &str) {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("toolconf_model.h"), &h).unwrap();
-    std::fs::write(dir.path().join("layout.c"), &c).unwrap();
+    std::fs::write(dir.path().join("toolconf_model.h"), h).unwrap();
+    std::fs::write(dir.path().join("layout.c"), c).unwrap();
     std::fs::write(dir.path().join("include.cpp"), "#include \"toolconf_model.h\"\nint main() { return toolconf_abi_version() == TOOLCONF_ABI_VERSION ? 0 : 1; }\n").unwrap();
     // As C11 with the layouts and signatures; as C++ (the extern "C" block), included alone.
     for (file, standard) in [("layout.c", "-std=c11"), ("include.cpp", "-std=c++11")] {

@@ -7,7 +7,7 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicIsize, AtomicUsize, Ordering};
 
-use toolconf_cabi::imp::Controller;
+use toolconf_cabi::bodies::Controller;
 use toolconf_cabi::toolconf_core::{Arm2, ArmModel, TaskKind};
 use toolconf_cabi::{handles, status};
 

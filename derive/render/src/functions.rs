@@ -205,46 +205,8 @@ fn function_view<'a>(
         .as_ref()
         .ok_or_else(|| bad(f, "coefficients but no unhoisted_cost"))?;
     let name = shared.map_or(c.r#struct.as_str(), |(_, s)| s.r#struct.as_str());
-    let own_type = format!("&{}", c.r#struct);
-    let mut call = Vec::new();
-    let mut with_signature = Vec::new();
-    for a in &c.args {
-        let rust_type = if a.name == "coefficients" {
-            if a.rust_type != own_type {
-                return Err(bad(
-                    f,
-                    "its coefficients argument is not its coefficient struct",
-                ));
-            }
-            call.push(format!("&{name}::new(params)"));
-            format!("&{name}")
-        } else {
-            call.push(a.name.clone());
-            a.rust_type.clone()
-        };
-        with_signature.push(format!("{}{}: {rust_type}", unused(a.used), a.name));
-    }
-    let sin_cos = if f.cost.sin_cos > 0 {
-        format!(", plus {} `sin_cos`", f.cost.sin_cos)
-    } else {
-        String::new()
-    };
-    let cost_doc = vec![
-        format!(
-            "Cost per call: {} operations, weighted {}{sin_cos}: [`{name}::new`] ({}, weighted {}), then [`{n}_with`] ({}, weighted {}). Build the coefficients once per tool and call [`{n}_with`] where it is called often.",
-            c.cost.ops + f.cost.ops,
-            c.cost.weighted + f.cost.weighted,
-            c.cost.ops,
-            c.cost.weighted,
-            f.cost.ops,
-            f.cost.weighted,
-            n = f.name,
-        ),
-        format!(
-            "The same closed form with the parameters inline (not hoisted) would take {}.",
-            ops_text(unhoisted)
-        ),
-    ];
+    let (call, with_signature) = with_arguments(f, c, name)?;
+    let cost_doc = hoisted_cost_doc(f, c, name, unhoisted);
     Ok(FunctionView {
         name: &f.name,
         doc: comment(&f.doc),
@@ -271,6 +233,61 @@ fn function_view<'a>(
             with_cost: ops_text(&f.cost),
         }),
     })
+}
+
+/// The `_with` function's call from the plain one (its coefficients built from the parameters
+/// as `name`, the struct they share) and its signature.
+fn with_arguments(
+    f: &Function,
+    c: &Coefficients,
+    name: &str,
+) -> Result<(Vec<String>, Vec<String>), RenderError> {
+    let own_type = format!("&{}", c.r#struct);
+    let mut call = Vec::new();
+    let mut with_signature = Vec::new();
+    for a in &c.args {
+        let rust_type = if a.name == "coefficients" {
+            if a.rust_type != own_type {
+                return Err(bad(
+                    f,
+                    "its coefficients argument is not its coefficient struct",
+                ));
+            }
+            call.push(format!("&{name}::new(params)"));
+            format!("&{name}")
+        } else {
+            call.push(a.name.clone());
+            a.rust_type.clone()
+        };
+        with_signature.push(format!("{}{}: {rust_type}", unused(a.used), a.name));
+    }
+    Ok((call, with_signature))
+}
+
+/// The cost of a function with hoisted coefficients: building them, the `_with` call, and the
+/// closed form with the parameters inline (`unhoisted`).
+fn hoisted_cost_doc(f: &Function, c: &Coefficients, name: &str, unhoisted: &Cost) -> Vec<String> {
+    let sin_cos = if f.cost.sin_cos > 0 {
+        format!(", plus {} `sin_cos`", f.cost.sin_cos)
+    } else {
+        String::new()
+    };
+    vec![
+        format!(
+            "Cost per call: {} operations, weighted {}{sin_cos}: [`{name}::new`] ({}, weighted {}), then [`{n}_with`] ({}, weighted {}). Build the coefficients once per tool and call [`{n}_with`] where it is called often.",
+            c.cost.ops + f.cost.ops,
+            c.cost.weighted + f.cost.weighted,
+            c.cost.ops,
+            c.cost.weighted,
+            f.cost.ops,
+            f.cost.weighted,
+            n = f.name,
+        ),
+        format!(
+            "The same closed form with the parameters inline (not hoisted) would take {}.",
+            ops_text(unhoisted)
+        ),
+    ]
 }
 
 fn unused(used: bool) -> &'static str {

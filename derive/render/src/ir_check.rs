@@ -20,7 +20,7 @@ use serde_json::Value;
 
 use crate::code;
 use crate::escape::{file_name_problem, name_problem, refused, shown, MAX_NAME};
-use crate::ir::{Function, Ir, Let};
+use crate::ir::{Coefficients, Function, Ir, Let, Output, Sequence};
 
 /// A field of the IR that is not what it must be: its key and why.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -242,34 +242,13 @@ fn bindings(key: &str, bindings: &[crate::ir::Binding]) -> Checked {
 
 fn check_function(key: &str, f: &Function) -> Checked {
     name(format!("{key}.name"), &f.name, MAX_DERIVED_NAME)?;
-    for (i, a) in f.args.iter().enumerate() {
-        name(format!("{key}.args[{i}].name"), &a.name, MAX_DERIVED_NAME)?;
-        grammar(
-            format!("{key}.args[{i}].rust_type"),
-            &a.rust_type,
-            code::rust_type,
-        )?;
-    }
+    let args = f
+        .args
+        .iter()
+        .map(|a| (a.name.as_str(), a.rust_type.as_str()));
+    arguments(&format!("{key}.args"), args)?;
     for (i, o) in f.outputs.iter().enumerate() {
-        name(
-            format!("{key}.outputs[{i}].name"),
-            &o.name,
-            MAX_DERIVED_NAME,
-        )?;
-        grammar(
-            format!("{key}.outputs[{i}].rust_type"),
-            &o.rust_type,
-            code::rust_type,
-        )?;
-        for (j, e) in o.entries.iter().enumerate() {
-            if let Some(rust) = &e.rust {
-                grammar(
-                    format!("{key}.outputs[{i}].entries[{j}].rust"),
-                    rust,
-                    code::expression,
-                )?;
-            }
-        }
+        output(&format!("{key}.outputs[{i}]"), o)?;
     }
     lets(&format!("{key}.constants"), &f.constants)?;
     bindings(&format!("{key}.bindings"), &f.bindings)?;
@@ -284,51 +263,76 @@ fn check_function(key: &str, f: &Function) -> Checked {
     lets(&format!("{key}.compounds"), &f.compounds)?;
     lets(&format!("{key}.temporaries"), &f.temporaries)?;
     if let Some(c) = &f.coefficients {
-        let key = format!("{key}.coefficients");
-        if !code::camel_case(&c.r#struct) || c.r#struct.len() > MAX_DERIVED_NAME {
-            return Err(refuse(
-                format!("{key}.struct"),
-                format!(
-                    "'{}' is not a struct's name (CamelCase ASCII)",
-                    shown(&c.r#struct)
-                ),
-            ));
-        }
-        lets(&format!("{key}.constants"), &c.constants)?;
-        bindings(&format!("{key}.bindings"), &c.bindings)?;
-        lets(&format!("{key}.temporaries"), &c.temporaries)?;
-        for (i, v) in c.values.iter().enumerate() {
-            grammar(format!("{key}.values[{i}]"), v, code::expression)?;
-        }
-        for (i, a) in c.args.iter().enumerate() {
-            name(format!("{key}.args[{i}].name"), &a.name, MAX_DERIVED_NAME)?;
-            grammar(
-                format!("{key}.args[{i}].rust_type"),
-                &a.rust_type,
-                code::rust_type,
-            )?;
-        }
+        coefficients(&format!("{key}.coefficients"), c)?;
     }
     if let Some(s) = &f.sequence {
-        for (i, slot) in s.slots.iter().enumerate() {
-            name(
-                format!("{key}.sequence.slots[{i}].name"),
-                &slot.name,
-                MAX_DERIVED_NAME,
-            )?;
+        sequence(&format!("{key}.sequence"), s)?;
+    }
+    Ok(())
+}
+
+/// Arguments (name, Rust type), `key` the array's.
+fn arguments<'a>(key: &str, args: impl Iterator<Item = (&'a str, &'a str)>) -> Checked {
+    for (i, (arg, rust_type)) in args.enumerate() {
+        name(format!("{key}[{i}].name"), arg, MAX_DERIVED_NAME)?;
+        grammar(format!("{key}[{i}].rust_type"), rust_type, code::rust_type)?;
+    }
+    Ok(())
+}
+
+fn output(key: &str, o: &Output) -> Checked {
+    name(format!("{key}.name"), &o.name, MAX_DERIVED_NAME)?;
+    grammar(format!("{key}.rust_type"), &o.rust_type, code::rust_type)?;
+    for (j, e) in o.entries.iter().enumerate() {
+        if let Some(rust) = &e.rust {
+            grammar(format!("{key}.entries[{j}].rust"), rust, code::expression)?;
         }
-        for (i, step) in s.steps.iter().enumerate() {
-            grammar(
-                format!("{key}.sequence.steps[{i}].target"),
-                &step.target,
-                code::target,
-            )?;
-            grammar(
-                format!("{key}.sequence.steps[{i}].rust"),
-                &step.rust,
-                code::expression,
-            )?;
-        }
+    }
+    Ok(())
+}
+
+fn coefficients(key: &str, c: &Coefficients) -> Checked {
+    if !code::camel_case(&c.r#struct) || c.r#struct.len() > MAX_DERIVED_NAME {
+        return Err(refuse(
+            format!("{key}.struct"),
+            format!(
+                "'{}' is not a struct's name (CamelCase ASCII)",
+                shown(&c.r#struct)
+            ),
+        ));
+    }
+    lets(&format!("{key}.constants"), &c.constants)?;
+    bindings(&format!("{key}.bindings"), &c.bindings)?;
+    lets(&format!("{key}.temporaries"), &c.temporaries)?;
+    for (i, v) in c.values.iter().enumerate() {
+        grammar(format!("{key}.values[{i}]"), v, code::expression)?;
+    }
+    let args = c
+        .args
+        .iter()
+        .map(|a| (a.name.as_str(), a.rust_type.as_str()));
+    arguments(&format!("{key}.args"), args)
+}
+
+fn sequence(key: &str, s: &Sequence) -> Checked {
+    for (i, slot) in s.slots.iter().enumerate() {
+        name(
+            format!("{key}.slots[{i}].name"),
+            &slot.name,
+            MAX_DERIVED_NAME,
+        )?;
+    }
+    for (i, step) in s.steps.iter().enumerate() {
+        grammar(
+            format!("{key}.steps[{i}].target"),
+            &step.target,
+            code::target,
+        )?;
+        grammar(
+            format!("{key}.steps[{i}].rust"),
+            &step.rust,
+            code::expression,
+        )?;
     }
     Ok(())
 }

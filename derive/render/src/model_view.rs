@@ -10,7 +10,9 @@ use serde_json::Value;
 
 use crate::escape::{comment, rust_string};
 use crate::functions::{function_views, FunctionView};
-use crate::ir::{ClosedFormReport, Equilibrium, Ir, Model, Report, TestVectors, UrdfReport};
+use crate::ir::{
+    ClosedFormReport, Equilibrium, Ir, Model, Report, TaskReport, TestVectors, UrdfReport,
+};
 use crate::tasks::{task_views, TaskView};
 use crate::tool_rule::{tool_rule_view, ToolRuleView};
 use crate::RenderError;
@@ -188,7 +190,35 @@ pub struct RemarkView {
 fn closed_form_report(m: &Model, r: &ClosedFormReport, tasks: &[TaskView]) -> ClosedFormReportView {
     let latex =
         |vs: &[crate::ir::Variable]| comment(&join(vs.iter().map(|v| v.latex.as_str()), "\\ "));
-    let compared = (!r.comparisons.is_empty()).then(|| ComparedView {
+    let compared = (!r.comparisons.is_empty()).then(|| compared_view(r));
+    let tasks = r
+        .tasks
+        .iter()
+        .map(|t| {
+            let formulation = tasks
+                .iter()
+                .find(|v| v.name == t.name)
+                .map_or_else(String::new, |v| v.formulation.clone());
+            task_report_view(t, formulation)
+        })
+        .collect();
+    ClosedFormReportView {
+        equation_refs: comment(&r.equation_refs.join(", ")),
+        equations: comment_all(&r.equations),
+        equilibrium_x: comment(&r.equilibrium_x),
+        equilibrium_u: comment(&r.equilibrium_u),
+        a: comment(&r.a),
+        b: comment(&r.b),
+        state: latex(&m.state),
+        control: latex(&m.control),
+        compared,
+        tasks,
+    }
+}
+
+/// The comparison of the derived matrices with the printed ones.
+fn compared_view(r: &ClosedFormReport) -> ComparedView {
+    ComparedView {
         printed_where: comment(&r.printed_where),
         count: r.comparisons.len(),
         differing: format!(
@@ -212,61 +242,46 @@ fn closed_form_report(m: &Model, r: &ClosedFormReport, tasks: &[TaskView]) -> Cl
                 equal: if c.equal { "yes" } else { "**no**" },
             })
             .collect(),
-    });
-    let tasks = r
-        .tasks
-        .iter()
-        .map(|t| TaskReportView {
-            name: comment(&t.name),
-            title: comment(&t.title),
-            doc: comment(&t.doc),
-            sensitivities: comment_all(&t.sensitivities),
-            confidence_formula: comment(&t.confidence_formula),
-            default_precisions: comment(&t.default_precisions),
-            confidence_default: comment(&t.confidence_default),
-            gradient_reference: comment(&t.gradient.reference),
-            gradient_values: comment(
-                &t.gradient
-                    .values
-                    .iter()
-                    .map(|g| format!("∂ln|Π^U|/∂{} = {}", g.name, g.value))
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            ),
-            gradient_closed: t.gradient.closed.as_deref().map(comment_all),
-            remarks: t
-                .remarks
+    }
+}
+
+/// A task's part of the report; `formulation` its sensitivities' formulation in words.
+fn task_report_view(t: &TaskReport, formulation: String) -> TaskReportView {
+    TaskReportView {
+        name: comment(&t.name),
+        title: comment(&t.title),
+        doc: comment(&t.doc),
+        sensitivities: comment_all(&t.sensitivities),
+        confidence_formula: comment(&t.confidence_formula),
+        default_precisions: comment(&t.default_precisions),
+        confidence_default: comment(&t.confidence_default),
+        gradient_reference: comment(&t.gradient.reference),
+        gradient_values: comment(
+            &t.gradient
+                .values
                 .iter()
-                .map(|x| RemarkView {
-                    what: comment(&x.what),
-                    text: comment(&x.text),
-                    alternative_formula: comment(&x.alternative_formula),
-                    alternative: comment(&x.alternative),
-                    used: comment(&x.used),
-                    relation: if x.equal {
-                        "equals"
-                    } else {
-                        "is **not** equal to"
-                    },
-                })
-                .collect(),
-            formulation: tasks
-                .iter()
-                .find(|v| v.name == t.name)
-                .map_or_else(String::new, |v| v.formulation.clone()),
-        })
-        .collect();
-    ClosedFormReportView {
-        equation_refs: comment(&r.equation_refs.join(", ")),
-        equations: comment_all(&r.equations),
-        equilibrium_x: comment(&r.equilibrium_x),
-        equilibrium_u: comment(&r.equilibrium_u),
-        a: comment(&r.a),
-        b: comment(&r.b),
-        state: latex(&m.state),
-        control: latex(&m.control),
-        compared,
-        tasks,
+                .map(|g| format!("∂ln|Π^U|/∂{} = {}", g.name, g.value))
+                .collect::<Vec<_>>()
+                .join(", "),
+        ),
+        gradient_closed: t.gradient.closed.as_deref().map(comment_all),
+        remarks: t
+            .remarks
+            .iter()
+            .map(|x| RemarkView {
+                what: comment(&x.what),
+                text: comment(&x.text),
+                alternative_formula: comment(&x.alternative_formula),
+                alternative: comment(&x.alternative),
+                used: comment(&x.used),
+                relation: if x.equal {
+                    "equals"
+                } else {
+                    "is **not** equal to"
+                },
+            })
+            .collect(),
+        formulation,
     }
 }
 

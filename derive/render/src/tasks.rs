@@ -265,25 +265,8 @@ pub fn task_view<'a>(task: &'a Task, terms: &'a [Term]) -> Result<TaskView<'a>, 
         doc: comment(&task.doc),
         terms: task.terms.iter().map(String::as_str).collect(),
         term_count: task.terms.len(),
-        goals: task
-            .goals
-            .iter()
-            .map(|g| GoalView {
-                term: &g.term,
-                constant: goal_constant(&g.term),
-                count: g.rust.len(),
-                values: &g.rust,
-            })
-            .collect(),
-        precisions: task
-            .precisions
-            .iter()
-            .map(|p| PrecisionView {
-                term: &p.term,
-                constant: precision_constant(&p.term),
-                rust: &p.rust,
-            })
-            .collect(),
+        goals: goal_views(task),
+        precisions: precision_views(task),
         confidence_function: &task.confidence_function,
         gradient_function: &task.gradient_function,
         variant: camel_case(name),
@@ -292,31 +275,28 @@ pub fn task_view<'a>(task: &'a Task, terms: &'a [Term]) -> Result<TaskView<'a>, 
             binding_pattern(&outputs),
             task.sensitivity_function
         ),
-        sensitivity_values: terms
-            .iter()
-            .map(|t| match senses(t) {
-                true => format!("Some({})", sensitivity(&t.name)),
-                false => "None".to_string(),
-            })
-            .collect(),
+        sensitivity_values: per_term(
+            terms,
+            senses,
+            |t| format!("Some({})", sensitivity(t)),
+            "None",
+        ),
         confidence_args: confidence_terms
             .map(|t| format!("&precision[{} as usize]", variant(t)))
             .collect::<Vec<_>>()
             .join(", "),
-        default_goals: terms
-            .iter()
-            .map(|t| match senses(t) {
-                true => format!("{name}::{}", goal_constant(&t.name)),
-                false => "[0.0; DOF]".to_string(),
-            })
-            .collect(),
-        default_precisions: terms
-            .iter()
-            .map(|t| match uses(t) {
-                true => format!("{name}::{}", precision_constant(&t.name)),
-                false => "0.0".to_string(),
-            })
-            .collect(),
+        default_goals: per_term(
+            terms,
+            senses,
+            |t| format!("{name}::{}", goal_constant(t)),
+            "[0.0; DOF]",
+        ),
+        default_precisions: per_term(
+            terms,
+            uses,
+            |t| format!("{name}::{}", precision_constant(t)),
+            "0.0",
+        ),
         term_variants: task.terms.iter().map(|t| variant(t)).collect(),
         error_variant: variant(&task.error),
         title_literal: string_literal(&task.title),
@@ -327,6 +307,50 @@ pub fn task_view<'a>(task: &'a Task, terms: &'a [Term]) -> Result<TaskView<'a>, 
             .map(|n| comment(n))
             .collect(),
     })
+}
+
+/// One entry per term of `terms`: `given` of the term's name where `has` the term, else `none`.
+fn per_term(
+    terms: &[Term],
+    has: impl Fn(&Term) -> bool,
+    given: impl Fn(&str) -> String,
+    none: &str,
+) -> Vec<String> {
+    terms
+        .iter()
+        .map(|t| {
+            if has(t) {
+                given(&t.name)
+            } else {
+                none.to_string()
+            }
+        })
+        .collect()
+}
+
+/// The task's goals, each a constant of the task's module.
+fn goal_views(task: &Task) -> Vec<GoalView<'_>> {
+    task.goals
+        .iter()
+        .map(|g| GoalView {
+            term: &g.term,
+            constant: goal_constant(&g.term),
+            count: g.rust.len(),
+            values: &g.rust,
+        })
+        .collect()
+}
+
+/// The task's precisions, each a constant of the task's module.
+fn precision_views(task: &Task) -> Vec<PrecisionView<'_>> {
+    task.precisions
+        .iter()
+        .map(|p| PrecisionView {
+            term: &p.term,
+            constant: precision_constant(&p.term),
+            rust: &p.rust,
+        })
+        .collect()
 }
 
 /// Why the model has the formulation, in words.

@@ -8,9 +8,11 @@ use toolconf_core::{
     control_confidence, ArmController, ArmModel, TaskKind, TaskN, Term, ToolN, TERMS,
 };
 
-use super::{flat, random_precisions, random_state, random_tool, Rng};
-use crate::imp::{status_of, Controller};
-use crate::{status, Exports};
+use super::{
+    flat, random_precisions, random_state, random_tool, try_create_controller, Create, Rng,
+};
+use crate::bodies::{status_of, Controller};
+use crate::{status, Exports, ModelInfo};
 
 fn same(what: &str, case: usize, got: &[f64], want: &[f64]) {
     assert_eq!(got.len(), want.len(), "{what}, case {case}: length");
@@ -43,6 +45,36 @@ fn c_str(_: &Exports, p: *const c_char) -> String {
     super::c_str(p)
 }
 
+/// An output compared: its name, the C ABI's numbers, the direct call's.
+type Compared<'a> = (&'a str, &'a [f64], &'a [f64]);
+
+/// One case's comparisons: the library's exports, the case's number, and how many numbers
+/// were compared so far.
+struct Case<'a> {
+    e: &'a Exports,
+    case: usize,
+    compared: usize,
+}
+
+impl Case<'_> {
+    /// `code` is OK and each output (its name, the C ABI's numbers, the direct call's) is the
+    /// same bit for bit.
+    fn outputs(&mut self, what: &str, code: i32, outputs: &[Compared]) {
+        ok(what, self.e, code);
+        for (name, got, want) in outputs {
+            self.compared += counted(name, self.case, got, want);
+        }
+    }
+
+    /// As [`Case::outputs`] when the direct call has a result (`want`); else `code` is `refused`.
+    fn optional(&mut self, what: &str, code: i32, want: Option<Vec<Compared>>, refused: i32) {
+        match want {
+            Some(outputs) => self.outputs(what, code, &outputs),
+            None => assert_eq!(code, refused, "{what}: refused"),
+        }
+    }
+}
+
 /// Every export through `e` against the direct Rust call, on `cases` random inputs from
 /// `seed`: bit for bit. Returns how many numbers were compared.
 pub fn bit_identity<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
@@ -60,176 +92,17 @@ where
     let mut rng = Rng::new(seed);
     let x_e = M::equilibrium_state();
     for case in 0..cases {
+        let mut c = Case { e, case, compared };
         let p = random_tool::<M, N, NX, NP, NZ>(&mut rng);
         let x = random_state(&mut rng, &x_e);
         let u = SVector::<f64, N>::from_fn(|_, _| rng.uniform(-5.0, 5.0));
-        let mut x_dot = [0.0; NX];
-        // SAFETY (every call below): each pointer points to the documented number of values.
-        ok("dynamics", e, unsafe {
-            (e.dynamics)(x.as_ptr(), u.as_ptr(), p.as_ptr(), x_dot.as_mut_ptr())
-        });
-        compared += counted("dynamics", case, &x_dot, M::dynamics(&x, &u, &p).as_slice());
-        let (mut f_x, mut f_u) = (vec![0.0; NX * NX], vec![0.0; NX * N]);
-        ok("dynamics_jacobian", e, unsafe {
-            (e.dynamics_jacobian)(
-                x.as_ptr(),
-                u.as_ptr(),
-                p.as_ptr(),
-                f_x.as_mut_ptr(),
-                f_u.as_mut_ptr(),
-            )
-        });
-        let (a, b) = M::dynamics_jacobian(&x, &u, &p);
-        compared += counted("dynamics_jacobian (f_x)", case, &f_x, a.as_slice());
-        compared += counted("dynamics_jacobian (f_u)", case, &f_u, b.as_slice());
-        ok("rigid_body_dynamics", e, unsafe {
-            (e.rigid_body_dynamics)(x.as_ptr(), u.as_ptr(), p.as_ptr(), x_dot.as_mut_ptr())
-        });
-        compared += counted(
-            "rigid_body_dynamics",
-            case,
-            &x_dot,
-            M::rigid_body_dynamics(&x, &u, &p).as_slice(),
-        );
-        let q = x.fixed_rows::<N>(0).into_owned();
-        let (mut y, mut j) = ([0.0; 3], vec![0.0; 3 * N]);
-        let code = unsafe { (e.tip)(q.as_ptr(), p.as_ptr(), y.as_mut_ptr(), j.as_mut_ptr()) };
-        match M::tip(&q, &p) {
-            Some((y0, j0)) => {
-                ok("tip", e, code);
-                compared += counted("tip (position)", case, &y, y0.as_slice());
-                compared += counted("tip (jacobian)", case, &j, j0.as_slice());
-            }
-            None => assert_eq!(code, status::NO_TIP, "tip of a model without one"),
-        }
-        let q_dot = x.fixed_rows::<N>(N).into_owned();
-        let mut bias = [0.0; 3];
-        let code =
-            unsafe { (e.tip_bias)(q.as_ptr(), q_dot.as_ptr(), p.as_ptr(), bias.as_mut_ptr()) };
-        match M::tip_bias(&q, &q_dot, &p) {
-            Some(b) => {
-                ok("tip_bias", e, code);
-                compared += counted("tip_bias", case, &bias, b.as_slice());
-            }
-            None => assert_eq!(code, status::NO_TIP, "tip_bias of a model without a tip"),
-        }
-        let mut a_e = vec![0.0; NX * NX];
-        ok("state_matrix", e, unsafe {
-            (e.state_matrix)(p.as_ptr(), a_e.as_mut_ptr())
-        });
-        compared += counted("state_matrix", case, &a_e, M::state_matrix(&p).as_slice());
-        let mut b_e = vec![0.0; NX * N];
-        ok("input_matrix", e, unsafe {
-            (e.input_matrix)(p.as_ptr(), b_e.as_mut_ptr())
-        });
-        compared += counted("input_matrix", case, &b_e, M::input_matrix(&p).as_slice());
+        state_functions::<M, N, NX, NP, NZ>(&mut c, &x, &u, &p);
+        tip_functions::<M, N, NX, NP, NZ>(&mut c, &x, &p);
         let precision = random_precisions::<N>(&mut rng);
-        let pf = flat(&precision);
         for (index, kind) in TaskKind::ALL.into_iter().enumerate() {
             let t = index as u32;
-            let name = kind.name();
-            let (mut goals, mut precisions) = (vec![0.0; TERMS * N], vec![0.0; TERMS * N * N]);
-            ok("task_defaults", e, unsafe {
-                (e.task_defaults)(t, goals.as_mut_ptr(), precisions.as_mut_ptr())
-            });
+            let (goals, precisions) = task_functions::<M, N, NX, NP, NZ>(&mut c, t, &p, precision);
             let paper = M::paper_task(kind);
-            compared += counted(
-                &format!("task_defaults {name} (goals)"),
-                case,
-                &goals,
-                &flat(&paper.goal),
-            );
-            compared += counted(
-                &format!("task_defaults {name} (precisions)"),
-                case,
-                &precisions,
-                &flat(&paper.precision),
-            );
-            let (mut s, mut used) = (vec![f64::NAN; TERMS * N * N], [7_i32; TERMS]);
-            ok("sensitivities", e, unsafe {
-                (e.sensitivities)(t, p.as_ptr(), s.as_mut_ptr(), used.as_mut_ptr())
-            });
-            let direct = M::sensitivities(kind, &p);
-            for term in Term::ALL {
-                let i = term.index();
-                let want = direct.d_du[i].unwrap_or_else(SMatrix::zeros);
-                compared += counted(
-                    &format!("sensitivities {name} {}", term.name()),
-                    case,
-                    &s[i * N * N..(i + 1) * N * N],
-                    want.as_slice(),
-                );
-                assert_eq!(
-                    used[i],
-                    i32::from(direct.d_du[i].is_some()),
-                    "sensitivities {name}: used[{i}]"
-                );
-            }
-            let task = TaskN {
-                kind,
-                goal: [SVector::zeros(); TERMS],
-                precision,
-            };
-            let mut pi = vec![0.0; N * N];
-            ok("pi_u", e, unsafe {
-                (e.pi_u)(t, p.as_ptr(), pf.as_ptr(), pi.as_mut_ptr())
-            });
-            compared += counted(
-                &format!("pi_u {name}"),
-                case,
-                &pi,
-                M::pi_u(&task, &p).as_slice(),
-            );
-            let mut grad = vec![0.0; NP];
-            ok("logdet_gradient", e, unsafe {
-                (e.logdet_gradient)(t, p.as_ptr(), pf.as_ptr(), grad.as_mut_ptr())
-            });
-            compared += counted(
-                &format!("logdet_gradient {name}"),
-                case,
-                &grad,
-                M::logdet_gradient(&task, &p).as_slice(),
-            );
-            // The validated paths on the model's own task: the same status, and the same bits.
-            let tool = ToolN::<M, N, NX, NP, NZ>::new(p.into());
-            let (mut pi_c, mut logdet) = (vec![0.0; N * N], 0.0);
-            let code = unsafe {
-                (e.control_confidence)(
-                    t,
-                    p.as_ptr(),
-                    goals.as_ptr(),
-                    precisions.as_ptr(),
-                    pi_c.as_mut_ptr(),
-                    &mut logdet,
-                )
-            };
-            match tool
-                .as_ref()
-                .map_err(status_of)
-                .and_then(|tool| control_confidence(tool, &paper).map_err(|e| status_of(&e)))
-            {
-                Ok(c) => {
-                    ok("control_confidence", e, code);
-                    compared += counted(
-                        &format!("control_confidence {name} (pi_u)"),
-                        case,
-                        &pi_c,
-                        c.pi_u.as_slice(),
-                    );
-                    compared += counted(
-                        &format!("control_confidence {name} (logdet)"),
-                        case,
-                        &[logdet],
-                        &[c.logdet],
-                    );
-                }
-                Err(want) => assert_eq!(
-                    code,
-                    want,
-                    "control_confidence {name}: {}",
-                    c_str(e, (e.last_error)())
-                ),
-            }
             ticks += controller::<M, N, NX, NP, NZ>(
                 e,
                 &mut rng,
@@ -241,6 +114,7 @@ where
                 &paper,
             );
         }
+        compared = c.compared;
     }
     // The ticks must have been compared at all: some tool and task must make a controller.
     assert!(
@@ -248,6 +122,220 @@ where
         "no controller of {cases} random tools on any task could be made"
     );
     compared + ticks
+}
+
+/// The functions of the state: the dynamics, their Jacobian, the rigid-body dynamics, A and B.
+fn state_functions<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    c: &mut Case,
+    x: &SVector<f64, NX>,
+    u: &SVector<f64, N>,
+    p: &SVector<f64, NP>,
+) where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let e = c.e;
+    let mut x_dot = [0.0; NX];
+    // SAFETY (every call below): each pointer points to the documented number of values.
+    let code = unsafe { (e.dynamics)(x.as_ptr(), u.as_ptr(), p.as_ptr(), x_dot.as_mut_ptr()) };
+    let want = M::dynamics(x, u, p);
+    c.outputs("dynamics", code, &[("dynamics", &x_dot, want.as_slice())]);
+    let (mut f_x, mut f_u) = (vec![0.0; NX * NX], vec![0.0; NX * N]);
+    let code = unsafe {
+        let (x, u, p) = (x.as_ptr(), u.as_ptr(), p.as_ptr());
+        (e.dynamics_jacobian)(x, u, p, f_x.as_mut_ptr(), f_u.as_mut_ptr())
+    };
+    let (a, b) = M::dynamics_jacobian(x, u, p);
+    let outputs = [
+        ("dynamics_jacobian (f_x)", &f_x[..], a.as_slice()),
+        ("dynamics_jacobian (f_u)", &f_u[..], b.as_slice()),
+    ];
+    c.outputs("dynamics_jacobian", code, &outputs);
+    let code =
+        unsafe { (e.rigid_body_dynamics)(x.as_ptr(), u.as_ptr(), p.as_ptr(), x_dot.as_mut_ptr()) };
+    let want = M::rigid_body_dynamics(x, u, p);
+    let what = "rigid_body_dynamics";
+    c.outputs(what, code, &[(what, &x_dot, want.as_slice())]);
+    let mut a_e = vec![0.0; NX * NX];
+    let code = unsafe { (e.state_matrix)(p.as_ptr(), a_e.as_mut_ptr()) };
+    let want = M::state_matrix(p);
+    c.outputs(
+        "state_matrix",
+        code,
+        &[("state_matrix", &a_e, want.as_slice())],
+    );
+    let mut b_e = vec![0.0; NX * N];
+    let code = unsafe { (e.input_matrix)(p.as_ptr(), b_e.as_mut_ptr()) };
+    let want = M::input_matrix(p);
+    c.outputs(
+        "input_matrix",
+        code,
+        &[("input_matrix", &b_e, want.as_slice())],
+    );
+}
+
+/// The tip and its bias, or NO_TIP for a model without a tip.
+fn tip_functions<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    c: &mut Case,
+    x: &SVector<f64, NX>,
+    p: &SVector<f64, NP>,
+) where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let e = c.e;
+    let q = x.fixed_rows::<N>(0).into_owned();
+    let (mut y, mut j) = ([0.0; 3], vec![0.0; 3 * N]);
+    // SAFETY (both calls): each pointer points to the documented number of values.
+    let code = unsafe { (e.tip)(q.as_ptr(), p.as_ptr(), y.as_mut_ptr(), j.as_mut_ptr()) };
+    let want = M::tip(&q, p);
+    let want = want.as_ref().map(|(y0, j0)| {
+        vec![
+            ("tip (position)", &y[..], y0.as_slice()),
+            ("tip (jacobian)", &j[..], j0.as_slice()),
+        ]
+    });
+    c.optional("tip", code, want, status::NO_TIP);
+    let q_dot = x.fixed_rows::<N>(N).into_owned();
+    let mut bias = [0.0; 3];
+    let code = unsafe { (e.tip_bias)(q.as_ptr(), q_dot.as_ptr(), p.as_ptr(), bias.as_mut_ptr()) };
+    let want = M::tip_bias(&q, &q_dot, p);
+    let want = want
+        .as_ref()
+        .map(|b| vec![("tip_bias", &bias[..], b.as_slice())]);
+    c.optional("tip_bias", code, want, status::NO_TIP);
+}
+
+/// The functions of task `t` on tool `p`: its defaults (returned: its goals and precisions,
+/// flat), its sensitivities, Π^U and ∂ln|Π^U|/∂p on `precision`, and the control confidence on
+/// the defaults.
+fn task_functions<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    c: &mut Case,
+    t: u32,
+    p: &SVector<f64, NP>,
+    precision: [SMatrix<f64, N, N>; TERMS],
+) -> (Vec<f64>, Vec<f64>)
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let e = c.e;
+    let kind = TaskKind::ALL[t as usize];
+    let name = kind.name();
+    let (mut goals, mut precisions) = (vec![0.0; TERMS * N], vec![0.0; TERMS * N * N]);
+    // SAFETY (every call below): each pointer points to the documented number of values.
+    let code = unsafe { (e.task_defaults)(t, goals.as_mut_ptr(), precisions.as_mut_ptr()) };
+    let paper = M::paper_task(kind);
+    let (goals_of, precisions_of) = (
+        format!("task_defaults {name} (goals)"),
+        format!("task_defaults {name} (precisions)"),
+    );
+    let outputs = [
+        (&goals_of[..], &goals[..], &flat(&paper.goal)[..]),
+        (
+            &precisions_of[..],
+            &precisions[..],
+            &flat(&paper.precision)[..],
+        ),
+    ];
+    c.outputs("task_defaults", code, &outputs);
+    sensitivities::<M, N, NX, NP, NZ>(c, t, p);
+    let task = TaskN {
+        kind,
+        goal: [SVector::zeros(); TERMS],
+        precision,
+    };
+    let pf = flat(&precision);
+    let mut pi = vec![0.0; N * N];
+    let code = unsafe { (e.pi_u)(t, p.as_ptr(), pf.as_ptr(), pi.as_mut_ptr()) };
+    let want = M::pi_u(&task, p);
+    c.outputs(
+        "pi_u",
+        code,
+        &[(&format!("pi_u {name}"), &pi, want.as_slice())],
+    );
+    let mut grad = vec![0.0; NP];
+    let code = unsafe { (e.logdet_gradient)(t, p.as_ptr(), pf.as_ptr(), grad.as_mut_ptr()) };
+    let want = M::logdet_gradient(&task, p);
+    let what = format!("logdet_gradient {name}");
+    c.outputs("logdet_gradient", code, &[(&what, &grad, want.as_slice())]);
+    confidence::<M, N, NX, NP, NZ>(c, t, p, &goals, &precisions, &paper);
+    (goals, precisions)
+}
+
+/// The sensitivities of task `t` on tool `p`, and which terms it uses.
+fn sensitivities<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    c: &mut Case,
+    t: u32,
+    p: &SVector<f64, NP>,
+) where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let kind = TaskKind::ALL[t as usize];
+    let name = kind.name();
+    let (mut s, mut used) = (vec![f64::NAN; TERMS * N * N], [7_i32; TERMS]);
+    // SAFETY: each pointer points to the documented number of values.
+    let code = unsafe { (c.e.sensitivities)(t, p.as_ptr(), s.as_mut_ptr(), used.as_mut_ptr()) };
+    ok("sensitivities", c.e, code);
+    let direct = M::sensitivities(kind, p);
+    for term in Term::ALL {
+        let i = term.index();
+        let want = direct.d_du[i].unwrap_or_else(SMatrix::zeros);
+        c.compared += counted(
+            &format!("sensitivities {name} {}", term.name()),
+            c.case,
+            &s[i * N * N..(i + 1) * N * N],
+            want.as_slice(),
+        );
+        assert_eq!(
+            used[i],
+            i32::from(direct.d_du[i].is_some()),
+            "sensitivities {name}: used[{i}]"
+        );
+    }
+}
+
+/// The validated path on the model's own task (`paper`, flat in `goals` and `precisions`): the
+/// same status as the direct call, and the same bits.
+fn confidence<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    c: &mut Case,
+    t: u32,
+    p: &SVector<f64, NP>,
+    goals: &[f64],
+    precisions: &[f64],
+    paper: &TaskN<N>,
+) where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let e = c.e;
+    let name = paper.kind.name();
+    let (mut pi_c, mut logdet) = (vec![0.0; N * N], 0.0);
+    // SAFETY: each pointer points to the documented number of values.
+    let code = unsafe {
+        let (g, pr) = (goals.as_ptr(), precisions.as_ptr());
+        (e.control_confidence)(t, p.as_ptr(), g, pr, pi_c.as_mut_ptr(), &mut logdet)
+    };
+    let tool = ToolN::<M, N, NX, NP, NZ>::new((*p).into());
+    let direct = tool
+        .as_ref()
+        .map_err(status_of)
+        .and_then(|tool| control_confidence(tool, paper).map_err(|e| status_of(&e)));
+    match direct {
+        Ok(want) => {
+            let (pi_of, logdet_of) = (
+                format!("control_confidence {name} (pi_u)"),
+                format!("control_confidence {name} (logdet)"),
+            );
+            let outputs = [
+                (&pi_of[..], &pi_c[..], want.pi_u.as_slice()),
+                (&logdet_of[..], &[logdet][..], &[want.logdet][..]),
+            ];
+            c.outputs("control_confidence", code, &outputs);
+        }
+        Err(want) => assert_eq!(
+            code,
+            want,
+            "control_confidence {name}: {}",
+            c_str(e, (e.last_error)())
+        ),
+    }
 }
 
 /// A controller through the C ABI against [`ArmController`] directly: the same creation
@@ -268,19 +356,10 @@ where
 {
     let name = task.kind.name();
     let u0 = [0.1; N];
-    let mut handle: *mut Controller = core::ptr::null_mut();
-    let code = unsafe {
-        (e.controller_create)(
-            p.as_ptr(),
-            t,
-            goals.as_ptr(),
-            precisions.as_ptr(),
-            1.0,
-            u0.as_ptr(),
-            1000.0,
-            &mut handle,
-        )
-    };
+    let flat_task = (t, goals.to_vec(), precisions.to_vec());
+    // SAFETY: the arrays hold the model's sizes.
+    let create = |c: Create| unsafe { c.through(e) };
+    let (code, handle) = try_create_controller(create, p.as_slice(), &flat_task, 1000.0);
     let direct = ToolN::<M, N, NX, NP, NZ>::new((*p).into())
         .and_then(|tool| ArmController::<M, N, NX, NP, NZ>::new(&tool, task, 1.0, u0, 1000.0));
     let mut direct = match direct {
@@ -299,6 +378,25 @@ where
             return 0;
         }
     };
+    let compared = ticks::<M, N, NX, NP, NZ>(e, rng, (case, name), handle, &mut direct);
+    ok("controller_destroy", e, unsafe {
+        (e.controller_destroy)(handle)
+    });
+    compared
+}
+
+/// The controller behind `handle` against `direct`, the same controller made directly (case
+/// `case`, task `name`): its Π^U, then four ticks on random measurements (with the accelerations every other one).
+fn ticks<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    e: &Exports,
+    rng: &mut Rng,
+    (case, name): (usize, &str),
+    handle: *mut Controller,
+    direct: &mut ArmController<M, N, NX, NP, NZ>,
+) -> usize
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
     let mut compared = 0;
     let mut pi = vec![0.0; N * N];
     ok("controller_pi_u", e, unsafe {
@@ -344,9 +442,6 @@ where
             Err(err) => assert_eq!(code, status_of(&err), "{what}"),
         }
     }
-    ok("controller_destroy", e, unsafe {
-        (e.controller_destroy)(handle)
-    });
     compared
 }
 
@@ -361,11 +456,6 @@ where
     // SAFETY: the library's metadata lives while it is loaded; the counts are its own.
     let i = unsafe { &*i };
     let s = |p: *const c_char| c_str(e, p);
-    let strings = |p: *const *const c_char, n: usize| -> Vec<String> {
-        (0..n).map(|k| s(unsafe { *p.add(k) })).collect()
-    };
-    let numbers =
-        |p: *const f64, n: usize| -> Vec<f64> { (0..n).map(|k| unsafe { *p.add(k) }).collect() };
     assert_eq!(i.abi_version, crate::ABI_VERSION);
     assert_eq!(
         (s(i.name), s(i.title), s(i.description)),
@@ -381,51 +471,7 @@ where
     assert_eq!(strings(i.parameter_units, NP), g.parameter_units);
     assert_eq!(strings(i.state_names, NX), g.state_names);
     assert_eq!(strings(i.control_names, N), g.control_names);
-    for (k, d) in g.domains.iter().enumerate() {
-        let c = unsafe { *i.domains.add(k) };
-        same("domains", k, &[c.lo, c.hi], &[d.lo, d.hi]);
-        assert_eq!(
-            (c.lo_open != 0, c.hi_open != 0, s(c.rule)),
-            (d.lo_open, d.hi_open, d.rule.into())
-        );
-    }
-    assert_eq!(i.constraint_count, g.constraints.len());
-    for (k, c) in g.constraints.iter().enumerate() {
-        let got = unsafe { *i.constraints.add(k) };
-        same(
-            "constraints",
-            k,
-            &numbers(got.coefficients, NP),
-            c.coefficients,
-        );
-        assert_eq!(s(got.rule), c.rule);
-    }
-    same(
-        "sample_lo",
-        0,
-        &numbers(i.sample_lo, NP),
-        &g.sample.iter().map(|s| s.0).collect::<Vec<_>>(),
-    );
-    same(
-        "sample_hi",
-        0,
-        &numbers(i.sample_hi, NP),
-        &g.sample.iter().map(|s| s.1).collect::<Vec<_>>(),
-    );
-    for (k, d) in g.defaults.iter().enumerate() {
-        let (has, value) = unsafe { (*i.has_default.add(k), *i.defaults.add(k)) };
-        assert_eq!(has != 0, d.is_some());
-        if let Some(v) = d {
-            same("defaults", k, &[value], &[*v]);
-        }
-    }
-    assert_eq!(i.has_inertia != 0, g.inertia.is_some());
-    if let Some(r) = g.inertia {
-        assert_eq!(i.inertia.moments.map(|v| v as usize), r.moments);
-        assert_eq!(i.inertia.products.map(|v| v as usize), r.products);
-        same("inertia slack", 0, &[i.inertia.slack], &[r.slack]);
-        assert_eq!(s(i.inertia.rule), r.rule);
-    }
+    check_tool_rule::<NP>(i, g);
     same(
         "equilibrium_state",
         0,
@@ -452,4 +498,58 @@ where
     assert_eq!(i.term_count, TERMS);
     assert_eq!(strings(i.term_names, TERMS), Term::NAMES);
     assert_eq!(s(i.tasks_fingerprint), crate::fingerprint::hex());
+}
+
+/// `n` C strings of the metadata from `p`.
+fn strings(p: *const *const c_char, n: usize) -> Vec<String> {
+    // SAFETY: the metadata's arrays hold their documented counts of live C strings.
+    (0..n).map(|k| super::c_str(unsafe { *p.add(k) })).collect()
+}
+
+/// `n` numbers of the metadata from `p`.
+fn numbers(p: *const f64, n: usize) -> Vec<f64> {
+    // SAFETY: the metadata's arrays hold their documented counts of numbers.
+    (0..n).map(|k| unsafe { *p.add(k) }).collect()
+}
+
+/// The tool's rule in the metadata equals the generated one: the domains, the constraints,
+/// the sampling box, the defaults and the inertia rule.
+fn check_tool_rule<const NP: usize>(i: &ModelInfo, g: &toolconf_core::generated::ModelInfo) {
+    let s = super::c_str;
+    for (k, d) in g.domains.iter().enumerate() {
+        let c = unsafe { *i.domains.add(k) };
+        same("domains", k, &[c.lo, c.hi], &[d.lo, d.hi]);
+        assert_eq!(
+            (c.lo_open != 0, c.hi_open != 0, s(c.rule)),
+            (d.lo_open, d.hi_open, d.rule.into())
+        );
+    }
+    assert_eq!(i.constraint_count, g.constraints.len());
+    for (k, c) in g.constraints.iter().enumerate() {
+        let got = unsafe { *i.constraints.add(k) };
+        same(
+            "constraints",
+            k,
+            &numbers(got.coefficients, NP),
+            c.coefficients,
+        );
+        assert_eq!(s(got.rule), c.rule);
+    }
+    let (lo, hi): (Vec<f64>, Vec<f64>) = g.sample.iter().copied().unzip();
+    same("sample_lo", 0, &numbers(i.sample_lo, NP), &lo);
+    same("sample_hi", 0, &numbers(i.sample_hi, NP), &hi);
+    for (k, d) in g.defaults.iter().enumerate() {
+        let (has, value) = unsafe { (*i.has_default.add(k), *i.defaults.add(k)) };
+        assert_eq!(has != 0, d.is_some());
+        if let Some(v) = d {
+            same("defaults", k, &[value], &[*v]);
+        }
+    }
+    assert_eq!(i.has_inertia != 0, g.inertia.is_some());
+    if let Some(r) = g.inertia {
+        assert_eq!(i.inertia.moments.map(|v| v as usize), r.moments);
+        assert_eq!(i.inertia.products.map(|v| v as usize), r.products);
+        same("inertia slack", 0, &[i.inertia.slack], &[r.slack]);
+        assert_eq!(s(i.inertia.rule), r.rule);
+    }
 }

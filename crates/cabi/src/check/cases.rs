@@ -9,10 +9,10 @@ use core::marker::PhantomData;
 use nalgebra::{SMatrix, SVector};
 use toolconf_core::{ArmController, ArmModel, SensitivitiesN, TaskKind, TaskN, ToolN};
 
+use super::bad_inputs::{Call, Target, Want, CASES};
 use super::fuzz::{fuzz, fuzz_cases, fuzz_threads, Foreign};
-use super::table::{Call, Target, Want, CASES};
-use super::{c_str, flat, Rng};
-use crate::imp::{self, Controller};
+use super::{c_str, flat, flat_paper_task, try_create_controller, Create, Rng};
+use crate::bodies::{Bodies, Controller};
 use crate::{status, Exports};
 
 /// An output array prefilled with a sentinel no export writes.
@@ -63,33 +63,26 @@ where
     None
 }
 
-/// A new controller of `M` made through `imp` directly (another model's, when `M` is not the
+/// A new controller of `M` made through [`Bodies`] directly (another model's, when `M` is not the
 /// library's): NULL if the model has none to make.
 pub fn controller_of<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
 ) -> *mut Controller
 where
     M: ArmModel<N, NX, NP, NZ> + 'static,
 {
-    let Some((p, t, rate)) = controllable::<M, N, NX, NP, NZ>() else {
-        return core::ptr::null_mut();
-    };
-    let task = M::paper_task(TaskKind::ALL[t as usize]);
-    let (g, pr) = (flat(&task.goal), flat(&task.precision));
-    let mut h = core::ptr::null_mut();
     // SAFETY: the arrays hold M's sizes.
-    unsafe {
-        imp::controller_create::<M, N, NX, NP, NZ>(
-            p.as_ptr(),
-            t,
-            g.as_ptr(),
-            pr.as_ptr(),
-            1.0,
-            [0.1; N].as_ptr(),
-            rate,
-            &mut h,
+    controller_made::<M, N, NX, NP, NZ>(|c| unsafe {
+        Bodies::<M, N, NX, NP, NZ>::controller_create(
+            c.params,
+            c.task,
+            c.goals,
+            c.precisions,
+            c.learning_rate,
+            c.initial_torque,
+            c.rate_hz,
+            c.controller,
         )
-    };
-    h
+    })
 }
 
 /// A new controller of model `M` made through library `e`'s `toolconf_controller_create` (NULL
@@ -100,25 +93,23 @@ pub fn controller_through<M, const N: usize, const NX: usize, const NP: usize, c
 where
     M: ArmModel<N, NX, NP, NZ>,
 {
-    let mut h = core::ptr::null_mut();
-    if let Some((p, t, rate)) = controllable::<M, N, NX, NP, NZ>() {
-        let task = M::paper_task(TaskKind::ALL[t as usize]);
-        let (g, pr) = (flat(&task.goal), flat(&task.precision));
-        // SAFETY: the arrays hold the model's sizes.
-        unsafe {
-            (e.controller_create)(
-                p.as_ptr(),
-                t,
-                g.as_ptr(),
-                pr.as_ptr(),
-                1.0,
-                [0.1; N].as_ptr(),
-                rate,
-                &mut h,
-            )
-        };
-    }
-    h
+    // SAFETY: the arrays hold the model's sizes.
+    controller_made::<M, N, NX, NP, NZ>(|c| unsafe { c.through(e) })
+}
+
+/// A controller of `M` made by `create` for a tool and task it can control (NULL if there is
+/// none, or if `create` refuses).
+fn controller_made<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    create: impl FnOnce(Create) -> i32,
+) -> *mut Controller
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let Some((p, t, rate)) = controllable::<M, N, NX, NP, NZ>() else {
+        return core::ptr::null_mut();
+    };
+    let task = flat_paper_task::<M, N, NX, NP, NZ>(TaskKind::ALL[t as usize]);
+    try_create_controller(create, &p, &task, rate).1
 }
 
 /// What the cases call with: model `M`'s library, a controllable tool and its task (goals
@@ -353,7 +344,7 @@ where
 {
     let create = || controller_of::<Twin<M>, N, NX, NP, NZ>();
     // SAFETY: any handle value is checked.
-    let destroy = |h| unsafe { imp::controller_destroy::<Twin<M>, N, NX, NP, NZ>(h) };
+    let destroy = |h| unsafe { Bodies::<Twin<M>, N, NX, NP, NZ>::controller_destroy(h) };
     let other = Foreign {
         create: &create,
         destroy: &destroy,

@@ -1,5 +1,5 @@
 //! [`fuzz`]: every export called with generated arguments, each status checked against the C
-//! ABI's rules rather than against a list of expected cases. The rules, in order (crate::imp):
+//! ABI's rules rather than against a list of expected cases. The rules, in order (crate::bodies):
 //!
 //! 1. a NULL pointer the function needs: `TOOLCONF_NULL_POINTER`, the first in argument order
 //!    named (`toolconf_controller_destroy(NULL)` is OK: nothing to do);
@@ -7,7 +7,7 @@
 //!    `TOOLCONF_BAD_HANDLE`;
 //! 3. a task index the model does not offer: `TOOLCONF_UNKNOWN_TASK`;
 //! 4. a NaN or infinite input: `TOOLCONF_NOT_FINITE`, the first in argument order named;
-//! 5. what toolconf-core's direct call refuses: its status (`imp::status_of`);
+//! 5. what toolconf-core's direct call refuses: its status (`bodies::status_of`);
 //! 6. a result that is not finite: `TOOLCONF_INVALID_TOOL` if the tool breaks its rule, else
 //!    `TOOLCONF_NOT_FINITE`;
 //!
@@ -22,7 +22,7 @@ use nalgebra::{SMatrix, SVector};
 use toolconf_core::{ArmController, ArmModel, TaskKind, TaskN, ToolN, TERMS};
 
 use super::{c_str, random_precisions, random_state, random_tool, Rng};
-use crate::imp::Controller;
+use crate::bodies::Controller;
 use crate::{status, Exports};
 
 /// A bit pattern no export writes (a NaN with a payload): an untouched output holds it.

@@ -7,7 +7,7 @@
 //! * [`fuzz`] calls every export with generated arguments (NULL pointers, misaligned arrays,
 //!   NaN, infinities, huge, tiny and subnormal numbers, unknown tasks, live, destroyed,
 //!   foreign and forged controller handles) and checks each status against the C ABI's rules
-//!   (the order of [`crate::imp`]'s checks), the outputs untouched on a failure and finite on
+//!   (the order of [`crate::bodies`]'s checks), the outputs untouched on a failure and finite on
 //!   success, and controllers ticked from several threads at once;
 //! * [`hostile`] runs the table of named cases ([`cases`]: every class of bad input once, the
 //!   regressions among them) and the fuzzer's default count.
@@ -17,12 +17,15 @@
 use core::ffi::{c_char, CStr};
 
 use nalgebra::{SMatrix, SVector};
-use toolconf_core::{ArmModel, TERMS};
+use toolconf_core::{ArmModel, TaskKind, TERMS};
 
+use crate::bodies::Controller;
+use crate::Exports;
+
+pub mod bad_inputs;
 mod bits;
 pub mod cases;
 pub mod fuzz;
-pub mod table;
 
 pub use bits::bit_identity;
 pub use cases::hostile;
@@ -113,4 +116,92 @@ pub(crate) fn random_precisions<const N: usize>(rng: &mut Rng) -> [SMatrix<f64, 
 
 pub(crate) fn flat<const R: usize, const C: usize>(blocks: &[SMatrix<f64, R, C>]) -> Vec<f64> {
     blocks.iter().flat_map(|m| m.as_slice().to_vec()).collect()
+}
+
+/// Model `M`'s task `kind` with its defaults, as the C ABI takes a task: its index, its goals
+/// and its precisions, flat.
+pub fn flat_paper_task<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    kind: TaskKind,
+) -> (u32, Vec<f64>, Vec<f64>)
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let index = TaskKind::ALL.iter().position(|k| *k == kind);
+    let task = M::paper_task(kind);
+    let index = index.expect("a task of TaskKind::ALL") as u32;
+    (index, flat(&task.goal), flat(&task.precision))
+}
+
+/// Creates a controller with `create` (`toolconf_controller_create` of a library, or a body of
+/// its signature, unsafe: [`crate::bodies`]): tool `p` on `task` (as [`flat_paper_task`]
+/// gives it) at learning rate 1, initial torque 0.1 on every joint and `rate_hz`. Returns the
+/// status and the handle.
+pub fn try_create_controller<F>(
+    create: F,
+    p: &[f64],
+    (index, goals, precisions): &(u32, Vec<f64>, Vec<f64>),
+    rate_hz: f64,
+) -> (i32, *mut Controller)
+where
+    F: FnOnce(Create) -> i32,
+{
+    let torque = vec![0.1; goals.len() / TERMS];
+    let mut h = core::ptr::null_mut();
+    let code = create(Create {
+        params: p.as_ptr(),
+        task: *index,
+        goals: goals.as_ptr(),
+        precisions: precisions.as_ptr(),
+        learning_rate: 1.0,
+        initial_torque: torque.as_ptr(),
+        rate_hz,
+        controller: &mut h,
+    });
+    (code, h)
+}
+
+/// The arguments of `toolconf_controller_create`, each pointer to as many values as the model
+/// needs.
+pub struct Create {
+    pub params: *const f64,
+    pub task: u32,
+    pub goals: *const f64,
+    pub precisions: *const f64,
+    pub learning_rate: f64,
+    pub initial_torque: *const f64,
+    pub rate_hz: f64,
+    pub controller: *mut *mut Controller,
+}
+
+impl Create {
+    /// Library `e`'s `toolconf_controller_create` on these arguments.
+    ///
+    /// # Safety
+    ///
+    /// Each pointer points to as many values as `e`'s model needs.
+    pub unsafe fn through(self, e: &Exports) -> i32 {
+        (e.controller_create)(
+            self.params,
+            self.task,
+            self.goals,
+            self.precisions,
+            self.learning_rate,
+            self.initial_torque,
+            self.rate_hz,
+            self.controller,
+        )
+    }
+}
+
+/// [`try_create_controller`] through library `e`, which must accept.
+pub fn create_controller(
+    e: &Exports,
+    p: &[f64],
+    task: &(u32, Vec<f64>, Vec<f64>),
+    rate_hz: f64,
+) -> *mut Controller {
+    // SAFETY: the arrays hold the model's sizes, if `task` is the model's.
+    let (code, h) = try_create_controller(|c| unsafe { c.through(e) }, p, task, rate_hz);
+    assert_eq!(code, crate::status::OK, "{}", c_str((e.last_error)()));
+    h
 }

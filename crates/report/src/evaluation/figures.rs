@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use toolconf::evaluation::trials::{MEASURES, RULES};
-use toolconf::evaluation::{Evaluation, HighlightRun};
+use toolconf::evaluation::{Evaluation, HighlightRun, ToolRecord};
 use toolconf::registry::AXES;
 use toolconf::stats::summary;
 
@@ -237,38 +237,7 @@ pub fn fig5(dir: &Path, e: &Evaluation) -> Result<Option<Figure>, ReproduceError
     if dots.is_empty() {
         return Ok(None);
     }
-    let mut ranked = swept.clone();
-    ranked.sort_by(|a, b| {
-        a.logdet()
-            .unwrap_or(0.0)
-            .total_cmp(&b.logdet().unwrap_or(0.0))
-    });
-    let third = ranked.len() / 3;
-    let mean_line = |group: &[&toolconf::evaluation::ToolRecord]| -> Vec<(f64, f64)> {
-        (0..scales.len())
-            .filter_map(|k| {
-                let v: Vec<f64> = group.iter().filter_map(|r| r.sweep_change(k)).collect();
-                Some((scales[k], summary(&v).ok()?.mean))
-            })
-            .collect()
-    };
-    let mut lines = vec![Series::new(
-        "all tools",
-        Colour(60, 60, 60),
-        mean_line(&ranked),
-    )];
-    if third >= 2 {
-        lines.push(Series::new(
-            "least confident third",
-            Colour(200, 30, 30),
-            mean_line(&ranked[..third]),
-        ));
-        lines.push(Series::new(
-            "most confident third",
-            Colour(30, 80, 200),
-            mean_line(&ranked[ranked.len() - third..]),
-        ));
-    }
+    let lines = fig5_mean_lines(scales, swept);
     let ys = |s: &[Series]| -> Vec<f64> {
         s.iter()
             .flat_map(|s| s.points.iter().map(|p| p.1))
@@ -301,6 +270,43 @@ pub fn fig5(dir: &Path, e: &Evaluation) -> Result<Option<Figure>, ReproduceError
         }),
     ];
     save(dir, "fig5_perturbation_sweep.svg", &panels, (620, 460)).map(Some)
+}
+
+/// Fig. 5's lines: the mean |Δ task error| per scale of all the swept tools, and (with six
+/// tools or more) of the least and the most confident third.
+fn fig5_mean_lines(scales: &[f64], mut ranked: Vec<&ToolRecord>) -> Vec<Series> {
+    ranked.sort_by(|a, b| {
+        a.logdet()
+            .unwrap_or(0.0)
+            .total_cmp(&b.logdet().unwrap_or(0.0))
+    });
+    let third = ranked.len() / 3;
+    let mean_line = |group: &[&ToolRecord]| -> Vec<(f64, f64)> {
+        (0..scales.len())
+            .filter_map(|k| {
+                let v: Vec<f64> = group.iter().filter_map(|r| r.sweep_change(k)).collect();
+                Some((scales[k], summary(&v).ok()?.mean))
+            })
+            .collect()
+    };
+    let mut lines = vec![Series::new(
+        "all tools",
+        Colour(60, 60, 60),
+        mean_line(&ranked),
+    )];
+    if third >= 2 {
+        lines.push(Series::new(
+            "least confident third",
+            Colour(200, 30, 30),
+            mean_line(&ranked[..third]),
+        ));
+        lines.push(Series::new(
+            "most confident third",
+            Colour(30, 80, 200),
+            mean_line(&ranked[ranked.len() - third..]),
+        ));
+    }
+    lines
 }
 
 /// Fig. 6: which tool of each trial ∫F and ∫J chose.

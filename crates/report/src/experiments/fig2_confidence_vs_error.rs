@@ -14,7 +14,7 @@ use super::figure_parts::{arm_cells, files_block, task_label, wants_log, PAPER_T
 use super::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::{negative_correlation_rule, num, Correlation};
-use super::{Context, Experiment, Plan, ReproduceError};
+use super::{described, Context, Experiment, Plan, ReproduceError};
 
 pub struct Fig2;
 
@@ -40,17 +40,7 @@ const SIMILAR_CV: f64 = 0.25;
 const COLOURS: [Colour; 3] = [Colour(0, 114, 178), Colour(213, 94, 0), Colour(0, 158, 115)];
 
 impl Experiment for Fig2 {
-    fn id(&self) -> &'static str {
-        "fig2"
-    }
-
-    fn title(&self) -> &'static str {
-        "Fig. 2: control confidence and task error (C1)"
-    }
-
-    fn outputs(&self) -> Vec<String> {
-        vec![CSV.into(), SVG.into()]
-    }
+    described!("fig2", "Fig. 2: control confidence and task error (C1)", [CSV, SVG]);
 
     fn planned_episodes(&self, plan: &Plan) -> u64 {
         3 * plan.fig2_tools as u64

@@ -15,7 +15,7 @@ use super::figure_parts::{arm_cells, dt_label, ARM_COLUMNS};
 use super::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::num;
-use super::{Context, Experiment, Plan, ReproduceError};
+use super::{described, Context, Experiment, Plan, ReproduceError};
 
 pub struct Fig3;
 
@@ -68,17 +68,7 @@ fn settling_time(tr: &Trajectory, goal: f64) -> Option<f64> {
 }
 
 impl Experiment for Fig3 {
-    fn id(&self) -> &'static str {
-        "fig3"
-    }
-
-    fn title(&self) -> &'static str {
-        "Fig. 3: high- and low-confidence tool under a perturbation (C2)"
-    }
-
-    fn outputs(&self) -> Vec<String> {
-        vec![TOOLS_CSV.into(), CSV.into(), SVG.into()]
-    }
+    described!("fig3", "Fig. 3: high- and low-confidence tool under a perturbation (C2)", [TOOLS_CSV, CSV, SVG]);
 
     fn planned_episodes(&self, _plan: &Plan) -> u64 {
         4

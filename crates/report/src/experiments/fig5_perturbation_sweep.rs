@@ -14,7 +14,7 @@ use super::figure_parts::{arm_cells, dt_label, files_block, wants_log};
 use super::plot::{self, diverging, Colour, Legend, Panel, Series, XyPanel};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::{mean_sd, negative_correlation_rule, num, p_value, Comparison, Correlation};
-use super::{Context, Experiment, Plan, ReproduceError};
+use super::{described, Context, Experiment, Plan, ReproduceError};
 
 pub struct Fig5;
 
@@ -50,17 +50,7 @@ fn episode_of(sweep: &[f64], dt: f64) -> usize {
 }
 
 impl Experiment for Fig5 {
-    fn id(&self) -> &'static str {
-        "fig5"
-    }
-
-    fn title(&self) -> &'static str {
-        "Fig. 5: variability over a range of perturbations, velocity task (C2)"
-    }
-
-    fn outputs(&self) -> Vec<String> {
-        vec![CSV.into(), SVG.into()]
-    }
+    described!("fig5", "Fig. 5: variability over a range of perturbations, velocity task (C2)", [CSV, SVG]);
 
     fn planned_episodes(&self, plan: &Plan) -> u64 {
         (plan.fig5_tools * (1 + sweep(plan).len())) as u64

@@ -15,7 +15,7 @@ use super::objectives::{choices, decision_rules, DecisionRule, Trial};
 use super::plot::{self, Colour, GridPanel, Panel};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::num;
-use super::{Context, Experiment, Plan, ReproduceError};
+use super::{described, Context, Experiment, Plan, ReproduceError};
 
 pub struct Fig6;
 
@@ -47,17 +47,7 @@ struct TrialResult {
 }
 
 impl Experiment for Fig6 {
-    fn id(&self) -> &'static str {
-        "fig6"
-    }
-
-    fn title(&self) -> &'static str {
-        "Fig. 6: which tool F and J select (C3)"
-    }
-
-    fn outputs(&self) -> Vec<String> {
-        vec![CSV.into(), SVG.into()]
-    }
+    described!("fig6", "Fig. 6: which tool F and J select (C3)", [CSV, SVG]);
 
     fn planned_episodes(&self, plan: &Plan) -> u64 {
         (plan.fig6_trials * plan.fig6_tools) as u64

@@ -16,7 +16,7 @@ use super::objectives::{choices, decision_rules, DecisionRule, MpcCost, Trial};
 use super::plot::{self, BoxPanel, Panel};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::{num, Comparison};
-use super::{Context, Experiment, Plan, ReproduceError};
+use super::{described, Context, Experiment, Plan, ReproduceError};
 use crate::mpc::MpcOptions;
 
 /// Fig. 7; `with_mpc` adds the MPC baseline's J* ranking to the paper's three rules when the run
@@ -124,17 +124,7 @@ fn metric(t: &TrialResult, m: usize, tool: usize) -> Option<f64> {
 }
 
 impl Experiment for Fig7 {
-    fn id(&self) -> &'static str {
-        "fig7"
-    }
-
-    fn title(&self) -> &'static str {
-        "Fig. 7: benchmarking tool selection by F, J and confidence (C4)"
-    }
-
-    fn outputs(&self) -> Vec<String> {
-        vec![CSV.into(), CHOICES_CSV.into(), SVG.into()]
-    }
+    described!("fig7", "Fig. 7: benchmarking tool selection by F, J and confidence (C4)", [CSV, CHOICES_CSV, SVG]);
 
     fn planned_episodes(&self, plan: &Plan) -> u64 {
         (if self.with_mpc && plan.mpc { 3 } else { 2 })
@@ -409,6 +399,7 @@ fn short(rule: &dyn DecisionRule) -> String {
     rule.label().split(' ').next().unwrap_or("").to_string()
 }
 
+/// The four verdicts of claim C4, when the rules F, J and confidence are all benchmarked.
 fn verdicts(
     rules: &[Box<dyn DecisionRule>],
     compare: &dyn Fn(usize, usize, usize) -> Comparison,
@@ -420,15 +411,39 @@ fn verdicts(
         return vec![];
     };
     let significant = format!("Wilcoxon signed-rank p < {alpha} (two-sided)");
-    let directional = |better: Option<bool>| match better {
+    vec![
+        confidence_verdict(&compare(0, f, j), alpha, &significant),
+        sensitivity_verdict(&compare(2, j, f), alpha, &significant),
+        task_error_verdict(rules, f, compare, alpha, &significant),
+        similarity_verdict(c, f, compare, alpha),
+    ]
+}
+
+/// Holds for a significantly greater a, does not for a significantly smaller one.
+fn directional(better: Option<bool>) -> Outcome {
+    match better {
         None => Outcome::NotJudged,
         Some(true) => Outcome::Holds,
         Some(false) => Outcome::DoesNotHold,
-    };
-    let mut out = Vec::new();
+    }
+}
 
-    let conf = compare(0, f, j);
-    out.push(Verdict {
+/// Not judged, or else holds, partly holds or does not hold, the first that applies.
+fn graded(judged: bool, holds: bool, partly: bool) -> Outcome {
+    if !judged {
+        Outcome::NotJudged
+    } else if holds {
+        Outcome::Holds
+    } else if partly {
+        Outcome::Partly
+    } else {
+        Outcome::DoesNotHold
+    }
+}
+
+/// C4: J's tools have the lower confidence (`conf`: F's − J's).
+fn confidence_verdict(conf: &Comparison, alpha: f64, significant: &str) -> Verdict {
+    Verdict {
         claim: "C4, confidence".into(),
         statement: "\"The tools selected by J showed lower control confidence\" than those \
                     selected by F."
@@ -439,10 +454,12 @@ fn verdicts(
             conf.describe()
         ),
         rule: format!("holds if F's tools have the higher confidence with {significant}; does not hold otherwise."),
-    });
+    }
+}
 
-    let sens = compare(2, j, f);
-    out.push(Verdict {
+/// C4: F's tools are the less sensitive to a perturbation (`sens`: J's − F's).
+fn sensitivity_verdict(sens: &Comparison, alpha: f64, significant: &str) -> Verdict {
+    Verdict {
         claim: "C4, sensitivity".into(),
         statement: "\"The tool selected using F has a superior tolerance to control \
                     perturbations than the tool selected using J\": J's tools have the higher \
@@ -454,8 +471,17 @@ fn verdicts(
             sens.describe()
         ),
         rule: format!("holds if J's tools are the more sensitive with {significant}; does not hold otherwise."),
-    });
+    }
+}
 
+/// C4: F (rule `f`) has the lowest mean task error of the rules.
+fn task_error_verdict(
+    rules: &[Box<dyn DecisionRule>],
+    f: usize,
+    compare: &dyn Fn(usize, usize, usize) -> Comparison,
+    alpha: f64,
+    significant: &str,
+) -> Verdict {
     let others: Vec<usize> = (0..rules.len()).filter(|&r| r != f).collect();
     let error_cmp: Vec<(usize, Comparison)> =
         others.iter().map(|&r| (r, compare(1, r, f))).collect();
@@ -466,18 +492,10 @@ fn verdicts(
         .iter()
         .all(|(_, c)| c.a_greater(alpha) == Some(true));
     let judged = error_cmp.iter().all(|(_, c)| c.mean_difference().is_some());
-    out.push(Verdict {
+    Verdict {
         claim: "C4, task error".into(),
         statement: "\"F has the lowest average task error\" of the rules.".into(),
-        outcome: if !judged {
-            Outcome::NotJudged
-        } else if lowest && all_significant {
-            Outcome::Holds
-        } else if lowest {
-            Outcome::Partly
-        } else {
-            Outcome::DoesNotHold
-        },
+        outcome: graded(judged, lowest && all_significant, lowest),
         evidence: error_cmp
             .iter()
             .map(|(r, c)| {
@@ -495,26 +513,30 @@ fn verdicts(
              {significant}; partly holds if it is the lowest mean but not significantly lower \
              than every other; does not hold if another rule has a lower mean."
         ),
-    });
+    }
+}
 
+/// C4: the confidence-only rule (`c`) is similar to F (`f`) on every measure.
+fn similarity_verdict(
+    c: usize,
+    f: usize,
+    compare: &dyn Fn(usize, usize, usize) -> Comparison,
+    alpha: f64,
+) -> Verdict {
     let similar: Vec<(usize, Comparison)> =
         (0..METRICS.len()).map(|m| (m, compare(m, c, f))).collect();
     let verdicts: Vec<Option<bool>> = similar.iter().map(|(_, s)| s.similar(alpha)).collect();
     let yes = verdicts.iter().filter(|v| **v == Some(true)).count();
-    out.push(Verdict {
+    Verdict {
         claim: "C4, confidence-only selection".into(),
         statement: "\"The confidence-based tool selection showed similar confidence, task error \
                     and sensitivity to that of F.\""
             .into(),
-        outcome: if verdicts.iter().any(Option::is_none) {
-            Outcome::NotJudged
-        } else if yes == METRICS.len() {
-            Outcome::Holds
-        } else if yes > 0 {
-            Outcome::Partly
-        } else {
-            Outcome::DoesNotHold
-        },
+        outcome: graded(
+            verdicts.iter().all(Option::is_some),
+            yes == METRICS.len(),
+            yes > 0,
+        ),
         evidence: similar
             .iter()
             .map(|(m, s)| {
@@ -533,6 +555,5 @@ fn verdicts(
              significant difference is weaker evidence than a proof of equality); holds if all \
              three measures are similar, partly holds if one or two are, does not hold if none."
         ),
-    });
-    out
+    }
 }

@@ -227,6 +227,25 @@ pub trait Experiment: Sync {
     }
 }
 
+/// An experiment's [`Experiment::id`], [`Experiment::title`] and [`Experiment::outputs`],
+/// inside its `impl Experiment`: `described!("fig2", "Fig. 2: ...", [CSV, SVG]);`.
+macro_rules! described {
+    ($id:literal, $title:literal, [$($file:expr),* $(,)?]) => {
+        fn id(&self) -> &'static str {
+            $id
+        }
+
+        fn title(&self) -> &'static str {
+            $title
+        }
+
+        fn outputs(&self) -> Vec<String> {
+            vec![$($file.into()),*]
+        }
+    };
+}
+pub(crate) use described;
+
 /// The registry: every experiment, in report order.
 pub fn experiments() -> Vec<Box<dyn Experiment>> {
     vec![

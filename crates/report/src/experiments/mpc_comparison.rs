@@ -18,7 +18,7 @@ use super::csv::{Cell, CsvWriter};
 use super::figure_parts::{arm_cells, files_block, task_label, PAPER_TASKS};
 use super::report::{Block, Section};
 use super::verdict::{num, Correlation};
-use super::{Context, Experiment, Plan, ReproduceError};
+use super::{described, Context, Experiment, Plan, ReproduceError};
 
 pub struct MpcComparison;
 
@@ -61,17 +61,7 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, Duration) {
 }
 
 impl Experiment for MpcComparison {
-    fn id(&self) -> &'static str {
-        "mpc"
-    }
-
-    fn title(&self) -> &'static str {
-        "Active inference against the MPC baseline"
-    }
-
-    fn outputs(&self) -> Vec<String> {
-        vec![CSV.into()]
-    }
+    described!("mpc", "Active inference against the MPC baseline", [CSV]);
 
     fn planned_episodes(&self, plan: &Plan) -> u64 {
         if plan.mpc {

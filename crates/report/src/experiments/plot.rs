@@ -5,10 +5,11 @@
 //! coordinate in a file is ever NaN. A logarithmic y axis is drawn as log10(y) on a linear axis
 //! with the ticks labelled in y (values ≤ 0 cannot be shown there and are counted in the title).
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::stats::summary;
+use crate::stats::{summary, Summary};
 
 use super::{write_atomically, ReproduceError};
 
@@ -188,32 +189,46 @@ fn legend_position(l: Legend) -> SeriesLabelPosition {
     }
 }
 
+/// A chart on linear x and y axes of f64.
+type Chart<'a, 'b, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// A series' points that can be drawn: finite, and on a log axis positive (as log10(y)); the
+/// count of values ≤ 0 a log axis leaves out is added to `hidden`.
+fn drawable(s: &Series, log: bool, hidden: &mut usize) -> Vec<(f64, f64)> {
+    s.points
+        .iter()
+        .filter_map(|&(x, y)| {
+            let y = if log {
+                if y > 0.0 {
+                    y.log10()
+                } else {
+                    *hidden += 1;
+                    return None;
+                }
+            } else {
+                y
+            };
+            (x.is_finite() && y.is_finite()).then_some((x, y))
+        })
+        .collect()
+}
+
 fn draw_xy<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &XyPanel) -> Result<(), String>
 where
     DB::ErrorType: 'static,
 {
     let log = p.log_y;
     let mut hidden = 0usize;
-    let mut map = |s: &Series| -> Vec<(f64, f64)> {
-        s.points
-            .iter()
-            .filter_map(|&(x, y)| {
-                let y = if log {
-                    if y > 0.0 {
-                        y.log10()
-                    } else {
-                        hidden += 1;
-                        return None;
-                    }
-                } else {
-                    y
-                };
-                (x.is_finite() && y.is_finite()).then_some((x, y))
-            })
-            .collect()
-    };
-    let dots: Vec<Vec<(f64, f64)>> = p.dots.iter().map(&mut map).collect();
-    let lines: Vec<Vec<(f64, f64)>> = p.lines.iter().map(&mut map).collect();
+    let dots: Vec<Vec<(f64, f64)>> = p
+        .dots
+        .iter()
+        .map(|s| drawable(s, log, &mut hidden))
+        .collect();
+    let lines: Vec<Vec<(f64, f64)>> = p
+        .lines
+        .iter()
+        .map(|s| drawable(s, log, &mut hidden))
+        .collect();
     let all = || dots.iter().chain(&lines).flatten();
     let (x0, x1) = padded_range(all().map(|q| q.0));
     let (y0, y1) = padded_range(all().map(|q| q.1));
@@ -253,8 +268,32 @@ where
         .bold_line_style(Colour(215, 215, 215))
         .draw()
         .map_err(text)?;
+    if draw_series(&mut chart, p, &dots, &lines)? {
+        chart
+            .configure_series_labels()
+            .position(legend_position(p.legend))
+            .background_style(WHITE.mix(0.85))
+            .border_style(Colour(150, 150, 150))
+            .label_font(("sans-serif", 12))
+            .draw()
+            .map_err(text)?;
+    }
+    Ok(())
+}
+
+/// The panel's lines, then its dots (`lines` and `dots` their drawable points); whether any has
+/// a legend entry.
+fn draw_series<DB: DrawingBackend>(
+    chart: &mut Chart<'_, '_, DB>,
+    p: &XyPanel,
+    dots: &[Vec<(f64, f64)>],
+    lines: &[Vec<(f64, f64)>],
+) -> Result<bool, String>
+where
+    DB::ErrorType: 'static,
+{
     let mut labelled = false;
-    for (s, pts) in p.lines.iter().zip(&lines) {
+    for (s, pts) in p.lines.iter().zip(lines) {
         let style = s.colour.stroke_width(2);
         let anno = if s.dashed {
             chart
@@ -271,7 +310,7 @@ where
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
         }
     }
-    for (s, pts) in p.dots.iter().zip(&dots) {
+    for (s, pts) in p.dots.iter().zip(dots) {
         let fill = s.colour.mix(0.75).filled();
         let anno = chart
             .draw_series(pts.iter().map(|&q| Circle::new(q, 3, fill)))
@@ -282,17 +321,7 @@ where
                 .legend(move |(x, y)| Circle::new((x + 9, y), 4, fill));
         }
     }
-    if labelled {
-        chart
-            .configure_series_labels()
-            .position(legend_position(p.legend))
-            .background_style(WHITE.mix(0.85))
-            .border_style(Colour(150, 150, 150))
-            .label_font(("sans-serif", 12))
-            .draw()
-            .map_err(text)?;
-    }
-    Ok(())
+    Ok(labelled)
 }
 
 fn draw_boxes<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &BoxPanel) -> Result<(), String>
@@ -300,8 +329,6 @@ where
     DB::ErrorType: 'static,
 {
     let k = p.groups.len().max(1);
-    let finite =
-        |v: &Vec<f64>| -> Vec<f64> { v.iter().copied().filter(|x| x.is_finite()).collect() };
     let stats: Vec<_> = p
         .groups
         .iter()
@@ -342,65 +369,73 @@ where
         .map_err(text)?;
     for (i, ((_, colour, values), s)) in p.groups.iter().zip(&stats).enumerate() {
         let Some(s) = s else { continue };
-        let x = i as f64 + 1.0;
-        let (l, r) = (x - 0.22, x + 0.22);
-        let edge = colour.stroke_width(2);
-        let iqr = s.q3 - s.q1;
-        let values = finite(values);
-        let inside = |v: &&f64| **v >= s.q1 - 1.5 * iqr && **v <= s.q3 + 1.5 * iqr;
-        let lo = values.iter().filter(inside).fold(s.q1, |a, &v| a.min(v));
-        let hi = values.iter().filter(inside).fold(s.q3, |a, &v| a.max(v));
-        let mut shapes: Vec<PathElement<(f64, f64)>> = vec![
-            PathElement::new(vec![(x, s.q3), (x, hi)], edge),
-            PathElement::new(vec![(x, s.q1), (x, lo)], edge),
-            PathElement::new(vec![(x - 0.1, hi), (x + 0.1, hi)], edge),
-            PathElement::new(vec![(x - 0.1, lo), (x + 0.1, lo)], edge),
-            PathElement::new(vec![(l, s.median), (r, s.median)], BLACK_.stroke_width(3)),
-        ];
-        // Mean ± sd beside the box.
-        let m = x + 0.34;
-        let sd_style = BLACK_.stroke_width(1);
-        shapes.push(PathElement::new(
-            vec![(m, s.mean - s.sd), (m, s.mean + s.sd)],
-            sd_style,
-        ));
-        shapes.push(PathElement::new(
-            vec![(m - 0.04, s.mean - s.sd), (m + 0.04, s.mean - s.sd)],
-            sd_style,
-        ));
-        shapes.push(PathElement::new(
-            vec![(m - 0.04, s.mean + s.sd), (m + 0.04, s.mean + s.sd)],
-            sd_style,
-        ));
-        chart
-            .draw_series(std::iter::once(Rectangle::new(
-                [(l, s.q1), (r, s.q3)],
-                colour.mix(0.35).filled(),
-            )))
-            .map_err(text)?;
-        chart
-            .draw_series(std::iter::once(Rectangle::new(
-                [(l, s.q1), (r, s.q3)],
-                edge,
-            )))
-            .map_err(text)?;
-        chart.draw_series(shapes).map_err(text)?;
-        chart
-            .draw_series(std::iter::once(TriangleMarker::new(
-                (m, s.mean),
-                5,
-                BLACK_.filled(),
-            )))
-            .map_err(text)?;
-        chart
-            .draw_series(
-                values
-                    .iter()
-                    .filter(|v| !inside(v))
-                    .map(|&v| Circle::new((x, v), 3, colour.stroke_width(1))),
-            )
-            .map_err(text)?;
+        draw_box(&mut chart, i as f64 + 1.0, *colour, &finite(values), s)?;
     }
+    Ok(())
+}
+
+/// The finite values of `v`.
+fn finite(v: &[f64]) -> Vec<f64> {
+    v.iter().copied().filter(|x| x.is_finite()).collect()
+}
+
+/// One box at `x`: quartiles, whiskers to the last values within 1.5 IQR, the median, mean ±
+/// sd beside it, and the values beyond the whiskers as circles.
+fn draw_box<DB: DrawingBackend>(
+    chart: &mut Chart<'_, '_, DB>,
+    x: f64,
+    colour: Colour,
+    values: &[f64],
+    s: &Summary,
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    let (l, r) = (x - 0.22, x + 0.22);
+    let edge = colour.stroke_width(2);
+    let iqr = s.q3 - s.q1;
+    let inside = |v: &&f64| **v >= s.q1 - 1.5 * iqr && **v <= s.q3 + 1.5 * iqr;
+    let lo = values.iter().filter(inside).fold(s.q1, |a, &v| a.min(v));
+    let hi = values.iter().filter(inside).fold(s.q3, |a, &v| a.max(v));
+    let mut shapes: Vec<PathElement<(f64, f64)>> = vec![
+        PathElement::new(vec![(x, s.q3), (x, hi)], edge),
+        PathElement::new(vec![(x, s.q1), (x, lo)], edge),
+        PathElement::new(vec![(x - 0.1, hi), (x + 0.1, hi)], edge),
+        PathElement::new(vec![(x - 0.1, lo), (x + 0.1, lo)], edge),
+        PathElement::new(vec![(l, s.median), (r, s.median)], BLACK_.stroke_width(3)),
+    ];
+    // Mean ± sd beside the box.
+    let m = x + 0.34;
+    let sd_style = BLACK_.stroke_width(1);
+    let (below, above) = (s.mean - s.sd, s.mean + s.sd);
+    shapes.push(PathElement::new(vec![(m, below), (m, above)], sd_style));
+    shapes.push(PathElement::new(
+        vec![(m - 0.04, below), (m + 0.04, below)],
+        sd_style,
+    ));
+    shapes.push(PathElement::new(
+        vec![(m - 0.04, above), (m + 0.04, above)],
+        sd_style,
+    ));
+    let corners = [(l, s.q1), (r, s.q3)];
+    let fill = colour.mix(0.35).filled();
+    chart
+        .draw_series(std::iter::once(Rectangle::new(corners, fill)))
+        .map_err(text)?;
+    chart
+        .draw_series(std::iter::once(Rectangle::new(corners, edge)))
+        .map_err(text)?;
+    chart.draw_series(shapes).map_err(text)?;
+    let mean = TriangleMarker::new((m, s.mean), 5, BLACK_.filled());
+    chart.draw_series(std::iter::once(mean)).map_err(text)?;
+    chart
+        .draw_series(
+            values
+                .iter()
+                .filter(|v| !inside(v))
+                .map(|&v| Circle::new((x, v), 3, colour.stroke_width(1))),
+        )
+        .map_err(text)?;
     Ok(())
 }
 

@@ -131,7 +131,31 @@ fn join<'a>(v: impl Iterator<Item = &'a f64>) -> String {
 
 /// The whole report: header, verdict summary, timing, then every section.
 pub fn document(info: &RunInfo, sections: &[Section]) -> Vec<Block> {
-    let mut doc = vec![
+    let mut doc = header(info);
+    doc.push(Block::Heading(2, "Verdicts".into()));
+    let mut rows = Vec::new();
+    for s in sections {
+        for v in s.verdicts() {
+            rows.push(vec![
+                v.claim.clone(),
+                s.title.clone(),
+                format!("**{}**", v.outcome.words()),
+            ]);
+        }
+    }
+    doc.push(Block::table(&["claim", "figure", "verdict"], rows));
+    doc.push(Block::Heading(2, "Run time".into()));
+    doc.extend(run_time(info));
+    for s in sections {
+        doc.push(Block::Heading(2, s.title.clone()));
+        doc.extend(s.blocks.iter().cloned());
+    }
+    doc
+}
+
+/// The report's title and what the run was: its command, seed, counts, settings and streams.
+fn header(info: &RunInfo) -> Vec<Block> {
+    vec![
         Block::Heading(
             1,
             "Reproduction of the Results of \"Confidence-Aware Decision-Making and Control for \
@@ -183,23 +207,14 @@ pub fn document(info: &RunInfo, sections: &[Section]) -> Vec<Block> {
              therefore independent of each other and of their order, and the CSVs and figures \
              are byte-identical whatever the thread count.",
         ),
-        Block::Heading(2, "Verdicts".into()),
-    ];
-    let mut rows = Vec::new();
-    for s in sections {
-        for v in s.verdicts() {
-            rows.push(vec![
-                v.claim.clone(),
-                s.title.clone(),
-                format!("**{}**", v.outcome.words()),
-            ]);
-        }
-    }
-    doc.push(Block::table(&["claim", "figure", "verdict"], rows));
-    doc.push(Block::Heading(2, "Run time".into()));
+    ]
+}
+
+/// The run's wall time and throughput, overall and per experiment.
+fn run_time(info: &RunInfo) -> [Block; 2] {
     let episodes: u64 = info.timings.iter().map(|t| t.episodes).sum();
     let secs = info.wall.as_secs_f64();
-    doc.push(Block::p(format!(
+    let overall = Block::p(format!(
         "Wall time {:.2} s on {} rayon thread{}; {} episodes, {:.0} episodes/s overall.",
         secs,
         info.threads,
@@ -210,7 +225,7 @@ pub fn document(info: &RunInfo, sections: &[Section]) -> Vec<Block> {
         } else {
             0.0
         }
-    )));
+    ));
     let rows = info
         .timings
         .iter()
@@ -229,7 +244,7 @@ pub fn document(info: &RunInfo, sections: &[Section]) -> Vec<Block> {
             ]
         })
         .collect();
-    doc.push(Block::table(
+    let table = Block::table(
         &[
             "experiment",
             "wall time [s]",
@@ -238,12 +253,8 @@ pub fn document(info: &RunInfo, sections: &[Section]) -> Vec<Block> {
             "RHS evaluations",
         ],
         rows,
-    ));
-    for s in sections {
-        doc.push(Block::Heading(2, s.title.clone()));
-        doc.extend(s.blocks.iter().cloned());
-    }
-    doc
+    );
+    [overall, table]
 }
 
 fn verdict_line(v: &Verdict) -> String {

@@ -5,8 +5,8 @@ use nalgebra::{SMatrix, SVector};
 use toolconf_core::{control_confidence, ArmModel, TaskKind, TaskN, ToolN, TERMS};
 
 use super::{results, rules, Array, Fuzz};
+use crate::bodies::status_of;
 use crate::check::c_str;
-use crate::imp::status_of;
 use crate::status;
 
 fn vector<const K: usize>(a: &Array) -> SVector<f64, K> {

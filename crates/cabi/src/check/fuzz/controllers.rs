@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use toolconf_core::{ArmController, ArmModel, TaskKind, TaskN, ToolN};
 
 use super::{rules, Fuzz, Handle, Want};
-use crate::imp::{status_of, Controller};
+use crate::bodies::{status_of, Controller};
 use crate::{status, Exports};
 
 /// What a handle that is not live gives (rule 2).

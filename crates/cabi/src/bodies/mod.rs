@@ -10,7 +10,7 @@
 //!    too large for the model's arithmetic ([`status::NOT_FINITE`], the result named).
 //!
 //! Then it copies the result out: nothing is written on a failure. The whole call runs inside
-//! [`guard`], so a panic becomes [`status::INTERNAL`] rather than unwinding into C.
+//! [`guard`] (through `call`), so a panic becomes [`status::INTERNAL`] rather than unwinding into C.
 //!
 //! # Safety
 //!
@@ -25,13 +25,11 @@
 mod controller;
 mod functions;
 
-pub use controller::*;
-pub use functions::*;
-
+use core::marker::PhantomData;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use nalgebra::{SMatrix, SVector};
-use toolconf_core::{ArmModel, Error, TaskKind, ToolN, TERMS};
+use toolconf_core::{ArmModel, Error, TaskKind, TaskN, ToolN, TERMS};
 
 use crate::status::{self, fail, Failure};
 
@@ -40,6 +38,33 @@ use crate::status::{self, fail, Failure};
 #[repr(C)]
 pub struct Controller {
     _opaque: [u8; 0],
+}
+
+/// The exports' bodies for model `M` (its sizes N, NX, NP, NZ): `Bodies::<M, ..>::dynamics` is
+/// `toolconf_dynamics`, and so on ([`crate::export_model!`] names each).
+pub struct Bodies<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    PhantomData<M>,
+);
+
+/// A pointer C passed, as the messages name it.
+type Named<'a> = (*const (), &'a str);
+
+/// `[(p.cast(), "p"), ...]`: the pointers an export needs, named by their C parameter's name,
+/// inputs first, in the order they are checked.
+macro_rules! named {
+    ($($p:ident),+ $(,)?) => {
+        [$(($p as *const (), stringify!($p))),+]
+    };
+}
+pub(crate) use named;
+
+/// An export's whole call: inside [`guard`], every pointer of `pointers` non-NULL (step 1),
+/// then `body` (the steps after it).
+fn call(function: &str, pointers: &[Named], body: impl FnOnce() -> Result<(), Failure>) -> i32 {
+    guard(function, || {
+        present(function, pointers)?;
+        body()
+    })
 }
 
 /// Runs `f`, turning its failure into its status and a panic into [`status::INTERNAL`].
@@ -65,7 +90,7 @@ fn null(function: &str, what: &str) -> Failure {
 }
 
 /// Step 1: every pointer of `pointers` non-NULL, else the first NULL one named.
-fn present(function: &str, pointers: &[(*const (), &str)]) -> Result<(), Failure> {
+fn present(function: &str, pointers: &[Named]) -> Result<(), Failure> {
     match pointers.iter().find(|(p, _)| p.is_null()) {
         Some((_, what)) => Err(null(function, what)),
         None => Ok(()),
@@ -152,60 +177,93 @@ unsafe fn write(ptr: *mut f64, values: &[f64]) {
     }
 }
 
-/// Step 6: every value of `results` finite, else why not. A tool that breaks its model's rule
-/// is the cause when it does ([`status::INVALID_TOOL`], the rule named: the closed forms are
-/// unchecked, and a mass of 0 divides by it); otherwise the inputs are too large for the
-/// model's arithmetic ([`status::NOT_FINITE`]). The result is named either way.
-fn finite_results<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
-    function: &str,
-    params: &SVector<f64, NP>,
-    results: &[(&str, &[f64])],
-) -> Result<(), Failure>
-where
-    M: ArmModel<N, NX, NP, NZ>,
-{
-    for (what, values) in results {
-        let Some((i, v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) else {
-            continue;
-        };
-        return Err(match ToolN::<M, N, NX, NP, NZ>::new((*params).into()) {
-            Err(e) => fail(
-                status::INVALID_TOOL,
-                format_args!("{function}: {what}[{i}] = {v} is not finite: {e}"),
-            ),
-            Ok(_) => fail(
-                status::NOT_FINITE,
-                format_args!(
-                    "{function}: {what}[{i}] = {v} is not finite: the inputs are too large for \
-                     model {}'s arithmetic",
-                    M::name()
-                ),
-            ),
-        });
-    }
-    Ok(())
-}
+/// A result to copy out: where, its C name, its values.
+type Output<'a> = (*mut f64, &'a str, &'a [f64]);
 
-/// The task with index `index` (`TaskKind::ALL`), which the model must offer.
-pub fn task<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
-    index: u32,
-    function: &str,
-) -> Result<TaskKind, Failure>
+/// The steps every export of model `M` shares.
+impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize> Bodies<M, N, NX, NP, NZ>
 where
     M: ArmModel<N, NX, NP, NZ>,
 {
-    let offered = crate::info::generated(M::name()).map_or(&[][..], |g| g.tasks);
-    match TaskKind::ALL.get(index as usize) {
-        Some(kind) if offered.contains(kind) => Ok(*kind),
-        _ => Err(fail(
-            status::UNKNOWN_TASK,
-            format_args!(
-                "{function}: task {index} is not one of model {}'s {} tasks (0 to {})",
-                M::name(),
-                TaskKind::ALL.len(),
-                TaskKind::ALL.len().saturating_sub(1)
-            ),
-        )),
+    /// Step 6 and the copy: every value of `results` finite, else why not, and only then each
+    /// written. A tool that breaks its model's rule is the cause when it does
+    /// ([`status::INVALID_TOOL`], the rule named: the closed forms are unchecked, and a mass of
+    /// 0 divides by it); otherwise the inputs are too large for the model's arithmetic
+    /// ([`status::NOT_FINITE`]). The result is named either way.
+    unsafe fn finish(
+        function: &str,
+        params: &SVector<f64, NP>,
+        results: &[Output],
+    ) -> Result<(), Failure> {
+        for (_, what, values) in results {
+            let Some((i, v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) else {
+                continue;
+            };
+            return Err(match ToolN::<M, N, NX, NP, NZ>::new((*params).into()) {
+                Err(e) => fail(
+                    status::INVALID_TOOL,
+                    format_args!("{function}: {what}[{i}] = {v} is not finite: {e}"),
+                ),
+                Ok(_) => fail(
+                    status::NOT_FINITE,
+                    format_args!(
+                        "{function}: {what}[{i}] = {v} is not finite: the inputs are too large \
+                         for model {}'s arithmetic",
+                        M::name()
+                    ),
+                ),
+            });
+        }
+        for (ptr, _, values) in results {
+            write(*ptr, values);
+        }
+        Ok(())
+    }
+
+    /// Step 3: the task with index `index` (`TaskKind::ALL`), which the model must offer.
+    fn task(index: u32, function: &str) -> Result<TaskKind, Failure> {
+        let offered = crate::info::generated(M::name()).map_or(&[][..], |g| g.tasks);
+        match TaskKind::ALL.get(index as usize) {
+            Some(kind) if offered.contains(kind) => Ok(*kind),
+            _ => Err(fail(
+                status::UNKNOWN_TASK,
+                format_args!(
+                    "{function}: task {index} is not one of model {}'s {} tasks (0 to {})",
+                    M::name(),
+                    TaskKind::ALL.len(),
+                    TaskKind::ALL.len().saturating_sub(1)
+                ),
+            )),
+        }
+    }
+
+    /// Step 5 for a tool: the model's rule.
+    fn checked_tool(
+        p: &SVector<f64, NP>,
+        function: &str,
+    ) -> Result<ToolN<M, N, NX, NP, NZ>, Failure> {
+        ToolN::<M, N, NX, NP, NZ>::new((*p).into()).map_err(|e| core_error(&e, function))
+    }
+
+    /// Steps 3 and 4 for a task and a tool from C arrays (their pointers checked already): the
+    /// task, then the parameters, goals and precisions read and checked finite.
+    unsafe fn task_inputs(
+        task_index: u32,
+        params: *const f64,
+        goals: *const f64,
+        precisions: *const f64,
+        function: &str,
+    ) -> Result<(SVector<f64, NP>, TaskN<N>), Failure> {
+        let kind = Self::task(task_index, function)?;
+        let p = vector::<NP>(params, function, "params")?;
+        let goal = per_term_vectors::<N>(goals, function, "goals")?;
+        let precision = per_term_matrices::<N>(precisions, function, "precisions")?;
+        let task = TaskN {
+            kind,
+            goal,
+            precision,
+        };
+        Ok((p, task))
     }
 }
 
