@@ -46,8 +46,8 @@ fn design(c: &mut Criterion) {
                 &polytope,
                 ModelKind::Arm2,
                 &tasks,
-                100_000,
-                5,
+                // No validation sample: the draws and the five kept, as before the check existed.
+                (100_000, 5, 0),
                 black_box(1),
                 &mut |_| {},
             )
