@@ -5,6 +5,7 @@
 use nalgebra::{DMatrix, SMatrix, SVector};
 
 use super::linear::LinearLoop;
+use crate::generated::Term;
 
 /// The step over `h` of the affine systems ż = M z + c_j, one per column c_j of `inputs`: the
 /// transition e^{M h} and, per input, the response ∫₀^h e^{M s} ds c_j.
@@ -41,9 +42,44 @@ pub(crate) struct Sums {
     pub free_energy: f64,
 }
 
+/// One term the sums read: its linearisation, its constant part under ΔT less its goal, its
+/// precision, and whether it is the task's error term and part of J.
+struct Read<'a, const N: usize, const NZ: usize> {
+    c: &'a SMatrix<f64, N, NZ>,
+    d: SVector<f64, N>,
+    p: SMatrix<f64, N, N>,
+    error: bool,
+    cost: bool,
+}
+
+/// The terms the task's error and J read (the others add nothing), under ΔT.
+fn reads<'a, const N: usize, const NX: usize, const NZ: usize>(
+    linear: &'a LinearLoop<N, NX, NZ>,
+    perturbation: &SVector<f64, N>,
+) -> Vec<Read<'a, N, NZ>> {
+    let task = &linear.controller.task;
+    let error_term = task.kind.error_term();
+    Term::COST_ORDER
+        .iter()
+        .filter(|&&term| term == error_term || task.kind.uses(term))
+        .map(|&term| {
+            let t = &linear.terms[term.index()];
+            Read {
+                c: &t.c,
+                d: t.offset + t.gain_dt * perturbation - task.goal(term),
+                p: *task.precision(term),
+                error: term == error_term,
+                cost: task.kind.uses(term),
+            }
+        })
+        .collect()
+}
+
 /// Steps `z0` over `grid` with the steps of every interval (`steps`: the regular one, and the
 /// last, shorter one where the horizon is not a whole number of output steps), input `which`
-/// of each step, and forms the [`Sums`] of the observations under ΔT.
+/// of each step, and forms the [`Sums`] of the observations under ΔT: at each point the task's
+/// weighted error (e − e^g)ᵀP(e − e^g) and J = ½ Σ (e − e^g)ᵀP(e − e^g) over the task's terms,
+/// as the controller forms them ([`crate::model::ActiveInferenceN::cost_j`]).
 pub(crate) fn sums<const N: usize, const NX: usize, const NZ: usize>(
     linear: &LinearLoop<N, NX, NZ>,
     grid: &[f64],
@@ -52,7 +88,8 @@ pub(crate) fn sums<const N: usize, const NX: usize, const NZ: usize>(
     z0: &SVector<f64, NZ>,
     perturbation: &SVector<f64, N>,
 ) -> Sums {
-    let controller = &linear.controller;
+    let half_logdet = 0.5 * linear.controller.logdet;
+    let reads = reads(linear, perturbation);
     let mut sums = Sums::default();
     let mut z = *z0;
     // (t, F, J) at the previous grid point, for the trapezoidal rule.
@@ -66,10 +103,19 @@ pub(crate) fn sums<const N: usize, const NX: usize, const NZ: usize>(
             };
             z = step.transition * z + step.responses[which];
         }
-        let observed = linear.observe(&z, perturbation);
-        sums.task_error += controller.task_error(&observed);
-        let j = controller.cost_j(&observed);
-        let f = j - 0.5 * controller.logdet;
+        let mut j = 0.0;
+        for r in &reads {
+            let e = r.c * z + r.d;
+            let v = e.dot(&(r.p * e));
+            if r.error {
+                sums.task_error += v;
+            }
+            if r.cost {
+                j += v;
+            }
+        }
+        let j = 0.5 * j;
+        let f = j - half_logdet;
         if let Some((t_prev, f_prev, j_prev)) = previous {
             let h = t - t_prev;
             sums.free_energy += 0.5 * h * (f + f_prev);
