@@ -151,7 +151,9 @@ fn run(a: &Args) -> Result<serde_json::Value, String> {
     let col = |f: fn(&Row) -> f64| rows.iter().map(f).collect::<Vec<_>>();
     let (logdet, p_te, p_f) = (col(|r| r.0), col(|r| r.1), col(|r| r.2));
     let (s_te, s_f) = (col(|r| r.3), col(|r| r.4));
-    let rho = |x: &[f64], y: &[f64]| spearman(x, y).map_err(|e| e.to_string());
+    // ρ is undefined (null) where a criterion is the same for every tool (ln|Π^U| on a task
+    // whose Π^U does not depend on the tool).
+    let rho = |x: &[f64], y: &[f64]| -> Result<Option<f64>, String> { Ok(spearman(x, y).ok()) };
     let neg_logdet: Vec<f64> = logdet.iter().map(|v| -v).collect();
     if let Some(path) = &a.points {
         let mut csv = String::from("distance,predicted_task_error,simulated_task_error\n");
