@@ -178,3 +178,57 @@ fn an_unstable_loop_is_refused_with_its_eigenvalue() {
         other => panic!("{other:?}"),
     }
 }
+
+/// The linear systems and predictions of tests/fixtures/prediction_scipy.json, which
+/// derive/tests/test_prediction_scipy.py recomputes with SciPy's `expm`: the fixture must be
+/// what the code gives now (`TOOLCONF_WRITE_FIXTURES=1` rewrites it).
+#[test]
+fn the_scipy_fixture_is_what_the_code_gives() {
+    let tool = franka_hand();
+    let mut cases = Vec::new();
+    for (name, text, dt) in [("panda touch", TOUCH, 0.0), ("panda push, dT", PUSH, 0.3)] {
+        let (task, mut options) = panda_task(text);
+        options.perturbation = dt;
+        cases.push((
+            name,
+            linear_system(&tool, &task, &options).unwrap(),
+            predict(&tool, &task, &options).unwrap(),
+        ));
+    }
+    let arm = ToolN::<Arm2, 2, 4, 4, 6>::new([1.0, 2.0, 0.8, 1.2]).unwrap();
+    let task = Arm2::paper_task(TaskKind::Position);
+    let mut options = EpisodeOptionsN::paper::<Arm2, 4, 6>();
+    options.t_end = 1.03;
+    cases.push((
+        "arm2 position, t_end 1.03",
+        linear_system(&arm, &task, &options).unwrap(),
+        predict(&arm, &task, &options).unwrap(),
+    ));
+    let json: Vec<serde_json::Value> = cases
+        .iter()
+        .map(|(name, system, p)| {
+            serde_json::json!({"name": name, "system": system, "task_error": p.task_error,
+                "free_energy": p.free_energy, "cost_j": p.cost_j})
+        })
+        .collect();
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../tests/fixtures/prediction_scipy.json"
+    );
+    if std::env::var_os("TOOLCONF_WRITE_FIXTURES").is_some() {
+        std::fs::write(path, serde_json::to_string(&json).unwrap() + "\n").unwrap();
+    }
+    let stored: Vec<serde_json::Value> =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    assert_eq!(stored.len(), json.len());
+    for (s, j) in stored.iter().zip(&json) {
+        for key in ["task_error", "free_energy", "cost_j"] {
+            let (a, b) = (s[key].as_f64().unwrap(), j[key].as_f64().unwrap());
+            assert!(
+                (a - b).abs() <= 1e-12 * a.abs().max(1.0),
+                "{}: {key} {a} != {b}",
+                j["name"]
+            );
+        }
+    }
+}
