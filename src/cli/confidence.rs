@@ -112,7 +112,7 @@ fn run_model(args: &Args, model: ModelKind, spec: &TaskSpec) -> Result<(), CliEr
             .iter()
             .map(|(name, m)| (name.to_string(), json!(m)))
             .collect();
-        let out = json!({
+        let mut out = json!({
             "model": model.name(),
             "params": named,
             "task": spec.kind,
@@ -122,6 +122,7 @@ fn run_model(args: &Args, model: ModelKind, spec: &TaskSpec) -> Result<(), CliEr
             "pi_u": l.pi_u,
             "logdet": l.logdet,
         });
+        super::prediction::add_prediction(&mut out, &tasks.predict(&tool));
         print_json(args, out);
         return Ok(());
     }

@@ -28,6 +28,7 @@ mod design;
 mod episode_args;
 mod evaluate;
 mod output;
+mod prediction;
 mod rank;
 mod reproduce;
 mod select;

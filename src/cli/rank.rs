@@ -168,6 +168,7 @@ fn csv_cells(r: &RankedTool, columns: &[&str]) -> Vec<Cell> {
             cells.push(Cell::from(e.to_string()));
         }
     }
+    cells.extend(super::prediction::csv_cells(&r.prediction));
     cells
 }
 
@@ -187,6 +188,7 @@ fn tool_json(rank: usize, r: &RankedTool) -> Value {
         "parameters": params,
     });
     add_outcome(&mut v, &r.logdet, &r.episode);
+    super::prediction::add_prediction(&mut v, &r.prediction);
     v
 }
 
@@ -206,12 +208,13 @@ fn print_table(results: &[RankedTool], order: &[usize]) {
         .iter()
         .any(|r| r.episode.as_ref().is_ok_and(|m| m.progress.is_some()));
     outln!(
-        "{:>5} {:>6}  {:<w$} {:<10} {:>12}  {:>14} {:>14} {:>14}{}  parameters",
+        "{:>5} {:>6}  {:<w$} {:<10} {:>12} {:>14}  {:>14} {:>14} {:>14}{}  parameters",
         "rank",
         "row",
         "name",
         "model",
         "ln|Pi^U|",
+        "predicted err",
         "task error",
         "int F dt",
         "int J dt",
@@ -242,12 +245,13 @@ fn print_table(results: &[RankedTool], order: &[usize]) {
             Err(e) => format!("failed: {e}"),
         };
         outln!(
-            "{:>5} {:>6}  {:<w$} {:<10} {:>12}  {metrics}  {}",
+            "{:>5} {:>6}  {:<w$} {:<10} {:>12} {}  {metrics}  {}",
             k + 1,
             r.row.row,
             name(r),
             r.row.tool.model().name(),
             logdet,
+            super::prediction::table_cell(&r.prediction),
             r.parameters_text()
         );
     }
@@ -370,6 +374,7 @@ fn simulate_streaming(
                 "progress",
                 "error",
             ]);
+            header.extend(super::prediction::CSV_COLUMNS);
             Some(CsvWriter::create(path, &header)?)
         }
         None => None,

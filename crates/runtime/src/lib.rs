@@ -44,6 +44,7 @@ pub mod mpc;
 /// Result files, by the one rule the command line, the reports and `make crate` share: the crate
 /// toolconf-files (`crates/files`), below the runtime so that the renderer can use it too.
 pub use toolconf_files as output;
+pub mod prediction;
 pub mod rank;
 pub mod registry;
 pub mod robot_scales;

@@ -711,7 +711,9 @@ pub(crate) fn out_of_work<const N: usize>(
 
 /// The episode's options against their documented ranges ([`crate::validate`]): what every
 /// front end also checks up front, checked again here for the library's own callers.
-fn check_options<const N: usize, const NX: usize>(o: &EpisodeOptionsN<N, NX>) -> Result<(), Error> {
+pub(crate) fn check_options<const N: usize, const NX: usize>(
+    o: &EpisodeOptionsN<N, NX>,
+) -> Result<(), Error> {
     use crate::validate::{ATOL, DT, JOINT_ANGLE, JOINT_RATE, LEARNING_RATE, RTOL, TORQUE, T_END};
     let within = |name, value: f64, range: crate::validate::Range| {
         if range.contains(value) {

@@ -24,6 +24,7 @@ pub(crate) mod closed_loop_n;
 
 pub use toolconf_core::*;
 
+pub(crate) use closed_loop_n::check_options as check_episode_options;
 pub use closed_loop_n::{
     episode, episode_on, simulate, simulate_on, ClosedLoopN, EpisodeN, EpisodeOptionsN, Metrics,
     ModelSimulationError, TrajectoryN, MAX_GRID_POINTS,

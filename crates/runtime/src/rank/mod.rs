@@ -25,6 +25,7 @@ use std::time::{Duration, Instant};
 use rayon::prelude::*;
 
 use crate::model::{Metrics, ModelSimulationError};
+use crate::prediction::{Prediction, PredictionError};
 use crate::select::Objective;
 use crate::tools_file::ToolRow;
 use crate::Error;
@@ -35,6 +36,8 @@ pub struct RankedTool {
     pub row: ToolRow,
     pub logdet: Result<f64, Error>,
     pub episode: Result<Metrics, ModelSimulationError>,
+    /// The episode's cost predicted by the linearised closed loop ([`crate::prediction`]).
+    pub prediction: Result<Prediction, PredictionError>,
 }
 
 impl RankedTool {
@@ -86,6 +89,7 @@ pub fn simulate_all_timed<E>(
                     row: c.row.clone(),
                     logdet: c.logdet.clone(),
                     episode,
+                    prediction: tasks.predict(&c.row.tool),
                 };
                 (r, took)
             })
@@ -256,6 +260,7 @@ mod tests {
             row: candidate(row, Ok(0.0)).row,
             logdet: Ok(0.0),
             episode,
+            prediction: Err(PredictionError::ZeroHorizon { t_end: 0.0 }),
         })
         .collect();
         let rows = |o: Objective| -> Vec<usize> {

@@ -5,6 +5,7 @@
 use std::sync::Arc;
 
 use crate::model::{Metrics, ModelSimulationError};
+use crate::prediction::{LinearSystem, Prediction, PredictionError};
 use crate::registry::{models, AnyTool, BoundTask, ModelKind};
 use crate::task_file::{TaskFileError, TaskSpec};
 use crate::{Error, TaskKind};
@@ -100,6 +101,16 @@ impl ModelTasks {
         record: bool,
     ) -> Result<AnyEpisode, ModelSimulationError> {
         self.of(tool)?.episode(tool.parameters(), record)
+    }
+
+    /// The episode's cost predicted by the linearised closed loop ([`crate::prediction`]).
+    pub fn predict(&self, tool: &AnyTool) -> Result<Prediction, PredictionError> {
+        self.of(tool)?.predict(tool.parameters())
+    }
+
+    /// The linear system [`ModelTasks::predict`] steps.
+    pub fn linear_system(&self, tool: &AnyTool) -> Result<LinearSystem, PredictionError> {
+        self.of(tool)?.linear_system(tool.parameters())
     }
 
     /// The task variable (θ, θ̇ or θ̈ as the task kind says) over time, with its goal.

@@ -19,6 +19,7 @@ use crate::model::{
     control_confidence, episode, simulate, ArmModel, EpisodeOptionsN, Metrics,
     ModelSimulationError, TaskN, ToolN, ValidatedTaskN,
 };
+use crate::prediction::{self, LinearSystem, Prediction, PredictionError};
 use crate::task_file::{TaskFileError, TaskSpec};
 use crate::validate::finite_output;
 use crate::{Error, TaskKind, Term};
@@ -312,6 +313,20 @@ where
         Ok(std::borrow::Cow::Owned(task))
     }
 
+    /// The task (goals resolved for `tool`) and options a prediction of its episode takes.
+    fn prediction_inputs(
+        &self,
+        tool: &ToolN<M, N, NX, NP, NZ>,
+    ) -> Result<(TaskN<N>, &EpisodeOptionsN<N, NX>), PredictionError> {
+        let input = |e: ModelSimulationError| match e {
+            ModelSimulationError::Input(e) => PredictionError::Input(e),
+            other => PredictionError::Input(Error::Unsupported(other.to_string())),
+        };
+        self.validated()?;
+        let task = self.task_for(tool).map_err(input)?.into_owned();
+        Ok((task, self.options().map_err(input)?))
+    }
+
     fn recorded(&self) -> Result<EpisodeOptionsN<N, NX>, ModelSimulationError> {
         Ok(EpisodeOptionsN {
             record_trajectory: true,
@@ -373,6 +388,18 @@ where
             pi_u: rows(&c.pi_u),
             logdet: c.logdet,
         })
+    }
+
+    fn predict(&self, params: &[f64]) -> Result<Prediction, PredictionError> {
+        let tool = tool::<M, N, NX, NP, NZ>(params)?;
+        let (task, options) = self.prediction_inputs(&tool)?;
+        prediction::predict(&tool, &task, options)
+    }
+
+    fn linear_system(&self, params: &[f64]) -> Result<LinearSystem, PredictionError> {
+        let tool = tool::<M, N, NX, NP, NZ>(params)?;
+        let (task, options) = self.prediction_inputs(&tool)?;
+        prediction::linear_system(&tool, &task, options)
     }
 
     fn confidences(&self, params: &[f64]) -> Result<Confidences, BatchError> {

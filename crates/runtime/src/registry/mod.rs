@@ -28,6 +28,7 @@ use crate::closed_loop::EpisodeOptions;
 use crate::generated;
 use crate::generated::validity::ParameterDomain;
 use crate::model::{ArmModel, Metrics, ModelSimulationError, ToolN};
+use crate::prediction::{LinearSystem, Prediction, PredictionError};
 use crate::task_file::{TaskFileError, TaskSpec};
 use crate::{Error, TaskKind};
 
@@ -136,6 +137,13 @@ pub trait BoundTask: Send + Sync + fmt::Debug {
 
     /// The task variable (θ, θ̇ or θ̈ as the task kind says) over time, with its goal.
     fn trace(&self, params: &[f64]) -> Result<TaskTrace, ModelSimulationError>;
+
+    /// The episode's cost predicted by the closed loop linearised at the equilibrium
+    /// ([`crate::prediction`]).
+    fn predict(&self, params: &[f64]) -> Result<Prediction, PredictionError>;
+
+    /// The linear system [`BoundTask::predict`] steps.
+    fn linear_system(&self, params: &[f64]) -> Result<LinearSystem, PredictionError>;
 }
 
 /// One [`entry::Generated`] per generated model, in registry order.
