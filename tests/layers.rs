@@ -208,3 +208,128 @@ fn the_on_robot_controller_builds_for_a_bare_metal_target() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// The toolconf crates each crate depends on directly (normal edges): one direction of flow,
+/// each part of the runtime's former whole on only what is below it. A new edge is a decision
+/// about the layers, taken here.
+#[test]
+fn each_crate_imports_only_the_layers_below_it() {
+    let layers: [(&str, &str, &[&str]); 9] = [
+        ("crates/files/Cargo.toml", "toolconf-files", &[]),
+        ("crates/stats/Cargo.toml", "toolconf-stats", &[]),
+        (
+            "crates/messages/Cargo.toml",
+            "toolconf-messages",
+            &["toolconf-core"],
+        ),
+        (
+            "crates/integrators/Cargo.toml",
+            "toolconf-integrators",
+            &["toolconf-core"],
+        ),
+        (
+            "crates/tool-urdf/Cargo.toml",
+            "toolconf-tool-urdf",
+            &["toolconf-files", "toolconf-messages"],
+        ),
+        (
+            "crates/runtime/Cargo.toml",
+            "toolconf",
+            &[
+                "toolconf-cabi",
+                "toolconf-core",
+                "toolconf-files",
+                "toolconf-generated",
+                "toolconf-integrators",
+                "toolconf-messages",
+                "toolconf-stats",
+            ],
+        ),
+        (
+            "crates/report/Cargo.toml",
+            "toolconf-report",
+            &[
+                "toolconf",
+                "toolconf-files",
+                "toolconf-integrators",
+                "toolconf-stats",
+            ],
+        ),
+        (
+            "python/Cargo.toml",
+            "toolconf-python",
+            &[
+                "toolconf",
+                "toolconf-files",
+                "toolconf-integrators",
+                "toolconf-messages",
+                "toolconf-tool-urdf",
+            ],
+        ),
+        (
+            "Cargo.toml",
+            "toolconf-cli",
+            &[
+                "toolconf",
+                "toolconf-files",
+                "toolconf-integrators",
+                "toolconf-messages",
+                "toolconf-report",
+                "toolconf-tool-urdf",
+            ],
+        ),
+    ];
+    for (manifest, package, expected) in layers {
+        let direct = tree(manifest, &["-e", "normal", "--depth", "1"]);
+        let ours: BTreeSet<&str> = direct
+            .iter()
+            .filter(|p| p.starts_with("toolconf") && p.as_str() != package)
+            .map(String::as_str)
+            .collect();
+        let expected: BTreeSet<&str> = expected.iter().copied().collect();
+        assert_eq!(ours, expected, "{manifest}'s toolconf dependencies");
+    }
+    // The integrators, the statistics, the messages and the URDF reader carry nothing heavy.
+    for manifest in [
+        "crates/integrators/Cargo.toml",
+        "crates/stats/Cargo.toml",
+        "crates/messages/Cargo.toml",
+        "crates/tool-urdf/Cargo.toml",
+    ] {
+        let all = tree(manifest, &["-e", "normal"]);
+        for heavy in HEAVY {
+            assert!(!all.contains(heavy), "{heavy} in {manifest}'s tree");
+        }
+    }
+}
+
+/// A crate's root re-exports no other toolconf crate's modules (`pub use toolconf_x as y;`,
+/// `use toolconf::{module, ...}` to reach them as `crate::module`): a path says which crate
+/// the code is in.
+#[test]
+fn no_crate_root_reexports_another_crates_modules() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for lib in [
+        "crates/files/src/lib.rs",
+        "crates/stats/src/lib.rs",
+        "crates/messages/src/lib.rs",
+        "crates/integrators/src/lib.rs",
+        "crates/tool-urdf/src/lib.rs",
+        "crates/runtime/src/lib.rs",
+        "crates/report/src/lib.rs",
+        "python/src/lib.rs",
+        "src/main.rs",
+    ] {
+        let text = std::fs::read_to_string(root.join(lib)).unwrap();
+        for line in text.lines().map(str::trim) {
+            let reexport = line.starts_with("pub use toolconf_files")
+                || line.starts_with("pub use toolconf_integrators")
+                || line.starts_with("pub use toolconf_stats")
+                || line.starts_with("pub use toolconf_tool_urdf")
+                || line.starts_with("pub use toolconf_messages as")
+                || line.starts_with("use toolconf::{")
+                || line.starts_with("pub use toolconf::");
+            assert!(!reexport, "{lib}: {line}");
+        }
+    }
+}

@@ -12,14 +12,14 @@ pub type Arm = Arm2Tool;
 /// Parses `M1,M2,L1,L2`, as the command line takes an arm.
 pub fn parse(text: &str) -> Result<Arm, Error> {
     let syntax = |reason: String| Error::ArmSyntax {
-        text: crate::display::Clip(text).to_string(),
+        text: toolconf_messages::Clip(text).to_string(),
         reason,
     };
     let values: Vec<f64> = text
         .split(',')
         .map(|v| {
             v.trim().parse::<f64>().map_err(|e| {
-                let v = crate::display::Clip(v.trim());
+                let v = toolconf_messages::Clip(v.trim());
                 syntax(format!("'{v}' is not a number ({e})"))
             })
         })

@@ -1,6 +1,6 @@
 //! The crate's error type: every bad input names the value that is wrong.
 
-use crate::display::Short;
+use toolconf_messages::Short;
 
 /// Everything that can go wrong in toolconf, each naming the offending value.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

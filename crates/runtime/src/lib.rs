@@ -7,14 +7,17 @@
 //! ([`Task`]) is position, velocity or acceleration control with the paper's goals and
 //! precisions. The closed-form control confidence Π^U = ∂²F/∂U² ([`control_confidence`]) and
 //! the controller come from the no_std core (`toolconf_core`, under [`model`]), built on the code
-//! `make derive` generates ([`generated`]); this crate adds integrators, closed-loop episodes,
-//! the MPC baseline, selection, ranking, design, task and tool files, and file output.
+//! `make derive` generates ([`generated`]); this crate adds closed-loop episodes (integrated by
+//! `toolconf_integrators`), the MPC baseline, selection, ranking, design, the evaluation (with
+//! the statistics of `toolconf_stats`), task and tool files, and the models loaded at run time.
 //!
 //! ```text
 //! generated/       toolconf-generated  no_std   the derived code: models, tasks, registry
 //! crates/core/     toolconf-core       no_std   models, tools, tasks, Π^U, the controller's tick
 //! crates/files/    toolconf-files      std      the one rule for output files (below it, beside core)
+//! crates/stats/, crates/messages/, crates/integrators/  std  statistics, messages, integrators
 //! crates/runtime/  toolconf            std      this crate
+//! crates/tool-urdf/ toolconf-tool-urdf std      a tool's row from its URDF (beside this crate)
 //! crates/report/   toolconf-report     std      the paper's experiments, figures, reports
 //! toolconf-cli (the `toolconf` command), toolconf-python (`import toolconf`)
 //! ```
@@ -28,7 +31,6 @@ pub mod bounded_read;
 pub mod closed_loop;
 pub mod confidence;
 pub mod design;
-pub mod display;
 pub mod error;
 pub mod evaluation;
 /// The code `make derive` writes into `generated/` (the crate toolconf-generated): one module
@@ -37,22 +39,16 @@ pub mod evaluation;
 /// templates and run `make derive`.
 pub use toolconf_generated as generated;
 pub use toolconf_generated::for_each_model;
-pub mod integrate;
 pub mod loaded;
 pub mod model;
 pub mod mpc;
-/// Result files, by the one rule the command line, the reports and `make crate` share: the crate
-/// toolconf-files (`crates/files`), below the runtime so that the renderer can use it too.
-pub use toolconf_files as output;
 pub mod rank;
 pub mod registry;
 pub mod robot_scales;
 pub mod select;
-pub mod stats;
 pub mod task;
 pub mod task_file;
 pub mod threads;
-pub mod tool_urdf;
 pub mod tools_file;
 pub mod validate;
 

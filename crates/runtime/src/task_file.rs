@@ -37,13 +37,13 @@ use nalgebra::{DMatrix, SMatrix, SVector};
 use serde::Deserialize;
 
 use crate::bounded_read::read_text_file;
-use crate::display::{Clip, ClipMessage, ClipPath, Short, ShortList, ShortRows as Rows};
 use crate::generated::TERMS;
 use crate::model::closed_loop_n::check_grid;
 use crate::model::{ArmModel, EpisodeOptionsN, TaskN};
 use crate::validate::goal_range;
 use crate::{TaskKind, Term};
 use toolconf_core::{term_components, term_identity};
+use toolconf_messages::{Clip, ClipMessage, ClipPath, Short, ShortList, ShortRows as Rows};
 
 mod tip_goal;
 pub use tip_goal::{at_initial_tip, TipGoal};
@@ -106,7 +106,7 @@ pub struct EpisodeSpec {
     pub rtol: Option<f64>,
     pub atol: Option<f64>,
     /// The integration method (not a task-file key: the command line's `--method`).
-    pub method: Option<crate::integrate::Method>,
+    pub method: Option<toolconf_integrators::Method>,
 }
 
 /// A task: one of the paper's built-in tasks, or a task file's, not yet bound to a model.

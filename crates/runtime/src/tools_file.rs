@@ -29,8 +29,8 @@ use serde::{Deserialize, Deserializer};
 use serde_json::{Map, Value};
 
 use crate::bounded_read::{record_error, CsvRows, JsonElements, RecordLimit};
-use crate::display::{Clip, ClipMessage, ClipPath, Short};
 use crate::registry::{AnyTool, ModelKind};
+use toolconf_messages::{Clip, ClipMessage, ClipPath, Short};
 
 /// One tool read from a file.
 #[derive(Debug, Clone, PartialEq)]

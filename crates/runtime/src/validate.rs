@@ -108,7 +108,7 @@ pub fn tool_parameter(
     } else {
         Err(format!(
             "{} must be {}",
-            crate::display::Short(value),
+            toolconf_messages::Short(value),
             domain.rule
         ))
     }

@@ -8,7 +8,7 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::stats::summary;
+use toolconf_stats::summary;
 
 use super::{write_atomically, ReproduceError};
 

@@ -14,7 +14,7 @@ pub type EpisodeOptions = EpisodeOptionsN<2, 4>;
 
 /// The paper's options for its arm: t_end = 5 s, dt = 0.05 s (101 points), X0 = X^e =
 /// [−π/2 −π/2 0 0], U0 = [0.1 0.1], ΔT = 0, γ = 1, MATLAB ode45's tolerances (rtol 1e-3,
-/// atol 1e-6) and [`crate::integrate::Method::Auto`]: DP5 (`ode45`) on tasks 1 and 2, the
+/// atol 1e-6) and [`toolconf_integrators::Method::Auto`]: DP5 (`ode45`) on tasks 1 and 2, the
 /// paper's runs, and the DP5-to-Rodas5P switch on task 3, whose θ̈ feedback (P^θ̈ = 10 acting
 /// through ∂θ̈/∂U ~ 3/(m2·l2²)) makes it stiff. Hairer's test would find tasks 1 and 2 stiff
 /// for small arms too (their P^θ̈ = 1), and switching there would move the paper's numbers.

@@ -7,8 +7,8 @@
 
 use std::fmt;
 
-use crate::display::Clip;
 use crate::validate::{CONSTRAINT_BOUND, CONSTRAINT_COEFFICIENT};
+use toolconf_messages::Clip;
 
 /// a·p ≤ b over a model's parameters (in the model's order), with the text it came from.
 #[derive(Debug, Clone, PartialEq)]
@@ -180,7 +180,7 @@ enum Token {
 impl Token {
     fn text(&self) -> String {
         match self {
-            Token::Number(v) => crate::display::Short(*v).to_string(),
+            Token::Number(v) => toolconf_messages::Short(*v).to_string(),
             Token::Name(n) => Clip(n).to_string(),
             Token::Sign(s) => (if *s > 0.0 { "+" } else { "-" }).into(),
             Token::Times => "*".into(),

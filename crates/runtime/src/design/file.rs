@@ -27,9 +27,9 @@ use serde::Deserialize;
 
 use super::constraint::{parse_constraint, LinearConstraint};
 use super::DesignError;
-use crate::display::{Clip, ClipMessage, ClipPath, ShortList};
 use crate::generated::validity::ParameterDomain;
 use crate::registry::ModelKind;
+use toolconf_messages::{Clip, ClipMessage, ClipPath, ShortList};
 
 /// What the design optimises.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

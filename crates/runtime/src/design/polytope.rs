@@ -10,7 +10,7 @@ use super::constraint::dot;
 use super::file::DesignSpec;
 use super::qp::{self, QpOutcome};
 use super::DesignError;
-use crate::display::Clip;
+use toolconf_messages::Clip;
 
 /// Points within this (absolute, in parameter units) of a constraint count as on it.
 pub const FEASIBILITY_TOLERANCE: f64 = 1e-9;
@@ -210,8 +210,8 @@ impl Polytope {
         let j = (i - m) / 2;
         let name = self.names.get(j).copied().unwrap_or("?");
         match ((i - m) % 2, self.hi.get(j), self.lo.get(j)) {
-            (0, Some(hi), _) => format!("the bound {name} <= {}", crate::display::Short(*hi)),
-            (_, _, Some(lo)) => format!("the bound {name} >= {}", crate::display::Short(*lo)),
+            (0, Some(hi), _) => format!("the bound {name} <= {}", toolconf_messages::Short(*hi)),
+            (_, _, Some(lo)) => format!("the bound {name} >= {}", toolconf_messages::Short(*lo)),
             _ => format!("row {i}"),
         }
     }

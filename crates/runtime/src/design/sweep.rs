@@ -25,7 +25,7 @@ pub struct SweepPoint {
 
 /// Parses `LEFT <= A..B:K` (or `>=`); K ≥ 2 values from A to B inclusive.
 pub fn parse_sweep(text: &str, names: &[&str]) -> Result<Sweep, String> {
-    let bad = |why: &str| format!("--sweep '{}': {why}", crate::display::Clip(text));
+    let bad = |why: &str| format!("--sweep '{}': {why}", toolconf_messages::Clip(text));
     let (left, sense, right) = split_comparison(text).map_err(|e| bad(&e))?;
     let op = if matches!(sense, super::constraint::Sense::AtMost) {
         "<="

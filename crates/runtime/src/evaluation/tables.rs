@@ -1,7 +1,7 @@
 //! The evaluation as tables, one per file of the paper's reproduction (`fig2_*.csv` …): what
 //! `toolconf reproduce --model` writes and `toolconf.reproduce` returns as DataFrames.
 
-use crate::output::csv::Cell;
+use toolconf_files::csv::Cell;
 
 use super::records::{Run, ToolRecord};
 use super::trials::{Trial, MEASURES, RULES};

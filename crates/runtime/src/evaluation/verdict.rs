@@ -15,7 +15,7 @@
 
 use serde_json::{json, Value};
 
-use crate::stats::{bootstrap_spearman_ci, paired_test, spearman, Interval, PairedTest};
+use toolconf_stats::{bootstrap_spearman_ci, paired_test, spearman, Interval, PairedTest};
 
 /// A claim's verdict.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -240,7 +240,7 @@ fn check_name(name: &str) -> Result<(), String> {
         Err(format!(
             "the model name '{}' is not one: 1 to 64 of a-z, 0-9 and _, starting with a \
              letter{hint}",
-            crate::display::Clip(name)
+            toolconf_messages::Clip(name)
         ))
     }
 }

@@ -67,7 +67,7 @@ static LOADED: Mutex<Vec<(PathBuf, Option<String>, ModelKind)>> = Mutex::new(Vec
 /// when `name` is `None`; returns its handle. Loading the same file under the same name again
 /// returns the same handle.
 pub fn load(path: &Path, name: Option<&str>) -> Result<ModelKind, LoadError> {
-    let shown = crate::display::ClipPath(&path.display().to_string()).to_string();
+    let shown = toolconf_messages::ClipPath(&path.display().to_string()).to_string();
     let fail = |reason: String| LoadError {
         path: shown.clone(),
         reason,
@@ -102,7 +102,7 @@ pub fn load(path: &Path, name: Option<&str>) -> Result<ModelKind, LoadError> {
 /// library stays loaded.
 pub fn open_exports(path: &Path) -> Result<Exports, LoadError> {
     let fail = |reason: String| LoadError {
-        path: crate::display::ClipPath(&path.display().to_string()).to_string(),
+        path: toolconf_messages::ClipPath(&path.display().to_string()).to_string(),
         reason,
     };
     let file = library_file(path).map_err(&fail)?;
@@ -122,7 +122,7 @@ fn room_for(
         let whose = match loaded.iter().find(|(_, _, k)| *k == other) {
             Some((p, _, _)) => format!(
                 "loaded from {}",
-                crate::display::ClipPath(&p.display().to_string())
+                toolconf_messages::ClipPath(&p.display().to_string())
             ),
             None => "built in".to_string(),
         };
@@ -175,7 +175,7 @@ pub fn environment_entries() -> Result<Vec<(String, Option<String>)>, LoadError>
         return Ok(Vec::new());
     };
     let value = value.to_str().ok_or_else(|| LoadError {
-        path: crate::display::ClipPath(&value.to_string_lossy()).to_string(),
+        path: toolconf_messages::ClipPath(&value.to_string_lossy()).to_string(),
         reason: "is not valid UTF-8".into(),
     })?;
     Ok(value
@@ -292,7 +292,7 @@ fn dlopen(f: std::fs::File, file: &Path) -> Result<libloading::Library, String> 
             .replace(&*by_fd.to_string_lossy(), &file.to_string_lossy());
         format!(
             "cannot be loaded: {}",
-            crate::display::ClipMessage(&message)
+            toolconf_messages::ClipMessage(&message)
         )
     })?;
     if target == by_fd {

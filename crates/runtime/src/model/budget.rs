@@ -1,6 +1,6 @@
 //! An episode's work budget: how many step attempts its integration may spend before it is
 //! stopped with one message saying where and why, instead of grinding through the integrator's
-//! own limit ([`crate::integrate::Options::max_steps`], 10⁶ attempts: 11 s of a Panda episode).
+//! own limit ([`toolconf_integrators::Options::max_steps`], 10⁶ attempts: 11 s of a Panda episode).
 //!
 //! An error-controlled method of order 5 takes steps h ∝ tol^(1/5) on a smooth solution, and a
 //! task's output step dt is the time scale its user asked to see. So the budget is
@@ -13,8 +13,8 @@
 //! a light tool, takes a few hundred attempts per output step); an episode that needs more is
 //! following dynamics far faster than anything it reports.
 
-use crate::display::Short;
 use crate::validate::{JOINT_ANGLE, JOINT_RATE};
+use toolconf_messages::Short;
 
 /// b: step attempts per output step at the paper's tolerances.
 pub const ATTEMPTS_PER_OUTPUT_STEP: f64 = 1000.0;

@@ -6,12 +6,12 @@ use nalgebra::{SMatrix, SVector};
 
 use super::{ActiveInferenceN, ArmModel, TaskN, ToolN};
 use crate::generated::{Read, Term, TERMS};
-use crate::integrate::{
-    solve_grid_with_jacobian, uniform_grid, IntegrationError, Method, Options as IntegratorOptions,
-};
 use crate::Error;
 use toolconf_core::{
     observe_tool, reads_tip, tip_parameters, ObservationN, TipKinematics, TipObserver,
+};
+use toolconf_integrators::{
+    solve_grid_with_jacobian, uniform_grid, IntegrationError, Method, Options as IntegratorOptions,
 };
 
 /// A grid state whose magnitude passes this is a diverging simulation, not a result.
@@ -464,7 +464,7 @@ pub enum ModelSimulationError {
         tool: String,
         source: IntegrationError,
     },
-    #[error("simulation of {tool} diverged at t = {} s: |state| = {magnitude:e} exceeds {DIVERGENCE_BOUND:e}", crate::display::Short(*t))]
+    #[error("simulation of {tool} diverged at t = {} s: |state| = {magnitude:e} exceeds {DIVERGENCE_BOUND:e}", toolconf_messages::Short(*t))]
     Diverged {
         tool: String,
         t: f64,

@@ -12,12 +12,12 @@ use nalgebra::SVector;
 
 use super::{MpcError, MpcN, MpcOptions};
 use crate::closed_loop::{EpisodeOptions, Plant};
-use crate::integrate::{solve_grid, IntegrationError};
 use crate::model::budget::{diagnosis, episode_budget};
 use crate::model::{
     ActiveInferenceN, Arm2, Arm2Exact, ArmModel, EpisodeOptionsN, TaskN, ToolN, TrajectoryN,
 };
 use crate::{Arm, Error, Task};
+use toolconf_integrators::{solve_grid, IntegrationError};
 
 /// What an MPC episode measures: the active-inference episode's metrics where they apply.
 #[derive(Debug, Clone, PartialEq)]
@@ -84,7 +84,7 @@ pub enum MpcSimulationError {
     Input(#[from] Error),
     #[error("MPC for {tool}: {source}")]
     Setup { tool: String, source: MpcError },
-    #[error("MPC for {tool} failed at t = {} s: {source}", crate::display::Short(*t))]
+    #[error("MPC for {tool} failed at t = {} s: {source}", toolconf_messages::Short(*t))]
     Controller {
         tool: String,
         t: f64,

@@ -3,7 +3,7 @@
 
 use std::time::Duration;
 
-use crate::display::Short;
+use toolconf_messages::Short;
 
 /// The linear model the QP plans with.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

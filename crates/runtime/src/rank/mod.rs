@@ -45,7 +45,7 @@ impl RankedTool {
             .tool
             .named_parameters()
             .iter()
-            .map(|(n, v)| format!("{n}={}", crate::output::csv::format_number(*v)))
+            .map(|(n, v)| format!("{n}={}", toolconf_files::csv::format_number(*v)))
             .collect();
         params.join(" ")
     }

@@ -245,7 +245,7 @@ pub fn screen_file(
     skip_bad_rows: bool,
     skipping: impl FnMut(&ToolFileError),
 ) -> Result<(Screen, usize), ScreenError> {
-    let source = crate::display::ClipPath(&path.to_string_lossy()).to_string();
+    let source = toolconf_messages::ClipPath(&path.to_string_lossy()).to_string();
     let read = |each: &mut EachRow| read_tools(path, each);
     let (screen, skipped) = screen_rows(&source, read, tasks, limit, skip_bad_rows, skipping)?;
     check_screened(&screen, skipped, &source, task)?;
@@ -281,7 +281,7 @@ pub fn screen_file_with_validation(
     skip_bad_rows: bool,
     skipping: impl FnMut(&ToolFileError),
 ) -> Result<(Screen, usize), ScreenError> {
-    let source = crate::display::ClipPath(&path.to_string_lossy()).to_string();
+    let source = toolconf_messages::ClipPath(&path.to_string_lossy()).to_string();
     let read = |each: &mut EachRow| read_tools(path, each);
     let screen = Screen::with_validation(limit, validation);
     let (screen, skipped) =

@@ -17,7 +17,10 @@
 //!   inline (no allocation per tool).
 
 pub(crate) mod entry;
+mod flange;
 mod results;
+
+pub use flange::{flange_model, flange_models};
 
 use std::fmt;
 use std::str::FromStr;
@@ -401,7 +404,7 @@ impl FromStr for ModelKind {
             format!(
                 "unknown model '{}': expected one of {} (or a model library loaded with \
                  --model-path, {} or toolconf.load_model)",
-                crate::display::Clip(&s),
+                toolconf_messages::Clip(&s),
                 names.join(", "),
                 crate::loaded::ENVIRONMENT
             )
@@ -486,7 +489,7 @@ impl fmt::Display for AnyTool {
             if i > 0 {
                 f.write_str(" ")?;
             }
-            write!(f, "{name}={}", crate::display::Short(value))?;
+            write!(f, "{name}={}", toolconf_messages::Short(value))?;
         }
         f.write_str(")")
     }

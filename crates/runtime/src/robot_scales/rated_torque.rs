@@ -12,7 +12,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::bounded_read::read_text_file;
-use crate::display::{Clip, ClipMessage, ClipPath};
+use toolconf_messages::{Clip, ClipMessage, ClipPath};
 
 /// The most bytes of a URDF read: the derivation's own limit for an arm's URDF.
 const MAX_URDF_BYTES: u64 = 4 << 20;

@@ -27,10 +27,10 @@
 use nalgebra::SVector;
 
 use super::TaskFileError;
-use crate::display::ShortList;
 use crate::model::{ArmModel, TaskN, ToolN};
 use crate::validate::goal_range;
 use crate::{Error, TaskKind, Term};
+use toolconf_messages::ShortList;
 
 /// How a task gives its tip goal.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -75,7 +75,7 @@ impl TipGoal {
             } => format!(
                 "relative: {} along {} (base frame) from each tool's own tip, at rest where the \
                  episode starts",
-                crate::display::Short(*magnitude),
+                toolconf_messages::Short(*magnitude),
                 ShortList(direction)
             ),
         }

@@ -1,3 +1,5 @@
+//! # toolconf-integrators
+//!
 //! Dormand–Prince 5(4) integration that reproduces MATLAB's `ode45`, the solver the paper used
 //! for its 5 s closed-loop simulations sampled every 0.05 s, and the Rosenbrock method Rodas5P
 //! for stiff problems, with an automatic switch from the first to the second.
@@ -11,7 +13,7 @@
 //! * [`Method::Stiff`]: Rodas5P (Steinebach 2023), a stiffly accurate L-stable Rosenbrock
 //!   method of order 5(4) with a dense output of order 4, one Jacobian per step and one LU
 //!   factorisation per attempt, with `ode45`'s error norm and step-size rules (see the
-//!   `rosenbrock` module). The Jacobian comes from the caller
+//!   `rosenbrock` and `rodas5p` modules). The Jacobian comes from the caller
 //!   ([`solve_grid_with_jacobian`]) or from forward differences ([`solve_grid`]).
 //! * [`Method::Auto`] (the default): DP5 with Hairer's stiffness detection (`DOPRI5`'s test:
 //!   `h·|λ| > 3.25`, |λ| estimated as `‖k7 − k6‖/‖y7 − y6‖`, on 15 accepted steps, the count
@@ -59,10 +61,12 @@
 //!   `NonNegative`, events, or `Refine` (irrelevant when output is requested at grid points).
 //! * [`Options::max_steps`] bounds attempted steps (`ode45` has no such limit).
 
+mod control;
 mod dopri5;
 mod grid;
 mod options;
 mod problem;
+mod rodas5p;
 mod rodas_lean;
 mod rosenbrock;
 mod stiffness;
@@ -174,7 +178,7 @@ where
                     ..Stats::default()
                 },
             };
-            return rosenbrock::integrate(&mut problem, start, grid, settings, output);
+            return rodas5p::integrate(&mut problem, start, grid, settings, output);
         }
     };
     let rhs = |t: f64, y: &SVector<f64, D>| problem.rhs(t, y);
@@ -192,7 +196,7 @@ where
             if method == Method::Fast {
                 rodas_lean::integrate(&mut problem, start, grid, settings, output)
             } else {
-                rosenbrock::integrate(&mut problem, start, grid, settings, output)
+                rodas5p::integrate(&mut problem, start, grid, settings, output)
             }
         }
     }

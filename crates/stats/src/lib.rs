@@ -1,3 +1,5 @@
+//! # toolconf-stats
+//!
 //! Statistics for the paper's Results section.
 //!
 //! - Confidence vs task error over random tools ("Control confidence and tool performance"):

@@ -2,6 +2,7 @@
 
 use nalgebra::SVector;
 
+use super::control::{after_rejection, after_success, error_norm, first_step};
 use super::stiffness::StiffnessDetector;
 use super::{eps_at, IntegrationError, Settings, Stats};
 
@@ -38,6 +39,8 @@ const E4: f64 = 71.0 / 1920.0;
 const E5: f64 = -17253.0 / 339200.0;
 const E6: f64 = 22.0 / 525.0;
 const E7: f64 = -1.0 / 40.0;
+/// 1/(order of the error estimate + 1): the estimate is O(h⁵).
+const EXPONENT: f64 = 0.2;
 // ntrp45's BI: row j gives the coefficients of s, s², s³, s⁴ multiplying k_j (row 2 is zero).
 const BI1: [f64; 4] = [1.0, -183.0 / 64.0, 37.0 / 12.0, -145.0 / 128.0];
 const BI3: [f64; 4] = [0.0, 1500.0 / 371.0, -1000.0 / 159.0, 1000.0 / 371.0];
@@ -113,24 +116,11 @@ where
     }
 }
 
-/// ode45's weighted error `‖E·k ./ max(|y|, |y_new|, threshold)‖_∞` (to be scaled by |h|), and
-/// whether E·k and y_new are finite. f64::max drops NaN, so finiteness cannot be read off the norm.
+/// DP5's error estimate `E·k` (to be weighted by [`error_norm`] and scaled by |h|).
 #[inline(always)]
-fn error_norm<const D: usize>(
-    y: &SVector<f64, D>,
-    step: &Attempt<D>,
-    threshold: f64,
-) -> (f64, bool) {
+fn estimate<const D: usize>(step: &Attempt<D>) -> SVector<f64, D> {
     let k = &step.k;
-    let ek = k[0] * E1 + k[1] * E3 + k[2] * E4 + k[3] * E5 + k[4] * E6 + k[5] * E7;
-    let mut finite = true;
-    let mut norm = 0.0f64;
-    for i in 0..D {
-        let y_new = step.y_new[i];
-        finite &= ek[i].is_finite() & y_new.is_finite();
-        norm = norm.max((ek[i] / y[i].abs().max(y_new.abs()).max(threshold)).abs());
-    }
-    (norm, finite)
+    k[0] * E1 + k[1] * E3 + k[2] * E4 + k[3] * E5 + k[4] * E6 + k[5] * E7
 }
 
 /// `ntrp45`: the 4th-order continuous extension at `t_out` inside the step `[t, t + h]`.
@@ -179,23 +169,11 @@ where
         return Err(IntegrationError::NonFinite { t });
     }
 
-    let mut hmin = 16.0 * eps_at(t);
-    let mut abs_h = match s.initial_step {
-        Some(h) => s.hmax.min(hmin.max(h)),
-        None => {
-            let scaled = k1
-                .iter()
-                .zip(y.iter())
-                .map(|(f, y)| (f / y.abs().max(threshold)).abs());
-            let rh = scaled.fold(0.0, f64::max) / (0.8 * rtol.powf(0.2));
-            let h = s.hmax.min(grid[1] - t0);
-            if h * rh > 1.0 { 1.0 / rh } else { h }.max(hmin)
-        }
-    };
+    let mut abs_h = first_step(s.initial_step, t, &y, &k1, grid[1] - t0, s, EXPONENT);
 
     let mut next = 1;
     loop {
-        hmin = 16.0 * eps_at(t);
+        let hmin = 16.0 * eps_at(t);
         abs_h = s.hmax.min(hmin.max(abs_h));
         let mut h = abs_h;
         let mut done = false;
@@ -219,7 +197,7 @@ where
             let t_new = if done { tf } else { t + h };
             let step = attempt(&mut rhs, t, &y, &k1, h, t_new);
             stats.rhs_evals += 6;
-            let (norm, finite) = error_norm(&y, &step, threshold);
+            let (norm, finite) = error_norm(&y, &step.y_new, &estimate(&step), threshold);
             if !finite {
                 return Err(IntegrationError::NonFinite { t: t_new });
             }
@@ -232,12 +210,7 @@ where
             if abs_h <= hmin {
                 return Err(IntegrationError::StepSizeTooSmall { t, h: abs_h });
             }
-            abs_h = if no_failures {
-                hmin.max(abs_h * 0.1f64.max(0.8 * (rtol / err).powf(0.2)))
-            } else {
-                // Repeated failure: the error model is unreliable here, so just halve.
-                hmin.max(0.5 * abs_h)
-            };
+            abs_h = after_rejection(abs_h, hmin, Some(err), no_failures, rtol, EXPONENT);
             no_failures = false;
             h = abs_h;
             done = false;
@@ -262,13 +235,7 @@ where
             .is_some_and(|d| d.stiff_after(h, &step.y6, &step.y_new, &step.k[4], &step.k[5]));
 
         if no_failures {
-            // err may be 0, hence the explicit cap at 5× growth.
-            let shrink = 1.25 * (err / rtol).powf(0.2);
-            abs_h = if shrink > 0.2 {
-                abs_h / shrink
-            } else {
-                5.0 * abs_h
-            };
+            abs_h = after_success(abs_h, err, rtol, EXPONENT);
         }
         t = step.t_new;
         y = step.y_new;

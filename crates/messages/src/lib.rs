@@ -1,3 +1,5 @@
+//! # toolconf-messages
+//!
 //! How a value the user gave is shown back in a message: numbers in a short form, long text
 //! clipped. A message is one line a reader can take in, whatever was typed.
 

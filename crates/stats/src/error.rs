@@ -1,4 +1,4 @@
-//! The one error type of `stats`, plus the input checks every routine shares.
+//! The one error type of the crate, plus the input checks every routine shares.
 
 /// Why a statistic could not be computed. Each message names the offending input.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -1,6 +1,6 @@
 //! Rodas5P with less work per step: the stepper of [`super::Method::Fast`], for throughput on
 //! populations of tools. The method, tableau, error norm and step-size rules are those
-//! of [`super::rosenbrock`] (`rodas.f`'s transformed form, `ode45`'s step control); what differs
+//! of [`super::rodas5p`] and [`super::rosenbrock`] (`rodas.f`'s transformed form, `ode45`'s step control); what differs
 //! is only how a step is computed:
 //!
 //! * Rodas5P's last three stages are evaluated on successive solutions
@@ -20,7 +20,8 @@
 use nalgebra::{SMatrix, SVector};
 use toolconf_core::linalg::Lu;
 
-use super::rosenbrock::{run, Problem, Start, Stepper, Tableau, RODAS5P};
+use super::rodas5p::RODAS5P;
+use super::rosenbrock::{run, Problem, Start, Stepper, Tableau};
 use super::{IntegrationError, Settings, Stats};
 
 /// Stages of Rodas5P.
@@ -200,9 +201,9 @@ mod tests {
         }
     }
 
-    /// The lean step is Rodas5P: the same steps and output as `rosenbrock.rs` up to rounding.
+    /// The lean step is Rodas5P: the same steps and output as `rodas5p.rs` up to rounding.
     #[test]
-    fn lean_rodas5p_takes_the_steps_of_rosenbrock_rs() {
+    fn lean_rodas5p_takes_the_steps_of_rodas5p_rs() {
         // Two relaxation jumps (period ≈ (3 − 2 ln 2)·μ ≈ 81) by t = 100.
         let grid = super::super::uniform_grid(0.0, 100.0, 0.25);
         let options = super::super::Options::default();
@@ -222,7 +223,7 @@ mod tests {
             let stats = if lean {
                 integrate(&mut VanDerPol, start, &grid, &settings, output)
             } else {
-                super::super::rosenbrock::integrate(&mut VanDerPol, start, &grid, &settings, output)
+                super::super::rodas5p::integrate(&mut VanDerPol, start, &grid, &settings, output)
             }
             .unwrap();
             (stats, out)

@@ -111,24 +111,24 @@ pub struct Stats {
 pub enum IntegrationError {
     /// The state or its derivative became NaN or infinite; `t` is the end of the step in which
     /// that happened (or `grid[0]` when `y0` or `f(t0, y0)` is not finite).
-    #[error("integration failed at t = {} s: state became non-finite", crate::display::Short(*t))]
+    #[error("integration failed at t = {} s: state became non-finite", toolconf_core::display::Short(*t))]
     NonFinite { t: f64 },
     /// The step size fell to `16·eps(t)` and the tolerances still could not be met, typically
     /// a singularity (finite-time blow-up) near `t`.
     #[error(
-        "integration failed at t = {} s: step size {h:e} s reached the minimum 16·eps(t) without meeting the tolerances", crate::display::Short(*t)
+        "integration failed at t = {} s: step size {h:e} s reached the minimum 16·eps(t) without meeting the tolerances", toolconf_core::display::Short(*t)
     )]
     StepSizeTooSmall { t: f64, h: f64 },
     /// More than `max_steps` step attempts; `h` is the step size about to be tried at `t`,
     /// `state` the solution there (what the dynamics were doing when the work ran out).
-    #[error("integration failed at t = {} s: exceeded the limit of {max_steps} step attempts (step size {h:e} s)", crate::display::Short(*t))]
+    #[error("integration failed at t = {} s: exceeded the limit of {max_steps} step attempts (step size {h:e} s)", toolconf_core::display::Short(*t))]
     TooManySteps {
         t: f64,
         max_steps: usize,
         h: f64,
         state: Vec<f64>,
     },
-    /// An episode's work budget ([`crate::model::budget`]) ran out: the integrator's
+    /// An episode's work budget (the runtime's `toolconf::model::budget`) ran out: the integrator's
     /// [`IntegrationError::TooManySteps`] at the episode's own limit, with the episode's
     /// reading of why (the state or the step size there).
     #[error("episode stopped after {attempts} step attempts at t = {t:.3e} s: {why}")]
