@@ -136,7 +136,7 @@ fn the_c_abi_is_on_the_core_alone_without_its_std_feature() {
 
 #[test]
 fn the_runtime_and_the_python_package_have_no_command_line_plots_or_progress_bars() {
-    for manifest in ["crates/runtime/Cargo.toml", "python/Cargo.toml"] {
+    for manifest in ["crates/toolconf/Cargo.toml", "python/Cargo.toml"] {
         let normal = tree(manifest, &["-e", "normal"]);
         for top in [
             "clap",
@@ -149,7 +149,7 @@ fn the_runtime_and_the_python_package_have_no_command_line_plots_or_progress_bar
         }
     }
     let runtime = tree(
-        "crates/runtime/Cargo.toml",
+        "crates/toolconf/Cargo.toml",
         &["-e", "normal", "--depth", "1"],
     );
     assert!(runtime.contains("toolconf-core") && runtime.contains("toolconf-generated"));
@@ -165,7 +165,7 @@ fn the_files_crate_is_a_leaf_that_the_runtime_and_the_renderer_share() {
     }
     // One output-file rule: the command line and the reports reach it through the runtime,
     // make crate through the renderer.
-    for manifest in ["crates/runtime/Cargo.toml", "derive/render/Cargo.toml"] {
+    for manifest in ["crates/toolconf/Cargo.toml", "derive/render/Cargo.toml"] {
         let direct = tree(manifest, &["-e", "normal", "--depth", "1"]);
         assert!(direct.contains("toolconf-files"), "{manifest}: {direct:?}");
     }
@@ -233,7 +233,7 @@ fn each_crate_imports_only_the_layers_below_it() {
             &["toolconf-files", "toolconf-messages"],
         ),
         (
-            "crates/runtime/Cargo.toml",
+            "crates/toolconf/Cargo.toml",
             "toolconf",
             &[
                 "toolconf-cabi",
@@ -315,7 +315,7 @@ fn no_crate_root_reexports_another_crates_modules() {
         "crates/messages/src/lib.rs",
         "crates/integrators/src/lib.rs",
         "crates/tool-urdf/src/lib.rs",
-        "crates/runtime/src/lib.rs",
+        "crates/toolconf/src/lib.rs",
         "crates/report/src/lib.rs",
         "python/src/lib.rs",
         "src/main.rs",

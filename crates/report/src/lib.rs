@@ -7,7 +7,7 @@
 //! the runtime nor the Python package needs.
 //!
 //! ```text
-//! generated/ → crates/core/ → crates/runtime/ (toolconf) → crates/report/ (this crate) → the CLI
+//! generated/ → crates/core/ → crates/toolconf/ (toolconf) → crates/report/ (this crate) → the CLI
 //! ```
 
 pub mod design;

@@ -16,7 +16,7 @@
 //! crates/core/     toolconf-core       no_std   models, tools, tasks, Π^U, the controller's tick
 //! crates/files/    toolconf-files      std      the one rule for output files (below it, beside core)
 //! crates/stats/, crates/messages/, crates/integrators/  std  statistics, messages, integrators
-//! crates/runtime/  toolconf            std      this crate
+//! crates/toolconf/  toolconf            std      this crate
 //! crates/tool-urdf/ toolconf-tool-urdf std      a tool's row from its URDF (beside this crate)
 //! crates/report/   toolconf-report     std      the paper's experiments, figures, reports
 //! toolconf-cli (the `toolconf` command), toolconf-python (`import toolconf`)
