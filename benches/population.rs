@@ -11,9 +11,9 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use toolconf::closed_loop::{simulate, EpisodeOptions};
-use toolconf::integrate::Method;
 use toolconf::select::draw_tools;
 use toolconf::{Task, TaskKind};
+use toolconf_integrators::Method;
 
 const TOOLS: usize = 2000;
 

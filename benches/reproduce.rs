@@ -19,7 +19,7 @@ fn default_reproduce(c: &mut Criterion) {
         progress: false,
         command: "toolconf reproduce --out <bench scratch dir> --seed 0".into(),
         // The command line's default (`--method explicit` is ode45's numbers).
-        method: toolconf::integrate::Method::Fast,
+        method: toolconf_integrators::Method::Fast,
     };
     let mut group = c.benchmark_group("reproduce");
     group.sample_size(10);

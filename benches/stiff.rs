@@ -9,8 +9,8 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use toolconf::closed_loop::{simulate, ClosedLoop, EpisodeOptions, JointState};
-use toolconf::integrate::Method;
 use toolconf::{Arm, Task, TaskKind};
+use toolconf_integrators::Method;
 
 const ARMS: [[f64; 4]; 3] = [
     [0.1, 0.1, 0.1, 0.1],

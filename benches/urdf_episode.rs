@@ -16,7 +16,6 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use nalgebra::SVector;
-use toolconf::integrate::Method;
 use toolconf::model::{ClosedLoopN, Panda, PandaTool};
 use toolconf::rank::{simulate_all, Candidate, ModelTasks};
 use toolconf::registry::{AnyTool, ModelKind};
@@ -24,6 +23,7 @@ use toolconf::select::mixed::MixedSampler;
 use toolconf::task_file::TaskSpec;
 use toolconf::tools_file::ToolRow;
 use toolconf::TaskKind;
+use toolconf_integrators::Method;
 
 /// `n` Panda tools from the mixed sampler's box (`generated::validity::panda`), seeded.
 fn tools(n: usize, seed: u64) -> Vec<AnyTool> {

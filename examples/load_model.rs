@@ -13,11 +13,11 @@
 
 use std::process::ExitCode;
 
-use toolconf::integrate::Method;
 use toolconf::loaded;
 use toolconf::rank::ModelTasks;
 use toolconf::registry::AnyTool;
 use toolconf::task_file::TaskSpec;
+use toolconf_integrators::Method;
 
 fn main() -> ExitCode {
     match run() {

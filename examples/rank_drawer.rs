@@ -12,10 +12,10 @@ use std::convert::Infallible;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use toolconf::integrate::Method;
 use toolconf::rank::{ranking, screen_file, simulate_all, ModelTasks};
 use toolconf::select::Objective;
 use toolconf::task_file::TaskSpec;
+use toolconf_integrators::Method;
 
 fn main() -> ExitCode {
     match run() {

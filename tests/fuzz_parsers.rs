@@ -20,9 +20,9 @@ use toolconf::design::sweep::parse_sweep;
 use toolconf::rank::ModelTasks;
 use toolconf::registry::ModelKind;
 use toolconf::task_file::TaskSpec;
-use toolconf::tool_urdf::{check_rigid_body, tool_from_urdf, Request};
 use toolconf::tools_file::read_tools_from;
 use toolconf::validate::TOOL_PARAMETER;
+use toolconf_tool_urdf::{check_rigid_body, tool_from_urdf, Request};
 
 /// The longest error line any input may give (values it repeats are clipped).
 const MAX_MESSAGE: usize = 600;
@@ -510,7 +510,7 @@ fn check_urdf(text: &str, request: &Request) -> Result<(), TestCaseError> {
             let file = tool.tools_file("fuzz.urdf", request, &request.root, Some("panda"));
             prop_assert_eq!(file.lines().count(), 3, "{}", file);
             for (column, v) in tool.values() {
-                let printed = toolconf::output::csv::format_number(v);
+                let printed = toolconf_files::csv::format_number(v);
                 prop_assert_eq!(printed.parse::<f64>().ok(), Some(v), "{}", column);
                 prop_assert!(file.lines().nth(2).unwrap().contains(&printed));
             }

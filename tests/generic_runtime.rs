@@ -119,7 +119,7 @@ fn the_default_options_are_the_papers_implementation_details() {
     assert_eq!(o.x0.as_slice(), &[half_pi, half_pi, 0.0, 0.0]);
     assert_eq!(o.u0.as_slice(), &[0.1, 0.1]);
     assert_eq!((o.integrator.rtol, o.integrator.atol), (1e-3, 1e-6));
-    assert_eq!(o.integrator.method, toolconf::integrate::Method::Auto);
+    assert_eq!(o.integrator.method, toolconf_integrators::Method::Auto);
     assert_eq!(o.joint_perturbation, nalgebra::Vector2::zeros());
     assert!(!o.record_trajectory);
     assert_eq!(

@@ -4,7 +4,7 @@
 use nalgebra::{Matrix2, SVector, Vector2};
 use proptest::prelude::*;
 use toolconf::generated::{arm2_exact, arm3};
-use toolconf::integrate::{solve_grid, uniform_grid, Options};
+use toolconf_integrators::{solve_grid, uniform_grid, Options};
 
 const G: f64 = 9.81;
 

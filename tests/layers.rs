@@ -136,7 +136,7 @@ fn the_c_abi_is_on_the_core_alone_without_its_std_feature() {
 
 #[test]
 fn the_runtime_and_the_python_package_have_no_command_line_plots_or_progress_bars() {
-    for manifest in ["crates/runtime/Cargo.toml", "python/Cargo.toml"] {
+    for manifest in ["crates/toolconf/Cargo.toml", "python/Cargo.toml"] {
         let normal = tree(manifest, &["-e", "normal"]);
         for top in [
             "clap",
@@ -149,7 +149,7 @@ fn the_runtime_and_the_python_package_have_no_command_line_plots_or_progress_bar
         }
     }
     let runtime = tree(
-        "crates/runtime/Cargo.toml",
+        "crates/toolconf/Cargo.toml",
         &["-e", "normal", "--depth", "1"],
     );
     assert!(runtime.contains("toolconf-core") && runtime.contains("toolconf-generated"));
@@ -165,7 +165,7 @@ fn the_files_crate_is_a_leaf_that_the_runtime_and_the_renderer_share() {
     }
     // One output-file rule: the command line and the reports reach it through the runtime,
     // make crate through the renderer.
-    for manifest in ["crates/runtime/Cargo.toml", "derive/render/Cargo.toml"] {
+    for manifest in ["crates/toolconf/Cargo.toml", "derive/render/Cargo.toml"] {
         let direct = tree(manifest, &["-e", "normal", "--depth", "1"]);
         assert!(direct.contains("toolconf-files"), "{manifest}: {direct:?}");
     }
@@ -207,4 +207,129 @@ fn the_on_robot_controller_builds_for_a_bare_metal_target() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+}
+
+/// The toolconf crates each crate depends on directly (normal edges): one direction of flow,
+/// each part of the runtime's former whole on only what is below it. A new edge is a decision
+/// about the layers, taken here.
+#[test]
+fn each_crate_imports_only_the_layers_below_it() {
+    let layers: [(&str, &str, &[&str]); 9] = [
+        ("crates/files/Cargo.toml", "toolconf-files", &[]),
+        ("crates/stats/Cargo.toml", "toolconf-stats", &[]),
+        (
+            "crates/messages/Cargo.toml",
+            "toolconf-messages",
+            &["toolconf-core"],
+        ),
+        (
+            "crates/integrators/Cargo.toml",
+            "toolconf-integrators",
+            &["toolconf-core"],
+        ),
+        (
+            "crates/tool-urdf/Cargo.toml",
+            "toolconf-tool-urdf",
+            &["toolconf-files", "toolconf-messages"],
+        ),
+        (
+            "crates/toolconf/Cargo.toml",
+            "toolconf",
+            &[
+                "toolconf-cabi",
+                "toolconf-core",
+                "toolconf-files",
+                "toolconf-generated",
+                "toolconf-integrators",
+                "toolconf-messages",
+                "toolconf-stats",
+            ],
+        ),
+        (
+            "crates/report/Cargo.toml",
+            "toolconf-report",
+            &[
+                "toolconf",
+                "toolconf-files",
+                "toolconf-integrators",
+                "toolconf-stats",
+            ],
+        ),
+        (
+            "python/Cargo.toml",
+            "toolconf-python",
+            &[
+                "toolconf",
+                "toolconf-files",
+                "toolconf-integrators",
+                "toolconf-messages",
+                "toolconf-tool-urdf",
+            ],
+        ),
+        (
+            "Cargo.toml",
+            "toolconf-cli",
+            &[
+                "toolconf",
+                "toolconf-files",
+                "toolconf-integrators",
+                "toolconf-messages",
+                "toolconf-report",
+                "toolconf-tool-urdf",
+            ],
+        ),
+    ];
+    for (manifest, package, expected) in layers {
+        let direct = tree(manifest, &["-e", "normal", "--depth", "1"]);
+        let ours: BTreeSet<&str> = direct
+            .iter()
+            .filter(|p| p.starts_with("toolconf") && p.as_str() != package)
+            .map(String::as_str)
+            .collect();
+        let expected: BTreeSet<&str> = expected.iter().copied().collect();
+        assert_eq!(ours, expected, "{manifest}'s toolconf dependencies");
+    }
+    // The integrators, the statistics, the messages and the URDF reader carry nothing heavy.
+    for manifest in [
+        "crates/integrators/Cargo.toml",
+        "crates/stats/Cargo.toml",
+        "crates/messages/Cargo.toml",
+        "crates/tool-urdf/Cargo.toml",
+    ] {
+        let all = tree(manifest, &["-e", "normal"]);
+        for heavy in HEAVY {
+            assert!(!all.contains(heavy), "{heavy} in {manifest}'s tree");
+        }
+    }
+}
+
+/// A crate's root re-exports no other toolconf crate's modules (`pub use toolconf_x as y;`,
+/// `use toolconf::{module, ...}` to reach them as `crate::module`): a path says which crate
+/// the code is in.
+#[test]
+fn no_crate_root_reexports_another_crates_modules() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for lib in [
+        "crates/files/src/lib.rs",
+        "crates/stats/src/lib.rs",
+        "crates/messages/src/lib.rs",
+        "crates/integrators/src/lib.rs",
+        "crates/tool-urdf/src/lib.rs",
+        "crates/toolconf/src/lib.rs",
+        "crates/report/src/lib.rs",
+        "python/src/lib.rs",
+        "src/main.rs",
+    ] {
+        let text = std::fs::read_to_string(root.join(lib)).unwrap();
+        for line in text.lines().map(str::trim) {
+            let reexport = line.starts_with("pub use toolconf_files")
+                || line.starts_with("pub use toolconf_integrators")
+                || line.starts_with("pub use toolconf_stats")
+                || line.starts_with("pub use toolconf_tool_urdf")
+                || line.starts_with("pub use toolconf_messages as")
+                || line.starts_with("use toolconf::{")
+                || line.starts_with("pub use toolconf::");
+            assert!(!reexport, "{lib}: {line}");
+        }
+    }
 }

@@ -1,4 +1,4 @@
-//! Models loaded at run time (crates/runtime/src/loaded/, `--model-path`,
+//! Models loaded at run time (crates/toolconf/src/loaded/, `--model-path`,
 //! `TOOLCONF_MODEL_PATH`): refusals of what is not a model library, each one line and status 2;
 //! and, with the libraries `make loaded-models-test` builds (every model of the repository,
 //! `make model IR=generated/<model>.json`), the loaded models equal the built-in ones bit for

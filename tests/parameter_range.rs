@@ -1,4 +1,4 @@
-//! The valid input ranges (crates/core/src/validate.rs, crates/runtime/src/validate.rs) keep the
+//! The valid input ranges (crates/core/src/validate.rs, crates/toolconf/src/validate.rs) keep the
 //! generated arithmetic finite: every generated function of every model, at every corner of the
 //! parameter box (each "> 0" parameter in [1e-6, 1e6], each signed one, a URDF tool's centre of
 //! mass, over its model's domain) that the model's rule admits, and at its centre, for every task with the paper's precisions and with precisions at

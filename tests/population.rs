@@ -9,9 +9,9 @@
 //! (`benches/timing/population.rs`); here 60 tools per task keep the debug build to seconds.
 
 use toolconf::closed_loop::{simulate, EpisodeOptions, Metrics, Plant};
-use toolconf::integrate::Method;
 use toolconf::select::{draw_tools, evaluate};
 use toolconf::{Arm, Task, TaskKind};
+use toolconf_integrators::Method;
 
 const TOOLS: usize = 60;
 

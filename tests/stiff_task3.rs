@@ -10,9 +10,9 @@
 //! Run with `cargo test --release --test stiff_task3 -- --nocapture` for the table.
 
 use toolconf::closed_loop::{simulate, EpisodeOptions, Metrics};
-use toolconf::integrate::Method;
 use toolconf::select::draw_tools;
 use toolconf::{Arm, Task, TaskKind};
+use toolconf_integrators::Method;
 
 /// The paper's three reference arms and 20 drawn ones.
 fn arms() -> Vec<Arm> {

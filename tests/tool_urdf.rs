@@ -7,7 +7,7 @@ use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
-use toolconf::tool_urdf::COLUMNS;
+use toolconf_tool_urdf::COLUMNS;
 
 const PANDA: &str = "derive/robots/panda_description/urdf/panda.urdf";
 

@@ -1,4 +1,4 @@
-//! The tool reader (`toolconf tool --urdf`, crates/runtime/src/tool_urdf.rs) against the corpus
+//! The tool reader (`toolconf tool --urdf`, crates/tool-urdf/) against the corpus
 //! both URDF readers share (tests/fixtures/urdf/, cases.json): each file accepted or refused as
 //! listed, a refusal one line naming the file and holding the listed phrase. The derivation's
 //! reader is run on the same files by derive/tests/test_urdf_corpus.py, so that the two agree on
@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use toolconf::tool_urdf::{tool_from_urdf_file, Request};
+use toolconf_tool_urdf::{tool_from_urdf_file, Request};
 
 fn request() -> Request {
     Request {

@@ -514,7 +514,7 @@ def render(results: dict, tight: dict, args) -> str:
         "the defaults (X0 = [-π/2 -π/2 0 0], U0 = [0.1 0.1], γ = 1, ΔT = 0), t ∈ [0, 5] with output "
         "every 0.05 s (101 points), rtol 1e-3, atol 1e-6; toolconf with "
         + ("`EpisodeOptions::default()`, i.e. the library's default integration method, `--method auto` "
-           "(DP5 with ode45's step control on tasks 1 and 2; see `crates/runtime/src/integrate` for task 3)"
+           "(DP5 with ode45's step control on tasks 1 and 2; see `crates/integrators` for task 3)"
            if args.method == "auto" else f"`--method {args.method}`")
         + ". Times are per episode on one thread: "
         f"toolconf the median of {args.toolconf_repeat} runs per tool (`benches/timing/peer_timing.rs`), in "

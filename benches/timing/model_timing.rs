@@ -16,10 +16,10 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use serde_json::{json, Value};
-use toolconf::integrate::Method;
 use toolconf::rank::ModelTasks;
 use toolconf::task_file::TaskSpec;
 use toolconf::tools_file::{read_tools, ToolRow};
+use toolconf_integrators::Method;
 
 struct Args {
     tools: PathBuf,

@@ -22,8 +22,8 @@ use std::time::Instant;
 
 use serde_json::{json, Value};
 use toolconf::closed_loop::{simulate, EpisodeOptions};
-use toolconf::integrate::Method;
 use toolconf::{Arm, Task, TaskKind};
+use toolconf_integrators::Method;
 
 fn arm_from(v: &Value) -> Result<Arm, String> {
     let v = v.get("arm").unwrap_or(v);

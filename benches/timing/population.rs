@@ -19,9 +19,9 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use toolconf::closed_loop::{simulate, EpisodeOptions, Metrics};
-use toolconf::integrate::Method;
 use toolconf::select::draw_tools;
 use toolconf::{Arm, Task, TaskKind};
+use toolconf_integrators::Method;
 
 struct Args {
     tools: usize,

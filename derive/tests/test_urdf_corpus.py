@@ -1,6 +1,6 @@
 """The derivation's URDF reader against the corpus both URDF readers share (tests/fixtures/urdf/,
 cases.json): each file accepted or refused as listed, a refusal one line naming the file and
-holding the listed phrase. The tool reader (crates/runtime/src/tool_urdf.rs) is run on the same
+holding the listed phrase. The tool reader (crates/tool-urdf/) is run on the same
 files by tests/urdf_corpus.rs, so that the two agree on what a URDF is (the URDF specification's
 rules: a <limit> on every revolute and prismatic joint, its absent bounds 0; the links one tree;
 numbers ASCII decimals).

@@ -29,7 +29,7 @@ How a URDF is read (one rule; docs/reference/urdf-arms.md, "How a URDF is read")
   of the chain are kept (`UrdfChain.limits`; continuous joints have none), and an equilibrium q^e
   outside them is refused by description.py, naming equilibrium.q[i], the joint, the value and
   the limits. Effort and velocity limits are not read.
-- The file's shape, as the tool reader (crates/runtime/src/tool_urdf.rs) reads every URDF: each
+- The file's shape, as the tool reader (crates/tool-urdf/) reads every URDF: each
   joint of a URDF type naming two defined links, no link with two parents, the links one tree
   (one root, no loop anywhere, on the chain or off it); numbers ASCII decimals between XML's
   blanks (no other script's digits). The two readers are tested on one corpus of files
@@ -73,7 +73,7 @@ ORTHONORMAL = mpmath.mpf("1e-12")
 SUPPORTED = ("revolute", "continuous", "prismatic", "fixed")
 # Every joint type of the URDF specification (the others are refused on the chain).
 URDF_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
-# A number of the file: ASCII decimal as the tool reader (crates/runtime/src/tool_urdf.rs) and
+# A number of the file: ASCII decimal as the tool reader (crates/tool-urdf/) and
 # Rust's f64 parser read it, between XML's blanks (space, tab, CR, LF); no other script's
 # digits, no `_`.
 NUMBER = re.compile(r"[+-]?(?:(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|inf|infinity|nan)",

@@ -50,7 +50,7 @@ pub fn named(names: &[&str], values: &[f64]) -> String {
     let parts: Vec<String> = names
         .iter()
         .zip(values)
-        .map(|(n, v)| format!("{n}={}", toolconf::display::Short(*v)))
+        .map(|(n, v)| format!("{n}={}", toolconf_messages::Short(*v)))
         .collect();
     parts.join(" ")
 }

@@ -60,7 +60,7 @@ impl Failure {
                 .str()
                 .map(|s| s.to_string())
                 .unwrap_or_else(|_| e.to_string());
-            let message = format!("{context}: {}", toolconf::display::ClipMessage(&words));
+            let message = format!("{context}: {}", toolconf_messages::ClipMessage(&words));
             if e.is_instance_of::<PyMemoryError>(py) {
                 Failure::Memory(message)
             } else if e.is_instance_of::<PyTypeError>(py) {

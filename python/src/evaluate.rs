@@ -12,9 +12,9 @@ use toolconf::evaluation::{
     check_population, evaluate, finish, parse_box, run_tools, Evaluation, Plan, Population, Setup,
     ToolRecord, MAX_TOOLS,
 };
-use toolconf::output::csv::Cell;
 use toolconf::registry::{AnyTool, ModelKind};
 use toolconf::tools_file::{read_columns, read_tools, ToolRow};
+use toolconf_files::csv::Cell;
 
 use crate::errors::{detached, Failure};
 use crate::task::portable_spec;
@@ -124,7 +124,7 @@ fn population(
             }
             let tools = Tools::from_py(t, source)?;
             let shown = match &tools {
-                Tools::File(p) => toolconf::display::ClipPath(&p.to_string_lossy()).to_string(),
+                Tools::File(p) => toolconf_messages::ClipPath(&p.to_string_lossy()).to_string(),
                 Tools::Columns { source, .. } => source.clone(),
             };
             let rows = rows(&tools)?;

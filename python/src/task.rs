@@ -8,9 +8,9 @@ use std::path::{Path, PathBuf};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use toolconf::bounded_read::read_text_file;
-use toolconf::display::{Clip, ClipPath};
 use toolconf::task_file::TaskSpec;
 use toolconf::TaskKind;
+use toolconf_messages::{Clip, ClipPath};
 
 use crate::errors::Failure;
 
@@ -220,8 +220,8 @@ fn repr(value: &Bound<'_, PyAny>) -> String {
 /// `method="fast"` (the command line's `--method`, and its default), `"explicit"` (MATLAB
 /// ode45 exactly, the paper's numerics), `"auto"` or `"stiff"`: [`Method::name`]s.
 ///
-/// [`Method::name`]: toolconf::integrate::Method::name
-pub fn method(name: &str) -> Result<toolconf::integrate::Method, Failure> {
+/// [`Method::name`]: toolconf_integrators::Method::name
+pub fn method(name: &str) -> Result<toolconf_integrators::Method, Failure> {
     name.parse()
         .map_err(|e: String| Failure::Input(format!("method = {e}")))
 }

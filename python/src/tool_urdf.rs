@@ -1,11 +1,12 @@
-//! `toolconf.tool_from_urdf`: `toolconf tool --urdf`'s row as a dict (`toolconf::tool_urdf`).
+//! `toolconf.tool_from_urdf`: `toolconf tool --urdf`'s row as a dict (the crate toolconf-tool-urdf).
 
 use std::path::PathBuf;
 
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict};
-use toolconf::display::Clip;
-use toolconf::tool_urdf::{flange_model, tool_from_urdf_file, Request};
+use toolconf::registry::flange_model;
+use toolconf_messages::Clip;
+use toolconf_tool_urdf::{tool_from_urdf_file, Request};
 
 use crate::errors::{detached, Failure};
 

@@ -122,7 +122,7 @@ fn columns(items: &Bound<'_, PyAny>, source: &str) -> Result<Vec<(String, Column
                 short_repr(&key)
             )));
         };
-        let context = format!("{source}, column '{}'", toolconf::display::Clip(&name));
+        let context = format!("{source}, column '{}'", toolconf_messages::Clip(&name));
         let bad = |e: PyErr| Failure::python(&format!("{context}: not an array"), e);
         // An array stays as it is; a list is taken as objects, cell by cell (NumPy would turn
         // ['a', nan] into the text 'nan').

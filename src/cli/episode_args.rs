@@ -4,9 +4,9 @@
 use std::path::PathBuf;
 
 use toolconf::closed_loop::{EpisodeOptions, Plant};
-use toolconf::integrate::Method;
 use toolconf::task_file::{PerJoint, TaskSpec};
 use toolconf::{Error, TaskKind};
+use toolconf_integrators::Method;
 
 use super::output::CliError;
 use super::parse_task;

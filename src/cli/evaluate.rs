@@ -111,7 +111,7 @@ impl ModelArgs {
         Ok(plan)
     }
 
-    fn spec(&self, method: toolconf::integrate::Method) -> Result<TaskSpec, CliError> {
+    fn spec(&self, method: toolconf_integrators::Method) -> Result<TaskSpec, CliError> {
         let mut spec = match (&self.task_file, self.task) {
             (Some(path), _) => TaskSpec::from_file(path)?,
             (None, Some(kind)) => TaskSpec::builtin(kind),
@@ -155,7 +155,7 @@ fn population(
 
 /// A tools file's rows, at most [`MAX_TOOLS`], every one of `model`.
 fn tools_file(path: &Path, model: ModelKind) -> Result<Population, CliError> {
-    let source = toolconf::display::ClipPath(&path.to_string_lossy()).to_string();
+    let source = toolconf_messages::ClipPath(&path.to_string_lossy()).to_string();
     let mut rows = Vec::new();
     read_tools(path, |row| {
         rows.push(row?);

@@ -39,8 +39,8 @@ mod tool;
 use std::process::ExitCode;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
-use toolconf::display::Clip;
 use toolconf::{Arm, TaskKind};
+use toolconf_messages::Clip;
 
 /// Confidence-aware decision-making and control for tool selection.
 #[derive(Parser)]
@@ -118,7 +118,7 @@ pub fn run() -> ExitCode {
     };
     // Ctrl-C, SIGTERM or SIGHUP then keep the old output files and remove the temporaries; the
     // signals' default (the process ends, the temporaries stay) is all a failure here costs.
-    let _ = toolconf::output::partial::remove_on_interrupt();
+    let _ = toolconf_files::partial::remove_on_interrupt();
     if let Some(note) = toolconf::threads::cap_pool() {
         errln!("toolconf: note: {note}");
     }

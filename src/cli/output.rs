@@ -2,7 +2,7 @@
 
 use nalgebra::SMatrix;
 use serde_json::Value;
-pub use toolconf::output::run_files::RunFiles;
+pub use toolconf_files::run_files::RunFiles;
 
 /// A matrix as a JSON list of rows.
 pub fn matrix_rows<const R: usize, const C: usize>(m: &SMatrix<f64, R, C>) -> Value {
@@ -69,7 +69,7 @@ pub enum CliError {
     #[error(transparent)]
     Output(#[from] toolconf_report::experiments::ReproduceError),
     #[error(transparent)]
-    Write(#[from] toolconf::output::WriteError),
+    Write(#[from] toolconf_files::WriteError),
     /// Bad input that is none of the above, in words.
     #[error("{0}")]
     Usage(String),
@@ -111,9 +111,9 @@ impl CliError {
 
 /// Writes a whole file or nothing: a temporary file beside the target, renamed into place, so an
 /// interrupted run never leaves a half-written file; a device or other non-regular file is
-/// written in place, never replaced ([`toolconf::output::file`]).
+/// written in place, never replaced ([`toolconf_files::file`]).
 pub fn write_atomically(path: &std::path::Path, contents: &str) -> Result<(), CliError> {
-    toolconf::output::file::write_whole(path, contents.as_bytes()).map_err(|source| CliError::Io {
+    toolconf_files::file::write_whole(path, contents.as_bytes()).map_err(|source| CliError::Io {
         path: path.to_path_buf(),
         source,
     })

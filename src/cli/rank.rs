@@ -9,9 +9,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use serde_json::{json, Map, Value};
-use toolconf::display::Clip;
 use toolconf::evaluation::{barely_moved, ConfidenceCheck};
-use toolconf::output::csv::{Cell, CsvWriter};
 use toolconf::rank::{
     ranking, screen_file_with_validation, simulate_all, simulate_all_timed, Candidate,
     ConfidenceTiming, ModelTasks, RankedTool, Screen, ScreenError, SimulationTiming, StageTimings,
@@ -20,6 +18,8 @@ use toolconf::registry::ModelKind;
 use toolconf::select::Objective;
 use toolconf::task_file::TaskSpec;
 use toolconf::TaskKind;
+use toolconf_files::csv::{Cell, CsvWriter};
+use toolconf_messages::Clip;
 use toolconf_report::progress::{self, ProgressBar};
 use toolconf_report::rank::{write_report, ReportInput};
 
@@ -295,7 +295,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         wall: started.elapsed(),
     };
     if let Some(dir) = &args.report {
-        toolconf::output::file::create_folder(dir).map_err(|source| CliError::Io {
+        toolconf_files::file::create_folder(dir).map_err(|source| CliError::Io {
             path: dir.clone(),
             source,
         })?;

@@ -40,7 +40,7 @@ pub struct Common {
     pub out: PathBuf,
     pub seed: u64,
     pub quick: bool,
-    pub method: toolconf::integrate::Method,
+    pub method: toolconf_integrators::Method,
     /// The command line, quoted in the report.
     pub command: String,
 }
@@ -58,7 +58,7 @@ fn parse_experiment(s: &str) -> Result<String, String> {
 }
 
 pub fn run(args: &Args) -> Result<(), CliError> {
-    let method = toolconf::integrate::Method::from(args.method.method);
+    let method = toolconf_integrators::Method::from(args.method.method);
     if let Some(model) = args.model.model {
         let command: Vec<String> = std::env::args().collect();
         let common = Common {
@@ -80,7 +80,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
 }
 
 /// The paper's Results section on its planar arm, as before `--model` existed.
-fn paper(args: &Args, method: toolconf::integrate::Method) -> Result<(), CliError> {
+fn paper(args: &Args, method: toolconf_integrators::Method) -> Result<(), CliError> {
     let mut command = format!(
         "toolconf reproduce --out {} --seed {}",
         args.out.display(),
@@ -95,7 +95,7 @@ fn paper(args: &Args, method: toolconf::integrate::Method) -> Result<(), CliErro
     if args.mpc {
         command.push_str(" --mpc");
     }
-    if method != toolconf::integrate::Method::Fast {
+    if method != toolconf_integrators::Method::Fast {
         command.push_str(&format!(
             " --method {}",
             format!("{method:?}").to_lowercase()

@@ -6,7 +6,6 @@
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use toolconf::closed_loop::{EpisodeOptions, Plant};
-use toolconf::integrate::Method;
 use toolconf::model::Arm2;
 use toolconf::rank::ModelTasks;
 use toolconf::registry::ModelKind;
@@ -16,6 +15,7 @@ use toolconf::select::{
 };
 use toolconf::task_file::TaskSpec;
 use toolconf::Task;
+use toolconf_integrators::Method;
 
 use super::episode_args::{two_link_options, EpisodeArgs, MethodArgs, PlantArg, TaskArgs};
 use super::output::{add_outcome, CliError};

@@ -4,7 +4,6 @@ use std::path::PathBuf;
 
 use serde_json::{json, Value};
 use toolconf::closed_loop::{Episode, Metrics, Plant};
-use toolconf::integrate::Method;
 use toolconf::model::{episode_on, Arm2, Arm2Exact};
 use toolconf::mpc::{MpcModel, MpcOptions};
 use toolconf::rank::{ModelTasks, TrajectoryTable};
@@ -12,6 +11,7 @@ use toolconf::registry::ModelKind;
 use toolconf::task_file::TaskSpec;
 use toolconf::validate::finite_output;
 use toolconf::{Arm, Task};
+use toolconf_integrators::Method;
 
 use super::episode_args::{two_link_options, EpisodeArgs, PlantArg, TaskArgs};
 use super::output::{check_files, write_atomically, CliError, RunFiles};

@@ -1,16 +1,16 @@
 //! `toolconf tool --urdf FILE --root LINK --tip LINK [--flange LINK] [--opening V]
 //! [--joint NAME=V]... [--name N] [--model M] [--out FILE]`: a tool's row of a tools file from
 //! the tool's own URDF (mass, centre of mass, full inertia and tip in the flange frame;
-//! `toolconf::tool_urdf` says how).
+//! the crate toolconf-tool-urdf says how).
 //!
 //! The `#` line, the header and the row go to standard output, or with `--out` to a new tools
-//! file by the project's one output rule (`toolconf::output`: a temporary file renamed into
+//! file by the project's one output rule (`toolconf_files`: a temporary file renamed into
 //! place; never the URDF itself, checked by device and inode).
 
 use std::path::PathBuf;
 
-use toolconf::display::Clip;
-use toolconf::tool_urdf::{tool_from_urdf_file, Request};
+use toolconf_messages::Clip;
+use toolconf_tool_urdf::{tool_from_urdf_file, Request};
 
 use super::output::{check_files, write_atomically, CliError, RunFiles};
 
@@ -69,7 +69,7 @@ fn parse_joint(s: &str) -> Result<(String, f64), String> {
 }
 
 fn parse_flange_model(s: &str) -> Result<String, String> {
-    toolconf::tool_urdf::flange_model(s).map(str::to_string)
+    toolconf::registry::flange_model(s).map(str::to_string)
 }
 
 pub fn run(args: &Args) -> Result<(), CliError> {

@@ -6,7 +6,7 @@ use core::fmt;
 /// A number as a message shows it: Rust's shortest round-trip digits, in exponent notation
 /// outside 1e-4 ≤ |x| < 1e6 (so `5e-324`, `1e9` and `1e300`, never 300-digit decimals), `NaN`,
 /// `inf` and `-inf` as such. (The result files' numbers,
-/// `toolconf::output::csv::format_number`, keep decimals up to 1e16 and leave the
+/// `toolconf_files::csv::format_number`, keep decimals up to 1e16 and leave the
 /// non-finite out.)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Short(pub f64);

@@ -14,7 +14,7 @@
 //!     ▲
 //! crates/core/     toolconf-core       no_std   this crate
 //!     ▲
-//! crates/runtime/  toolconf            std      integrators, episodes, MPC, ranking, design, files
+//! crates/toolconf/  toolconf            std      integrators, episodes, MPC, ranking, design, files
 //!     ▲
 //! crates/report/   toolconf-report     std      the paper's experiments, figures, reports
 //!     ▲

@@ -7,8 +7,9 @@
 //! ([`folder`]). A file a user names is read whole and bounded, never blocking on a FIFO
 //! ([`input`]).
 //!
-//! The lowest layer for file output, on no other toolconf crate: the runtime re-exports it as
-//! `toolconf::output`, and the renderer (`derive/render`, which `make crate` runs) uses it too.
+//! The lowest layer for file output, on no other toolconf crate: the runtime, the reports, the
+//! command line and the Python package use it, and the renderer (`derive/render`, which
+//! `make crate` runs) too.
 
 pub mod csv;
 pub mod file;

@@ -28,7 +28,7 @@ pub struct ReportInput<'a> {
 pub use toolconf::design::parameters_text;
 
 /// The files [`write_report`] writes into its folder, with a sweep or without (checked against
-/// the run's other files before any work: [`toolconf::output::run_files`]).
+/// the run's other files before any work: [`toolconf_files::run_files`]).
 pub fn report_files(sweep: bool) -> &'static [&'static str] {
     if sweep {
         &["report.md", "report.html", SWEEP_CSV, SWEEP_SVG]
@@ -39,7 +39,7 @@ pub fn report_files(sweep: bool) -> &'static [&'static str] {
 
 /// Writes the report into `dir` (created if needed); returns the files written.
 pub fn write_report(dir: &Path, input: &ReportInput) -> Result<Vec<PathBuf>, ReproduceError> {
-    toolconf::output::file::create_folder(dir).map_err(ReproduceError::io(dir))?;
+    toolconf_files::file::create_folder(dir).map_err(ReproduceError::io(dir))?;
     let r = input.result;
     let mut doc = vec![
         Block::Heading(1, format!("Tool design for the {} task ({})", input.task, input.model)),

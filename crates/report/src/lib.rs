@@ -7,14 +7,8 @@
 //! the runtime nor the Python package needs.
 //!
 //! ```text
-//! generated/ → crates/core/ → crates/runtime/ (toolconf) → crates/report/ (this crate) → the CLI
+//! generated/ → crates/core/ → crates/toolconf/ (toolconf) → crates/report/ (this crate) → the CLI
 //! ```
-
-// The runtime's modules and 2-link names at this crate's root: the experiments were written
-// inside the runtime crate, and they keep their paths (`crate::closed_loop`, `crate::Arm`, ...).
-use toolconf::{
-    closed_loop, confidence, integrate, mpc, select, stats, task_file, Arm, Task, TaskKind, Term,
-};
 
 pub mod design;
 pub mod evaluation;

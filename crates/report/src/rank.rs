@@ -9,13 +9,13 @@ use crate::experiments::figure_parts::wants_log;
 use crate::experiments::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use crate::experiments::report::{to_html, to_markdown, Block};
 use crate::experiments::{write_atomically, ReproduceError};
-use crate::select::Objective;
-use crate::stats::spearman;
-use crate::task_file::{PerJoint, PrecisionSpec, TaskSpec};
-use crate::{TaskKind, Term};
 use toolconf::generated::Read;
 use toolconf::rank::{score, ModelTasks, RankedTool, StageTimings, TaskTrace};
 use toolconf::registry::{ModelKind, AXES};
+use toolconf::select::Objective;
+use toolconf::task_file::{PerJoint, PrecisionSpec, TaskSpec};
+use toolconf::{TaskKind, Term};
+use toolconf_stats::spearman;
 
 /// What the report describes.
 pub struct ReportInput<'a> {
@@ -44,12 +44,12 @@ const LISTED: usize = 50;
 const TRACED: usize = 3;
 
 /// The files [`write_report`] writes into its folder (checked against the run's other files
-/// before any work: [`toolconf::output::run_files`]).
+/// before any work: [`toolconf_files::run_files`]).
 pub const REPORT_FILES: [&str; 4] = ["report.md", "report.html", CONFIDENCE_SVG, TRAJECTORY_SVG];
 
 /// Writes the report into `dir` (created if needed); returns the files written.
 pub fn write_report(dir: &Path, input: &ReportInput) -> Result<Vec<PathBuf>, ReproduceError> {
-    toolconf::output::file::create_folder(dir).map_err(ReproduceError::io(dir))?;
+    toolconf_files::file::create_folder(dir).map_err(ReproduceError::io(dir))?;
     let mut doc = introduction(input);
     for note in &input.notes {
         doc.push(Block::p(format!("**Note: {note}.**")));

@@ -3,7 +3,7 @@
 
 use toolconf::evaluation::trials::{MEASURES, RULES};
 use toolconf::evaluation::{Claim, ClaimVerdict, Evaluation, Finding};
-use toolconf::stats::summary;
+use toolconf_stats::summary;
 
 use super::figures::Figure;
 use super::RunInfo;

@@ -6,7 +6,7 @@ use std::path::Path;
 use toolconf::evaluation::trials::{MEASURES, RULES};
 use toolconf::evaluation::{Evaluation, HighlightRun, ToolRecord};
 use toolconf::registry::AXES;
-use toolconf::stats::summary;
+use toolconf_stats::summary;
 
 use crate::experiments::plot::{
     self, diverging, BoxPanel, Colour, GridPanel, Legend, Panel, Series, XyPanel,

@@ -10,7 +10,7 @@ use std::time::Duration;
 
 use toolconf::evaluation::tables::tables;
 use toolconf::evaluation::Evaluation;
-use toolconf::output::csv::CsvWriter;
+use toolconf_files::csv::CsvWriter;
 
 use crate::experiments::{report, write_atomically, ReproduceError};
 
@@ -47,7 +47,7 @@ pub struct RunInfo<'a> {
 /// paths of `report.md` and `report.html`. Files of an earlier run that this one does not write
 /// (a figure without data) are removed first, so none describes other data.
 pub fn write(dir: &Path, e: &Evaluation, info: &RunInfo) -> Result<[PathBuf; 2], ReproduceError> {
-    toolconf::output::file::create_folder(dir).map_err(ReproduceError::io(dir))?;
+    toolconf_files::file::create_folder(dir).map_err(ReproduceError::io(dir))?;
     for file in FILES {
         remove_if_present(&dir.join(file))?;
     }

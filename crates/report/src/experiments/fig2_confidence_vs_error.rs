@@ -4,17 +4,17 @@
 //! Seeds: tools from `"fig2/tools"` (the same tools for every task, as in the paper), bootstrap
 //! from `"fig2/bootstrap/<task>"`.
 
-use crate::select::draw_tools;
-use crate::stats::{fit_exponential, summary};
-use crate::{Task, TaskKind};
+use toolconf::select::draw_tools;
+use toolconf::{Task, TaskKind};
+use toolconf_stats::{fit_exponential, summary};
 
 use super::batch::{map_ordered, run_tool, ToolRuns};
-use super::csv::{Cell, CsvWriter};
 use super::figure_parts::{arm_cells, files_block, task_label, wants_log, PAPER_TASKS};
 use super::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::{negative_correlation_rule, num, Correlation};
 use super::{described, Context, Experiment, Plan, ReproduceError};
+use toolconf_files::csv::{Cell, CsvWriter};
 
 pub struct Fig2;
 
@@ -129,7 +129,7 @@ const TABLE_HEADER: [&str; 9] = [
 /// episodes finish, results in (task, tool) order.
 fn simulate_every_task(
     ctx: &Context,
-    tools: &[crate::Arm],
+    tools: &[toolconf::Arm],
 ) -> Result<Vec<(TaskKind, usize, ToolRuns)>, ReproduceError> {
     let items: Vec<(TaskKind, usize)> = PAPER_TASKS
         .iter()
@@ -185,10 +185,10 @@ struct TaskStats {
     /// (min, max) of ln|Π^U|.
     x_range: (f64, f64),
     spread: f64,
-    error_summary: Result<crate::stats::Summary, crate::stats::StatsError>,
+    error_summary: Result<toolconf_stats::Summary, toolconf_stats::StatsError>,
     /// Coefficient of variation sd/mean of the task errors.
     cv: Option<f64>,
-    fit: Result<crate::stats::ExpFit, crate::stats::StatsError>,
+    fit: Result<toolconf_stats::ExpFit, toolconf_stats::StatsError>,
 }
 
 impl TaskStats {

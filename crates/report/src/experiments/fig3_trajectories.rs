@@ -4,18 +4,18 @@
 //! Seed: the sample from `"fig3/tools"`. Confidence needs no simulation, so only the two chosen
 //! tools are simulated (four episodes, trajectories recorded).
 
-use crate::closed_loop::{Metrics, Trajectory};
-use crate::confidence::control_confidence;
-use crate::select::draw_tools;
-use crate::{Arm, Task, TaskKind, Term};
+use toolconf::closed_loop::{Metrics, Trajectory};
+use toolconf::confidence::control_confidence;
+use toolconf::select::draw_tools;
+use toolconf::{Arm, Task, TaskKind, Term};
 
 use super::batch::map_ordered;
-use super::csv::{Cell, CsvWriter};
 use super::figure_parts::{arm_cells, dt_label, ARM_COLUMNS};
 use super::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::num;
 use super::{described, Context, Experiment, Plan, ReproduceError};
+use toolconf_files::csv::{Cell, CsvWriter};
 
 pub struct Fig3;
 

@@ -4,16 +4,16 @@
 //! Seeds: tools from `"fig4/tools"` (the same tools for both tasks), bootstrap from
 //! `"fig4/bootstrap/<task>"`.
 
-use crate::select::draw_tools;
-use crate::{Arm, Task, TaskKind};
+use toolconf::select::draw_tools;
+use toolconf::{Arm, Task, TaskKind};
 
 use super::batch::{map_ordered, run_tool, ToolRuns};
-use super::csv::{Cell, CsvWriter};
 use super::figure_parts::{arm_cells, dt_label, files_block, task_label, wants_log};
 use super::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use super::report::{Block, Section, Verdict};
 use super::verdict::{mean_sd, negative_correlation_rule, Correlation};
 use super::{described, Context, Experiment, Plan, ReproduceError};
+use toolconf_files::csv::{Cell, CsvWriter};
 
 pub struct Fig4;
 

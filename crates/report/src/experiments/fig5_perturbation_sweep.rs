@@ -4,17 +4,17 @@
 //!
 //! Seeds: tools from `"fig5/tools"`, bootstrap from `"fig5/bootstrap/<ΔT>"`.
 
-use crate::select::draw_tools;
-use crate::stats::summary;
-use crate::{Task, TaskKind};
+use toolconf::select::draw_tools;
+use toolconf::{Task, TaskKind};
+use toolconf_stats::summary;
 
 use super::batch::{map_ordered, run_tool, ToolRuns};
-use super::csv::{Cell, CsvWriter};
 use super::figure_parts::{arm_cells, dt_label, files_block, wants_log};
 use super::plot::{self, diverging, Colour, Legend, Panel, Series, XyPanel};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::{mean_sd, negative_correlation_rule, num, p_value, Comparison, Correlation};
 use super::{described, Context, Experiment, Plan, ReproduceError};
+use toolconf_files::csv::{Cell, CsvWriter};
 
 pub struct Fig5;
 
@@ -140,7 +140,7 @@ const SIGN_HEADER: [&str; 5] = [
 /// reference ΔT = 0 included) as each tool finishes. Returns the runs and the rows per tool.
 fn simulate_sweep(
     ctx: &Context,
-    tools: &[crate::Arm],
+    tools: &[toolconf::Arm],
     sweep: &[f64],
 ) -> Result<(Vec<ToolRuns>, usize), ReproduceError> {
     let task = Task::paper(TaskKind::Velocity);

@@ -5,17 +5,17 @@
 //! trials run. Every rule of [`decision_rules`] gets a `chosen_by_<id>` column; the grid and the
 //! verdict contrast the first two (F and J), as the paper does.
 
-use crate::select::{draw_tools, evaluate, ToolResult};
-use crate::{Arm, Task, TaskKind};
+use toolconf::select::{draw_tools, evaluate, ToolResult};
+use toolconf::{Arm, Task, TaskKind};
 
 use super::batch::map_ordered;
-use super::csv::{Cell, CsvWriter};
 use super::figure_parts::{arm_cells, files_block, ARM_COLUMNS};
 use super::objectives::{choices, decision_rules, DecisionRule, Trial};
 use super::plot::{self, Colour, GridPanel, Panel};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::num;
 use super::{described, Context, Experiment, Plan, ReproduceError};
+use toolconf_files::csv::{Cell, CsvWriter};
 
 pub struct Fig6;
 

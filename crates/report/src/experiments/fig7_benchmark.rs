@@ -5,19 +5,19 @@
 //!
 //! Seeds: trial k draws its tools from `"fig7/trial/<k>"`.
 
-use crate::select::{draw_tools, evaluate, ToolResult};
-use crate::stats::summary;
-use crate::{Arm, Task, TaskKind};
+use toolconf::select::{draw_tools, evaluate, ToolResult};
+use toolconf::{Arm, Task, TaskKind};
+use toolconf_stats::summary;
 
 use super::batch::map_ordered;
-use super::csv::{Cell, CsvWriter};
 use super::figure_parts::{arm_cells, dt_label, files_block, ARM_COLUMNS};
 use super::objectives::{choices, decision_rules, DecisionRule, MpcCost, Trial};
 use super::plot::{self, BoxPanel, Panel};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::{num, Comparison};
 use super::{described, Context, Experiment, Plan, ReproduceError};
-use crate::mpc::MpcOptions;
+use toolconf::mpc::MpcOptions;
+use toolconf_files::csv::{Cell, CsvWriter};
 
 /// Fig. 7; `with_mpc` adds the MPC baseline's J* ranking to the paper's three rules when the run
 /// has the MPC switched on ([`Plan::mpc`]).

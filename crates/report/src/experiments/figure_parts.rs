@@ -1,9 +1,9 @@
 //! Small pieces the figure modules share: labels, tool columns, axis choices.
 
-use crate::{Arm, TaskKind};
+use toolconf::{Arm, TaskKind};
 
-use super::csv::Cell;
 use super::report::Block;
+use toolconf_files::csv::Cell;
 
 /// The paper's three tasks, which its Results section runs (a task added to
 /// `derive/tasks.toml` is everywhere else, but not in the paper's figures).

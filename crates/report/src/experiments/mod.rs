@@ -18,7 +18,7 @@
 //! per row ([`csv::CsvWriter`]), into a temporary file renamed over the CSV when the experiment
 //! has finished it. The files are therefore byte-identical whatever the thread count, and an
 //! interrupted run keeps the file that was there. Figures and the report are written whole
-//! (`.X.*.partial`, then renamed: [`toolconf::output::file`]).
+//! (`.X.*.partial`, then renamed: [`toolconf_files::file`]).
 //!
 //! # Extending
 //!
@@ -27,8 +27,6 @@
 //! [`objectives::decision_rules`], which the selection experiments (Figs. 6 and 7) iterate over.
 
 pub mod batch;
-/// The CSV writer, the runtime's ([`toolconf::output::csv`]).
-pub use toolconf::output::csv;
 mod exact_plant;
 mod fig2_confidence_vs_error;
 mod fig3_trajectories;
@@ -48,8 +46,8 @@ use std::time::{Duration, Instant};
 
 use indicatif::ProgressBar;
 
-use crate::closed_loop::{EpisodeOptions, Plant};
 pub use report::{Block, Outcome, Section, Verdict};
+use toolconf::closed_loop::{EpisodeOptions, Plant};
 
 /// How many tools, trials and resamples each experiment uses.
 #[derive(Debug, Clone, PartialEq)]
@@ -158,8 +156,8 @@ pub enum ReproduceError {
     UnknownExperiment(String),
 }
 
-impl From<toolconf::output::WriteError> for ReproduceError {
-    fn from(e: toolconf::output::WriteError) -> Self {
+impl From<toolconf_files::WriteError> for ReproduceError {
+    fn from(e: toolconf_files::WriteError) -> Self {
         ReproduceError::Io {
             path: e.path,
             source: e.source,
@@ -290,9 +288,9 @@ pub struct Config {
     pub progress: bool,
     /// The command line, quoted in the report.
     pub command: String,
-    /// The integration method of every episode ([`crate::integrate::Method::Fast`] from the
-    /// command line; [`crate::integrate::Method::Explicit`] is the paper's ode45).
-    pub method: crate::integrate::Method,
+    /// The integration method of every episode ([`toolconf_integrators::Method::Fast`] from the
+    /// command line; [`toolconf_integrators::Method::Explicit`] is the paper's ode45).
+    pub method: toolconf_integrators::Method,
 }
 
 /// Timing of one experiment.
@@ -348,7 +346,7 @@ fn select<'a>(
 
 /// The files [`reproduce`] writes into its folder under `config`: every selected experiment's,
 /// and the report (checked against each other before any work:
-/// [`toolconf::output::run_files`]).
+/// [`toolconf_files::run_files`]).
 pub fn output_files(config: &Config) -> Result<Vec<String>, ReproduceError> {
     let all = experiments();
     let mut files: Vec<String> = select(&all, config)?
@@ -365,7 +363,7 @@ pub fn reproduce(config: &Config) -> Result<Summary, ReproduceError> {
     let all = experiments();
     let selected = select(&all, config)?;
     let out = config.out_dir.as_path();
-    toolconf::output::file::create_folder(out).map_err(ReproduceError::io(out))?;
+    toolconf_files::file::create_folder(out).map_err(ReproduceError::io(out))?;
     let report_md = out.join("report.md");
     let report_html = out.join("report.html");
     // A report left from an older run would describe other data than an interrupted run leaves.
@@ -445,9 +443,9 @@ fn remove_if_present(path: &Path) -> Result<(), ReproduceError> {
     }
 }
 
-/// Writes a whole file or nothing (the runtime's [`toolconf::output::write_atomically`]).
+/// Writes a whole file or nothing (the runtime's [`toolconf_files::write_atomically`]).
 pub fn write_atomically(path: &Path, contents: &str) -> Result<(), ReproduceError> {
-    Ok(toolconf::output::write_atomically(path, contents)?)
+    Ok(toolconf_files::write_atomically(path, contents)?)
 }
 
 #[cfg(test)]

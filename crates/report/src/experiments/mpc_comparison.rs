@@ -8,17 +8,17 @@
 
 use std::time::{Duration, Instant};
 
-use crate::mpc::MpcOptions;
-use crate::select::draw_tools;
-use crate::stats::summary;
-use crate::{Arm, Task, TaskKind};
+use toolconf::mpc::MpcOptions;
+use toolconf::select::draw_tools;
+use toolconf::{Arm, Task, TaskKind};
+use toolconf_stats::summary;
 
 use super::batch::map_ordered;
-use super::csv::{Cell, CsvWriter};
 use super::figure_parts::{arm_cells, files_block, task_label, PAPER_TASKS};
 use super::report::{Block, Section};
 use super::verdict::{num, Correlation};
 use super::{described, Context, Experiment, Plan, ReproduceError};
+use toolconf_files::csv::{Cell, CsvWriter};
 
 pub struct MpcComparison;
 
@@ -166,7 +166,7 @@ fn run_both_controllers(ctx: &Context, tools: &[Arm]) -> Result<Vec<Item>, Repro
                 kind,
                 tool: i,
                 arm,
-                logdet: crate::confidence::control_confidence(&arm, &task)
+                logdet: toolconf::confidence::control_confidence(&arm, &task)
                     .ok()
                     .map(|c| c.logdet),
                 runs: [

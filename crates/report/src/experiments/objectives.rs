@@ -2,17 +2,17 @@
 //!
 //! A rule sees a whole trial (the task, the tools, and every tool's confidence and unperturbed
 //! active-inference episode) and names the tool it picks. The paper's three are ∫F, ∫J and
-//! confidence alone ([`crate::select::Objective`]). Another rule, for instance a ranking by an
+//! confidence alone ([`toolconf::select::Objective`]). Another rule, for instance a ranking by an
 //! MPC baseline's cost J*, implements [`DecisionRule`] (running whatever it needs inside
 //! `choose`) and is added to [`decision_rules`]; the experiments then report its choices, its
 //! tools' statistics and its paired tests against every other rule without further changes.
 
 use plotters::style::RGBColor;
 
-use crate::closed_loop::{EpisodeOptions, Plant};
-use crate::mpc::MpcOptions;
-use crate::select::{Objective, ToolResult};
-use crate::{Arm, Task};
+use toolconf::closed_loop::{EpisodeOptions, Plant};
+use toolconf::mpc::MpcOptions;
+use toolconf::select::{Objective, ToolResult};
+use toolconf::{Arm, Task};
 
 /// One trial of a selection experiment, as the rules see it.
 pub struct Trial<'a> {
@@ -86,7 +86,7 @@ impl DecisionRule for MpcCost {
     }
 
     fn choose(&self, trial: &Trial) -> Option<usize> {
-        crate::select::first_argmin(trial.tools.iter().enumerate().filter_map(|(i, arm)| {
+        toolconf::select::first_argmin(trial.tools.iter().enumerate().filter_map(|(i, arm)| {
             (trial.plant)
                 .simulate_mpc(arm, trial.task, trial.options, &self.0)
                 .ok()

@@ -9,7 +9,7 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::stats::{summary, Summary};
+use toolconf_stats::{summary, Summary};
 
 use super::{write_atomically, ReproduceError};
 

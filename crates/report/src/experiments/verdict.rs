@@ -1,7 +1,7 @@
 //! The statistics the verdicts rest on, the rules that turn them into verdicts, and how numbers
 //! are printed in the report (never as NaN: what cannot be computed is said in words).
 
-use crate::stats::{bootstrap_spearman_ci, paired_test, spearman, summary, Interval, PairedTest};
+use toolconf_stats::{bootstrap_spearman_ci, paired_test, spearman, summary, Interval, PairedTest};
 
 use super::report::Outcome;
 
