@@ -22,7 +22,7 @@ use serde_json::json;
 use toolconf::evaluation::Population;
 use toolconf::rank::ModelTasks;
 use toolconf::registry::{lookup, AnyTool};
-use toolconf::stats::spearman;
+use toolconf_stats::spearman;
 use toolconf::task_file::TaskSpec;
 
 struct Args {

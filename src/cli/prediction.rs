@@ -2,7 +2,7 @@
 //! (`toolconf::prediction`): numbers, or `null` with the reason; never NaN.
 
 use serde_json::{json, Value};
-use toolconf::output::csv::Cell;
+use toolconf_files::csv::Cell;
 use toolconf::prediction::{Prediction, PredictionError};
 
 /// The JSON fields: `predicted_task_error`, `predicted_free_energy`, `predicted_cost_j`,

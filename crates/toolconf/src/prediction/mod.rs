@@ -28,7 +28,7 @@ mod tests;
 
 use nalgebra::{DMatrix, SVector};
 
-use crate::integrate::uniform_grid;
+use toolconf_integrators::uniform_grid;
 use crate::model::{ArmModel, EpisodeOptionsN, TaskN, ToolN};
 use crate::Error;
 
