@@ -22,8 +22,8 @@ use serde_json::json;
 use toolconf::evaluation::Population;
 use toolconf::rank::ModelTasks;
 use toolconf::registry::{lookup, AnyTool};
-use toolconf_stats::spearman;
 use toolconf::task_file::TaskSpec;
+use toolconf_stats::spearman;
 
 struct Args {
     model: String,

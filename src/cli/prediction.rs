@@ -2,8 +2,8 @@
 //! (`toolconf::prediction`): numbers, or `null` with the reason; never NaN.
 
 use serde_json::{json, Value};
-use toolconf_files::csv::Cell;
 use toolconf::prediction::{Prediction, PredictionError};
+use toolconf_files::csv::Cell;
 
 /// The JSON fields: `predicted_task_error`, `predicted_free_energy`, `predicted_cost_j`,
 /// `predicted_perturbation_effect` (each `null` without a prediction) and `prediction_note`

@@ -40,7 +40,11 @@ const SIMILAR_CV: f64 = 0.25;
 const COLOURS: [Colour; 3] = [Colour(0, 114, 178), Colour(213, 94, 0), Colour(0, 158, 115)];
 
 impl Experiment for Fig2 {
-    described!("fig2", "Fig. 2: control confidence and task error (C1)", [CSV, SVG]);
+    described!(
+        "fig2",
+        "Fig. 2: control confidence and task error (C1)",
+        [CSV, SVG]
+    );
 
     fn planned_episodes(&self, plan: &Plan) -> u64 {
         3 * plan.fig2_tools as u64

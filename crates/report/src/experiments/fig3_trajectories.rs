@@ -68,7 +68,11 @@ fn settling_time(tr: &Trajectory, goal: f64) -> Option<f64> {
 }
 
 impl Experiment for Fig3 {
-    described!("fig3", "Fig. 3: high- and low-confidence tool under a perturbation (C2)", [TOOLS_CSV, CSV, SVG]);
+    described!(
+        "fig3",
+        "Fig. 3: high- and low-confidence tool under a perturbation (C2)",
+        [TOOLS_CSV, CSV, SVG]
+    );
 
     fn planned_episodes(&self, _plan: &Plan) -> u64 {
         4

@@ -35,7 +35,11 @@ pub const HEADER: [&str; 11] = [
 const TASKS: [TaskKind; 2] = [TaskKind::Position, TaskKind::Velocity];
 
 impl Experiment for Fig4 {
-    described!("fig4", "Fig. 4: confidence and sensitivity to a perturbation (C2)", [CSV, SVG]);
+    described!(
+        "fig4",
+        "Fig. 4: confidence and sensitivity to a perturbation (C2)",
+        [CSV, SVG]
+    );
 
     fn planned_episodes(&self, plan: &Plan) -> u64 {
         2 * 2 * plan.fig4_tools as u64

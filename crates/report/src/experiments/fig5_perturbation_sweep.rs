@@ -50,7 +50,11 @@ fn episode_of(sweep: &[f64], dt: f64) -> usize {
 }
 
 impl Experiment for Fig5 {
-    described!("fig5", "Fig. 5: variability over a range of perturbations, velocity task (C2)", [CSV, SVG]);
+    described!(
+        "fig5",
+        "Fig. 5: variability over a range of perturbations, velocity task (C2)",
+        [CSV, SVG]
+    );
 
     fn planned_episodes(&self, plan: &Plan) -> u64 {
         (plan.fig5_tools * (1 + sweep(plan).len())) as u64

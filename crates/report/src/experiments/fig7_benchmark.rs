@@ -124,7 +124,11 @@ fn metric(t: &TrialResult, m: usize, tool: usize) -> Option<f64> {
 }
 
 impl Experiment for Fig7 {
-    described!("fig7", "Fig. 7: benchmarking tool selection by F, J and confidence (C4)", [CSV, CHOICES_CSV, SVG]);
+    described!(
+        "fig7",
+        "Fig. 7: benchmarking tool selection by F, J and confidence (C4)",
+        [CSV, CHOICES_CSV, SVG]
+    );
 
     fn planned_episodes(&self, plan: &Plan) -> u64 {
         (if self.with_mpc && plan.mpc { 3 } else { 2 })

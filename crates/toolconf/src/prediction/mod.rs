@@ -28,9 +28,9 @@ mod tests;
 
 use nalgebra::{DMatrix, SVector};
 
-use toolconf_integrators::uniform_grid;
 use crate::model::{ArmModel, EpisodeOptionsN, TaskN, ToolN};
 use crate::Error;
+use toolconf_integrators::uniform_grid;
 
 pub use export::{ExportedTerm, LinearSystem};
 pub use linear::{LinearLoop, LinearTerm};
