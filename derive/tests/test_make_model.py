@@ -30,6 +30,14 @@ from test_make_crate import files_under, git_status  # noqa: E402
 MAKES_OWN = re.compile(r"make(\[\d+\])?: \*\*\* ")
 
 
+
+def interruptible() -> None:
+    """In the child, SIGINT's default action, as a shell in a terminal gives its foreground job: a
+    test run started in the background of a non-interactive shell inherits SIGINT ignored, and an
+    ignored signal is discarded even while make model's first lines hold it blocked."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 class MakeModel(unittest.TestCase):
     def setUp(self):
         tmp = tempfile.TemporaryDirectory(prefix="toolconf-make-model-")
@@ -225,7 +233,7 @@ class MakeModel(unittest.TestCase):
         for delay in (0.0, 0.01, 0.02, 0.04, 0.06, 0.08, 0.1):
             run = subprocess.Popen(["make", "--no-print-directory", "-s", "model", f"DESC={self.desc}",
                                     f"OUT={self.base / 'out'}"], cwd=ROOT, stderr=subprocess.PIPE, text=True,
-                                   start_new_session=True)
+                                   start_new_session=True, preexec_fn=interruptible)
             time.sleep(delay)
             os.killpg(run.pid, signal.SIGINT)
             stderr = run.communicate(timeout=300)[1]
