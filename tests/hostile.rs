@@ -73,7 +73,7 @@ impl Case {
         self
     }
 
-    fn to_full(mut self) -> Self {
+    fn into_full(mut self) -> Self {
         self.stdout = Sink::Full;
         self
     }
@@ -137,12 +137,12 @@ fn panics_and_reads(f: &Fixtures) -> Vec<Case> {
             .file("long.csv", format!("name,m1,m2,l1,l2\n{long_name},0.3,0.4,0.5,0.2\n")),
         case("long name, JSON", &["rank", "--tools", "long.json", "--task", "position"], 0, &[])
             .file("long.json", format!("[{{\"name\": \"{long_name}\", \"m1\": 0.3, \"m2\": 0.4, \"l1\": 0.5, \"l2\": 0.2}}]")),
-        case("confidence > /dev/full", &["confidence", "--arm", ARM, "--task", "velocity"], 1, &["cannot write to standard output", "No space left"]).to_full(),
-        case("simulate > /dev/full", &["simulate", "--arm", ARM, "--task", "position", "--json"], 1, &["standard output"]).to_full(),
-        case("select > /dev/full", &["select", "--tools", "2", "--task", "velocity"], 1, &["standard output"]).to_full(),
-        case("rank > /dev/full", &["rank", "--tools", d, "--task", "position", "--screen", "1"], 1, &["standard output"]).to_full(),
-        case("design > /dev/full", &["design", "--task", "velocity", "--design", design], 1, &["standard output"]).to_full(),
-        case("--help > /dev/full", &["rank", "--help"], 1, &["standard output"]).to_full(),
+        case("confidence > /dev/full", &["confidence", "--arm", ARM, "--task", "velocity"], 1, &["cannot write to standard output", "No space left"]).into_full(),
+        case("simulate > /dev/full", &["simulate", "--arm", ARM, "--task", "position", "--json"], 1, &["standard output"]).into_full(),
+        case("select > /dev/full", &["select", "--tools", "2", "--task", "velocity"], 1, &["standard output"]).into_full(),
+        case("rank > /dev/full", &["rank", "--tools", d, "--task", "position", "--screen", "1"], 1, &["standard output"]).into_full(),
+        case("design > /dev/full", &["design", "--task", "velocity", "--design", design], 1, &["standard output"]).into_full(),
+        case("--help > /dev/full", &["rank", "--help"], 1, &["standard output"]).into_full(),
         // 2. Unbounded reads.
         case("tools /dev/zero", &["rank", "--tools", "/dev/zero", "--task", "position"], 2, &["/dev/zero", "is a device, not a tools file"]),
         case("tools JSON /dev/zero", &["rank", "--tools", "zero.json", "--task", "position"], 2, &["zero.json", "is a device, not a tools file"]),

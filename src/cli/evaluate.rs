@@ -207,7 +207,7 @@ pub fn run(
     bar.finish_and_clear();
     let info = RunInfo {
         command: &common.command,
-        method: &common.method.describe(),
+        method: common.method.describe(),
         wall: started.elapsed(),
         threads: rayon::current_num_threads(),
     };

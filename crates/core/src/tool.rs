@@ -66,10 +66,7 @@ where
         let rule = &M::tool_rule();
         // A "> 0" domain within TOOL_PARAMETER first: that also refuses NaN, ±∞ and values ≤ 0,
         // so a domain the rule finds broken below is always another kind.
-        let named = M::parameter_names()
-            .into_iter()
-            .zip(params)
-            .zip(&rule.domains);
+        let named = M::parameter_names().iter().zip(params).zip(&rule.domains);
         for ((name, value), domain) in named {
             if domain.is_positive() && !crate::validate::TOOL_PARAMETER.contains(value) {
                 return Err(Error::InvalidParameter { name, value });

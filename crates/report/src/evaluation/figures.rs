@@ -152,12 +152,11 @@ pub fn fig3(dir: &Path, e: &Evaluation) -> Result<Option<Figure>, ReproduceError
     save(dir, "fig3_trajectories.svg", &panels, (560, 460)).map(Some)
 }
 
+/// How a run's points become its drawn series (colour, dashes, label).
+type SeriesOf<'a> = dyn Fn(&HighlightRun, Vec<(f64, f64)>) -> Series + 'a;
+
 /// The tip's path in two projections (one for a planar arm), goals and starts marked.
-fn tip_paths(
-    runs: &[&HighlightRun],
-    e: &Evaluation,
-    series: &dyn Fn(&HighlightRun, Vec<(f64, f64)>) -> Series,
-) -> Vec<Panel> {
+fn tip_paths(runs: &[&HighlightRun], e: &Evaluation, series: &SeriesOf) -> Vec<Panel> {
     let paths: Vec<(&HighlightRun, &Vec<Vec<f64>>)> = runs
         .iter()
         .filter_map(|r| Some((*r, r.trace.as_ref().ok()?.tip_path.as_ref()?)))

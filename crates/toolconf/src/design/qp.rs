@@ -97,9 +97,8 @@ fn solve_with(
     h: &[f64],
 ) -> QpOutcome {
     let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
-    if !(finite(q) && finite(h) && g.iter().all(|r| finite(r)))
-        || !hessian.map_or(true, |hm| hm.iter().all(|r| finite(r)))
-    {
+    let hessian_finite = hessian.map_or(true, |hm| hm.iter().all(|r| finite(r)));
+    if !(finite(q) && finite(h) && g.iter().all(|r| finite(r)) && hessian_finite) {
         let tight = (0..h.len())
             .filter(|&i| !(finite(&g[i]) && h[i].is_finite()))
             .collect();

@@ -75,7 +75,7 @@ impl Setup {
     pub fn level(&self, k: usize) -> &ModelTasks {
         match (&self.sweep[k], self.scales[k]) {
             (Some(tasks), _) => tasks,
-            (None, s) if s == 0.0 => &self.base,
+            (None, 0.0) => &self.base,
             (None, _) => &self.perturbed,
         }
     }

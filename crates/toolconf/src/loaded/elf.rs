@@ -111,8 +111,8 @@ pub(super) fn check(file: &File, len: u64, ident: &[u8; 6]) -> Result<(), String
     for (i, s) in segments.iter().enumerate() {
         within(
             &format!("segment {i}"),
-            s.p_offset(endian).into(),
-            s.p_filesz(endian).into(),
+            s.p_offset(endian),
+            s.p_filesz(endian),
             len,
         )?;
         dynamic |= s.p_type(endian) == elf::PT_DYNAMIC;
@@ -133,8 +133,8 @@ pub(super) fn check(file: &File, len: u64, ident: &[u8; 6]) -> Result<(), String
         if s.sh_type(endian) != elf::SHT_NOBITS {
             within(
                 &format!("section {i}"),
-                s.sh_offset(endian).into(),
-                s.sh_size(endian).into(),
+                s.sh_offset(endian),
+                s.sh_size(endian),
                 len,
             )?;
         }
