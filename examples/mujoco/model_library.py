@@ -15,7 +15,9 @@ from pathlib import Path
 
 import numpy as np
 
-ABI_VERSION = 1
+# The C ABI this binding speaks (toolconf_model.h's TOOLCONF_ABI_VERSION): version 2 made controller
+# handles registry keys and added TOOLCONF_OUT_OF_MEMORY, with every signature and struct unchanged.
+ABI_VERSION = 2
 _DOUBLES = POINTER(c_double)
 
 
