@@ -115,8 +115,9 @@ fn bad_input_exits_2_with_a_message_naming_the_value() {
 
 #[test]
 fn simulate_json_and_csv() {
-    let dir = std::env::temp_dir().join(format!("toolconf-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    // A folder of the test's own, removed when it ends, whatever the outcome.
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
     let csv = dir.join("trajectory.csv");
     let out = toolconf(&[
         "simulate",
@@ -160,7 +161,7 @@ fn simulate_json_and_csv() {
     assert!(lines[1..]
         .iter()
         .all(|l| l.split(',').count() == 9 && !l.contains("NaN")));
-    let left: Vec<_> = std::fs::read_dir(&dir)
+    let left: Vec<_> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .filter(|name| name.contains(".partial"))

@@ -34,9 +34,8 @@ fn rendered_rust_is_rustfmt_stable() {
 
 #[test]
 fn unknown_schema_is_rejected() {
-    let dir = std::env::temp_dir().join(format!("toolconf-render-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("bad.json");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad.json");
     std::fs::write(&path, r#"{"schema": 99, "model": {"name": "x"}}"#).unwrap();
     let err = read_ir(&path).unwrap_err().to_string();
     assert!(err.contains("schema"), "{err}");
