@@ -16,9 +16,9 @@
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use toolconf::model::{Arm2, ArmModel, ValidatedTaskN};
 use toolconf::select::draw_tools;
-use toolconf::{control_confidence, Arm, Task, TaskKind};
+use toolconf_model::model::{Arm2, ArmModel, ValidatedTaskN};
+use toolconf_model::{control_confidence, Arm, Task, TaskKind};
 
 fn confidence(c: &mut Criterion) {
     let arm = Arm::new([0.3, 0.4, 0.5, 0.2]).unwrap();

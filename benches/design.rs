@@ -15,9 +15,9 @@ use toolconf::design::file::DesignSpec;
 use toolconf::design::polytope::Polytope;
 use toolconf::design::{confidence_optimum, verify, Setting};
 use toolconf::rank::ModelTasks;
-use toolconf::registry::{AnyTool, ModelKind};
-use toolconf::task_file::TaskSpec;
-use toolconf::TaskKind;
+use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::registry::{AnyTool, ModelKind};
+use toolconf_model::TaskKind;
 
 fn design(c: &mut Criterion) {
     let text = std::fs::read_to_string(concat!(

@@ -7,9 +7,9 @@
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use toolconf::closed_loop::{simulate, ClosedLoop, EpisodeOptions, JointState, Plant};
 use toolconf::select::{draw_tools, evaluate};
-use toolconf::{Arm, Task, TaskKind};
+use toolconf_model::closed_loop::{simulate, ClosedLoop, EpisodeOptions, JointState, Plant};
+use toolconf_model::{Arm, Task, TaskKind};
 
 /// The fixed arm of docs/tutorials/paper-arm.md (m1, m2, l1, l2).
 fn arm() -> Arm {

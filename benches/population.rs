@@ -10,10 +10,10 @@
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use toolconf::closed_loop::{simulate, EpisodeOptions};
 use toolconf::select::draw_tools;
-use toolconf::{Task, TaskKind};
 use toolconf_integrators::Method;
+use toolconf_model::closed_loop::{simulate, EpisodeOptions};
+use toolconf_model::{Task, TaskKind};
 
 const TOOLS: usize = 2000;
 

@@ -8,9 +8,9 @@
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use toolconf::closed_loop::{simulate, ClosedLoop, EpisodeOptions, JointState};
-use toolconf::{Arm, Task, TaskKind};
 use toolconf_integrators::Method;
+use toolconf_model::closed_loop::{simulate, ClosedLoop, EpisodeOptions, JointState};
+use toolconf_model::{Arm, Task, TaskKind};
 
 const ARMS: [[f64; 4]; 3] = [
     [0.1, 0.1, 0.1, 0.1],

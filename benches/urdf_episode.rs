@@ -16,14 +16,14 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use nalgebra::SVector;
-use toolconf::model::{ClosedLoopN, Panda, PandaTool};
 use toolconf::rank::{simulate_all, Candidate, ModelTasks};
-use toolconf::registry::{AnyTool, ModelKind};
 use toolconf::select::mixed::MixedSampler;
-use toolconf::task_file::TaskSpec;
-use toolconf::tools_file::ToolRow;
-use toolconf::TaskKind;
 use toolconf_integrators::Method;
+use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::inputs::tools_file::ToolRow;
+use toolconf_model::model::{ClosedLoopN, Panda, PandaTool};
+use toolconf_model::registry::{AnyTool, ModelKind};
+use toolconf_model::TaskKind;
 
 /// `n` Panda tools from the mixed sampler's box (`generated::validity::panda`), seeded.
 fn tools(n: usize, seed: u64) -> Vec<AnyTool> {
@@ -50,7 +50,7 @@ fn rank_task(kind: TaskKind) -> ModelTasks {
 fn closed_loop_rhs(c: &mut Criterion) {
     let tool = panda(&tools(1, 1)[0]);
     let mut z = SVector::<f64, 21>::zeros();
-    for (i, v) in toolconf::generated::panda::EQUILIBRIUM_STATE
+    for (i, v) in toolconf_generated::panda::EQUILIBRIUM_STATE
         .iter()
         .enumerate()
     {
@@ -58,7 +58,7 @@ fn closed_loop_rhs(c: &mut Criterion) {
     }
     let mut group = c.benchmark_group("panda_closed_loop_rhs");
     for kind in TaskKind::ALL {
-        let task = <Panda as toolconf::model::ArmModel<7, 14, 13, 21>>::paper_task(kind);
+        let task = <Panda as toolconf_model::model::ArmModel<7, 14, 13, 21>>::paper_task(kind);
         let system = ClosedLoopN::<Panda, 7, 14, 13, 21>::new(&tool, &task, 1.0, 0.0).unwrap();
         group.bench_function(kind.name(), |b| b.iter(|| system.rhs(black_box(&z))));
     }

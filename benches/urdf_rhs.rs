@@ -11,7 +11,7 @@ use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use nalgebra::SVector;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use toolconf::generated::{panda, ur5};
+use toolconf_generated::{panda, ur5};
 
 const POPULATION: usize = 1000;
 

@@ -8,8 +8,8 @@
 //! `toolconf simulate --arm 0.35,0.35,0.35,0.35 --task position --method auto` prints the same
 //! numbers.
 
-use toolconf::closed_loop::{simulate, EpisodeOptions};
-use toolconf::{Arm, Task, TaskKind, Term};
+use toolconf_model::closed_loop::{simulate, EpisodeOptions};
+use toolconf_model::{Arm, Task, TaskKind, Term};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     // The tool: link masses m1, m2 [kg] and lengths l1, l2 [m], checked once here.

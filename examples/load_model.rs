@@ -13,11 +13,11 @@
 
 use std::process::ExitCode;
 
-use toolconf::loaded;
 use toolconf::rank::ModelTasks;
-use toolconf::registry::AnyTool;
-use toolconf::task_file::TaskSpec;
 use toolconf_integrators::Method;
+use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::loaded;
+use toolconf_model::registry::AnyTool;
 
 fn main() -> ExitCode {
     match run() {

@@ -14,8 +14,8 @@ use std::process::ExitCode;
 
 use toolconf::rank::{ranking, screen_file, simulate_all, ModelTasks};
 use toolconf::select::Objective;
-use toolconf::task_file::TaskSpec;
 use toolconf_integrators::Method;
+use toolconf_model::inputs::task_file::TaskSpec;
 
 fn main() -> ExitCode {
     match run() {

@@ -3,11 +3,11 @@
 //! determinism of selection across thread counts.
 
 use proptest::prelude::*;
-use toolconf::closed_loop::{simulate, EpisodeOptions, Metrics, Plant};
-use toolconf::model::{Arm2, ArmModel};
 use toolconf::select::{draw_tools, evaluate, Objective};
-use toolconf::Term;
-use toolconf::{Arm, Task, TaskKind, Vector2};
+use toolconf_model::closed_loop::{simulate, EpisodeOptions, Metrics, Plant};
+use toolconf_model::model::{Arm2, ArmModel};
+use toolconf_model::Term;
+use toolconf_model::{Arm, Task, TaskKind, Vector2};
 
 const ARMS: [[f64; 4]; 3] = [
     [0.3, 0.4, 0.5, 0.2],

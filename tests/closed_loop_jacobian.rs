@@ -3,8 +3,8 @@
 //! perturbations and states far from the equilibrium.
 
 use proptest::prelude::*;
-use toolconf::closed_loop::{ClosedLoop, JointJacobian, JointState};
-use toolconf::{Arm, Task, TaskKind};
+use toolconf_model::closed_loop::{ClosedLoop, JointJacobian, JointState};
+use toolconf_model::{Arm, Task, TaskKind};
 
 /// ∂Ż/∂Z by central differences, column j with the step `1e-6·max(1, |z_j|)`.
 fn central_differences(system: &ClosedLoop, z: &JointState) -> JointJacobian {

@@ -5,10 +5,10 @@
 use toolconf::design::file::DesignSpec;
 use toolconf::design::{confidence_optimum, design, DesignError, Setting};
 use toolconf::rank::ModelTasks;
-use toolconf::registry::{AnyTool, ModelKind};
 use toolconf::select::mixed::MixedSampler;
-use toolconf::task_file::TaskSpec;
-use toolconf::TaskKind;
+use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::registry::{AnyTool, ModelKind};
+use toolconf_model::TaskKind;
 
 const MINIMAL: &str = r#"
 objective = "confidence"
@@ -219,8 +219,8 @@ fn an_unconverged_optimum_is_reported_as_such() {
     assert!(
         matches!(
             tasks.logdet(&tool),
-            Err(toolconf::Error::Core(
-                toolconf::model::Error::IllConditioned { .. }
+            Err(toolconf_model::Error::Core(
+                toolconf_model::model::Error::IllConditioned { .. }
             ))
         ),
         "{q:?}"

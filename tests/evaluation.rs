@@ -11,9 +11,9 @@ use std::process::{Command, Output};
 
 use serde_json::Value;
 use toolconf::rank::ModelTasks;
-use toolconf::registry::{AnyTool, ModelKind};
-use toolconf::task_file::TaskSpec;
-use toolconf::tools_file::read_tools;
+use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::inputs::tools_file::read_tools;
+use toolconf_model::registry::{AnyTool, ModelKind};
 
 fn fresh_dir(name: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("evaluation-{name}"));

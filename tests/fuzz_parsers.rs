@@ -18,10 +18,10 @@ use toolconf::design::file::DesignSpec;
 use toolconf::design::polytope::Polytope;
 use toolconf::design::sweep::parse_sweep;
 use toolconf::rank::ModelTasks;
-use toolconf::registry::ModelKind;
-use toolconf::task_file::TaskSpec;
-use toolconf::tools_file::read_tools_from;
-use toolconf::validate::TOOL_PARAMETER;
+use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::inputs::tools_file::read_tools_from;
+use toolconf_model::registry::ModelKind;
+use toolconf_model::validate::TOOL_PARAMETER;
 use toolconf_tool_urdf::{check_rigid_body, tool_from_urdf, Request};
 
 /// The longest error line any input may give (values it repeats are clipped).
@@ -321,7 +321,7 @@ const ARMS: &[&str] = &["0.3,0.4,0.5,0.2", "1e-6,1e6,0.1,0.1"];
 /// is "never closed".
 fn check_csv_rows(cells: &[Vec<String>]) -> Result<(), TestCaseError> {
     use std::io::Read;
-    use toolconf::bounded_read::{record_error, CsvRows, RecordLimit};
+    use toolconf_model::inputs::bounded_read::{record_error, CsvRows, RecordLimit};
     let mut writer = csv::WriterBuilder::new()
         .flexible(true)
         .from_writer(Vec::new());
@@ -580,7 +580,7 @@ proptest! {
 
     #[test]
     fn arms(text in mutated(ARMS)) {
-        match toolconf::arm::parse(&text) {
+        match toolconf_model::arm::parse(&text) {
             Ok(arm) => prop_assert!(arm.params().iter().all(|v| TOOL_PARAMETER.contains(*v))),
             Err(e) => {
                 let m = e.to_string();

@@ -1,10 +1,10 @@
 //! The MPC baseline over the model-generic runtime: the paper's arm's plant choice runs it on the
 //! chosen model, and it runs the 3-link arm.
 
-use toolconf::closed_loop::{EpisodeOptions, Plant};
-use toolconf::model::{Arm2, Arm2Exact, Arm3, Arm3Tool, ArmModel, EpisodeOptionsN};
-use toolconf::mpc::{simulate_mpc, simulate_mpc_on, MpcOptions, MpcSimulationError};
-use toolconf::{Arm, Task, TaskKind};
+use toolconf::mpc::{simulate_mpc, simulate_mpc_on, MpcOptions, MpcSimulationError, SimulateMpc};
+use toolconf_model::closed_loop::{EpisodeOptions, Plant};
+use toolconf_model::model::{Arm2, Arm2Exact, Arm3, Arm3Tool, ArmModel, EpisodeOptionsN};
+use toolconf_model::{Arm, Task, TaskKind};
 
 #[test]
 fn the_plant_choice_runs_the_generic_mpc_episode_on_that_model() {

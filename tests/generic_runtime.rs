@@ -1,22 +1,22 @@
-//! The model-generic runtime (`toolconf::model`): the paper's arm's plant choice runs it on the
+//! The model-generic runtime (`toolconf_model::model`): the paper's arm's plant choice runs it on the
 //! chosen model; arm3 runs; bad input gives typed errors; mixed tool sets draw and rank
 //! deterministically.
 
 use std::process::Command;
-use toolconf::Term;
+use toolconf_model::Term;
 
 use nalgebra::SMatrix;
 use proptest::prelude::*;
 use serde_json::Value;
-use toolconf::closed_loop::{self, EpisodeOptions, Metrics, Plant};
-use toolconf::model::{
+use toolconf::select::mixed::{draw_mixed_tools, evaluate_mixed, MixedObjective, MixedResult};
+use toolconf::select::{draw_tools, PARAMETER_RANGE};
+use toolconf_model::closed_loop::{self, EpisodeOptions, Metrics, Plant};
+use toolconf_model::model::{
     self, control_confidence, simulate, simulate_on, Arm2, Arm2Exact, Arm2Tool, Arm3, Arm3Tool,
     ArmModel, EpisodeOptionsN,
 };
-use toolconf::registry::{AnyTool, ModelKind};
-use toolconf::select::mixed::{draw_mixed_tools, evaluate_mixed, MixedObjective, MixedResult};
-use toolconf::select::{draw_tools, PARAMETER_RANGE};
-use toolconf::{Arm, Error, Task, TaskKind};
+use toolconf_model::registry::{AnyTool, ModelKind};
+use toolconf_model::{Arm, Error, Task, TaskKind};
 
 /// Every field of the metrics as bits, so that "equal" means bit-identical (and NaN-safe).
 fn bits(m: &Metrics) -> [u64; 10] {
@@ -556,7 +556,7 @@ fn validated_task_gives_the_same_confidence_as_the_checked_api() {
         let task = Task::paper(kind);
         let validated = task.validated().unwrap();
         for arm in draw_tools(200, 9) {
-            let checked = toolconf::control_confidence(&arm, &task).unwrap();
+            let checked = toolconf_model::control_confidence(&arm, &task).unwrap();
             let fast = validated.control_confidence(&arm).unwrap();
             assert_eq!(checked.logdet.to_bits(), fast.logdet.to_bits());
             assert_eq!(checked.pi_u, fast.pi_u);

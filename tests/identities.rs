@@ -3,9 +3,9 @@
 
 use nalgebra::{SMatrix, SVector};
 use proptest::prelude::*;
-use toolconf::model::{self, Arm2, ArmModel};
-use toolconf::Term;
-use toolconf::{control_confidence, Arm, Error, Matrix2, Task, TaskKind, Vector2};
+use toolconf_model::model::{self, Arm2, ArmModel};
+use toolconf_model::Term;
+use toolconf_model::{control_confidence, Arm, Error, Matrix2, Task, TaskKind, Vector2};
 
 fn arm_strategy() -> impl Strategy<Value = Arm> {
     (0.1..0.6f64, 0.1..0.6f64, 0.1..0.6f64, 0.1..0.6f64)
@@ -160,22 +160,22 @@ fn invalid_arms_are_errors_naming_the_parameter() {
         }
     }
     assert!(matches!(
-        toolconf::arm::parse("0.3,0.4,x,0.2"),
+        toolconf_model::arm::parse("0.3,0.4,x,0.2"),
         Err(Error::ArmSyntax { .. })
     ));
     assert!(matches!(
-        toolconf::arm::parse("0.3,0.4,0.5"),
+        toolconf_model::arm::parse("0.3,0.4,0.5"),
         Err(Error::ArmSyntax { .. })
     ));
     assert!(matches!(
-        toolconf::arm::parse("0.3,0.4,-0.5,0.2"),
+        toolconf_model::arm::parse("0.3,0.4,-0.5,0.2"),
         Err(Error::Core(model::Error::InvalidParameter {
             name: "l1",
             ..
         }))
     ));
     assert_eq!(
-        toolconf::arm::parse("0.3, 0.4,0.5 ,0.2").unwrap(),
+        toolconf_model::arm::parse("0.3, 0.4,0.5 ,0.2").unwrap(),
         Arm::new([0.3, 0.4, 0.5, 0.2]).unwrap()
     );
 }
@@ -222,7 +222,7 @@ fn invalid_tasks_are_errors() {
         Err(model::Error::NotPositiveDefinite { .. })
     ));
     assert!(matches!(
-        toolconf::task::parse_task("jump"),
+        toolconf_model::task::parse_task("jump"),
         Err(Error::UnknownTask(ref t)) if t == "jump"
     ));
     assert_eq!("2".parse::<TaskKind>().unwrap(), TaskKind::Velocity);

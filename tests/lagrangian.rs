@@ -3,7 +3,7 @@
 
 use nalgebra::{Matrix2, SVector, Vector2};
 use proptest::prelude::*;
-use toolconf::generated::{arm2_exact, arm3};
+use toolconf_generated::{arm2_exact, arm3};
 use toolconf_integrators::{solve_grid, uniform_grid, Options};
 
 const G: f64 = 9.81;
@@ -77,11 +77,11 @@ fn the_papers_model_shares_the_statics_but_not_the_dynamics() {
     let xe = SVector::<f64, 4>::from(arm2_exact::EQUILIBRIUM_STATE);
     assert!(arm2_exact::dynamics(&xe, &Vector2::zeros(), &p).amax() < 1e-12);
     let exact = arm2_exact::velocity_sensitivity(&p).0;
-    let paper = toolconf::generated::arm2::velocity_sensitivity(&p).0;
+    let paper = toolconf_generated::arm2::velocity_sensitivity(&p).0;
     // Statics: −[I O]A⁻¹B = (∂G/∂θ)⁻¹S does not involve the mass matrix, so task 2's sensitivity agrees.
     assert!((exact - paper).amax() < 1e-12 * paper.amax());
     assert!(
-        (arm2_exact::state_matrix(&p) - toolconf::generated::arm2::state_matrix(&p)).amax() > 1.0
+        (arm2_exact::state_matrix(&p) - toolconf_generated::arm2::state_matrix(&p)).amax() > 1.0
     );
 }
 
@@ -138,7 +138,7 @@ fn energy_is_conserved_without_torques() {
     // The paper's generative process is not a conservative mechanical system: its link-2
     // equation ignores the pivot's acceleration, so its "energy" drifts at the same tolerance.
     let paper = energy_drift::<4, 2>(
-        |x| toolconf::generated::arm2::dynamics(x, &Vector2::zeros(), &p2),
+        |x| toolconf_generated::arm2::dynamics(x, &Vector2::zeros(), &p2),
         x2,
         &[0.3, 0.4],
         &[0.5, 0.2],

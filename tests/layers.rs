@@ -136,7 +136,11 @@ fn the_c_abi_is_on_the_core_alone_without_its_std_feature() {
 
 #[test]
 fn the_runtime_and_the_python_package_have_no_command_line_plots_or_progress_bars() {
-    for manifest in ["crates/toolconf/Cargo.toml", "python/Cargo.toml"] {
+    for manifest in [
+        "crates/model/Cargo.toml",
+        "crates/toolconf/Cargo.toml",
+        "python/Cargo.toml",
+    ] {
         let normal = tree(manifest, &["-e", "normal"]);
         for top in [
             "clap",
@@ -214,7 +218,7 @@ fn the_on_robot_controller_builds_for_a_bare_metal_target() {
 /// about the layers, taken here.
 #[test]
 fn each_crate_imports_only_the_layers_below_it() {
-    let layers: [(&str, &str, &[&str]); 9] = [
+    let layers: [(&str, &str, &[&str]); 10] = [
         ("crates/files/Cargo.toml", "toolconf-files", &[]),
         ("crates/stats/Cargo.toml", "toolconf-stats", &[]),
         (
@@ -233,8 +237,8 @@ fn each_crate_imports_only_the_layers_below_it() {
             &["toolconf-files", "toolconf-messages"],
         ),
         (
-            "crates/toolconf/Cargo.toml",
-            "toolconf",
+            "crates/model/Cargo.toml",
+            "toolconf-model",
             &[
                 "toolconf-cabi",
                 "toolconf-core",
@@ -242,6 +246,18 @@ fn each_crate_imports_only_the_layers_below_it() {
                 "toolconf-generated",
                 "toolconf-integrators",
                 "toolconf-messages",
+            ],
+        ),
+        (
+            "crates/toolconf/Cargo.toml",
+            "toolconf",
+            &[
+                "toolconf-core",
+                "toolconf-files",
+                "toolconf-generated",
+                "toolconf-integrators",
+                "toolconf-messages",
+                "toolconf-model",
                 "toolconf-stats",
             ],
         ),
@@ -251,7 +267,9 @@ fn each_crate_imports_only_the_layers_below_it() {
             &[
                 "toolconf",
                 "toolconf-files",
+                "toolconf-generated",
                 "toolconf-integrators",
+                "toolconf-model",
                 "toolconf-stats",
             ],
         ),
@@ -261,8 +279,10 @@ fn each_crate_imports_only_the_layers_below_it() {
             &[
                 "toolconf",
                 "toolconf-files",
+                "toolconf-generated",
                 "toolconf-integrators",
                 "toolconf-messages",
+                "toolconf-model",
                 "toolconf-tool-urdf",
             ],
         ),
@@ -272,8 +292,10 @@ fn each_crate_imports_only_the_layers_below_it() {
             &[
                 "toolconf",
                 "toolconf-files",
+                "toolconf-generated",
                 "toolconf-integrators",
                 "toolconf-messages",
+                "toolconf-model",
                 "toolconf-report",
                 "toolconf-tool-urdf",
             ],
@@ -315,6 +337,7 @@ fn no_crate_root_reexports_another_crates_modules() {
         "crates/messages/src/lib.rs",
         "crates/integrators/src/lib.rs",
         "crates/tool-urdf/src/lib.rs",
+        "crates/model/src/lib.rs",
         "crates/toolconf/src/lib.rs",
         "crates/report/src/lib.rs",
         "python/src/lib.rs",
@@ -327,6 +350,9 @@ fn no_crate_root_reexports_another_crates_modules() {
                 || line.starts_with("pub use toolconf_stats")
                 || line.starts_with("pub use toolconf_tool_urdf")
                 || line.starts_with("pub use toolconf_messages as")
+                || line.starts_with("pub use toolconf_generated")
+                || line.starts_with("pub use toolconf_model")
+                || line.starts_with("use toolconf_model::{")
                 || line.starts_with("use toolconf::{")
                 || line.starts_with("pub use toolconf::");
             assert!(!reexport, "{lib}: {line}");

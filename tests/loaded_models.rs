@@ -1,4 +1,4 @@
-//! Models loaded at run time (crates/toolconf/src/loaded/, `--model-path`,
+//! Models loaded at run time (crates/model/src/loaded/, `--model-path`,
 //! `TOOLCONF_MODEL_PATH`): refusals of what is not a model library, each one line and status 2;
 //! and, with the libraries `make loaded-models-test` builds (every model of the repository,
 //! `make model IR=generated/<model>.json`), the loaded models equal the built-in ones bit for
@@ -13,10 +13,10 @@ use std::process::Command;
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use toolconf::closed_loop::EpisodeOptions;
-use toolconf::loaded;
-use toolconf::registry::{ModelKind, Rows};
-use toolconf::task_file::TaskSpec;
+use toolconf_model::closed_loop::EpisodeOptions;
+use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::loaded;
+use toolconf_model::registry::{ModelKind, Rows};
 
 const BIN: &str = env!("CARGO_BIN_EXE_toolconf");
 
@@ -79,7 +79,7 @@ impl Same {
     }
 }
 
-/// Every operation of the registry ([`toolconf::registry::Model`], [`toolconf::registry::
+/// Every operation of the registry ([`toolconf_model::registry::Model`], [`toolconf_model::registry::
 /// BoundTask`]) on the built-in model and on its library, loaded as `<model>_loaded`.
 fn compare(builtin: ModelKind, library: &Path) -> usize {
     let name = format!("{}_loaded", builtin.name());

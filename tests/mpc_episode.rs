@@ -1,11 +1,11 @@
 //! The MPC baseline in closed loop with the nonlinear plant.
 
 use std::f64::consts::FRAC_PI_2;
-use toolconf::Term;
+use toolconf_model::Term;
 
-use toolconf::closed_loop::EpisodeOptions;
 use toolconf::mpc::{simulate_mpc, Mpc, MpcEpisodeError, MpcModel, MpcOptions};
-use toolconf::{Arm, Task, TaskKind, Vector2};
+use toolconf_model::closed_loop::EpisodeOptions;
+use toolconf_model::{Arm, Task, TaskKind, Vector2};
 
 fn arm() -> Arm {
     Arm::new([0.3, 0.4, 0.5, 0.2]).unwrap()

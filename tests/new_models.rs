@@ -5,7 +5,7 @@
 
 use nalgebra::{Matrix2, SMatrix, SVector, Vector1, Vector2};
 use proptest::prelude::*;
-use toolconf::generated::{arm2_exact, arm2_payload, msd};
+use toolconf_generated::{arm2_exact, arm2_payload, msd};
 use toolconf_integrators::{solve_grid, uniform_grid, Options};
 
 const G: f64 = 9.81;

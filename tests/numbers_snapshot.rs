@@ -2,9 +2,9 @@
 //! pinned by an insta snapshot: a change in the derivation that moves any number is a reviewed diff.
 
 use std::fmt::Write;
-use toolconf::Term;
+use toolconf_model::Term;
 
-use toolconf::{control_confidence, Arm, Task, TaskKind};
+use toolconf_model::{control_confidence, Arm, Task, TaskKind};
 
 /// Tools spanning the paper's parameter domain [0.1, 0.6], corners and the CLI example.
 const TOOLS: [[f64; 4]; 5] = [
@@ -56,7 +56,7 @@ fn linearisation_sensitivities_and_confidence_table() {
 #[test]
 fn lagrangian_models_table() {
     use nalgebra::{SMatrix, SVector};
-    use toolconf::generated::{arm2_exact, arm3};
+    use toolconf_generated::{arm2_exact, arm3};
 
     fn rows<const R: usize, const C: usize>(name: &str, m: &SMatrix<f64, R, C>) -> String {
         (0..R)

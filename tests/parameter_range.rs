@@ -1,4 +1,4 @@
-//! The valid input ranges (crates/core/src/validate.rs, crates/toolconf/src/validate.rs) keep the
+//! The valid input ranges (crates/core/src/validate.rs, crates/model/src/validate.rs) keep the
 //! generated arithmetic finite: every generated function of every model, at every corner of the
 //! parameter box (each "> 0" parameter in [1e-6, 1e6], each signed one, a URDF tool's centre of
 //! mass, over its model's domain) that the model's rule admits, and at its centre, for every task with the paper's precisions and with precisions at
@@ -9,12 +9,12 @@
 //! computed. Just outside the box, a tool is refused.
 
 use nalgebra::{SMatrix, SVector};
-use toolconf::generated;
-use toolconf::generated::validity::ToolRule;
-use toolconf::model::Error;
-use toolconf::model::{logdet_of, reads_tip, ArmModel, TaskN, ToolN};
-use toolconf::validate::{STATE_BOUND, TOOL_PARAMETER};
-use toolconf::{TaskKind, Term};
+use toolconf_generated as generated;
+use toolconf_generated::validity::ToolRule;
+use toolconf_model::model::Error;
+use toolconf_model::model::{logdet_of, reads_tip, ArmModel, TaskN, ToolN};
+use toolconf_model::validate::{STATE_BOUND, TOOL_PARAMETER};
+use toolconf_model::{TaskKind, Term};
 
 /// The corners of the box `boxes` (one interval per parameter) that the model's rule admits
 /// (a URDF tool's inertia tensor a rigid body's), and its centre: in ln p for a "> 0" parameter,
@@ -174,7 +174,7 @@ macro_rules! range_tests {
                 #[test]
                 fn $module() {
                     check::<
-                        toolconf::model::$marker,
+                        toolconf_model::model::$marker,
                         { generated::$module::DOF },
                         { generated::$module::STATE_DIM },
                         { generated::$module::PARAMETER_COUNT },
@@ -186,4 +186,4 @@ macro_rules! range_tests {
     };
 }
 
-toolconf::for_each_model!(range_tests);
+toolconf_generated::for_each_model!(range_tests);

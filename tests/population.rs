@@ -8,10 +8,10 @@
 //! The full 2000-tool check (`draw_tools(2000, 1)`) is `benches/population.sh`
 //! (`benches/timing/population.rs`); here 60 tools per task keep the debug build to seconds.
 
-use toolconf::closed_loop::{simulate, EpisodeOptions, Metrics, Plant};
 use toolconf::select::{draw_tools, evaluate};
-use toolconf::{Arm, Task, TaskKind};
 use toolconf_integrators::Method;
+use toolconf_model::closed_loop::{simulate, EpisodeOptions, Metrics, Plant};
+use toolconf_model::{Arm, Task, TaskKind};
 
 const TOOLS: usize = 60;
 

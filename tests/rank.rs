@@ -4,11 +4,11 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use toolconf::Term;
+use toolconf_model::Term;
 
 use serde_json::Value;
-use toolconf::model::{Arm2, Arm2Tool, ClosedLoopN, TaskN};
-use toolconf::TaskKind;
+use toolconf_model::model::{Arm2, Arm2Tool, ClosedLoopN, TaskN};
+use toolconf_model::TaskKind;
 
 const DRAWER: &str = "examples/tools/drawer.csv";
 const PAPER_TASK: &str = "examples/tasks/paper_position.toml";

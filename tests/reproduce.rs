@@ -358,11 +358,11 @@ fn the_mpc_comparison_runs_when_switched_on() {
 
 #[test]
 fn mpc_cost_rule_picks_the_tool_with_the_lowest_mpc_cost() {
-    use toolconf::closed_loop::EpisodeOptions;
-    use toolconf::closed_loop::Plant;
     use toolconf::mpc::{simulate_mpc, MpcOptions};
     use toolconf::select::{draw_tools, evaluate};
-    use toolconf::{Task, TaskKind};
+    use toolconf_model::closed_loop::EpisodeOptions;
+    use toolconf_model::closed_loop::Plant;
+    use toolconf_model::{Task, TaskKind};
     use toolconf_report::experiments::objectives::{DecisionRule, MpcCost, Trial};
     let tools = draw_tools(3, 21);
     let task = Task::paper(TaskKind::Velocity);

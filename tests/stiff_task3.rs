@@ -9,10 +9,10 @@
 //!
 //! Run with `cargo test --release --test stiff_task3 -- --nocapture` for the table.
 
-use toolconf::closed_loop::{simulate, EpisodeOptions, Metrics};
 use toolconf::select::draw_tools;
-use toolconf::{Arm, Task, TaskKind};
 use toolconf_integrators::Method;
+use toolconf_model::closed_loop::{simulate, EpisodeOptions, Metrics};
+use toolconf_model::{Arm, Task, TaskKind};
 
 /// The paper's three reference arms and 20 drawn ones.
 fn arms() -> Vec<Arm> {

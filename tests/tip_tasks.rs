@@ -10,15 +10,15 @@
 use std::path::Path;
 
 use nalgebra::{SMatrix, SVector};
-use toolconf::generated::Read;
-use toolconf::model::{
+use toolconf::rank::{screen_file, ModelTasks};
+use toolconf_generated::Read;
+use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::inputs::tools_file::read_tools;
+use toolconf_model::model::{
     reads_tip, term_components, Arm2, Arm2Tool, Arm3, ArmModel, ClosedLoopN, Panda, PandaTool,
     TaskN, Ur5,
 };
-use toolconf::rank::{screen_file, ModelTasks};
-use toolconf::task_file::TaskSpec;
-use toolconf::tools_file::read_tools;
-use toolconf::{TaskKind, Term};
+use toolconf_model::{TaskKind, Term};
 
 fn repo(path: &str) -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
@@ -232,7 +232,7 @@ fn the_generated_tip_bias_is_the_tips_second_derivative_along_q_dot() {
     check::<Ur5, 6, 12, 13, 18>(&ur5, 2);
     check::<Arm2, 2, 4, 4, 6>(&SVector::from([0.3, 0.4, 0.5, 0.2]), 3);
     let arm3 = SVector::from_fn(|i, _| 0.3 + 0.1 * i as f64);
-    check::<Arm3, 3, 6, { toolconf::generated::arm3::PARAMETER_COUNT }, 9>(&arm3, 4);
+    check::<Arm3, 3, 6, { toolconf_generated::arm3::PARAMETER_COUNT }, 9>(&arm3, 4);
 }
 
 /// The derivation writes ∂y/∂U = J ∂θ/∂U (J at q^e, its first TIP_DIM rows): the generated

@@ -1,6 +1,6 @@
 """toolconf's closed loop for a URDF arm, written as a Python user would write it: Pinocchio's
 `aba` in the right-hand side, SciPy's `solve_ivp`, numpy for the rest. The same loop as
-toolconf's (crates/toolconf/src/model/closed_loop_n.rs, crates/core/src/controller.rs):
+toolconf's (crates/model/src/model/closed_loop_n.rs, crates/core/src/controller.rs):
 
     plant       tau = U + dT + K (q^e - q) - D q_dot + g(q^e),   q_ddot = aba(q, q_dot, tau)
     controller  U_dot = -gamma [sum over the task's terms of K_term (term - goal) + P^U U]

@@ -17,10 +17,10 @@ use std::ops::{Add, Div, Mul, Neg, Sub};
 use std::time::Instant;
 
 use nalgebra::SVector;
-use toolconf::generated::arm2::DynamicsCoefficients;
-use toolconf::model::{Arm2, ArmModel, ClosedLoopN, TaskN};
 use toolconf::select::draw_tools;
-use toolconf::{Task, TaskKind};
+use toolconf_generated::arm2::DynamicsCoefficients;
+use toolconf_model::model::{Arm2, ArmModel, ClosedLoopN, TaskN};
+use toolconf_model::{Task, TaskKind};
 
 /// One f64 per lane, each lane a tool: what a SIMD register of W doubles holds.
 #[derive(Clone, Copy, Debug)]
@@ -88,7 +88,7 @@ impl<const W: usize> PerLane<W> {
 
 #[inline(always)]
 fn sin_cos<const W: usize>(x: PerLane<W>) -> (PerLane<W>, PerLane<W>) {
-    let (s, c) = toolconf::generated::trig::sin_cos_lanes(x.0);
+    let (s, c) = toolconf_generated::trig::sin_cos_lanes(x.0);
     (PerLane(s), PerLane(c))
 }
 
@@ -345,7 +345,10 @@ fn run_lanes_avx2<const W: usize>(loops: &[Loop<1>], z0: &Z<1>) -> Vec<([f64; 6]
     run_lanes::<W>(loops, z0)
 }
 
-fn lane_loop(arm: &toolconf::Arm, task: &TaskN<2>) -> (Loop<1>, ClosedLoopN<Arm2, 2, 4, 4, 6>) {
+fn lane_loop(
+    arm: &toolconf_model::Arm,
+    task: &TaskN<2>,
+) -> (Loop<1>, ClosedLoopN<Arm2, 2, 4, 4, 6>) {
     let tool = *arm;
     let cl = ClosedLoopN::<Arm2, 2, 4, 4, 6>::new(&tool, task, 1.0, 0.0).expect("closed loop");
     let coeff = DynamicsCoefficients::new(&tool.params());

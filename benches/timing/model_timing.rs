@@ -17,9 +17,9 @@ use std::time::Instant;
 
 use serde_json::{json, Value};
 use toolconf::rank::ModelTasks;
-use toolconf::task_file::TaskSpec;
-use toolconf::tools_file::{read_tools, ToolRow};
 use toolconf_integrators::Method;
+use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::inputs::tools_file::{read_tools, ToolRow};
 
 struct Args {
     tools: PathBuf,

@@ -21,9 +21,9 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use serde_json::{json, Value};
-use toolconf::closed_loop::{simulate, EpisodeOptions};
-use toolconf::{Arm, Task, TaskKind};
 use toolconf_integrators::Method;
+use toolconf_model::closed_loop::{simulate, EpisodeOptions};
+use toolconf_model::{Arm, Task, TaskKind};
 
 fn arm_from(v: &Value) -> Result<Arm, String> {
     let v = v.get("arm").unwrap_or(v);

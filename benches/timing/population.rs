@@ -18,10 +18,10 @@
 use std::process::ExitCode;
 use std::time::Instant;
 
-use toolconf::closed_loop::{simulate, EpisodeOptions, Metrics};
 use toolconf::select::draw_tools;
-use toolconf::{Arm, Task, TaskKind};
 use toolconf_integrators::Method;
+use toolconf_model::closed_loop::{simulate, EpisodeOptions, Metrics};
+use toolconf_model::{Arm, Task, TaskKind};
 
 struct Args {
     tools: usize,

@@ -1,5 +1,5 @@
 //! How well, and how cheaply, the linearised closed loop predicts the episode
-//! (`toolconf::prediction`), beside ln|Π^U|: for one model and task, on random tools.
+//! (`toolconf_model::prediction`), beside ln|Π^U|: for one model and task, on random tools.
 //!
 //! Prints one JSON object: Spearman's ρ of the predicted and the simulated task error and ∫F dt,
 //! ρ of ln|Π^U| and the same, the median |predicted/simulated − 1|, the recall of the best 1 %
@@ -21,8 +21,8 @@ use rayon::prelude::*;
 use serde_json::json;
 use toolconf::evaluation::Population;
 use toolconf::rank::ModelTasks;
-use toolconf::registry::{lookup, AnyTool};
-use toolconf::task_file::TaskSpec;
+use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::registry::{lookup, AnyTool};
 use toolconf_stats::spearman;
 
 struct Args {
@@ -64,7 +64,7 @@ fn parse_args() -> Result<Args, String> {
 }
 
 fn spec(task: &str) -> Result<TaskSpec, String> {
-    match toolconf::task::parse_task(task) {
+    match toolconf_model::task::parse_task(task) {
         Ok(kind) => Ok(TaskSpec::builtin(kind)),
         Err(_) => TaskSpec::from_file(std::path::Path::new(task)).map_err(|e| e.to_string()),
     }

@@ -218,7 +218,7 @@ RUST_KEYWORDS = frozenset((
     "struct", "super", "trait", "true", "type", "unsafe", "use", "where", "while", "async", "await", "dyn",
     "abstract", "become", "box", "do", "final", "macro", "override", "priv", "typeof", "unsized", "virtual",
     "yield", "try", "gen"))
-# The columns a tools file has besides the parameters' (crates/toolconf/src/tools_file.rs).
+# The columns a tools file has besides the parameters' (crates/model/src/inputs/tools_file.rs).
 TOOL_FILE_COLUMNS = ("name", "model")
 
 # The keys each table may have, as serde's deny_unknown_fields: a misspelt key is an error, not a

@@ -114,7 +114,7 @@ def read_task(path: str | Path, library: ModelLibrary) -> Task:
 @dataclass
 class Run:
     """One episode on the output grid: t, q, the tip y and ẏ (base frame), U, and the metrics
-    as toolconf defines them (crates/toolconf/src/model/closed_loop_n.rs, `Metrics`)."""
+    as toolconf defines them (crates/model/src/model/closed_loop_n.rs, `Metrics`)."""
     t: np.ndarray
     q: np.ndarray
     tip: np.ndarray

@@ -134,7 +134,7 @@ pub fn collect<T>(items: impl ExactSizeIterator<Item = T>, what: &str) -> Result
 /// trailing defaults (a URDF tool of toolconf's earlier 7: no products of inertia, tip at the
 /// flange; `ModelKind::with_defaults`), as a tools file without those columns does.
 pub fn tool_params(
-    kind: toolconf::registry::ModelKind,
+    kind: toolconf_model::registry::ModelKind,
     value: &Bound<'_, PyAny>,
 ) -> PyResult<(Vec<usize>, Vec<f64>)> {
     let (mut shape, values) = float_argument("params", value)?;

@@ -5,9 +5,9 @@ use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
-use toolconf::model::Metrics;
-use toolconf::registry::ModelKind;
-use toolconf::task_file::TaskSpec;
+use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::model::Metrics;
+use toolconf_model::registry::ModelKind;
 
 use crate::errors::{detached, Failure};
 use crate::models::model_kind;

@@ -3,8 +3,8 @@
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyFloat};
-use toolconf::registry::{BatchError, Confidences, ModelKind};
-use toolconf::task_file::TaskSpec;
+use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::registry::{BatchError, Confidences, ModelKind};
 
 use crate::errors::{detached, Failure};
 use crate::models::model_kind;

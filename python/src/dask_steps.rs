@@ -15,7 +15,7 @@
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
 use toolconf::rank::{check_screened, simulate_all, ModelTasks, Screen, ScreenedBlock};
-use toolconf::task_file::TaskSpec;
+use toolconf_model::inputs::task_file::TaskSpec;
 
 use crate::errors::{detached, Failure};
 use crate::rank::{objective, screen_limit};
@@ -44,9 +44,11 @@ pub fn portable_task<'py>(
     if spec.file.is_empty() || task.cast::<PyDict>().is_ok() || task.cast::<PyTuple>().is_ok() {
         return Ok(task.clone());
     }
-    let text =
-        toolconf::bounded_read::read_text_file(std::path::Path::new(&spec.file), "task file")
-            .map_err(|m| Failure::Input(format!("{}: {m}", spec.file)).into_pyerr(py))?;
+    let text = toolconf_model::inputs::bounded_read::read_text_file(
+        std::path::Path::new(&spec.file),
+        "task file",
+    )
+    .map_err(|m| Failure::Input(format!("{}: {m}", spec.file)).into_pyerr(py))?;
     Ok(PyTuple::new(py, [TASK_TEXT, spec.file.as_str(), text.as_str()])?.into_any())
 }
 

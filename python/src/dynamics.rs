@@ -4,7 +4,7 @@
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use toolconf::registry::{BatchError, ModelKind, Rows};
+use toolconf_model::registry::{BatchError, ModelKind, Rows};
 
 use crate::errors::{detached, Failure};
 use crate::models::model_kind;

@@ -6,7 +6,7 @@
 use pyo3::create_exception;
 use pyo3::exceptions::{PyMemoryError, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use toolconf::model::ModelSimulationError;
+use toolconf_model::model::ModelSimulationError;
 
 create_exception!(
     toolconf,
@@ -72,7 +72,7 @@ impl Failure {
     }
 
     /// A crate error: bad input, or a result that is not finite (a failed run).
-    pub fn from_error(e: toolconf::Error) -> Self {
+    pub fn from_error(e: toolconf_model::Error) -> Self {
         if e.is_failed_run() {
             Failure::Run(e.to_string())
         } else {

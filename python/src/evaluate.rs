@@ -12,9 +12,9 @@ use toolconf::evaluation::{
     check_population, evaluate, finish, parse_box, run_tools, Evaluation, Plan, Population, Setup,
     ToolRecord, MAX_TOOLS,
 };
-use toolconf::registry::{AnyTool, ModelKind};
-use toolconf::tools_file::{read_columns, read_tools, ToolRow};
 use toolconf_files::csv::Cell;
+use toolconf_model::inputs::tools_file::{read_columns, read_tools, ToolRow};
+use toolconf_model::registry::{AnyTool, ModelKind};
 
 use crate::errors::{detached, Failure};
 use crate::task::portable_spec;
@@ -82,10 +82,10 @@ fn read_plan(plan: &str) -> Result<Plan, Failure> {
 /// Every row of `tools`, at most [`MAX_TOOLS`].
 fn rows(tools: &Tools) -> Result<Vec<ToolRow>, Failure> {
     let mut rows = Vec::new();
-    let mut each = |row: Result<ToolRow, toolconf::tools_file::ToolFileError>| {
+    let mut each = |row: Result<ToolRow, toolconf_model::inputs::tools_file::ToolFileError>| {
         rows.push(row?);
         if rows.len() > MAX_TOOLS {
-            return Err(toolconf::tools_file::ToolFileError {
+            return Err(toolconf_model::inputs::tools_file::ToolFileError {
                 file: "tools".into(),
                 place: String::new(),
                 message: format!("more than {MAX_TOOLS} tools, the most one evaluation takes"),

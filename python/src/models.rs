@@ -1,8 +1,8 @@
-//! The models of the registry (`toolconf::registry`), by name.
+//! The models of the registry (`toolconf_model::registry`), by name.
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use toolconf::registry::ModelKind;
+use toolconf_model::registry::ModelKind;
 
 use crate::errors::Failure;
 
@@ -41,7 +41,7 @@ pub fn models(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
 /// ∂(term)/∂U in ``confidence``'s ``sensitivities`` (``None`` for the control's term).
 #[pyfunction]
 pub fn terms(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
-    toolconf::Term::ALL
+    toolconf_model::Term::ALL
         .into_iter()
         .map(|term| {
             let entry = PyDict::new(py);
@@ -65,7 +65,7 @@ pub fn terms(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
 #[pyfunction]
 pub fn ranges(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let out = PyDict::new(py);
-    for (name, range) in toolconf::validate::RANGES {
+    for (name, range) in toolconf_model::validate::RANGES {
         let entry = PyDict::new(py);
         entry.set_item("low", range.lo)?;
         entry.set_item("high", range.hi)?;
@@ -94,16 +94,16 @@ pub fn load_model(
     path: std::path::PathBuf,
     name: Option<String>,
 ) -> PyResult<String> {
-    py.detach(|| toolconf::loaded::load(&path, name.as_deref()))
+    py.detach(|| toolconf_model::loaded::load(&path, name.as_deref()))
         .map(|kind| kind.name().to_string())
         .map_err(|e| Failure::Input(e.to_string()).into_pyerr(py))
 }
 
 /// ``TOOLCONF_MODEL_PATH``'s entries as ``[(path, name or None), ...]``, read by the command
-/// line's rule (``toolconf::loaded::environment_entries``): what ``import toolconf`` loads.
+/// line's rule (``toolconf_model::loaded::environment_entries``): what ``import toolconf`` loads.
 #[pyfunction]
 #[pyo3(name = "_model_path_entries")]
 pub fn model_path_entries(py: Python<'_>) -> PyResult<Vec<(String, Option<String>)>> {
-    toolconf::loaded::environment_entries()
+    toolconf_model::loaded::environment_entries()
         .map_err(|e| Failure::Input(e.to_string()).into_pyerr(py))
 }

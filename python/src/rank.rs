@@ -5,7 +5,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use toolconf::rank::{simulate_all, ModelTasks};
 use toolconf::select::Objective;
-use toolconf::task_file::TaskSpec;
+use toolconf_model::inputs::task_file::TaskSpec;
 
 use crate::errors::{detached, Failure};
 use crate::task::task_spec;

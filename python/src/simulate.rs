@@ -3,10 +3,10 @@
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use toolconf::generated::{Term, TERMS};
-use toolconf::model::Metrics;
-use toolconf::registry::{AnyTool, ModelKind};
-use toolconf::task_file::TaskSpec;
+use toolconf_generated::{Term, TERMS};
+use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::model::Metrics;
+use toolconf_model::registry::{AnyTool, ModelKind};
 
 use crate::errors::{detached, Failure};
 use crate::models::model_kind;

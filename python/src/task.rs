@@ -7,10 +7,10 @@ use std::path::{Path, PathBuf};
 
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
-use toolconf::bounded_read::read_text_file;
-use toolconf::task_file::TaskSpec;
-use toolconf::TaskKind;
 use toolconf_messages::{Clip, ClipPath};
+use toolconf_model::inputs::bounded_read::read_text_file;
+use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::TaskKind;
 
 use crate::errors::Failure;
 
@@ -44,7 +44,7 @@ pub fn task_spec(
             "task = {}: expected a built-in task name ({}), a task file's path, or a dict with a \
              task file's keys",
             repr(task),
-            toolconf::task::task_choices()
+            toolconf_model::task::task_choices()
         )))
     };
     spec.map_err(|f| f.into_pyerr(py))
@@ -99,7 +99,7 @@ fn named(name: &Path, episode: Option<toml::Table>) -> Result<TaskSpec, Failure>
         return Err(Failure::Input(format!(
             "task '{}': neither a built-in task ({}) nor an existing task file",
             ClipPath(&name.to_string_lossy()),
-            toolconf::task::task_choices()
+            toolconf_model::task::task_choices()
         )));
     }
     let spec = TaskSpec::from_file(name).map_err(Failure::input)?;

@@ -10,11 +10,11 @@
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use toolconf::model::Metrics;
 use toolconf::rank::{objective_value, order_by_score, Candidate, ModelTasks, RankedTool};
-use toolconf::registry::{AnyTool, ModelKind};
 use toolconf::select::Objective;
-use toolconf::tools_file::ToolRow;
+use toolconf_model::inputs::tools_file::ToolRow;
+use toolconf_model::model::Metrics;
+use toolconf_model::registry::{AnyTool, ModelKind};
 
 use crate::errors::Failure;
 

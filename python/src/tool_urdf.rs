@@ -4,8 +4,8 @@ use std::path::PathBuf;
 
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict};
-use toolconf::registry::flange_model;
 use toolconf_messages::Clip;
+use toolconf_model::registry::flange_model;
 use toolconf_tool_urdf::{tool_from_urdf_file, Request};
 
 use crate::errors::{detached, Failure};

@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyFloat, PyInt, PyList, PyMapping, PyString};
 use toolconf::rank::ScreenError;
 use toolconf::rank::{check_screened, screen_file, screen_rows, EachRow, ModelTasks, Screen};
-use toolconf::tools_file::{read_columns, Column, MemoryCell, ToolFileError};
+use toolconf_model::inputs::tools_file::{read_columns, Column, MemoryCell, ToolFileError};
 
 use crate::errors::Failure;
 

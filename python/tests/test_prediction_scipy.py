@@ -1,4 +1,4 @@
-"""The runtime's predicted episode cost (crates/toolconf/src/prediction) recomputed with SciPy on the
+"""The runtime's predicted episode cost (crates/model/src/prediction) recomputed with SciPy on the
 same linear systems: tests/fixtures/prediction_scipy.json holds each system (M, c, z0, the terms'
 C, offset, goal and precision, the grid, ln|Pi^U|) and the runtime's prediction, and a Rust test
 (`the_scipy_fixture_is_what_the_code_gives`) keeps it the code's. Here scipy.linalg.expm steps the

@@ -2,12 +2,12 @@
 //! for a tool of any generated model.
 
 use serde_json::{json, Value};
-use toolconf::model::Arm2;
 use toolconf::rank::{Linearisation, ModelTasks};
-use toolconf::registry::ModelKind;
-use toolconf::task_file::TaskSpec;
-use toolconf::validate::finite_output;
-use toolconf::{control_confidence, Arm, Term};
+use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::model::Arm2;
+use toolconf_model::registry::ModelKind;
+use toolconf_model::validate::finite_output;
+use toolconf_model::{control_confidence, Arm, Term};
 
 use super::episode_args::TaskArgs;
 use super::output::{matrix_rows, print_matrix, CliError};
@@ -22,7 +22,7 @@ pub struct Args {
     /// A tool of any generated model instead of --arm (with --params).
     #[arg(long, value_parser = parse_model, requires = "params", help = format!(
         "A tool of any generated model instead of --arm: {} (with --params)",
-        toolconf::generated::MODEL_NAMES.join(", ")))]
+        toolconf_generated::MODEL_NAMES.join(", ")))]
     model: Option<ModelKind>,
     /// The model's parameters in its order, comma-separated (panda, ur5: tool_mass, tool_com_x,
     /// tool_com_y, tool_com_z, tool_ixx, tool_iyy, tool_izz; `toolconf select --help` lists
@@ -49,7 +49,7 @@ fn run_arm(args: &Args, arm: &Arm, spec: &TaskSpec) -> Result<(), CliError> {
     let kind = spec.kind;
     // Π^U does not depend on the goals, so a relative tip goal needs no tool here.
     let (task, _) = spec.task_and_offset::<Arm2, 2, 4, 4, 6>()?;
-    let confidence = control_confidence(arm, &task).map_err(toolconf::Error::from)?;
+    let confidence = control_confidence(arm, &task).map_err(toolconf_model::Error::from)?;
     let s = arm.sensitivities(kind);
     let a = arm.state_matrix();
     let b = arm.input_matrix();

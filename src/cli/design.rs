@@ -11,7 +11,7 @@ use toolconf::design::solver::KKT_TOLERANCE;
 use toolconf::design::sweep::{parse_sweep, run_sweep};
 use toolconf::design::{design_with_progress, DesignError, DesignResult, Setting};
 use toolconf::rank::ModelTasks;
-use toolconf::registry::ModelKind;
+use toolconf_model::registry::ModelKind;
 use toolconf_report::design::{parameters_text, write_report, ReportInput};
 
 use super::output::{check_files, CliError, RunFiles};

@@ -3,10 +3,10 @@
 
 use std::path::PathBuf;
 
-use toolconf::closed_loop::{EpisodeOptions, Plant};
-use toolconf::task_file::{PerJoint, TaskSpec};
-use toolconf::{Error, TaskKind};
 use toolconf_integrators::Method;
+use toolconf_model::closed_loop::{EpisodeOptions, Plant};
+use toolconf_model::inputs::task_file::{PerJoint, TaskSpec};
+use toolconf_model::{Error, TaskKind};
 
 use super::output::CliError;
 use super::parse_task;
@@ -15,7 +15,7 @@ use super::parse_task;
 #[derive(clap::Args, Debug, Clone)]
 pub struct TaskArgs {
     /// The task (from derive/tasks.toml).
-    #[arg(long, help = format!("The task: {}", toolconf::task::task_choices()), value_parser = parse_task, required_unless_present = "task_file", conflicts_with = "task_file")]
+    #[arg(long, help = format!("The task: {}", toolconf_model::task::task_choices()), value_parser = parse_task, required_unless_present = "task_file", conflicts_with = "task_file")]
     pub task: Option<TaskKind>,
     /// A task file (TOML: kind, [goal], [precision], [episode]; see docs/reference/file-formats.md) instead of a
     /// built-in task. Episode flags given on the command line override its [episode].
@@ -141,7 +141,7 @@ impl EpisodeArgs {
     }
 
     /// Puts the flags that were given over the task's `[episode]`, then checks every option
-    /// against its range ([`toolconf::task_file::EpisodeSpec::check`]): a refused value is named
+    /// against its range ([`toolconf_model::inputs::task_file::EpisodeSpec::check`]): a refused value is named
     /// by the flag that gave it (`--dt: 0 must be a number in [1e-6, 1e6] s`), else by the task
     /// file and key.
     pub fn apply(&self, spec: &mut TaskSpec) -> Result<(), CliError> {

@@ -11,9 +11,9 @@ use toolconf::evaluation::{
     check_population, evaluate, parse_box, planned_episodes, EvaluationError, Plan, Population,
     Setup, MAX_TOOLS,
 };
-use toolconf::registry::ModelKind;
-use toolconf::task_file::TaskSpec;
-use toolconf::tools_file::read_tools;
+use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::inputs::tools_file::read_tools;
+use toolconf_model::registry::ModelKind;
 use toolconf_report::evaluation::{write, RunInfo, FILES};
 
 use super::output::{check_files, CliError, RunFiles};
@@ -27,7 +27,7 @@ pub struct ModelArgs {
     pub model: Option<ModelKind>,
     /// With --model: a built-in task (position, velocity, acceleration, tip_position, …).
     #[arg(long, value_parser = super::parse_task, conflicts_with = "task_file")]
-    pub task: Option<toolconf::TaskKind>,
+    pub task: Option<toolconf_model::TaskKind>,
     /// With --model: a task file; its [episode] perturbation is the experiments' ΔT.
     #[arg(long)]
     pub task_file: Option<PathBuf>,
@@ -160,7 +160,7 @@ fn tools_file(path: &Path, model: ModelKind) -> Result<Population, CliError> {
     read_tools(path, |row| {
         rows.push(row?);
         if rows.len() > MAX_TOOLS {
-            return Err(toolconf::tools_file::ToolFileError {
+            return Err(toolconf_model::inputs::tools_file::ToolFileError {
                 file: source.clone(),
                 place: String::new(),
                 message: format!("more than {MAX_TOOLS} tools, the most one evaluation takes"),

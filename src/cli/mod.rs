@@ -39,8 +39,8 @@ mod tool;
 use std::process::ExitCode;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
-use toolconf::{Arm, TaskKind};
 use toolconf_messages::Clip;
+use toolconf_model::{Arm, TaskKind};
 
 /// Confidence-aware decision-making and control for tool selection.
 #[derive(Parser)]
@@ -77,18 +77,18 @@ enum Command {
 }
 
 pub(crate) fn parse_arm(s: &str) -> Result<Arm, String> {
-    toolconf::arm::parse(s).map_err(|e| e.to_string())
+    toolconf_model::arm::parse(s).map_err(|e| e.to_string())
 }
 
-pub(crate) fn parse_model(s: &str) -> Result<toolconf::registry::ModelKind, String> {
+pub(crate) fn parse_model(s: &str) -> Result<toolconf_model::registry::ModelKind, String> {
     s.parse()
 }
 
 /// A tool of `model` from `--params P1,P2,…` in the model's parameter order.
 pub(crate) fn tool_from_params(
-    model: toolconf::registry::ModelKind,
+    model: toolconf_model::registry::ModelKind,
     text: &str,
-) -> Result<toolconf::registry::AnyTool, output::CliError> {
+) -> Result<toolconf_model::registry::AnyTool, output::CliError> {
     let params = text
         .split(',')
         .map(|v| {
@@ -99,11 +99,11 @@ pub(crate) fn tool_from_params(
         })
         .collect::<Result<Vec<f64>, _>>()?;
     let params = model.with_defaults(&params).unwrap_or(params);
-    Ok(toolconf::registry::AnyTool::new(model, &params)?)
+    Ok(toolconf_model::registry::AnyTool::new(model, &params)?)
 }
 
 pub(crate) fn parse_task(s: &str) -> Result<TaskKind, String> {
-    toolconf::task::parse_task(s).map_err(|e| e.to_string())
+    toolconf_model::task::parse_task(s).map_err(|e| e.to_string())
 }
 
 pub fn run() -> ExitCode {
@@ -189,8 +189,8 @@ fn parse() -> Result<Cli, ExitCode> {
 /// (found by a scan of the arguments ahead of clap, which parses model names with the models
 /// there are), in order.
 fn load_model_libraries() -> Result<(), String> {
-    toolconf::loaded::load_environment()
-        .map_err(|e| format!("{}: {e}", toolconf::loaded::ENVIRONMENT))?;
+    toolconf_model::loaded::load_environment()
+        .map_err(|e| format!("{}: {e}", toolconf_model::loaded::ENVIRONMENT))?;
     let mut args = std::env::args_os().skip(1);
     while let Some(arg) = args.next() {
         if arg == "--" {
@@ -214,7 +214,7 @@ fn load_model_libraries() -> Result<(), String> {
                 Clip(&value.to_string_lossy())
             )
         })?;
-        toolconf::loaded::load_entry(value).map_err(|e| format!("--model-path: {e}"))?;
+        toolconf_model::loaded::load_entry(value).map_err(|e| format!("--model-path: {e}"))?;
     }
     Ok(())
 }

@@ -28,7 +28,7 @@ pub fn print_matrix<const R: usize, const C: usize>(title: &str, m: &SMatrix<f64
 pub fn add_outcome<E: std::fmt::Display, F: std::fmt::Display>(
     v: &mut Value,
     logdet: &Result<f64, E>,
-    episode: &Result<toolconf::closed_loop::Metrics, F>,
+    episode: &Result<toolconf_model::closed_loop::Metrics, F>,
 ) {
     match logdet {
         Ok(l) => v["logdet"] = Value::from(*l),
@@ -52,7 +52,7 @@ pub fn add_outcome<E: std::fmt::Display, F: std::fmt::Display>(
 #[derive(Debug, thiserror::Error)]
 pub enum CliError {
     #[error(transparent)]
-    Input(#[from] toolconf::Error),
+    Input(#[from] toolconf_model::Error),
     #[error(transparent)]
     Mpc(#[from] toolconf::mpc::MpcEpisodeError),
     #[error("cannot write {path}: {source}")]
@@ -61,11 +61,11 @@ pub enum CliError {
         source: std::io::Error,
     },
     #[error(transparent)]
-    TaskFile(#[from] toolconf::task_file::TaskFileError),
+    TaskFile(#[from] toolconf_model::inputs::task_file::TaskFileError),
     #[error(transparent)]
-    ToolsFile(#[from] toolconf::tools_file::ToolFileError),
+    ToolsFile(#[from] toolconf_model::inputs::tools_file::ToolFileError),
     #[error(transparent)]
-    Model(#[from] toolconf::model::ModelSimulationError),
+    Model(#[from] toolconf_model::model::ModelSimulationError),
     #[error(transparent)]
     Output(#[from] toolconf_report::experiments::ReproduceError),
     #[error(transparent)]
@@ -87,14 +87,14 @@ impl CliError {
             // Valid input the arithmetic cannot answer: a failed run, not bad input.
             CliError::Input(e)
             | CliError::Mpc(toolconf::mpc::MpcEpisodeError::Input(e))
-            | CliError::Model(toolconf::model::ModelSimulationError::Input(e))
+            | CliError::Model(toolconf_model::model::ModelSimulationError::Input(e))
                 if e.is_failed_run() =>
             {
                 1
             }
             CliError::Input(_)
             | CliError::Mpc(toolconf::mpc::MpcEpisodeError::Input(_))
-            | CliError::Model(toolconf::model::ModelSimulationError::Input(_))
+            | CliError::Model(toolconf_model::model::ModelSimulationError::Input(_))
             | CliError::TaskFile(_)
             | CliError::ToolsFile(_)
             | CliError::Usage(_) => 2,

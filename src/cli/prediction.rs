@@ -1,9 +1,9 @@
 //! The prediction's fields in `confidence --json` and `rank`'s JSON, CSV and table
-//! (`toolconf::prediction`): numbers, or `null` with the reason; never NaN.
+//! (`toolconf_model::prediction`): numbers, or `null` with the reason; never NaN.
 
 use serde_json::{json, Value};
-use toolconf::prediction::{Prediction, PredictionError};
 use toolconf_files::csv::Cell;
+use toolconf_model::prediction::{Prediction, PredictionError};
 
 /// The JSON fields: `predicted_task_error`, `predicted_free_energy`, `predicted_cost_j`,
 /// `predicted_perturbation_effect` (each `null` without a prediction) and `prediction_note`

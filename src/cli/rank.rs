@@ -14,12 +14,12 @@ use toolconf::rank::{
     ranking, screen_file_with_validation, simulate_all, simulate_all_timed, Candidate,
     ConfidenceTiming, ModelTasks, RankedTool, Screen, ScreenError, SimulationTiming, StageTimings,
 };
-use toolconf::registry::ModelKind;
 use toolconf::select::Objective;
-use toolconf::task_file::TaskSpec;
-use toolconf::TaskKind;
 use toolconf_files::csv::{Cell, CsvWriter};
 use toolconf_messages::Clip;
+use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::registry::ModelKind;
+use toolconf_model::TaskKind;
 use toolconf_report::progress::{self, ProgressBar};
 use toolconf_report::rank::{write_report, ReportInput};
 
@@ -32,7 +32,7 @@ pub struct Args {
     #[arg(long)]
     tools: PathBuf,
     /// The task: a built-in name or a task file.
-    #[arg(long, help = format!("The task: a built-in name ({}) or a task file", toolconf::task::task_choices()))]
+    #[arg(long, help = format!("The task: a built-in name ({}) or a task file", toolconf_model::task::task_choices()))]
     task: String,
     /// Simulate only the K most confident tools (largest ln|Pi^U|, computed without simulating).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
@@ -88,7 +88,7 @@ pub(crate) fn task_spec(task: &str) -> Result<TaskSpec, CliError> {
         return Err(CliError::Usage(format!(
             "--task {}: neither a built-in task ({}) nor an existing task file",
             Clip(task),
-            toolconf::task::task_choices()
+            toolconf_model::task::task_choices()
         )));
     }
     Ok(TaskSpec::from_file(Path::new(task))?)

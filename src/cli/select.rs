@@ -5,17 +5,17 @@
 
 use rayon::prelude::*;
 use serde_json::{json, Value};
-use toolconf::closed_loop::{EpisodeOptions, Plant};
-use toolconf::model::Arm2;
 use toolconf::rank::ModelTasks;
-use toolconf::registry::ModelKind;
 use toolconf::select::mixed::{draw_mixed_tools, evaluate_mixed, MixedObjective, MixedResult};
 use toolconf::select::{
     choose_by_mpc_cost, draw_tools, evaluate, evaluate_mpc, Objective, ToolResult,
 };
-use toolconf::task_file::TaskSpec;
-use toolconf::Task;
 use toolconf_integrators::Method;
+use toolconf_model::closed_loop::{EpisodeOptions, Plant};
+use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::model::Arm2;
+use toolconf_model::registry::ModelKind;
+use toolconf_model::Task;
 
 use super::episode_args::{two_link_options, EpisodeArgs, MethodArgs, PlantArg, TaskArgs};
 use super::output::{add_outcome, CliError};
@@ -38,7 +38,7 @@ pub struct Args {
     #[arg(long, value_delimiter = ',', default_value = "arm2", value_parser = parse_model,
           long_help = format!("Models the tools are drawn from, comma-separated: any of {}. Per tool a \
               model is drawn, then its parameters; each tool runs its own model's version of the task.",
-              toolconf::generated::MODEL_NAMES.join(", ")))]
+              toolconf_generated::MODEL_NAMES.join(", ")))]
     models: Vec<ModelKind>,
     #[command(flatten)]
     episode: EpisodeArgs,
@@ -63,7 +63,7 @@ fn tool_json(r: &ToolResult) -> Value {
 pub fn run(args: &Args) -> Result<(), CliError> {
     if args.models != [ModelKind::PAPER_ARM] {
         if args.mpc {
-            return Err(toolconf::Error::Unsupported(
+            return Err(toolconf_model::Error::Unsupported(
                 "--mpc ranks 2-link tools only (the MPC baseline is built on the 2-link model); drop --models or --mpc".into(),
             )
             .into());
@@ -231,7 +231,7 @@ fn with_flags(args: &Args, mut spec: TaskSpec) -> Result<TaskSpec, CliError> {
 fn evaluate_on_file(
     args: &Args,
     spec: TaskSpec,
-    tools: &[toolconf::registry::AnyTool],
+    tools: &[toolconf_model::registry::AnyTool],
 ) -> Result<Vec<MixedResult>, CliError> {
     if args.episode.plant != PlantArg::Paper {
         return Err(CliError::Usage(

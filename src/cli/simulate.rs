@@ -3,15 +3,15 @@
 use std::path::PathBuf;
 
 use serde_json::{json, Value};
-use toolconf::closed_loop::{Episode, Metrics, Plant};
-use toolconf::model::{episode_on, Arm2, Arm2Exact};
-use toolconf::mpc::{MpcModel, MpcOptions};
+use toolconf::mpc::{MpcModel, MpcOptions, SimulateMpc};
 use toolconf::rank::{ModelTasks, TrajectoryTable};
-use toolconf::registry::ModelKind;
-use toolconf::task_file::TaskSpec;
-use toolconf::validate::finite_output;
-use toolconf::{Arm, Task};
 use toolconf_integrators::Method;
+use toolconf_model::closed_loop::{Episode, Metrics, Plant};
+use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::model::{episode_on, Arm2, Arm2Exact};
+use toolconf_model::registry::ModelKind;
+use toolconf_model::validate::finite_output;
+use toolconf_model::{Arm, Task};
 
 use super::episode_args::{two_link_options, EpisodeArgs, PlantArg, TaskArgs};
 use super::output::{check_files, write_atomically, CliError, RunFiles};
@@ -26,7 +26,7 @@ pub struct Args {
     /// A tool of any generated model instead of --arm (with --params).
     #[arg(long, value_parser = parse_model, requires = "params", help = format!(
         "A tool of any generated model instead of --arm: {} (with --params)",
-        toolconf::generated::MODEL_NAMES.join(", ")))]
+        toolconf_generated::MODEL_NAMES.join(", ")))]
     model: Option<ModelKind>,
     /// The model's parameters in its order, comma-separated (e.g. m1,m2,l1,l2,mp for
     /// arm2_payload; `toolconf select --help` lists every model's).
@@ -90,11 +90,11 @@ pub enum MpcModelArg {
 }
 
 impl MpcArgs {
-    /// The options, each flag against its range ([`toolconf::validate`]) and all of them
+    /// The options, each flag against its range ([`toolconf_model::validate`]) and all of them
     /// against an episode of `t_end` s output every `dt` s ([`MpcOptions::check_grid`]), before
     /// any episode runs.
     pub fn options(&self, t_end: f64, dt: f64) -> Result<MpcOptions, CliError> {
-        use toolconf::validate::{MPC_HORIZON, MPC_PERIOD, OBSERVER_GAIN, TORQUE_LIMIT};
+        use toolconf_model::validate::{MPC_HORIZON, MPC_PERIOD, OBSERVER_GAIN, TORQUE_LIMIT};
         for (flag, value, range) in [
             ("--mpc-period", self.mpc_period, MPC_PERIOD),
             ("--horizon", self.horizon, MPC_HORIZON),
@@ -221,14 +221,14 @@ fn print_episode(args: &Args, mut out: Value, heading: &str, m: &Metrics) -> Res
 fn two_link_task(
     spec: &TaskSpec,
     arm: &Arm,
-    options: &toolconf::model::EpisodeOptionsN<2, 4>,
+    options: &toolconf_model::model::EpisodeOptionsN<2, 4>,
 ) -> Result<Task, CliError> {
     let (task, offset) = spec.task_and_offset::<Arm2, 2, 4, 4, 6>()?;
     let Some(offset) = offset else {
         return Ok(task);
     };
     let q0 = options.x0.fixed_rows::<2>(0).into_owned();
-    Ok(toolconf::task_file::at_initial_tip(
+    Ok(toolconf_model::inputs::task_file::at_initial_tip(
         &task, &offset, arm, &q0,
     )?)
 }

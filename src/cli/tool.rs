@@ -69,7 +69,7 @@ fn parse_joint(s: &str) -> Result<(String, f64), String> {
 }
 
 fn parse_flange_model(s: &str) -> Result<String, String> {
-    toolconf::registry::flange_model(s).map(str::to_string)
+    toolconf_model::registry::flange_model(s).map(str::to_string)
 }
 
 pub fn run(args: &Args) -> Result<(), CliError> {

@@ -211,7 +211,7 @@ fn sum<const R: usize, const C: usize>(
 /// The task-based active-inference controller of one tool for one task, U̇ = −γ ∂F/∂U
 /// (eq. U_dot_deriv), with every matrix that does not change during an episode precomputed.
 ///
-/// The runtime integrates U̇ with the plant (`toolconf::model::ClosedLoopN`); a robot calls
+/// The runtime integrates U̇ with the plant (`toolconf_model::model::ClosedLoopN`); a robot calls
 /// [`ActiveInferenceN::tick`] once per control period instead.
 #[derive(Debug, Clone, Copy)]
 pub struct ActiveInferenceN<const N: usize> {

@@ -1,6 +1,6 @@
 //! The core's error type: every bad input names the value that is wrong, without allocating
 //! (names are `&'static str`, values `f64`, numbers shown by [`Short`]). The runtime's
-//! `toolconf::Error` wraps it transparently, so the command line and the Python package print
+//! `toolconf_model::Error` wraps it transparently, so the command line and the Python package print
 //! these messages as they are.
 
 use core::fmt;

@@ -1,6 +1,6 @@
 //! The valid ranges the core checks itself: tool parameters ([`crate::ToolN::new`]), goals and
 //! precisions ([`crate::TaskN::validate`]). Why these ranges (the generated arithmetic's
-//! exponents, bounded from the IR) is in the runtime's `toolconf::validate`, which adds the
+//! exponents, bounded from the IR) is in the runtime's `toolconf_model::validate`, which adds the
 //! ranges of the episode, integrator, MPC and design options and re-exports these.
 
 use core::f64::consts::PI;
@@ -85,7 +85,7 @@ impl fmt::Display for Range {
     }
 }
 
-/// Every tool parameter, in its SI unit (kg, m, N/m, N s/m): see the runtime's `toolconf::validate` for why.
+/// Every tool parameter, in its SI unit (kg, m, N/m, N s/m): see the runtime's `toolconf_model::validate` for why.
 pub const TOOL_PARAMETER: Range = Range::closed(1e-6, 1e6, "");
 /// Each entry of a precision matrix (a precision is also symmetric positive semi-definite).
 pub const PRECISION_ENTRY: Range = Range::closed(-1e6, 1e6, "");
@@ -93,7 +93,7 @@ pub const PRECISION_ENTRY: Range = Range::closed(-1e6, 1e6, "");
 /// (the runtime's `DIVERGENCE_BOUND`).
 pub const STATE_BOUND: f64 = 1e6;
 /// Torques, the initial torque U0 and the perturbation ΔT: the divergence bound, over which
-/// the generated arithmetic is shown to stay finite (the runtime's `toolconf::validate`).
+/// the generated arithmetic is shown to stay finite (the runtime's `toolconf_model::validate`).
 pub const TORQUE: Range = Range::closed(-STATE_BOUND, STATE_BOUND, "N m");
 /// The controller's learning rate γ.
 pub const LEARNING_RATE: Range = Range::above(0.0, 1e6, "");

@@ -128,7 +128,7 @@ pub enum IntegrationError {
         h: f64,
         state: Vec<f64>,
     },
-    /// An episode's work budget (the runtime's `toolconf::model::budget`) ran out: the integrator's
+    /// An episode's work budget (the runtime's `toolconf_model::model::budget`) ran out: the integrator's
     /// [`IntegrationError::TooManySteps`] at the episode's own limit, with the episode's
     /// reading of why (the state or the step size there).
     #[error("episode stopped after {attempts} step attempts at t = {t:.3e} s: {why}")]

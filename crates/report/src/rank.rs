@@ -9,12 +9,12 @@ use crate::experiments::figure_parts::wants_log;
 use crate::experiments::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use crate::experiments::report::{to_html, to_markdown, Block};
 use crate::experiments::{write_atomically, ReproduceError};
-use toolconf::generated::Read;
 use toolconf::rank::{score, ModelTasks, RankedTool, StageTimings, TaskTrace};
-use toolconf::registry::{ModelKind, AXES};
 use toolconf::select::Objective;
-use toolconf::task_file::{PerJoint, PrecisionSpec, TaskSpec};
-use toolconf::{TaskKind, Term};
+use toolconf_generated::Read;
+use toolconf_model::inputs::task_file::{PerJoint, PrecisionSpec, TaskSpec};
+use toolconf_model::registry::{ModelKind, AXES};
+use toolconf_model::{TaskKind, Term};
 use toolconf_stats::spearman;
 
 /// What the report describes.
@@ -249,7 +249,7 @@ fn task_table(input: &ReportInput) -> Vec<Block> {
             .terms()
             .iter()
             .any(|t| matches!(t.read(), Read::Tip { .. }));
-    let default_precision = |term: Term| match toolconf::robot_scales::default_words(term) {
+    let default_precision = |term: Term| match toolconf_model::robot_scales::default_words(term) {
         Some(words) if scaled => {
             format!("on a URDF arm {words} (the robot's own scale), else {paper}")
         }
@@ -260,8 +260,13 @@ fn task_table(input: &ReportInput) -> Vec<Block> {
         if term.has_goal() {
             let name = format!("goal {} [{}]", term.symbol(), term.unit());
             let value = match (&spec.tip_goal, term) {
-                (toolconf::task_file::TipGoal::Offset(_), Term::Tip) => spec.tip_goal.describe(),
-                (toolconf::task_file::TipGoal::Motion { .. }, Term::TipDot | Term::TipDdot) => {
+                (toolconf_model::inputs::task_file::TipGoal::Offset(_), Term::Tip) => {
+                    spec.tip_goal.describe()
+                }
+                (
+                    toolconf_model::inputs::task_file::TipGoal::Motion { .. },
+                    Term::TipDot | Term::TipDdot,
+                ) => {
                     format!(
                         "{} ({})",
                         given(vector(&spec.goal[i]), paper),

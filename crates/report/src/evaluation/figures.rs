@@ -5,7 +5,7 @@ use std::path::Path;
 
 use toolconf::evaluation::trials::{MEASURES, RULES};
 use toolconf::evaluation::{Evaluation, HighlightRun, ToolRecord};
-use toolconf::registry::AXES;
+use toolconf_model::registry::AXES;
 use toolconf_stats::summary;
 
 use crate::experiments::plot::{
@@ -165,7 +165,7 @@ fn tip_paths(runs: &[&HighlightRun], e: &Evaluation, series: &SeriesOf) -> Vec<P
     let Some(dims) = paths.iter().map(|p| p.1.len()).min() else {
         return Vec::new();
     };
-    let point_goal = e.setup.spec.kind == toolconf::TaskKind::TipPosition;
+    let point_goal = e.setup.spec.kind == toolconf_model::TaskKind::TipPosition;
     let projections: &[(usize, usize, &str)] = if dims >= 3 {
         &[
             (0, 1, "the tip seen from above (x–y)"),

@@ -5,9 +5,9 @@
 use indicatif::ProgressBar;
 use rayon::prelude::*;
 
-use toolconf::closed_loop::{EpisodeOptions, Metrics, Plant};
-use toolconf::confidence::control_confidence;
-use toolconf::{Arm, Task};
+use toolconf_model::closed_loop::{EpisodeOptions, Metrics, Plant};
+use toolconf_model::confidence::control_confidence;
+use toolconf_model::{Arm, Task};
 
 /// Maps `f` over `items` in parallel; `sink` sees every result in input order as soon as its
 /// chunk is done. The chunk size (4 per thread, at least 8) affects only when rows are written,
@@ -158,7 +158,7 @@ mod tests {
     #[test]
     fn a_failed_episode_is_data_not_an_abort() {
         let arm = Arm::new([0.3, 0.4, 0.5, 0.2]).unwrap();
-        let task = Task::paper(toolconf::TaskKind::Position);
+        let task = Task::paper(toolconf_model::TaskKind::Position);
         let bad = EpisodeOptions {
             t_end: -1.0,
             ..EpisodeOptions::default()

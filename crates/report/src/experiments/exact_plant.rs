@@ -9,7 +9,7 @@
 
 use super::report::{Block, Section};
 use super::{Context, Experiment, Plan, ReproduceError};
-use toolconf::closed_loop::Plant;
+use toolconf_model::closed_loop::Plant;
 
 /// The prefix of the wrapped experiments' files.
 pub const FILE_PREFIX: &str = "exact_plant_";

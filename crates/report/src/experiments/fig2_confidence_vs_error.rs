@@ -5,7 +5,7 @@
 //! from `"fig2/bootstrap/<task>"`.
 
 use toolconf::select::draw_tools;
-use toolconf::{Task, TaskKind};
+use toolconf_model::{Task, TaskKind};
 use toolconf_stats::{fit_exponential, summary};
 
 use super::batch::{map_ordered, run_tool, ToolRuns};
@@ -133,7 +133,7 @@ const TABLE_HEADER: [&str; 9] = [
 /// episodes finish, results in (task, tool) order.
 fn simulate_every_task(
     ctx: &Context,
-    tools: &[toolconf::Arm],
+    tools: &[toolconf_model::Arm],
 ) -> Result<Vec<(TaskKind, usize, ToolRuns)>, ReproduceError> {
     let items: Vec<(TaskKind, usize)> = PAPER_TASKS
         .iter()

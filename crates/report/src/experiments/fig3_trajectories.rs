@@ -4,10 +4,10 @@
 //! Seed: the sample from `"fig3/tools"`. Confidence needs no simulation, so only the two chosen
 //! tools are simulated (four episodes, trajectories recorded).
 
-use toolconf::closed_loop::{Metrics, Trajectory};
-use toolconf::confidence::control_confidence;
 use toolconf::select::draw_tools;
-use toolconf::{Arm, Task, TaskKind, Term};
+use toolconf_model::closed_loop::{Metrics, Trajectory};
+use toolconf_model::confidence::control_confidence;
+use toolconf_model::{Arm, Task, TaskKind, Term};
 
 use super::batch::map_ordered;
 use super::figure_parts::{arm_cells, dt_label, ARM_COLUMNS};
@@ -503,7 +503,7 @@ mod tests {
 
     #[test]
     fn settling_time_is_when_the_band_is_entered_for_good() {
-        let theta = |v: f64| toolconf::Vector2::new(0.0, v);
+        let theta = |v: f64| toolconf_model::Vector2::new(0.0, v);
         let mut tr = Trajectory {
             t: vec![0.0, 1.0, 2.0, 3.0],
             ..Trajectory::default()

@@ -5,7 +5,7 @@
 //! `"fig4/bootstrap/<task>"`.
 
 use toolconf::select::draw_tools;
-use toolconf::{Arm, Task, TaskKind};
+use toolconf_model::{Arm, Task, TaskKind};
 
 use super::batch::{map_ordered, run_tool, ToolRuns};
 use super::figure_parts::{arm_cells, dt_label, files_block, task_label, wants_log};

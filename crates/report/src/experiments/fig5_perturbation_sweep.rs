@@ -5,7 +5,7 @@
 //! Seeds: tools from `"fig5/tools"`, bootstrap from `"fig5/bootstrap/<ΔT>"`.
 
 use toolconf::select::draw_tools;
-use toolconf::{Task, TaskKind};
+use toolconf_model::{Task, TaskKind};
 use toolconf_stats::summary;
 
 use super::batch::{map_ordered, run_tool, ToolRuns};
@@ -144,7 +144,7 @@ const SIGN_HEADER: [&str; 5] = [
 /// reference ΔT = 0 included) as each tool finishes. Returns the runs and the rows per tool.
 fn simulate_sweep(
     ctx: &Context,
-    tools: &[toolconf::Arm],
+    tools: &[toolconf_model::Arm],
     sweep: &[f64],
 ) -> Result<(Vec<ToolRuns>, usize), ReproduceError> {
     let task = Task::paper(TaskKind::Velocity);

@@ -6,7 +6,7 @@
 //! verdict contrast the first two (F and J), as the paper does.
 
 use toolconf::select::{draw_tools, evaluate, ToolResult};
-use toolconf::{Arm, Task, TaskKind};
+use toolconf_model::{Arm, Task, TaskKind};
 
 use super::batch::map_ordered;
 use super::figure_parts::{arm_cells, files_block, ARM_COLUMNS};

@@ -6,7 +6,7 @@
 //! Seeds: trial k draws its tools from `"fig7/trial/<k>"`.
 
 use toolconf::select::{draw_tools, evaluate, ToolResult};
-use toolconf::{Arm, Task, TaskKind};
+use toolconf_model::{Arm, Task, TaskKind};
 use toolconf_stats::summary;
 
 use super::batch::map_ordered;

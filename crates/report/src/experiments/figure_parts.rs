@@ -1,6 +1,6 @@
 //! Small pieces the figure modules share: labels, tool columns, axis choices.
 
-use toolconf::{Arm, TaskKind};
+use toolconf_model::{Arm, TaskKind};
 
 use super::report::Block;
 use toolconf_files::csv::Cell;

@@ -47,7 +47,7 @@ use std::time::{Duration, Instant};
 use indicatif::ProgressBar;
 
 pub use report::{Block, Outcome, Section, Verdict};
-use toolconf::closed_loop::{EpisodeOptions, Plant};
+use toolconf_model::closed_loop::{EpisodeOptions, Plant};
 
 /// How many tools, trials and resamples each experiment uses.
 #[derive(Debug, Clone, PartialEq)]

@@ -8,9 +8,9 @@
 
 use std::time::{Duration, Instant};
 
-use toolconf::mpc::MpcOptions;
+use toolconf::mpc::{MpcOptions, SimulateMpc};
 use toolconf::select::draw_tools;
-use toolconf::{Arm, Task, TaskKind};
+use toolconf_model::{Arm, Task, TaskKind};
 use toolconf_stats::summary;
 
 use super::batch::map_ordered;
@@ -166,7 +166,7 @@ fn run_both_controllers(ctx: &Context, tools: &[Arm]) -> Result<Vec<Item>, Repro
                 kind,
                 tool: i,
                 arm,
-                logdet: toolconf::confidence::control_confidence(&arm, &task)
+                logdet: toolconf_model::confidence::control_confidence(&arm, &task)
                     .ok()
                     .map(|c| c.logdet),
                 runs: [

@@ -9,10 +9,10 @@
 
 use plotters::style::RGBColor;
 
-use toolconf::closed_loop::{EpisodeOptions, Plant};
-use toolconf::mpc::MpcOptions;
+use toolconf::mpc::{MpcOptions, SimulateMpc};
 use toolconf::select::{Objective, ToolResult};
-use toolconf::{Arm, Task};
+use toolconf_model::closed_loop::{EpisodeOptions, Plant};
+use toolconf_model::{Arm, Task};
 
 /// One trial of a selection experiment, as the rules see it.
 pub struct Trial<'a> {

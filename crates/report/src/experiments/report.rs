@@ -8,7 +8,7 @@ use std::fmt::Write as _;
 use std::time::Duration;
 
 use super::{Plan, Timing};
-use toolconf::closed_loop::EpisodeOptions;
+use toolconf_model::closed_loop::EpisodeOptions;
 
 /// A verdict on a claim.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

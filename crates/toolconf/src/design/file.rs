@@ -27,9 +27,9 @@ use serde::Deserialize;
 
 use super::constraint::{parse_constraint, LinearConstraint};
 use super::DesignError;
-use crate::generated::validity::ParameterDomain;
-use crate::registry::ModelKind;
+use toolconf_generated::validity::ParameterDomain;
 use toolconf_messages::{Clip, ClipMessage, ClipPath, ShortList};
+use toolconf_model::registry::ModelKind;
 
 /// What the design optimises.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -118,7 +118,7 @@ impl DesignSpec {
     /// Reads and checks a design file for a tool of `model`.
     pub fn from_file(path: &Path, model: ModelKind) -> Result<Self, DesignError> {
         let file = ClipPath(&path.to_string_lossy()).to_string();
-        let text = crate::bounded_read::read_text_file(path, "design file")
+        let text = toolconf_model::inputs::bounded_read::read_text_file(path, "design file")
             .map_err(|message| DesignError::input(&file, "", message))?;
         Self::parse(&text, &file, model)
     }
@@ -169,7 +169,7 @@ impl DesignSpec {
         let mut fixed = vec![None; names.len()];
         for (name, &value) in &raw.fixed {
             let k = known(format!("fixed.{name}"), name)?;
-            if let Err(why) = crate::validate::tool_parameter(&domains[k], value) {
+            if let Err(why) = toolconf_model::validate::tool_parameter(&domains[k], value) {
                 return Err(err(&format!("fixed.{name}"), why));
             }
             fixed[k] = Some(value);
@@ -267,7 +267,7 @@ fn check_bounds(range: &[f64], domain: &ParameterDomain) -> Result<(f64, f64), S
     };
     let shown = ShortList(range);
     if domain.is_positive() {
-        let valid = crate::validate::TOOL_PARAMETER;
+        let valid = toolconf_model::validate::TOOL_PARAMETER;
         if lo <= 0.0 {
             return Err(format!(
                 "{shown} admits values <= 0; masses and lengths must be > 0 (give lo > 0)"
@@ -312,7 +312,7 @@ fn search_settings(raw: &RawSearch) -> Result<SearchSettings, (&'static str, Str
     if s.simulate > 1000 {
         return Err(("simulate", format!("{} is more than 1000", s.simulate)));
     }
-    crate::validate::TORQUE
+    toolconf_model::validate::TORQUE
         .check(s.perturbation)
         .map_err(|m| ("perturbation", m))?;
     Ok(s)

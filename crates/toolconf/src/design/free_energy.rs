@@ -9,7 +9,7 @@
 
 use rayon::prelude::*;
 
-use crate::registry::AnyTool;
+use toolconf_model::registry::AnyTool;
 
 use super::polytope::Polytope;
 use super::{DesignError, Setting};

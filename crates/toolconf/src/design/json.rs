@@ -7,7 +7,7 @@ use super::file::DesignSpec;
 use super::polytope::Polytope;
 use super::sweep::SweepPoint;
 use super::DesignResult;
-use crate::registry::ModelKind;
+use toolconf_model::registry::ModelKind;
 
 /// The design `r` of `model` on the task named `task` (as the user gave it), with the sweep's
 /// front if there was one. Keys: `objective`, `params` (by name), `logdet`,

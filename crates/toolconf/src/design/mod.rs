@@ -23,8 +23,8 @@ pub mod sweep;
 pub mod verify;
 
 use crate::rank::ModelTasks;
-use crate::registry::{AnyTool, ModelKind};
-use crate::task_file::TaskSpec;
+use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::registry::{AnyTool, ModelKind};
 
 use file::{DesignObjective, DesignSpec};
 use polytope::{FeasibleSampler, Polytope, Spread};
@@ -247,11 +247,11 @@ pub fn parameters_text(names: &[&str], params: &[f64]) -> String {
 }
 
 impl DesignResult {
-    /// Every number the design reports finite ([`crate::validate::finite_output`]), for the
+    /// Every number the design reports finite ([`toolconf_model::validate::finite_output`]), for the
     /// command line and the Python package alike.
-    pub fn check_finite(&self, names: &[&str]) -> Result<(), crate::Error> {
+    pub fn check_finite(&self, names: &[&str]) -> Result<(), toolconf_model::Error> {
         let o = &self.confidence_optimum;
-        crate::validate::finite_output(
+        toolconf_model::validate::finite_output(
             &format!("the design {}", parameters_text(names, &self.params)),
             "ln|Π^U|, the KKT residual or the gradient check",
             [self.logdet, o.value, o.kkt_residual, self.gradient_check],

@@ -5,8 +5,8 @@
 use rayon::prelude::*;
 
 use crate::rank::ModelTasks;
-use crate::registry::{AnyTool, ModelKind};
-use crate::task_file::{PerJoint, TaskSpec};
+use toolconf_model::inputs::task_file::{PerJoint, TaskSpec};
+use toolconf_model::registry::{AnyTool, ModelKind};
 
 use super::polytope::{FeasibleSampler, Polytope};
 
@@ -211,8 +211,8 @@ fn simulate(
 mod tests {
     use super::*;
     use crate::design::file::DesignSpec;
-    use crate::task_file::TaskSpec;
-    use crate::TaskKind;
+    use toolconf_model::inputs::task_file::TaskSpec;
+    use toolconf_model::TaskKind;
 
     /// A feasible set of about 10⁻¹⁴ of its box: the draws stop at their budget, with what
     /// they found, and progress heard of them every 2¹⁶ draws.

@@ -218,7 +218,7 @@ pub const BARELY_MOVED: f64 = 0.1;
 
 /// On a position task (joint or tip), when every tool's progress 1 − e(T)/e(0) is below
 /// [`BARELY_MOVED`]: the sentence saying so and which precision to raise.
-pub fn barely_moved(kind: crate::TaskKind, progress: &[f64]) -> Option<String> {
+pub fn barely_moved(kind: toolconf_model::TaskKind, progress: &[f64]) -> Option<String> {
     let largest = progress.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     if progress.is_empty() || largest >= BARELY_MOVED {
         return None;

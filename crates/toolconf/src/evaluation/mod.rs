@@ -19,7 +19,7 @@
 //!
 //! The task file's `[episode] perturbation`, one value for every joint or one per joint; else
 //! −10 % of each joint's rated torque on a URDF arm, the paper's −0.8 N m otherwise
-//! ([`crate::robot_scales::default_perturbation`]). The unperturbed runs use ΔT = 0 whatever the
+//! ([`toolconf_model::robot_scales::default_perturbation`]). The unperturbed runs use ΔT = 0 whatever the
 //! file says.
 //!
 //! # Seeds
@@ -57,7 +57,7 @@ pub use verdict::{Claim, ClaimVerdict, Finding};
 
 use serde_json::{json, Value};
 
-use crate::generated::Read;
+use toolconf_generated::Read;
 
 /// Why an evaluation gave no result.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -178,7 +178,7 @@ impl Evaluation {
         match term.read() {
             Read::Tip { .. } => {
                 let d = self.setup.model.info().tip_dim;
-                crate::registry::AXES[..d.min(3)]
+                toolconf_model::registry::AXES[..d.min(3)]
                     .iter()
                     .map(|a| format!("{}_{a}", term.name()))
                     .collect()

@@ -11,9 +11,9 @@
 use rand::{RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::registry::{AnyTool, ModelKind};
-use crate::tools_file::ToolRow;
 use toolconf_messages::{Clip, Short};
+use toolconf_model::inputs::tools_file::ToolRow;
+use toolconf_model::registry::{AnyTool, ModelKind};
 
 /// Draws of one tool before a box is called empty of valid tools.
 const MAX_REDRAWS: usize = 10_000;

@@ -8,8 +8,8 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::model::Metrics;
-use crate::registry::AnyTool;
+use toolconf_model::model::Metrics;
+use toolconf_model::registry::AnyTool;
 
 use super::Setup;
 

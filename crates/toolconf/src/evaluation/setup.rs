@@ -2,9 +2,9 @@
 //! the task's ΔT (Figs. 3, 4, 7) and at every level of the sweep (Fig. 5).
 
 use crate::rank::ModelTasks;
-use crate::registry::ModelKind;
-use crate::robot_scales::{default_perturbation, Perturbation};
-use crate::task_file::{PerJoint, TaskSpec};
+use toolconf_model::inputs::task_file::{PerJoint, TaskSpec};
+use toolconf_model::registry::ModelKind;
+use toolconf_model::robot_scales::{default_perturbation, Perturbation};
 
 use super::{EvaluationError, Plan};
 

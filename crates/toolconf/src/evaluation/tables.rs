@@ -6,7 +6,7 @@ use toolconf_files::csv::Cell;
 use super::records::{Run, ToolRecord};
 use super::trials::{Trial, MEASURES, RULES};
 use super::Evaluation;
-use crate::registry::AXES;
+use toolconf_model::registry::AXES;
 
 /// A table: its file's name (without `.csv`), header and rows.
 #[derive(Debug, Clone, PartialEq)]

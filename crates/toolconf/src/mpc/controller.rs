@@ -10,7 +10,7 @@ use nalgebra::{SMatrix, SVector};
 use super::discretise::{discretise, Discretised};
 use super::options::{MpcError, MpcModel, MpcOptions, SolveInfo};
 use super::qp::{QpSolver, StageCost};
-use crate::model::{Arm2, ArmModel, TaskN, ToolN};
+use toolconf_model::model::{Arm2, ArmModel, TaskN, ToolN};
 
 /// A continuous affine model ẋ = a x + b u + c.
 #[derive(Debug, Clone, Copy, PartialEq)]

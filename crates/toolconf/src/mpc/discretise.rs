@@ -40,8 +40,8 @@ pub fn discretise<const N: usize, const M: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{Arm2, ArmModel};
-    use crate::Arm;
+    use toolconf_model::model::{Arm2, ArmModel};
+    use toolconf_model::Arm;
 
     #[test]
     fn double_integrator_matches_closed_form() {

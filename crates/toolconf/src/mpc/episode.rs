@@ -3,7 +3,7 @@
 //! Ẋ = f(X, U + ΔT) is integrated; metrics are those of the active-inference episode.
 //!
 //! [`simulate_mpc_on`] is the implementation for any [`ArmModel`]; [`simulate_mpc`] and
-//! [`Plant::simulate_mpc`] run it for the paper's arm on the plant chosen at run time, the errors
+//! [`SimulateMpc::simulate_mpc`] run it for the paper's arm on the plant chosen at run time, the errors
 //! naming `arm m1=…`.
 
 use std::time::Duration;
@@ -11,13 +11,13 @@ use std::time::Duration;
 use nalgebra::SVector;
 
 use super::{MpcError, MpcN, MpcOptions};
-use crate::closed_loop::{EpisodeOptions, Plant};
-use crate::model::budget::{diagnosis, episode_budget};
-use crate::model::{
+use toolconf_integrators::{solve_grid, IntegrationError};
+use toolconf_model::closed_loop::{EpisodeOptions, Plant};
+use toolconf_model::model::budget::{diagnosis, episode_budget};
+use toolconf_model::model::{
     ActiveInferenceN, Arm2, Arm2Exact, ArmModel, EpisodeOptionsN, TaskN, ToolN, TrajectoryN,
 };
-use crate::{Arm, Error, Task};
-use toolconf_integrators::{solve_grid, IntegrationError};
+use toolconf_model::{Arm, Error, Task};
 
 /// What an MPC episode measures: the active-inference episode's metrics where they apply.
 #[derive(Debug, Clone, PartialEq)]
@@ -119,7 +119,7 @@ impl MpcSimulationError {
 }
 
 /// Runs the MPC baseline for one episode of the paper's 2-DOF arm on the paper's plant
-/// ([`Plant::simulate_mpc`]).
+/// ([`SimulateMpc::simulate_mpc`]).
 pub fn simulate_mpc(
     arm: &Arm,
     task: &Task,
@@ -129,12 +129,24 @@ pub fn simulate_mpc(
     Plant::Paper.simulate_mpc(arm, task, options, mpc_options)
 }
 
-impl Plant {
+/// The MPC baseline on a [`Plant`] chosen at run time (the plant is the model layer's; the MPC
+/// is this crate's, hence a trait).
+pub trait SimulateMpc {
     /// The MPC baseline for one episode of the paper's 2-DOF arm on this plant (matched once
     /// here), with the same options (horizon, grid, initial state, perturbation, integrator) as
     /// the active-inference episode. The output grid spacing must be a whole number of control
     /// periods. The paper's U0 is not used: the MPC chooses U at t = 0.
-    pub fn simulate_mpc(
+    fn simulate_mpc(
+        self,
+        arm: &Arm,
+        task: &Task,
+        options: &EpisodeOptions,
+        mpc_options: &MpcOptions,
+    ) -> Result<MpcEpisode, MpcEpisodeError>;
+}
+
+impl SimulateMpc for Plant {
+    fn simulate_mpc(
         self,
         arm: &Arm,
         task: &Task,
@@ -151,7 +163,7 @@ impl Plant {
 
 /// The MPC episode of `tool` (prediction model `M`) on `task`, simulated on plant model `P`
 /// (`P = M` normally), with the same options as the active-inference episode
-/// ([`crate::model::episode_on`]); as [`simulate_mpc`], U0 is not used.
+/// ([`toolconf_model::model::episode_on`]); as [`simulate_mpc`], U0 is not used.
 pub fn simulate_mpc_on<M, P, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
     tool: &ToolN<M, N, NX, NP, NZ>,
     task: &TaskN<N>,
@@ -187,7 +199,7 @@ where
     // The QP log holds one entry per control period: refuse horizons too long to keep.
     for step in [options.dt, mpc_options.period] {
         if step > 0.0 {
-            crate::model::closed_loop_n::check_grid(options.t_end, step)?;
+            toolconf_model::model::check_grid(options.t_end, step)?;
         }
     }
     let period = mpc_options.period;

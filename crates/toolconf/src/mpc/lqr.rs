@@ -5,7 +5,7 @@ use nalgebra::{SMatrix, SVector};
 
 use super::discretise::Discretised;
 use super::qp::StageCost;
-use crate::{State, Vector2};
+use toolconf_model::{State, Vector2};
 
 /// The optimal open-loop controls u_0..u_{N−1} from x0 for the same problem the QP poses:
 /// stage cost ½wᵀHw + hᵀw over w = [x; u] (cross terms included), affine dynamics

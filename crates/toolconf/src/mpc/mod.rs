@@ -2,9 +2,9 @@
 //! a linear(ised) arm model, solved as a sparse QP with Clarabel.
 //!
 //! The controller ([`MpcN`]) and its episode ([`simulate_mpc_on`]) are generic over the arm
-//! model ([`crate::model::ArmModel`]), like the active-inference runtime; [`Mpc`] is the
+//! model ([`toolconf_model::model::ArmModel`]), like the active-inference runtime; [`Mpc`] is the
 //! controller of the paper's arm, and [`simulate_mpc`] (the paper's plant) and
-//! [`crate::closed_loop::Plant::simulate_mpc`] run its episode, the tool named `arm m1=…`.
+//! [`toolconf_model::closed_loop::Plant::simulate_mpc`] run its episode, the tool named `arm m1=…`.
 //! The sizes quoted below (6×6 stage blocks, four x_0 rows, the 7×7 exponential) are the 2-link
 //! arm's; for an arm with n joints (state 2n) they are 3n×3n, 2n and 3n + 1.
 //!
@@ -172,15 +172,15 @@ pub use controller::{Mpc, MpcN};
 pub use discretise::{discretise, Discretised};
 pub use episode::{
     simulate_mpc, simulate_mpc_on, MpcEpisode, MpcEpisodeError, MpcEpisodeN, MpcMetrics,
-    MpcMetricsN, MpcSimulationError,
+    MpcMetricsN, MpcSimulationError, SimulateMpc,
 };
 pub use options::{MpcError, MpcModel, MpcOptions, SolveInfo};
 
 /// The tasks the MPC baseline takes: the joint-space ones. It minimises J over the linearised
 /// joint state, which does not hold the tool's tip (a task that reads the tip,
 /// [`toolconf_core::reads_tip`], is refused with a message).
-pub fn tasks() -> impl Iterator<Item = crate::TaskKind> {
-    crate::TaskKind::ALL
+pub fn tasks() -> impl Iterator<Item = toolconf_model::TaskKind> {
+    toolconf_model::TaskKind::ALL
         .into_iter()
         .filter(|k| !toolconf_core::reads_tip(*k))
 }

@@ -16,11 +16,11 @@ use clarabel::solver::{
 use nalgebra::{SMatrix, SVector};
 
 use super::discretise::Discretised;
-use crate::generated::{Read, Term};
-use crate::model::TaskN;
+use toolconf_generated::{Read, Term};
+use toolconf_model::model::TaskN;
 // The 2-link names the unit tests below use (through `use super::*`).
 #[cfg(test)]
-use crate::{State, Task, Vector2};
+use toolconf_model::{State, Task, Vector2};
 
 /// The paper's J per stage, times the period, as a quadratic in w = [x; u]:
 /// ½wᵀ hessian w + linearᵀw (+ a constant that does not move the optimum).
@@ -98,8 +98,8 @@ impl<const N: usize, const NX: usize, const NZ: usize> StageCost<N, NX, NZ> {
 impl StageCost {
     /// [`StageCost::of`] for the 2-link arm and its [`Task`].
     pub fn new(
-        a: &crate::StateMatrix,
-        b: &crate::InputMatrix,
+        a: &toolconf_model::StateMatrix,
+        b: &toolconf_model::InputMatrix,
         c: &State,
         task: &Task,
         period: f64,
@@ -425,15 +425,15 @@ fn write_q<const N: usize, const NX: usize, const NZ: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{Arm2, ArmModel};
-    use crate::Arm;
+    use toolconf_model::model::{Arm2, ArmModel};
+    use toolconf_model::Arm;
 
     /// The paper's J times the period, evaluated directly.
     fn direct_cost(arm: &Arm, task: &Task, x: &State, u: &Vector2, period: f64) -> f64 {
         let accel = (arm.state_matrix() * (x - Arm2::equilibrium_state()) + arm.input_matrix() * u)
             .fixed_rows::<2>(2)
             .into_owned();
-        let quad = |e: Vector2, p: &crate::Matrix2| (e.transpose() * p * e)[0];
+        let quad = |e: Vector2, p: &toolconf_model::Matrix2| (e.transpose() * p * e)[0];
         0.5 * period
             * (quad(
                 x.fixed_rows::<2>(0) - task.goal(Term::Theta),
@@ -464,7 +464,7 @@ mod tests {
             StageCost::new(&a, &b, &c, task, t),
         );
         let (x, u) = (State::new(1.0, 0.5, 0.3, 2.0), Vector2::new(1.0, -0.5));
-        let (a, b) = crate::generated::arm2::dynamics_jacobian(&x, &u, &arm.params());
+        let (a, b) = toolconf_generated::arm2::dynamics_jacobian(&x, &u, &arm.params());
         let c = arm.dynamics(&x, &u) - a * x - b * u + b * Vector2::new(0.2, -0.1);
         let local = (
             crate::mpc::discretise(&a, &b, &c, t),

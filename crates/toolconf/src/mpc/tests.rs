@@ -3,9 +3,9 @@
 
 use super::qp::StageCost;
 use super::*;
-use crate::generated::arm2;
-use crate::model::{Arm2, ArmModel};
-use crate::{Arm, State, Task, TaskKind, Vector2};
+use toolconf_generated::arm2;
+use toolconf_model::model::{Arm2, ArmModel};
+use toolconf_model::{Arm, State, Task, TaskKind, Vector2};
 
 fn arms() -> [Arm; 3] {
     [

@@ -24,11 +24,11 @@ use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
-use crate::model::{Metrics, ModelSimulationError};
-use crate::prediction::{Prediction, PredictionError};
 use crate::select::Objective;
-use crate::tools_file::ToolRow;
-use crate::Error;
+use toolconf_model::inputs::tools_file::ToolRow;
+use toolconf_model::model::{Metrics, ModelSimulationError};
+use toolconf_model::prediction::{Prediction, PredictionError};
+use toolconf_model::Error;
 
 /// A simulated tool.
 #[derive(Debug, Clone, PartialEq)]
@@ -36,7 +36,7 @@ pub struct RankedTool {
     pub row: ToolRow,
     pub logdet: Result<f64, Error>,
     pub episode: Result<Metrics, ModelSimulationError>,
-    /// The episode's cost predicted by the linearised closed loop ([`crate::prediction`]).
+    /// The episode's cost predicted by the linearised closed loop ([`toolconf_model::prediction`]).
     pub prediction: Result<Prediction, PredictionError>,
 }
 

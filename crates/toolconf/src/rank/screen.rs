@@ -6,8 +6,8 @@ use std::collections::BinaryHeap;
 use std::path::Path;
 
 use super::ModelTasks;
-use crate::tools_file::{read_tools, ToolFileError, ToolRow};
-use crate::Error;
+use toolconf_model::inputs::tools_file::{read_tools, ToolFileError, ToolRow};
+use toolconf_model::Error;
 
 /// A tool that passed the cheap stage, with its confidence.
 #[derive(Debug, Clone, PartialEq)]
@@ -253,7 +253,7 @@ pub fn screen_file(
 }
 
 /// Where a reader of tools hands each row ([`read_tools`]'s and
-/// [`read_columns`](crate::tools_file::read_columns)'s callback); an `Err` it returns stops the
+/// [`read_columns`](toolconf_model::inputs::tools_file::read_columns)'s callback); an `Err` it returns stops the
 /// read.
 pub type EachRow<'a> = dyn FnMut(Result<ToolRow, ToolFileError>) -> Result<(), ToolFileError> + 'a;
 
@@ -373,7 +373,7 @@ pub fn check_screened(
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
-    use crate::registry::{AnyTool, ModelKind};
+    use toolconf_model::registry::{AnyTool, ModelKind};
 
     pub(in crate::rank) fn candidate(row: usize, logdet: Result<f64, Error>) -> Candidate {
         Candidate {

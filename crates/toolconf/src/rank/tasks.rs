@@ -4,13 +4,13 @@
 
 use std::sync::Arc;
 
-use crate::model::{Metrics, ModelSimulationError};
-use crate::prediction::{LinearSystem, Prediction, PredictionError};
-use crate::registry::{models, AnyTool, BoundTask, ModelKind};
-use crate::task_file::{TaskFileError, TaskSpec};
-use crate::{Error, TaskKind};
+use toolconf_model::inputs::task_file::{TaskFileError, TaskSpec};
+use toolconf_model::model::{Metrics, ModelSimulationError};
+use toolconf_model::prediction::{LinearSystem, Prediction, PredictionError};
+use toolconf_model::registry::{models, AnyTool, BoundTask, ModelKind};
+use toolconf_model::{Error, TaskKind};
 
-pub use crate::registry::{AnyEpisode, Linearisation, TaskTrace, TrajectoryTable};
+pub use toolconf_model::registry::{AnyEpisode, Linearisation, TaskTrace, TrajectoryTable};
 
 /// The task bound to every model, in registry order. A task that does not fit a model (a goal
 /// of the wrong length) is an error only once a tool of that model turns up
@@ -26,7 +26,7 @@ pub struct ModelTasks {
 /// `spec` bound to `model`: its goals and precisions checked against the model, then its
 /// episode options, then the task's validation (as `key precision`).
 fn bind(
-    model: &dyn crate::registry::Model,
+    model: &dyn toolconf_model::registry::Model,
     spec: &TaskSpec,
 ) -> Result<Arc<dyn BoundTask>, TaskFileError> {
     let bound = model.bind(spec)?;
@@ -103,7 +103,7 @@ impl ModelTasks {
         self.of(tool)?.episode(tool.parameters(), record)
     }
 
-    /// The episode's cost predicted by the linearised closed loop ([`crate::prediction`]).
+    /// The episode's cost predicted by the linearised closed loop ([`toolconf_model::prediction`]).
     pub fn predict(&self, tool: &AnyTool) -> Result<Prediction, PredictionError> {
         self.of(tool)?.predict(tool.parameters())
     }

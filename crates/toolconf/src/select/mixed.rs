@@ -31,10 +31,12 @@ use rayon::prelude::*;
 
 /// Draws of one tool before [`MixedSampler`] takes the sampling box's centre instead.
 const MAX_REDRAWS: usize = 10_000;
-use crate::closed_loop::{EpisodeOptions, Metrics, Plant};
-use crate::model::{control_confidence, simulate_on, Arm2, Arm2Exact, ModelSimulationError, TaskN};
-use crate::registry::{paper_options, AnyTool, ModelKind};
-use crate::{Error, TaskKind};
+use toolconf_model::closed_loop::{EpisodeOptions, Metrics, Plant};
+use toolconf_model::model::{
+    control_confidence, simulate_on, Arm2, Arm2Exact, ModelSimulationError, TaskN,
+};
+use toolconf_model::registry::{paper_options, AnyTool, ModelKind};
+use toolconf_model::{Error, TaskKind};
 
 /// A seeded stream of tools of several models (see the module docs for the mapping).
 pub struct MixedSampler {

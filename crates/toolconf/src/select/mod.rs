@@ -14,10 +14,10 @@ use rand::{RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use crate::closed_loop::{EpisodeOptions, Metrics, Plant, SimulationError};
-use crate::confidence::control_confidence;
-use crate::mpc::{MpcEpisodeError, MpcMetrics, MpcOptions};
-use crate::{Arm, Error, Task};
+use crate::mpc::{MpcEpisodeError, MpcMetrics, MpcOptions, SimulateMpc};
+use toolconf_model::closed_loop::{EpisodeOptions, Metrics, Plant, SimulationError};
+use toolconf_model::confidence::control_confidence;
+use toolconf_model::{Arm, Error, Task};
 
 /// The paper's parameter domain for m1, m2, l1, l2 ("Implementation details").
 pub const PARAMETER_RANGE: (f64, f64) = (0.1, 0.6);

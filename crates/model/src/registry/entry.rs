@@ -13,16 +13,16 @@ use super::{
     TrajectoryTable,
 };
 use crate::closed_loop::EpisodeOptions;
-use crate::generated;
-use crate::generated::TERMS;
+use crate::inputs::task_file::{TaskFileError, TaskSpec};
 use crate::model::{
     control_confidence, episode, simulate, ArmModel, EpisodeOptionsN, Metrics,
     ModelSimulationError, TaskN, ToolN, ValidatedTaskN,
 };
 use crate::prediction::{self, LinearSystem, Prediction, PredictionError};
-use crate::task_file::{TaskFileError, TaskSpec};
 use crate::validate::finite_output;
 use crate::{Error, TaskKind, Term};
+use toolconf_generated as generated;
+use toolconf_generated::TERMS;
 
 /// Below this many tools a batch of confidences runs on one thread: spreading it costs more
 /// than it saves.
@@ -279,7 +279,7 @@ struct TaskOn<M, const N: usize, const NX: usize, const NP: usize, const NZ: usi
     kind: TaskKind,
     task: TaskN<N>,
     /// A tip goal relative to each tool's tip where the episode starts
-    /// ([`crate::task_file::TipGoal::Offset`]); `task`'s tip goal is then resolved per tool.
+    /// ([`crate::inputs::task_file::TipGoal::Offset`]); `task`'s tip goal is then resolved per tool.
     offset: Option<SVector<f64, N>>,
     validated: Result<ValidatedTaskN<N>, Error>,
     options: Result<EpisodeOptionsN<N, NX>, TaskFileError>,
@@ -309,7 +309,7 @@ where
             return Ok(std::borrow::Cow::Borrowed(&self.task));
         };
         let q0 = self.options()?.x0.fixed_rows::<N>(0).into_owned();
-        let task = crate::task_file::at_initial_tip(&self.task, offset, tool, &q0)?;
+        let task = crate::inputs::task_file::at_initial_tip(&self.task, offset, tool, &q0)?;
         Ok(std::borrow::Cow::Owned(task))
     }
 

@@ -5,11 +5,11 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::{ActiveInferenceN, ArmModel, TaskN, ToolN};
-use crate::generated::{Read, Term, TERMS};
 use crate::Error;
 use toolconf_core::{
     observe_tool, reads_tip, tip_parameters, ObservationN, TipKinematics, TipObserver,
 };
+use toolconf_generated::{Read, Term, TERMS};
 use toolconf_integrators::{
     solve_grid_with_jacobian, uniform_grid, IntegrationError, Method, Options as IntegratorOptions,
 };
@@ -757,7 +757,7 @@ pub(crate) fn check_options<const N: usize, const NX: usize>(
 pub const MAX_GRID_POINTS: usize = 1_000_000;
 
 /// [`Error::GridTooLarge`] when t_end/dt + 1 exceeds [`MAX_GRID_POINTS`].
-pub(crate) fn check_grid(t_end: f64, dt: f64) -> Result<(), Error> {
+pub fn check_grid(t_end: f64, dt: f64) -> Result<(), Error> {
     let points = (t_end / dt).floor() + 1.0;
     if points > MAX_GRID_POINTS as f64 {
         return Err(Error::GridTooLarge {

@@ -5,7 +5,7 @@ use crate::Error;
 
 /// Which task-specific controller: generated from `derive/tasks.toml` (a task added there appears
 /// after `make derive`), with its name, number, terms and error term.
-pub use crate::generated::{TaskKind, Term};
+pub use toolconf_generated::{TaskKind, Term};
 
 /// A task of the paper's 2-DOF arm: goals θ^g, θ̇^g, θ̈^g and prior precisions P^θ, P^θ̇, P^θ̈,
 /// P^U (eq. free_energy); `Task::paper(kind)` is the paper's.
@@ -14,7 +14,7 @@ pub type Task = TaskN<2>;
 /// The task names and numbers a command line accepts, for messages and `--help`:
 /// "position, velocity or acceleration (or 1, 2, 3)".
 pub fn task_choices() -> String {
-    crate::generated::TASK_CHOICES.to_string()
+    toolconf_generated::TASK_CHOICES.to_string()
 }
 
 /// A task by its name (`position`, ...) or number (`1`, ...), or [`Error::UnknownTask`] naming

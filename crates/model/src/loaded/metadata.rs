@@ -8,10 +8,10 @@ use toolconf_cabi::info::{Domain, ModelInfo as CInfo};
 use toolconf_cabi::{Exports, ABI_VERSION};
 
 use super::c_text;
-use crate::generated::validity::{InertiaRule, ParameterDomain};
-use crate::generated::{Constraint, MAX_PARAMETER_COUNT};
 use crate::registry::ModelInfo;
 use crate::{TaskKind, Term};
+use toolconf_generated::validity::{InertiaRule, ParameterDomain};
+use toolconf_generated::{Constraint, MAX_PARAMETER_COUNT};
 
 /// The metadata, owned until the model is registered ([`Metadata::leak`]).
 pub(crate) struct Metadata {

@@ -8,7 +8,7 @@
 //!
 //! * [`ArmModel`] is implemented for one marker type per generated model ([`Arm2`],
 //!   [`Arm2Exact`], [`Arm3`], ...), forwarding to the generated module; the list comes from the
-//!   generated registry ([`crate::for_each_model!`]), so a new model description needs no edit here.
+//!   generated registry ([`toolconf_generated::for_each_model!`]), so a new model description needs no edit here.
 //! * [`ToolN`] (validated parameters), [`TaskN`] (goals and precisions), [`control_confidence`]
 //!   (Π^U and ln|Π^U|), [`ActiveInferenceN`], [`ClosedLoopN`], [`simulate`]/[`simulate_on`]
 //!   (metrics) and [`episode`]/[`episode_on`] (metrics and trajectory).
@@ -26,6 +26,6 @@ pub use toolconf_core::*;
 
 pub(crate) use closed_loop_n::check_options as check_episode_options;
 pub use closed_loop_n::{
-    episode, episode_on, simulate, simulate_on, ClosedLoopN, EpisodeN, EpisodeOptionsN, Metrics,
-    ModelSimulationError, TrajectoryN, MAX_GRID_POINTS,
+    check_grid, episode, episode_on, simulate, simulate_on, ClosedLoopN, EpisodeN, EpisodeOptionsN,
+    Metrics, ModelSimulationError, TrajectoryN, MAX_GRID_POINTS,
 };

@@ -5,8 +5,8 @@ use nalgebra::{SMatrix, SVector};
 use serde::Serialize;
 
 use super::LinearLoop;
-use crate::generated::Term;
 use crate::model::{EpisodeOptionsN, TaskN};
+use toolconf_generated::Term;
 
 /// One term of the cost: term ≈ `offset` + `c` z (ΔT included in `offset`), its goal and
 /// precision, and whether the task's J uses it.

@@ -16,10 +16,10 @@ use super::Library;
 use crate::registry::entry::Generated;
 use crate::registry::{Model, ModelInfo};
 
-use crate::generated::validity::{LinearRule, ToolRule};
-use crate::generated::TERMS;
 use crate::model::{ArmModel, SensitivitiesN, TaskN};
 use crate::TaskKind;
+use toolconf_generated::validity::{LinearRule, ToolRule};
+use toolconf_generated::TERMS;
 
 /// What a loaded model's functions read: the library's exports and its metadata as the types
 /// the runtime keeps for a built-in model.

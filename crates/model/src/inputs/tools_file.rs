@@ -15,7 +15,7 @@
 //! `[{"name": "hammer", "model": "arm2", "m1": 0.3, "m2": 0.4, "l1": 0.5, "l2": 0.2}]`.
 //!
 //! Rows are handed to a callback one at a time, so a file of 10⁷ tools is never held in memory,
-//! and each row (a JSON tool) may be at most 1 MiB ([`crate::bounded_read`]), so that no file,
+//! and each row (a JSON tool) may be at most 1 MiB ([`crate::inputs::bounded_read`]), so that no file,
 //! `/dev/zero` included, is read without bound. A bad row is an error naming the file, the line
 //! (CSV) or tool number (JSON), the key and the value (clipped if long); the callback decides
 //! whether it stops the read or is skipped. A column given twice in a CSV header, or a key twice
@@ -28,7 +28,7 @@ use serde::de::{Error as _, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 use serde_json::{Map, Value};
 
-use crate::bounded_read::{record_error, CsvRows, JsonElements, RecordLimit};
+use crate::inputs::bounded_read::{record_error, CsvRows, JsonElements, RecordLimit};
 use crate::registry::{AnyTool, ModelKind};
 use toolconf_messages::{Clip, ClipMessage, ClipPath, Short};
 
@@ -206,7 +206,7 @@ fn read_csv<R: Read>(
 }
 
 /// A CSV error's line and message: a row too long or a quote never closed as the bounded
-/// reader says ([`crate::bounded_read`]), a row of the wrong length in cells, else the `csv`
+/// reader says ([`crate::inputs::bounded_read`]), a row of the wrong length in cells, else the `csv`
 /// crate's words.
 fn csv_error(e: &csv::Error) -> (Option<u64>, String) {
     match e.kind() {

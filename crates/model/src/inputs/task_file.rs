@@ -36,13 +36,13 @@ use std::path::Path;
 use nalgebra::{DMatrix, SMatrix, SVector};
 use serde::Deserialize;
 
-use crate::bounded_read::read_text_file;
-use crate::generated::TERMS;
+use crate::inputs::bounded_read::read_text_file;
 use crate::model::closed_loop_n::check_grid;
 use crate::model::{ArmModel, EpisodeOptionsN, TaskN};
 use crate::validate::goal_range;
 use crate::{TaskKind, Term};
 use toolconf_core::{term_components, term_identity};
+use toolconf_generated::TERMS;
 use toolconf_messages::{Clip, ClipMessage, ClipPath, Short, ShortList, ShortRows as Rows};
 
 mod tip_goal;
@@ -660,7 +660,7 @@ impl TaskSpec {
     where
         M: ArmModel<N, NX, NP, NZ>,
     {
-        if !matches!(term.read(), crate::generated::Read::Tip { .. }) {
+        if !matches!(term.read(), toolconf_generated::Read::Tip { .. }) {
             return self.vector::<M, N, NX, NP, NZ>(key, v);
         }
         let d = term_components(term, N, M::tip_dim());
@@ -856,7 +856,7 @@ fn check_precision(p: &PrecisionSpec) -> Result<(), String> {
             Clip(&format!("{lengths:?}"))
         ));
     }
-    let most = crate::generated::MODELS
+    let most = toolconf_generated::MODELS
         .iter()
         .map(|m| m.dof)
         .max()

@@ -98,7 +98,7 @@ pub const RANGES: [(&str, Range); 19] = [
 /// domain (a mass, a length, a moment), [`TOOL_PARAMETER`]: the value, or why not in words
 /// (`0 must be a number in [1e-6, 1e6]`), as [`toolconf_core::ToolN::new`] judges it.
 pub fn tool_parameter(
-    domain: &crate::generated::validity::ParameterDomain,
+    domain: &toolconf_generated::validity::ParameterDomain,
     value: f64,
 ) -> Result<f64, String> {
     if domain.is_positive() {

@@ -5,7 +5,7 @@
 use nalgebra::{DMatrix, SMatrix, SVector};
 
 use super::linear::LinearLoop;
-use crate::generated::Term;
+use toolconf_generated::Term;
 
 /// The step over `h` of the affine systems ż = M z + c_j, one per column c_j of `inputs`: the
 /// transition e^{M h} and, per input, the response ∫₀^h e^{M s} ds c_j.

@@ -11,7 +11,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::bounded_read::read_text_file;
+use crate::inputs::bounded_read::read_text_file;
 use toolconf_messages::{Clip, ClipMessage, ClipPath};
 
 /// The most bytes of a URDF read: the derivation's own limit for an arm's URDF.

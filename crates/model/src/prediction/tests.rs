@@ -4,8 +4,8 @@
 use nalgebra::SVector;
 
 use super::*;
+use crate::inputs::task_file::TaskSpec;
 use crate::model::{simulate, Arm2, ClosedLoopN, Panda};
-use crate::task_file::TaskSpec;
 use crate::TaskKind;
 
 type PandaTool = ToolN<Panda, 7, 14, 13, 21>;

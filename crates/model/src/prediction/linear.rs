@@ -3,10 +3,10 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::generated::{Read, Term, TERMS};
 use crate::model::{ActiveInferenceN, ArmModel, TaskN, ToolN};
 use crate::Error;
 use toolconf_core::{reads_tip, TipKinematics};
+use toolconf_generated::{Read, Term, TERMS};
 
 /// One observed term, linearised: term ≈ `offset` + `gain_dt` ΔT + `c` z.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -3,9 +3,9 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::generated::{Read, Term, TERMS};
 use crate::model::{Metrics, TrajectoryN};
 use crate::Error;
+use toolconf_generated::{Read, Term, TERMS};
 
 /// A tool's linearisation and confidence with the sizes known only at run time (matrices as
 /// rows): what `toolconf confidence --model` prints.

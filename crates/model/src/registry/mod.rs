@@ -3,7 +3,7 @@
 //! package) dispatches once per tool or per batch instead of matching on models.
 //!
 //! * [`models`] is the one list of models (built from the generated registry,
-//!   [`crate::for_each_model!`], here and nowhere else); [`ModelKind`] is a `Copy` handle into it
+//!   [`toolconf_generated::for_each_model!`], here and nowhere else); [`ModelKind`] is a `Copy` handle into it
 //!   and [`ModelKind::from_str`] looks a model up by name.
 //! * [`Model`] takes and returns data whose sizes are known only at run time (slices, `Vec`,
 //!   [`Rows`]): what a model loaded at run time could implement as well. Its metadata is the
@@ -28,12 +28,12 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 
 use crate::closed_loop::EpisodeOptions;
-use crate::generated;
-use crate::generated::validity::ParameterDomain;
+use crate::inputs::task_file::{TaskFileError, TaskSpec};
 use crate::model::{ArmModel, Metrics, ModelSimulationError, ToolN};
 use crate::prediction::{LinearSystem, Prediction, PredictionError};
-use crate::task_file::{TaskFileError, TaskSpec};
 use crate::{Error, TaskKind};
+use toolconf_generated as generated;
+use toolconf_generated::validity::ParameterDomain;
 
 pub use entry::paper_options;
 pub use generated::{Constraint, ModelInfo, MAX_PARAMETER_COUNT};
@@ -173,7 +173,7 @@ macro_rules! registry {
     };
 }
 
-crate::for_each_model!(registry);
+toolconf_generated::for_each_model!(registry);
 
 /// The most models one process loads at run time ([`crate::loaded`]).
 pub const MAX_LOADED: usize = 64;
