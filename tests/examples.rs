@@ -17,13 +17,26 @@ const BIN: &str = env!("CARGO_BIN_EXE_toolconf");
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
 /// `cargo run --example NAME -- ARGS` from the repository root: its standard output. Built with
-/// `--workspace`, the features `cargo test --workspace` (make test) built the examples with, so
-/// that nothing is compiled twice there; run alone, `cargo test --workspace --test examples`.
+/// `--workspace` and the profile this test was built with (`test`, or `release` under
+/// `cargo test --release`): the features and profile `cargo test --workspace` (make test) built
+/// the examples with, so that nothing is compiled twice there (under `dev`, cargo builds every
+/// crate of the workspace again); run alone, `cargo test --workspace --test examples`.
 fn example(name: &str, args: &[&str]) -> String {
+    // This test is target/<profile dir>/deps/examples-<hash>; the examples are beside deps/.
+    let exe = std::env::current_exe().expect("the test's path");
+    let examples = exe
+        .parent()
+        .and_then(Path::parent)
+        .expect("target/<profile dir>");
+    let profile = match examples.file_name().and_then(|n| n.to_str()) {
+        Some("release") => "release",
+        _ => "test",
+    };
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let build = Command::new(cargo)
         .current_dir(ROOT)
-        .args(["build", "--quiet", "--workspace", "--example", name])
+        .args(["build", "--quiet", "--profile", profile, "--workspace"])
+        .args(["--example", name])
         .output()
         .expect("run cargo");
     let stderr = String::from_utf8_lossy(&build.stderr);
@@ -31,12 +44,6 @@ fn example(name: &str, args: &[&str]) -> String {
         build.status.success(),
         "cargo build --example {name}: {stderr}"
     );
-    // This test is target/<profile>/deps/examples-<hash>; the examples are beside deps/.
-    let exe = std::env::current_exe().expect("the test's path");
-    let examples = exe
-        .parent()
-        .and_then(Path::parent)
-        .expect("target/<profile>");
     let out = Command::new(examples.join("examples").join(name))
         .current_dir(ROOT)
         .args(args)
