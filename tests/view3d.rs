@@ -240,3 +240,42 @@ fn check_view(scratch: &Path, before: &[&str], tools: &Path, task: &str) {
         "the arm did not move: {changed} pixels of the canvas changed"
     );
 }
+
+/// Where there can be no view, the report says why in one line and keeps its 2-D figures: a
+/// planar arm (no URDF flange), and a view over its size budget (2,501 output times per episode:
+/// some 2 MB of poses against the 1.5 MB budget).
+#[test]
+fn no_urdf_or_over_budget_gets_one_line_instead_of_the_view() {
+    let scratch = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let planar = rank_report(
+        scratch.path(),
+        &[],
+        &root.join("examples/tools/drawer.csv"),
+        "examples/tasks/arm2_reach_point.toml",
+    );
+    let long_task = scratch.path().join("long.toml");
+    let touch = std::fs::read_to_string(root.join("examples/tasks/panda_touch_point.toml")).unwrap();
+    std::fs::write(&long_task, touch.replace("[episode]", "[episode]\ndt = 0.002")).unwrap();
+    let cases = [
+        (planar, "There is no 3-D view: model `arm2` has no URDF"),
+        (
+            rank_report(
+                &scratch.path().join("long"),
+                &[],
+                &root.join("examples/tools/panda_tools.csv"),
+                long_task.to_str().unwrap(),
+            ),
+            "The 3-D view is not written: it would add ",
+        ),
+    ];
+    for (html, line) in cases {
+        let md = std::fs::read_to_string(html.with_file_name("report.md")).unwrap();
+        let page = std::fs::read_to_string(&html).unwrap();
+        assert_eq!(md.matches(line).count(), 1, "{}: {md}", html.display());
+        // The HTML has the same line (its `code` marked up) and no view.
+        let start = line.split('`').next().unwrap();
+        assert_eq!(page.matches(start).count(), 1, "{}", html.display());
+        assert!(!page.contains("view3d-canvas"), "{}", html.display());
+    }
+}
