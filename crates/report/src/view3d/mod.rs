@@ -83,12 +83,12 @@ pub fn section_within(goal: Option<[f64; 3]>, shown: &[Shown], budget: usize) ->
         Block::Html {
             markdown: "`report.html` shows these two episodes in 3-D: the arm drawn from the \
                        model's kinematics, the tool as its inertia box with its tip, the goal, \
-                       and the tip's trail, animated under a time slider; the tip paths above \
+                       and the tip's trail, animated under a time slider; the figures above \
                        are their static picture."
                 .into(),
             html: format!(
-                "<p>The best (left, blue) and the worst (right, red) tool's episode: the arm \
-                 drawn from the model's own kinematics (links between its joints' axes), the \
+                "<p>Two episodes side by side (left, blue; right, red; each named above it): the \
+                 arm drawn from the model's own kinematics (links between its joints' axes), the \
                  tool as the box of its mass and inertia with its tip (black), the goal (green) \
                  and the tip's trail. Drag the slider or press play; drag nothing else \
                  (three.js {THREE_RELEASE}, inlined).</p>\n{html}"
