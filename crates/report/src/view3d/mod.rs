@@ -81,10 +81,9 @@ pub fn section_within(goal: Option<[f64; 3]>, shown: &[Shown], budget: usize) ->
     vec![
         Block::Heading(2, "The arm at work, in 3-D".into()),
         Block::Html {
-            markdown: "`report.html` shows these two episodes in 3-D: the arm drawn from the \
+            markdown: "`report.html` shows these episodes in 3-D: the arm drawn from the \
                        model's kinematics, the tool as its inertia box with its tip, the goal, \
-                       and the tip's trail, animated under a time slider; the figures above \
-                       are their static picture."
+                       and the tip's trail, animated under a time slider."
                 .into(),
             html: format!(
                 "<p>Two episodes side by side (left, blue; right, red; each named above it): the \
