@@ -255,8 +255,13 @@ fn no_urdf_or_over_budget_gets_one_line_instead_of_the_view() {
         "examples/tasks/arm2_reach_point.toml",
     );
     let long_task = scratch.path().join("long.toml");
-    let touch = std::fs::read_to_string(root.join("examples/tasks/panda_touch_point.toml")).unwrap();
-    std::fs::write(&long_task, touch.replace("[episode]", "[episode]\ndt = 0.002")).unwrap();
+    let touch =
+        std::fs::read_to_string(root.join("examples/tasks/panda_touch_point.toml")).unwrap();
+    std::fs::write(
+        &long_task,
+        touch.replace("[episode]", "[episode]\ndt = 0.002"),
+    )
+    .unwrap();
     let cases = [
         (planar, "There is no 3-D view: model `arm2` has no URDF"),
         (
