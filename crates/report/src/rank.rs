@@ -1,7 +1,7 @@
 //! The report of a ranking (`toolconf rank --report DIR`): `report.md` and `report.html` (the
 //! same text, figures inline), written for a reader who has not read the paper, with its
-//! figures: confidence against task error, the best and worst tools over time, and on a tip
-//! task the tip's path.
+//! figures: confidence against task error, the best and worst tools over time, on a tip task
+//! the tip's path, and on a URDF arm their episodes in 3-D in the HTML ([`crate::view3d`]).
 
 use std::path::{Path, PathBuf};
 
