@@ -77,7 +77,7 @@ c-example-test: $(PY)
 ## from its unedited URDF (make model DESC=examples/robots/xarm7.toml), into a temporary folder (or takes
 ## those in $TOOLCONF_TEST_LIBRARIES, as make test gives them: scripts/model_libraries.sh); then checks
 ## that each loaded library gives its built-in model's numbers bit for bit in every operation and subcommand
-## (tests/loaded_models.rs), in Python and on Dask's workers (python/loaded_tests/), and the xArm7's
+## (tests/loaded_models.rs), that rank's 3-D view of the xArm7 works in headless Chromium (tests/view3d.rs), in Python and on Dask's workers (python/loaded_tests/), and the xArm7's
 ## dynamics against Pinocchio's aba; and runs the examples that load a library (examples/load_model.rs,
 ## examples/python/load_model.py) on the Panda's. Needs the Python package installed (make python-test does it).
 loaded-models-test: $(PY_DEV)
@@ -86,6 +86,7 @@ loaded-models-test: $(PY_DEV)
 	echo "loaded-models-test: $$(ls -d $$TOOLCONF_TEST_LIBRARIES/*/ | wc -l) model libraries" && \
 	cargo test --quiet --test loaded_models -- --include-ignored && \
 	cargo test --quiet --test examples -- --ignored && \
+	cargo test --quiet --test view3d -- --ignored && \
 	$(PY) -m pytest -q python/loaded_tests
 
 ## make mujoco-test: the on-robot controller on MuJoCo (examples/mujoco/, docs/tutorials/mujoco.md). Installs the example's

@@ -117,6 +117,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             spec: &spec,
             result: &result,
             sweep: sweep.as_ref().zip(front.as_deref()),
+            tasks: &tasks,
+            model_kind: model,
         };
         write_report(dir, &input)?;
     }

@@ -11,6 +11,11 @@ use crate::experiments::{write_atomically, ReproduceError};
 use toolconf::design::file::DesignSpec;
 use toolconf::design::sweep::{Sweep, SweepPoint};
 use toolconf::design::DesignResult;
+use toolconf::rank::ModelTasks;
+use toolconf_generated::Read;
+use toolconf_model::registry::{AnyTool, ModelKind};
+
+use crate::view3d;
 
 pub const SWEEP_CSV: &str = "sweep.csv";
 pub const SWEEP_SVG: &str = "sweep.svg";
@@ -23,6 +28,9 @@ pub struct ReportInput<'a> {
     pub spec: &'a DesignSpec,
     pub result: &'a DesignResult,
     pub sweep: Option<(&'a Sweep, &'a [SweepPoint])>,
+    /// The task bound to every model and the designed model: what the 3-D view's episodes run.
+    pub tasks: &'a ModelTasks,
+    pub model_kind: ModelKind,
 }
 
 pub use toolconf::design::parameters_text;
@@ -100,6 +108,7 @@ pub fn write_report(dir: &Path, input: &ReportInput) -> Result<Vec<PathBuf>, Rep
         doc.extend(sweep_section(dir, input.spec, sweep, points)?);
         files.extend([dir.join(SWEEP_CSV), dir.join(SWEEP_SVG)]);
     }
+    doc.extend(arm_view(input));
     doc.push(Block::Heading(2, "How this was made".into()));
     doc.push(Block::p(format!(
         "Command: `{}`. The same file and seed give the same design.",
@@ -159,4 +168,59 @@ fn sweep_section(
         )),
         Block::Figure { file: SWEEP_SVG.into(), caption: "Best ln|Π^U| against the swept budget.".into(), svg },
     ])
+}
+
+/// The 3-D view of the design's episode beside the simulated random tool with the largest ∫F
+/// (on a model without a URDF flange, the line saying why there is none).
+fn arm_view(input: &ReportInput) -> Vec<Block> {
+    let simulated =
+        |c: &&toolconf::design::verify::ToolCheck| c.simulated.as_ref().ok().map(|s| s.free_energy);
+    let design = input.result.checks.first();
+    let worst = input
+        .result
+        .checks
+        .iter()
+        .skip(1)
+        .filter(|c| simulated(c).is_some())
+        .max_by(|a, b| {
+            simulated(a)
+                .partial_cmp(&simulated(b))
+                .unwrap_or(std::cmp::Ordering::Equal)
+        });
+    let picked: Vec<(String, AnyTool)> = design
+        .into_iter()
+        .chain(worst)
+        .filter_map(|c| {
+            Some((
+                c.label.clone(),
+                AnyTool::new(input.model_kind, &c.params).ok()?,
+            ))
+        })
+        .collect();
+    let traces: Vec<_> = picked
+        .iter()
+        .map(|(_, tool)| input.tasks.trace(tool).ok())
+        .collect();
+    let shown: Vec<view3d::Shown> = picked
+        .iter()
+        .zip(&traces)
+        .filter_map(|((label, tool), trace)| {
+            Some(view3d::Shown {
+                label: label.clone(),
+                tool,
+                trace: trace.as_ref()?,
+            })
+        })
+        .collect();
+    let goal = shown
+        .first()
+        .filter(|_| matches!(input.tasks.kind.error_term().read(), Read::Tip { order: 0 }))
+        .and_then(|s| {
+            Some([
+                *s.trace.goal.first()?,
+                *s.trace.goal.get(1)?,
+                *s.trace.goal.get(2)?,
+            ])
+        });
+    view3d::section(goal, &shown)
 }

@@ -15,3 +15,4 @@ pub mod evaluation;
 pub mod experiments;
 pub mod progress;
 pub mod rank;
+pub mod view3d;

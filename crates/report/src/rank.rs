@@ -1,7 +1,7 @@
 //! The report of a ranking (`toolconf rank --report DIR`): `report.md` and `report.html` (the
 //! same text, figures inline), written for a reader who has not read the paper, with its
-//! figures: confidence against task error, the best and worst tools over time, and on a tip
-//! task the tip's path.
+//! figures: confidence against task error, the best and worst tools over time, on a tip task
+//! the tip's path, and on a URDF arm their episodes in 3-D in the HTML ([`crate::view3d`]).
 
 use std::path::{Path, PathBuf};
 
@@ -9,6 +9,7 @@ use crate::experiments::figure_parts::wants_log;
 use crate::experiments::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use crate::experiments::report::{to_html, to_markdown, Block};
 use crate::experiments::{write_atomically, ReproduceError};
+use crate::view3d;
 use toolconf::rank::{score, ModelTasks, RankedTool, StageTimings, TaskTrace};
 use toolconf::select::Objective;
 use toolconf_generated::Read;
@@ -485,13 +486,20 @@ fn trajectory_figure(dir: &Path, input: &ReportInput) -> Result<Vec<Block>, Repr
         Colour(240, 170, 110),
     ];
     let mut traces: Vec<(String, Colour, bool, TaskTrace)> = Vec::new();
+    // The best and the worst tool's (result, trace) indices, for the 3-D view.
+    let mut ends: Vec<(usize, usize)> = Vec::new();
     let mut notes = Vec::new();
     for (group, colours, dashed) in [(&best, BEST, false), (&worst, WORST, true)] {
         for (k, &i) in group.iter().enumerate() {
             let r = &input.results[i];
             let rank = input.order.iter().position(|&j| j == i).unwrap_or(0) + 1;
             match input.tasks.trace(&r.row.tool) {
-                Ok(t) => traces.push((format!("#{rank} {}", r.row.label()), colours[k], dashed, t)),
+                Ok(t) => {
+                    if k == 0 {
+                        ends.push((i, traces.len()));
+                    }
+                    traces.push((format!("#{rank} {}", r.row.label()), colours[k], dashed, t))
+                }
                 Err(e) => notes.push(format!("#{rank} {}: {e}", r.row.label())),
             }
         }
@@ -566,7 +574,41 @@ fn trajectory_figure(dir: &Path, input: &ReportInput) -> Result<Vec<Block>, Repr
         blocks.push(Block::Bullets(notes));
     }
     blocks.extend(tip_path_figure(dir, input, &traces)?);
+    blocks.extend(arm_view(input, &ends, &traces));
     Ok(blocks)
+}
+
+/// The 3-D view of the best and the worst tool's episodes (`ends`: their result and trace
+/// indices), with the goal point of a tip position task; on a model without a URDF flange, the
+/// line saying why there is none.
+fn arm_view(
+    input: &ReportInput,
+    ends: &[(usize, usize)],
+    traces: &[(String, Colour, bool, TaskTrace)],
+) -> Vec<Block> {
+    let shown: Vec<view3d::Shown> = ends
+        .iter()
+        .zip(["best", "worst"])
+        .filter_map(|(&(i, k), which)| {
+            let (label, _, _, trace) = traces.get(k)?;
+            Some(view3d::Shown {
+                label: format!("{which}: {label}"),
+                tool: &input.results[i].row.tool,
+                trace,
+            })
+        })
+        .collect();
+    let goal = shown
+        .first()
+        .filter(|_| matches!(input.spec.kind.error_term().read(), Read::Tip { order: 0 }))
+        .and_then(|s| {
+            Some([
+                *s.trace.goal.first()?,
+                *s.trace.goal.get(1)?,
+                *s.trace.goal.get(2)?,
+            ])
+        });
+    view3d::section(goal, &shown)
 }
 
 /// A panel's title: `joint 2`, or `tip y` for a component of a tip term.

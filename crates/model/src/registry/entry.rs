@@ -445,6 +445,7 @@ where
             value: components(series, count),
             goal: goal.iter().take(count).copied().collect(),
             tip_path,
+            joints: components(tr.of(Term::Theta), N),
         })
     }
 }

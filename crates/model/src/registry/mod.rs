@@ -19,6 +19,7 @@
 pub(crate) mod entry;
 mod flange;
 mod results;
+pub mod skeleton;
 
 pub use flange::{flange_model, flange_models};
 

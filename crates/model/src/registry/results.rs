@@ -129,6 +129,8 @@ pub struct TaskTrace {
     /// On a tip task, the tip's path in the base frame: `tip_path[j][i]` is component j of
     /// y(q(t_i)) (whatever the error term: ẏ on a tip velocity task).
     pub tip_path: Option<Vec<Vec<f64>>>,
+    /// The joint angles: `joints[j][i]` is θ_j(t_i) (what a view of the arm poses it by).
+    pub joints: Vec<Vec<f64>>,
 }
 
 /// Why a batch over many tools or states gave no result.

@@ -9,6 +9,8 @@ use super::figures::Figure;
 use super::RunInfo;
 use crate::experiments::report::{Block, Outcome, Verdict};
 use crate::experiments::verdict::num;
+use crate::view3d;
+use toolconf_generated::Read;
 
 fn outcome(f: Finding) -> Outcome {
     match f {
@@ -249,6 +251,44 @@ fn fig3_section(e: &Evaluation, figures: &[Option<Figure>]) -> Vec<Block> {
             ),
         ),
     ]
+    .into_iter()
+    .chain(fig3_view(e))
+    .collect()
+}
+
+/// The 3-D view of Fig. 3's most and least confident tools without ΔT (on a model without a URDF
+/// flange, the line saying why there is none).
+fn fig3_view(e: &Evaluation) -> Vec<Block> {
+    let shown: Vec<view3d::Shown> = ["high", "low"]
+        .into_iter()
+        .filter_map(|role| {
+            let run = e
+                .highlight
+                .runs
+                .iter()
+                .find(|r| r.role == role && !r.perturbed)?;
+            Some(view3d::Shown {
+                label: match e.population.names.get(run.tool) {
+                    Some(Some(name)) => format!("{role} confidence: tool {} ({name})", run.tool),
+                    _ => format!("{role} confidence: tool {}", run.tool),
+                },
+                tool: e.population.tools.get(run.tool)?,
+                trace: run.trace.as_ref().ok()?,
+            })
+        })
+        .collect();
+    let tip_point = matches!(
+        e.setup.spec.kind.error_term().read(),
+        Read::Tip { order: 0 }
+    );
+    let goal = shown.first().filter(|_| tip_point).and_then(|s| {
+        Some([
+            *s.trace.goal.first()?,
+            *s.trace.goal.get(1)?,
+            *s.trace.goal.get(2)?,
+        ])
+    });
+    view3d::section(goal, &shown)
 }
 
 fn fig4_section(e: &Evaluation, figures: &[Option<Figure>]) -> Vec<Block> {

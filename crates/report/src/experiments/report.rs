@@ -78,6 +78,12 @@ pub enum Block {
         svg: String,
     },
     Verdict(Verdict),
+    /// A part of the HTML report alone (an interactive view, trusted markup made by this crate),
+    /// with the paragraph the Markdown report shows in its place.
+    Html {
+        markdown: String,
+        html: String,
+    },
 }
 
 impl Block {
@@ -306,6 +312,9 @@ pub fn to_markdown(doc: &[Block]) -> String {
                 let _ = writeln!(out, "{}\n", verdict_line(v));
                 let _ = writeln!(out, "Rule: {}\n", v.rule);
             }
+            Block::Html { markdown, .. } => {
+                let _ = writeln!(out, "{markdown}\n");
+            }
         }
     }
     out
@@ -424,6 +433,9 @@ pub fn to_html(doc: &[Block]) -> String {
                     inline(&verdict_line(v)),
                     inline(&v.rule)
                 );
+            }
+            Block::Html { html, .. } => {
+                let _ = writeln!(out, "{}", html.trim());
             }
         }
     }
