@@ -10,7 +10,7 @@ use crate::experiments::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use crate::experiments::report::{to_html, to_markdown, Block};
 use crate::experiments::{write_atomically, ReproduceError};
 use toolconf::generated::Read;
-use toolconf::rank::{score, ModelTasks, RankedTool, StageTimings, TaskTrace};
+use toolconf::rank::{score, ModelTasks, RankedTool, ScreenBy, StageTimings, TaskTrace};
 use toolconf::registry::{ModelKind, AXES};
 use toolconf::select::Objective;
 use toolconf::task_file::{PerJoint, PrecisionSpec, TaskSpec};
@@ -24,10 +24,10 @@ pub struct ReportInput<'a> {
     pub spec: &'a TaskSpec,
     pub tasks: &'a ModelTasks,
     pub objective: Objective,
-    /// Tools read, rows skipped as bad, and the screen's K (if any).
+    /// Tools read, rows skipped as bad, and the screen's K and criterion (if any).
     pub read: usize,
     pub skipped: usize,
-    pub screen: Option<usize>,
+    pub screen: Option<(usize, ScreenBy)>,
     /// Simulated tools in file order, and their order from best to worst.
     pub results: &'a [RankedTool],
     pub order: &'a [usize],
@@ -126,8 +126,14 @@ fn introduction(input: &ReportInput) -> Vec<Block> {
     let (var, _) = variable(spec.kind);
     let goal = spec.kind.doc();
     let screened = match input.screen {
-        Some(k) => format!(
+        Some((k, ScreenBy::Confidence)) => format!(
             "Only the {} most confident of the {} tools were simulated (`--screen {k}`).",
+            input.results.len(),
+            input.read
+        ),
+        Some((k, ScreenBy::Predicted(_))) => format!(
+            "Only the {} of the {} tools whose episode the closed loop linearised at the \
+             equilibrium predicts cheapest were simulated (`--screen {k} --screen-by predicted`).",
             input.results.len(),
             input.read
         ),
