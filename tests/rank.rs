@@ -483,6 +483,7 @@ fn the_report_has_markdown_html_and_inline_figures() {
         "Control confidence",
         "Task error",
         "## Ranking",
+        "| predicted task error | task error |",
         "best_and_worst.svg",
     ] {
         assert!(md.contains(part), "report.md lacks {part}");

@@ -365,6 +365,10 @@ fn ranking_table(input: &ReportInput) -> Vec<Block> {
             r.row.tool.model().name().to_string(),
             r.parameters_text(),
             logdet,
+            // The prediction, or why there is none (an unstable linearised loop).
+            r.prediction
+                .as_ref()
+                .map_or_else(|e| format!("– ({})", e.reason()), |p| number(p.task_error)),
         ];
         row.extend(metrics);
         rows.push(row);
@@ -386,6 +390,7 @@ fn ranking_table(input: &ReportInput) -> Vec<Block> {
             "model",
             "parameters",
             "ln|Π^U|",
+            "predicted task error",
             "task error",
             "∫F dt",
             "∫J dt",
