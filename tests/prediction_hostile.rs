@@ -36,7 +36,9 @@ fn no_nan(text: &str) {
     let lower = text.to_lowercase();
     for word in ["nan", "inf"] {
         assert!(
-            !lower.split(|c: char| !c.is_alphanumeric()).any(|w| w == word),
+            !lower
+                .split(|c: char| !c.is_alphanumeric())
+                .any(|w| w == word),
             "{word} in {text}"
         );
     }
@@ -47,8 +49,25 @@ fn a_horizon_of_zero_is_one_line_naming_the_key() {
     let dir = tempfile::tempdir().unwrap();
     let task = touch_with(dir.path(), "zero.toml", "t_end = 0.0");
     for args in [
-        vec!["confidence", "--model", "panda", "--params", HAND, "--task-file", &task, "--json"],
-        vec!["rank", "--tools", PANDA_TOOLS, "--task", &task, "--screen", "2"],
+        vec![
+            "confidence",
+            "--model",
+            "panda",
+            "--params",
+            HAND,
+            "--task-file",
+            &task,
+            "--json",
+        ],
+        vec![
+            "rank",
+            "--tools",
+            PANDA_TOOLS,
+            "--task",
+            &task,
+            "--screen",
+            "2",
+        ],
     ] {
         let out = toolconf(&args);
         assert_eq!(out.status.code(), Some(2), "{args:?}");
@@ -64,30 +83,56 @@ fn an_unstable_linearised_loop_is_a_stated_null_never_nan() {
     let dir = tempfile::tempdir().unwrap();
     let task = touch_with(dir.path(), "fast.toml", "learning_rate = 100.0");
     let out = toolconf(&[
-        "confidence", "--model", "panda", "--params", HAND, "--task-file", &task, "--json",
+        "confidence",
+        "--model",
+        "panda",
+        "--params",
+        HAND,
+        "--task-file",
+        &task,
+        "--json",
     ]);
     assert!(out.status.success());
     let v: Value = serde_json::from_slice(&out.stdout).unwrap();
-    for key in ["predicted_task_error", "predicted_free_energy", "predicted_cost_j"] {
+    for key in [
+        "predicted_task_error",
+        "predicted_free_energy",
+        "predicted_cost_j",
+    ] {
         assert_eq!(v[key], Value::Null, "{key}");
     }
     let note = v["prediction_note"].as_str().unwrap();
-    assert!(note.starts_with("the closed loop linearised at the equilibrium is unstable"), "{note}");
+    assert!(
+        note.starts_with("the closed loop linearised at the equilibrium is unstable"),
+        "{note}"
+    );
 
     // rank, screened by prediction: no tool has one, so the first rows are kept, with a note.
     let csv = dir.path().join("out.csv");
     let csv_arg = csv.display().to_string();
-    let args = ["rank", "--tools", PANDA_TOOLS, "--task", &task, "--screen", "3"];
+    let args = [
+        "rank",
+        "--tools",
+        PANDA_TOOLS,
+        "--task",
+        &task,
+        "--screen",
+        "3",
+    ];
     let text = toolconf(&[&args[..], &["--csv", &csv_arg]].concat());
-    assert!(text.status.success(), "{}", String::from_utf8_lossy(&text.stderr));
+    assert!(
+        text.status.success(),
+        "{}",
+        String::from_utf8_lossy(&text.stderr)
+    );
     let stdout = String::from_utf8(text.stdout).unwrap();
     no_nan(&stdout);
     assert!(
         stdout.contains("note: 11 tools have no prediction (the closed loop linearised"),
         "{stdout}"
     );
-    let json: Value = serde_json::from_slice(&toolconf(&[&args[..], &["--json"]].concat()).stdout)
-        .unwrap();
+    let json: Value =
+        serde_json::from_slice(&toolconf(&[&args[..], &["--json"]].concat()).stdout).unwrap();
     assert_eq!(json["without_prediction"], 11);
     let mut rows: Vec<u64> = json["tools"]
         .as_array()
@@ -112,11 +157,17 @@ fn an_unstable_linearised_loop_is_a_stated_null_never_nan() {
         r.sort();
         r[..3].to_vec()
     };
-    assert_eq!(rows, first, "without predictions the screen keeps the first rows");
+    assert_eq!(
+        rows, first,
+        "without predictions the screen keeps the first rows"
+    );
     let csv = std::fs::read_to_string(&csv).unwrap();
     no_nan(&csv);
     let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
-    let col = header.iter().position(|h| *h == "predicted_task_error").unwrap();
+    let col = header
+        .iter()
+        .position(|h| *h == "predicted_task_error")
+        .unwrap();
     for line in csv.lines().skip(1) {
         assert!(line.contains("unstable"), "{line}");
         // The reason may hold commas (quoted): the predicted cell comes before it, empty.
