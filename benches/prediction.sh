@@ -1,12 +1,15 @@
 #!/bin/sh
 # The prediction (toolconf::prediction) against episodes and ln|Pi^U| on random tools: one JSON line
-# per model and task (benches/timing/prediction.rs), and the points of docs/prediction.md's figure.
+# per model and task (benches/timing/prediction.rs), and the points of docs/prediction.md's figure;
+# then design by the predicted task error against design by confidence and RANDOM random feasible
+# tools on the touch task's design file (benches/timing/design_predicted.rs, $out/design_touch.json).
+# The cost per tool side by side (prediction, ln|Pi^U|, episode): cargo bench --bench prediction_cost
 # Usage: sh benches/prediction.sh [TOOLS] [OUT_DIR]   (from the repository root; 1000 tools by default)
 set -eu
 tools=${1:-1000}
 out=${2:-target/prediction}
 mkdir -p "$out"
-cargo build --release --example prediction
+cargo build --release --example prediction --example design_predicted
 run() {
     name=$1; shift
     target/release/examples/prediction --tools "$tools" --points "$out/$name.csv" "$@"
@@ -20,3 +23,6 @@ run ur5_push --model ur5 --task examples/tasks/ur5_push_off.toml
 run arm2_position --model arm2 --task position
 run arm2_velocity --model arm2 --task velocity
 run arm2_acceleration --model arm2 --task acceleration
+target/release/examples/design_predicted --model panda --task examples/tasks/panda_touch_point.toml \
+    --design examples/design/panda_tip_length.toml --random "${RANDOM_TOOLS:-10000}" > "$out/design_touch.json"
+cat "$out/design_touch.json"

@@ -2,7 +2,8 @@
 # Both stages of `toolconf rank --screen K` on a large tools file: writes
 # target/rank_screen/tools_N.csv (N arm2 tools, every parameter uniform on [0.1, 0.6) as
 # draw_tools draws them, from Python's random.Random(SEED), six decimals), then runs
-# `toolconf rank --screen K --json` (release) on each task and prints both stages' wall time and
+# `toolconf rank --screen K --screen-by confidence --json` (SCREEN_BY=predicted for the other
+# screen; release) on each task and prints both stages' wall time and
 # throughput, with the load average before and after each run. Nothing is written into docs/.
 #   benches/rank_screen.sh [N=1000000] [K=1000] [TASKS=position,velocity] [THREADS=1] [SEED=1]
 set -euo pipefail
@@ -30,7 +31,7 @@ echo "tools: $tools ($(($(wc -l < "$tools") - 1)) rows, $(du -h "$tools" | cut -
 for task in ${tasks//,/ }; do
   before="$(cut -d' ' -f1-3 /proc/loadavg)"
   RAYON_NUM_THREADS="$threads" ./target/release/toolconf rank --tools "$tools" --task "$task" \
-    --screen "$k" --json > "$dir/rank_$task.json"
+    --screen "$k" --screen-by "${SCREEN_BY:-confidence}" --json > "$dir/rank_$task.json"
   after="$(cut -d' ' -f1-3 /proc/loadavg)"
   python3 - "$dir/rank_$task.json" "$task" "$before" "$after" <<'PY'
 import json, sys

@@ -4,7 +4,8 @@
 # mass 0.1-3 kg, centre of mass within 5 cm of the flange axis and up to 20 cm out, the principal
 # moments of a solid box of 1-30 cm sides about it (so the triangle inequality holds), no products
 # of inertia, the tip within 5 cm of the axis and 5-40 cm out; Python's random.Random(SEED), six
-# significant digits), then runs `toolconf rank --screen K --json` (release) on the task and
+# significant digits), then runs `toolconf rank --screen K --screen-by confidence --json` (SCREEN_BY=predicted
+# for the other screen; release) on the task and
 # prints the confidence stage's wall time and throughput, with the load average around the run.
 #   benches/tip_screen.sh [N=1000000] [K=100] [TASK=examples/tasks/panda_touch_point.toml] [THREADS=2] [SEED=1]
 set -euo pipefail
@@ -39,7 +40,7 @@ fi
 echo "tools: $tools ($(($(wc -l < "$tools") - 1)) rows, $(du -h "$tools" | cut -f1)); task $task; --screen $k; RAYON_NUM_THREADS=$threads"
 before="$(cut -d' ' -f1-3 /proc/loadavg)"
 RAYON_NUM_THREADS="$threads" ./target/release/toolconf rank --tools "$tools" --task "$task" \
-  --screen "$k" --json > "$dir/rank.json"
+  --screen "$k" --screen-by "${SCREEN_BY:-confidence}" --json > "$dir/rank.json"
 after="$(cut -d' ' -f1-3 /proc/loadavg)"
 python3 - "$dir/rank.json" "$before" "$after" <<'PY'
 import json, sys

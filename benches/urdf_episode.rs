@@ -96,6 +96,7 @@ fn rank_1000(c: &mut Criterion) {
                 defaulted: Vec::new(),
             },
             logdet: Ok(0.0),
+            prediction: None,
         })
         .collect();
     let pool = rayon::ThreadPoolBuilder::new()

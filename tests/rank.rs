@@ -483,6 +483,7 @@ fn the_report_has_markdown_html_and_inline_figures() {
         "Control confidence",
         "Task error",
         "## Ranking",
+        "| predicted task error | task error |",
         "best_and_worst.svg",
     ] {
         assert!(md.contains(part), "report.md lacks {part}");
@@ -915,4 +916,88 @@ fn an_episode_too_long_to_hold_is_refused_up_front() {
         );
         assert_eq!(stderr.trim_end().lines().count(), 1);
     }
+}
+
+/// The K rows with the smallest `key` (ties: the earlier row), from an unscreened ranking.
+fn best_rows(all: &Value, key: &str, k: usize, larger_first: bool) -> Vec<u64> {
+    let mut tools: Vec<(f64, u64)> = all["tools"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| (f(t, key), t["row"].as_u64().unwrap()))
+        .collect();
+    tools.sort_by(|a, b| {
+        let by_key = if larger_first {
+            b.0.total_cmp(&a.0)
+        } else {
+            a.0.total_cmp(&b.0)
+        };
+        by_key.then(a.1.cmp(&b.1))
+    });
+    let mut rows: Vec<u64> = tools[..k].iter().map(|t| t.1).collect();
+    rows.sort();
+    rows
+}
+
+fn rows_of(v: &Value) -> Vec<u64> {
+    let mut rows: Vec<u64> = v["tools"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["row"].as_u64().unwrap())
+        .collect();
+    rows.sort();
+    rows
+}
+
+/// By default `--screen K` keeps the K tools with the lowest predicted ∫F dt (∫J dt when ranking
+/// by ∫J dt), the values `rank` without a screen reports for every tool; `--screen-by
+/// confidence` keeps the K most confident; either is the same on 1 and 2 threads.
+#[test]
+fn the_screen_by_prediction_keeps_the_tools_predicted_cheapest() {
+    let base = ["rank", "--tools", DRAWER, "--task", REACH_TASK, "--json"];
+    let all = json_of(&toolconf(&base));
+    for (objective, key) in [
+        ("free-energy", "predicted_free_energy"),
+        ("cost-j", "predicted_cost_j"),
+    ] {
+        let args = [&base[..], &["--screen", "4", "--objective", objective]].concat();
+        let screened = json_of(&toolconf(&args));
+        assert_eq!(screened["screen_by"], "predicted");
+        assert_eq!(
+            rows_of(&screened),
+            best_rows(&all, key, 4, false),
+            "{objective}"
+        );
+        let one = run(&args, Some("1"));
+        let two = run(&args, Some("2"));
+        assert_eq!(
+            json_of(&one)["tools"],
+            json_of(&two)["tools"],
+            "the screen depends on the thread count"
+        );
+    }
+    let args = [&base[..], &["--screen", "4", "--screen-by", "confidence"]].concat();
+    let screened = json_of(&toolconf(&args));
+    assert_eq!(screened["screen_by"], "confidence");
+    assert_eq!(rows_of(&screened), best_rows(&all, "logdet", 4, true));
+    assert!(screened.get("prediction_check").is_none());
+    assert!(all.get("screen_by").is_none(), "no screen, no criterion");
+}
+
+/// `--screen-by` means nothing without `--screen`: a usage error, status 2.
+#[test]
+fn screen_by_without_a_screen_is_a_usage_error() {
+    let out = toolconf(&[
+        "rank",
+        "--tools",
+        DRAWER,
+        "--task",
+        "position",
+        "--screen-by",
+        "predicted",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--screen <SCREEN>"), "{err}");
 }

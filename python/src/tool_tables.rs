@@ -265,7 +265,11 @@ pub fn candidates_from_py(
             } else {
                 Ok(l)
             };
-            Candidate { row, logdet }
+            Candidate {
+                row,
+                logdet,
+                prediction: None,
+            }
         })
         .collect())
 }

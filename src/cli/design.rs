@@ -175,6 +175,14 @@ fn spec_params(spec: &DesignSpec, o: &toolconf::design::solver::Optimum) -> Vec<
     toolconf::design::polytope::Polytope::new(spec).full(&o.x)
 }
 
+/// The predicted cost from the SQP's value: it maximised −ln(task error) or −∫F dt.
+fn predicted_value(objective: toolconf::design::file::DesignObjective, value: f64) -> f64 {
+    match objective {
+        toolconf::design::file::DesignObjective::PredictedTaskError => (-value).exp(),
+        _ => -value,
+    }
+}
+
 fn print_text(spec: &DesignSpec, r: &DesignResult, seconds: f64) {
     let o = &r.confidence_optimum;
     outln!(
@@ -189,6 +197,19 @@ fn print_text(spec: &DesignSpec, r: &DesignResult, seconds: f64) {
             r.free_energy_evaluations,
             parameters_text(&spec.names, &spec_params(spec, o)),
             o.value
+        );
+    }
+    if let Some(p) = &r.predicted_optimum {
+        outln!(
+            "  predicted {}: {:.6e} (KKT residual {:.2e}, {} SQP iterations from start {})",
+            match r.objective {
+                toolconf::design::file::DesignObjective::PredictedTaskError => "task error",
+                _ => "int F dt",
+            },
+            predicted_value(r.objective, p.value),
+            p.kkt_residual,
+            p.iterations,
+            p.start
         );
     }
     outln!("  confidence optimum: KKT residual {:.2e}, {} SQP iterations from start {}, gradient vs central differences {:.1e}", o.kkt_residual, o.iterations, o.start, r.gradient_check);

@@ -1,5 +1,5 @@
-//! `toolconf rank --tools FILE --task NAME|FILE [--screen K] [--objective O] [--json]
-//! [--csv OUT] [--report DIR] [--skip-bad-rows]`: the user's tools on the user's task.
+//! `toolconf rank --tools FILE --task NAME|FILE [--screen K [--screen-by predicted|confidence]]
+//! [--objective O] [--json] [--csv OUT] [--report DIR] [--skip-bad-rows]`: the user's tools on the user's task.
 //!
 //! The whole tools file is read and checked (and every tool's confidence computed) before any
 //! output is created, so bad input leaves nothing half-written.
@@ -9,10 +9,11 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use serde_json::{json, Map, Value};
-use toolconf::evaluation::{barely_moved, ConfidenceCheck};
+use toolconf::evaluation::{barely_moved, ConfidenceCheck, PredictionCheck};
 use toolconf::rank::{
     ranking, screen_file_with_validation, simulate_all, simulate_all_timed, Candidate,
-    ConfidenceTiming, ModelTasks, RankedTool, Screen, ScreenError, SimulationTiming, StageTimings,
+    ConfidenceTiming, ModelTasks, RankedTool, Screen, ScreenBy, ScreenError, SimulationTiming,
+    StageTimings,
 };
 use toolconf::select::Objective;
 use toolconf_files::csv::{Cell, CsvWriter};
@@ -34,9 +35,15 @@ pub struct Args {
     /// The task: a built-in name or a task file.
     #[arg(long, help = format!("The task: a built-in name ({}) or a task file", toolconf_model::task::task_choices()))]
     task: String,
-    /// Simulate only the K most confident tools (largest ln|Pi^U|, computed without simulating).
+    /// Simulate only K tools, chosen without simulating (see --screen-by).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     screen: Option<u64>,
+    /// With --screen: keep the K tools with the lowest predicted cost (predicted: ∫F dt, or ∫J dt
+    /// with --objective cost-j, of the closed loop linearised at the equilibrium; a tool without
+    /// a prediction comes last) or the K most confident (confidence: largest ln|Pi^U|). Default:
+    /// predicted, or confidence with --objective confidence.
+    #[arg(long, value_enum, requires = "screen")]
+    screen_by: Option<ScreenByArg>,
     /// What to rank by: free-energy (the paper's ∫F dt), cost-j (∫J dt) or confidence (ln|Pi^U|).
     #[arg(long, value_enum, default_value_t = ObjectiveArg::FreeEnergy)]
     objective: ObjectiveArg,
@@ -67,6 +74,23 @@ enum ObjectiveArg {
     FreeEnergy,
     CostJ,
     Confidence,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum ScreenByArg {
+    Predicted,
+    Confidence,
+}
+
+/// The screen's criterion: the one asked for, else the prediction of what the ranking minimises
+/// (measured to keep the best tools where confidence does not: docs/explanation/prediction.md),
+/// except when the ranking is by confidence, which the confidence screen keeps exactly.
+fn screen_by(args: &Args) -> ScreenBy {
+    let objective = Objective::from(args.objective);
+    match (args.screen_by, objective) {
+        (Some(ScreenByArg::Confidence), _) | (None, Objective::Confidence) => ScreenBy::Confidence,
+        (Some(ScreenByArg::Predicted), _) | (None, _) => ScreenBy::Predicted(objective),
+    }
 }
 
 impl From<ObjectiveArg> for Objective {
@@ -106,7 +130,7 @@ fn screen_tools(args: &Args, tasks: &ModelTasks) -> Result<(Screen, usize), CliE
         &args.tools,
         tasks,
         &args.task,
-        (limit, validation),
+        (limit, validation, screen_by(args)),
         args.skip_bad_rows,
         |bad| errln!("toolconf: skipping {bad}"),
     )
@@ -262,6 +286,8 @@ struct Counts {
     read: usize,
     skipped: usize,
     without_confidence: usize,
+    without_prediction: usize,
+    first_prediction_error: Option<String>,
 }
 
 pub fn run(args: &Args) -> Result<(), CliError> {
@@ -287,6 +313,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         read: screen.read,
         skipped,
         without_confidence: screen.without_confidence,
+        without_prediction: screen.without_prediction,
+        first_prediction_error: screen.first_prediction_error.clone(),
     };
     let sample = screen.validation_sample();
     let candidates = screen.finish();
@@ -306,12 +334,16 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         simulation,
     };
     let order = ranking(&results, objective);
-    let check = (!sample.is_empty()).then(|| confidence_check(sample, &results, &tasks));
-    let notes = notes(&spec, check.as_ref(), &results);
+    let by = screen_by(args);
+    let checks = (!sample.is_empty()).then(|| validation_checks(sample, &results, &tasks, by));
+    let notes = notes(&spec, checks.as_ref(), by, &counts, &results);
     if args.json {
         let mut out = rank_json(args, &spec, objective, &counts, &results, &order, &timing);
-        if let Some(check) = &check {
+        if let Some((check, prediction)) = &checks {
             out["confidence_check"] = check.json();
+            if let Some(p) = prediction {
+                out["prediction_check"] = p.json();
+            }
         }
         out["notes"] = json!(notes);
         outln!(
@@ -334,7 +366,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             objective,
             read: counts.read,
             skipped: counts.skipped,
-            screen: args.screen.map(|k| k as usize),
+            screen: args.screen.map(|k| (k as usize, by)),
             results: &results,
             order: &order,
             timing: Some(timing),
@@ -433,45 +465,86 @@ fn timing_text(t: &StageTimings) -> String {
     )
 }
 
-/// Claim (a) on the validation sample: its tools' task errors, from the ranking's episodes where
-/// the screen kept them, else simulated here.
-fn confidence_check(
+/// Claim (a) on the validation sample, and with a screen by prediction the prediction's check
+/// on the same tools: their task errors from the ranking's episodes where the screen kept them,
+/// else simulated here.
+fn validation_checks(
     sample: Vec<Candidate>,
     results: &[RankedTool],
     tasks: &ModelTasks,
-) -> ConfidenceCheck {
+    by: ScreenBy,
+) -> (ConfidenceCheck, Option<PredictionCheck>) {
     let sampled = sample.len();
     let (known, extra): (Vec<Candidate>, Vec<Candidate>) = sample
         .into_iter()
         .partition(|c| results.iter().any(|r| r.row.row == c.row.row));
     let episodes = extra.len();
     let simulated = simulate_all(extra, tasks, |_| Ok::<(), ()>(())).unwrap_or_default();
-    let points: Vec<(f64, f64)> = known
+    let tools: Vec<&RankedTool> = known
         .iter()
         .filter_map(|c| results.iter().find(|r| r.row.row == c.row.row))
         .chain(&simulated)
-        .filter_map(|r| {
-            Some((
-                *r.logdet.as_ref().ok()?,
-                r.episode.as_ref().ok()?.task_error,
-            ))
-        })
         .collect();
-    ConfidenceCheck::compute(&points, sampled, episodes, "from the tools file")
+    let points = |x: &dyn Fn(&RankedTool) -> Option<f64>| -> Vec<(f64, f64)> {
+        tools
+            .iter()
+            .filter_map(|r| Some((x(r)?, r.episode.as_ref().ok()?.task_error)))
+            .collect()
+    };
+    let population = "from the tools file";
+    let confidence = ConfidenceCheck::compute(
+        &points(&|r| r.logdet.as_ref().ok().copied()),
+        sampled,
+        episodes,
+        population,
+    );
+    let prediction = by.needs_prediction().then(|| {
+        let without = tools.iter().filter(|r| r.prediction.is_err()).count();
+        PredictionCheck::compute(
+            &points(&|r| r.prediction.as_ref().ok().map(|p| p.task_error)),
+            sampled,
+            without,
+            population,
+        )
+    });
+    (confidence, prediction)
 }
 
-/// What the output and the report add in words: confidence does not predict the task error
-/// (with a screen), or the task barely moved the tools.
-fn notes(spec: &TaskSpec, check: Option<&ConfidenceCheck>, results: &[RankedTool]) -> Vec<String> {
-    let consequence = "the screen keeps the most confident tools, which need not be the best \
-                       here; screen less, or not at all";
+/// What the output and the report add in words: the screen's criterion does not predict the
+/// task error (with a screen), some tools have no prediction (with a screen by prediction), or
+/// the task barely moved the tools.
+fn notes(
+    spec: &TaskSpec,
+    checks: Option<&(ConfidenceCheck, Option<PredictionCheck>)>,
+    by: ScreenBy,
+    counts: &Counts,
+    results: &[RankedTool],
+) -> Vec<String> {
     let progress: Vec<f64> = results
         .iter()
         .filter_map(|r| r.episode.as_ref().ok()?.progress)
         .collect();
+    let check = checks.and_then(|(confidence, prediction)| match (by, prediction) {
+        (ScreenBy::Predicted(_), Some(p)) => p.note(
+            "the screen keeps the tools predicted cheapest, which need not be the best here; \
+             screen by confidence, less, or not at all",
+        ),
+        _ => confidence.note(
+            "the screen keeps the most confident tools, which need not be the best here; \
+             screen less, or not at all",
+        ),
+    });
+    let unpredicted = (by.needs_prediction() && counts.without_prediction > 0).then(|| {
+        format!(
+            "{} tools have no prediction ({}): the screen by prediction ranked them after every \
+             tool with one, in file order",
+            counts.without_prediction,
+            counts.first_prediction_error.as_deref().unwrap_or("")
+        )
+    });
     check
-        .and_then(|c| c.note(consequence))
         .into_iter()
+        .chain(unpredicted)
         .chain(barely_moved(spec.kind, &progress))
         .collect()
 }
@@ -485,7 +558,7 @@ fn rank_json(
     order: &[usize],
     timing: &StageTimings,
 ) -> Value {
-    json!({
+    let mut v = json!({
         "task": spec.kind,
         "task_file": (!spec.file.is_empty()).then_some(&spec.file),
         "tools_file": args.tools,
@@ -503,7 +576,21 @@ fn rank_json(
             .map(|(k, &i)| tool_json(k + 1, &results[i]))
             .collect::<Vec<_>>(),
         "goal": spec.tip_goal.kind_name(),
-    })
+    });
+    // Only with a screen, so that the output without one is unchanged.
+    if args.screen.is_some() {
+        v["screen_by"] = json!(screen_by(args).name());
+        v["without_prediction"] = json!(counts.without_prediction);
+    }
+    v
+}
+
+/// What a screen by prediction minimises, in the table's words.
+fn predicted_name(objective: Objective) -> &'static str {
+    match objective {
+        Objective::CostJ => "int J dt",
+        Objective::FreeEnergy | Objective::Confidence => "int F dt",
+    }
 }
 
 fn print_text(
@@ -525,12 +612,21 @@ fn print_text(
         "integration method: {}",
         spec.episode.method.unwrap_or_default().describe()
     );
-    let screened = args.screen.map_or(String::new(), |k| {
-        format!(
-            "    screened to the {k} most confident ({} without a confidence)",
-            counts.without_confidence
-        )
-    });
+    let screened = args
+        .screen
+        .map_or(String::new(), |k| match screen_by(args) {
+            ScreenBy::Confidence => format!(
+                "    screened to the {k} most confident ({} without a confidence)",
+                counts.without_confidence
+            ),
+            ScreenBy::Predicted(o) => format!(
+            "    screened to the {k} with the lowest predicted {} ({} without a confidence, {} \
+             without a prediction)",
+            predicted_name(o),
+            counts.without_confidence,
+            counts.without_prediction
+        ),
+        });
     outln!(
         "read {} tools    skipped {} bad rows    simulated {}{screened}",
         counts.read,

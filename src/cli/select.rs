@@ -232,7 +232,7 @@ fn evaluate_on_file(
     args: &Args,
     spec: TaskSpec,
     tools: &[toolconf_model::registry::AnyTool],
-) -> Result<Vec<MixedResult>, CliError> {
+) -> Result<(Vec<MixedResult>, Vec<Predicted>), CliError> {
     if args.episode.plant != PlantArg::Paper {
         return Err(CliError::Usage(
             "--plant exact with --task-file and --models: draw arm2_exact tools instead".into(),
@@ -245,14 +245,21 @@ fn evaluate_on_file(
     Ok(tools
         .par_iter()
         .enumerate()
-        .map(|(index, tool)| MixedResult {
-            index,
-            tool: *tool,
-            logdet: tasks.logdet(tool),
-            episode: tasks.simulate(tool),
+        .map(|(index, tool)| {
+            let result = MixedResult {
+                index,
+                tool: *tool,
+                logdet: tasks.logdet(tool),
+                episode: tasks.simulate(tool),
+            };
+            (result, tasks.predict(tool))
         })
-        .collect())
+        .unzip())
 }
+
+/// A tool's predicted cost on a task file's task (`toolconf_model::prediction`), or why there is none.
+type Predicted =
+    Result<toolconf_model::prediction::Prediction, toolconf_model::prediction::PredictionError>;
 
 fn mixed_tool_json(r: &MixedResult) -> Value {
     let params: serde_json::Map<String, Value> = r
@@ -276,8 +283,13 @@ fn run_mixed(args: &Args) -> Result<(), CliError> {
     let mut options = args.episode.options(false)?;
     options.integrator.method = args.method.method.into();
     let tools = draw_mixed_tools(&args.models, args.tools as usize, args.seed)?;
-    let results = match args.task.task_file {
-        None => evaluate_mixed(&tools, kind, &options, args.episode.plant.into()),
+    // With a task file, each tool's prediction too (in the JSON: the built-in tasks' output is
+    // unchanged).
+    let (results, predictions) = match args.task.task_file {
+        None => (
+            evaluate_mixed(&tools, kind, &options, args.episode.plant.into()),
+            Vec::new(),
+        ),
         Some(_) => evaluate_on_file(args, spec, &tools)?,
     };
     let choices: Vec<(MixedObjective, Option<usize>)> = MixedObjective::ALL
@@ -298,7 +310,17 @@ fn run_mixed(args: &Args) -> Result<(), CliError> {
             "method": Method::from(args.method.method).describe(),
             "perturb": options.perturbation,
             "models": models,
-            "tools": results.iter().map(mixed_tool_json).collect::<Vec<_>>(),
+            "tools": results
+                .iter()
+                .enumerate()
+                .map(|(i, r)| {
+                    let mut v = mixed_tool_json(r);
+                    if let Some(p) = predictions.get(i) {
+                        super::prediction::add_prediction(&mut v, p);
+                    }
+                    v
+                })
+                .collect::<Vec<_>>(),
             "choice": choice,
         });
         outln!(

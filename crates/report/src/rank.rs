@@ -10,7 +10,7 @@ use crate::experiments::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use crate::experiments::report::{to_html, to_markdown, Block};
 use crate::experiments::{write_atomically, ReproduceError};
 use crate::view3d;
-use toolconf::rank::{score, ModelTasks, RankedTool, StageTimings, TaskTrace};
+use toolconf::rank::{score, ModelTasks, RankedTool, ScreenBy, StageTimings, TaskTrace};
 use toolconf::select::Objective;
 use toolconf_generated::Read;
 use toolconf_model::inputs::task_file::{PerJoint, PrecisionSpec, TaskSpec};
@@ -25,10 +25,10 @@ pub struct ReportInput<'a> {
     pub spec: &'a TaskSpec,
     pub tasks: &'a ModelTasks,
     pub objective: Objective,
-    /// Tools read, rows skipped as bad, and the screen's K (if any).
+    /// Tools read, rows skipped as bad, and the screen's K and criterion (if any).
     pub read: usize,
     pub skipped: usize,
-    pub screen: Option<usize>,
+    pub screen: Option<(usize, ScreenBy)>,
     /// Simulated tools in file order, and their order from best to worst.
     pub results: &'a [RankedTool],
     pub order: &'a [usize],
@@ -127,8 +127,14 @@ fn introduction(input: &ReportInput) -> Vec<Block> {
     let (var, _) = variable(spec.kind);
     let goal = spec.kind.doc();
     let screened = match input.screen {
-        Some(k) => format!(
+        Some((k, ScreenBy::Confidence)) => format!(
             "Only the {} most confident of the {} tools were simulated (`--screen {k}`).",
+            input.results.len(),
+            input.read
+        ),
+        Some((k, ScreenBy::Predicted(_))) => format!(
+            "Only the {} of the {} tools whose episode the closed loop linearised at the \
+             equilibrium predicts cheapest were simulated (`--screen {k} --screen-by predicted`).",
             input.results.len(),
             input.read
         ),
@@ -365,6 +371,10 @@ fn ranking_table(input: &ReportInput) -> Vec<Block> {
             r.row.tool.model().name().to_string(),
             r.parameters_text(),
             logdet,
+            // The prediction, or why there is none (an unstable linearised loop).
+            r.prediction
+                .as_ref()
+                .map_or_else(|e| format!("– ({})", e.reason()), |p| number(p.task_error)),
         ];
         row.extend(metrics);
         rows.push(row);
@@ -386,6 +396,7 @@ fn ranking_table(input: &ReportInput) -> Vec<Block> {
             "model",
             "parameters",
             "ln|Π^U|",
+            "predicted task error",
             "task error",
             "∫F dt",
             "∫J dt",

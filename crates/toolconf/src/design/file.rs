@@ -38,6 +38,11 @@ pub enum DesignObjective {
     Confidence,
     /// Minimise ∫F dt by simulation, started from the confidence optimum.
     FreeEnergy,
+    /// Minimise the predicted task error of the closed loop linearised at the equilibrium
+    /// ([`toolconf_model::prediction`]; its gradient in [`super::predicted`]).
+    PredictedTaskError,
+    /// Minimise the predicted ∫F dt of the same linearised loop.
+    PredictedFreeEnergy,
 }
 
 impl DesignObjective {
@@ -45,6 +50,8 @@ impl DesignObjective {
         match self {
             DesignObjective::Confidence => "confidence",
             DesignObjective::FreeEnergy => "free_energy",
+            DesignObjective::PredictedTaskError => "predicted_task_error",
+            DesignObjective::PredictedFreeEnergy => "predicted_free_energy",
         }
     }
 }
@@ -144,11 +151,14 @@ impl DesignSpec {
         let objective = match raw.objective.as_deref() {
             None | Some("confidence") => DesignObjective::Confidence,
             Some("free_energy") | Some("free-energy") => DesignObjective::FreeEnergy,
+            Some("predicted_task_error") => DesignObjective::PredictedTaskError,
+            Some("predicted_free_energy") => DesignObjective::PredictedFreeEnergy,
             Some(other) => {
                 return Err(err(
                     "objective",
                     format!(
-                        "'{}' is not an objective (confidence or free_energy)",
+                        "'{}' is not an objective (confidence, free_energy, \
+                         predicted_task_error or predicted_free_energy)",
                         Clip(other)
                     ),
                 ))

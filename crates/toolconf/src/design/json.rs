@@ -99,6 +99,20 @@ fn result_json(spec: &DesignSpec, r: &DesignResult) -> Value {
         "verification": verification,
         "notes": r.confidence_note().into_iter().collect::<Vec<_>>(),
     });
+    // Only for a predicted objective, so that the other objectives' output is unchanged.
+    if let Some(p) = &r.predicted_optimum {
+        let value = match r.objective {
+            super::file::DesignObjective::PredictedTaskError => (-p.value).exp(),
+            _ => -p.value,
+        };
+        v["predicted_optimum"] = json!({
+            "value": value,
+            "kkt_residual": p.kkt_residual,
+            "converged": p.converged(),
+            "iterations": p.iterations,
+            "start": p.start,
+        });
+    }
     // No check at all (no random feasible tool to sample) is a missing key, not a null.
     if let Some(check) = &r.confidence_check {
         v["confidence_check"] = check.json();

@@ -17,6 +17,7 @@ pub mod file;
 pub mod free_energy;
 pub mod json;
 pub mod polytope;
+pub mod predicted;
 pub mod qp;
 pub mod solver;
 pub mod sweep;
@@ -82,15 +83,7 @@ pub fn confidence_optimum(
     setting: &Setting,
 ) -> Result<(Polytope, Optimum), DesignError> {
     let polytope = Polytope::new(spec);
-    let mut starts = vec![polytope.centre(&spec.file)?];
-    let mut sampler = FeasibleSampler::with_spread(&polytope, spec.search.seed, Spread::LogUniform);
-    while starts.len() <= spec.search.starts {
-        match sampler.next_point(100_000) {
-            Some(x) => starts.push(x),
-            None => break,
-        }
-    }
-    starts.extend(polytope.feasible_corners());
+    let starts = starts(spec, &polytope)?;
     let mut objective = |x: &[f64]| setting.confidence(&polytope, x);
     let optimum = solver::maximise(&polytope, &starts, &mut objective)
         .map_err(|f| polytope.solver_failed(&spec.file, "climbing ln|Π^U|", &f.reason, &f.tight))?
@@ -102,6 +95,21 @@ pub fn confidence_optimum(
             ))
         })?;
     Ok((polytope, optimum))
+}
+
+/// The multi-start's starts: the centre, `search.starts` seeded random feasible starts (uniform
+/// in ln p) and the box's feasible corners ([`confidence_optimum`] says why).
+pub fn starts(spec: &DesignSpec, polytope: &Polytope) -> Result<Vec<Vec<f64>>, DesignError> {
+    let mut starts = vec![polytope.centre(&spec.file)?];
+    let mut sampler = FeasibleSampler::with_spread(polytope, spec.search.seed, Spread::LogUniform);
+    while starts.len() <= spec.search.starts {
+        match sampler.next_point(100_000) {
+            Some(x) => starts.push(x),
+            None => break,
+        }
+    }
+    starts.extend(polytope.feasible_corners());
+    Ok(starts)
 }
 
 /// Finite differences of ln|Π^U| at the optimum, for the report's gradient check: the largest
@@ -161,6 +169,9 @@ pub struct DesignResult {
     pub gradient_check: f64,
     /// Simulations of the ∫F search (0 for the confidence objective).
     pub free_energy_evaluations: usize,
+    /// The predicted cost's optimum (the design) for a predicted objective: its value is
+    /// −ln(predicted task error) or −(predicted ∫F dt) ([`predicted::objective`]).
+    pub predicted_optimum: Option<Optimum>,
     pub random: RandomTools,
     /// The design first, then the most confident random tools.
     pub checks: Vec<ToolCheck>,
@@ -192,8 +203,30 @@ pub fn design_with_progress(
 ) -> Result<DesignResult, DesignError> {
     let (polytope, optimum) = confidence_optimum(spec, setting)?;
     let check = gradient_check(setting, &polytope, &optimum);
+    let mut predicted_optimum = None;
     let (x, logdet, evaluations) = match spec.objective {
         DesignObjective::Confidence => (optimum.x.clone(), optimum.value, 0),
+        DesignObjective::PredictedTaskError | DesignObjective::PredictedFreeEnergy => {
+            let which = match spec.objective {
+                DesignObjective::PredictedTaskError => predicted::PredictedCost::TaskError,
+                _ => predicted::PredictedCost::FreeEnergy,
+            };
+            // The confidence optimum is one more start: the design is never worse by the
+            // prediction than the confidence design.
+            let mut from = starts(spec, &polytope)?;
+            from.push(optimum.x.clone());
+            let found = predicted::optimum(spec, setting, &polytope, &from, which)?;
+            let Some((logdet, _)) = setting.confidence(&polytope, &found.x) else {
+                return Err(DesignError::Failed(format!(
+                    "{}: ln|Π^U| is undefined at the predicted optimum {}",
+                    spec.file,
+                    parameters_text(&spec.names, &polytope.full(&found.x))
+                )));
+            };
+            let x = found.x.clone();
+            predicted_optimum = Some(found);
+            (x, logdet, 0)
+        }
         DesignObjective::FreeEnergy => {
             let found = free_energy::minimise(&polytope, setting, &optimum.x)?;
             let Some((logdet, _)) = setting.confidence(&polytope, &found.x) else {
@@ -230,6 +263,7 @@ pub fn design_with_progress(
         confidence_optimum: optimum,
         gradient_check: check,
         free_energy_evaluations: evaluations,
+        predicted_optimum,
         random,
         checks,
         confidence_check,

@@ -2,7 +2,8 @@
 //!
 //! Two stages, as the paper suggests: the cheap one computes every tool's control confidence
 //! Π^U = ∂²F/∂U² and ln|Π^U| in closed form (no simulation), streaming through the tools file
-//! and keeping only the K most confident when screening ([`Screen`]); the expensive one simulates
+//! and keeping only the K most confident when screening ([`Screen`]), or the K whose episode
+//! the linearised closed loop predicts cheapest ([`ScreenBy::Predicted`]); the expensive one simulates
 //! the kept tools' episodes in parallel ([`simulate_all`]) and ranks them by ∫F dt, ∫J dt or
 //! ln|Π^U| ([`ranking`]). A tool whose episode fails keeps its error and goes last.
 //!
@@ -11,12 +12,14 @@
 //! are identical whatever the number of threads.
 
 mod screen;
+mod screen_by;
 mod tasks;
 
 pub use screen::{
     check_screened, screen_file, screen_file_with_validation, screen_rows, Candidate, EachRow,
     Screen, ScreenError, ScreenedBlock,
 };
+pub use screen_by::{predicted_cost, ScreenBy};
 pub use tasks::{AnyEpisode, Linearisation, ModelTasks, TaskTrace, TrajectoryTable};
 
 use std::cmp::Ordering;
@@ -89,7 +92,11 @@ pub fn simulate_all_timed<E>(
                     row: c.row.clone(),
                     logdet: c.logdet.clone(),
                     episode,
-                    prediction: tasks.predict(&c.row.tool),
+                    // The screen's prediction where it made one: the same value.
+                    prediction: c
+                        .prediction
+                        .clone()
+                        .unwrap_or_else(|| tasks.predict(&c.row.tool)),
                 };
                 (r, took)
             })

@@ -1,19 +1,25 @@
 //! The cheap stage: every tool of a file read, checked against the task and given its control
-//! confidence, the [`Screen`] keeping what will be simulated.
+//! confidence (and, when the screen is by prediction, its predicted cost), the [`Screen`]
+//! keeping what will be simulated.
 
 use std::cmp::{Ordering, Reverse};
 use std::collections::BinaryHeap;
 use std::path::Path;
 
-use super::ModelTasks;
+use rayon::prelude::*;
+
+use super::{ModelTasks, ScreenBy};
 use toolconf_model::inputs::tools_file::{read_tools, ToolFileError, ToolRow};
+use toolconf_model::prediction::{Prediction, PredictionError};
 use toolconf_model::Error;
 
-/// A tool that passed the cheap stage, with its confidence.
+/// A tool that passed the cheap stage, with its confidence and, when the screen is by
+/// prediction ([`ScreenBy::Predicted`]), its predicted cost.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Candidate {
     pub row: ToolRow,
     pub logdet: Result<f64, Error>,
+    pub prediction: Option<Result<Prediction, PredictionError>>,
 }
 
 /// A candidate in the validation sample's heap (ordered by its key and row alone).
@@ -39,16 +45,17 @@ impl Ord for SampledCandidate {
     }
 }
 
-/// A candidate in the screen's heap, ordered by confidence; on a tie the later row is less.
+/// A candidate in the screen's heap, ordered by its key ([`ScreenBy::key`]); on a tie the later
+/// row is less.
 struct Screened {
-    logdet: f64,
+    key: f64,
     candidate: Candidate,
 }
 
 impl Ord for Screened {
     fn cmp(&self, other: &Self) -> Ordering {
-        self.logdet
-            .total_cmp(&other.logdet)
+        self.key
+            .total_cmp(&other.key)
             .then(other.candidate.row.row.cmp(&self.candidate.row.row))
     }
 }
@@ -67,10 +74,12 @@ impl PartialEq for Screened {
 
 impl Eq for Screened {}
 
-/// The cheap stage over a stream of tools: keeps every tool, or only the `k` most confident
-/// (largest ln|Π^U|, the earlier row on ties) in O(k) memory.
+/// The cheap stage over a stream of tools: keeps every tool, or only the `k` best by its
+/// criterion ([`ScreenBy`]: by default the largest ln|Π^U|; the earlier row on ties) in O(k)
+/// memory. A tool without a confidence is never kept by a screen.
 pub struct Screen {
     limit: Option<usize>,
+    by: ScreenBy,
     heap: BinaryHeap<Reverse<Screened>>,
     all: Vec<Candidate>,
     /// The validation sample's size ([`Screen::with_validation`]) and its tools, by key.
@@ -81,6 +90,10 @@ pub struct Screen {
     /// Tools whose Π^U is not positive definite (never kept by a screen), and the first reason.
     pub without_confidence: usize,
     pub first_confidence_error: Option<String>,
+    /// Tools with a confidence but no prediction (a screen by prediction ranks them last), and
+    /// the first reason.
+    pub without_prediction: usize,
+    pub first_prediction_error: Option<String>,
 }
 
 impl Screen {
@@ -88,6 +101,7 @@ impl Screen {
     pub fn new(limit: Option<usize>) -> Self {
         Self {
             limit,
+            by: ScreenBy::Confidence,
             heap: BinaryHeap::new(),
             all: Vec::new(),
             validation: 0,
@@ -95,7 +109,22 @@ impl Screen {
             read: 0,
             without_confidence: 0,
             first_confidence_error: None,
+            without_prediction: 0,
+            first_prediction_error: None,
         }
+    }
+
+    /// A screen keeping the `limit` best tools by `by`.
+    pub fn by(limit: Option<usize>, by: ScreenBy) -> Self {
+        Self {
+            by,
+            ..Self::new(limit)
+        }
+    }
+
+    /// The screen's criterion.
+    pub fn criterion(&self) -> ScreenBy {
+        self.by
     }
 
     /// A screen that also keeps a uniform sample of `validation` tools with a confidence, the
@@ -145,6 +174,11 @@ impl Screen {
             self.first_confidence_error
                 .get_or_insert_with(|| e.to_string());
         }
+        if let Some(Err(e)) = &candidate.prediction {
+            self.without_prediction += 1;
+            self.first_prediction_error
+                .get_or_insert_with(|| e.reason());
+        }
         self.keep(candidate);
     }
 
@@ -183,7 +217,8 @@ impl Screen {
         let Ok(logdet) = candidate.logdet else {
             return;
         };
-        let entry = Screened { logdet, candidate };
+        let key = self.by.key(logdet, candidate.prediction.as_ref());
+        let entry = Screened { key, candidate };
         if self.heap.len() < k {
             self.heap.push(Reverse(entry));
         } else if self
@@ -271,26 +306,34 @@ pub fn screen_rows(
     screen_rows_into(screen, tools_file, read, tasks, skip_bad_rows, skipping)
 }
 
-/// [`screen_file`] into a [`Screen::with_validation`]: the kept tools, and a sample of
-/// `validation` tools of the whole file to check claim (a) on.
+/// [`screen_file`] into a [`Screen::with_validation`] by `by`: the kept tools, and a sample of
+/// `validation` tools of the whole file to check claim (a) (or the prediction) on.
 pub fn screen_file_with_validation(
     path: &Path,
     tasks: &ModelTasks,
     task: &str,
-    (limit, validation): (Option<usize>, usize),
+    (limit, validation, by): (Option<usize>, usize, ScreenBy),
     skip_bad_rows: bool,
     skipping: impl FnMut(&ToolFileError),
 ) -> Result<(Screen, usize), ScreenError> {
     let source = toolconf_messages::ClipPath(&path.to_string_lossy()).to_string();
     let read = |each: &mut EachRow| read_tools(path, each);
-    let screen = Screen::with_validation(limit, validation);
+    let screen = Screen {
+        by,
+        ..Screen::with_validation(limit, validation)
+    };
     let (screen, skipped) =
         screen_rows_into(screen, &source, read, tasks, skip_bad_rows, skipping)?;
     check_screened(&screen, skipped, &source, task)?;
     Ok((screen, skipped))
 }
 
-/// The rows `read` gives pushed into `screen`.
+/// How many tools are predicted in parallel before they are pushed, in row order.
+const PREDICTION_CHUNK: usize = 256;
+
+/// The rows `read` gives pushed into `screen`, each with its prediction when the screen needs
+/// one (computed in parallel, a chunk at a time, and pushed in row order: the screen keeps the
+/// same tools whatever the number of threads).
 fn screen_rows_into(
     mut screen: Screen,
     tools_file: &str,
@@ -301,6 +344,8 @@ fn screen_rows_into(
 ) -> Result<(Screen, usize), ScreenError> {
     let mut skipped = 0;
     let mut misfit = None;
+    let predict = screen.by.needs_prediction();
+    let mut pending = Vec::new();
     let read = read(&mut |row| match row {
         Ok(row) => {
             if let Err(e) = tasks.check(row.tool.model()) {
@@ -316,21 +361,16 @@ fn screen_rows_into(
                     row_level: false,
                 });
             }
-            let missing_tip = match toolconf_core::reads_tip(tasks.kind) {
-                true => row.missing_tip(),
-                false => Vec::new(),
-            };
-            let logdet = if missing_tip.is_empty() {
-                tasks.logdet(&row.tool)
-            } else {
-                Err(Error::ToolWithoutTip {
-                    file: tools_file.into(),
-                    row: row.row,
-                    kind: tasks.kind,
-                    columns: missing_tip.join(", "),
-                })
-            };
-            screen.push(Candidate { row, logdet });
+            let candidate = confidence_of(row, tasks, tools_file);
+            match predict {
+                true => {
+                    pending.push(candidate);
+                    if pending.len() == PREDICTION_CHUNK {
+                        push_predicted(&mut screen, std::mem::take(&mut pending), tasks);
+                    }
+                }
+                false => screen.push(candidate),
+            }
             Ok(())
         }
         Err(bad) if skip_bad_rows && bad.row_level => {
@@ -344,7 +384,43 @@ fn screen_rows_into(
         return Err(ScreenError::Input(message));
     }
     read?;
+    push_predicted(&mut screen, pending, tasks);
     Ok((screen, skipped))
+}
+
+/// `row` with its ln|Π^U|, or why it has none (a tip task's tool without its tip).
+fn confidence_of(row: ToolRow, tasks: &ModelTasks, tools_file: &str) -> Candidate {
+    let missing_tip = match toolconf_core::reads_tip(tasks.kind) {
+        true => row.missing_tip(),
+        false => Vec::new(),
+    };
+    let logdet = if missing_tip.is_empty() {
+        tasks.logdet(&row.tool)
+    } else {
+        Err(Error::ToolWithoutTip {
+            file: tools_file.into(),
+            row: row.row,
+            kind: tasks.kind,
+            columns: missing_tip.join(", "),
+        })
+    };
+    Candidate {
+        row,
+        logdet,
+        prediction: None,
+    }
+}
+
+/// `candidates` given their predictions (in parallel; a tool without a confidence is never
+/// kept, so it is not predicted) and pushed in order.
+fn push_predicted(screen: &mut Screen, mut candidates: Vec<Candidate>, tasks: &ModelTasks) {
+    candidates
+        .par_iter_mut()
+        .filter(|c| c.logdet.is_ok())
+        .for_each(|c| c.prediction = Some(tasks.predict(&c.row.tool)));
+    for candidate in candidates {
+        screen.push(candidate);
+    }
 }
 
 /// The whole input's checks after the cheap stage: some row was valid (`skipped` rows were
@@ -377,6 +453,7 @@ pub(super) mod tests {
 
     pub(in crate::rank) fn candidate(row: usize, logdet: Result<f64, Error>) -> Candidate {
         Candidate {
+            prediction: None,
             row: ToolRow {
                 row,
                 name: None,
@@ -441,5 +518,51 @@ pub(super) mod tests {
             }
             assert_eq!(merged.into_block(), whole.into_block(), "{limit:?}");
         }
+    }
+
+    #[test]
+    fn a_screen_by_prediction_keeps_the_cheapest_and_puts_tools_without_one_last() {
+        use crate::select::Objective;
+        use toolconf_model::prediction::Prediction;
+        let predicted = |free_energy: f64| {
+            Some(Ok(Prediction {
+                task_error: 0.0,
+                free_energy,
+                cost_j: -free_energy,
+                perturbation_effect: 0.0,
+                abscissa: -1.0,
+            }))
+        };
+        let unstable = || Some(Err(PredictionError::Unstable { abscissa: 0.5 }));
+        let tools = [
+            (1, unstable()),
+            (2, predicted(3.0)),
+            (3, predicted(1.0)),
+            (4, unstable()),
+            (5, predicted(2.0)),
+            (6, predicted(1.0)),
+        ];
+        let kept = |by: ScreenBy, k: usize| -> (Vec<usize>, usize) {
+            let mut screen = Screen::by(Some(k), by);
+            for (row, p) in tools.clone() {
+                // Confidence orders the rows the other way, so it cannot decide here.
+                let mut c = candidate(row, Ok(row as f64));
+                c.prediction = p;
+                screen.push(c);
+            }
+            let without = screen.without_prediction;
+            (screen.finish().iter().map(|c| c.row.row).collect(), without)
+        };
+        let by_f = ScreenBy::Predicted(Objective::FreeEnergy);
+        assert_eq!(kept(by_f, 2), (vec![3, 6], 2));
+        assert_eq!(kept(by_f, 3), (vec![3, 5, 6], 2));
+        // Fewer tools with a prediction than K: those without come next, the earlier first.
+        assert_eq!(kept(by_f, 5), (vec![1, 2, 3, 5, 6], 2));
+        // Ranking by ∫J dt, the screen minimises predicted ∫J dt (here −∫F dt).
+        assert_eq!(
+            kept(ScreenBy::Predicted(Objective::CostJ), 2),
+            (vec![2, 5], 2)
+        );
+        assert_eq!(kept(ScreenBy::Confidence, 2), (vec![5, 6], 2));
     }
 }

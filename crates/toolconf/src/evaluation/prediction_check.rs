@@ -1,0 +1,113 @@
+//! Whether the prediction ([`toolconf_model::prediction`]) predicts the task error where `rank --screen
+//! --screen-by predicted` follows it: Spearman's ρ(predicted task error, simulated task error)
+//! on the same seeded sample the confidence check simulates ([`super::check`]).
+//!
+//! The rule mirrors claim (a)'s with the prediction's sign: **holds** where the 95 % bootstrap
+//! interval lies above 0 (tools predicted worse do worse), **reversed** below 0, **no
+//! relation** where it contains 0.
+
+use serde_json::{json, Value};
+
+use super::seeds::derive_seed;
+use super::verdict::{Correlation, Finding};
+
+/// Bootstrap resamples of the check's interval (as the confidence check's).
+const RESAMPLES: usize = 2000;
+
+/// ρ(predicted, simulated task error) on the sample, and the verdict by the rule above.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PredictionCheck {
+    pub correlation: Correlation,
+    pub finding: Finding,
+    /// Tools sampled (`correlation.n` counts those with a prediction and an episode).
+    pub sampled: usize,
+    /// Sampled tools without a prediction (an unstable linearised loop).
+    pub without_prediction: usize,
+    pub population: String,
+}
+
+impl PredictionCheck {
+    /// The check on (predicted, simulated task error) of the sampled tools that have both.
+    pub fn compute(
+        points: &[(f64, f64)],
+        sampled: usize,
+        without_prediction: usize,
+        population: &str,
+    ) -> Self {
+        let (x, y): (Vec<f64>, Vec<f64>) = points.iter().copied().unzip();
+        let seed = derive_seed(0, "validation/prediction");
+        let correlation = Correlation::compute(&x, &y, RESAMPLES, 0.95, seed);
+        let finding = match &correlation.ci {
+            Ok(ci) if ci.low > 0.0 => Finding::Holds,
+            Ok(ci) if ci.high < 0.0 => Finding::Reversed,
+            Ok(_) => Finding::NoRelation,
+            Err(_) => Finding::NotJudged,
+        };
+        Self {
+            correlation,
+            finding,
+            sampled,
+            without_prediction,
+            population: population.into(),
+        }
+    }
+
+    /// The one line `rank` prints when the prediction does not predict the task error here
+    /// (`None` when it does); `consequence` says what that means for the command.
+    pub fn note(&self, consequence: &str) -> Option<String> {
+        let what = match self.finding {
+            Finding::Holds => return None,
+            Finding::Reversed => "tools predicted cheaper do the task worse here",
+            Finding::NoRelation => "the prediction says nothing about the task error here",
+            Finding::NotJudged => {
+                "whether the prediction predicts the task error here cannot be judged"
+            }
+        };
+        Some(format!(
+            "{what} ({}, {} tools sampled {} and simulated alongside; {} without a prediction): \
+             {consequence}",
+            self.correlation.describe_short(),
+            self.sampled,
+            self.population,
+            self.without_prediction
+        ))
+    }
+
+    pub fn json(&self) -> Value {
+        json!({
+            "verdict": self.finding.words(),
+            "correlation": self.correlation.json(),
+            "sampled": self.sampled,
+            "without_prediction": self.without_prediction,
+            "population": self.population,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_prediction_that_orders_the_tools_holds_and_one_that_reverses_them_is_said() {
+        let up: Vec<(f64, f64)> = (0..40).map(|i| (i as f64, (i * i) as f64)).collect();
+        let check = PredictionCheck::compute(&up, 40, 0, "of x");
+        assert_eq!(check.finding, Finding::Holds);
+        assert_eq!(check.correlation.rho, Ok(1.0));
+        assert_eq!(check.note("c"), None);
+        let down: Vec<(f64, f64)> = up.iter().map(|&(x, y)| (-x, y)).collect();
+        let check = PredictionCheck::compute(&down, 41, 1, "of x");
+        assert_eq!(check.finding, Finding::Reversed);
+        let note = check.note("so what").unwrap();
+        assert!(
+            note.starts_with("tools predicted cheaper do the task worse here (ρ = −1.00"),
+            "{note}"
+        );
+        assert!(
+            note.ends_with(
+                "41 tools sampled of x and simulated alongside; 1 without a prediction): so what"
+            ),
+            "{note}"
+        );
+    }
+}
