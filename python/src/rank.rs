@@ -58,7 +58,8 @@ fn run(
 ///         makes this mapping of it). In memory, NaN and None are empty cells; rows are named
 ///         ``row N`` (1-based) in errors.
 ///     task: a built-in task name, a task file's path, or a dict with a task file's keys.
-///     screen: simulate only the K most confident tools (K ≥ 1); ``None`` simulates all.
+///     screen: simulate only the K most confident tools (K ≥ 1), as the command line's
+///         ``--screen K --screen-by confidence``; ``None`` simulates all.
 ///     objective: ``"free-energy"`` (the paper's ∫F dt, the default), ``"cost-j"`` (∫J dt) or
 ///         ``"confidence"`` (ln|Π^U|).
 ///     skip_bad_rows: warn about a bad row (``UserWarning``) and go on without it, instead of

@@ -159,7 +159,8 @@ def rank(
             ``tools DataFrame, row 7: m2 = 'heavy' is not a number (tool 'mallet')``.
         task: a built-in task name, a task file's path, or a dict with a task file's keys.
         screen: simulate only the K most confident tools (an integer in [1, 2⁶⁴ − 1], as the
-            command line's ``--screen``); ``None`` simulates all.
+            command line's ``--screen K --screen-by confidence``; the command line's default
+            screen, by the predicted cost, is not yet offered here); ``None`` simulates all.
         objective: ``"free-energy"`` (the paper's ∫F dt, the default), ``"cost-j"`` (∫J dt) or
             ``"confidence"`` (ln|Π^U|).
         skip_bad_rows: warn about a bad row (``UserWarning``) and go on without it, instead of
