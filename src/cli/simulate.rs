@@ -3,10 +3,10 @@
 use std::path::PathBuf;
 
 use serde_json::{json, Value};
-use toolconf::mpc::{MpcModel, MpcOptions, SimulateMpc};
+use toolconf::mpc::{MpcMetrics, MpcModel, MpcOptions, SimulateMpc};
 use toolconf::rank::{ModelTasks, TrajectoryTable};
 use toolconf_integrators::Method;
-use toolconf_model::closed_loop::{Episode, Metrics, Plant};
+use toolconf_model::closed_loop::{Episode, EpisodeOptions, Metrics, Plant};
 use toolconf_model::inputs::task_file::TaskSpec;
 use toolconf_model::model::{episode_on, Arm2, Arm2Exact};
 use toolconf_model::registry::ModelKind;
@@ -258,21 +258,10 @@ fn from_task_file(
     Ok((episode, perturb))
 }
 
+/// `--controller mpc`: one MPC episode of the paper's arm, its metrics checked finite before
+/// anything is written.
 fn run_mpc(args: &Args, arm: &Arm, mut spec: TaskSpec) -> Result<(), CliError> {
-    let (task, options) = match args.task.task_file {
-        None => (
-            Task::paper(spec.kind),
-            args.episode.options(args.csv.is_some())?,
-        ),
-        Some(_) => {
-            args.episode.apply(&mut spec)?;
-            let mut o = spec.episode::<Arm2, 2, 4, 4, 6>()?;
-            let task = two_link_task(&spec, arm, &o)?;
-            o.record_trajectory = args.csv.is_some();
-            let why = "is not supported by the MPC baseline";
-            (task, two_link_options(&o, why)?)
-        }
-    };
+    let (task, options) = mpc_task(args, arm, &mut spec)?;
     let plant = Plant::from(args.episode.plant);
     let mpc = args.mpc.options(options.t_end, options.dt)?;
     let episode = plant.simulate_mpc(arm, &task, &options, &mpc)?;
@@ -289,62 +278,95 @@ fn run_mpc(args: &Args, arm: &Arm, mut spec: TaskSpec) -> Result<(), CliError> {
         write_atomically(path, &TrajectoryTable::from_trajectory(tr).to_csv())?;
     }
     if args.json {
-        let out = json!({
-            "arm": arm,
-            "task": spec.kind,
-            "controller": "mpc",
-            "perturb": options.perturbation,
-            "task_error": m.task_error,
-            "free_energy": m.free_energy,
-            "cost_j": m.cost_j,
-            "control_effort": m.control_effort,
-            "logdet": m.logdet,
-            "rhs_evals": m.rhs_evals,
-            "qp_solves": m.qp_solves,
-            "qp_iterations": m.qp_iterations,
-            "median_solve_time_us": m.median_solve_time.as_secs_f64() * 1e6,
-            "max_solve_time_us": m.max_solve_time.as_secs_f64() * 1e6,
-            "solver_status": m.worst_status,
-        });
+        let out = mpc_json(arm, &spec, &options, m);
         outln!(
             "{}",
             serde_json::to_string_pretty(&out).expect("finite numbers")
         );
     } else {
-        outln!(
-            "arm: {}    task: {}    controller: MPC    perturbation: {} N m",
-            arm,
-            spec.label(),
-            options.perturbation
-        );
-        outln!("task error       {:.9e}", m.task_error);
-        outln!(
-            "integral J dt    {:.9e}  (J*: the cost the MPC achieves)",
-            m.cost_j
-        );
-        outln!(
-            "integral F dt    {:.9e}  (J* - T/2 ln|Pi^U|)",
-            m.free_energy
-        );
-        outln!(
-            "control effort   {:.9e}  (integral |U|^2 dt)",
-            m.control_effort
-        );
-        outln!("ln|Pi^U|         {:.9e}", m.logdet);
-        outln!("rhs evals        {}", m.rhs_evals);
-        outln!(
-            "QP solves        {} ({} iterations, median {:.1} us, max {:.1} us, status {})",
-            m.qp_solves,
-            m.qp_iterations,
-            m.median_solve_time.as_secs_f64() * 1e6,
-            m.max_solve_time.as_secs_f64() * 1e6,
-            m.worst_status
-        );
-        if let Some(path) = &args.csv {
-            outln!("trajectory       {}", path.display());
-        }
+        print_mpc(args, arm, &spec, &options, m);
     }
     Ok(())
+}
+
+/// The MPC episode's task and options: the paper's task with the flags, or the task file's
+/// (its tip goal resolved for `arm`) with the flags over its [episode].
+fn mpc_task(
+    args: &Args,
+    arm: &Arm,
+    spec: &mut TaskSpec,
+) -> Result<(Task, EpisodeOptions), CliError> {
+    Ok(match args.task.task_file {
+        None => (
+            Task::paper(spec.kind),
+            args.episode.options(args.csv.is_some())?,
+        ),
+        Some(_) => {
+            args.episode.apply(spec)?;
+            let mut o = spec.episode::<Arm2, 2, 4, 4, 6>()?;
+            let task = two_link_task(spec, arm, &o)?;
+            o.record_trajectory = args.csv.is_some();
+            let why = "is not supported by the MPC baseline";
+            (task, two_link_options(&o, why)?)
+        }
+    })
+}
+
+/// The `--json` object of an MPC episode.
+fn mpc_json(arm: &Arm, spec: &TaskSpec, options: &EpisodeOptions, m: &MpcMetrics) -> Value {
+    json!({
+        "arm": arm,
+        "task": spec.kind,
+        "controller": "mpc",
+        "perturb": options.perturbation,
+        "task_error": m.task_error,
+        "free_energy": m.free_energy,
+        "cost_j": m.cost_j,
+        "control_effort": m.control_effort,
+        "logdet": m.logdet,
+        "rhs_evals": m.rhs_evals,
+        "qp_solves": m.qp_solves,
+        "qp_iterations": m.qp_iterations,
+        "median_solve_time_us": m.median_solve_time.as_secs_f64() * 1e6,
+        "max_solve_time_us": m.max_solve_time.as_secs_f64() * 1e6,
+        "solver_status": m.worst_status,
+    })
+}
+
+/// The text output of an MPC episode.
+fn print_mpc(args: &Args, arm: &Arm, spec: &TaskSpec, options: &EpisodeOptions, m: &MpcMetrics) {
+    outln!(
+        "arm: {}    task: {}    controller: MPC    perturbation: {} N m",
+        arm,
+        spec.label(),
+        options.perturbation
+    );
+    outln!("task error       {:.9e}", m.task_error);
+    outln!(
+        "integral J dt    {:.9e}  (J*: the cost the MPC achieves)",
+        m.cost_j
+    );
+    outln!(
+        "integral F dt    {:.9e}  (J* - T/2 ln|Pi^U|)",
+        m.free_energy
+    );
+    outln!(
+        "control effort   {:.9e}  (integral |U|^2 dt)",
+        m.control_effort
+    );
+    outln!("ln|Pi^U|         {:.9e}", m.logdet);
+    outln!("rhs evals        {}", m.rhs_evals);
+    outln!(
+        "QP solves        {} ({} iterations, median {:.1} us, max {:.1} us, status {})",
+        m.qp_solves,
+        m.qp_iterations,
+        m.median_solve_time.as_secs_f64() * 1e6,
+        m.max_solve_time.as_secs_f64() * 1e6,
+        m.worst_status
+    );
+    if let Some(path) = &args.csv {
+        outln!("trajectory       {}", path.display());
+    }
 }
 
 /// One episode of a tool of any generated model (`--model M --params …`) on a built-in task or
