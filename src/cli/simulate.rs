@@ -15,23 +15,13 @@ use toolconf_model::{Arm, Task};
 
 use super::episode_args::{two_link_options, EpisodeArgs, PlantArg, TaskArgs};
 use super::output::{check_files, write_atomically, CliError, RunFiles};
-use super::{parse_arm, parse_model, tool_from_params};
+use super::tool_args::ToolArgs;
+use super::tool_from_params;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// The tool: link masses and lengths M1,M2,L1,L2 (kg, m), all > 0, of the paper's arm.
-    #[arg(long, value_parser = parse_arm, allow_hyphen_values = true,
-          required_unless_present = "model", conflicts_with_all = ["model", "params"])]
-    arm: Option<Arm>,
-    /// A tool of any generated model instead of --arm (with --params).
-    #[arg(long, value_parser = parse_model, requires = "params", help = format!(
-        "A tool of any generated model instead of --arm: {} (with --params)",
-        toolconf_generated::MODEL_NAMES.join(", ")))]
-    model: Option<ModelKind>,
-    /// The model's parameters in its order, comma-separated (e.g. m1,m2,l1,l2,mp for
-    /// arm2_payload; `toolconf select --help` lists every model's).
-    #[arg(long, requires = "model", allow_hyphen_values = true)]
-    params: Option<String>,
+    #[command(flatten)]
+    tool: ToolArgs,
     #[command(flatten)]
     task: TaskArgs,
     #[command(flatten)]
@@ -135,7 +125,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         files.output_file("--csv", path);
     }
     check_files(&files)?;
-    let arm = match (args.arm, args.model) {
+    let arm = match (args.tool.arm, args.tool.model) {
         (Some(arm), _) => arm,
         (None, Some(model)) => return run_model(args, model, spec),
         (None, None) => return Err(CliError::Usage("give --arm or --model".into())),
@@ -383,7 +373,7 @@ fn run_model(args: &Args, model: ModelKind, mut spec: TaskSpec) -> Result<(), Cl
                 .into(),
         ));
     }
-    let tool = tool_from_params(model, args.params.as_deref().unwrap_or_default())?;
+    let tool = tool_from_params(model, args.tool.params.as_deref().unwrap_or_default())?;
     args.episode.apply(&mut spec)?;
     spec.episode.method = Some(args.method.method.into());
     let tasks = ModelTasks::new(&spec);
