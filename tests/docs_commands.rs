@@ -542,79 +542,87 @@ fn documented_as(name: &str) -> String {
     name.to_string()
 }
 
-#[test]
-fn the_outputs_reference_names_every_key_and_column() {
-    let reference = read(&Path::new(ROOT).join("docs/reference/outputs.md"));
-    let sandbox = Sandbox::new();
-    let json = |command: &str| -> serde_json::Value {
-        let path = format!(
-            "{}:{}",
-            sandbox.bin.display(),
-            std::env::var("PATH").unwrap_or_default()
-        );
-        let out = Command::new("bash")
-            .args(["-c", command])
-            .current_dir(&sandbox.work)
-            .env("PATH", path)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{command}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{command}: {e}"))
-    };
-    let header = |file: &str| -> BTreeSet<String> {
-        let text = read(&sandbox.work.join(file));
-        text.lines()
-            .find(|l| !l.starts_with('#'))
-            .unwrap()
-            .split(',')
-            .map(documented_as)
-            .collect()
-    };
-    let arm = "--arm 0.3,0.4,0.5,0.2";
-    let panda = "--model panda --params 0.73,0,0,0.06,3e-3,3e-3,1e-3";
-    let drawer = "--tools examples/tools/drawer.csv --task examples/tasks/reach_45.toml --screen 3";
-    let mut names = BTreeSet::new();
-    names.extend(keys(
-        &json(&format!("toolconf confidence {arm} --task velocity --json")),
+/// The commands whose JSON docs/reference/outputs.md documents, each with the paths below the
+/// top level whose keys it documents too (`tools.0`: the first tool's).
+const JSON_OUTPUTS: &[(&str, &[&str])] = &[
+    (
+        "toolconf confidence --arm 0.3,0.4,0.5,0.2 --task velocity --json",
         &[],
-    ));
-    names.extend(keys(
-        &json(&format!(
-            "toolconf simulate {arm} --task position --json --csv arm.csv"
-        )),
+    ),
+    (
+        "toolconf simulate --arm 0.3,0.4,0.5,0.2 --task position --json --csv arm.csv",
         &[],
-    ));
-    names.extend(keys(
-        &json(&format!(
-            "toolconf simulate {panda} --task tip_position --json --csv tip.csv"
-        )),
+    ),
+    (
+        "toolconf simulate --model panda --params 0.73,0,0,0.06,3e-3,3e-3,1e-3 --task tip_position --json --csv tip.csv",
         &[],
-    ));
-    names.extend(keys(
-        &json("toolconf select --task velocity --tools 3 --json"),
+    ),
+    (
+        "toolconf select --task velocity --tools 3 --json",
         &["tools.0", "choice"],
-    ));
-    names.extend(keys(
-        &json(&format!("toolconf rank {drawer} --json --csv ranked.csv")),
+    ),
+    (
+        "toolconf rank --tools examples/tools/drawer.csv --task examples/tasks/reach_45.toml --screen 3 --json --csv ranked.csv",
         &[
             "tools.0",
             "timing",
             "timing.confidence_stage",
             "timing.simulation_stage",
         ],
-    ));
-    names.extend(keys(
-        &json(
-            "toolconf design --task velocity --design examples/design/reach_and_budget.toml --json",
-        ),
+    ),
+    (
+        "toolconf design --task velocity --design examples/design/reach_and_budget.toml --json",
         &["verification.0"],
-    ));
-    for file in ["arm.csv", "tip.csv", "ranked.csv"] {
-        names.extend(header(file));
+    ),
+];
+
+/// The CSV files the commands of [`JSON_OUTPUTS`] write, whose columns the page documents.
+const CSV_OUTPUTS: [&str; 3] = ["arm.csv", "tip.csv", "ranked.csv"];
+
+/// `command`'s standard output as JSON, run by bash in the sandbox with its `toolconf` first on
+/// the PATH; it must succeed.
+fn json_of(sandbox: &Sandbox, command: &str) -> serde_json::Value {
+    let path = format!(
+        "{}:{}",
+        sandbox.bin.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let out = Command::new("bash")
+        .args(["-c", command])
+        .current_dir(&sandbox.work)
+        .env("PATH", path)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{command}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{command}: {e}"))
+}
+
+/// The columns of a CSV file the sandbox's commands wrote (its first line that is not a
+/// comment), as the page writes them.
+fn csv_columns(sandbox: &Sandbox, file: &str) -> BTreeSet<String> {
+    let text = read(&sandbox.work.join(file));
+    text.lines()
+        .find(|l| !l.starts_with('#'))
+        .unwrap()
+        .split(',')
+        .map(documented_as)
+        .collect()
+}
+
+#[test]
+fn the_outputs_reference_names_every_key_and_column() {
+    let reference = read(&Path::new(ROOT).join("docs/reference/outputs.md"));
+    let sandbox = Sandbox::new();
+    let mut names = BTreeSet::new();
+    for (command, nested) in JSON_OUTPUTS {
+        names.extend(keys(&json_of(&sandbox, command), nested));
+    }
+    for file in CSV_OUTPUTS {
+        names.extend(csv_columns(&sandbox, file));
     }
     let missing: Vec<&String> = names
         .iter()

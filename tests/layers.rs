@@ -213,95 +213,107 @@ fn the_on_robot_controller_builds_for_a_bare_metal_target() {
     );
 }
 
-/// The toolconf crates each crate depends on directly (normal edges): one direction of flow,
-/// each part of the runtime's former whole on only what is below it. A new edge is a decision
-/// about the layers, taken here.
+/// The toolconf crates each crate depends on directly (normal edges): (manifest, package, the
+/// toolconf packages it may import). One direction of flow, each part of the runtime's former
+/// whole on only what is below it. A new edge is a decision about the layers, taken here.
+const LAYERS: &[(&str, &str, &[&str])] = &[
+    ("crates/files/Cargo.toml", "toolconf-files", &[]),
+    ("crates/stats/Cargo.toml", "toolconf-stats", &[]),
+    (
+        "crates/messages/Cargo.toml",
+        "toolconf-messages",
+        &["toolconf-core"],
+    ),
+    (
+        "crates/integrators/Cargo.toml",
+        "toolconf-integrators",
+        &["toolconf-core"],
+    ),
+    (
+        "crates/tool-urdf/Cargo.toml",
+        "toolconf-tool-urdf",
+        &["toolconf-files", "toolconf-messages"],
+    ),
+    (
+        "crates/model/Cargo.toml",
+        "toolconf-model",
+        &[
+            "toolconf-cabi",
+            "toolconf-core",
+            "toolconf-files",
+            "toolconf-generated",
+            "toolconf-integrators",
+            "toolconf-messages",
+        ],
+    ),
+    (
+        "crates/toolconf/Cargo.toml",
+        "toolconf",
+        &[
+            "toolconf-core",
+            "toolconf-files",
+            "toolconf-generated",
+            "toolconf-integrators",
+            "toolconf-messages",
+            "toolconf-model",
+            "toolconf-stats",
+        ],
+    ),
+    (
+        "crates/report/Cargo.toml",
+        "toolconf-report",
+        &[
+            "toolconf",
+            "toolconf-files",
+            "toolconf-generated",
+            "toolconf-integrators",
+            "toolconf-model",
+            "toolconf-stats",
+        ],
+    ),
+    (
+        "python/Cargo.toml",
+        "toolconf-python",
+        &[
+            "toolconf",
+            "toolconf-files",
+            "toolconf-generated",
+            "toolconf-integrators",
+            "toolconf-messages",
+            "toolconf-model",
+            "toolconf-tool-urdf",
+        ],
+    ),
+    (
+        "Cargo.toml",
+        "toolconf-cli",
+        &[
+            "toolconf",
+            "toolconf-files",
+            "toolconf-generated",
+            "toolconf-integrators",
+            "toolconf-messages",
+            "toolconf-model",
+            "toolconf-report",
+            "toolconf-tool-urdf",
+        ],
+    ),
+];
+
+/// The crates that carry nothing heavy ([`HEAVY`]): the integrators, the statistics, the
+/// messages and the URDF reader.
+const LIGHT: [&str; 4] = [
+    "crates/integrators/Cargo.toml",
+    "crates/stats/Cargo.toml",
+    "crates/messages/Cargo.toml",
+    "crates/tool-urdf/Cargo.toml",
+];
+
+/// Each crate's direct toolconf dependencies are its row of [`LAYERS`], and the [`LIGHT`]
+/// crates' whole trees hold nothing [`HEAVY`].
 #[test]
 fn each_crate_imports_only_the_layers_below_it() {
-    let layers: [(&str, &str, &[&str]); 10] = [
-        ("crates/files/Cargo.toml", "toolconf-files", &[]),
-        ("crates/stats/Cargo.toml", "toolconf-stats", &[]),
-        (
-            "crates/messages/Cargo.toml",
-            "toolconf-messages",
-            &["toolconf-core"],
-        ),
-        (
-            "crates/integrators/Cargo.toml",
-            "toolconf-integrators",
-            &["toolconf-core"],
-        ),
-        (
-            "crates/tool-urdf/Cargo.toml",
-            "toolconf-tool-urdf",
-            &["toolconf-files", "toolconf-messages"],
-        ),
-        (
-            "crates/model/Cargo.toml",
-            "toolconf-model",
-            &[
-                "toolconf-cabi",
-                "toolconf-core",
-                "toolconf-files",
-                "toolconf-generated",
-                "toolconf-integrators",
-                "toolconf-messages",
-            ],
-        ),
-        (
-            "crates/toolconf/Cargo.toml",
-            "toolconf",
-            &[
-                "toolconf-core",
-                "toolconf-files",
-                "toolconf-generated",
-                "toolconf-integrators",
-                "toolconf-messages",
-                "toolconf-model",
-                "toolconf-stats",
-            ],
-        ),
-        (
-            "crates/report/Cargo.toml",
-            "toolconf-report",
-            &[
-                "toolconf",
-                "toolconf-files",
-                "toolconf-generated",
-                "toolconf-integrators",
-                "toolconf-model",
-                "toolconf-stats",
-            ],
-        ),
-        (
-            "python/Cargo.toml",
-            "toolconf-python",
-            &[
-                "toolconf",
-                "toolconf-files",
-                "toolconf-generated",
-                "toolconf-integrators",
-                "toolconf-messages",
-                "toolconf-model",
-                "toolconf-tool-urdf",
-            ],
-        ),
-        (
-            "Cargo.toml",
-            "toolconf-cli",
-            &[
-                "toolconf",
-                "toolconf-files",
-                "toolconf-generated",
-                "toolconf-integrators",
-                "toolconf-messages",
-                "toolconf-model",
-                "toolconf-report",
-                "toolconf-tool-urdf",
-            ],
-        ),
-    ];
-    for (manifest, package, expected) in layers {
+    for &(manifest, package, expected) in LAYERS {
         let direct = tree(manifest, &["-e", "normal", "--depth", "1"]);
         let ours: BTreeSet<&str> = direct
             .iter()
@@ -311,13 +323,7 @@ fn each_crate_imports_only_the_layers_below_it() {
         let expected: BTreeSet<&str> = expected.iter().copied().collect();
         assert_eq!(ours, expected, "{manifest}'s toolconf dependencies");
     }
-    // The integrators, the statistics, the messages and the URDF reader carry nothing heavy.
-    for manifest in [
-        "crates/integrators/Cargo.toml",
-        "crates/stats/Cargo.toml",
-        "crates/messages/Cargo.toml",
-        "crates/tool-urdf/Cargo.toml",
-    ] {
+    for manifest in LIGHT {
         let all = tree(manifest, &["-e", "normal"]);
         for heavy in HEAVY {
             assert!(!all.contains(heavy), "{heavy} in {manifest}'s tree");

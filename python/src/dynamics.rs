@@ -164,54 +164,87 @@ pub fn tip<'py>(
         ))
         .into_pyerr(py));
     }
-    let (n, np) = (kind.dof(), kind.parameter_names().len());
-    let (p_shape, p_data) = crate::arrays::tool_params(kind, params)?;
-    let (q_shape, q_data) = crate::arrays::float_argument("q", q)?;
+    let params = crate::arrays::tool_params(kind, params)?;
+    let q = crate::arrays::float_argument("q", q)?;
     let rates = q_dot
         .map(|v| crate::arrays::float_argument("q_dot", v))
         .transpose()?;
     if let Some((shape, _)) = &rates {
-        if *shape != q_shape {
+        if *shape != q.0 {
             return Err(Failure::Input(format!(
-                "q_dot of shape {shape:?}: it must have q's shape {q_shape:?}"
+                "q_dot of shape {shape:?}: it must have q's shape {:?}",
+                q.0
             ))
             .into_pyerr(py));
         }
     }
-    let out = detached(py, || {
-        let (p, kp) = rows("params", &p_shape, &p_data, np, kind, "tool parameters")?;
-        let (qs, kq) = rows("q", &q_shape, &q_data, n, kind, "joint positions")?;
-        if let (Some(a), Some(b)) = (kp, kq) {
-            if a != b {
-                return Err(Failure::Input(format!(
-                    "params and q have {a} and {b} rows: the 2-D ones must have the same number"
-                )));
-            }
+    let tips = detached(py, || tips(kind, &params, &q, rates.as_ref()))?;
+    tips_dict(py, tips, kind.dof())
+}
+
+/// An array argument as read from Python: its shape and its values in row-major order.
+type Argument = (Vec<usize>, Vec<f64>);
+
+/// What [`tip`] computes, flat, before it is shaped into arrays: `rows` is the batch's size,
+/// or None for 1-D arguments.
+struct Tips {
+    position: Vec<f64>,
+    jacobian: Vec<f64>,
+    bias: Option<Vec<f64>>,
+    rows: Option<usize>,
+}
+
+/// The tips of the tools `params` at the configurations `q` (and, with `q_dot`, J̇ q̇): the
+/// work [`tip`] does without the GIL, its arguments' rows checked against each other.
+fn tips(
+    kind: ModelKind,
+    params: &Argument,
+    q: &Argument,
+    q_dot: Option<&Argument>,
+) -> Result<Tips, Failure> {
+    let (n, np) = (kind.dof(), kind.parameter_names().len());
+    let (p, kp) = rows("params", &params.0, &params.1, np, kind, "tool parameters")?;
+    let (qs, kq) = rows("q", &q.0, &q.1, n, kind, "joint positions")?;
+    if let (Some(a), Some(b)) = (kp, kq) {
+        if a != b {
+            return Err(Failure::Input(format!(
+                "params and q have {a} and {b} rows: the 2-D ones must have the same number"
+            )));
         }
-        let k = kq.or(kp);
-        let count = k.unwrap_or(1);
-        let what = format!("tips of {count} configurations");
-        let mut position = crate::arrays::zeros(count.saturating_mul(3), &what)?;
-        let mut jacobian = crate::arrays::zeros(count.saturating_mul(3 * n), &what)?;
-        // A 1-D q (or q_dot) is one configuration shared by every tool.
-        let model = kind.model();
-        model
-            .tip(count, &p, &qs, &mut position, &mut jacobian)
-            .map_err(|e| batch_failure(e, &what))?;
-        let bias = match &rates {
-            None => None,
-            Some((shape, data)) => {
-                let (v, _) = rows("q_dot", shape, data, n, kind, "joint velocities")?;
-                let mut bias = crate::arrays::zeros(count.saturating_mul(3), &what)?;
-                model
-                    .tip_bias(count, &p, &qs, &v, &mut bias)
-                    .map_err(|e| batch_failure(e, &what))?;
-                Some(bias)
-            }
-        };
-        Ok((position, jacobian, bias, k))
-    })?;
-    let (position, jacobian, bias, k) = out;
+    }
+    let k = kq.or(kp);
+    let count = k.unwrap_or(1);
+    let what = format!("tips of {count} configurations");
+    let mut position = crate::arrays::zeros(count.saturating_mul(3), &what)?;
+    let mut jacobian = crate::arrays::zeros(count.saturating_mul(3 * n), &what)?;
+    // A 1-D q (or q_dot) is one configuration shared by every tool.
+    let model = kind.model();
+    model
+        .tip(count, &p, &qs, &mut position, &mut jacobian)
+        .map_err(|e| batch_failure(e, &what))?;
+    let bias = match q_dot {
+        None => None,
+        Some((shape, data)) => {
+            let (v, _) = rows("q_dot", shape, data, n, kind, "joint velocities")?;
+            let mut bias = crate::arrays::zeros(count.saturating_mul(3), &what)?;
+            model
+                .tip_bias(count, &p, &qs, &v, &mut bias)
+                .map_err(|e| batch_failure(e, &what))?;
+            Some(bias)
+        }
+    };
+    Ok(Tips {
+        position,
+        jacobian,
+        bias,
+        rows: k,
+    })
+}
+
+/// [`tip`]'s dict: `position` (3,) or (k, 3), `jacobian` (3, n) or (k, 3, n), and `bias` as
+/// `position` when there is one.
+fn tips_dict<'py>(py: Python<'py>, tips: Tips, n: usize) -> PyResult<Bound<'py, PyDict>> {
+    let k = tips.rows;
     let dict = PyDict::new(py);
     let vector = |v: Vec<f64>| -> PyResult<Bound<'py, PyAny>> {
         let a = PyArray1::from_vec(py, v);
@@ -220,13 +253,13 @@ pub fn tip<'py>(
             Some(k) => a.reshape([k, 3])?.into_any(),
         })
     };
-    dict.set_item("position", vector(position)?)?;
-    let jacobian = PyArray1::from_vec(py, jacobian);
+    dict.set_item("position", vector(tips.position)?)?;
+    let jacobian = PyArray1::from_vec(py, tips.jacobian);
     match k {
         None => dict.set_item("jacobian", jacobian.reshape([3, n])?)?,
         Some(k) => dict.set_item("jacobian", jacobian.reshape([k, 3, n])?)?,
     }
-    if let Some(bias) = bias {
+    if let Some(bias) = tips.bias {
         dict.set_item("bias", vector(bias)?)?;
     }
     Ok(dict)

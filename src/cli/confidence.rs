@@ -11,24 +11,15 @@ use toolconf_model::{control_confidence, Arm, Term};
 
 use super::episode_args::TaskArgs;
 use super::output::{matrix_rows, print_matrix, CliError};
-use super::{parse_arm, parse_model, tool_from_params};
+use super::tool_args::{ToolArgs, CONFIDENCE_PARAMS_HELP};
+use super::tool_from_params;
 
 #[derive(clap::Args)]
+// The tool's flags are shared with `simulate`; only --params' help here is this command's own.
+#[command(mut_arg("params", |a| a.help(CONFIDENCE_PARAMS_HELP)))]
 pub struct Args {
-    /// The tool: link masses and lengths M1,M2,L1,L2 (kg, m), all > 0, of the paper's arm.
-    #[arg(long, value_parser = parse_arm, allow_hyphen_values = true,
-          required_unless_present = "model", conflicts_with_all = ["model", "params"])]
-    arm: Option<Arm>,
-    /// A tool of any generated model instead of --arm (with --params).
-    #[arg(long, value_parser = parse_model, requires = "params", help = format!(
-        "A tool of any generated model instead of --arm: {} (with --params)",
-        toolconf_generated::MODEL_NAMES.join(", ")))]
-    model: Option<ModelKind>,
-    /// The model's parameters in its order, comma-separated (panda, ur5: tool_mass, tool_com_x,
-    /// tool_com_y, tool_com_z, tool_ixx, tool_iyy, tool_izz; `toolconf select --help` lists
-    /// every model's).
-    #[arg(long, requires = "model", allow_hyphen_values = true)]
-    params: Option<String>,
+    #[command(flatten)]
+    tool: ToolArgs,
     #[command(flatten)]
     task: TaskArgs,
     /// Print one JSON object instead of text.
@@ -38,7 +29,7 @@ pub struct Args {
 
 pub fn run(args: &Args) -> Result<(), CliError> {
     let spec = args.task.spec()?;
-    match (args.arm, args.model) {
+    match (args.tool.arm, args.tool.model) {
         (Some(arm), _) => run_arm(args, &arm, &spec),
         (None, Some(model)) => run_model(args, model, &spec),
         (None, None) => Err(CliError::Usage("give --arm or --model".into())),
@@ -96,7 +87,7 @@ fn run_arm(args: &Args, arm: &Arm, spec: &TaskSpec) -> Result<(), CliError> {
 /// A tool of any model, through the model-generic runtime: the numbers `rank` and Python's
 /// `toolconf.confidence` give it.
 fn run_model(args: &Args, model: ModelKind, spec: &TaskSpec) -> Result<(), CliError> {
-    let tool = tool_from_params(model, args.params.as_deref().unwrap_or_default())?;
+    let tool = tool_from_params(model, args.tool.params.as_deref().unwrap_or_default())?;
     let tasks = ModelTasks::new(spec);
     tasks.check(model)?;
     let l: Linearisation = tasks.linearisation(&tool)?;

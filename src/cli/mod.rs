@@ -35,6 +35,7 @@ mod select;
 mod simulate;
 mod stdout;
 mod tool;
+mod tool_args;
 
 use std::process::ExitCode;
 

@@ -5,17 +5,18 @@
 
 use rayon::prelude::*;
 use serde_json::{json, Value};
+use toolconf::mpc::{MpcEpisodeError, MpcMetrics};
 use toolconf::rank::ModelTasks;
 use toolconf::select::mixed::{draw_mixed_tools, evaluate_mixed, MixedObjective, MixedResult};
 use toolconf::select::{
     choose_by_mpc_cost, draw_tools, evaluate, evaluate_mpc, Objective, ToolResult,
 };
 use toolconf_integrators::Method;
-use toolconf_model::closed_loop::{EpisodeOptions, Plant};
+use toolconf_model::closed_loop::{EpisodeOptions, Metrics, Plant};
 use toolconf_model::inputs::task_file::TaskSpec;
 use toolconf_model::model::Arm2;
 use toolconf_model::registry::ModelKind;
-use toolconf_model::Task;
+use toolconf_model::{Task, TaskKind};
 
 use super::episode_args::{two_link_options, EpisodeArgs, MethodArgs, PlantArg, TaskArgs};
 use super::output::{add_outcome, CliError};
@@ -60,6 +61,16 @@ fn tool_json(r: &ToolResult) -> Value {
     v
 }
 
+/// What the 2-link selection found: each tool's episode and the tool each objective chooses,
+/// and, with `--mpc`, each tool's MPC episode.
+struct Selection {
+    kind: TaskKind,
+    options: EpisodeOptions,
+    results: Vec<ToolResult>,
+    choices: Vec<(Objective, Option<usize>)>,
+    mpc: Option<Vec<Result<MpcMetrics, MpcEpisodeError>>>,
+}
+
 pub fn run(args: &Args) -> Result<(), CliError> {
     if args.models != [ModelKind::PAPER_ARM] {
         if args.mpc {
@@ -70,55 +81,81 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         }
         return run_mixed(args);
     }
+    let selection = select(args)?;
+    let errors = selection
+        .results
+        .iter()
+        .filter_map(|r| r.episode.as_ref().err());
+    let outcome = every_tool_failed(selection.results.len(), errors);
+    if args.json {
+        let out = selection_json(args, &selection);
+        outln!(
+            "{}",
+            serde_json::to_string_pretty(&out).expect("finite numbers")
+        );
+    } else {
+        print_selection(args, &selection);
+    }
+    outcome
+}
+
+/// Draws the tools and runs each one's episode (and MPC episode, with `--mpc`).
+fn select(args: &Args) -> Result<Selection, CliError> {
     let (task, options) = two_link_task(args)?;
     let mpc_options = match args.mpc {
         true => Some(args.mpc_options.options(options.t_end, options.dt)?),
         false => None,
     };
-    let kind = task.kind;
     let tools = draw_tools(args.tools as usize, args.seed);
     let plant = Plant::from(args.episode.plant);
     let results = evaluate(&tools, &task, &options, plant);
-    let choices: Vec<(Objective, Option<usize>)> = Objective::ALL
+    let choices = Objective::ALL
         .iter()
         .map(|o| (*o, o.choose(&results)))
         .collect();
     let mpc = mpc_options.map(|o| evaluate_mpc(&tools, &task, &options, &o, plant));
-    let errors = results.iter().filter_map(|r| r.episode.as_ref().err());
-    let outcome = every_tool_failed(results.len(), errors);
-    if args.json {
-        let mut choice = serde_json::Map::new();
-        for (o, c) in &choices {
-            choice.insert(o.name().into(), json!(c));
-        }
-        let mut tools_json: Vec<Value> = results.iter().map(tool_json).collect();
-        if let Some(mpc) = &mpc {
-            choice.insert("mpc_cost".into(), json!(choose_by_mpc_cost(mpc)));
-            for (t, r) in tools_json.iter_mut().zip(mpc) {
-                match r {
-                    Ok(m) => t["mpc_cost"] = json!(m.cost_j),
-                    Err(e) => t["mpc_error"] = json!(e.to_string()),
-                }
+    Ok(Selection {
+        kind: task.kind,
+        options,
+        results,
+        choices,
+        mpc,
+    })
+}
+
+/// The `--json` object of a 2-link selection.
+fn selection_json(args: &Args, s: &Selection) -> Value {
+    let mut choice = serde_json::Map::new();
+    for (o, c) in &s.choices {
+        choice.insert(o.name().into(), json!(c));
+    }
+    let mut tools_json: Vec<Value> = s.results.iter().map(tool_json).collect();
+    if let Some(mpc) = &s.mpc {
+        choice.insert("mpc_cost".into(), json!(choose_by_mpc_cost(mpc)));
+        for (t, r) in tools_json.iter_mut().zip(mpc) {
+            match r {
+                Ok(m) => t["mpc_cost"] = json!(m.cost_j),
+                Err(e) => t["mpc_error"] = json!(e.to_string()),
             }
         }
-        let out = json!({
-            "task": kind,
-            "seed": args.seed,
-            "method": Method::from(args.method.method).describe(),
-            "perturb": options.perturbation,
-            "tools": tools_json,
-            "choice": choice,
-        });
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&out).expect("finite numbers")
-        );
-        return outcome;
     }
+    json!({
+        "task": s.kind,
+        "seed": args.seed,
+        "method": Method::from(args.method.method).describe(),
+        "perturb": s.options.perturbation,
+        "tools": tools_json,
+        "choice": choice,
+    })
+}
+
+/// The text output of a 2-link selection: the header, a row per tool, the MPC costs, the
+/// choices.
+fn print_selection(args: &Args, s: &Selection) {
     outln!(
         "task: {} (task {})    tools: {}    seed: {}",
-        kind,
-        kind.paper_index(),
+        s.kind,
+        s.kind.paper_index(),
         args.tools,
         args.seed
     );
@@ -138,31 +175,10 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         "int F dt",
         "int J dt"
     );
-    for r in &results {
-        let logdet = r
-            .logdet
-            .as_ref()
-            .map_or("error".to_string(), |l| format!("{l:.6}"));
-        let metrics = match &r.episode {
-            Ok(m) => format!(
-                "{:>14.6e} {:>14.6e} {:>14.6e}",
-                m.task_error, m.free_energy, m.cost_j
-            ),
-            Err(e) => format!("failed: {e}"),
-        };
-        let p = r.arm.params();
-        outln!(
-            "{:>5}  {:>7.4} {:>7.4} {:>7.4} {:>7.4}  {:>12} {}",
-            r.index,
-            p[0],
-            p[1],
-            p[2],
-            p[3],
-            logdet,
-            metrics
-        );
+    for r in &s.results {
+        print_tool_row(r);
     }
-    if let Some(mpc) = &mpc {
+    if let Some(mpc) = &s.mpc {
         for (i, r) in mpc.iter().enumerate() {
             match r {
                 Ok(m) => outln!("tool {i:>3}  J* (MPC int J dt) {:>14.6e}", m.cost_j),
@@ -170,13 +186,13 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             }
         }
     }
-    for (o, c) in &choices {
+    for (o, c) in &s.choices {
         match c {
             Some(i) => outln!("chosen by {:<12} tool {i}", o.name()),
             None => outln!("chosen by {:<12} none (every tool failed)", o.name()),
         }
     }
-    if let Some(mpc) = &mpc {
+    if let Some(mpc) = &s.mpc {
         match choose_by_mpc_cost(mpc) {
             Some(i) => outln!("chosen by {:<12} tool {i}", "mpc_cost"),
             None => outln!(
@@ -185,7 +201,36 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             ),
         }
     }
-    outcome
+}
+
+/// A 2-link tool's row: its parameters, ln|Π^U| and the episode's metrics (or why it failed).
+fn print_tool_row(r: &ToolResult) {
+    let logdet = r
+        .logdet
+        .as_ref()
+        .map_or("error".to_string(), |l| format!("{l:.6}"));
+    let p = r.arm.params();
+    outln!(
+        "{:>5}  {:>7.4} {:>7.4} {:>7.4} {:>7.4}  {:>12} {}",
+        r.index,
+        p[0],
+        p[1],
+        p[2],
+        p[3],
+        logdet,
+        metrics_cells(&r.episode)
+    );
+}
+
+/// An episode's three metric columns (task error, ∫F dt, ∫J dt), or `failed: <why>`.
+fn metrics_cells<E: std::fmt::Display>(episode: &Result<Metrics, E>) -> String {
+    match episode {
+        Ok(m) => format!(
+            "{:>14.6e} {:>14.6e} {:>14.6e}",
+            m.task_error, m.free_energy, m.cost_j
+        ),
+        Err(e) => format!("failed: {e}"),
+    }
 }
 
 /// A batch succeeds if one tool's episode did (the others' failures are in its output); if
@@ -276,8 +321,39 @@ fn mixed_tool_json(r: &MixedResult) -> Value {
     v
 }
 
+/// What a selection over several models found: each tool's episode on its own model's task and
+/// the tool each objective chooses.
+struct MixedSelection {
+    kind: TaskKind,
+    options: EpisodeOptions,
+    results: Vec<MixedResult>,
+    /// With a task file, each tool's predicted cost, in the order of `results`; else empty.
+    predictions: Vec<Predicted>,
+    choices: Vec<(MixedObjective, Option<usize>)>,
+}
+
 /// Selection over tools of several models (each on its own model's paper-style task).
 fn run_mixed(args: &Args) -> Result<(), CliError> {
+    let selection = select_mixed(args)?;
+    let errors = selection
+        .results
+        .iter()
+        .filter_map(|r| r.episode.as_ref().err());
+    let outcome = every_tool_failed(selection.results.len(), errors);
+    if args.json {
+        let out = mixed_selection_json(args, &selection);
+        outln!(
+            "{}",
+            serde_json::to_string_pretty(&out).expect("finite numbers")
+        );
+    } else {
+        print_mixed_selection(args, &selection);
+    }
+    outcome
+}
+
+/// Draws the tools of the models and runs each one's episode.
+fn select_mixed(args: &Args) -> Result<MixedSelection, CliError> {
     let spec = args.task.spec()?;
     let kind = spec.kind;
     let mut options = args.episode.options(false)?;
@@ -292,47 +368,60 @@ fn run_mixed(args: &Args) -> Result<(), CliError> {
         ),
         Some(_) => evaluate_on_file(args, spec, &tools)?,
     };
-    let choices: Vec<(MixedObjective, Option<usize>)> = MixedObjective::ALL
+    let choices = MixedObjective::ALL
         .iter()
         .map(|o| (*o, o.choose(&results)))
         .collect();
-    let errors = results.iter().filter_map(|r| r.episode.as_ref().err());
-    let outcome = every_tool_failed(results.len(), errors);
-    let models: Vec<&str> = args.models.iter().map(|m| m.name()).collect();
-    if args.json {
-        let mut choice = serde_json::Map::new();
-        for (o, c) in &choices {
-            choice.insert(o.name().into(), json!(c));
-        }
-        let out = json!({
-            "task": kind,
-            "seed": args.seed,
-            "method": Method::from(args.method.method).describe(),
-            "perturb": options.perturbation,
-            "models": models,
-            "tools": results
-                .iter()
-                .enumerate()
-                .map(|(i, r)| {
-                    let mut v = mixed_tool_json(r);
-                    if let Some(p) = predictions.get(i) {
-                        super::prediction::add_prediction(&mut v, p);
-                    }
-                    v
-                })
-                .collect::<Vec<_>>(),
-            "choice": choice,
-        });
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&out).expect("finite numbers")
-        );
-        return outcome;
+    Ok(MixedSelection {
+        kind,
+        options,
+        results,
+        predictions,
+        choices,
+    })
+}
+
+/// The names of `--models`, in their order.
+fn model_names(args: &Args) -> Vec<&'static str> {
+    args.models.iter().map(|m| m.name()).collect()
+}
+
+/// The `--json` object of a selection over several models.
+fn mixed_selection_json(args: &Args, s: &MixedSelection) -> Value {
+    let mut choice = serde_json::Map::new();
+    for (o, c) in &s.choices {
+        choice.insert(o.name().into(), json!(c));
     }
+    json!({
+        "task": s.kind,
+        "seed": args.seed,
+        "method": Method::from(args.method.method).describe(),
+        "perturb": s.options.perturbation,
+        "models": model_names(args),
+        "tools": s
+            .results
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                let mut v = mixed_tool_json(r);
+                if let Some(p) = s.predictions.get(i) {
+                    super::prediction::add_prediction(&mut v, p);
+                }
+                v
+            })
+            .collect::<Vec<_>>(),
+        "choice": choice,
+    })
+}
+
+/// The text output of a selection over several models: the header, a row per tool, the
+/// choices (each naming the chosen tool's model).
+fn print_mixed_selection(args: &Args, s: &MixedSelection) {
+    let models = model_names(args);
     outln!(
         "task: {} (task {})    tools: {}    seed: {}    models: {}",
-        kind,
-        kind.paper_index(),
+        s.kind,
+        s.kind.paper_index(),
         args.tools,
         args.seed,
         models.join(",")
@@ -353,43 +442,40 @@ fn run_mixed(args: &Args) -> Result<(), CliError> {
         "int F dt",
         "int J dt"
     );
-    for r in &results {
-        let (logdet, per_joint) = match (&r.logdet, r.logdet_per_joint()) {
-            (Ok(l), Some(n)) => (format!("{l:.6}"), format!("{n:.6}")),
-            _ => ("error".to_string(), "error".to_string()),
-        };
-        let metrics = match &r.episode {
-            Ok(m) => format!(
-                "{:>14.6e} {:>14.6e} {:>14.6e}",
-                m.task_error, m.free_energy, m.cost_j
-            ),
-            Err(e) => format!("failed: {e}"),
-        };
-        let params: Vec<String> = r
-            .tool
-            .named_parameters()
-            .into_iter()
-            .map(|(name, value)| format!("{name}={value:.4}"))
-            .collect();
-        outln!(
-            "{:>5}  {:<w$} {:>12} {:>12}  {}  {}",
-            r.index,
-            r.model().name(),
-            logdet,
-            per_joint,
-            metrics,
-            params.join(" ")
-        );
+    for r in &s.results {
+        print_mixed_tool_row(r, w);
     }
-    for (o, c) in &choices {
+    for (o, c) in &s.choices {
         match c {
             Some(i) => outln!(
                 "chosen by {:<21} tool {i} ({})",
                 o.name(),
-                results[*i].model().name()
+                s.results[*i].model().name()
             ),
             None => outln!("chosen by {:<21} none (every tool failed)", o.name()),
         }
     }
-    outcome
+}
+
+/// A tool's row in a selection over several models, the model column `w` wide.
+fn print_mixed_tool_row(r: &MixedResult, w: usize) {
+    let (logdet, per_joint) = match (&r.logdet, r.logdet_per_joint()) {
+        (Ok(l), Some(n)) => (format!("{l:.6}"), format!("{n:.6}")),
+        _ => ("error".to_string(), "error".to_string()),
+    };
+    let params: Vec<String> = r
+        .tool
+        .named_parameters()
+        .into_iter()
+        .map(|(name, value)| format!("{name}={value:.4}"))
+        .collect();
+    outln!(
+        "{:>5}  {:<w$} {:>12} {:>12}  {}  {}",
+        r.index,
+        r.model().name(),
+        logdet,
+        per_joint,
+        metrics_cells(&r.episode),
+        params.join(" ")
+    );
 }

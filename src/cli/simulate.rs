@@ -3,10 +3,10 @@
 use std::path::PathBuf;
 
 use serde_json::{json, Value};
-use toolconf::mpc::{MpcModel, MpcOptions, SimulateMpc};
+use toolconf::mpc::{MpcMetrics, MpcModel, MpcOptions, SimulateMpc};
 use toolconf::rank::{ModelTasks, TrajectoryTable};
 use toolconf_integrators::Method;
-use toolconf_model::closed_loop::{Episode, Metrics, Plant};
+use toolconf_model::closed_loop::{Episode, EpisodeOptions, Metrics, Plant};
 use toolconf_model::inputs::task_file::TaskSpec;
 use toolconf_model::model::{episode_on, Arm2, Arm2Exact};
 use toolconf_model::registry::ModelKind;
@@ -15,23 +15,13 @@ use toolconf_model::{Arm, Task};
 
 use super::episode_args::{two_link_options, EpisodeArgs, PlantArg, TaskArgs};
 use super::output::{check_files, write_atomically, CliError, RunFiles};
-use super::{parse_arm, parse_model, tool_from_params};
+use super::tool_args::ToolArgs;
+use super::tool_from_params;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// The tool: link masses and lengths M1,M2,L1,L2 (kg, m), all > 0, of the paper's arm.
-    #[arg(long, value_parser = parse_arm, allow_hyphen_values = true,
-          required_unless_present = "model", conflicts_with_all = ["model", "params"])]
-    arm: Option<Arm>,
-    /// A tool of any generated model instead of --arm (with --params).
-    #[arg(long, value_parser = parse_model, requires = "params", help = format!(
-        "A tool of any generated model instead of --arm: {} (with --params)",
-        toolconf_generated::MODEL_NAMES.join(", ")))]
-    model: Option<ModelKind>,
-    /// The model's parameters in its order, comma-separated (e.g. m1,m2,l1,l2,mp for
-    /// arm2_payload; `toolconf select --help` lists every model's).
-    #[arg(long, requires = "model", allow_hyphen_values = true)]
-    params: Option<String>,
+    #[command(flatten)]
+    tool: ToolArgs,
     #[command(flatten)]
     task: TaskArgs,
     #[command(flatten)]
@@ -135,7 +125,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         files.output_file("--csv", path);
     }
     check_files(&files)?;
-    let arm = match (args.arm, args.model) {
+    let arm = match (args.tool.arm, args.tool.model) {
         (Some(arm), _) => arm,
         (None, Some(model)) => return run_model(args, model, spec),
         (None, None) => return Err(CliError::Usage("give --arm or --model".into())),
@@ -258,21 +248,10 @@ fn from_task_file(
     Ok((episode, perturb))
 }
 
+/// `--controller mpc`: one MPC episode of the paper's arm, its metrics checked finite before
+/// anything is written.
 fn run_mpc(args: &Args, arm: &Arm, mut spec: TaskSpec) -> Result<(), CliError> {
-    let (task, options) = match args.task.task_file {
-        None => (
-            Task::paper(spec.kind),
-            args.episode.options(args.csv.is_some())?,
-        ),
-        Some(_) => {
-            args.episode.apply(&mut spec)?;
-            let mut o = spec.episode::<Arm2, 2, 4, 4, 6>()?;
-            let task = two_link_task(&spec, arm, &o)?;
-            o.record_trajectory = args.csv.is_some();
-            let why = "is not supported by the MPC baseline";
-            (task, two_link_options(&o, why)?)
-        }
-    };
+    let (task, options) = mpc_task(args, arm, &mut spec)?;
     let plant = Plant::from(args.episode.plant);
     let mpc = args.mpc.options(options.t_end, options.dt)?;
     let episode = plant.simulate_mpc(arm, &task, &options, &mpc)?;
@@ -289,62 +268,95 @@ fn run_mpc(args: &Args, arm: &Arm, mut spec: TaskSpec) -> Result<(), CliError> {
         write_atomically(path, &TrajectoryTable::from_trajectory(tr).to_csv())?;
     }
     if args.json {
-        let out = json!({
-            "arm": arm,
-            "task": spec.kind,
-            "controller": "mpc",
-            "perturb": options.perturbation,
-            "task_error": m.task_error,
-            "free_energy": m.free_energy,
-            "cost_j": m.cost_j,
-            "control_effort": m.control_effort,
-            "logdet": m.logdet,
-            "rhs_evals": m.rhs_evals,
-            "qp_solves": m.qp_solves,
-            "qp_iterations": m.qp_iterations,
-            "median_solve_time_us": m.median_solve_time.as_secs_f64() * 1e6,
-            "max_solve_time_us": m.max_solve_time.as_secs_f64() * 1e6,
-            "solver_status": m.worst_status,
-        });
+        let out = mpc_json(arm, &spec, &options, m);
         outln!(
             "{}",
             serde_json::to_string_pretty(&out).expect("finite numbers")
         );
     } else {
-        outln!(
-            "arm: {}    task: {}    controller: MPC    perturbation: {} N m",
-            arm,
-            spec.label(),
-            options.perturbation
-        );
-        outln!("task error       {:.9e}", m.task_error);
-        outln!(
-            "integral J dt    {:.9e}  (J*: the cost the MPC achieves)",
-            m.cost_j
-        );
-        outln!(
-            "integral F dt    {:.9e}  (J* - T/2 ln|Pi^U|)",
-            m.free_energy
-        );
-        outln!(
-            "control effort   {:.9e}  (integral |U|^2 dt)",
-            m.control_effort
-        );
-        outln!("ln|Pi^U|         {:.9e}", m.logdet);
-        outln!("rhs evals        {}", m.rhs_evals);
-        outln!(
-            "QP solves        {} ({} iterations, median {:.1} us, max {:.1} us, status {})",
-            m.qp_solves,
-            m.qp_iterations,
-            m.median_solve_time.as_secs_f64() * 1e6,
-            m.max_solve_time.as_secs_f64() * 1e6,
-            m.worst_status
-        );
-        if let Some(path) = &args.csv {
-            outln!("trajectory       {}", path.display());
-        }
+        print_mpc(args, arm, &spec, &options, m);
     }
     Ok(())
+}
+
+/// The MPC episode's task and options: the paper's task with the flags, or the task file's
+/// (its tip goal resolved for `arm`) with the flags over its [episode].
+fn mpc_task(
+    args: &Args,
+    arm: &Arm,
+    spec: &mut TaskSpec,
+) -> Result<(Task, EpisodeOptions), CliError> {
+    Ok(match args.task.task_file {
+        None => (
+            Task::paper(spec.kind),
+            args.episode.options(args.csv.is_some())?,
+        ),
+        Some(_) => {
+            args.episode.apply(spec)?;
+            let mut o = spec.episode::<Arm2, 2, 4, 4, 6>()?;
+            let task = two_link_task(spec, arm, &o)?;
+            o.record_trajectory = args.csv.is_some();
+            let why = "is not supported by the MPC baseline";
+            (task, two_link_options(&o, why)?)
+        }
+    })
+}
+
+/// The `--json` object of an MPC episode.
+fn mpc_json(arm: &Arm, spec: &TaskSpec, options: &EpisodeOptions, m: &MpcMetrics) -> Value {
+    json!({
+        "arm": arm,
+        "task": spec.kind,
+        "controller": "mpc",
+        "perturb": options.perturbation,
+        "task_error": m.task_error,
+        "free_energy": m.free_energy,
+        "cost_j": m.cost_j,
+        "control_effort": m.control_effort,
+        "logdet": m.logdet,
+        "rhs_evals": m.rhs_evals,
+        "qp_solves": m.qp_solves,
+        "qp_iterations": m.qp_iterations,
+        "median_solve_time_us": m.median_solve_time.as_secs_f64() * 1e6,
+        "max_solve_time_us": m.max_solve_time.as_secs_f64() * 1e6,
+        "solver_status": m.worst_status,
+    })
+}
+
+/// The text output of an MPC episode.
+fn print_mpc(args: &Args, arm: &Arm, spec: &TaskSpec, options: &EpisodeOptions, m: &MpcMetrics) {
+    outln!(
+        "arm: {}    task: {}    controller: MPC    perturbation: {} N m",
+        arm,
+        spec.label(),
+        options.perturbation
+    );
+    outln!("task error       {:.9e}", m.task_error);
+    outln!(
+        "integral J dt    {:.9e}  (J*: the cost the MPC achieves)",
+        m.cost_j
+    );
+    outln!(
+        "integral F dt    {:.9e}  (J* - T/2 ln|Pi^U|)",
+        m.free_energy
+    );
+    outln!(
+        "control effort   {:.9e}  (integral |U|^2 dt)",
+        m.control_effort
+    );
+    outln!("ln|Pi^U|         {:.9e}", m.logdet);
+    outln!("rhs evals        {}", m.rhs_evals);
+    outln!(
+        "QP solves        {} ({} iterations, median {:.1} us, max {:.1} us, status {})",
+        m.qp_solves,
+        m.qp_iterations,
+        m.median_solve_time.as_secs_f64() * 1e6,
+        m.max_solve_time.as_secs_f64() * 1e6,
+        m.worst_status
+    );
+    if let Some(path) = &args.csv {
+        outln!("trajectory       {}", path.display());
+    }
 }
 
 /// One episode of a tool of any generated model (`--model M --params …`) on a built-in task or
@@ -361,7 +373,7 @@ fn run_model(args: &Args, model: ModelKind, mut spec: TaskSpec) -> Result<(), Cl
                 .into(),
         ));
     }
-    let tool = tool_from_params(model, args.params.as_deref().unwrap_or_default())?;
+    let tool = tool_from_params(model, args.tool.params.as_deref().unwrap_or_default())?;
     args.episode.apply(&mut spec)?;
     spec.episode.method = Some(args.method.method.into());
     let tasks = ModelTasks::new(&spec);

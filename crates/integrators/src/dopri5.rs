@@ -146,6 +146,7 @@ fn interpolate<const D: usize>(
 /// The `ode45` main loop over a validated grid and settings. With a `detector`, the steps are
 /// also tested for stiffness and the integration stops at the end of the step the detector
 /// fires on (the steps taken until then are exactly those without a detector).
+// A transcription of Dormand–Prince with MATLAB ode45's control (ode45.m): kept whole to be read beside it.
 pub(super) fn integrate<const D: usize, F, O>(
     mut rhs: F,
     y0: &SVector<f64, D>,

@@ -129,6 +129,7 @@ pub(super) trait Stepper<const D: usize, const S: usize> {
 /// The main loop of any stiffly accurate method in the form of [`Tableau`], its steps taken by
 /// `stepper`: `ode45`'s step-size rules, `hmin`, the stretch onto `tf`, singular matrices and
 /// output at the grid points.
+// A transcription of Hairer & Wanner's RODAS (rodas.f) / Steinebach's Rodas5P: kept whole to be read beside it.
 pub(super) fn run<const D: usize, const S: usize, P, O, M>(
     tab: &Tableau<S>,
     stepper: &M,

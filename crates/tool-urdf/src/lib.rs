@@ -459,54 +459,121 @@ mod tests {
         );
     }
 
+    /// A valid file: two links on a fixed joint, the one [`BAD_EDITS`] and [`bad_files`] spoil.
+    const OK: &str = r#"<robot name="x"><link name="a"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link><link name="b"/><joint name="j" type="fixed"><parent link="a"/><child link="b"/><origin xyz="0 0 1"/></joint></robot>"#;
+
+    /// One edit of [`OK`] (its first `from` made `to`) and what the message then says.
+    const BAD_EDITS: &[(&str, &str, &str)] = &[
+        ("<robot", "", "not a well-formed XML file"),
+        (
+            "xyz=\"0 0 1\"",
+            "xyz=\"0 0\"",
+            "xyz = '0 0' has 2 numbers, not 3",
+        ),
+        ("xyz=\"0 0 1\"", "xyz=\"0 0 nan\"", "'nan' is not finite"),
+        (
+            "value=\"1\"",
+            "value=\"-1\"",
+            "<mass> value = -1 is negative",
+        ),
+        (
+            "value=\"1\"",
+            "value=\"heavy\"",
+            "value = 'heavy' is not a number",
+        ),
+        (
+            "<child link=\"b\"/>",
+            "<child link=\"c\"/>",
+            "link = 'c' is no link of the file",
+        ),
+        (
+            "<child link=\"b\"/>",
+            "<child link=\"a\"/>",
+            "joins link 'a' to itself",
+        ),
+        (
+            "type=\"fixed\"",
+            "type=\"hinge\"",
+            "'hinge' is not a URDF joint type",
+        ),
+        (
+            "<link name=\"b\"/>",
+            "<link name=\"a\"/>",
+            "a second link named 'a'",
+        ),
+        ("ixx=\"1\"", "ixx=\"10\"", "break the triangle inequality"),
+        ("ixx=\"1\"", "ixx=\"0\"", "is not positive definite"),
+        ("value=\"1\"", "value=\"0\"", "have no mass"),
+    ];
+
+    /// What a message must say: all of it, or a part.
+    enum Says {
+        Exactly(&'static str),
+        Part(&'static str),
+    }
+
+    /// Bad files and requests beyond one edit, each with the request made of it and what the
+    /// message says.
+    fn bad_files() -> Vec<(String, Request, Says)> {
+        let flange = Request {
+            flange: Some("b".into()),
+            ..request("a", "b")
+        };
+        // Finite numbers whose composite is not: 1e300 kg, 1e10 m apart.
+        let body = r#"<inertial><mass value="1e300"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>"#;
+        let huge = format!(
+            r#"<robot name="x"><link name="a">{body}</link><link name="b">{body}</link><joint name="j" type="fixed"><parent link="a"/><child link="b"/><origin xyz="0 0 1e10"/></joint></robot>"#
+        );
+        // Two parents; a loop.
+        let two = OK.replace(
+            "</robot>",
+            r#"<link name="c"/><joint name="k" type="fixed"><parent link="c"/><child link="b"/></joint></robot>"#,
+        );
+        let cycle = OK.replace(
+            "</robot>",
+            r#"<joint name="k" type="fixed"><parent link="b"/><child link="a"/></joint></robot>"#,
+        );
+        use Says::*;
+        vec![
+            (
+                OK.into(),
+                request("b", "a"),
+                Exactly("x.urdf: --tip 'a' is not --root 'b' or a link below it"),
+            ),
+            (
+                OK.into(),
+                request("zz", "a"),
+                Part("--root 'zz' is no link of the file"),
+            ),
+            (
+                OK.into(),
+                flange,
+                Exactly("x.urdf: --flange 'b' is not an ancestor of --root 'a'"),
+            ),
+            (
+                OK.replace("robot", "rob"),
+                request("a", "b"),
+                Exactly("x.urdf, line 1: the top element is <rob>, not <robot>: not a URDF file"),
+            ),
+            (
+                huge,
+                request("a", "b"),
+                Part("that is not finite (mass 2e300 kg)"),
+            ),
+            (two, request("a", "b"), Part("link 'b' has two parents")),
+            (
+                cycle,
+                request("a", "b"),
+                Part("leads back to link 'a': the links form a loop"),
+            ),
+        ]
+    }
+
     #[test]
     fn bad_files_are_one_line_naming_the_element() {
-        let ok = r#"<robot name="x"><link name="a"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial></link><link name="b"/><joint name="j" type="fixed"><parent link="a"/><child link="b"/><origin xyz="0 0 1"/></joint></robot>"#;
-        assert!(tool_from_urdf(ok, "x.urdf", &request("a", "b")).is_ok());
-        let cases: &[(&str, &str, &str)] = &[
-            ("<robot", "", "not a well-formed XML file"),
-            (
-                "xyz=\"0 0 1\"",
-                "xyz=\"0 0\"",
-                "xyz = '0 0' has 2 numbers, not 3",
-            ),
-            ("xyz=\"0 0 1\"", "xyz=\"0 0 nan\"", "'nan' is not finite"),
-            (
-                "value=\"1\"",
-                "value=\"-1\"",
-                "<mass> value = -1 is negative",
-            ),
-            (
-                "value=\"1\"",
-                "value=\"heavy\"",
-                "value = 'heavy' is not a number",
-            ),
-            (
-                "<child link=\"b\"/>",
-                "<child link=\"c\"/>",
-                "link = 'c' is no link of the file",
-            ),
-            (
-                "<child link=\"b\"/>",
-                "<child link=\"a\"/>",
-                "joins link 'a' to itself",
-            ),
-            (
-                "type=\"fixed\"",
-                "type=\"hinge\"",
-                "'hinge' is not a URDF joint type",
-            ),
-            (
-                "<link name=\"b\"/>",
-                "<link name=\"a\"/>",
-                "a second link named 'a'",
-            ),
-            ("ixx=\"1\"", "ixx=\"10\"", "break the triangle inequality"),
-            ("ixx=\"1\"", "ixx=\"0\"", "is not positive definite"),
-            ("value=\"1\"", "value=\"0\"", "have no mass"),
-        ];
-        for (from, to, expected) in cases {
-            let bad = ok.replacen(from, to, 1);
+        assert!(tool_from_urdf(OK, "x.urdf", &request("a", "b")).is_ok());
+        for (from, to, expected) in BAD_EDITS {
+            let bad = OK.replacen(from, to, 1);
             let e = tool_from_urdf(&bad, "x.urdf", &request("a", "b"))
                 .unwrap_err()
                 .to_string();
@@ -514,53 +581,14 @@ mod tests {
             assert!(e.contains(expected), "{from} -> {to}: {e}");
             assert!(!e.contains('\n'), "{e}");
         }
-        let e = tool_from_urdf(ok, "x.urdf", &request("b", "a"))
-            .unwrap_err()
-            .to_string();
-        assert_eq!(e, "x.urdf: --tip 'a' is not --root 'b' or a link below it");
-        let e = tool_from_urdf(ok, "x.urdf", &request("zz", "a"))
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("--root 'zz' is no link of the file"), "{e}");
-        let mut r = request("a", "b");
-        r.flange = Some("b".into());
-        let e = tool_from_urdf(ok, "x.urdf", &r).unwrap_err().to_string();
-        assert_eq!(e, "x.urdf: --flange 'b' is not an ancestor of --root 'a'");
-        let e = tool_from_urdf(&ok.replace("robot", "rob"), "x.urdf", &request("a", "b"))
-            .unwrap_err()
-            .to_string();
-        assert_eq!(
-            e,
-            "x.urdf, line 1: the top element is <rob>, not <robot>: not a URDF file"
-        );
-        // Finite numbers whose composite is not: 1e300 kg, 1e10 m apart.
-        let body = r#"<inertial><mass value="1e300"/><inertia ixx="1" iyy="1" izz="1" ixy="0" ixz="0" iyz="0"/></inertial>"#;
-        let huge = format!(
-            r#"<robot name="x"><link name="a">{body}</link><link name="b">{body}</link><joint name="j" type="fixed"><parent link="a"/><child link="b"/><origin xyz="0 0 1e10"/></joint></robot>"#
-        );
-        let e = tool_from_urdf(&huge, "x.urdf", &request("a", "b"))
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("that is not finite (mass 2e300 kg)"), "{e}");
-        // Two parents; a loop.
-        let two = ok.replace(
-            "</robot>",
-            r#"<link name="c"/><joint name="k" type="fixed"><parent link="c"/><child link="b"/></joint></robot>"#,
-        );
-        let e = tool_from_urdf(&two, "x.urdf", &request("a", "b"))
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("link 'b' has two parents"), "{e}");
-        let cycle = ok.replace(
-            "</robot>",
-            r#"<joint name="k" type="fixed"><parent link="b"/><child link="a"/></joint></robot>"#,
-        );
-        let e = tool_from_urdf(&cycle, "x.urdf", &request("a", "b"))
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.contains("leads back to link 'a': the links form a loop"),
-            "{e}"
-        );
+        for (file, request, says) in bad_files() {
+            let e = tool_from_urdf(&file, "x.urdf", &request)
+                .unwrap_err()
+                .to_string();
+            match says {
+                Says::Exactly(expected) => assert_eq!(e, expected),
+                Says::Part(expected) => assert!(e.contains(expected), "{e}"),
+            }
+        }
     }
 }

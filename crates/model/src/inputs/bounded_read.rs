@@ -11,6 +11,7 @@
 
 use std::fmt;
 use std::io::{self, Read};
+use std::ops::ControlFlow;
 use std::path::Path;
 
 /// The longest record (a CSV row, a JSON tool) a tools file may have.
@@ -145,13 +146,11 @@ impl CsvRows {
         self.in_row = false;
         at
     }
-}
 
-impl Records for CsvRows {
-    const RECORD: &'static str = "row";
-
-    fn next_end(&mut self, bytes: &[u8]) -> Option<usize> {
-        use CsvState::*;
+    /// Where this chunk's bytes start: past the byte-order mark at the input's start; and at a
+    /// row's first byte, whether the row is a comment.
+    #[inline]
+    fn start(&mut self, bytes: &[u8]) -> usize {
         let mut i = 0;
         if !self.started && !bytes.is_empty() {
             self.started = true;
@@ -163,53 +162,41 @@ impl Records for CsvRows {
             self.comment = bytes[i] == b'#';
             self.in_row = true;
         }
-        if self.comment {
-            let k = memchr::memchr2(b'\n', b'\r', &bytes[i..])?;
-            self.comment = false;
-            return Some(self.row_ends(i + k, bytes[i + k]));
+        i
+    }
+
+    /// The common row, without a quote: its end is the next line break, found at memchr's
+    /// speed (SIMD), cell boundaries need not be followed. `Continue` when a quote (or a quoted
+    /// cell already open) needs [`Self::walk`].
+    #[inline]
+    fn unquoted_end(&mut self, bytes: &[u8], i: usize) -> ControlFlow<Option<usize>> {
+        use CsvState::*;
+        if !matches!(self.state, FieldStart | Unquoted) {
+            return ControlFlow::Continue(());
         }
-        // The common row, without a quote: its end is the next line break, found at memchr's
-        // speed (SIMD), cell boundaries need not be followed.
-        if matches!(self.state, FieldStart | Unquoted) {
-            if let Some(k) = memchr::memchr3(b'\n', b'\r', b'"', &bytes[i..]) {
-                let at = i + k;
-                if bytes[at] != b'"' {
-                    return Some(self.row_ends(at, bytes[at]));
-                }
-            } else {
-                // No line break and no quote: whether the last byte ends a cell or not, the
-                // state is one of these two, and FieldStart matters only before a quote.
-                self.state = if bytes.last() == Some(&b',') {
-                    FieldStart
-                } else {
-                    Unquoted
-                };
-                return None;
+        if let Some(k) = memchr::memchr3(b'\n', b'\r', b'"', &bytes[i..]) {
+            let at = i + k;
+            if bytes[at] != b'"' {
+                return ControlFlow::Break(Some(self.row_ends(at, bytes[at])));
             }
+            return ControlFlow::Continue(());
         }
+        // No line break and no quote: whether the last byte ends a cell or not, the state is
+        // one of these two, and FieldStart matters only before a quote.
+        self.state = if bytes.last() == Some(&b',') {
+            FieldStart
+        } else {
+            Unquoted
+        };
+        ControlFlow::Break(None)
+    }
+
+    /// csv-core's state machine from `bytes[i]`, byte by byte where quotes are involved: the
+    /// row's end, or None if these bytes do not end it.
+    fn walk(&mut self, bytes: &[u8], mut i: usize) -> Option<usize> {
+        use CsvState::*;
         while i < bytes.len() {
-            match self.state {
-                // To the next byte that can change the state (cells are short: a plain loop
-                // beats a memchr call per cell).
-                Unquoted => {
-                    while i < bytes.len() && !matches!(bytes[i], b',' | b'\n' | b'\r') {
-                        i += 1;
-                    }
-                    if i == bytes.len() {
-                        return None;
-                    }
-                }
-                Quoted => {
-                    while i < bytes.len() && bytes[i] != b'"' {
-                        self.line += u64::from(bytes[i] == b'\n');
-                        i += 1;
-                    }
-                    if i == bytes.len() {
-                        return None;
-                    }
-                }
-                FieldStart | QuoteInQuoted => {}
-            }
+            i = self.skip_plain(bytes, i)?;
             let byte = bytes[i];
             let terminator = byte == b'\n' || byte == b'\r';
             let (next, ends) = match (self.state, byte) {
@@ -231,6 +218,45 @@ impl Records for CsvRows {
             i += 1;
         }
         None
+    }
+
+    /// To the next byte from `i` that can change the state (cells are short: a plain loop beats
+    /// a memchr call per cell), counting the line breaks inside a quoted cell; None at the end
+    /// of the bytes.
+    #[inline]
+    fn skip_plain(&mut self, bytes: &[u8], mut i: usize) -> Option<usize> {
+        match self.state {
+            CsvState::Unquoted => {
+                while i < bytes.len() && !matches!(bytes[i], b',' | b'\n' | b'\r') {
+                    i += 1;
+                }
+            }
+            CsvState::Quoted => {
+                while i < bytes.len() && bytes[i] != b'"' {
+                    self.line += u64::from(bytes[i] == b'\n');
+                    i += 1;
+                }
+            }
+            CsvState::FieldStart | CsvState::QuoteInQuoted => {}
+        }
+        (i < bytes.len()).then_some(i)
+    }
+}
+
+impl Records for CsvRows {
+    const RECORD: &'static str = "row";
+
+    fn next_end(&mut self, bytes: &[u8]) -> Option<usize> {
+        let i = self.start(bytes);
+        if self.comment {
+            let k = memchr::memchr2(b'\n', b'\r', &bytes[i..])?;
+            self.comment = false;
+            return Some(self.row_ends(i + k, bytes[i + k]));
+        }
+        if let ControlFlow::Break(end) = self.unquoted_end(bytes, i) {
+            return end;
+        }
+        self.walk(bytes, i)
     }
 
     fn lines(&self) -> u64 {

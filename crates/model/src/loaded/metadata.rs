@@ -112,6 +112,54 @@ pub(crate) fn read(exports: &Exports, name: Option<&str>) -> Result<Metadata, St
     }
     // SAFETY: a non-NULL pointer to the library's metadata, valid while it is loaded.
     let c = unsafe { &*p };
+    check_counts(c)?;
+    let (n, np) = (c.dof, c.parameter_count);
+    // SAFETY (every read below): the metadata's arrays hold the counts it gives.
+    let own_name = unsafe { text(c.name, "name") }?;
+    // A name given is taken as given: refused if it is not one, never changed into one.
+    let name = name.map_or(own_name, str::to_string);
+    check_name(&name)?;
+    unsafe { check_task_and_term_names(c) }?;
+    let offered = unsafe { numbers_i32(c.task_offered, c.task_count, "task_offered") }?;
+    let defaults_given = unsafe { numbers_i32(c.has_default, np, "has_default") }?;
+    let default_values = unsafe { raw(c.defaults, np, "defaults") }?;
+    let metadata = Metadata {
+        title: unsafe { text(c.title, "title") }?,
+        description: unsafe { text(c.description, "description") }?,
+        dof: n,
+        parameter_names: unsafe { texts(c.parameter_names, np, "parameter_names") }?,
+        parameter_units: unsafe { texts(c.parameter_units, np, "parameter_units") }?,
+        state_names: unsafe { texts(c.state_names, 2 * n, "state_names") }?,
+        control_names: unsafe { texts(c.control_names, n, "control_names") }?,
+        domains: unsafe { domains(c.domains, np) }?,
+        constraints: unsafe { constraints(c, np) }?,
+        sample: unsafe { finite(c.sample_lo, np, "sample_lo") }?
+            .into_iter()
+            .zip(unsafe { finite(c.sample_hi, np, "sample_hi") }?)
+            .collect(),
+        defaults: defaults_given
+            .iter()
+            .zip(&default_values)
+            .map(|(given, v)| (*given != 0 && v.is_finite()).then_some(*v))
+            .collect(),
+        inertia: unsafe { inertia(c) }?,
+        has_tip: c.has_tip != 0,
+        tip_dim: c.tip_dim,
+        equilibrium_state: unsafe { finite(c.equilibrium_state, 2 * n, "equilibrium_state") }?,
+        equilibrium_control: unsafe { finite(c.equilibrium_control, n, "equilibrium_control") }?,
+        tasks: TaskKind::ALL
+            .into_iter()
+            .zip(offered)
+            .filter_map(|(k, o)| (o != 0).then_some(k))
+            .collect(),
+        name,
+    };
+    Ok(metadata)
+}
+
+/// The metadata's version and counts, checked before any array is read: every read after
+/// trusts them for its length.
+fn check_counts(c: &CInfo) -> Result<(), String> {
     if c.abi_version != ABI_VERSION {
         return Err(format!(
             "its metadata is of C ABI version {}, not {ABI_VERSION}",
@@ -146,13 +194,17 @@ pub(crate) fn read(exports: &Exports, name: Option<&str>) -> Result<Metadata, St
             Term::ALL.len()
         ));
     }
-    // SAFETY (every read below): the metadata's arrays hold the counts it gives.
-    let own_name = unsafe { text(c.name, "name") }?;
-    // A name given is taken as given: refused if it is not one, never changed into one.
-    let name = name.map_or(own_name, str::to_string);
-    check_name(&name)?;
-    let task_names = unsafe { texts(c.task_names, c.task_count, "task_names") }?;
-    let term_names = unsafe { texts(c.term_names, c.term_count, "term_names") }?;
+    Ok(())
+}
+
+/// The library's tasks and terms, one for one this toolconf's (in the same order): the task
+/// offers and the sensitivities are indexed by them.
+///
+/// # Safety
+/// `c`'s task and term name arrays hold the counts it gives ([`check_counts`] passed).
+unsafe fn check_task_and_term_names(c: &CInfo) -> Result<(), String> {
+    let task_names = texts(c.task_names, c.task_count, "task_names")?;
+    let term_names = texts(c.term_names, c.term_count, "term_names")?;
     for (theirs, ours) in task_names.iter().zip(TaskKind::ALL) {
         if theirs != ours.name() {
             return Err(format!(
@@ -169,57 +221,31 @@ pub(crate) fn read(exports: &Exports, name: Option<&str>) -> Result<Metadata, St
             ));
         }
     }
-    let offered = unsafe { numbers_i32(c.task_offered, c.task_count, "task_offered") }?;
-    let defaults_given = unsafe { numbers_i32(c.has_default, np, "has_default") }?;
-    let default_values = unsafe { raw(c.defaults, np, "defaults") }?;
-    let metadata = Metadata {
-        title: unsafe { text(c.title, "title") }?,
-        description: unsafe { text(c.description, "description") }?,
-        dof: n,
-        parameter_names: unsafe { texts(c.parameter_names, np, "parameter_names") }?,
-        parameter_units: unsafe { texts(c.parameter_units, np, "parameter_units") }?,
-        state_names: unsafe { texts(c.state_names, 2 * n, "state_names") }?,
-        control_names: unsafe { texts(c.control_names, n, "control_names") }?,
-        domains: unsafe { domains(c.domains, np) }?,
-        constraints: unsafe { constraints(c, np) }?,
-        sample: unsafe { finite(c.sample_lo, np, "sample_lo") }?
-            .into_iter()
-            .zip(unsafe { finite(c.sample_hi, np, "sample_hi") }?)
-            .collect(),
-        defaults: defaults_given
-            .iter()
-            .zip(&default_values)
-            .map(|(given, v)| (*given != 0 && v.is_finite()).then_some(*v))
-            .collect(),
-        inertia: match c.has_inertia {
-            0 => None,
-            _ => {
-                let r = &c.inertia;
-                let index = |i: u32| usize::try_from(i).ok().filter(|i| *i < np);
-                let (m, pr) = (r.moments.map(index), r.products.map(index));
-                if m.iter().chain(&pr).any(Option::is_none) || !r.slack.is_finite() {
-                    return Err("its inertia rule names a parameter it does not have".into());
-                }
-                Some((
-                    m.map(|i| i.unwrap_or(0)),
-                    pr.map(|i| i.unwrap_or(0)),
-                    r.slack,
-                    unsafe { text(r.rule, "inertia.rule") }?,
-                ))
-            }
-        },
-        has_tip: c.has_tip != 0,
-        tip_dim: c.tip_dim,
-        equilibrium_state: unsafe { finite(c.equilibrium_state, 2 * n, "equilibrium_state") }?,
-        equilibrium_control: unsafe { finite(c.equilibrium_control, n, "equilibrium_control") }?,
-        tasks: TaskKind::ALL
-            .into_iter()
-            .zip(offered)
-            .filter_map(|(k, o)| (o != 0).then_some(k))
-            .collect(),
-        name,
-    };
-    Ok(metadata)
+    Ok(())
+}
+
+/// The inertia rule, if the library has one: the parameters it names must be the library's.
+///
+/// # Safety
+/// `c`'s inertia rule text, if it has one, is NUL-terminated.
+#[allow(clippy::type_complexity)]
+unsafe fn inertia(c: &CInfo) -> Result<Option<([usize; 3], [usize; 3], f64, String)>, String> {
+    if c.has_inertia == 0 {
+        return Ok(None);
+    }
+    let np = c.parameter_count;
+    let r = &c.inertia;
+    let index = |i: u32| usize::try_from(i).ok().filter(|i| *i < np);
+    let (m, pr) = (r.moments.map(index), r.products.map(index));
+    if m.iter().chain(&pr).any(Option::is_none) || !r.slack.is_finite() {
+        return Err("its inertia rule names a parameter it does not have".into());
+    }
+    Ok(Some((
+        m.map(|i| i.unwrap_or(0)),
+        pr.map(|i| i.unwrap_or(0)),
+        r.slack,
+        text(r.rule, "inertia.rule")?,
+    )))
 }
 
 /// A model's name: what `--models`, a tools file's `model` column and Python take.

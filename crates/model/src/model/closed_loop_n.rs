@@ -12,6 +12,7 @@ use toolconf_core::{
 use toolconf_generated::{Read, Term, TERMS};
 use toolconf_integrators::{
     solve_grid_with_jacobian, uniform_grid, IntegrationError, Method, Options as IntegratorOptions,
+    Stats,
 };
 
 /// A grid state whose magnitude passes this is a diverging simulation, not a result.
@@ -583,25 +584,33 @@ where
     z0.fixed_rows_mut::<NX>(0).copy_from(&options.x0);
     z0.fixed_rows_mut::<N>(NX).copy_from(&options.u0);
 
-    let mut trajectory = options.record_trajectory.then(|| TrajectoryN {
+    let trajectory = options.record_trajectory.then(|| TrajectoryN {
         t: Vec::with_capacity(grid.len()),
         tip_dim: reads_tip(task.kind).then_some(P::tip_dim()),
         ..TrajectoryN::default()
     });
-    let mut task_error = 0.0;
-    let (mut int_f, mut int_j, mut effort) = (0.0, 0.0, 0.0);
-    // (t, F, J, |U|²) at the previous grid point, for the trapezoidal rule.
-    let mut previous: Option<(f64, f64, f64, f64)> = None;
-    let mut divergence: Option<(f64, f64)> = None;
-    // The distance to the goal at the first and the latest grid point, for `progress`.
-    let error_term = task.kind.error_term();
-    let position_task = is_position(error_term);
-    let (mut first_distance, mut distance) = (None::<f64>, 0.0);
-
+    let mut sums = GridSums::new(task, trajectory);
     let rhs = |_t: f64, z: &SVector<f64, NZ>| system.rhs(z);
     // The closed loop is autonomous: ∂Ż/∂t = 0.
     let jacobian = |_t: f64, z: &SVector<f64, NZ>| (system.jacobian(z), SVector::zeros());
-    let mut integrator = options.integrator;
+    let integrator = episode_integrator(task, &options.integrator, grid.len() - 1);
+    let cap = options.integrator.max_steps;
+    let stats = solve_grid_with_jacobian(rhs, jacobian, &z0, &grid, &integrator, |_, t, z| {
+        let (_, observed) = system.rhs_and_observation(z);
+        sums.add::<NX, NZ>(controller, task, t, z, observed);
+    })
+    .map_err(|e| EpisodeFailure::Integration(out_of_work::<N>(e, cap, options.dt)))?;
+    sums.episode(controller.logdet, &stats, options.t_end)
+}
+
+/// The integrator's options for an episode of `task` over `intervals` output steps: the
+/// method Auto resolved where it must not switch, and the work budget of the whole episode.
+fn episode_integrator<const N: usize>(
+    task: &TaskN<N>,
+    options: &IntegratorOptions,
+    intervals: usize,
+) -> IntegratorOptions {
+    let mut integrator = *options;
     // Auto switches only on acceleration-control tasks (θ̈ feedback makes them stiff); elsewhere
     // it stays DP5 so the paper's ode45 runs keep their numbers (see EpisodeOptions::integrator).
     let fed_back_through_the_plant = matches!(
@@ -612,71 +621,127 @@ where
         integrator.method = Method::Explicit;
     }
     let cap = integrator.max_steps;
-    integrator.max_steps = super::budget::episode_budget(
-        (grid.len() - 1) as f64,
-        integrator.rtol,
-        integrator.atol,
-        cap,
-    );
-    let stats = solve_grid_with_jacobian(rhs, jacobian, &z0, &grid, &integrator, |_, t, z| {
-        let (_, observed) = system.rhs_and_observation(z);
+    integrator.max_steps =
+        super::budget::episode_budget(intervals as f64, integrator.rtol, integrator.atol, cap);
+    integrator
+}
+
+/// What an episode accumulates at each output grid point: the sums of [`Metrics`] (Σ task
+/// error; ∫F dt, ∫J dt and ∫|U|² dt by the trapezoidal rule), the first divergence, the
+/// distance to the goal for `progress`, and the trajectory if kept. A struct the grid's output
+/// closure borrows mutably, as it did the locals: nothing allocated per point.
+struct GridSums<const N: usize> {
+    task_error: f64,
+    int_f: f64,
+    int_j: f64,
+    effort: f64,
+    /// (t, F, J, |U|²) at the previous grid point, for the trapezoidal rule.
+    previous: Option<(f64, f64, f64, f64)>,
+    /// (t, |Z|∞) at the first grid point past [`DIVERGENCE_BOUND`].
+    divergence: Option<(f64, f64)>,
+    /// The task's error term, on a position task (the only ones `progress` measures).
+    position: Option<Term>,
+    /// The distance to the goal at the first and the latest grid point, for `progress`.
+    first_distance: Option<f64>,
+    distance: f64,
+    trajectory: Option<TrajectoryN<N>>,
+}
+
+impl<const N: usize> GridSums<N> {
+    fn new(task: &TaskN<N>, trajectory: Option<TrajectoryN<N>>) -> Self {
+        let error_term = task.kind.error_term();
+        GridSums {
+            task_error: 0.0,
+            int_f: 0.0,
+            int_j: 0.0,
+            effort: 0.0,
+            previous: None,
+            divergence: None,
+            position: is_position(error_term).then_some(error_term),
+            first_distance: None,
+            distance: 0.0,
+            trajectory,
+        }
+    }
+
+    /// Adds the grid point at `t`, joint state `z` = [X; U], where the controller observes
+    /// `observed`.
+    #[inline]
+    fn add<const NX: usize, const NZ: usize>(
+        &mut self,
+        controller: &ActiveInferenceN<N>,
+        task: &TaskN<N>,
+        t: f64,
+        z: &SVector<f64, NZ>,
+        observed: ObservationN<N>,
+    ) {
         let u = z.fixed_rows::<N>(NX).into_owned();
         let magnitude = z.amax();
-        if divergence.is_none() && magnitude > DIVERGENCE_BOUND {
-            divergence = Some((t, magnitude));
+        if self.divergence.is_none() && magnitude > DIVERGENCE_BOUND {
+            self.divergence = Some((t, magnitude));
         }
-        task_error += controller.task_error(&observed);
-        if position_task {
-            distance = (observed[error_term.index()] - task.goal(error_term)).norm();
-            first_distance.get_or_insert(distance);
+        self.task_error += controller.task_error(&observed);
+        if let Some(error_term) = self.position {
+            self.distance = (observed[error_term.index()] - task.goal(error_term)).norm();
+            self.first_distance.get_or_insert(self.distance);
         }
         let j = controller.cost_j(&observed);
         let f = j - 0.5 * controller.logdet;
         let e = u.norm_squared();
-        if let Some((t_prev, f_prev, j_prev, e_prev)) = previous {
+        if let Some((t_prev, f_prev, j_prev, e_prev)) = self.previous {
             let h = t - t_prev;
-            int_f += 0.5 * h * (f + f_prev);
-            int_j += 0.5 * h * (j + j_prev);
-            effort += 0.5 * h * (e + e_prev);
+            self.int_f += 0.5 * h * (f + f_prev);
+            self.int_j += 0.5 * h * (j + j_prev);
+            self.effort += 0.5 * h * (e + e_prev);
         }
-        previous = Some((t, f, j, e));
-        if let Some(tr) = trajectory.as_mut() {
+        self.previous = Some((t, f, j, e));
+        if let Some(tr) = self.trajectory.as_mut() {
             tr.push(t, observed);
         }
-    })
-    .map_err(|e| EpisodeFailure::Integration(out_of_work::<N>(e, cap, options.dt)))?;
+    }
 
-    if let Some((t, magnitude)) = divergence {
-        return Err(EpisodeFailure::Diverged { t, magnitude });
+    /// The episode from the sums and the integrator's counts, or why it diverged: a state past
+    /// the bound on the grid, or metrics that are not finite (at `t_end`).
+    fn episode(
+        self,
+        logdet: f64,
+        stats: &Stats,
+        t_end: f64,
+    ) -> Result<EpisodeN<N>, EpisodeFailure> {
+        if let Some((t, magnitude)) = self.divergence {
+            return Err(EpisodeFailure::Diverged { t, magnitude });
+        }
+        let distance = self.distance;
+        let metrics = Metrics {
+            task_error: self.task_error,
+            free_energy: self.int_f,
+            cost_j: self.int_j,
+            logdet,
+            rhs_evals: stats.rhs_evals,
+            steps: stats.steps,
+            rejected_steps: stats.rejected,
+            control_effort: self.effort,
+            jacobian_evals: stats.jacobian_evals,
+            factorisations: stats.factorisations,
+            progress: self
+                .first_distance
+                .filter(|&d0| d0 > 0.0)
+                .map(|d0| 1.0 - distance / d0),
+        };
+        if ![metrics.task_error, metrics.free_energy, metrics.cost_j]
+            .iter()
+            .all(|v| v.is_finite())
+        {
+            return Err(EpisodeFailure::Diverged {
+                t: t_end,
+                magnitude: f64::INFINITY,
+            });
+        }
+        Ok(EpisodeN {
+            metrics,
+            trajectory: self.trajectory,
+        })
     }
-    let metrics = Metrics {
-        task_error,
-        free_energy: int_f,
-        cost_j: int_j,
-        logdet: controller.logdet,
-        rhs_evals: stats.rhs_evals,
-        steps: stats.steps,
-        rejected_steps: stats.rejected,
-        control_effort: effort,
-        jacobian_evals: stats.jacobian_evals,
-        factorisations: stats.factorisations,
-        progress: first_distance
-            .filter(|&d0| d0 > 0.0)
-            .map(|d0| 1.0 - distance / d0),
-    };
-    if ![metrics.task_error, metrics.free_energy, metrics.cost_j]
-        .iter()
-        .all(|v| v.is_finite())
-    {
-        return Err(EpisodeFailure::Diverged {
-            t: options.t_end,
-            magnitude: f64::INFINITY,
-        });
-    }
-    Ok(EpisodeN {
-        metrics,
-        trajectory,
-    })
 }
 
 /// Whether `term` is a position, joint or tip (θ, y): what [`Metrics::progress`] measures.

@@ -188,6 +188,88 @@ where
     M: ArmModel<N, NX, NP, NZ>,
     P: ArmModel<N, NX, NP, NZ>,
 {
+    let (metrics_of, grid) = check_episode(tool, task, options, mpc_options)?;
+    let mut mpc = MpcN::new(tool, task, mpc_options).map_err(MpcFailure::Setup)?;
+    // The plant's parameter-only factors, once per episode (as the active-inference loop does).
+    let plant = P::dynamics_coefficients(&tool.params());
+    let mut log = SolveLog::with_capacity(grid.steps + 1);
+    let mut sums = Samples::new(options.record_trajectory);
+    let sample = |sums: &mut Samples<N>, t: f64, x: &SVector<f64, NX>, u: &SVector<f64, N>| {
+        let x_dot = P::dynamics_with(x, &(u + grid.perturbation), &plant);
+        sums.add(&metrics_of, t, toolconf_core::observe(x, &x_dot, u), u);
+    };
+
+    let mut x = options.x0;
+    let mut u = log.control(&mut mpc, &x, 0.0)?;
+    sample(&mut sums, 0.0, &x, &u);
+    let mut rhs_evals = 0;
+    // One work budget for the whole episode (a control period is at most an output step), shared
+    // by the periods' integrations: what one period spends, the next may not.
+    let mut integrator = options.integrator;
+    let cap = integrator.max_steps;
+    let budget = episode_budget(grid.steps as f64, integrator.rtol, integrator.atol, cap);
+    let mut spent = 0;
+    for k in 0..grid.steps {
+        let (t0, t1) = (k as f64 * grid.period, (k + 1) as f64 * grid.period);
+        let held = u + grid.perturbation;
+        let mut next = x;
+        integrator.max_steps = budget.saturating_sub(spent).max(1);
+        let stats = solve_grid(
+            |_, x: &SVector<f64, NX>| P::dynamics_with(x, &held, &plant),
+            &x,
+            &[t0, t1],
+            &integrator,
+            |i, _, y| {
+                if i == 1 {
+                    next = *y;
+                }
+            },
+        )
+        .map_err(|e| {
+            MpcFailure::Integration(mpc_out_of_work::<N>(e, spent, budget < cap, options.dt))
+        })?;
+        spent += stats.steps + stats.rejected;
+        rhs_evals += stats.rhs_evals;
+        x = next;
+        u = log.control(&mut mpc, &x, t1)?;
+        if (k + 1) % grid.every == 0 {
+            sample(&mut sums, t1, &x, &u);
+        }
+    }
+    let metrics = sums.metrics(
+        log,
+        metrics_of.logdet,
+        options.t_end,
+        rhs_evals,
+        mpc.disturbance_estimate(),
+    );
+    Ok(MpcEpisodeN {
+        metrics,
+        trajectory: sums.trajectory,
+    })
+}
+
+/// The episode's control grid: `steps` control periods of `period` s, an output sample every
+/// `every` of them, under the constant perturbation dT.
+struct ControlGrid<const N: usize> {
+    period: f64,
+    steps: usize,
+    every: usize,
+    perturbation: SVector<f64, N>,
+}
+
+/// The refusals an MPC episode makes before it builds the controller, in the order the user
+/// meets them (the task, the tool's Π^U, the grids, the perturbation), and what they leave:
+/// the metrics' weights (an active-inference controller of the tool) and the control grid.
+fn check_episode<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    tool: &ToolN<M, N, NX, NP, NZ>,
+    task: &TaskN<N>,
+    options: &EpisodeOptionsN<N, NX>,
+    mpc_options: &MpcOptions,
+) -> Result<(ActiveInferenceN<N>, ControlGrid<N>), MpcFailure>
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
     if toolconf_core::reads_tip(task.kind) {
         return Err(Error::Unsupported(format!(
             "the MPC baseline minimises J over the linearised joint state; the {} task reads the tool's tip, whose cost it does not model (run it with the active-inference controller)",
@@ -219,106 +301,124 @@ where
         }
         .into());
     }
-    let mut mpc = MpcN::new(tool, task, mpc_options).map_err(MpcFailure::Setup)?;
-    // The plant's parameter-only factors, once per episode (as the active-inference loop does).
-    let plant = P::dynamics_coefficients(&tool.params());
-    let logdet = metrics_of.logdet;
+    let grid = ControlGrid {
+        period,
+        steps,
+        every,
+        perturbation,
+    };
+    Ok((metrics_of, grid))
+}
 
-    let mut solve_times = Vec::with_capacity(steps + 1);
-    let mut qp_iterations = 0u64;
-    let mut worst_status = String::from("Solved");
-    let mut control = |mpc: &mut MpcN<M, N, NX, NP, NZ>,
-                       x: &SVector<f64, NX>,
-                       t: f64|
-     -> Result<SVector<f64, N>, MpcFailure> {
+/// The QP solves of an episode, one per control period and one at the final time: what the
+/// metrics report of the solver (times, iterations, the worst accepted status).
+struct SolveLog {
+    solve_times: Vec<Duration>,
+    qp_iterations: u64,
+    worst_status: String,
+}
+
+impl SolveLog {
+    fn with_capacity(solves: usize) -> Self {
+        SolveLog {
+            solve_times: Vec::with_capacity(solves),
+            qp_iterations: 0,
+            worst_status: String::from("Solved"),
+        }
+    }
+
+    /// The MPC's control at state `x`, time `t`, logging its solve (a failure names `t`).
+    fn control<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+        &mut self,
+        mpc: &mut MpcN<M, N, NX, NP, NZ>,
+        x: &SVector<f64, NX>,
+        t: f64,
+    ) -> Result<SVector<f64, N>, MpcFailure>
+    where
+        M: ArmModel<N, NX, NP, NZ>,
+    {
         let u = mpc
             .control(x)
             .map_err(|source| MpcFailure::Controller { t, source })?;
         let info = mpc.last_solve();
-        solve_times.push(info.solve_time);
-        qp_iterations += u64::from(info.iterations);
-        if info.status != "Solved" && worst_status == "Solved" {
-            worst_status = info.status;
+        self.solve_times.push(info.solve_time);
+        self.qp_iterations += u64::from(info.iterations);
+        if info.status != "Solved" && self.worst_status == "Solved" {
+            self.worst_status = info.status;
         }
         Ok(u)
-    };
+    }
+}
 
-    let mut trajectory = options.record_trajectory.then(TrajectoryN::default);
-    let (mut task_error, mut int_j, mut effort) = (0.0, 0.0, 0.0);
-    let mut previous: Option<(f64, f64, f64)> = None;
-    let mut sample = |t: f64, x: &SVector<f64, NX>, u: &SVector<f64, N>| {
-        let x_dot = P::dynamics_with(x, &(u + perturbation), &plant);
-        let observed = toolconf_core::observe(x, &x_dot, u);
-        task_error += metrics_of.task_error(&observed);
-        let j = metrics_of.cost_j(&observed);
-        let e = u.norm_squared();
-        if let Some((t0, j0, e0)) = previous {
-            int_j += 0.5 * (t - t0) * (j + j0);
-            effort += 0.5 * (t - t0) * (e + e0);
-        }
-        previous = Some((t, j, e));
-        if let Some(tr) = trajectory.as_mut() {
-            tr.push(t, observed);
-        }
-    };
+/// The sums over the output grid the metrics are made of: Σ task error, and ∫J dt and ∫|U|² dt
+/// by the trapezoidal rule (hence the previous sample), with the trajectory when recorded.
+struct Samples<const N: usize> {
+    task_error: f64,
+    int_j: f64,
+    effort: f64,
+    previous: Option<(f64, f64, f64)>,
+    trajectory: Option<TrajectoryN<N>>,
+}
 
-    let mut x = options.x0;
-    let mut u = control(&mut mpc, &x, 0.0)?;
-    sample(0.0, &x, &u);
-    let mut rhs_evals = 0;
-    // One work budget for the whole episode (a control period is at most an output step), shared
-    // by the periods' integrations: what one period spends, the next may not.
-    let mut integrator = options.integrator;
-    let cap = integrator.max_steps;
-    let budget = episode_budget(steps as f64, integrator.rtol, integrator.atol, cap);
-    let mut spent = 0;
-    for k in 0..steps {
-        let (t0, t1) = (k as f64 * period, (k + 1) as f64 * period);
-        let held = u + perturbation;
-        let mut next = x;
-        integrator.max_steps = budget.saturating_sub(spent).max(1);
-        let stats = solve_grid(
-            |_, x: &SVector<f64, NX>| P::dynamics_with(x, &held, &plant),
-            &x,
-            &[t0, t1],
-            &integrator,
-            |i, _, y| {
-                if i == 1 {
-                    next = *y;
-                }
-            },
-        )
-        .map_err(|e| {
-            MpcFailure::Integration(mpc_out_of_work::<N>(e, spent, budget < cap, options.dt))
-        })?;
-        spent += stats.steps + stats.rejected;
-        rhs_evals += stats.rhs_evals;
-        x = next;
-        u = control(&mut mpc, &x, t1)?;
-        if (k + 1) % every == 0 {
-            sample(t1, &x, &u);
+impl<const N: usize> Samples<N> {
+    fn new(record_trajectory: bool) -> Self {
+        Samples {
+            task_error: 0.0,
+            int_j: 0.0,
+            effort: 0.0,
+            previous: None,
+            trajectory: record_trajectory.then(TrajectoryN::default),
         }
     }
 
-    solve_times.sort_unstable();
-    let metrics = MpcMetricsN {
-        task_error,
-        cost_j: int_j,
-        free_energy: int_j - 0.5 * options.t_end * logdet,
-        control_effort: effort,
-        logdet,
-        rhs_evals,
-        qp_solves: solve_times.len(),
-        qp_iterations,
-        median_solve_time: solve_times[solve_times.len() / 2],
-        max_solve_time: *solve_times.last().expect("at least one solve"),
-        worst_status,
-        disturbance_estimate: mpc.disturbance_estimate(),
-    };
-    Ok(MpcEpisodeN {
-        metrics,
-        trajectory,
-    })
+    /// Adds the output sample at `t` (what is observed, under control `u`).
+    fn add(
+        &mut self,
+        metrics_of: &ActiveInferenceN<N>,
+        t: f64,
+        observed: toolconf_core::ObservationN<N>,
+        u: &SVector<f64, N>,
+    ) {
+        self.task_error += metrics_of.task_error(&observed);
+        let j = metrics_of.cost_j(&observed);
+        let e = u.norm_squared();
+        if let Some((t0, j0, e0)) = self.previous {
+            self.int_j += 0.5 * (t - t0) * (j + j0);
+            self.effort += 0.5 * (t - t0) * (e + e0);
+        }
+        self.previous = Some((t, j, e));
+        if let Some(tr) = self.trajectory.as_mut() {
+            tr.push(t, observed);
+        }
+    }
+
+    /// The episode's metrics from these sums and the solve log (F = ∫J dt − ½ T ln|Π^U|), with
+    /// the disturbance observer's final estimate d̂.
+    fn metrics(
+        &self,
+        mut log: SolveLog,
+        logdet: f64,
+        t_end: f64,
+        rhs_evals: usize,
+        disturbance_estimate: SVector<f64, N>,
+    ) -> MpcMetricsN<N> {
+        log.solve_times.sort_unstable();
+        let solve_times = log.solve_times;
+        MpcMetricsN {
+            task_error: self.task_error,
+            cost_j: self.int_j,
+            free_energy: self.int_j - 0.5 * t_end * logdet,
+            control_effort: self.effort,
+            logdet,
+            rhs_evals,
+            qp_solves: solve_times.len(),
+            qp_iterations: log.qp_iterations,
+            median_solve_time: solve_times[solve_times.len() / 2],
+            max_solve_time: *solve_times.last().expect("at least one solve"),
+            worst_status: log.worst_status,
+            disturbance_estimate,
+        }
+    }
 }
 
 /// A period's [`IntegrationError::TooManySteps`] as the episode's

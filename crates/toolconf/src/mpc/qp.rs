@@ -217,6 +217,69 @@ pub(crate) fn default_settings() -> DefaultSettings<f64> {
         .expect("valid Clarabel settings")
 }
 
+/// P's upper triangle: each stage's Hessian of J in w_k = [x_k; u_k], then the terminal
+/// Hessian on x_N (Clarabel takes the upper triangle of a symmetric P).
+fn hessian<const N: usize, const NX: usize, const NZ: usize>(
+    layout: Layout,
+    cost: &StageCost<N, NX, NZ>,
+) -> Triplets {
+    let mut p = Triplets::default();
+    for k in 0..layout.horizon {
+        for ((i, j), value) in zip(stage_upper::<NZ>(), stage_values(cost)) {
+            p.push(layout.w(k, i), layout.w(k, j), value);
+        }
+    }
+    let terminal = layout.x(layout.horizon);
+    for i in 0..NX {
+        for j in i..NX {
+            p.push(terminal + i, terminal + j, cost.terminal_hessian[(i, j)]);
+        }
+    }
+    p
+}
+
+/// A, b and the cones of the constraints A z + s = b: the equalities (the measured state, then
+/// the dynamics), then the torque bounds if `torque_limit` is finite.
+fn constraints<const N: usize, const NX: usize>(
+    layout: Layout,
+    model: &Discretised<NX, N>,
+    torque_limit: f64,
+) -> (Triplets, Vec<f64>, Vec<SupportedConeT<f64>>) {
+    let horizon = layout.horizon;
+    // Equalities: x_0 = measured state (b filled in by `solve`), then the dynamics
+    // x_{k+1} − Ad x_k − Bd u_k = cd.
+    let mut a = Triplets::default();
+    let mut b = vec![0.0; NX * (horizon + 1)];
+    for i in 0..NX {
+        a.push(i, layout.x(0) + i, 1.0);
+    }
+    for k in 0..horizon {
+        let row = layout.dynamics_row(k);
+        for i in 0..NX {
+            a.push(row + i, layout.x(k + 1) + i, 1.0);
+            b[row + i] = model.cd[i];
+        }
+        for ((i, j), value) in zip(dynamics_entries::<N, NX>(), dynamics_values(model)) {
+            a.push(row + i, layout.w(k, j), value);
+        }
+    }
+    let mut cones: Vec<SupportedConeT<f64>> = vec![ZeroConeT(b.len())];
+    // |u| ≤ L as u + s = L and −u + s = L with s ≥ 0; an infinite bound is no constraint
+    // (Clarabel's presolve would drop it, and presolve forbids data updates).
+    if torque_limit.is_finite() {
+        let first = b.len();
+        for k in 0..horizon {
+            for j in 0..N {
+                a.push(first + 2 * N * k + j, layout.u(k) + j, 1.0);
+                a.push(first + 2 * N * k + N + j, layout.u(k) + j, -1.0);
+            }
+        }
+        b.resize(first + 2 * N * horizon, torque_limit);
+        cones.push(NonnegativeConeT(2 * N * horizon));
+    }
+    (a, b, cones)
+}
+
 /// A Clarabel solver holding the whole QP. Between solves b[0..NX] (= x_0) changes, and
 /// [`QpSolver::update`] can overwrite the model-dependent values of P, q, A and b in place.
 /// The defaults are the 2-link sizes.
@@ -258,53 +321,8 @@ impl<const N: usize, const NX: usize, const NZ: usize> QpSolver<N, NX, NZ> {
             nu: N,
         };
         let n = layout.variables();
-
-        let mut p = Triplets::default();
-        for k in 0..horizon {
-            for ((i, j), value) in zip(stage_upper::<NZ>(), stage_values(cost)) {
-                p.push(layout.w(k, i), layout.w(k, j), value);
-            }
-        }
-        let terminal = layout.x(horizon);
-        for i in 0..NX {
-            for j in i..NX {
-                p.push(terminal + i, terminal + j, cost.terminal_hessian[(i, j)]);
-            }
-        }
-
-        // Equalities: x_0 = measured state (b filled in by `solve`), then the dynamics
-        // x_{k+1} − Ad x_k − Bd u_k = cd.
-        let mut a = Triplets::default();
-        let mut b = vec![0.0; NX * (horizon + 1)];
-        for i in 0..NX {
-            a.push(i, layout.x(0) + i, 1.0);
-        }
-        for k in 0..horizon {
-            let row = layout.dynamics_row(k);
-            for i in 0..NX {
-                a.push(row + i, layout.x(k + 1) + i, 1.0);
-                b[row + i] = model.cd[i];
-            }
-            for ((i, j), value) in zip(dynamics_entries::<N, NX>(), dynamics_values(model)) {
-                a.push(row + i, layout.w(k, j), value);
-            }
-        }
-        let mut cones: Vec<SupportedConeT<f64>> = vec![ZeroConeT(b.len())];
-        // |u| ≤ L as u + s = L and −u + s = L with s ≥ 0; an infinite bound is no constraint
-        // (Clarabel's presolve would drop it, and presolve forbids data updates).
-        if torque_limit.is_finite() {
-            let first = b.len();
-            for k in 0..horizon {
-                for j in 0..N {
-                    a.push(first + 2 * N * k + j, layout.u(k) + j, 1.0);
-                    a.push(first + 2 * N * k + N + j, layout.u(k) + j, -1.0);
-                }
-            }
-            b.resize(first + 2 * N * horizon, torque_limit);
-            cones.push(NonnegativeConeT(2 * N * horizon));
-        }
-
-        let p = p.into_csc(n, n);
+        let p = hessian::<N, NX, NZ>(layout, cost).into_csc(n, n);
+        let (a, b, cones) = constraints::<N, NX>(layout, model, torque_limit);
         let a = a.into_csc(b.len(), n);
         let p_index = (0..horizon)
             .flat_map(|k| stage_upper::<NZ>().map(move |(i, j)| (layout.w(k, i), layout.w(k, j))))
