@@ -20,6 +20,7 @@
 //! an unstable linearised loop (an eigenvalue of M with a positive real part), whose
 //! linearisation the episode leaves at once.
 
+pub mod derivative;
 mod export;
 mod linear;
 mod propagate;
