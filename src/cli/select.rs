@@ -87,16 +87,24 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         .iter()
         .filter_map(|r| r.episode.as_ref().err());
     let outcome = every_tool_failed(selection.results.len(), errors);
+    emit(
+        args,
+        || selection_json(args, &selection),
+        || print_selection(args, &selection),
+    );
+    outcome
+}
+
+/// A selection's output: the `--json` object `json` builds, or the table `table` prints.
+fn emit(args: &Args, json: impl FnOnce() -> Value, table: impl FnOnce()) {
     if args.json {
-        let out = selection_json(args, &selection);
         outln!(
             "{}",
-            serde_json::to_string_pretty(&out).expect("finite numbers")
+            serde_json::to_string_pretty(&json()).expect("finite numbers")
         );
     } else {
-        print_selection(args, &selection);
+        table();
     }
-    outcome
 }
 
 /// Draws the tools and runs each one's episode (and MPC episode, with `--mpc`).
@@ -340,15 +348,11 @@ fn run_mixed(args: &Args) -> Result<(), CliError> {
         .iter()
         .filter_map(|r| r.episode.as_ref().err());
     let outcome = every_tool_failed(selection.results.len(), errors);
-    if args.json {
-        let out = mixed_selection_json(args, &selection);
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&out).expect("finite numbers")
-        );
-    } else {
-        print_mixed_selection(args, &selection);
-    }
+    emit(
+        args,
+        || mixed_selection_json(args, &selection),
+        || print_mixed_selection(args, &selection),
+    );
     outcome
 }
 
