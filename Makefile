@@ -25,33 +25,17 @@ bench:
 ## on an imitated older one; it builds the renderer in release, what make crate and make model run,
 ## before their tests time them), the derivation's own tests, the crates', the Python package's, then
 ## the tests that load a model library, on libraries built once for all of them
-## (scripts/model_libraries.sh: every committed model and the xArm7). Two parts run at a time
-## (make -j2): the derivation's beside the crates', then the Python package's beside the model
-## libraries' build and the tests that load them.
+## (scripts/model_libraries.sh: every committed model and the xArm7).
 ## The fuzzers of every parser run in it with bounded case counts (TOOLCONF_FUZZ_CASES raises
 ## them: docs/reference/errors.md), and so does the sweep of hostile inputs (tests/hostile.rs).
-test: $(PY_DEV)
-	@$(MAKE) --no-print-directory -j2 --output-sync=target test-derivation test-crates
-	$(PYTHON_BUILD)
-	@d=$$(mktemp -d) && trap 'rm -rf "$$d"' EXIT && \
-	TOOLCONF_TEST_LIBRARIES=$$d $(MAKE) --no-print-directory -j2 --output-sync=target test-python test-c-and-loaded test-mujoco
-
-# make test's parts, two at a time on two cores: one lane is mostly Python on one core while the
-# other compiles on both (each part's output is printed whole when it ends).
-.PHONY: test-derivation test-crates test-python test-libraries test-c-and-loaded test-mujoco
-test-derivation: drift-check $(PY_DEV)
+test: drift-check $(PY_DEV)
 	$(PY) -m unittest discover --start-directory derive/tests
-test-crates:
 	cargo test --workspace --quiet
-	@$(MAKE) --no-print-directory on-robot-test
-test-python: $(PY_DEV)
+	$(MAKE) --no-print-directory on-robot-test
+	$(PYTHON_BUILD)
 	$(PYTHON_TESTS)
-test-libraries: $(PY_DEV)
-	scripts/model_libraries.sh $(PY) "$$TOOLCONF_TEST_LIBRARIES"
-test-c-and-loaded: test-libraries
-	@$(MAKE) --no-print-directory c-example-test loaded-models-test
-test-mujoco: test-libraries test-python
-	@$(MAKE) --no-print-directory mujoco-test
+	@d=$$(mktemp -d) && trap 'rm -rf "$$d"' EXIT && scripts/model_libraries.sh $(PY) $$d && \
+	TOOLCONF_TEST_LIBRARIES=$$d $(MAKE) --no-print-directory c-example-test loaded-models-test mujoco-test
 
 ## make check: the inner loop, after each edit (under 3 min warm): rustfmt over the workspace; clippy
 ## (warnings are errors) and the unit tests of each package the working tree changes against main
