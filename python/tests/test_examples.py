@@ -63,7 +63,7 @@ def test_rank_dataframe_ranks_its_tools_as_the_command_line(tmp_path, cli_json):
     tools = tmp_path / "tools.csv"
     example["tools"]().to_csv(tools, index=False)  # Python's repr of each float: the same values
     want = cli_json("rank", "--tools", tools, "--task", example["TASK"],
-                    "--screen", example["SCREEN"])["tools"]
+                    "--screen", example["SCREEN"], "--screen-by", "confidence")["tools"]
     lines = run("rank_dataframe.py").splitlines()
     rows = [re.match(r"\s*(\d+)\s+(.+?)\s+(\S+)\s+(\S+)\s+(\S+)$", line) for line in lines[1:-1]]
     assert len(rows) == len(want) == example["SCREEN"] and all(rows), lines

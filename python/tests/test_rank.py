@@ -35,7 +35,8 @@ def assert_same_as_cli(got, expected_tools):
 def test_rank_equals_the_command_line(task, screen, objective, cli_json):
     args = ["rank", "--tools", DRAWER, "--task", task, "--objective", objective]
     if screen:
-        args += ["--screen", screen]
+        # Python's screen keeps the most confident: the command line's --screen-by confidence.
+        args += ["--screen", screen, "--screen-by", "confidence"]
     expected = cli_json(*args)["tools"]
     got = toolconf.rank(DRAWER, task, screen=screen, objective=objective)
     assert_same_as_cli(got, expected)
