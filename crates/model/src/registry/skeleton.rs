@@ -167,6 +167,18 @@ fn foot_towards(a: &JointAxis, b: &JointAxis) -> Option<Vector3<f64>> {
 mod tests {
     use super::*;
 
+    /// The Panda's joint origins at q = 0, from its URDF's offsets by hand (metres): each on its
+    /// joint's axis, and each the foot of the common perpendicular to the next axis.
+    const PANDA_POINTS_AT_ZERO: [[f64; 3]; 7] = [
+        [0.0, 0.0, 0.333],
+        [0.0, 0.0, 0.333],
+        [0.0, 0.0, 0.649],
+        [0.0825, 0.0, 0.649],
+        [0.0, 0.0, 1.033],
+        [0.0, 0.0, 1.033],
+        [0.088, 0.0, 1.033],
+    ];
+
     /// The Panda at q = 0, against its URDF (derive/robots/panda_description/urdf/panda.urdf)
     /// composed by hand: joint origins z 0.333, 0.333 + 0.316, x 0.0825, z + 0.384, x 0.088;
     /// frames turned by ±90° about x; the flange 0.107 along joint 7's axis, which points down.
@@ -177,15 +189,7 @@ mod tests {
             1.0, 0.0, 0.0, 0.05, 0.01, 0.01, 0.01, 0.0, 0.0, 0.0, 0.02, -0.01, 0.1,
         ];
         let pose = &arm_poses(panda, &tool, &[vec![0.0; 7]]).unwrap()[0];
-        let origins = [
-            [0.0, 0.0, 0.333],
-            [0.0, 0.0, 0.333],
-            [0.0, 0.0, 0.649],
-            [0.0825, 0.0, 0.649],
-            [0.0, 0.0, 1.033],
-            [0.0, 0.0, 1.033],
-            [0.088, 0.0, 1.033],
-        ];
+        let origins = PANDA_POINTS_AT_ZERO;
         let directions = [
             [0.0, 0.0, 1.0],
             [0.0, 1.0, 0.0],
@@ -240,15 +244,7 @@ mod tests {
             1.0, 0.0, 0.0, 0.05, 0.01, 0.01, 0.01, 0.0, 0.0, 0.0, 0.0, 0.0, 0.1,
         ];
         let points = arm_poses(panda, &tool, &[vec![0.0; 7]]).unwrap()[0].link_points();
-        let expected = [
-            [0.0, 0.0, 0.333],
-            [0.0, 0.0, 0.333],
-            [0.0, 0.0, 0.649],
-            [0.0825, 0.0, 0.649],
-            [0.0, 0.0, 1.033],
-            [0.0, 0.0, 1.033],
-            [0.088, 0.0, 1.033],
-        ];
+        let expected = PANDA_POINTS_AT_ZERO;
         for (j, p) in points.iter().enumerate() {
             assert!(
                 (p - Vector3::from(expected[j])).norm() < 1e-9,
