@@ -25,6 +25,7 @@ pub mod verify;
 
 use crate::rank::ModelTasks;
 use toolconf_model::inputs::task_file::TaskSpec;
+use toolconf_model::prediction::derivative::PredictedCost;
 use toolconf_model::registry::{AnyTool, ModelKind};
 
 use file::{DesignObjective, DesignSpec};
@@ -208,8 +209,8 @@ pub fn design_with_progress(
         DesignObjective::Confidence => (optimum.x.clone(), optimum.value, 0),
         DesignObjective::PredictedTaskError | DesignObjective::PredictedFreeEnergy => {
             let which = match spec.objective {
-                DesignObjective::PredictedTaskError => predicted::PredictedCost::TaskError,
-                _ => predicted::PredictedCost::FreeEnergy,
+                DesignObjective::PredictedTaskError => PredictedCost::TaskError,
+                _ => PredictedCost::FreeEnergy,
             };
             // The confidence optimum is one more start: the design is never worse by the
             // prediction than the confidence design.

@@ -17,8 +17,9 @@ use super::file::DesignSpec;
 use super::polytope::Polytope;
 use super::solver::{self, Optimum};
 use super::{DesignError, Setting};
-pub use toolconf_model::prediction::derivative::PredictedCost;
-use toolconf_model::prediction::derivative::{costs_and_derivatives, Costs, DenseSystem};
+use toolconf_model::prediction::derivative::{
+    costs_and_derivatives, Costs, DenseSystem, PredictedCost,
+};
 use toolconf_model::registry::AnyTool;
 
 /// The central-difference step of parameter p: ε^{1/3}·max(|p|, 10⁻³), the step that balances
