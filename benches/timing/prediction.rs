@@ -136,6 +136,9 @@ fn evaluate(tasks: &ModelTasks, tool: &AnyTool) -> Result<Row, String> {
 }
 
 fn run(a: &Args) -> Result<serde_json::Value, String> {
+    // A model loaded at run time (TOOLCONF_MODEL_PATH, as the command line's), e.g. the xArm7.
+    toolconf_model::loaded::load_environment()
+        .map_err(|e| format!("{}: {e}", toolconf_model::loaded::ENVIRONMENT))?;
     let model = lookup(&a.model)?;
     let spec = spec(&a.task)?;
     let tasks = ModelTasks::new(&spec);
