@@ -106,8 +106,14 @@ fn an_unstable_linearised_loop_is_a_stated_null_never_nan() {
         note.starts_with("the closed loop linearised at the equilibrium is unstable"),
         "{note}"
     );
+}
 
-    // rank, screened by prediction: no tool has one, so the first rows are kept, with a note.
+/// rank, screened by prediction, where no tool has one (an unstable linearised loop): the first
+/// rows are kept, with a note, and neither the table nor the CSV holds a NaN.
+#[test]
+fn an_unstable_linearised_loop_screens_in_row_order_and_writes_no_nan() {
+    let dir = tempfile::tempdir().unwrap();
+    let task = touch_with(dir.path(), "fast.toml", "learning_rate = 100.0");
     let csv = dir.path().join("out.csv");
     let csv_arg = csv.display().to_string();
     let args = [

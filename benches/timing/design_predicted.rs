@@ -30,6 +30,41 @@ fn value(args: &[String], key: &str) -> Option<String> {
         .and_then(|i| args.get(i + 1).cloned())
 }
 
+/// The design by confidence and by the predicted task error, each as JSON with its simulated
+/// task error, and those errors in that order.
+fn design_both(
+    spec: &DesignSpec,
+    setting: &Setting,
+    simulated: &dyn Fn(&[f64]) -> Option<f64>,
+) -> (serde_json::Map<String, serde_json::Value>, Vec<Option<f64>>) {
+    let mut designs = serde_json::Map::new();
+    let mut errors = Vec::new();
+    for objective in [
+        DesignObjective::Confidence,
+        DesignObjective::PredictedTaskError,
+    ] {
+        let spec = DesignSpec {
+            objective,
+            ..spec.clone()
+        };
+        let started = Instant::now();
+        let r = design(&spec, setting).expect("design");
+        let seconds = started.elapsed().as_secs_f64();
+        let error = simulated(&r.params);
+        errors.push(error);
+        designs.insert(
+            objective.name().into(),
+            json!({
+                "params": parameters_text(&spec.names, &r.params),
+                "logdet": r.logdet,
+                "simulated_task_error": error,
+                "seconds_with_verification": seconds,
+            }),
+        );
+    }
+    (designs, errors)
+}
+
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().collect();
     let (Some(model), Some(task), Some(file)) = (
@@ -60,31 +95,7 @@ fn main() -> ExitCode {
         let tool = AnyTool::new(model, params).ok()?;
         tasks.simulate(&tool).ok().map(|m| m.task_error)
     };
-    let mut designs = serde_json::Map::new();
-    let mut errors = Vec::new();
-    for objective in [
-        DesignObjective::Confidence,
-        DesignObjective::PredictedTaskError,
-    ] {
-        let spec = DesignSpec {
-            objective,
-            ..spec.clone()
-        };
-        let started = Instant::now();
-        let r = design(&spec, &setting).expect("design");
-        let seconds = started.elapsed().as_secs_f64();
-        let error = simulated(&r.params);
-        errors.push(error);
-        designs.insert(
-            objective.name().into(),
-            json!({
-                "params": parameters_text(&spec.names, &r.params),
-                "logdet": r.logdet,
-                "simulated_task_error": error,
-                "seconds_with_verification": seconds,
-            }),
-        );
-    }
+    let (designs, errors) = design_both(&spec, &setting, &simulated);
     let polytope = Polytope::new(&spec);
     let mut sampler = FeasibleSampler::new(&polytope, spec.search.seed ^ 0x5eed);
     let points: Vec<Vec<f64>> = (0..random)

@@ -8,7 +8,7 @@ use std::time::Instant;
 use toolconf::design::file::DesignSpec;
 use toolconf::design::json::design_json;
 use toolconf::design::solver::KKT_TOLERANCE;
-use toolconf::design::sweep::{parse_sweep, run_sweep};
+use toolconf::design::sweep::{parse_sweep, run_sweep, Sweep, SweepPoint};
 use toolconf::design::{design_with_progress, DesignError, DesignResult, Setting};
 use toolconf::rank::ModelTasks;
 use toolconf_model::registry::ModelKind;
@@ -100,18 +100,8 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         None => None,
     };
     if let Some(dir) = &args.report {
-        let command = format!(
-            "toolconf design --model {} --task {} --design {}{}",
-            model,
-            args.task,
-            args.design.display(),
-            args.sweep
-                .as_ref()
-                .map(|s| format!(" --sweep '{s}'"))
-                .unwrap_or_default()
-        );
         let input = ReportInput {
-            command: &command,
+            command: &command_line(args, model),
             model: model.name(),
             task: &args.task,
             spec: &spec,
@@ -128,20 +118,39 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     } else {
         print_text(&spec, &result, elapsed.as_secs_f64());
         if let (Some(s), Some(points)) = (&sweep, &front) {
-            outln!("\ntrade-off, {} b:", s.label);
-            for p in points {
-                match &p.outcome {
-                    Ok((params, logdet, _)) => outln!(
-                        "  b = {:<8} ln|Pi^U| = {logdet:.6}  {}",
-                        p.value,
-                        parameters_text(&names, params)
-                    ),
-                    Err(e) => outln!("  b = {:<8} {e}", p.value),
-                }
-            }
+            print_front(s, points, &names);
         }
     }
     Ok(())
+}
+
+/// The command that made a report, as its page shows it.
+fn command_line(args: &Args, model: ModelKind) -> String {
+    format!(
+        "toolconf design --model {} --task {} --design {}{}",
+        model,
+        args.task,
+        args.design.display(),
+        args.sweep
+            .as_ref()
+            .map(|s| format!(" --sweep '{s}'"))
+            .unwrap_or_default()
+    )
+}
+
+/// The trade-off front of `--sweep`, a line per value of b.
+fn print_front(sweep: &Sweep, points: &[SweepPoint], names: &[&str]) {
+    outln!("\ntrade-off, {} b:", sweep.label);
+    for p in points {
+        match &p.outcome {
+            Ok((params, logdet, _)) => outln!(
+                "  b = {:<8} ln|Pi^U| = {logdet:.6}  {}",
+                p.value,
+                parameters_text(names, params)
+            ),
+            Err(e) => outln!("  b = {:<8} {e}", p.value),
+        }
+    }
 }
 
 /// What the result itself cannot say loudly enough, on stderr: an optimum that did not converge,

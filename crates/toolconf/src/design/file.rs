@@ -145,77 +145,11 @@ impl DesignSpec {
 
     fn from_raw(raw: RawDesign, file: &str, model: ModelKind) -> Result<Self, DesignError> {
         let names = model.parameter_names();
-        let domains = model.parameter_domains();
         let err =
             |key: &str, message: String| DesignError::input(file, &format!("key {key}"), message);
-        let objective = match raw.objective.as_deref() {
-            None | Some("confidence") => DesignObjective::Confidence,
-            Some("free_energy") | Some("free-energy") => DesignObjective::FreeEnergy,
-            Some("predicted_task_error") => DesignObjective::PredictedTaskError,
-            Some("predicted_free_energy") => DesignObjective::PredictedFreeEnergy,
-            Some(other) => {
-                return Err(err(
-                    "objective",
-                    format!(
-                        "'{}' is not an objective (confidence, free_energy, \
-                         predicted_task_error or predicted_free_energy)",
-                        Clip(other)
-                    ),
-                ))
-            }
-        };
-        let known = |key: String, name: &str| -> Result<usize, DesignError> {
-            names.iter().position(|n| *n == name).ok_or_else(|| {
-                err(
-                    &Clip(&key).to_string(),
-                    format!(
-                        "unknown parameter '{}' (parameters: {})",
-                        Clip(name),
-                        names.join(", ")
-                    ),
-                )
-            })
-        };
-        let mut fixed = vec![None; names.len()];
-        for (name, &value) in &raw.fixed {
-            let k = known(format!("fixed.{name}"), name)?;
-            if let Err(why) = toolconf_model::validate::tool_parameter(&domains[k], value) {
-                return Err(err(&format!("fixed.{name}"), why));
-            }
-            fixed[k] = Some(value);
-        }
-        let mut bounds = vec![None; names.len()];
-        for (name, range) in &raw.bounds {
-            let key = format!("bounds.{name}");
-            let k = known(key.clone(), name)?;
-            if fixed[k].is_some() {
-                return Err(err(
-                    &key,
-                    format!("'{name}' is also fixed; give one of the two"),
-                ));
-            }
-            bounds[k] = Some(check_bounds(range, &domains[k]).map_err(|m| err(&key, m))?);
-        }
-        // A parameter a tools file may leave out (a URDF tool's products of inertia and tip) is
-        // fixed at its default where the design file is silent on it.
-        for (k, default) in model.parameter_defaults().iter().enumerate() {
-            if fixed[k].is_none() && bounds[k].is_none() {
-                fixed[k] = *default;
-            }
-        }
-        let mut out = Vec::with_capacity(names.len());
-        for (k, name) in names.iter().enumerate() {
-            match (fixed[k], bounds[k]) {
-                (Some(v), _) => out.push((v, v)),
-                (None, Some(b)) => out.push(b),
-                (None, None) => {
-                    return Err(err(
-                        "bounds",
-                        format!("parameter '{name}' has no bounds: give bounds.{name} = [lo, hi] or fixed.{name} = value"),
-                    ))
-                }
-            }
-        }
+        let objective =
+            design_objective(raw.objective.as_deref()).map_err(|m| err("objective", m))?;
+        let (fixed, bounds) = fixed_and_bounds(&raw, model, &err)?;
         let mut constraints = raw
             .constraints
             .iter()
@@ -231,12 +165,92 @@ impl DesignSpec {
             objective,
             names: names.to_vec(),
             fixed,
-            bounds: out,
+            bounds,
             constraints,
             search: search_settings(&raw.search)
                 .map_err(|(k, m)| err(&format!("search.{k}"), m))?,
         })
     }
+}
+
+/// The file's `objective`: confidence (the default), free_energy, or a predicted cost.
+fn design_objective(name: Option<&str>) -> Result<DesignObjective, String> {
+    match name {
+        None | Some("confidence") => Ok(DesignObjective::Confidence),
+        Some("free_energy") | Some("free-energy") => Ok(DesignObjective::FreeEnergy),
+        Some("predicted_task_error") => Ok(DesignObjective::PredictedTaskError),
+        Some("predicted_free_energy") => Ok(DesignObjective::PredictedFreeEnergy),
+        Some(other) => Err(format!(
+            "'{}' is not an objective (confidence, free_energy, predicted_task_error or \
+             predicted_free_energy)",
+            Clip(other)
+        )),
+    }
+}
+
+/// Each parameter's fixed value (the file's, else the model's default where the file gives no
+/// bounds either) and its range ((v, v) for a fixed one), each checked against its domain;
+/// `err` makes the error naming a key.
+fn fixed_and_bounds(
+    raw: &RawDesign,
+    model: ModelKind,
+    err: &dyn Fn(&str, String) -> DesignError,
+) -> Result<(Vec<Option<f64>>, Vec<(f64, f64)>), DesignError> {
+    let names = model.parameter_names();
+    let domains = model.parameter_domains();
+    let known = |key: String, name: &str| -> Result<usize, DesignError> {
+        names.iter().position(|n| *n == name).ok_or_else(|| {
+            err(
+                &Clip(&key).to_string(),
+                format!(
+                    "unknown parameter '{}' (parameters: {})",
+                    Clip(name),
+                    names.join(", ")
+                ),
+            )
+        })
+    };
+    let mut fixed = vec![None; names.len()];
+    for (name, &value) in &raw.fixed {
+        let k = known(format!("fixed.{name}"), name)?;
+        if let Err(why) = toolconf_model::validate::tool_parameter(&domains[k], value) {
+            return Err(err(&format!("fixed.{name}"), why));
+        }
+        fixed[k] = Some(value);
+    }
+    let mut bounds = vec![None; names.len()];
+    for (name, range) in &raw.bounds {
+        let key = format!("bounds.{name}");
+        let k = known(key.clone(), name)?;
+        if fixed[k].is_some() {
+            return Err(err(
+                &key,
+                format!("'{name}' is also fixed; give one of the two"),
+            ));
+        }
+        bounds[k] = Some(check_bounds(range, &domains[k]).map_err(|m| err(&key, m))?);
+    }
+    // A parameter a tools file may leave out (a URDF tool's products of inertia and tip) is
+    // fixed at its default where the design file is silent on it.
+    for (k, default) in model.parameter_defaults().iter().enumerate() {
+        if fixed[k].is_none() && bounds[k].is_none() {
+            fixed[k] = *default;
+        }
+    }
+    let mut out = Vec::with_capacity(names.len());
+    for (k, name) in names.iter().enumerate() {
+        match (fixed[k], bounds[k]) {
+            (Some(v), _) => out.push((v, v)),
+            (None, Some(b)) => out.push(b),
+            (None, None) => {
+                return Err(err(
+                    "bounds",
+                    format!("parameter '{name}' has no bounds: give bounds.{name} = [lo, hi] or fixed.{name} = value"),
+                ))
+            }
+        }
+    }
+    Ok((fixed, out))
 }
 
 /// The model's constraints across its parameters as design constraints (c · p ≤ 0), but those

@@ -148,15 +148,7 @@ fn climb_with(
     let mut x = x0.to_vec();
     let mut evaluations = 1;
     if n == 0 {
-        return Ok(Some(Optimum {
-            x,
-            value,
-            gradient: grad,
-            iterations: 0,
-            evaluations,
-            kkt_residual: 0.0,
-            start: 0,
-        }));
+        return Ok(Some(optimum(x, value, grad, (0, evaluations), Some(0.0))));
     }
     let mut b = log_curvature(&scales(polytope, &x), &grad);
     let mut fresh = true;
@@ -180,22 +172,9 @@ fn climb_with(
         if step.relative <= STEP_TOLERANCE {
             break;
         }
-        let d = step.d;
-        let slope = dot(&grad, &d);
-        let mut alpha = 1.0;
-        let mut accepted = None;
-        while alpha > 1e-12 {
-            let trial: Vec<f64> = x.iter().zip(&d).map(|(xi, di)| xi + alpha * di).collect();
-            evaluations += 1;
-            if let Some((v, g)) = objective(&trial) {
-                if v >= value + ARMIJO * alpha * slope && v >= value {
-                    accepted = Some((trial, v, g));
-                    break;
-                }
-            }
-            alpha *= 0.5;
-        }
-        let Some((trial, v, g)) = accepted else {
+        let slope = dot(&grad, &step.d);
+        let accepted = line_search(&x, &step.d, (value, slope), objective, &mut evaluations);
+        let Some((trial, v, g, alpha)) = accepted else {
             // A BFGS matrix that no longer points uphill (it learnt the curvature of a region
             // left behind, decades away): restart it once from the local scale, then stop.
             if fresh {
@@ -218,8 +197,93 @@ fn climb_with(
             break;
         }
     }
-    // The QP's interior-point solution sits ~1e-14 (relative) inside an active bound: put it on
-    // the bound, so a design at the box's corner reads 0.1, not 0.10000000000000249.
+    snap_to_bounds(
+        polytope,
+        objective,
+        (&mut x, &mut value, &mut grad),
+        &mut evaluations,
+    );
+    let kkt = final_kkt(kkt, polytope, (&x, &grad), (&g_rows, &h));
+    Ok(Some(optimum(
+        x,
+        value,
+        grad,
+        (iterations, evaluations),
+        kkt,
+    )))
+}
+
+/// The KKT residual at the climb's end: the last QP's, or the active rows' own where smaller.
+/// At a degenerate vertex (a box corner, every bound active) the QP's multipliers, an interior
+/// point's, are good to only about 1e-5 of the largest; the active rows' give it exactly.
+fn final_kkt(
+    qp: Option<f64>,
+    polytope: &Polytope,
+    (x, grad): (&[f64], &[f64]),
+    (g_rows, h): (&[Vec<f64>], &[f64]),
+) -> Option<f64> {
+    match (
+        qp,
+        active_set_residual(x, &scales(polytope, x), grad, g_rows, h),
+    ) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    }
+}
+
+/// The climb's end from the first start: x, φ(x), ∇φ(x), (iterations, evaluations), and the
+/// KKT residual (infinite where none could be formed).
+fn optimum(
+    x: Vec<f64>,
+    value: f64,
+    gradient: Vec<f64>,
+    (iterations, evaluations): (usize, usize),
+    kkt: Option<f64>,
+) -> Optimum {
+    Optimum {
+        x,
+        value,
+        gradient,
+        iterations,
+        evaluations,
+        kkt_residual: kkt.unwrap_or(f64::INFINITY),
+        start: 0,
+    }
+}
+
+/// Backtracking from α = 1 along d: the first trial point that rises by Armijo's rule (and not
+/// below φ(x)), with φ, ∇φ there and its α, given (φ(x), ∇φ(x)·d); every objective call
+/// counts in `evaluations`.
+fn line_search(
+    x: &[f64],
+    d: &[f64],
+    (value, slope): (f64, f64),
+    objective: &mut Objective,
+    evaluations: &mut usize,
+) -> Option<(Vec<f64>, f64, Vec<f64>, f64)> {
+    let mut alpha = 1.0;
+    while alpha > 1e-12 {
+        let trial: Vec<f64> = x.iter().zip(d).map(|(xi, di)| xi + alpha * di).collect();
+        *evaluations += 1;
+        if let Some((v, g)) = objective(&trial) {
+            if v >= value + ARMIJO * alpha * slope && v >= value {
+                return Some((trial, v, g, alpha));
+            }
+        }
+        alpha *= 0.5;
+    }
+    None
+}
+
+/// The QP's interior-point solution sits ~1e-14 (relative) inside an active bound: put it on
+/// the bound, so a design at the box's corner reads 0.1, not 0.10000000000000249, where φ there
+/// is no worse (to 1e-9 relative). (x, φ(x), ∇φ(x)) are updated in place.
+fn snap_to_bounds(
+    polytope: &Polytope,
+    objective: &mut Objective,
+    (x, value, grad): (&mut Vec<f64>, &mut f64, &mut Vec<f64>),
+    evaluations: &mut usize,
+) {
     let snapped: Vec<f64> = x
         .iter()
         .enumerate()
@@ -228,41 +292,23 @@ fn climb_with(
             if (v - lo).abs() <= 1e-9 * lo {
                 lo
             } else if (v - hi).abs() <= 1e-9 * hi {
-                polytope.hi[j]
+                hi
             } else {
                 v
             }
         })
         .collect();
-    if snapped != x && polytope.contains(&snapped) {
-        if let Some((v, g)) = objective(&snapped) {
-            evaluations += 1;
-            if v >= value - 1e-9 * value.abs().max(1.0) {
-                x = snapped;
-                value = v;
-                grad = g;
-            }
+    if snapped == *x || !polytope.contains(&snapped) {
+        return;
+    }
+    if let Some((v, g)) = objective(&snapped) {
+        *evaluations += 1;
+        if v >= *value - 1e-9 * value.abs().max(1.0) {
+            *x = snapped;
+            *value = v;
+            *grad = g;
         }
     }
-    // At a degenerate vertex (a box corner, every bound active) the QP's multipliers, an
-    // interior point's, are good to only about 1e-5 of the largest; the active rows' own give
-    // the residual exactly.
-    let kkt = match (
-        kkt,
-        active_set_residual(&x, &scales(polytope, &x), &grad, &g_rows, &h),
-    ) {
-        (Some(a), Some(b)) => Some(a.min(b)),
-        (a, b) => a.or(b),
-    };
-    Ok(Some(Optimum {
-        x,
-        value,
-        gradient: grad,
-        iterations,
-        evaluations,
-        kkt_residual: kkt.unwrap_or(f64::INFINITY),
-        start: 0,
-    }))
 }
 
 /// The KKT residual at x with the multipliers of the active rows (relative slack ≤ 1e-9)
