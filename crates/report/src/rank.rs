@@ -239,6 +239,22 @@ fn precision(p: &PrecisionSpec) -> String {
     }
 }
 
+/// A term's goal in words: the file's (with how a relative tip goal is resolved), else
+/// `paper`.
+fn goal_words(spec: &TaskSpec, term: Term, paper: &str) -> String {
+    use toolconf_model::inputs::task_file::TipGoal;
+    let given = spec.goal[term.index()]
+        .as_ref()
+        .map_or_else(|| paper.to_string(), |v| format!("{v:?}"));
+    match (&spec.tip_goal, term) {
+        (TipGoal::Offset(_), Term::Tip) => spec.tip_goal.describe(),
+        (TipGoal::Motion { .. }, Term::TipDot | Term::TipDdot) => {
+            format!("{given} ({})", spec.tip_goal.describe())
+        }
+        _ => given,
+    }
+}
+
 /// What the task sets, in words; what it leaves out is each model's paper value.
 fn task_table(input: &ReportInput) -> Vec<Block> {
     let spec = input.spec;
@@ -266,23 +282,7 @@ fn task_table(input: &ReportInput) -> Vec<Block> {
         let i = term.index();
         if term.has_goal() {
             let name = format!("goal {} [{}]", term.symbol(), term.unit());
-            let value = match (&spec.tip_goal, term) {
-                (toolconf_model::inputs::task_file::TipGoal::Offset(_), Term::Tip) => {
-                    spec.tip_goal.describe()
-                }
-                (
-                    toolconf_model::inputs::task_file::TipGoal::Motion { .. },
-                    Term::TipDot | Term::TipDdot,
-                ) => {
-                    format!(
-                        "{} ({})",
-                        given(vector(&spec.goal[i]), paper),
-                        spec.tip_goal.describe()
-                    )
-                }
-                _ => given(vector(&spec.goal[i]), paper),
-            };
-            add(&name, value);
+            add(&name, goal_words(spec, term, paper));
         }
         let name = format!("precision P^{}", term.symbol());
         add(
@@ -470,7 +470,13 @@ fn confidence_figure(dir: &Path, input: &ReportInput) -> Result<Vec<Block>, Repr
     ])
 }
 
-fn trajectory_figure(dir: &Path, input: &ReportInput) -> Result<Vec<Block>, ReproduceError> {
+/// A traced tool: its legend ("#rank name"), colour, whether dashed (a worst tool), and its
+/// task variable over the episode.
+type Traced = (String, Colour, bool, TaskTrace);
+
+/// The [`TRACED`] best tools by the objective, and the [`TRACED`] worst not among them, each
+/// as indices into the results, best or worst first.
+fn best_and_worst(input: &ReportInput) -> (Vec<usize>, Vec<usize>) {
     let ok: Vec<usize> = input
         .order
         .iter()
@@ -485,7 +491,17 @@ fn trajectory_figure(dir: &Path, input: &ReportInput) -> Result<Vec<Block>, Repr
         .filter(|i| !best.contains(i))
         .take(TRACED)
         .collect();
-    let (var, axis) = variable(input.spec.kind);
+    (best, worst)
+}
+
+/// Each tool's trace of `best` (solid, blues) and `worst` (dashed, reds); the (result, trace)
+/// indices of the best and the worst tool, for the 3-D view; and a note per tool whose trace
+/// failed.
+fn traces_of(
+    input: &ReportInput,
+    best: &[usize],
+    worst: &[usize],
+) -> (Vec<Traced>, Vec<(usize, usize)>, Vec<String>) {
     const BEST: [Colour; TRACED] = [
         Colour(0, 90, 200),
         Colour(60, 150, 230),
@@ -496,11 +512,10 @@ fn trajectory_figure(dir: &Path, input: &ReportInput) -> Result<Vec<Block>, Repr
         Colour(230, 110, 60),
         Colour(240, 170, 110),
     ];
-    let mut traces: Vec<(String, Colour, bool, TaskTrace)> = Vec::new();
-    // The best and the worst tool's (result, trace) indices, for the 3-D view.
+    let mut traces: Vec<Traced> = Vec::new();
     let mut ends: Vec<(usize, usize)> = Vec::new();
     let mut notes = Vec::new();
-    for (group, colours, dashed) in [(&best, BEST, false), (&worst, WORST, true)] {
+    for (group, colours, dashed) in [(best, BEST, false), (worst, WORST, true)] {
         for (k, &i) in group.iter().enumerate() {
             let r = &input.results[i];
             let rank = input.order.iter().position(|&j| j == i).unwrap_or(0) + 1;
@@ -515,50 +530,60 @@ fn trajectory_figure(dir: &Path, input: &ReportInput) -> Result<Vec<Block>, Repr
             }
         }
     }
+    (traces, ends, notes)
+}
+
+/// The panel of component `j` of the task variable: each trace that has it, and its goal.
+fn trace_panel(j: usize, traces: &[Traced], kind: TaskKind, axis: &str) -> Panel {
+    let mut lines: Vec<Series> = traces
+        .iter()
+        .filter(|t| j < t.3.value.len())
+        .map(|(label, colour, dashed, t)| {
+            let s = Series::new(
+                label.clone(),
+                *colour,
+                t.t.iter()
+                    .copied()
+                    .zip(t.value[j].iter().copied())
+                    .collect(),
+            );
+            if *dashed {
+                s.dashed()
+            } else {
+                s
+            }
+        })
+        .collect();
+    if let Some((_, _, _, t)) = traces.iter().find(|t| j < t.3.value.len()) {
+        let end = t.t.last().copied().unwrap_or(0.0);
+        lines.push(
+            Series::new(
+                "goal",
+                plot::GOAL_GREY,
+                vec![(0.0, t.goal[j]), (end, t.goal[j])],
+            )
+            .dashed(),
+        );
+    }
+    Panel::Xy(XyPanel {
+        title: component_title(kind, j),
+        x_label: "time t [s]".into(),
+        y_label: axis.into(),
+        dots: Vec::new(),
+        lines,
+        log_y: false,
+        legend: Legend::LowerRight,
+        headroom: 0.35,
+    })
+}
+
+fn trajectory_figure(dir: &Path, input: &ReportInput) -> Result<Vec<Block>, ReproduceError> {
+    let (best, worst) = best_and_worst(input);
+    let (var, axis) = variable(input.spec.kind);
+    let (traces, ends, notes) = traces_of(input, &best, &worst);
     let joints = traces.iter().map(|t| t.3.value.len()).max().unwrap_or(0);
     let panels: Vec<Panel> = (0..joints.max(1))
-        .map(|j| {
-            let mut lines: Vec<Series> = traces
-                .iter()
-                .filter(|t| j < t.3.value.len())
-                .map(|(label, colour, dashed, t)| {
-                    let s = Series::new(
-                        label.clone(),
-                        *colour,
-                        t.t.iter()
-                            .copied()
-                            .zip(t.value[j].iter().copied())
-                            .collect(),
-                    );
-                    if *dashed {
-                        s.dashed()
-                    } else {
-                        s
-                    }
-                })
-                .collect();
-            if let Some((_, _, _, t)) = traces.iter().find(|t| j < t.3.value.len()) {
-                let end = t.t.last().copied().unwrap_or(0.0);
-                lines.push(
-                    Series::new(
-                        "goal",
-                        plot::GOAL_GREY,
-                        vec![(0.0, t.goal[j]), (end, t.goal[j])],
-                    )
-                    .dashed(),
-                );
-            }
-            Panel::Xy(XyPanel {
-                title: component_title(input.spec.kind, j),
-                x_label: "time t [s]".into(),
-                y_label: axis.as_str().into(),
-                dots: Vec::new(),
-                lines,
-                log_y: false,
-                legend: Legend::LowerRight,
-                headroom: 0.35,
-            })
-        })
+        .map(|j| trace_panel(j, &traces, input.spec.kind, &axis))
         .collect();
     let svg = plot::save(&dir.join(TRAJECTORY_SVG), &panels, (560, 420))?;
     let mut blocks = vec![
@@ -592,11 +617,7 @@ fn trajectory_figure(dir: &Path, input: &ReportInput) -> Result<Vec<Block>, Repr
 /// The 3-D view of the best and the worst tool's episodes (`ends`: their result and trace
 /// indices), with the goal point of a tip position task; on a model without a URDF flange, the
 /// line saying why there is none.
-fn arm_view(
-    input: &ReportInput,
-    ends: &[(usize, usize)],
-    traces: &[(String, Colour, bool, TaskTrace)],
-) -> Vec<Block> {
+fn arm_view(input: &ReportInput, ends: &[(usize, usize)], traces: &[Traced]) -> Vec<Block> {
     let shown: Vec<view3d::Shown> = ends
         .iter()
         .zip(["best", "worst"])
@@ -632,21 +653,67 @@ fn component_title(kind: TaskKind, j: usize) -> String {
 
 const TIP_PATH_SVG: &str = "tip_paths.svg";
 
+/// The tips' paths projected on the base frame's axes (a, b), with each start and, where the
+/// goal is a point, the goal.
+fn tip_path_panel(
+    paths: &[(&Traced, &[Vec<f64>])],
+    (a, b, title): (usize, usize, &str),
+    goal_is_point: bool,
+) -> Panel {
+    let lines: Vec<Series> = paths
+        .iter()
+        .map(|((label, colour, dashed, _), path)| {
+            let points = path[a]
+                .iter()
+                .copied()
+                .zip(path[b].iter().copied())
+                .collect();
+            let s = Series::new(label.clone(), *colour, points);
+            if *dashed {
+                s.dashed()
+            } else {
+                s
+            }
+        })
+        .collect();
+    let mut dots = Vec::new();
+    if let Some(((_, _, _, t), _)) = paths.first().filter(|_| goal_is_point) {
+        dots.push(Series::new(
+            "goal",
+            plot::GOAL_GREY,
+            vec![(t.goal[a], t.goal[b])],
+        ));
+    }
+    let starts: Vec<(f64, f64)> = paths
+        .iter()
+        .filter_map(|p| Some((*p.1[a].first()?, *p.1[b].first()?)))
+        .collect();
+    dots.push(Series::new("start", Colour(190, 190, 190), starts));
+    Panel::Xy(XyPanel {
+        title: title.into(),
+        x_label: format!("tip {} [m]", AXES[a]),
+        y_label: format!("tip {} [m]", AXES[b]),
+        dots,
+        lines,
+        log_y: false,
+        legend: Legend::UpperLeft,
+        headroom: 0.6,
+    })
+}
+
 /// On a tip task, the tip's path of the best and worst tools in two projections of the base
 /// frame (x–y seen from above, x–z from the side; the plane of a planar arm alone), with the
 /// goal point of a tip position task marked.
 fn tip_path_figure(
     dir: &Path,
     input: &ReportInput,
-    traces: &[(String, Colour, bool, TaskTrace)],
+    traces: &[Traced],
 ) -> Result<Vec<Block>, ReproduceError> {
-    let paths: Vec<_> = traces
+    let paths: Vec<(&Traced, &[Vec<f64>])> = traces
         .iter()
-        .filter_map(|(label, colour, dashed, t)| {
-            Some((label, colour, dashed, t.tip_path.as_ref()?, t))
-        })
+        .filter_map(|t| Some((t, t.3.tip_path.as_deref()?)))
         .collect();
-    let Some(dims) = paths.iter().map(|p| p.3.len()).min().filter(|&d| d >= 2) else {
+    let Some(dims) = paths.iter().map(|p| p.1.len()).min().filter(|&d| d >= 2) else {
         return Ok(Vec::new());
     };
     let goal_is_point = matches!(input.spec.kind.error_term().read(), Read::Tip { order: 0 });
@@ -660,47 +727,7 @@ fn tip_path_figure(
     };
     let panels: Vec<Panel> = projections
         .iter()
-        .map(|&(a, b, title)| {
-            let lines: Vec<Series> = paths
-                .iter()
-                .map(|(label, colour, dashed, path, _)| {
-                    let points = path[a]
-                        .iter()
-                        .copied()
-                        .zip(path[b].iter().copied())
-                        .collect();
-                    let s = Series::new((*label).clone(), **colour, points);
-                    if **dashed {
-                        s.dashed()
-                    } else {
-                        s
-                    }
-                })
-                .collect();
-            let mut dots = Vec::new();
-            if let Some((_, _, _, _, t)) = paths.first().filter(|_| goal_is_point) {
-                dots.push(Series::new(
-                    "goal",
-                    plot::GOAL_GREY,
-                    vec![(t.goal[a], t.goal[b])],
-                ));
-            }
-            let starts: Vec<(f64, f64)> = paths
-                .iter()
-                .filter_map(|p| Some((*p.3[a].first()?, *p.3[b].first()?)))
-                .collect();
-            dots.push(Series::new("start", Colour(190, 190, 190), starts));
-            Panel::Xy(XyPanel {
-                title: title.into(),
-                x_label: format!("tip {} [m]", AXES[a]),
-                y_label: format!("tip {} [m]", AXES[b]),
-                dots,
-                lines,
-                log_y: false,
-                legend: Legend::UpperLeft,
-                headroom: 0.6,
-            })
-        })
+        .map(|&projection| tip_path_panel(&paths, projection, goal_is_point))
         .collect();
     let svg = plot::save(&dir.join(TIP_PATH_SVG), &panels, (560, 420))?;
     Ok(vec![
