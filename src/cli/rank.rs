@@ -290,8 +290,21 @@ struct Counts {
     first_prediction_error: Option<String>,
 }
 
-pub fn run(args: &Args) -> Result<(), CliError> {
-    let mut spec = task_spec(&args.task)?;
+impl Counts {
+    /// The screen's counts (no bad row skipped).
+    fn of(screen: &Screen) -> Self {
+        Counts {
+            read: screen.read,
+            skipped: 0,
+            without_confidence: screen.without_confidence,
+            without_prediction: screen.without_prediction,
+            first_prediction_error: screen.first_prediction_error.clone(),
+        }
+    }
+}
+
+/// The files the run reads and writes, checked before anything is read or written.
+fn check_run_files(args: &Args, spec: &TaskSpec) -> Result<(), CliError> {
     let mut files = RunFiles::new();
     files.input("--tools", &args.tools);
     if !spec.file.is_empty() {
@@ -303,18 +316,20 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     if let Some(dir) = &args.report {
         files.output_folder("--report", dir, &toolconf_report::rank::REPORT_FILES);
     }
-    check_files(&files)?;
+    check_files(&files)
+}
+
+pub fn run(args: &Args) -> Result<(), CliError> {
+    let mut spec = task_spec(&args.task)?;
+    check_run_files(args, &spec)?;
     spec.episode.method = Some(args.method.method.into());
     let tasks = ModelTasks::new(&spec);
     let objective = Objective::from(args.objective);
     let started = Instant::now();
     let (screen, skipped) = screen_tools(args, &tasks)?;
     let counts = Counts {
-        read: screen.read,
         skipped,
-        without_confidence: screen.without_confidence,
-        without_prediction: screen.without_prediction,
-        first_prediction_error: screen.first_prediction_error.clone(),
+        ..Counts::of(&screen)
     };
     let sample = screen.validation_sample();
     let candidates = screen.finish();
@@ -377,13 +392,18 @@ pub fn run(args: &Args) -> Result<(), CliError> {
             outln!("report: {}", files[1].display());
         }
     }
-    if results.iter().all(|r| r.episode.is_err()) {
-        return Err(CliError::Failed(format!(
+    some_succeeded(&results)
+}
+
+/// A run whose every simulated tool failed is a failed run (status 1).
+fn some_succeeded(results: &[RankedTool]) -> Result<(), CliError> {
+    match results.iter().all(|r| r.episode.is_err()) {
+        true => Err(CliError::Failed(format!(
             "every one of the {} simulated tools failed",
             results.len()
-        )));
+        ))),
+        false => Ok(()),
     }
-    Ok(())
 }
 
 /// The expensive stage, each result written to `--csv` (file order) as its chunk finishes.
