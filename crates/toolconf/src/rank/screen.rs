@@ -609,7 +609,11 @@ pub(super) mod tests {
             let whole = whole.into_block();
             assert_eq!((whole.without_prediction, whole.read), (3, 7));
             // The first reason is the first row's (real part 0.5), whatever the blocks.
-            assert!(whole.first_prediction_error.as_ref().unwrap().contains("5.000000e-1"));
+            assert!(whole
+                .first_prediction_error
+                .as_ref()
+                .unwrap()
+                .contains("5.000000e-1"));
             assert_eq!(merged.into_block(), whole, "{limit:?}");
         }
     }
