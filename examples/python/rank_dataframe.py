@@ -5,8 +5,10 @@ without writing a file, then the paper's claim looked at with pandas.
     python examples/python/rank_dataframe.py
 
 ``toolconf.rank`` takes a DataFrame with a tools file's columns (``name``, ``model`` and the
-models' parameters) and gives back a DataFrame, best tool first. With ``screen=K`` only the K
-most confident tools (largest ln|Pi^U|, computed without simulating) are simulated.
+models' parameters) and gives back a DataFrame, best tool first. With ``screen=K`` only K tools
+are simulated, chosen without simulating: by default those whose episode the closed loop
+linearised at the equilibrium predicts cheapest (``screen_by="confidence"``: the K most
+confident, largest ln|Pi^U|).
 """
 
 from pathlib import Path

@@ -24,7 +24,7 @@ def main() -> None:
     parser.add_argument("tools", nargs="?", default=EXAMPLES / "tools" / "drawer.csv")
     parser.add_argument("task", nargs="?", default=EXAMPLES / "tasks" / "reach_45.toml")
     parser.add_argument("--screen", type=int, default=None,
-                        help="simulate only the K most confident tools")
+                        help="simulate only the K tools predicted cheapest")
     parser.add_argument("--out", default="confidence_vs_task_error.png")
     args = parser.parse_args()
 

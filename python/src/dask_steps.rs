@@ -4,7 +4,8 @@
 //!
 //! 1. [`screen_block`] on each partition: the cheap stage over its rows, numbered globally.
 //! 2. [`merge_screens`] on the client: the partitions' screens absorbed in row order (the
-//!    global top K, ties by global row) and the whole input's checks.
+//!    global top K by the screen's criterion, its predictions carried in the blocks; ties and
+//!    tools without a prediction by global row) and the whole input's checks.
 //! 3. [`episodes`] on the workers: the kept tools' episodes, a block at a time.
 //! 4. [`rank_table`] on the client: the simulated blocks ranked into one table.
 //!
@@ -14,11 +15,11 @@
 
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
-use toolconf::rank::{check_screened, simulate_all, ModelTasks, Screen, ScreenedBlock};
+use toolconf::rank::{check_screened, simulate_all, ModelTasks, Screen, ScreenBy, ScreenedBlock};
 use toolconf_model::inputs::task_file::TaskSpec;
 
 use crate::errors::{detached, Failure};
-use crate::rank::{objective, screen_limit};
+use crate::rank::{objective, screen_by, screen_limit};
 use crate::task::{portable_spec, TASK_TEXT};
 use crate::tool_tables::{
     block_to_py, candidates_from_py, candidates_to_py, outcomes_from_py, ranked_to_py, Outcome,
@@ -27,18 +28,21 @@ use crate::tools::Tools;
 
 /// The task as workers can read it: a built-in name or a dict as it is, a task file as
 /// ``("toolconf task file", name, text)``. Checks the options first, in ``toolconf.rank``'s
-/// order and with its ``ValueError``: ``objective``, ``screen``, the task, ``method``.
+/// order and with its ``ValueError``: ``objective``, ``screen``, ``screen_by``, the task,
+/// ``method``.
 #[pyfunction]
-#[pyo3(name = "_portable_task", signature = (task, screen=None, objective="free-energy", method="fast"))]
+#[pyo3(name = "_portable_task", signature = (task, screen=None, objective="free-energy", method="fast", screen_by=None))]
 pub fn portable_task<'py>(
     task: &Bound<'py, PyAny>,
     screen: Option<&Bound<'py, PyAny>>,
     objective: &str,
     method: &str,
+    screen_by: Option<&str>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let py = task.py();
-    self::objective(objective).map_err(|f| f.into_pyerr(py))?;
+    let objective = self::objective(objective).map_err(|f| f.into_pyerr(py))?;
     screen_limit(screen).map_err(|f| f.into_pyerr(py))?;
+    self::screen_by(screen_by, objective).map_err(|f| f.into_pyerr(py))?;
     let spec = block_task(task)?;
     crate::task::method(method).map_err(|f| f.into_pyerr(py))?;
     if spec.file.is_empty() || task.cast::<PyDict>().is_ok() || task.cast::<PyTuple>().is_ok() {
@@ -57,16 +61,36 @@ fn block_task(task: &Bound<'_, PyAny>) -> PyResult<TaskSpec> {
     portable_spec(task, None)
 }
 
+/// The screen's criterion of a block step: ``screen_by`` for ``objective`` with a screen; none
+/// without (nothing is chosen, the episodes' stage predicts every tool), as ``toolconf.rank``.
+fn block_screen_by(
+    py: Python<'_>,
+    limit: Option<usize>,
+    screen_by: Option<&str>,
+    objective: &str,
+) -> PyResult<ScreenBy> {
+    let objective = self::objective(objective).map_err(|f| f.into_pyerr(py))?;
+    let by = self::screen_by(screen_by, objective).map_err(|f| f.into_pyerr(py))?;
+    Ok(if limit.is_some() {
+        by
+    } else {
+        ScreenBy::Confidence
+    })
+}
+
 /// The cheap stage over one block of a table (a Dask partition), its rows numbered from
 /// ``first_row`` (its first row's 1-based place in the whole table), without the whole
 /// table's checks (``_merge_screens`` makes them).
 ///
-/// Returns a dict: ``kept`` (the block's candidates: the ``screen`` most confident, or all),
-/// ``read``, ``without_confidence``, ``first_confidence_error``, ``skipped`` (one warning per
-/// bad row skipped) and ``rows``. Raises ``ValueError`` for the block's first bad row (unless
-/// ``skip_bad_rows``) or a tool the task does not fit, with ``toolconf.rank``'s message.
+/// Returns a dict: ``kept`` (the block's candidates: the ``screen`` best by ``screen_by`` for
+/// ``objective``, with their predictions when by prediction, or all), ``read``,
+/// ``without_confidence``, ``first_confidence_error``, ``without_prediction``,
+/// ``first_prediction_error``, ``skipped`` (one warning per bad row skipped) and ``rows``.
+/// Raises ``ValueError`` for the block's first bad row (unless ``skip_bad_rows``) or a tool the
+/// task does not fit, with ``toolconf.rank``'s message.
 #[pyfunction]
-#[pyo3(name = "_screen_block", signature = (tools, task, first_row, screen=None, skip_bad_rows=false, source="tools DataFrame"))]
+#[pyo3(name = "_screen_block", signature = (tools, task, first_row, screen=None, skip_bad_rows=false, source="tools DataFrame", objective="free-energy", screen_by=None))]
+#[allow(clippy::too_many_arguments)]
 pub fn screen_block<'py>(
     py: Python<'py>,
     tools: &Bound<'py, PyAny>,
@@ -75,8 +99,11 @@ pub fn screen_block<'py>(
     screen: Option<&Bound<'py, PyAny>>,
     skip_bad_rows: bool,
     source: &str,
+    objective: &str,
+    screen_by: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let limit = screen_limit(screen).map_err(|f| f.into_pyerr(py))?;
+    let by = block_screen_by(py, limit, screen_by, objective)?;
     let spec = block_task(task)?;
     let tools = Tools::from_py(tools, Some(source)).map_err(|f| f.into_pyerr(py))?;
     let rows = tools.rows().unwrap_or(0);
@@ -85,9 +112,9 @@ pub fn screen_block<'py>(
         if rows == 0 {
             // An empty partition: nothing to read (a whole table without rows is refused on
             // the client, by toolconf.rank's own message).
-            return Ok((Screen::new(limit).into_block(), Vec::new()));
+            return Ok((Screen::by(limit, by).into_block(), Vec::new()));
         }
-        let screened = tools.screen(&tasks, limit, skip_bad_rows, first_row.max(1), false)?;
+        let screened = tools.screen(&tasks, (limit, by), skip_bad_rows, first_row.max(1), false)?;
         Ok((screened.screen.into_block(), screened.skipped))
     })?;
     let out = PyDict::new(py);
@@ -95,29 +122,36 @@ pub fn screen_block<'py>(
     out.set_item("read", block.read)?;
     out.set_item("without_confidence", block.without_confidence)?;
     out.set_item("first_confidence_error", block.first_confidence_error)?;
+    out.set_item("without_prediction", block.without_prediction)?;
+    out.set_item("first_prediction_error", block.first_prediction_error)?;
     out.set_item("skipped", skipped)?;
     out.set_item("rows", rows)?;
     Ok(out)
 }
 
 /// The blocks' screens (``_screen_block``'s dicts, in row order; ``kept`` may be None when only
-/// the counts matter) absorbed into one: the global ``screen`` most confident, ties broken by
-/// the global row, then the whole table's checks (some valid row, some tool with a
-/// confidence). Returns the kept candidates as a block; raises ``ValueError`` as
-/// ``toolconf.rank`` does.
+/// the counts matter) absorbed into one: the global ``screen`` best by ``screen_by`` for
+/// ``objective`` (the blocks' own criterion), ties and tools without a prediction by the
+/// global row, then the whole table's checks (some valid row, some tool with a confidence).
+/// Returns ``(kept, note)``: the kept candidates as a block, and what ``toolconf.rank`` warns of
+/// the tools without a prediction (None if nothing); raises ``ValueError`` as ``toolconf.rank``
+/// does.
 #[pyfunction]
-#[pyo3(name = "_merge_screens", signature = (blocks, task, screen=None, source="tools DataFrame"))]
+#[pyo3(name = "_merge_screens", signature = (blocks, task, screen=None, source="tools DataFrame", objective="free-energy", screen_by=None))]
 pub fn merge_screens<'py>(
     py: Python<'py>,
     blocks: &Bound<'py, PyList>,
     task: &Bound<'py, PyAny>,
     screen: Option<&Bound<'py, PyAny>>,
     source: &str,
-) -> PyResult<Bound<'py, PyDict>> {
+    objective: &str,
+    screen_by: Option<&str>,
+) -> PyResult<(Bound<'py, PyDict>, Option<String>)> {
     let limit = screen_limit(screen).map_err(|f| f.into_pyerr(py))?;
+    let by = block_screen_by(py, limit, screen_by, objective)?;
     let spec = block_task(task)?;
     let tasks = ModelTasks::new(&spec);
-    let mut merged = Screen::new(limit);
+    let mut merged = Screen::by(limit, by);
     let mut skipped = 0;
     for block in blocks.iter() {
         let block = block.cast::<PyDict>()?;
@@ -137,12 +171,15 @@ pub fn merge_screens<'py>(
             read: item("read")?.extract()?,
             without_confidence: item("without_confidence")?.extract()?,
             first_confidence_error: item("first_confidence_error")?.extract()?,
+            without_prediction: item("without_prediction")?.extract()?,
+            first_prediction_error: item("first_prediction_error")?.extract()?,
         });
         skipped += item("skipped")?.len()?;
     }
     check_screened(&merged, skipped, source, &tasks.kind.to_string())
         .map_err(|e| Failure::input(e).into_pyerr(py))?;
-    candidates_to_py(py, &merged.finish())
+    let note = merged.unpredicted_note();
+    Ok((candidates_to_py(py, &merged.finish())?, note))
 }
 
 /// The episodes of a block of candidates (``_screen_block``'s ``kept``, or a slice of

@@ -5,7 +5,11 @@
 //! Columns, each one entry per tool: `row` (1-based in the whole input), `name` (str or None),
 //! `model`, one column per parameter of the models present (NaN where a tool's model has no
 //! such parameter), `logdet` (ln|Π^U|, NaN without one); ranked tools add `task_error`,
-//! `free_energy`, `cost_j` (NaN for a failed episode), `rhs_evals` (-1 for one) and `error`.
+//! `free_energy`, `cost_j` (NaN for a failed episode), `rhs_evals` (-1 for one) and `error`;
+//! both add the prediction's columns (`predicted_task_error`, …, NaN without one, and
+//! `prediction_note`) where there is one: ranked tools always, candidates when the screen is by
+//! prediction. Blocks also carry `predicted_abscissa`, so that a prediction read back is the one
+//! written.
 
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -14,6 +18,7 @@ use toolconf::rank::{objective_value, order_by_score, Candidate, ModelTasks, Ran
 use toolconf::select::Objective;
 use toolconf_model::inputs::tools_file::ToolRow;
 use toolconf_model::model::Metrics;
+use toolconf_model::prediction::Prediction;
 use toolconf_model::registry::{AnyTool, ModelKind};
 
 use crate::errors::Failure;
@@ -25,6 +30,8 @@ pub struct Outcome {
     pub tool: ToolRow,
     pub logdet: Option<f64>,
     pub episode: Result<Shown, String>,
+    /// The episode's predicted cost, or why there is none.
+    pub prediction: Result<Prediction, String>,
 }
 
 /// The metrics a ranked table shows.
@@ -54,6 +61,7 @@ impl Outcome {
             tool: r.row,
             logdet: r.logdet.ok(),
             episode: r.episode.map(shown).map_err(|e| e.to_string()),
+            prediction: r.prediction.map_err(|e| e.reason()),
         }
     }
 }
@@ -100,7 +108,33 @@ fn put_tools(out: &Bound<'_, PyDict>, tools: &[&ToolRow]) -> PyResult<()> {
     Ok(())
 }
 
-/// Candidates (after the screen) as a block: the tool columns and `logdet`.
+/// The prediction's columns, as `toolconf rank --json` names its fields: each value (NaN
+/// without a prediction) and `prediction_note` (None, or why there is none); with `abscissa`
+/// (a block's), also `predicted_abscissa`.
+fn put_predictions(
+    out: &Bound<'_, PyDict>,
+    predictions: &[Result<&Prediction, &str>],
+    abscissa: bool,
+) -> PyResult<()> {
+    let py = out.py();
+    let items: Vec<&Result<&Prediction, &str>> = predictions.iter().collect();
+    let column = |f: fn(&Prediction) -> f64| floats(py, &items, move |p| p.ok().map(f));
+    out.set_item("predicted_task_error", column(|p| p.task_error))?;
+    out.set_item("predicted_free_energy", column(|p| p.free_energy))?;
+    out.set_item("predicted_cost_j", column(|p| p.cost_j))?;
+    out.set_item(
+        "predicted_perturbation_effect",
+        column(|p| p.perturbation_effect),
+    )?;
+    if abscissa {
+        out.set_item("predicted_abscissa", column(|p| p.abscissa))?;
+    }
+    let notes: Vec<Option<&str>> = predictions.iter().map(|p| p.err()).collect();
+    out.set_item("prediction_note", notes)
+}
+
+/// Candidates (after the screen) as a block: the tool columns, `logdet` and, when the screen
+/// predicted them, the predictions.
 pub fn candidates_to_py<'py>(py: Python<'py>, kept: &[Candidate]) -> PyResult<Bound<'py, PyDict>> {
     let out = PyDict::new(py);
     let tools: Vec<&ToolRow> = kept.iter().map(|c| &c.row).collect();
@@ -111,6 +145,20 @@ pub fn candidates_to_py<'py>(py: Python<'py>, kept: &[Candidate]) -> PyResult<Bo
             c.logdet.as_ref().ok().copied()
         }),
     )?;
+    // The screen predicts every tool it keeps, or none.
+    let predictions: Option<Vec<_>> = kept.iter().map(|c| c.prediction.as_ref()).collect();
+    if let Some(predictions) = predictions.filter(|p| !p.is_empty()) {
+        let reasons: Vec<String> = predictions
+            .iter()
+            .map(|p| p.as_ref().err().map(|e| e.reason()).unwrap_or_default())
+            .collect();
+        let shown: Vec<Result<&Prediction, &str>> = predictions
+            .iter()
+            .zip(&reasons)
+            .map(|(p, reason)| p.as_ref().map_err(|_| reason.as_str()))
+            .collect();
+        put_predictions(&out, &shown, true)?;
+    }
     Ok(out)
 }
 
@@ -152,6 +200,11 @@ fn outcomes_to_py<'py>(
         .map(|o| o.episode.as_ref().err().map(String::as_str))
         .collect();
     out.set_item("error", errors)?;
+    let predictions: Vec<Result<&Prediction, &str>> = items
+        .iter()
+        .map(|o| o.prediction.as_ref().map_err(String::as_str))
+        .collect();
+    put_predictions(&out, &predictions, !ranked)?;
     if !ranked {
         out.set_item("score", shown(|s| s.score))?;
     }
@@ -248,27 +301,90 @@ fn tools_from_py(block: &Bound<'_, PyDict>) -> Result<Vec<ToolRow>, Failure> {
     Ok(tools)
 }
 
+/// The predictions of a block written by [`put_predictions`] with their abscissae, one per
+/// tool of `n` (a prediction, or its note); `None` for a block without them.
+fn predictions_from_py(
+    block: &Bound<'_, PyDict>,
+    n: usize,
+) -> Result<Option<Vec<Result<Prediction, String>>>, Failure> {
+    if !block.contains("prediction_note").unwrap_or(false) {
+        return Ok(None);
+    }
+    let notes: Vec<Option<String>> = column(block, "prediction_note")?;
+    let [task_error, free_energy, cost_j, perturbation_effect, abscissa] = [
+        "predicted_task_error",
+        "predicted_free_energy",
+        "predicted_cost_j",
+        "predicted_perturbation_effect",
+        "predicted_abscissa",
+    ]
+    .map(|key| float_column(block, key));
+    let (task_error, free_energy, cost_j) = (task_error?, free_energy?, cost_j?);
+    let (perturbation_effect, abscissa) = (perturbation_effect?, abscissa?);
+    let lengths = [
+        notes.len(),
+        task_error.len(),
+        free_energy.len(),
+        cost_j.len(),
+        perturbation_effect.len(),
+        abscissa.len(),
+    ];
+    if lengths.iter().any(|&l| l != n) {
+        return Err(Failure::Input(
+            "tools block: columns of different lengths".into(),
+        ));
+    }
+    Ok(Some(
+        notes
+            .into_iter()
+            .enumerate()
+            .map(|(i, note)| match note {
+                Some(note) => Err(note),
+                None => Ok(Prediction {
+                    task_error: task_error[i],
+                    free_energy: free_energy[i],
+                    cost_j: cost_j[i],
+                    perturbation_effect: perturbation_effect[i],
+                    abscissa: abscissa[i],
+                }),
+            })
+            .collect(),
+    ))
+}
+
 /// The candidates of a block written by [`candidates_to_py`]: a tool without a confidence
-/// (NaN) gets its error again from `tasks`, the same function of the tool and the task.
+/// (NaN), or without a prediction where the block has them, gets its error again from
+/// `tasks`, the same function of the tool and the task.
 pub fn candidates_from_py(
     block: &Bound<'_, PyDict>,
     tasks: &ModelTasks,
 ) -> Result<Vec<Candidate>, Failure> {
     let tools = tools_from_py(block)?;
     let logdets = float_column(block, "logdet")?;
+    if logdets.len() != tools.len() {
+        return Err(Failure::Input(
+            "tools block: columns of different lengths".into(),
+        ));
+    }
+    let predictions = predictions_from_py(block, tools.len())?;
     Ok(tools
         .into_iter()
         .zip(logdets)
-        .map(|(row, l)| {
+        .enumerate()
+        .map(|(i, (row, l))| {
             let logdet = if l.is_nan() {
                 tasks.logdet(&row.tool)
             } else {
                 Ok(l)
             };
+            let prediction = predictions.as_ref().map(|p| match &p[i] {
+                Ok(p) => Ok(*p),
+                Err(_) => tasks.predict(&row.tool),
+            });
             Candidate {
                 row,
                 logdet,
-                prediction: None,
+                prediction,
             }
         })
         .collect())
@@ -286,6 +402,8 @@ pub fn outcomes_from_py(block: &Bound<'_, PyDict>) -> Result<Vec<Outcome>, Failu
     let evals: Vec<i64> = numeric_column(block, "rhs_evals", "int64")?;
     let errors: Vec<Option<String>> = column(block, "error")?;
     let n = tools.len();
+    let predictions = predictions_from_py(block, n)?
+        .ok_or_else(|| Failure::Input("tools block: no column 'prediction_note'".into()))?;
     if [
         logdet.len(),
         task_error.len(),
@@ -307,8 +425,10 @@ pub fn outcomes_from_py(block: &Bound<'_, PyDict>) -> Result<Vec<Outcome>, Failu
         .into_iter()
         .enumerate()
         .zip(errors)
-        .map(|((i, tool), error)| Outcome {
+        .zip(predictions)
+        .map(|(((i, tool), error), prediction)| Outcome {
             tool,
+            prediction,
             logdet: Some(logdet[i]).filter(|l| !l.is_nan()),
             episode: match error {
                 Some(e) => Err(e),

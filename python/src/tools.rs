@@ -8,7 +8,9 @@ use std::path::PathBuf;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyFloat, PyInt, PyList, PyMapping, PyString};
 use toolconf::rank::ScreenError;
-use toolconf::rank::{check_screened, screen_file, screen_rows, EachRow, ModelTasks, Screen};
+use toolconf::rank::{
+    check_screened, screen_file_with_validation, screen_rows, EachRow, ModelTasks, Screen, ScreenBy,
+};
 use toolconf_model::inputs::tools_file::{read_columns, Column, MemoryCell, ToolFileError};
 
 use crate::errors::Failure;
@@ -67,12 +69,13 @@ impl Tools {
         }
     }
 
-    /// The cheap stage over these tools (the library's [`screen_rows`]), the rows numbered
-    /// from `first_row`; with `whole`, also the checks of a whole input ([`check_screened`]).
+    /// The cheap stage over these tools (the library's [`screen_rows`]), keeping `limit` tools
+    /// by `by`, the rows numbered from `first_row`; with `whole`, also the checks of a whole
+    /// input ([`check_screened`]).
     pub fn screen(
         &self,
         tasks: &ModelTasks,
-        limit: Option<usize>,
+        (limit, by): (Option<usize>, ScreenBy),
         skip_bad_rows: bool,
         first_row: usize,
         whole: bool,
@@ -81,10 +84,18 @@ impl Tools {
         let mut skipped = Vec::new();
         let skipping = |bad: &ToolFileError| skipped.push(format!("toolconf: skipping {bad}"));
         let screened = match self {
-            Tools::File(path) => screen_file(path, tasks, &task, limit, skip_bad_rows, skipping),
+            // No validation sample: the package ranks, it does not check claim (a).
+            Tools::File(path) => screen_file_with_validation(
+                path,
+                tasks,
+                &task,
+                (limit, 0, by),
+                skip_bad_rows,
+                skipping,
+            ),
             Tools::Columns { source, columns } => {
                 let read = |each: &mut EachRow| read_columns(source, columns, first_row, each);
-                screen_rows(source, read, tasks, limit, skip_bad_rows, skipping).and_then(
+                screen_rows(source, read, tasks, (limit, by), skip_bad_rows, skipping).and_then(
                     |(screen, n)| {
                         if whole {
                             check_screened(&screen, n, source, &task)?;

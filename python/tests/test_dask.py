@@ -59,13 +59,16 @@ def test_the_workers_import_the_clients_extension_on_the_loopback(dask_client):
     assert all(address.startswith("tcp://127.0.0.1:") for address in there)
 
 
-@pytest.mark.parametrize("task, screen, objective", [
-    ("position", None, "free-energy"),
-    ("position", 3, "free-energy"),
-    ("velocity", 7, "cost-j"),
-    ("task file", 25, "confidence"),
+@pytest.mark.parametrize("task, screen, objective, screen_by", [
+    ("position", None, "free-energy", None),
+    ("position", 3, "free-energy", "confidence"),
+    ("position", 3, "free-energy", None),
+    ("velocity", 7, "cost-j", None),
+    ("velocity", 7, "cost-j", "confidence"),
+    ("task file", 25, "confidence", None),
+    ("task file", 25, "free-energy", "predicted"),
 ])
-def test_rank_equals_toolconf_rank_on_the_concatenated_rows(task, screen, objective,
+def test_rank_equals_toolconf_rank_on_the_concatenated_rows(task, screen, objective, screen_by,
                                                             dask_client, tmp_path):
     if task == "task file":
         # Read on the client and sent as text: the workers need not see the file.
@@ -74,16 +77,34 @@ def test_rank_equals_toolconf_rank_on_the_concatenated_rows(task, screen, object
                         't_end = 3.0\nperturbation = -0.3\n')
     frame = tools()
     ddf = partitioned(frame, CUTS)
-    got = tdask.rank(ddf, task, screen=screen, objective=objective, client=dask_client)
-    expected = toolconf.rank(ddf.compute(), task, screen=screen, objective=objective)
+    got = tdask.rank(ddf, task, screen=screen, objective=objective, client=dask_client,
+                     screen_by=screen_by)
+    expected = toolconf.rank(ddf.compute(), task, screen=screen, objective=objective,
+                             screen_by=screen_by)
     pd.testing.assert_frame_equal(got, expected, check_exact=True)
-    if screen == 3:
+    if screen == 3 and screen_by == "confidence":
         # The giant (row 45) is the most confident, then a tie of three equal tools (rows 21,
         # 51, 76 in three partitions): the two earlier rows are kept.
         assert sorted(got["row"]) == [21, 45, 51]
     if screen is None and task == "position":
         assert got["name"].iloc[-1] == "tool 44" and "diverged" in got["error"].iloc[-1]
         assert len(got) == len(frame)
+
+
+def test_a_tie_in_prediction_across_partitions_keeps_the_earlier_rows(dask_client):
+    # Row 36 is the tool predicted cheapest on the position task; copies of it in rows 11 and
+    # 71 (other partitions) tie with it: the screen of 2 keeps rows 11 and 36.
+    frame = tools()
+    params = ["m1", "m2", "l1", "l2"]
+    assert sorted(toolconf.rank(frame, "position", screen=1)["row"]) == [36]
+    for index in (10, 70):
+        frame.loc[index, params] = frame.loc[35, params].values
+    ddf = partitioned(frame, CUTS)
+    got = tdask.rank(ddf, "position", screen=2, client=dask_client)
+    pd.testing.assert_frame_equal(got, toolconf.rank(frame, "position", screen=2),
+                                  check_exact=True)
+    assert sorted(got["row"]) == [11, 36]
+    assert got["predicted_free_energy"].iloc[0] == got["predicted_free_energy"].iloc[1]
 
 
 def test_episodes_spread_in_small_blocks_give_the_same_table(dask_client):
@@ -145,7 +166,8 @@ def test_whole_table_errors_equal_toolconfs(frame, task, dask_client):
 
 def test_bad_options_raise_before_the_cluster_works(dask_client):
     ddf = partitioned(tools(), CUTS)
-    for kwargs in ({"screen": 0}, {"objective": "speed"}, {"method": "rk4"}):
+    for kwargs in ({"screen": 0}, {"objective": "speed"}, {"method": "rk4"},
+                   {"screen": 3, "screen_by": "speed"}):
         with pytest.raises(ValueError) as expected:
             toolconf.rank(ddf.compute(), "position", **kwargs)
         with pytest.raises(ValueError) as got:
@@ -254,3 +276,27 @@ def test_without_a_client_the_error_is_one_line(monkeypatch):
         tdask.simulate_batch("arm2", np.full((2, 4), 0.3), "position")
     assert str(caught.value) == ("client = None and no distributed.Client is running: start one "
                                  "(distributed.Client(cluster)) or pass client=")
+
+
+@pytest.mark.parametrize("screen_by", [None, "confidence"])
+@pytest.mark.parametrize("cuts", [[2, 5, 5, 8], [1, 10], [6], [0, 3, 4, 7, 9]])
+def test_tools_without_a_prediction_go_last_in_row_order_whatever_the_partitioning(
+        cuts, screen_by, dask_client, tmp_path):
+    # The Panda's touch task at a learning rate where some tools' linearised loop is unstable
+    # (python/tests/test_rank.py): by prediction, those tools come after every tool with one,
+    # in row order across the partitions, and the warning counts them all.
+    from test_rank import PANDA_TOOLS, SPLIT_RATE, touch_with
+
+    task = touch_with(tmp_path, SPLIT_RATE)
+    frame = pd.read_csv(PANDA_TOOLS, comment="#")
+    ddf = partitioned(frame, cuts)
+    for screen in (3, 8, 11):
+        with warnings.catch_warnings(record=True) as expected_warnings:
+            warnings.simplefilter("always")
+            expected = toolconf.rank(frame, task, screen=screen, screen_by=screen_by)
+        with warnings.catch_warnings(record=True) as got_warnings:
+            warnings.simplefilter("always")
+            got = tdask.rank(ddf, task, screen=screen, screen_by=screen_by, client=dask_client)
+        pd.testing.assert_frame_equal(got, expected, check_exact=True)
+        assert [str(w.message) for w in got_warnings] == [str(w.message) for w in expected_warnings]
+        assert len(got_warnings) == (0 if screen_by == "confidence" else 1)

@@ -62,8 +62,12 @@ def test_rank_dataframe_ranks_its_tools_as_the_command_line(tmp_path, cli_json):
     example = module("rank_dataframe.py")
     tools = tmp_path / "tools.csv"
     example["tools"]().to_csv(tools, index=False)  # Python's repr of each float: the same values
+    # The example's screen is the default one, by prediction: the command line's default too.
     want = cli_json("rank", "--tools", tools, "--task", example["TASK"],
-                    "--screen", example["SCREEN"], "--screen-by", "confidence")["tools"]
+                    "--screen", example["SCREEN"])["tools"]
+    by_confidence = cli_json("rank", "--tools", tools, "--task", example["TASK"],
+                             "--screen", example["SCREEN"], "--screen-by", "confidence")["tools"]
+    assert {t["row"] for t in want} != {t["row"] for t in by_confidence}
     lines = run("rank_dataframe.py").splitlines()
     rows = [re.match(r"\s*(\d+)\s+(.+?)\s+(\S+)\s+(\S+)\s+(\S+)$", line) for line in lines[1:-1]]
     assert len(rows) == len(want) == example["SCREEN"] and all(rows), lines

@@ -9,9 +9,10 @@ The runtime is Rust (the ``toolconf`` crate); this package exposes it over NumPy
   trajectory.
 * ``simulate_batch(model, params_2d, task, perturbations=..., **episode_options)``: the
   episodes of many tools under many perturbations, one row of metrics each.
-* ``rank(tools, task, screen=None, objective="free-energy")``: ``toolconf rank`` on a tools
-  file, a pandas DataFrame, a dict of 1-D arrays or a NumPy structured array; a DataFrame for a
-  DataFrame, else a dict of columns.
+* ``rank(tools, task, screen=None, objective="free-energy", screen_by=None)``: ``toolconf
+  rank`` on a tools file, a pandas DataFrame, a dict of 1-D arrays or a NumPy structured array,
+  each tool's predicted cost beside its episode's; a DataFrame for a DataFrame, else a dict of
+  columns.
 * ``design(model, task, design)``: ``toolconf design --json``, which tool to build.
 * ``reproduce(model, task, tools=... | sample=N)``: ``toolconf reproduce --model``, the
   paper's evaluation (Figs. 2-7) on any model, task and tool population: its tables as
@@ -138,13 +139,16 @@ def rank(
     objective: Literal["free-energy", "cost-j", "confidence"] = "free-energy",
     skip_bad_rows: bool = False,
     method: Literal["fast", "explicit", "auto", "stiff"] = "fast",
+    *,
+    screen_by: Optional[Literal["predicted", "confidence"]] = None,
 ) -> Union["pandas.DataFrame", "Columns"]:
     """Ranks your tools on a task, as ``toolconf rank`` does, with the same numbers.
 
     First every tool's control confidence ln|Π^U| in closed form (no simulation); then an
-    episode for every tool, or with ``screen=K`` only for the K most confident (ties: the
-    earlier row); then the ranking by ``objective``. Episodes run on rayon's threads without the
-    GIL; results do not depend on the number of threads.
+    episode for every tool, or with ``screen=K`` only for K of them chosen without simulating
+    (``screen_by``: by default the K whose episode the closed loop linearised at the equilibrium
+    predicts cheapest); then the ranking by ``objective``. Episodes run on rayon's threads
+    without the GIL; results do not depend on the number of threads.
 
     Args:
         tools: the tools, one per row, with a tools file's columns (``name``, ``model``, and the
@@ -158,9 +162,8 @@ def rank(
             ``row N`` (1-based, the result's ``row``) where a file's names the line, e.g.
             ``tools DataFrame, row 7: m2 = 'heavy' is not a number (tool 'mallet')``.
         task: a built-in task name, a task file's path, or a dict with a task file's keys.
-        screen: simulate only the K most confident tools (an integer in [1, 2⁶⁴ − 1], as the
-            command line's ``--screen K --screen-by confidence``; the command line's default
-            screen, by the predicted cost, is not yet offered here); ``None`` simulates all.
+        screen: simulate only K tools (an integer in [1, 2⁶⁴ − 1], the command line's
+            ``--screen K``), chosen by ``screen_by``; ``None`` simulates all.
         objective: ``"free-energy"`` (the paper's ∫F dt, the default), ``"cost-j"`` (∫J dt) or
             ``"confidence"`` (ln|Π^U|).
         skip_bad_rows: warn about a bad row (``UserWarning``) and go on without it, instead of
@@ -168,28 +171,47 @@ def rank(
         method: the integrator, as the command line's ``--method``: ``"fast"`` (the default),
             ``"explicit"`` (exactly MATLAB ode45, the paper's numerics), ``"auto"`` or
             ``"stiff"``.
+        screen_by: with ``screen``, which K tools (the command line's ``--screen-by``):
+            ``"predicted"``, the K with the lowest predicted cost (∫F dt, or ∫J dt with
+            ``objective="cost-j"``, of the closed loop linearised at the equilibrium; a tool
+            without a prediction comes after every tool with one, in row order), or
+            ``"confidence"``, the K most confident (the largest ln|Π^U|); ties: the earlier
+            row. ``None`` (the default): ``"predicted"``, or ``"confidence"`` with
+            ``objective="confidence"``, as the command line. Without ``screen`` it changes
+            nothing.
 
     Returns:
         The ranked tools, best first, with the columns ``rank``, ``row`` (1-based in the file
         or table), ``name``, ``model``, one per parameter of the models present (NaN where a
         tool's model has none), ``logdet``, ``task_error``, ``free_energy``, ``cost_j`` (NaN
         for a failed episode), on a position task (joint or tip) ``progress`` (1 − e(T)/e(0)
-        with e the distance to the goal; NaN for a failed episode), ``rhs_evals`` (-1 for one)
-        and ``error`` (None, or why the
-        episode failed: such tools rank last, in row order). A pandas DataFrame when ``tools``
+        with e the distance to the goal; NaN for a failed episode), ``rhs_evals`` (-1 for one),
+        ``error`` (None, or why the episode failed: such tools rank last, in row order), the
+        episode's cost predicted by the closed loop linearised at the equilibrium
+        (``predicted_task_error``, ``predicted_free_energy``, ``predicted_cost_j``,
+        ``predicted_perturbation_effect``; NaN without a prediction) and ``prediction_note``
+        (None, or why there is no prediction, e.g. the linearised loop is unstable). A pandas
+        DataFrame when ``tools``
         was one; otherwise a dict of columns (NumPy arrays and lists), so that pandas stays
         optional (``pandas.DataFrame(result)`` makes the same frame). The numbers are
         ``toolconf rank --json``'s for the same rows.
 
     Raises:
         ValueError: a bad tools file, table or row (naming the file or table, the line or row
-            and the value), a bad task (naming the key), an unknown objective, or
-            ``screen`` outside [1, 2⁶⁴ − 1]; the command line's message.
-        TypeError: a ``screen`` that is not an integer, or a column of booleans or complex
-            numbers.
+            and the value), a bad task (naming the key), an unknown objective or
+            ``screen_by``, or ``screen`` outside [1, 2⁶⁴ − 1]; the command line's message.
+        TypeError: a ``screen`` that is not an integer, a ``screen_by`` that is not a str, or
+            a column of booleans or complex numbers.
+
+    Warns:
+        UserWarning: each bad row skipped (``skip_bad_rows``, the command line's ``toolconf:
+            skipping …`` line); then, when a screen by prediction met tools without one, the
+            command line's ``note:`` (how many, the first reason, and that they were ranked
+            after every tool with one).
     """
     native, source, frame = native_tools(tools)
-    table = _toolconf.rank(native, task, screen, objective, skip_bad_rows, method, source)
+    table = _toolconf.rank(native, task, screen, objective, skip_bad_rows, method, source,
+                           screen_by)
     if frame:
         import pandas
 

@@ -188,12 +188,18 @@ def rank(
     skip_bad_rows: bool = False,
     method: Literal["fast", "explicit", "auto", "stiff"] = "fast",
     source: Optional[str] = None,
+    screen_by: Optional[Literal["predicted", "confidence"]] = None,
 ) -> Columns:
     """``toolconf rank`` as a dict of columns, best tool first: ``rank``, ``row``, ``name``,
     ``model``, the parameters, ``logdet``, ``task_error``, ``free_energy``, ``cost_j``,
-    ``rhs_evals``, ``error``. ``tools`` is a tools file or columns in memory (``source`` names
-    them in errors). ``toolconf.rank`` wraps this for DataFrames and structured arrays. Raises
-    ``ValueError`` for bad input (``screen`` outside [1, 2⁶⁴ − 1] included)."""
+    (``progress``), ``rhs_evals``, ``error``, ``predicted_task_error``,
+    ``predicted_free_energy``, ``predicted_cost_j``, ``predicted_perturbation_effect`` (NaN
+    without a prediction), ``prediction_note``. ``tools`` is a tools file or columns in memory
+    (``source`` names them in errors); ``screen`` keeps K tools by ``screen_by`` (default
+    ``"predicted"``, ``"confidence"`` with ``objective="confidence"``). ``toolconf.rank`` wraps
+    this for DataFrames and structured arrays. Raises ``ValueError`` for bad input (``screen``
+    outside [1, 2⁶⁴ − 1], an unknown ``screen_by`` included); warns (``UserWarning``) of each
+    bad row skipped and of the tools a screen by prediction found without one."""
 
 def simulate_batch(
     model: str,
@@ -254,6 +260,7 @@ def _portable_task(
     screen: Optional[int] = None,
     objective: str = "free-energy",
     method: str = "fast",
+    screen_by: Optional[str] = None,
 ) -> PortableTask:
     """The task as workers read it (a task file as its text); checks the options as ``rank``."""
 
@@ -264,19 +271,25 @@ def _screen_block(
     screen: Optional[int] = None,
     skip_bad_rows: bool = False,
     source: str = "tools DataFrame",
+    objective: str = "free-energy",
+    screen_by: Optional[str] = None,
 ) -> dict[str, Any]:
-    """The confidence stage over one block of rows numbered from ``first_row``: ``kept``
-    (candidates), ``read``, ``without_confidence``, ``first_confidence_error``, ``skipped``,
-    ``rows``."""
+    """The cheap stage over one block of rows numbered from ``first_row``: ``kept``
+    (candidates, with their predictions when the screen is by prediction), ``read``,
+    ``without_confidence``, ``first_confidence_error``, ``without_prediction``,
+    ``first_prediction_error``, ``skipped``, ``rows``."""
 
 def _merge_screens(
     blocks: list[dict[str, Any]],
     task: PortableTask,
     screen: Optional[int] = None,
     source: str = "tools DataFrame",
-) -> Columns:
-    """The blocks' screens (in row order) absorbed into the global top ``screen``, with the
-    whole table's checks; the kept candidates."""
+    objective: str = "free-energy",
+    screen_by: Optional[str] = None,
+) -> tuple[Columns, Optional[str]]:
+    """The blocks' screens (in row order) absorbed into the global top ``screen`` by
+    ``screen_by``, with the whole table's checks: the kept candidates, and the warning of the
+    tools without a prediction (or None)."""
 
 def _episodes(
     block: Columns,

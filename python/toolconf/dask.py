@@ -11,10 +11,12 @@ the native library's own code:
 
 1. each partition's row count, so that every row has its global number (the ``row`` column and
    the messages);
-2. the confidence stage, partition by partition on the workers: each partition's rows checked
-   as a tools file's are, its ln|Π^U| computed, its K most confident kept;
-3. on the client, the partitions' screens absorbed in row order: the global K most confident,
-   ties broken by global row order, and the whole table's checks;
+2. the cheap stage, partition by partition on the workers: each partition's rows checked as a
+   tools file's are, its ln|Π^U| (and with ``screen_by="predicted"`` its predicted cost)
+   computed, its K best by the screen's criterion kept (with their predictions);
+3. on the client, the partitions' screens absorbed in row order: the global K best by the same
+   keys, ties and tools without a prediction in global row order, and the whole table's
+   checks;
 4. the K kept tools' episodes, in blocks spread over the workers (without a screen, each
    partition's episodes run where the partition is);
 5. on the client, the simulated blocks ranked into one table.
@@ -80,10 +82,11 @@ def _partition_length(frame) -> int:
     return len(frame)
 
 
-def _screen_partition(frame, task, first_row, screen, skip_bad_rows, loaded):
+def _screen_partition(frame, task, first_row, screen, skip_bad_rows, objective, screen_by,
+                      loaded):
     _ensure_loaded(loaded)
     return _toolconf._screen_block(frame_columns(frame), task, first_row, screen,
-                                   skip_bad_rows, DATAFRAME_SOURCE)
+                                   skip_bad_rows, DATAFRAME_SOURCE, objective, screen_by)
 
 
 def _counts(block):
@@ -150,22 +153,24 @@ def rank(
     skip_bad_rows: bool = False,
     method: Literal["fast", "explicit", "auto", "stiff"] = "fast",
     *,
+    screen_by: Optional[Literal["predicted", "confidence"]] = None,
     client: Optional["distributed.Client"] = None,
     episodes_per_task: Optional[int] = None,
 ) -> "pandas.DataFrame":
     """``toolconf.rank`` of a ``dask.dataframe.DataFrame`` of tools on a Dask cluster.
 
-    The confidence stage runs partition by partition on the workers; the global ``screen`` most
-    confident tools (ties: the earlier row of the whole frame) are kept, and their episodes are
-    spread over the workers. The result is ``toolconf.rank(ddf.compute(), task, ...)``, row for
-    row and digit for digit (``row`` is the 1-based place in the whole frame).
+    The cheap stage runs partition by partition on the workers; the global ``screen`` best tools
+    by ``screen_by`` (ties, and tools without a prediction, in the row order of the whole frame)
+    are kept, and their episodes are spread over the workers. The result is
+    ``toolconf.rank(ddf.compute(), task, ...)``, row for row and digit for digit (``row`` is the
+    1-based place in the whole frame), whatever the partitioning, with the same warnings.
 
     Args:
         ddf: a dask DataFrame with a tools file's columns (``name``, ``model``, the models'
             parameters). It is read twice: once for its partitions' lengths, once for the
             screen (``ddf.persist()`` first if reading it is expensive).
-        task, screen, objective, skip_bad_rows, method: as ``toolconf.rank``. A task file is
-            read here and sent to the workers as text.
+        task, screen, objective, skip_bad_rows, method, screen_by: as ``toolconf.rank``. A
+            task file is read here and sent to the workers as text.
         client: the ``distributed.Client`` to run on (default: the current one).
         episodes_per_task: how many episodes one cluster task runs (each on its worker's rayon
             threads), an integer ≥ 1; by default the kept tools are cut into about four blocks
@@ -191,17 +196,19 @@ def rank(
     client = _client(client)
     loaded = tuple(_LOADED)
     given = task
-    task = _toolconf._portable_task(task, screen, objective, method)
+    task = _toolconf._portable_task(task, screen, objective, method, screen_by)
     parts = ddf.to_delayed()
     lengths = client.gather(client.compute([delayed(_partition_length)(p) for p in parts]))
     if sum(lengths) == 0:
         # No rows: toolconf.rank's own refusal of the empty frame (its columns checked first).
         from . import rank as local_rank
 
-        return local_rank(ddf._meta, given, screen, objective, skip_bad_rows, method)
+        return local_rank(ddf._meta, given, screen, objective, skip_bad_rows, method,
+                          screen_by=screen_by)
     first_rows = np.concatenate([[1], 1 + np.cumsum(lengths)[:-1]]).tolist()
     screened = client.compute([
-        delayed(_screen_partition)(p, task, first, screen, skip_bad_rows, loaded)
+        delayed(_screen_partition)(p, task, first, screen, skip_bad_rows, objective, screen_by,
+                                   loaded)
         for p, first in zip(parts, first_rows)
     ])
     if screen is None:
@@ -212,11 +219,13 @@ def rank(
     for block in counts:
         for warning in block["skipped"]:
             warnings.warn(warning, UserWarning, stacklevel=2)
+    kept, note = _toolconf._merge_screens(counts, task, screen, DATAFRAME_SOURCE, objective,
+                                          screen_by)
+    if note is not None:
+        warnings.warn(note, UserWarning, stacklevel=2)
     if screen is None:
-        _toolconf._merge_screens(counts, task, None, DATAFRAME_SOURCE)
         simulated = [client.submit(_kept_episodes, s, task, objective, method, loaded) for s in screened]
     else:
-        kept = _toolconf._merge_screens(counts, task, screen, DATAFRAME_SOURCE)
         n = len(kept["row"])
         per_block = episodes_per_task or max(1, math.ceil(n / (4 * _threads(client))))
         simulated = [

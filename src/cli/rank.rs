@@ -11,9 +11,9 @@ use std::time::Instant;
 use serde_json::{json, Map, Value};
 use toolconf::evaluation::{barely_moved, ConfidenceCheck, PredictionCheck};
 use toolconf::rank::{
-    ranking, screen_file_with_validation, simulate_all, simulate_all_timed, Candidate,
-    ConfidenceTiming, ModelTasks, RankedTool, Screen, ScreenBy, ScreenError, SimulationTiming,
-    StageTimings,
+    ranking, screen_file_with_validation, simulate_all, simulate_all_timed, unpredicted_note,
+    Candidate, ConfidenceTiming, ModelTasks, RankedTool, Screen, ScreenBy, ScreenError,
+    SimulationTiming, StageTimings,
 };
 use toolconf::select::Objective;
 use toolconf_files::csv::{Cell, CsvWriter};
@@ -554,14 +554,11 @@ fn notes(
              screen less, or not at all",
         ),
     });
-    let unpredicted = (by.needs_prediction() && counts.without_prediction > 0).then(|| {
-        format!(
-            "{} tools have no prediction ({}): the screen by prediction ranked them after every \
-             tool with one, in file order",
-            counts.without_prediction,
-            counts.first_prediction_error.as_deref().unwrap_or("")
-        )
-    });
+    let unpredicted = unpredicted_note(
+        by,
+        counts.without_prediction,
+        counts.first_prediction_error.as_deref(),
+    );
     check
         .into_iter()
         .chain(unpredicted)

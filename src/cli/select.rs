@@ -418,8 +418,9 @@ fn mixed_selection_json(args: &Args, s: &MixedSelection) -> Value {
     })
 }
 
-/// The text output of a selection over several models: the header, a row per tool, the
-/// choices (each naming the chosen tool's model).
+/// The text output of a selection over several models: the header, a row per tool (with a task
+/// file, its predicted task error beside its confidence, as `rank`'s table), the choices (each
+/// naming the chosen tool's model).
 fn print_mixed_selection(args: &Args, s: &MixedSelection) {
     let models = model_names(args);
     outln!(
@@ -436,8 +437,13 @@ fn print_mixed_selection(args: &Args, s: &MixedSelection) {
     );
     // The model column fits the longest name in this set (at least 10 wide).
     let w = models.iter().map(|m| m.len()).max().unwrap_or(0).max(10);
+    // The built-in tasks have no prediction: their table is unchanged.
+    let predicted = match s.predictions.is_empty() {
+        true => String::new(),
+        false => format!(" {:>14}", "predicted err"),
+    };
     outln!(
-        "{:>5}  {:<w$} {:>12} {:>12}  {:>14} {:>14} {:>14}  parameters",
+        "{:>5}  {:<w$} {:>12} {:>12}{predicted}  {:>14} {:>14} {:>14}  parameters",
         "tool",
         "model",
         "ln|Pi^U|",
@@ -446,8 +452,8 @@ fn print_mixed_selection(args: &Args, s: &MixedSelection) {
         "int F dt",
         "int J dt"
     );
-    for r in &s.results {
-        print_mixed_tool_row(r, w);
+    for (i, r) in s.results.iter().enumerate() {
+        print_mixed_tool_row(r, s.predictions.get(i), w);
     }
     for (o, c) in &s.choices {
         match c {
@@ -461,8 +467,9 @@ fn print_mixed_selection(args: &Args, s: &MixedSelection) {
     }
 }
 
-/// A tool's row in a selection over several models, the model column `w` wide.
-fn print_mixed_tool_row(r: &MixedResult, w: usize) {
+/// A tool's row in a selection over several models, the model column `w` wide, with its
+/// predicted task error if it was predicted.
+fn print_mixed_tool_row(r: &MixedResult, prediction: Option<&Predicted>, w: usize) {
     let (logdet, per_joint) = match (&r.logdet, r.logdet_per_joint()) {
         (Ok(l), Some(n)) => (format!("{l:.6}"), format!("{n:.6}")),
         _ => ("error".to_string(), "error".to_string()),
@@ -473,8 +480,11 @@ fn print_mixed_tool_row(r: &MixedResult, w: usize) {
         .into_iter()
         .map(|(name, value)| format!("{name}={value:.4}"))
         .collect();
+    let predicted = prediction.map_or(String::new(), |p| {
+        format!(" {}", super::prediction::table_cell(p))
+    });
     outln!(
-        "{:>5}  {:<w$} {:>12} {:>12}  {}  {}",
+        "{:>5}  {:<w$} {:>12} {:>12}{predicted}  {}  {}",
         r.index,
         r.model().name(),
         logdet,

@@ -16,8 +16,8 @@ mod screen_by;
 mod tasks;
 
 pub use screen::{
-    check_screened, screen_file, screen_file_with_validation, screen_rows, Candidate, EachRow,
-    Screen, ScreenError, ScreenedBlock,
+    check_screened, screen_file, screen_file_with_validation, screen_rows, unpredicted_note,
+    Candidate, EachRow, Screen, ScreenError, ScreenedBlock,
 };
 pub use screen_by::{predicted_cost, ScreenBy};
 pub use tasks::{AnyEpisode, Linearisation, ModelTasks, TaskTrace, TrajectoryTable};

@@ -185,12 +185,18 @@ impl Screen {
     /// Takes in what screening another block of the same rows found, as if its rows had been
     /// pushed here: the kept tools are the most confident of both (ties: the earlier row) and
     /// the counts add up. Blocks screened apart (toolconf.dask's partitions) are absorbed in
-    /// row order, so that the first reason a tool has no confidence stays the first row's.
+    /// row order, so that the first reason a tool has no confidence (or no prediction) stays the
+    /// first row's. The blocks' candidates carry their predictions when the screen is by
+    /// prediction: the key they were kept by is the key they are kept by here.
     pub fn absorb(&mut self, block: ScreenedBlock) {
         self.read += block.read;
         self.without_confidence += block.without_confidence;
         if self.first_confidence_error.is_none() {
             self.first_confidence_error = block.first_confidence_error;
+        }
+        self.without_prediction += block.without_prediction;
+        if self.first_prediction_error.is_none() {
+            self.first_prediction_error = block.first_prediction_error;
         }
         for candidate in block.kept {
             self.keep(candidate);
@@ -201,12 +207,26 @@ impl Screen {
     pub fn into_block(mut self) -> ScreenedBlock {
         let (read, without_confidence) = (self.read, self.without_confidence);
         let first_confidence_error = self.first_confidence_error.take();
+        let without_prediction = self.without_prediction;
+        let first_prediction_error = self.first_prediction_error.take();
         ScreenedBlock {
             kept: self.finish(),
             read,
             without_confidence,
             first_confidence_error,
+            without_prediction,
+            first_prediction_error,
         }
+    }
+
+    /// What the output says of the tools without a prediction when the screen is by prediction
+    /// and some have none (`rank`'s `note:` line, the Python package's warning); else `None`.
+    pub fn unpredicted_note(&self) -> Option<String> {
+        unpredicted_note(
+            self.by,
+            self.without_prediction,
+            self.first_prediction_error.as_deref(),
+        )
     }
 
     fn keep(&mut self, candidate: Candidate) {
@@ -254,6 +274,21 @@ pub struct ScreenedBlock {
     pub read: usize,
     pub without_confidence: usize,
     pub first_confidence_error: Option<String>,
+    /// Tools with a confidence but no prediction (a screen by prediction), and the first reason.
+    pub without_prediction: usize,
+    pub first_prediction_error: Option<String>,
+}
+
+/// [`Screen::unpredicted_note`] from its counts: `without` tools had a confidence but no
+/// prediction, the first for the reason `first`.
+pub fn unpredicted_note(by: ScreenBy, without: usize, first: Option<&str>) -> Option<String> {
+    (by.needs_prediction() && without > 0).then(|| {
+        format!(
+            "{without} tools have no prediction ({}): the screen by prediction ranked them after \
+             every tool with one, in file order",
+            first.unwrap_or("")
+        )
+    })
 }
 
 /// Why a tools file gives nothing to simulate.
@@ -282,7 +317,14 @@ pub fn screen_file(
 ) -> Result<(Screen, usize), ScreenError> {
     let source = toolconf_messages::ClipPath(&path.to_string_lossy()).to_string();
     let read = |each: &mut EachRow| read_tools(path, each);
-    let (screen, skipped) = screen_rows(&source, read, tasks, limit, skip_bad_rows, skipping)?;
+    let (screen, skipped) = screen_rows(
+        &source,
+        read,
+        tasks,
+        (limit, ScreenBy::Confidence),
+        skip_bad_rows,
+        skipping,
+    )?;
     check_screened(&screen, skipped, &source, task)?;
     Ok((screen, skipped))
 }
@@ -292,17 +334,18 @@ pub fn screen_file(
 /// read.
 pub type EachRow<'a> = dyn FnMut(Result<ToolRow, ToolFileError>) -> Result<(), ToolFileError> + 'a;
 
-/// [`screen_file`] over the rows `read` gives (`tools_file` names them in errors), without the
-/// checks of the whole input ([`check_screened`]): what one block of a larger table runs.
+/// [`screen_file`] over the rows `read` gives (`tools_file` names them in errors), keeping
+/// `limit` tools by `by`, without the checks of the whole input ([`check_screened`]): what one
+/// block of a larger table runs.
 pub fn screen_rows(
     tools_file: &str,
     read: impl FnOnce(&mut EachRow) -> Result<usize, ToolFileError>,
     tasks: &ModelTasks,
-    limit: Option<usize>,
+    (limit, by): (Option<usize>, ScreenBy),
     skip_bad_rows: bool,
     skipping: impl FnMut(&ToolFileError),
 ) -> Result<(Screen, usize), ScreenError> {
-    let screen = Screen::new(limit);
+    let screen = Screen::by(limit, by);
     screen_rows_into(screen, tools_file, read, tasks, skip_bad_rows, skipping)
 }
 
@@ -517,6 +560,61 @@ pub(super) mod tests {
                 merged.absorb(part.into_block());
             }
             assert_eq!(merged.into_block(), whole.into_block(), "{limit:?}");
+        }
+    }
+
+    #[test]
+    fn blocks_screened_by_prediction_apart_and_absorbed_keep_and_count_what_one_screen_does() {
+        use crate::select::Objective;
+        use toolconf_model::prediction::Prediction;
+        let predicted = |free_energy: f64| {
+            Some(Ok(Prediction {
+                task_error: 0.0,
+                free_energy,
+                cost_j: free_energy,
+                perturbation_effect: 0.0,
+                abscissa: -1.0,
+            }))
+        };
+        let unstable = |abscissa: f64| Some(Err(PredictionError::Unstable { abscissa }));
+        let tools = [
+            unstable(0.5),
+            predicted(3.0),
+            predicted(1.0),
+            unstable(0.25),
+            predicted(1.0),
+            predicted(2.0),
+            unstable(0.125),
+        ];
+        let by = ScreenBy::Predicted(Objective::FreeEnergy);
+        let candidate_of = |i: usize| {
+            let mut c = candidate(i + 1, Ok(i as f64));
+            c.prediction = tools[i].clone();
+            c
+        };
+        for limit in [Some(1), Some(2), Some(5), Some(20), None] {
+            let mut whole = Screen::by(limit, by);
+            for i in 0..tools.len() {
+                whole.push(candidate_of(i));
+            }
+            let mut merged = Screen::by(limit, by);
+            for block in [0..2, 2..2, 2..5, 5..7] {
+                let mut part = Screen::by(limit, by);
+                for i in block {
+                    part.push(candidate_of(i));
+                }
+                merged.absorb(part.into_block());
+            }
+            assert_eq!(merged.unpredicted_note(), whole.unpredicted_note());
+            let whole = whole.into_block();
+            assert_eq!((whole.without_prediction, whole.read), (3, 7));
+            // The first reason is the first row's (real part 0.5), whatever the blocks.
+            assert!(whole
+                .first_prediction_error
+                .as_ref()
+                .unwrap()
+                .contains("5.000000e-1"));
+            assert_eq!(merged.into_block(), whole, "{limit:?}");
         }
     }
 
