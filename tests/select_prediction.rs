@@ -161,3 +161,48 @@ fn selects_table_on_a_task_file_shows_the_predicted_task_error_as_ranks() {
     ]);
     assert!(!builtin.contains("predicted"), "{builtin}");
 }
+
+/// The default 2-link tools on a task file: each tool's prediction equals the registry's
+/// (`confidence --model arm2`) for that tool alone, in the JSON and the table; with `--plant exact` (whose loop the
+/// prediction of the paper's model does not describe) it is `null` with that reason.
+#[test]
+fn two_link_select_on_a_task_file_predicts_with_the_papers_plant_only() {
+    let task = "examples/tasks/paper_position.toml";
+    let args = ["select", "--task-file", task, "--tools", "4", "--seed", "2"];
+    let v = toolconf(&[&args[..], &["--json"]].concat());
+    let tools = v["tools"].as_array().unwrap();
+    let cells = predicted_cells(&toolconf_text(&args));
+    assert_eq!(cells.len(), tools.len());
+    for (t, cell) in tools.iter().zip(&cells) {
+        let arm = ["m1", "m2", "l1", "l2"].map(|k| format!("{}", t["arm"][k].as_f64().unwrap()));
+        let alone = toolconf(&[
+            "confidence",
+            "--model",
+            "arm2",
+            "--params",
+            &arm.join(","),
+            "--task-file",
+            task,
+            "--json",
+        ]);
+        for key in [
+            "predicted_task_error",
+            "predicted_free_energy",
+            "predicted_cost_j",
+        ] {
+            let (a, b) = (t[key].as_f64().unwrap(), alone[key].as_f64().unwrap());
+            assert!(
+                (a / b - 1.0).abs() < 1e-12,
+                "{key}: select {a}, confidence {b}"
+            );
+        }
+        let p = t["predicted_task_error"].as_f64().unwrap();
+        assert_eq!(*cell, format!("{p:.6e}"));
+    }
+    let exact = toolconf(&[&args[..], &["--plant", "exact", "--json"]].concat());
+    for t in exact["tools"].as_array().unwrap() {
+        assert_eq!(t["predicted_task_error"], Value::Null);
+        let note = t["prediction_note"].as_str().unwrap();
+        assert!(note.contains("--plant exact"), "{note}");
+    }
+}

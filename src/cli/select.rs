@@ -16,7 +16,7 @@ use toolconf_model::closed_loop::{EpisodeOptions, Metrics, Plant};
 use toolconf_model::inputs::task_file::TaskSpec;
 use toolconf_model::model::Arm2;
 use toolconf_model::registry::ModelKind;
-use toolconf_model::{Task, TaskKind};
+use toolconf_model::{Arm, Task, TaskKind};
 
 use super::episode_args::{two_link_options, EpisodeArgs, MethodArgs, PlantArg, TaskArgs};
 use super::output::{add_outcome, CliError};
@@ -67,6 +67,8 @@ struct Selection {
     kind: TaskKind,
     options: EpisodeOptions,
     results: Vec<ToolResult>,
+    /// With a task file, each tool's predicted cost, in the order of `results`; else empty.
+    predictions: Vec<Predicted>,
     choices: Vec<(Objective, Option<usize>)>,
     mpc: Option<Vec<Result<MpcMetrics, MpcEpisodeError>>>,
 }
@@ -122,13 +124,40 @@ fn select(args: &Args) -> Result<Selection, CliError> {
         .map(|o| (*o, o.choose(&results)))
         .collect();
     let mpc = mpc_options.map(|o| evaluate_mpc(&tools, &task, &options, &o, plant));
+    let predictions = match args.task.task_file {
+        Some(_) => two_link_predictions(&tools, &task, &options, plant),
+        None => Vec::new(),
+    };
     Ok(Selection {
         kind: task.kind,
         options,
         results,
+        predictions,
         choices,
         mpc,
     })
+}
+
+/// Each 2-link tool's predicted cost, in parallel, in the tools' order. The prediction
+/// linearises the controller's own model, the paper's: with the exact plant it would predict
+/// another loop than the one simulated, so there it is `null` with that reason.
+fn two_link_predictions(
+    tools: &[Arm],
+    task: &Task,
+    options: &EpisodeOptions,
+    plant: Plant,
+) -> Vec<Predicted> {
+    tools
+        .par_iter()
+        .map(|arm| match plant {
+            Plant::Paper => toolconf_model::prediction::predict(arm, task, options),
+            Plant::Exact => Err(toolconf_model::Error::Unsupported(
+                "--plant exact: the prediction linearises the paper's model, not the exact plant"
+                    .into(),
+            )
+            .into()),
+        })
+        .collect()
 }
 
 /// The `--json` object of a 2-link selection.
@@ -138,6 +167,9 @@ fn selection_json(args: &Args, s: &Selection) -> Value {
         choice.insert(o.name().into(), json!(c));
     }
     let mut tools_json: Vec<Value> = s.results.iter().map(tool_json).collect();
+    for (t, p) in tools_json.iter_mut().zip(&s.predictions) {
+        super::prediction::add_prediction(t, p);
+    }
     if let Some(mpc) = &s.mpc {
         choice.insert("mpc_cost".into(), json!(choose_by_mpc_cost(mpc)));
         for (t, r) in tools_json.iter_mut().zip(mpc) {
@@ -171,8 +203,13 @@ fn print_selection(args: &Args, s: &Selection) {
         "integration method: {}",
         Method::from(args.method.method).describe()
     );
+    // The built-in tasks have no prediction: their table is unchanged.
+    let predicted = match s.predictions.is_empty() {
+        true => String::new(),
+        false => format!(" {:>14}", "predicted err"),
+    };
     outln!(
-        "{:>5}  {:>7} {:>7} {:>7} {:>7}  {:>12} {:>14} {:>14} {:>14}",
+        "{:>5}  {:>7} {:>7} {:>7} {:>7}  {:>12}{predicted} {:>14} {:>14} {:>14}",
         "tool",
         "m1",
         "m2",
@@ -183,8 +220,8 @@ fn print_selection(args: &Args, s: &Selection) {
         "int F dt",
         "int J dt"
     );
-    for r in &s.results {
-        print_tool_row(r);
+    for (i, r) in s.results.iter().enumerate() {
+        print_tool_row(r, s.predictions.get(i));
     }
     if let Some(mpc) = &s.mpc {
         for (i, r) in mpc.iter().enumerate() {
@@ -211,15 +248,19 @@ fn print_selection(args: &Args, s: &Selection) {
     }
 }
 
-/// A 2-link tool's row: its parameters, ln|Π^U| and the episode's metrics (or why it failed).
-fn print_tool_row(r: &ToolResult) {
+/// A 2-link tool's row: its parameters, ln|Π^U|, its predicted task error if it was predicted,
+/// and the episode's metrics (or why it failed).
+fn print_tool_row(r: &ToolResult, prediction: Option<&Predicted>) {
     let logdet = r
         .logdet
         .as_ref()
         .map_or("error".to_string(), |l| format!("{l:.6}"));
     let p = r.arm.params();
+    let predicted = prediction.map_or(String::new(), |p| {
+        format!(" {}", super::prediction::table_cell(p))
+    });
     outln!(
-        "{:>5}  {:>7.4} {:>7.4} {:>7.4} {:>7.4}  {:>12} {}",
+        "{:>5}  {:>7.4} {:>7.4} {:>7.4} {:>7.4}  {:>12}{predicted} {}",
         r.index,
         p[0],
         p[1],
