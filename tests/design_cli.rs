@@ -1,6 +1,8 @@
 //! `toolconf design` as a user runs it: the example of docs/tutorials/design-a-tool.md, JSON keys, the report and sweep
 //! files, determinism across thread counts, and bad input as one line with exit status 2.
 
+mod common;
+
 use std::process::Command;
 
 use serde_json::Value;
@@ -25,12 +27,7 @@ fn design_json(threads: &str) -> Value {
         ],
         threads,
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("JSON")
+    common::json_ok(&out)
 }
 
 #[test]
@@ -69,11 +66,7 @@ fn report_and_sweep_write_csv_and_svg() {
         ],
         "2",
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_ok(&out);
     let csv = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines[0], "budget,logdet,kkt_residual,m1,m2,l1,l2,error");

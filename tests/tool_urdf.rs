@@ -3,7 +3,8 @@
 //! line naming it, never a panic, unbounded memory (each run under a 2 GB address-space limit) or
 //! a harmed file. Agreement with Pinocchio is python/tests/test_tool_urdf.py's.
 
-use std::os::unix::process::CommandExt;
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
@@ -19,12 +20,7 @@ fn repo(path: &str) -> String {
 }
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("tool_urdf")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::fresh_dir(&format!("tool_urdf/{name}"))
 }
 
 /// `toolconf tool ARGS` in `dir`, under a 2 GB address-space limit.
@@ -34,18 +30,9 @@ fn tool(dir: &Path, args: &[&str]) -> Output {
         .args(args)
         .current_dir(dir)
         .stdin(Stdio::null());
-    // SAFETY: between fork and exec only setrlimit, which is async-signal-safe.
-    unsafe {
-        cmd.pre_exec(|| {
-            let limit = libc::rlimit {
-                rlim_cur: 2 << 30,
-                rlim_max: 2 << 30,
-            };
-            libc::setrlimit(libc::RLIMIT_AS, &limit);
-            Ok(())
-        });
-    }
-    cmd.output().expect("run toolconf")
+    common::limit_memory(&mut cmd)
+        .output()
+        .expect("run toolconf")
 }
 
 /// The `#` line, then the header and the one row, parsed by the csv crate.
@@ -89,12 +76,8 @@ fn the_franka_hand_row_parses_as_csv_with_the_documented_columns() {
         "Franka Hand, open",
     ];
     let out = tool(&dir, hand);
+    common::assert_ok(&out);
     let stdout = String::from_utf8(out.stdout).unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let (comment, header, row) = parse(&stdout);
     assert!(comment.starts_with("# from "), "{comment}");
     assert!(
