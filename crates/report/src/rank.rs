@@ -690,16 +690,7 @@ fn tip_path_figure(
                 .filter_map(|p| Some((*p.3[a].first()?, *p.3[b].first()?)))
                 .collect();
             dots.push(Series::new("start", Colour(190, 190, 190), starts));
-            Panel::Xy(XyPanel {
-                title: title.into(),
-                x_label: format!("tip {} [m]", AXES[a]),
-                y_label: format!("tip {} [m]", AXES[b]),
-                dots,
-                lines,
-                log_y: false,
-                legend: Legend::UpperLeft,
-                headroom: 0.6,
-            })
+            plot::tip_path_panel(title, (a, b), dots, lines)
         })
         .collect();
     let svg = plot::save(&dir.join(TIP_PATH_SVG), &panels, (560, 420))?;

@@ -9,10 +9,12 @@ use toolconf_model::{Task, TaskKind};
 use toolconf_stats::{fit_exponential, summary};
 
 use super::batch::{map_ordered, run_tool, ToolRuns};
-use super::figure_parts::{arm_cells, files_block, task_label, wants_log, PAPER_TASKS};
+use super::figure_parts::{
+    arm_cells, columns, files_block, task_label, wants_log, PAPER_TASKS, TOOL_COLUMNS,
+};
 use super::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use super::report::{Block, Outcome, Section, Verdict};
-use super::verdict::{negative_correlation_rule, num, Correlation};
+use super::verdict::{negative_correlation_rule, num, Correlation, CorrelationReport};
 use super::{described, Context, Experiment, Plan, ReproduceError};
 use toolconf_files::csv::{Cell, CsvWriter};
 
@@ -20,20 +22,11 @@ pub struct Fig2;
 
 const CSV: &str = "fig2_confidence_vs_error.csv";
 const SVG: &str = "fig2_confidence_vs_error.svg";
-pub const HEADER: [&str; 12] = [
-    "task",
-    "tool",
-    "m1",
-    "m2",
-    "l1",
-    "l2",
-    "logdet",
-    "task_error",
-    "free_energy",
-    "cost_j",
-    "rhs_evals",
-    "error",
-];
+pub const HEADER: [&str; 12] = columns(&[
+    &["task"],
+    &TOOL_COLUMNS,
+    &["task_error", "free_energy", "cost_j", "rhs_evals", "error"],
+]);
 /// Task errors whose coefficient of variation (sd/mean) is at most this count as "similar".
 const SIMILAR_CV: f64 = 0.25;
 
@@ -311,7 +304,7 @@ impl TaskStats {
                 task_label(kind)
             ),
             outcome: corr.negative_outcome(),
-            evidence: format!("{}{}.", corr.describe(), self.failed_note()),
+            evidence: format!("{}{}.", corr.sentence(), self.failed_note()),
             rule: negative_correlation_rule(level),
         }
     }
@@ -355,7 +348,7 @@ impl TaskStats {
                     None => "undefined",
                 },
                 self.failed_note(),
-                corr.describe()
+                corr.sentence()
             ),
             rule: format!(
                 "two parts: equal confidence (max − min of ln|Π^U| ≤ 1e-9 relative) \

@@ -8,10 +8,12 @@ use toolconf::select::draw_tools;
 use toolconf_model::{Arm, Task, TaskKind};
 
 use super::batch::{map_ordered, run_tool, ToolRuns};
-use super::figure_parts::{arm_cells, dt_label, files_block, task_label, wants_log};
+use super::figure_parts::{
+    arm_cells, columns, dt_label, files_block, task_label, wants_log, TOOL_COLUMNS,
+};
 use super::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use super::report::{Block, Section, Verdict};
-use super::verdict::{mean_sd, negative_correlation_rule, Correlation};
+use super::verdict::{mean_sd, negative_correlation_rule, Correlation, CorrelationReport};
 use super::{described, Context, Experiment, Plan, ReproduceError};
 use toolconf_files::csv::{Cell, CsvWriter};
 
@@ -19,19 +21,11 @@ pub struct Fig4;
 
 const CSV: &str = "fig4_perturbation_change.csv";
 const SVG: &str = "fig4_perturbation_change.svg";
-pub const HEADER: [&str; 11] = [
-    "task",
-    "tool",
-    "m1",
-    "m2",
-    "l1",
-    "l2",
-    "logdet",
-    "task_error",
-    "task_error_perturbed",
-    "abs_change",
-    "error",
-];
+pub const HEADER: [&str; 11] = columns(&[
+    &["task"],
+    &TOOL_COLUMNS,
+    &["task_error", "task_error_perturbed", "abs_change", "error"],
+]);
 const TASKS: [TaskKind; 2] = [TaskKind::Position, TaskKind::Velocity];
 
 impl Experiment for Fig4 {
@@ -171,7 +165,7 @@ fn verdict(kind: TaskKind, corr: &Correlation, failed: usize, plan: &Plan) -> Ve
         outcome: corr.negative_outcome(),
         evidence: format!(
             "{} between ln|Π^U| and |task error(ΔT) − task error(0)|{}.",
-            corr.describe(),
+            corr.sentence(),
             if failed > 0 {
                 format!(" ({failed} tool(s) with a failed episode left out)")
             } else {

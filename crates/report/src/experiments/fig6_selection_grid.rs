@@ -9,7 +9,7 @@ use toolconf::select::{draw_tools, evaluate, ToolResult};
 use toolconf_model::{Arm, Task, TaskKind};
 
 use super::batch::map_ordered;
-use super::figure_parts::{arm_cells, files_block, ARM_COLUMNS};
+use super::figure_parts::{arm_cells, files_block, rhs_evals, ARM_COLUMNS};
 use super::objectives::{choices, decision_rules, DecisionRule, Trial};
 use super::plot::{self, Colour, GridPanel, Panel};
 use super::report::{Block, Outcome, Section, Verdict};
@@ -114,12 +114,7 @@ impl Experiment for Fig6 {
             title: self.title().into(),
             blocks,
             episodes: (done.len() * plan.fig6_tools) as u64,
-            rhs_evals: done
-                .iter()
-                .flat_map(|t| &t.results)
-                .filter_map(|r| r.episode.as_ref().ok())
-                .map(|m| m.rhs_evals as u64)
-                .sum(),
+            rhs_evals: rhs_evals(done.iter().flat_map(|t| &t.results)),
         })
     }
 }

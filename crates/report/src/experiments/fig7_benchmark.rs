@@ -10,7 +10,7 @@ use toolconf_model::{Arm, Task, TaskKind};
 use toolconf_stats::summary;
 
 use super::batch::map_ordered;
-use super::figure_parts::{arm_cells, dt_label, files_block, ARM_COLUMNS};
+use super::figure_parts::{arm_cells, dt_label, files_block, rhs_evals, ARM_COLUMNS};
 use super::objectives::{choices, decision_rules, DecisionRule, MpcCost, Trial};
 use super::plot::{self, BoxPanel, Panel};
 use super::report::{Block, Outcome, Section, Verdict};
@@ -197,12 +197,10 @@ impl Experiment for Fig7 {
             title: self.title().into(),
             blocks,
             episodes: 2 * (done.len() * plan.fig7_tools) as u64,
-            rhs_evals: done
-                .iter()
-                .flat_map(|t| t.results.iter().chain(&t.perturbed))
-                .filter_map(|r| r.episode.as_ref().ok())
-                .map(|m| m.rhs_evals as u64)
-                .sum(),
+            rhs_evals: rhs_evals(
+                done.iter()
+                    .flat_map(|t| t.results.iter().chain(&t.perturbed)),
+            ),
         })
     }
 }
