@@ -266,12 +266,7 @@ fn select_ranks_by_the_mpc_cost_when_asked() {
         "select", "--task", "velocity", "--tools", "2", "--seed", "3", "--mpc", "--json",
     ]);
     let v: Value = common::json_ok(&out);
-    let costs: Vec<f64> = v["tools"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|t| t["mpc_cost"].as_f64().unwrap())
-        .collect();
+    let costs: Vec<f64> = common::each_tool(&v, |t| t["mpc_cost"].as_f64().unwrap());
     let best = if costs[1] < costs[0] { 1 } else { 0 };
     assert_eq!(v["choice"]["mpc_cost"], best);
     let mixed = toolconf(&[

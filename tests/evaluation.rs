@@ -280,12 +280,7 @@ fn a_goal_only_tip_task_moves_the_panda_catalogue() {
     let task = "kind = \"tip_position\"\n[goal]\ntip = [0.36, 0.03, 0.39]\n";
     let out = rank_panda_catalogue("goal-only", task, &["--json"]);
     let json: Value = serde_json::from_slice(&out.stdout).unwrap();
-    let mut progress: Vec<f64> = json["tools"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|t| t["progress"].as_f64().unwrap())
-        .collect();
+    let mut progress: Vec<f64> = common::each_tool(&json, |t| t["progress"].as_f64().unwrap());
     progress.sort_by(f64::total_cmp);
     let median = progress[progress.len() / 2];
     assert!(median >= 0.5, "median progress {median}: {progress:?}");

@@ -131,12 +131,7 @@ fn an_unstable_linearised_loop_is_a_stated_null_never_nan() {
     let first: Vec<u64> = {
         let all = toolconf(&["rank", "--tools", PANDA_TOOLS, "--task", &task, "--json"]);
         let all: Value = serde_json::from_slice(&all.stdout).unwrap();
-        let mut r: Vec<u64> = all["tools"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|t| t["row"].as_u64().unwrap())
-            .collect();
+        let mut r: Vec<u64> = common::each_tool(&all, |t| t["row"].as_u64().unwrap());
         r.sort();
         r[..3].to_vec()
     };

@@ -327,12 +327,7 @@ fn the_screen_keeps_the_most_confident_tools() {
             .collect()
     };
     assert_eq!(names(&screened, 4), names(&all, 4));
-    let logdets: Vec<f64> = all["tools"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|t| f(t, "logdet"))
-        .collect();
+    let logdets: Vec<f64> = common::each_tool(&all, |t| f(t, "logdet"));
     assert!(logdets.windows(2).all(|w| w[0] >= w[1]));
     let top = &all["tools"][0];
     let p = &top["parameters"];
@@ -900,12 +895,8 @@ fn an_episode_too_long_to_hold_is_refused_up_front() {
 
 /// The K rows with the smallest `key` (ties: the earlier row), from an unscreened ranking.
 fn best_rows(all: &Value, key: &str, k: usize, larger_first: bool) -> Vec<u64> {
-    let mut tools: Vec<(f64, u64)> = all["tools"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|t| (f(t, key), t["row"].as_u64().unwrap()))
-        .collect();
+    let mut tools: Vec<(f64, u64)> =
+        common::each_tool(&all, |t| (f(t, key), t["row"].as_u64().unwrap()));
     tools.sort_by(|a, b| {
         let by_key = if larger_first {
             b.0.total_cmp(&a.0)
@@ -920,12 +911,7 @@ fn best_rows(all: &Value, key: &str, k: usize, larger_first: bool) -> Vec<u64> {
 }
 
 fn rows_of(v: &Value) -> Vec<u64> {
-    let mut rows: Vec<u64> = v["tools"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|t| t["row"].as_u64().unwrap())
-        .collect();
+    let mut rows: Vec<u64> = common::each_tool(&v, |t| t["row"].as_u64().unwrap());
     rows.sort();
     rows
 }

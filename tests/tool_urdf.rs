@@ -12,6 +12,21 @@ use toolconf_tool_urdf::COLUMNS;
 
 const PANDA: &str = "derive/robots/panda_description/urdf/panda.urdf";
 
+/// The Franka Hand of the URDF `urdf`, its fingers `opening` apart.
+fn hand_of<'a>(urdf: &'a str, opening: &'a str) -> [&'a str; 8] {
+    let (root, tip) = ("panda_hand", "panda_hand_tcp");
+    [
+        "--urdf",
+        urdf,
+        "--root",
+        root,
+        "--tip",
+        tip,
+        "--opening",
+        opening,
+    ]
+}
+
 fn repo(path: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join(path)
@@ -60,21 +75,17 @@ fn the_franka_hand_row_parses_as_csv_with_the_documented_columns() {
     let dir = scratch("row");
     let panda = repo(PANDA);
     let hand: &[&str] = &[
-        "--urdf",
-        &panda,
-        "--root",
-        "panda_hand",
-        "--tip",
-        "panda_hand_tcp",
-        "--opening",
-        "0.04",
-        "--flange",
-        "panda_link8",
-        "--model",
-        "panda",
-        "--name",
-        "Franka Hand, open",
-    ];
+        &hand_of(&panda, "0.04")[..],
+        &[
+            "--flange",
+            "panda_link8",
+            "--model",
+            "panda",
+            "--name",
+            "Franka Hand, open",
+        ],
+    ]
+    .concat();
     let out = tool(&dir, hand);
     common::assert_ok(&out);
     let stdout = String::from_utf8(out.stdout).unwrap();
@@ -110,18 +121,7 @@ fn out_never_overwrites_the_urdf_it_reads() {
     let before = std::fs::read(dir.join("copy.urdf")).unwrap();
     let out = tool(
         &dir,
-        &[
-            "--urdf",
-            "copy.urdf",
-            "--root",
-            "panda_hand",
-            "--tip",
-            "panda_hand_tcp",
-            "--opening",
-            "0",
-            "--out",
-            "copy.urdf",
-        ],
+        &[&hand_of("copy.urdf", "0")[..], &["--out", "copy.urdf"]].concat(),
     );
     assert_eq!(out.status.code(), Some(2));
     assert_eq!(std::fs::read(dir.join("copy.urdf")).unwrap(), before);
@@ -216,17 +216,8 @@ fn a_full_standard_output_is_status_1() {
     let dir = scratch("full");
     let panda = repo(PANDA);
     let out = Command::new(env!("CARGO_BIN_EXE_toolconf"))
-        .args([
-            "tool",
-            "--urdf",
-            &panda,
-            "--root",
-            "panda_hand",
-            "--tip",
-            "panda_hand_tcp",
-            "--opening",
-            "0.02",
-        ])
+        .arg("tool")
+        .args(hand_of(&panda, "0.02"))
         .current_dir(&dir)
         .stdout(std::fs::File::create("/dev/full").unwrap())
         .output()

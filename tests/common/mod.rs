@@ -108,3 +108,13 @@ pub fn central_differences<const N: usize>(
     }
     j
 }
+
+/// `each` of the tools of `rank`'s or `select`'s JSON, in its order.
+pub fn each_tool<T>(v: &Value, each: impl FnMut(&Value) -> T) -> Vec<T> {
+    v["tools"]
+        .as_array()
+        .expect("a tools list")
+        .iter()
+        .map(each)
+        .collect()
+}
