@@ -359,8 +359,7 @@ fn simulate_model_arm2_equals_simulate_arm_on_every_task() {
 /// the 1-DOF mass–spring–damper, with a trajectory CSV of their own width.
 #[test]
 fn simulate_model_runs_the_payload_arm_and_the_mass_spring_damper() {
-    let dir = std::env::temp_dir().join(format!("toolconf-sim-model-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("sim-model");
     for (model, params, columns) in [
         (
             "arm2_payload",

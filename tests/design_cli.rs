@@ -143,8 +143,7 @@ fn bad_input_is_one_line_and_status_2() {
 /// optimum that did not converge does too: tests/design.rs finds one).
 #[test]
 fn a_thin_set_is_warned_about() {
-    let dir = std::env::temp_dir().join(format!("toolconf-design-warn-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::fresh_dir("design-warn");
     let thin = dir.join("thin.toml");
     std::fs::write(
         &thin,

@@ -344,8 +344,7 @@ fn a_tip_position_episode_reaches_its_goal_on_every_catalogue_tool() {
 
 #[test]
 fn a_tip_task_refuses_a_tools_file_row_without_a_tip() {
-    let dir = std::env::temp_dir().join(format!("toolconf-tip-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::fresh_dir("tip-tasks");
     let path = dir.join("no_tips.csv");
     std::fs::write(
         &path,
