@@ -896,7 +896,7 @@ fn an_episode_too_long_to_hold_is_refused_up_front() {
 /// The K rows with the smallest `key` (ties: the earlier row), from an unscreened ranking.
 fn best_rows(all: &Value, key: &str, k: usize, larger_first: bool) -> Vec<u64> {
     let mut tools: Vec<(f64, u64)> =
-        common::each_tool(&all, |t| (f(t, key), t["row"].as_u64().unwrap()));
+        common::each_tool(all, |t| (f(t, key), t["row"].as_u64().unwrap()));
     tools.sort_by(|a, b| {
         let by_key = if larger_first {
             b.0.total_cmp(&a.0)
@@ -911,7 +911,7 @@ fn best_rows(all: &Value, key: &str, k: usize, larger_first: bool) -> Vec<u64> {
 }
 
 fn rows_of(v: &Value) -> Vec<u64> {
-    let mut rows: Vec<u64> = common::each_tool(&v, |t| t["row"].as_u64().unwrap());
+    let mut rows: Vec<u64> = common::each_tool(v, |t| t["row"].as_u64().unwrap());
     rows.sort();
     rows
 }
