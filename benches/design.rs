@@ -28,11 +28,7 @@ fn design(c: &mut Criterion) {
     let spec = DesignSpec::parse(&text, "reach_and_budget.toml", ModelKind::Arm2).unwrap();
     let task = TaskSpec::builtin(TaskKind::Velocity);
     let tasks = ModelTasks::new(&task);
-    let setting = Setting {
-        model: ModelKind::Arm2,
-        task: &task,
-        tasks: &tasks,
-    };
+    let setting = Setting::new(ModelKind::Arm2, &task, &tasks);
     let polytope = Polytope::new(&spec);
     let tool = AnyTool::new(ModelKind::Arm2, &[0.3, 0.2, 0.4, 0.3]).unwrap();
     let mut group = c.benchmark_group("design");

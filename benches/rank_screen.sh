@@ -6,27 +6,17 @@
 # screen; release) on each task and prints both stages' wall time and
 # throughput, with the load average before and after each run. Nothing is written into docs/.
 #   benches/rank_screen.sh [N=1000000] [K=1000] [TASKS=position,velocity] [THREADS=1] [SEED=1]
-set -euo pipefail
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-cd "$root"
+source "$(dirname "${BASH_SOURCE[0]}")/screen_lib.sh"
 n="${1:-1000000}" k="${2:-1000}" tasks="${3:-position,velocity}" threads="${4:-1}" seed="${5:-1}"
-export CARGO_BUILD_JOBS="${CARGO_BUILD_JOBS:-1}"
-cargo build --release --quiet --bin toolconf
 dir=target/rank_screen
 tools="$dir/tools_${n}_seed${seed}.csv"
-mkdir -p "$dir"
-if [[ ! -s "$tools" ]]; then
-  python3 - "$n" "$seed" "$tools" <<'PY'
-import random, sys
-n, seed, path = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
-rng = random.Random(seed)
+tools_file "$tools" "$n" "$seed" <<'PY'
 with open(path, "w") as f:
     f.write("name,model,m1,m2,l1,l2\n")
     for i in range(n):
         p = [0.1 + 0.5 * rng.random() for _ in range(4)]
         f.write(f"t{i},arm2," + ",".join(f"{v:.6f}" for v in p) + "\n")
 PY
-fi
 echo "tools: $tools ($(($(wc -l < "$tools") - 1)) rows, $(du -h "$tools" | cut -f1)); --screen $k; RAYON_NUM_THREADS=$threads"
 for task in ${tasks//,/ }; do
   before="$(cut -d' ' -f1-3 /proc/loadavg)"

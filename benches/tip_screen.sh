@@ -8,20 +8,11 @@
 # for the other screen; release) on the task and
 # prints the confidence stage's wall time and throughput, with the load average around the run.
 #   benches/tip_screen.sh [N=1000000] [K=100] [TASK=examples/tasks/panda_touch_point.toml] [THREADS=2] [SEED=1]
-set -euo pipefail
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-cd "$root"
+source "$(dirname "${BASH_SOURCE[0]}")/screen_lib.sh"
 n="${1:-1000000}" k="${2:-100}" task="${3:-examples/tasks/panda_touch_point.toml}" threads="${4:-2}" seed="${5:-1}"
-export CARGO_BUILD_JOBS="${CARGO_BUILD_JOBS:-1}"
-cargo build --release --quiet --bin toolconf
 dir=target/tip_screen
 tools="$dir/panda_${n}_seed${seed}.csv"
-mkdir -p "$dir"
-if [[ ! -s "$tools" ]]; then
-  python3 - "$n" "$seed" "$tools" <<'PY'
-import random, sys
-n, seed, path = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
-rng = random.Random(seed)
+tools_file "$tools" "$n" "$seed" <<'PY'
 columns = ("tool_mass,tool_com_x,tool_com_y,tool_com_z,tool_ixx,tool_iyy,tool_izz,"
            "tool_tip_x,tool_tip_y,tool_tip_z")
 with open(path + ".part", "w") as f:
@@ -36,7 +27,6 @@ with open(path + ".part", "w") as f:
 import os
 os.replace(path + ".part", path)
 PY
-fi
 echo "tools: $tools ($(($(wc -l < "$tools") - 1)) rows, $(du -h "$tools" | cut -f1)); task $task; --screen $k; RAYON_NUM_THREADS=$threads"
 before="$(cut -d' ' -f1-3 /proc/loadavg)"
 RAYON_NUM_THREADS="$threads" ./target/release/toolconf rank --tools "$tools" --task "$task" \

@@ -1,15 +1,11 @@
 //! The command line as a user runs it: output shape, and bad input as exit status 2.
 
+mod common;
+
 use std::process::Command;
 
+use common::toolconf;
 use serde_json::Value;
-
-fn toolconf(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_toolconf"))
-        .args(args)
-        .output()
-        .expect("run toolconf")
-}
 
 #[test]
 fn confidence_json_has_the_documented_keys() {
@@ -21,12 +17,7 @@ fn confidence_json_has_the_documented_keys() {
         "velocity",
         "--json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let v: Value = common::json_ok(&out);
     for key in ["a", "b", "pi_u", "logdet", "task", "arm"] {
         assert!(v.get(key).is_some(), "missing key {key}");
     }
@@ -131,12 +122,7 @@ fn simulate_json_and_csv() {
         "--csv",
         csv.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let v: Value = common::json_ok(&out);
     for key in [
         "task_error",
         "free_energy",
@@ -184,12 +170,7 @@ fn select_chooses_by_each_objective() {
     let out = toolconf(&[
         "select", "--task", "velocity", "--tools", "6", "--seed", "3", "--json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let v: Value = common::json_ok(&out);
     let tools = v["tools"].as_array().unwrap();
     assert_eq!(tools.len(), 6);
     let column = |key: &str| {
@@ -284,18 +265,8 @@ fn select_ranks_by_the_mpc_cost_when_asked() {
     let out = toolconf(&[
         "select", "--task", "velocity", "--tools", "2", "--seed", "3", "--mpc", "--json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).expect("JSON");
-    let costs: Vec<f64> = v["tools"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|t| t["mpc_cost"].as_f64().unwrap())
-        .collect();
+    let v: Value = common::json_ok(&out);
+    let costs: Vec<f64> = common::each_tool(&v, |t| t["mpc_cost"].as_f64().unwrap());
     let best = if costs[1] < costs[0] { 1 } else { 0 };
     assert_eq!(v["choice"]["mpc_cost"], best);
     let mixed = toolconf(&[
@@ -345,12 +316,7 @@ fn simulate_model_arm2_equals_simulate_arm_on_every_task() {
     for task in ["position", "velocity", "acceleration"] {
         let json = |args: &[&str]| -> Value {
             let out = toolconf(args);
-            assert!(
-                out.status.success(),
-                "{}",
-                String::from_utf8_lossy(&out.stderr)
-            );
-            serde_json::from_slice(&out.stdout).expect("JSON")
+            common::json_ok(&out)
         };
         let by_model = json(&[
             "simulate",
@@ -393,8 +359,7 @@ fn simulate_model_arm2_equals_simulate_arm_on_every_task() {
 /// the 1-DOF mass–spring–damper, with a trajectory CSV of their own width.
 #[test]
 fn simulate_model_runs_the_payload_arm_and_the_mass_spring_damper() {
-    let dir = std::env::temp_dir().join(format!("toolconf-sim-model-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("sim-model");
     for (model, params, columns) in [
         (
             "arm2_payload",
@@ -416,12 +381,7 @@ fn simulate_model_runs_the_payload_arm_and_the_mass_spring_damper() {
             "--csv",
             csv.to_str().unwrap(),
         ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let v: Value = serde_json::from_slice(&out.stdout).expect("JSON");
+        let v: Value = common::json_ok(&out);
         assert_eq!(v["model"], model);
         assert!(v["task_error"].as_f64().unwrap().is_finite());
         let text = std::fs::read_to_string(&csv).unwrap();
@@ -469,10 +429,7 @@ fn simulate_model_rejects_bad_parameters_and_two_link_only_options() {
 
 /// A folder of the test's own, empty.
 fn scratch(name: &str) -> std::path::PathBuf {
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli-{name}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::fresh_dir(&format!("cli-{name}"))
 }
 
 /// The temporary files in `dir`.

@@ -2,23 +2,15 @@
 //! central differences of `ClosedLoop::rhs`, on random arms, tasks, learning rates,
 //! perturbations and states far from the equilibrium.
 
+mod common;
+
 use proptest::prelude::*;
 use toolconf_model::closed_loop::{ClosedLoop, JointJacobian, JointState};
 use toolconf_model::{Arm, Task, TaskKind};
 
-/// ∂Ż/∂Z by central differences, column j with the step `1e-6·max(1, |z_j|)`.
+/// ∂Ż/∂Z by central differences (tests/common).
 fn central_differences(system: &ClosedLoop, z: &JointState) -> JointJacobian {
-    let mut j = JointJacobian::zeros();
-    for c in 0..6 {
-        let h = 1e-6 * z[c].abs().max(1.0);
-        let (mut plus, mut minus) = (*z, *z);
-        plus[c] += h;
-        minus[c] -= h;
-        // The increment as represented.
-        let width = plus[c] - minus[c];
-        j.set_column(c, &((system.rhs(&plus) - system.rhs(&minus)) / width));
-    }
-    j
+    common::central_differences(|z| system.rhs(z), z)
 }
 
 fn arm_strategy() -> impl Strategy<Value = Arm> {

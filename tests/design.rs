@@ -126,11 +126,7 @@ k = [0.5, 4.0]
     let s = spec(text, ModelKind::Msd);
     let task = TaskSpec::builtin(TaskKind::Position);
     let tasks = ModelTasks::new(&task);
-    let setting = Setting {
-        model: ModelKind::Msd,
-        task: &task,
-        tasks: &tasks,
-    };
+    let setting = Setting::new(ModelKind::Msd, &task, &tasks);
     let (polytope, o) = confidence_optimum(&s, &setting).unwrap();
     let p = polytope.full(&o.x);
     // Parameter order m, k, c.
@@ -151,11 +147,7 @@ fn a_box_of_twelve_decades_reaches_its_light_short_corner() {
     for kind in [TaskKind::Position, TaskKind::Velocity] {
         let task = TaskSpec::builtin(kind);
         let tasks = ModelTasks::new(&task);
-        let setting = Setting {
-            model: ModelKind::Arm2,
-            task: &task,
-            tasks: &tasks,
-        };
+        let setting = Setting::new(ModelKind::Arm2, &task, &tasks);
         let (polytope, o) = confidence_optimum(&s, &setting).unwrap();
         assert_eq!(polytope.full(&o.x), [1e-6; 4], "{kind}");
         assert!(o.converged(), "{kind}: KKT residual {}", o.kkt_residual);
@@ -200,11 +192,7 @@ fn an_unconverged_optimum_is_reported_as_such() {
     let s = spec(text, ModelKind::Arm2);
     let task = TaskSpec::builtin(TaskKind::Velocity);
     let tasks = ModelTasks::new(&task);
-    let setting = Setting {
-        model: ModelKind::Arm2,
-        task: &task,
-        tasks: &tasks,
-    };
+    let setting = Setting::new(ModelKind::Arm2, &task, &tasks);
     let (polytope, o) = confidence_optimum(&s, &setting).unwrap();
     assert!(!o.converged() && o.kkt_residual > 0.1, "{}", o.kkt_residual);
     // Independently: ∂ln|Π^U|/∂l1 is far from balanced by the constraints' multipliers, and
@@ -233,11 +221,7 @@ fn paper_arm_design_beats_the_best_of_100k_random_feasible_tools() {
     let s = spec(MINIMAL, ModelKind::Arm2);
     let task = TaskSpec::builtin(TaskKind::Velocity);
     let tasks = ModelTasks::new(&task);
-    let setting = Setting {
-        model: ModelKind::Arm2,
-        task: &task,
-        tasks: &tasks,
-    };
+    let setting = Setting::new(ModelKind::Arm2, &task, &tasks);
     let r = design(&s, &setting).unwrap();
     assert_eq!(r.random.feasible, 100_000);
     let best_random = r.random.top[0].1;
@@ -270,11 +254,7 @@ fn infeasible_constraints_are_refused() {
     let s = spec(&text, ModelKind::Arm2);
     let task = TaskSpec::builtin(TaskKind::Velocity);
     let tasks = ModelTasks::new(&task);
-    let setting = Setting {
-        model: ModelKind::Arm2,
-        task: &task,
-        tasks: &tasks,
-    };
+    let setting = Setting::new(ModelKind::Arm2, &task, &tasks);
     match design(&s, &setting) {
         Err(DesignError::Infeasible(m)) => assert!(
             m.contains("infeasible") && m.contains("l1 + l2 >= 1.3"),
@@ -292,11 +272,7 @@ fn same_seed_same_design_whatever_the_thread_count() {
     );
     let task = TaskSpec::builtin(TaskKind::Position);
     let tasks = ModelTasks::new(&task);
-    let setting = Setting {
-        model: ModelKind::Arm2,
-        task: &task,
-        tasks: &tasks,
-    };
+    let setting = Setting::new(ModelKind::Arm2, &task, &tasks);
     let one = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
@@ -345,11 +321,7 @@ fn the_gradient_check_holds_where_a_parameter_sits_at_zero_or_a_bound() {
     let task = TaskSpec::parse(&read("examples/tasks/panda_wrist_turn.toml"), "task").unwrap();
     let s = spec(&read("examples/design/panda_tool.toml"), ModelKind::Panda);
     let tasks = ModelTasks::new(&task);
-    let setting = Setting {
-        model: ModelKind::Panda,
-        task: &task,
-        tasks: &tasks,
-    };
+    let setting = Setting::new(ModelKind::Panda, &task, &tasks);
     let (polytope, optimum) = confidence_optimum(&s, &setting).unwrap();
     let at_zero_or_bound = (0..optimum.x.len()).filter(|&j| {
         let x = optimum.x[j];

@@ -1,6 +1,8 @@
 //! `toolconf design` as a user runs it: the example of docs/tutorials/design-a-tool.md, JSON keys, the report and sweep
 //! files, determinism across thread counts, and bad input as one line with exit status 2.
 
+mod common;
+
 use std::process::Command;
 
 use serde_json::Value;
@@ -25,12 +27,7 @@ fn design_json(threads: &str) -> Value {
         ],
         threads,
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("JSON")
+    common::json_ok(&out)
 }
 
 #[test]
@@ -69,11 +66,7 @@ fn report_and_sweep_write_csv_and_svg() {
         ],
         "2",
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_ok(&out);
     let csv = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines[0], "budget,logdet,kkt_residual,m1,m2,l1,l2,error");
@@ -150,8 +143,7 @@ fn bad_input_is_one_line_and_status_2() {
 /// optimum that did not converge does too: tests/design.rs finds one).
 #[test]
 fn a_thin_set_is_warned_about() {
-    let dir = std::env::temp_dir().join(format!("toolconf-design-warn-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::fresh_dir("design-warn");
     let thin = dir.join("thin.toml");
     std::fs::write(
         &thin,

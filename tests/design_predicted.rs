@@ -3,6 +3,8 @@
 //! the tool `design` by confidence gives, and the prediction at the design is within 10 % of
 //! the simulation.
 
+mod common;
+
 use std::process::Command;
 
 use serde_json::Value;
@@ -35,12 +37,7 @@ fn design(objective: &str, dir: &std::path::Path) -> Value {
         ])
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
+    common::json_ok(&out)
 }
 
 fn simulated_task_error(v: &Value) -> f64 {

@@ -16,6 +16,8 @@
 //! - No page cites a tracker's entry (its word followed by a number, or its possessive): a page
 //!   states the requirement itself.
 
+mod common;
+
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -593,11 +595,7 @@ fn json_of(sandbox: &Sandbox, command: &str) -> serde_json::Value {
         .env("PATH", path)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{command}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_ok_with(&out, &format!("{command}: "));
     serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{command}: {e}"))
 }
 

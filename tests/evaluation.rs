@@ -5,6 +5,8 @@
 //! relative tip goal starts every tool at the same distance, and a goal-only tip task moves the
 //! Panda's catalogue.
 
+mod common;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -16,10 +18,7 @@ use toolconf_model::inputs::tools_file::read_tools;
 use toolconf_model::registry::{AnyTool, ModelKind};
 
 fn fresh_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("evaluation-{name}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::fresh_dir(&format!("evaluation-{name}"))
 }
 
 fn repo(path: &str) -> PathBuf {
@@ -32,11 +31,7 @@ fn toolconf(args: &[&str], threads: usize) -> Output {
         .env("RAYON_NUM_THREADS", threads.to_string())
         .output()
         .expect("run toolconf");
-    assert!(
-        out.status.success(),
-        "toolconf {args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_ok_with(&out, &format!("toolconf {args:?} failed:\n"));
     out
 }
 
@@ -48,16 +43,7 @@ description = \"UR5: lift the tip 6 cm and move it 3 cm sideways\"\n\
 [episode]\nperturbation = [-12.0, -12.0, -12.0, -2.0, -2.0, -2.0]\n";
 
 fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| {
-            let e = e.unwrap();
-            (
-                e.file_name().to_string_lossy().into_owned(),
-                std::fs::read(e.path()).unwrap(),
-            )
-        })
-        .collect()
+    common::folder_files(dir)
 }
 
 fn count(text: &str, needle: &str) -> usize {
@@ -294,12 +280,7 @@ fn a_goal_only_tip_task_moves_the_panda_catalogue() {
     let task = "kind = \"tip_position\"\n[goal]\ntip = [0.36, 0.03, 0.39]\n";
     let out = rank_panda_catalogue("goal-only", task, &["--json"]);
     let json: Value = serde_json::from_slice(&out.stdout).unwrap();
-    let mut progress: Vec<f64> = json["tools"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|t| t["progress"].as_f64().unwrap())
-        .collect();
+    let mut progress: Vec<f64> = common::each_tool(&json, |t| t["progress"].as_f64().unwrap());
     progress.sort_by(f64::total_cmp);
     let median = progress[progress.len() / 2];
     assert!(median >= 0.5, "median progress {median}: {progress:?}");

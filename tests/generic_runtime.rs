@@ -2,9 +2,11 @@
 //! chosen model; arm3 runs; bad input gives typed errors; mixed tool sets draw and rank
 //! deterministically.
 
-use std::process::Command;
+mod common;
+
 use toolconf_model::Term;
 
+use common::toolconf;
 use nalgebra::SMatrix;
 use proptest::prelude::*;
 use serde_json::Value;
@@ -471,13 +473,6 @@ fn mixed_selection_snapshot() {
     insta::assert_snapshot!("mixed_selection", text);
 }
 
-fn toolconf(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_toolconf"))
-        .args(args)
-        .output()
-        .expect("run toolconf")
-}
-
 #[test]
 fn cli_default_models_keep_the_two_link_output() {
     for json in [false, true] {
@@ -514,12 +509,7 @@ fn cli_mixed_selection_json_and_text() {
         "arm2,arm3",
     ];
     let out = toolconf(&[&select[..], &["--json"]].concat());
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v: Value = common::json_ok(&out);
     let tools = v["tools"].as_array().unwrap();
     assert_eq!(tools.len(), 5);
     for t in tools {

@@ -7,8 +7,9 @@
 //! NaN or inf on stdout, nor a JSON null where a number belongs; no temporary file left behind;
 //! symbolic links still links and devices still devices.
 
+mod common;
+
 use std::os::unix::fs::FileTypeExt;
-use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -346,18 +347,9 @@ fn run(c: &Case, dir: &Path) -> Output {
     for (k, v) in &c.env {
         cmd.env(k, v);
     }
-    // SAFETY: between fork and exec only setrlimit, which is async-signal-safe.
-    unsafe {
-        cmd.pre_exec(|| {
-            let limit = libc::rlimit {
-                rlim_cur: 2 << 30,
-                rlim_max: 2 << 30,
-            };
-            libc::setrlimit(libc::RLIMIT_AS, &limit);
-            Ok(())
-        });
-    }
-    cmd.output().expect("run toolconf")
+    common::limit_memory(&mut cmd)
+        .output()
+        .expect("run toolconf")
 }
 
 /// The paths under `dir` whose names mark a temporary file.

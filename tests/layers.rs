@@ -1,6 +1,8 @@
 //! The layers as crates (docs/explanation/pipeline.md, "Crates"): each depends only on the ones below it, and the low
 //! ones carry little. Checked with `cargo tree` on the manifests, as a user would look.
 
+mod common;
+
 use std::collections::BTreeSet;
 use std::path::Path;
 use std::process::Command;
@@ -36,11 +38,7 @@ fn tree(manifest: &str, args: &[&str]) -> BTreeSet<String> {
         .args(args)
         .output()
         .expect("run cargo tree");
-    assert!(
-        out.status.success(),
-        "cargo tree {manifest}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_ok_with(&out, &format!("cargo tree {manifest}: "));
     String::from_utf8(out.stdout)
         .unwrap()
         .lines()
@@ -206,11 +204,7 @@ fn the_on_robot_controller_builds_for_a_bare_metal_target() {
         ])
         .output()
         .expect("run cargo build");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_ok(&out);
 }
 
 /// The toolconf crates each crate depends on directly (normal edges): (manifest, package, the

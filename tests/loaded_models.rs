@@ -8,6 +8,8 @@
 //! loaded-models-test` (part of `make test`) builds them into a temporary folder and runs them
 //! with `TOOLCONF_TEST_LIBRARIES` naming it. Without it they fail, never pass.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -220,11 +222,7 @@ fn json(args: &[&str], env: Option<(&str, &str)>) -> serde_json::Value {
         command.env(k, v);
     }
     let out = command.output().unwrap();
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_ok_with(&out, &format!("{args:?}: "));
     let mut value: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     strip(&mut value);
     value

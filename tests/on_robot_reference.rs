@@ -3,6 +3,8 @@
 //! examples/on_robot/tests/reference/mod.rs (that crate has no toolconf runtime to run). This
 //! runs the commands and checks the record is still their output, digit for digit.
 
+mod common;
+
 use std::process::Command;
 
 #[path = "../examples/on_robot/tests/reference/mod.rs"]
@@ -38,12 +40,7 @@ fn the_on_robot_reference_is_what_simulate_prints() {
                 .arg(&csv)
                 .output()
                 .unwrap();
-            assert!(
-                out.status.success(),
-                "{}",
-                String::from_utf8_lossy(&out.stderr)
-            );
-            let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+            let json: serde_json::Value = common::json_ok(&out);
             assert_eq!(
                 json["task_error"].as_f64().unwrap().to_bits(),
                 task_error.to_bits(),

@@ -8,6 +8,8 @@
 //! The full 2000-tool check (`draw_tools(2000, 1)`) is `benches/population.sh`
 //! (`benches/timing/population.rs`); here 60 tools per task keep the debug build to seconds.
 
+mod common;
+
 use toolconf::select::{draw_tools, evaluate};
 use toolconf_integrators::Method;
 use toolconf_model::closed_loop::{simulate, EpisodeOptions, Metrics, Plant};
@@ -137,25 +139,12 @@ fn fast_results_do_not_depend_on_the_number_of_threads() {
     assert_eq!(metrics(1), metrics(3));
 }
 
-fn toolconf(args: &[&str]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_toolconf"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
 fn select_json(extra: &[&str]) -> serde_json::Value {
     let mut args = vec![
         "select", "--task", "position", "--tools", "8", "--seed", "1", "--json",
     ];
     args.extend_from_slice(extra);
-    let out = toolconf(&args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
+    common::toolconf_json(&args)
 }
 
 /// `select` runs `Method::Fast` unless told otherwise, says so, and `--method explicit` gives
@@ -190,7 +179,7 @@ fn the_command_line_defaults_to_fast_and_names_the_method() {
         select_json(&["--method", "explicit"])["tools"][0]["cost_j"].as_f64(),
         Some(m.cost_j)
     );
-    let out = toolconf(&[
+    let out = common::toolconf(&[
         "select", "--task", "position", "--tools", "2", "--method", "rk4",
     ]);
     assert_eq!(out.status.code(), Some(2));

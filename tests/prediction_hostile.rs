@@ -5,21 +5,42 @@
 //! reason in CSV, never NaN, and a screen by prediction keeps such tools last, in file order,
 //! with a note.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
+use std::path::Path;
+
+use common::toolconf;
 use serde_json::Value;
 
 const TOUCH: &str = "examples/tasks/panda_touch_point.toml";
 const PANDA_TOOLS: &str = "examples/tools/panda_tools.csv";
 const HAND: &str = "1.0,0,0,0.1,0.005,0.005,0.002";
 
-fn toolconf(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_toolconf"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("run toolconf")
+/// `confidence` of the hand `HAND` on the Panda, for `task`, as JSON.
+fn hand_confidence(task: &str) -> [&str; 8] {
+    [
+        "confidence",
+        "--model",
+        "panda",
+        "--params",
+        HAND,
+        "--task-file",
+        task,
+        "--json",
+    ]
+}
+
+/// `rank` of the Panda's tools on `task`, the cheap stage keeping `keep`.
+fn screened_rank<'a>(task: &'a str, keep: &'a str) -> [&'a str; 7] {
+    [
+        "rank",
+        "--tools",
+        PANDA_TOOLS,
+        "--task",
+        task,
+        "--screen",
+        keep,
+    ]
 }
 
 /// The touch task with `line` added to its [episode] table (its last table).
@@ -49,25 +70,8 @@ fn a_horizon_of_zero_is_one_line_naming_the_key() {
     let dir = tempfile::tempdir().unwrap();
     let task = touch_with(dir.path(), "zero.toml", "t_end = 0.0");
     for args in [
-        vec![
-            "confidence",
-            "--model",
-            "panda",
-            "--params",
-            HAND,
-            "--task-file",
-            &task,
-            "--json",
-        ],
-        vec![
-            "rank",
-            "--tools",
-            PANDA_TOOLS,
-            "--task",
-            &task,
-            "--screen",
-            "2",
-        ],
+        hand_confidence(&task).to_vec(),
+        screened_rank(&task, "2").to_vec(),
     ] {
         let out = toolconf(&args);
         assert_eq!(out.status.code(), Some(2), "{args:?}");
@@ -82,16 +86,7 @@ fn a_horizon_of_zero_is_one_line_naming_the_key() {
 fn an_unstable_linearised_loop_is_a_stated_null_never_nan() {
     let dir = tempfile::tempdir().unwrap();
     let task = touch_with(dir.path(), "fast.toml", "learning_rate = 100.0");
-    let out = toolconf(&[
-        "confidence",
-        "--model",
-        "panda",
-        "--params",
-        HAND,
-        "--task-file",
-        &task,
-        "--json",
-    ]);
+    let out = toolconf(&hand_confidence(&task));
     assert!(out.status.success());
     let v: Value = serde_json::from_slice(&out.stdout).unwrap();
     for key in [
@@ -116,21 +111,9 @@ fn an_unstable_linearised_loop_screens_in_row_order_and_writes_no_nan() {
     let task = touch_with(dir.path(), "fast.toml", "learning_rate = 100.0");
     let csv = dir.path().join("out.csv");
     let csv_arg = csv.display().to_string();
-    let args = [
-        "rank",
-        "--tools",
-        PANDA_TOOLS,
-        "--task",
-        &task,
-        "--screen",
-        "3",
-    ];
+    let args = screened_rank(&task, "3");
     let text = toolconf(&[&args[..], &["--csv", &csv_arg]].concat());
-    assert!(
-        text.status.success(),
-        "{}",
-        String::from_utf8_lossy(&text.stderr)
-    );
+    common::assert_ok(&text);
     let stdout = String::from_utf8(text.stdout).unwrap();
     no_nan(&stdout);
     assert!(
@@ -154,12 +137,7 @@ fn an_unstable_linearised_loop_screens_in_row_order_and_writes_no_nan() {
     let first: Vec<u64> = {
         let all = toolconf(&["rank", "--tools", PANDA_TOOLS, "--task", &task, "--json"]);
         let all: Value = serde_json::from_slice(&all.stdout).unwrap();
-        let mut r: Vec<u64> = all["tools"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|t| t["row"].as_u64().unwrap())
-            .collect();
+        let mut r: Vec<u64> = common::each_tool(&all, |t| t["row"].as_u64().unwrap());
         r.sort();
         r[..3].to_vec()
     };

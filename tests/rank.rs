@@ -2,8 +2,10 @@
 //! paper's task written as a file against `simulate`, a custom task against an independent
 //! fine-step integration, determinism across thread counts, and every kind of bad input.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 use toolconf_model::Term;
 
 use serde_json::Value;
@@ -15,8 +17,8 @@ const PAPER_TASK: &str = "examples/tasks/paper_position.toml";
 const REACH_TASK: &str = "examples/tasks/reach_45.toml";
 
 fn run(args: &[&str], threads: Option<&str>) -> Output {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_toolconf"));
-    cmd.args(args).current_dir(env!("CARGO_MANIFEST_DIR"));
+    let mut cmd = common::toolconf_command();
+    cmd.args(args);
     if let Some(t) = threads {
         cmd.env("RAYON_NUM_THREADS", t);
     }
@@ -27,23 +29,9 @@ fn toolconf(args: &[&str]) -> Output {
     run(args, None)
 }
 
-fn json_of(out: &Output) -> Value {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("JSON on stdout")
-}
-
 /// A fresh folder for one test's files.
 fn scratch(test: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("rank")
-        .join(test);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::fresh_dir(&format!("rank/{test}"))
 }
 
 fn write(dir: &Path, name: &str, text: &str) -> String {
@@ -60,7 +48,7 @@ fn f(v: &Value, key: &str) -> f64 {
 
 #[test]
 fn the_readme_example_ranks_every_tool_by_free_energy() {
-    let v = json_of(&toolconf(&[
+    let v = common::json_ok(&toolconf(&[
         "rank", "--tools", DRAWER, "--task", REACH_TASK, "--json",
     ]));
     let tools = v["tools"].as_array().unwrap();
@@ -104,10 +92,10 @@ fn the_readme_example_ranks_every_tool_by_free_energy() {
 /// gives for every tool, arm2_exact ones included).
 #[test]
 fn the_paper_task_as_a_file_equals_simulate_for_every_tool() {
-    let from_file = json_of(&toolconf(&[
+    let from_file = common::json_ok(&toolconf(&[
         "rank", "--tools", DRAWER, "--task", PAPER_TASK, "--json",
     ]));
-    let builtin = json_of(&toolconf(&[
+    let builtin = common::json_ok(&toolconf(&[
         "rank", "--tools", DRAWER, "--task", "position", "--json",
     ]));
     assert_eq!(from_file["tools"], builtin["tools"]);
@@ -118,7 +106,7 @@ fn the_paper_task_as_a_file_equals_simulate_for_every_tool() {
         }
         let p = &t["parameters"];
         let arm = format!("{},{},{},{}", p["m1"], p["m2"], p["l1"], p["l2"]);
-        let s = json_of(&toolconf(&[
+        let s = common::json_ok(&toolconf(&[
             "simulate", "--arm", &arm, "--task", "position", "--json",
         ]));
         for key in ["task_error", "free_energy", "cost_j", "logdet"] {
@@ -217,7 +205,7 @@ fn a_custom_goal_and_precision_agree_with_a_fine_step_integration() {
         ("default.toml", CUSTOM_TASK, 1e-3),
     ] {
         let task = write(&dir, file, text);
-        let v = json_of(&toolconf(&[
+        let v = common::json_ok(&toolconf(&[
             "rank", "--tools", &tools, "--task", &task, "--json",
         ]));
         for t in v["tools"].as_array().unwrap() {
@@ -278,11 +266,7 @@ fn results_do_not_depend_on_the_number_of_threads() {
                 ],
                 Some(threads),
             );
-            assert!(
-                out.status.success(),
-                "{}",
-                String::from_utf8_lossy(&out.stderr)
-            );
+            common::assert_ok(&out);
             (out.stdout, std::fs::read(&csv).unwrap())
         })
         .collect();
@@ -314,7 +298,7 @@ fn results_do_not_depend_on_the_number_of_threads() {
 /// `--screen K` simulates the K tools with the largest ln|Π^U|, which `confidence` computes.
 #[test]
 fn the_screen_keeps_the_most_confident_tools() {
-    let all = json_of(&toolconf(&[
+    let all = common::json_ok(&toolconf(&[
         "rank",
         "--tools",
         DRAWER,
@@ -324,7 +308,7 @@ fn the_screen_keeps_the_most_confident_tools() {
         "--objective",
         "confidence",
     ]));
-    let screened = json_of(&toolconf(&[
+    let screened = common::json_ok(&toolconf(&[
         "rank",
         "--tools",
         DRAWER,
@@ -343,18 +327,13 @@ fn the_screen_keeps_the_most_confident_tools() {
             .collect()
     };
     assert_eq!(names(&screened, 4), names(&all, 4));
-    let logdets: Vec<f64> = all["tools"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|t| f(t, "logdet"))
-        .collect();
+    let logdets: Vec<f64> = common::each_tool(&all, |t| f(t, "logdet"));
     assert!(logdets.windows(2).all(|w| w[0] >= w[1]));
     let top = &all["tools"][0];
     let p = &top["parameters"];
     if top["model"] == "arm2" {
         let arm = format!("{},{},{},{}", p["m1"], p["m2"], p["l1"], p["l2"]);
-        let c = json_of(&toolconf(&[
+        let c = common::json_ok(&toolconf(&[
             "confidence",
             "--arm",
             &arm,
@@ -383,7 +362,7 @@ fn both_stages_report_their_wall_time_and_throughput() {
         "--report",
         report.to_str().unwrap(),
     ];
-    let v = json_of(&run(&[&args[..], &["--json"]].concat(), Some("1")));
+    let v = common::json_ok(&run(&[&args[..], &["--json"]].concat(), Some("1")));
     let (c, s) = (
         &v["timing"]["confidence_stage"],
         &v["timing"]["simulation_stage"],
@@ -439,7 +418,7 @@ fn a_json_tools_file_gives_what_the_same_csv_gives() {
         r#"[{"name": "x", "m1": 0.3, "m2": 0.4, "l1": 0.5, "l2": 0.2},
             {"name": "y", "model": "arm3", "m1": 0.3, "m2": 0.25, "m3": 0.2, "l1": 0.4, "l2": 0.35, "l3": 0.3}]"#,
     );
-    let a = json_of(&toolconf(&[
+    let a = common::json_ok(&toolconf(&[
         "rank",
         "--tools",
         &csv,
@@ -447,7 +426,7 @@ fn a_json_tools_file_gives_what_the_same_csv_gives() {
         "acceleration",
         "--json",
     ]));
-    let b = json_of(&toolconf(&[
+    let b = common::json_ok(&toolconf(&[
         "rank",
         "--tools",
         &json,
@@ -472,11 +451,7 @@ fn the_report_has_markdown_html_and_inline_figures() {
         "--report",
         report.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_ok(&out);
     let md = std::fs::read_to_string(report.join("report.md")).unwrap();
     let html = std::fs::read_to_string(report.join("report.html")).unwrap();
     for part in [
@@ -510,7 +485,7 @@ fn a_failed_tool_keeps_its_error_and_goes_last() {
         "kind = \"position\"\n[precision]\ntheta = [[1.0, 0.0], [0.0, 0.0]]\ntheta_dot = 0.0\n\
          theta_ddot = 0.0\nu = [[0.0, 0.0], [0.0, 1.0]]\n[episode]\nt_end = 0.5\n",
     );
-    let v = json_of(&toolconf(&[
+    let v = common::json_ok(&toolconf(&[
         "rank", "--tools", &tools, "--task", &singular, "--json",
     ]));
     let tools_json = v["tools"].as_array().unwrap();
@@ -586,7 +561,7 @@ fn skip_bad_rows_reports_each_and_ranks_the_rest() {
         "--json",
         "--skip-bad-rows",
     ]);
-    let v = json_of(&out);
+    let v = common::json_ok(&out);
     assert_eq!(v["tools"].as_array().unwrap().len(), 2);
     assert_eq!(v["skipped_rows"], 2);
     let stderr = String::from_utf8_lossy(&out.stderr);
@@ -763,7 +738,7 @@ fn every_bad_task_file_is_refused_naming_file_key_and_value() {
 
 #[test]
 fn simulate_and_confidence_take_a_task_file() {
-    let p = json_of(&toolconf(&[
+    let p = common::json_ok(&toolconf(&[
         "simulate",
         "--arm",
         "0.3,0.4,0.5,0.2",
@@ -771,7 +746,7 @@ fn simulate_and_confidence_take_a_task_file() {
         PAPER_TASK,
         "--json",
     ]));
-    let q = json_of(&toolconf(&[
+    let q = common::json_ok(&toolconf(&[
         "simulate",
         "--arm",
         "0.3,0.4,0.5,0.2",
@@ -782,7 +757,7 @@ fn simulate_and_confidence_take_a_task_file() {
     for key in ["task_error", "free_energy", "cost_j", "logdet"] {
         assert_eq!(f(&p, key), f(&q, key), "{key}");
     }
-    let c = json_of(&toolconf(&[
+    let c = common::json_ok(&toolconf(&[
         "confidence",
         "--arm",
         "0.3,0.4,0.5,0.2",
@@ -791,7 +766,7 @@ fn simulate_and_confidence_take_a_task_file() {
         "--json",
     ]));
     // Π^U of the file's precisions differs from the paper's task 1 (P^θ is not 100·I).
-    let paper = json_of(&toolconf(&[
+    let paper = common::json_ok(&toolconf(&[
         "confidence",
         "--arm",
         "0.3,0.4,0.5,0.2",
@@ -801,7 +776,7 @@ fn simulate_and_confidence_take_a_task_file() {
     ]));
     assert_ne!(c["logdet"], paper["logdet"]);
     // A command-line flag overrides the file's [episode].
-    let shorter = json_of(&toolconf(&[
+    let shorter = common::json_ok(&toolconf(&[
         "simulate",
         "--arm",
         "0.3,0.4,0.5,0.2",
@@ -811,7 +786,7 @@ fn simulate_and_confidence_take_a_task_file() {
         "1",
         "--json",
     ]));
-    let full = json_of(&toolconf(&[
+    let full = common::json_ok(&toolconf(&[
         "simulate",
         "--arm",
         "0.3,0.4,0.5,0.2",
@@ -825,7 +800,7 @@ fn simulate_and_confidence_take_a_task_file() {
 
 #[test]
 fn select_takes_a_task_file_for_each_drawn_model() {
-    let s = json_of(&toolconf(&[
+    let s = common::json_ok(&toolconf(&[
         "select",
         "--task-file",
         PAPER_TASK,
@@ -833,7 +808,7 @@ fn select_takes_a_task_file_for_each_drawn_model() {
         "3",
         "--json",
     ]));
-    let t = json_of(&toolconf(&[
+    let t = common::json_ok(&toolconf(&[
         "select", "--task", "position", "--tools", "3", "--json",
     ]));
     // The same episodes; the task file adds each tool's prediction.
@@ -845,7 +820,7 @@ fn select_takes_a_task_file_for_each_drawn_model() {
     }
     assert_eq!(from_file, t["tools"]);
     // Drawn tools of several models each run the file's task bound to their model...
-    let mixed = json_of(&toolconf(&[
+    let mixed = common::json_ok(&toolconf(&[
         "select",
         "--task-file",
         REACH_TASK,
@@ -927,12 +902,8 @@ fn an_episode_too_long_to_hold_is_refused_up_front() {
 
 /// The K rows with the smallest `key` (ties: the earlier row), from an unscreened ranking.
 fn best_rows(all: &Value, key: &str, k: usize, larger_first: bool) -> Vec<u64> {
-    let mut tools: Vec<(f64, u64)> = all["tools"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|t| (f(t, key), t["row"].as_u64().unwrap()))
-        .collect();
+    let mut tools: Vec<(f64, u64)> =
+        common::each_tool(all, |t| (f(t, key), t["row"].as_u64().unwrap()));
     tools.sort_by(|a, b| {
         let by_key = if larger_first {
             b.0.total_cmp(&a.0)
@@ -947,12 +918,7 @@ fn best_rows(all: &Value, key: &str, k: usize, larger_first: bool) -> Vec<u64> {
 }
 
 fn rows_of(v: &Value) -> Vec<u64> {
-    let mut rows: Vec<u64> = v["tools"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|t| t["row"].as_u64().unwrap())
-        .collect();
+    let mut rows: Vec<u64> = common::each_tool(v, |t| t["row"].as_u64().unwrap());
     rows.sort();
     rows
 }
@@ -963,13 +929,13 @@ fn rows_of(v: &Value) -> Vec<u64> {
 #[test]
 fn the_screen_by_prediction_keeps_the_tools_predicted_cheapest() {
     let base = ["rank", "--tools", DRAWER, "--task", REACH_TASK, "--json"];
-    let all = json_of(&toolconf(&base));
+    let all = common::json_ok(&toolconf(&base));
     for (objective, key) in [
         ("free-energy", "predicted_free_energy"),
         ("cost-j", "predicted_cost_j"),
     ] {
         let args = [&base[..], &["--screen", "4", "--objective", objective]].concat();
-        let screened = json_of(&toolconf(&args));
+        let screened = common::json_ok(&toolconf(&args));
         assert_eq!(screened["screen_by"], "predicted");
         assert_eq!(
             rows_of(&screened),
@@ -979,13 +945,13 @@ fn the_screen_by_prediction_keeps_the_tools_predicted_cheapest() {
         let one = run(&args, Some("1"));
         let two = run(&args, Some("2"));
         assert_eq!(
-            json_of(&one)["tools"],
-            json_of(&two)["tools"],
+            common::json_ok(&one)["tools"],
+            common::json_ok(&two)["tools"],
             "the screen depends on the thread count"
         );
     }
     let args = [&base[..], &["--screen", "4", "--screen-by", "confidence"]].concat();
-    let screened = json_of(&toolconf(&args));
+    let screened = common::json_ok(&toolconf(&args));
     assert_eq!(screened["screen_by"], "confidence");
     assert_eq!(rows_of(&screened), best_rows(&all, "logdet", 4, true));
     assert!(screened.get("prediction_check").is_none());

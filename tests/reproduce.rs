@@ -2,16 +2,15 @@
 //! headers and column counts, a verdict per claim in the report, no NaN anywhere, and the same
 //! bytes whatever the number of threads.
 
+mod common;
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// A fresh directory under cargo's per-test temporary directory.
 fn fresh_dir(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("reproduce-{name}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::fresh_dir(&format!("reproduce-{name}"))
 }
 
 fn reproduce(out: &Path, threads: usize, extra: &[&str]) -> std::process::Child {
@@ -28,11 +27,7 @@ fn reproduce(out: &Path, threads: usize, extra: &[&str]) -> std::process::Child 
 
 fn finish(child: std::process::Child) -> Output {
     let out = child.wait_with_output().unwrap();
-    assert!(
-        out.status.success(),
-        "toolconf reproduce failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_ok_with(&out, "toolconf reproduce failed:\n");
     out
 }
 
@@ -59,16 +54,7 @@ fn cells(line: &str) -> Vec<String> {
 type Files = BTreeMap<String, Vec<u8>>;
 
 fn files(dir: &Path) -> Files {
-    std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| {
-            let e = e.unwrap();
-            (
-                e.file_name().to_string_lossy().into_owned(),
-                std::fs::read(e.path()).unwrap(),
-            )
-        })
-        .collect()
+    common::folder_files(dir)
 }
 
 const ARM: &str = "m1,m2,l1,l2";

@@ -1,23 +1,10 @@
 //! `select --models M --task-file F --json` gives each tool's predicted cost, the numbers
 //! `confidence --model M --params … --task-file F --json` gives for that tool alone.
 
-use std::process::Command;
+mod common;
 
+use common::toolconf_json as toolconf;
 use serde_json::Value;
-
-fn toolconf(args: &[&str]) -> Value {
-    let out = Command::new(env!("CARGO_BIN_EXE_toolconf"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
-}
 
 #[test]
 fn select_on_a_task_file_gives_each_tools_prediction() {

@@ -7,6 +7,8 @@
 //! reaches its goal on every tool of the Panda catalogue; tools files without a tip are refused
 //! by a tip task, naming the file, the row and the columns.
 
+mod common;
+
 use std::path::Path;
 
 use nalgebra::{SMatrix, SVector};
@@ -59,16 +61,7 @@ fn central_differences<P, const N: usize, const NX: usize, const NP: usize, cons
 where
     P: ArmModel<N, NX, NP, NZ>,
 {
-    let mut j = SMatrix::<f64, NZ, NZ>::zeros();
-    for c in 0..NZ {
-        let h = 1e-6 * z[c].abs().max(1.0);
-        let (mut plus, mut minus) = (*z, *z);
-        plus[c] += h;
-        minus[c] -= h;
-        let width = plus[c] - minus[c];
-        j.set_column(c, &((system.rhs(&plus) - system.rhs(&minus)) / width));
-    }
-    j
+    common::central_differences(|z| system.rhs(z), z)
 }
 
 /// Largest entry-wise error, relative to the largest entry of its row.
@@ -351,8 +344,7 @@ fn a_tip_position_episode_reaches_its_goal_on_every_catalogue_tool() {
 
 #[test]
 fn a_tip_task_refuses_a_tools_file_row_without_a_tip() {
-    let dir = std::env::temp_dir().join(format!("toolconf-tip-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::fresh_dir("tip-tasks");
     let path = dir.join("no_tips.csv");
     std::fs::write(
         &path,

@@ -3,13 +3,29 @@
 //! line naming it, never a panic, unbounded memory (each run under a 2 GB address-space limit) or
 //! a harmed file. Agreement with Pinocchio is python/tests/test_tool_urdf.py's.
 
-use std::os::unix::process::CommandExt;
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
 use toolconf_tool_urdf::COLUMNS;
 
 const PANDA: &str = "derive/robots/panda_description/urdf/panda.urdf";
+
+/// The Franka Hand of the URDF `urdf`, its fingers `opening` apart.
+fn hand_of<'a>(urdf: &'a str, opening: &'a str) -> [&'a str; 8] {
+    let (root, tip) = ("panda_hand", "panda_hand_tcp");
+    [
+        "--urdf",
+        urdf,
+        "--root",
+        root,
+        "--tip",
+        tip,
+        "--opening",
+        opening,
+    ]
+}
 
 fn repo(path: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -19,12 +35,7 @@ fn repo(path: &str) -> String {
 }
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("tool_urdf")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::fresh_dir(&format!("tool_urdf/{name}"))
 }
 
 /// `toolconf tool ARGS` in `dir`, under a 2 GB address-space limit.
@@ -34,18 +45,9 @@ fn tool(dir: &Path, args: &[&str]) -> Output {
         .args(args)
         .current_dir(dir)
         .stdin(Stdio::null());
-    // SAFETY: between fork and exec only setrlimit, which is async-signal-safe.
-    unsafe {
-        cmd.pre_exec(|| {
-            let limit = libc::rlimit {
-                rlim_cur: 2 << 30,
-                rlim_max: 2 << 30,
-            };
-            libc::setrlimit(libc::RLIMIT_AS, &limit);
-            Ok(())
-        });
-    }
-    cmd.output().expect("run toolconf")
+    common::limit_memory(&mut cmd)
+        .output()
+        .expect("run toolconf")
 }
 
 /// The `#` line, then the header and the one row, parsed by the csv crate.
@@ -73,28 +75,20 @@ fn the_franka_hand_row_parses_as_csv_with_the_documented_columns() {
     let dir = scratch("row");
     let panda = repo(PANDA);
     let hand: &[&str] = &[
-        "--urdf",
-        &panda,
-        "--root",
-        "panda_hand",
-        "--tip",
-        "panda_hand_tcp",
-        "--opening",
-        "0.04",
-        "--flange",
-        "panda_link8",
-        "--model",
-        "panda",
-        "--name",
-        "Franka Hand, open",
-    ];
+        &hand_of(&panda, "0.04")[..],
+        &[
+            "--flange",
+            "panda_link8",
+            "--model",
+            "panda",
+            "--name",
+            "Franka Hand, open",
+        ],
+    ]
+    .concat();
     let out = tool(&dir, hand);
+    common::assert_ok(&out);
     let stdout = String::from_utf8(out.stdout).unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     let (comment, header, row) = parse(&stdout);
     assert!(comment.starts_with("# from "), "{comment}");
     assert!(
@@ -127,18 +121,7 @@ fn out_never_overwrites_the_urdf_it_reads() {
     let before = std::fs::read(dir.join("copy.urdf")).unwrap();
     let out = tool(
         &dir,
-        &[
-            "--urdf",
-            "copy.urdf",
-            "--root",
-            "panda_hand",
-            "--tip",
-            "panda_hand_tcp",
-            "--opening",
-            "0",
-            "--out",
-            "copy.urdf",
-        ],
+        &[&hand_of("copy.urdf", "0")[..], &["--out", "copy.urdf"]].concat(),
     );
     assert_eq!(out.status.code(), Some(2));
     assert_eq!(std::fs::read(dir.join("copy.urdf")).unwrap(), before);
@@ -233,17 +216,8 @@ fn a_full_standard_output_is_status_1() {
     let dir = scratch("full");
     let panda = repo(PANDA);
     let out = Command::new(env!("CARGO_BIN_EXE_toolconf"))
-        .args([
-            "tool",
-            "--urdf",
-            &panda,
-            "--root",
-            "panda_hand",
-            "--tip",
-            "panda_hand_tcp",
-            "--opening",
-            "0.02",
-        ])
+        .arg("tool")
+        .args(hand_of(&panda, "0.02"))
         .current_dir(&dir)
         .stdout(std::fs::File::create("/dev/full").unwrap())
         .output()

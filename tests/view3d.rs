@@ -6,6 +6,8 @@
 //! differ). Skipped with one line where no Chromium is installed. Everything it writes (the
 //! report, the browser's profile and temporary files) is in one folder removed at the end.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -91,11 +93,7 @@ fn rank_report(scratch: &Path, before: &[&str], tools: &Path, task: &str) -> Pat
         .arg(&report)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_ok(&out);
     report.join("report.html")
 }
 

@@ -85,11 +85,7 @@ fn main() -> ExitCode {
     };
     let spec_task = TaskSpec::from_file(Path::new(&task)).expect("task file");
     let tasks = ModelTasks::new(&spec_task);
-    let setting = Setting {
-        model,
-        task: &spec_task,
-        tasks: &tasks,
-    };
+    let setting = Setting::new(model, &spec_task, &tasks);
     let spec = DesignSpec::from_file(Path::new(&file), model).expect("design file");
     let simulated = |params: &[f64]| -> Option<f64> {
         let tool = AnyTool::new(model, params).ok()?;

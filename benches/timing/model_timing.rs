@@ -11,6 +11,8 @@
 //! cargo run --release --example model_timing -- --tools FILE --task NAME|FILE [--repeat 11] [--method fast]
 //! ```
 
+mod common;
+
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -36,18 +38,7 @@ fn parse_args() -> Result<Args, String> {
         match flag.as_str() {
             "--tools" => tools = Some(PathBuf::from(value()?)),
             "--task" => task = Some(value()?),
-            "--repeat" => {
-                repeat = value()?
-                    .parse()
-                    .map_err(|e| format!("--repeat: {e}"))
-                    .and_then(|r: usize| {
-                        if r > 0 {
-                            Ok(r)
-                        } else {
-                            Err("--repeat must be ≥ 1".into())
-                        }
-                    })?
-            }
+            "--repeat" => repeat = common::repeat_count(&value()?)?,
             "--method" => method = Some(value()?.parse().map_err(|e| format!("--method {e}"))?),
             _ => return Err(format!("unknown argument {flag}")),
         }
@@ -58,16 +49,6 @@ fn parse_args() -> Result<Args, String> {
         repeat,
         method,
     })
-}
-
-fn median(values: &mut [f64]) -> f64 {
-    values.sort_by(f64::total_cmp);
-    let n = values.len();
-    if n % 2 == 1 {
-        values[n / 2]
-    } else {
-        0.5 * (values[n / 2 - 1] + values[n / 2])
-    }
 }
 
 fn run() -> Result<Value, String> {
@@ -102,7 +83,7 @@ fn run() -> Result<Value, String> {
         per_tool.push(json!({
             "row": row.row,
             "model": row.tool.model().name(),
-            "us": median(&mut runs),
+            "us": common::median(&mut runs),
             "rhs_evals": first.rhs_evals,
             "jacobian_evals": first.jacobian_evals,
             "task_error": first.task_error,
@@ -119,17 +100,5 @@ fn run() -> Result<Value, String> {
 }
 
 fn main() -> ExitCode {
-    match run() {
-        Ok(v) => {
-            println!(
-                "{}",
-                serde_json::to_string_pretty(&v).expect("finite numbers")
-            );
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            eprintln!("model_timing: {e}");
-            ExitCode::from(2)
-        }
-    }
+    common::exit_code("model_timing", run().map(|v| common::print_json(&v)))
 }

@@ -16,6 +16,8 @@
 //!
 //! With `--repeat 1` it is also the small driver for profiling N episodes under callgrind.
 
+mod common;
+
 use std::io::Read;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -41,16 +43,6 @@ fn arm_from(v: &Value) -> Result<Arm, String> {
     }
 }
 
-fn median(values: &mut [f64]) -> f64 {
-    values.sort_by(f64::total_cmp);
-    let n = values.len();
-    if n % 2 == 1 {
-        values[n / 2]
-    } else {
-        0.5 * (values[n / 2 - 1] + values[n / 2])
-    }
-}
-
 struct Args {
     tasks: Vec<TaskKind>,
     repeat: usize,
@@ -69,24 +61,8 @@ fn parse_args() -> Result<Args, String> {
     while let Some(flag) = it.next() {
         let mut value = || it.next().ok_or(format!("{flag} needs a value"));
         match flag.as_str() {
-            "--tasks" => {
-                args.tasks = value()?
-                    .split(',')
-                    .map(|t| t.parse::<TaskKind>().map_err(|e| e.to_string()))
-                    .collect::<Result<_, _>>()?
-            }
-            "--repeat" => {
-                args.repeat = value()?
-                    .parse()
-                    .map_err(|e| format!("--repeat: {e}"))
-                    .and_then(|r: usize| {
-                        if r > 0 {
-                            Ok(r)
-                        } else {
-                            Err("--repeat must be ≥ 1".into())
-                        }
-                    })?
-            }
+            "--tasks" => args.tasks = common::task_kinds(&value()?)?,
+            "--repeat" => args.repeat = common::repeat_count(&value()?)?,
             "--method" => args.method = value()?.parse().map_err(|e| format!("--method {e}"))?,
             "--limit" => args.limit = Some(value()?.parse().map_err(|e| format!("--limit: {e}"))?),
             _ => return Err(format!("unknown argument {flag}")),
@@ -131,7 +107,7 @@ fn run() -> Result<Value, String> {
                     elapsed * 1e6
                 })
                 .collect();
-            let us = median(&mut runs);
+            let us = common::median(&mut runs);
             times.push(us);
             let m = first.metrics;
             per_tool.push(json!({
@@ -145,7 +121,7 @@ fn run() -> Result<Value, String> {
         out.insert(
             kind.name().into(),
             json!({
-                "median_us": median(&mut times),
+                "median_us": common::median(&mut times),
                 "repeat": args.repeat,
                 "tools": per_tool,
             }),
@@ -155,17 +131,5 @@ fn run() -> Result<Value, String> {
 }
 
 fn main() -> ExitCode {
-    match run() {
-        Ok(v) => {
-            println!(
-                "{}",
-                serde_json::to_string_pretty(&v).expect("finite numbers")
-            );
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            eprintln!("peer_timing: {e}");
-            ExitCode::from(2)
-        }
-    }
+    common::exit_code("peer_timing", run().map(|v| common::print_json(&v)))
 }

@@ -15,6 +15,8 @@
 //!     [--tasks position,velocity,acceleration] [--methods explicit,auto,stiff,fast] [--markdown]
 //! ```
 
+mod common;
+
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -68,12 +70,7 @@ fn parse_args() -> Result<Args, String> {
             "--tools" => args.tools = value()?.parse().map_err(|e| format!("--tools: {e}"))?,
             "--seed" => args.seed = value()?.parse().map_err(|e| format!("--seed: {e}"))?,
             "--repeat" => args.repeat = value()?.parse().map_err(|e| format!("--repeat: {e}"))?,
-            "--tasks" => {
-                args.tasks = value()?
-                    .split(',')
-                    .map(|t| t.parse::<TaskKind>().map_err(|e| e.to_string()))
-                    .collect::<Result<_, _>>()?
-            }
+            "--tasks" => args.tasks = common::task_kinds(&value()?)?,
             "--methods" => {
                 args.methods = value()?
                     .split(',')
@@ -268,11 +265,5 @@ fn print_task(kind: TaskKind, rows: &[Row], refs: &[Metrics], markdown: bool) {
 }
 
 fn main() -> ExitCode {
-    match run() {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("population: {e}");
-            ExitCode::from(2)
-        }
-    }
+    common::exit_code("population", run())
 }

@@ -16,6 +16,8 @@ import time
 import unittest
 from pathlib import Path
 
+from urdf_model_text import urdf_model_head
+
 ROOT = Path(__file__).resolve().parents[2]
 DERIVE = ROOT / "derive" / "derive.py"
 MAKE_CRATE = ROOT / "derive" / "make_crate.py"
@@ -45,18 +47,7 @@ URDF = """<?xml version="1.0"?><robot name="test">
 <axis xyz="1 0 0"/><limit lower="-4" upper="4" effort="10" velocity="1"/></joint>
 <joint name="fix" type="fixed"><parent link="c"/><child link="flange"/><origin xyz="0 0 0.1" rpy="0 0 0"/></joint>
 </robot>"""
-URDF_MODEL = """
-[model]
-name = "three"
-dof = 3
-[dynamics]
-kind = "urdf"
-[urdf]
-file = "{file}"
-base = "base"
-flange = "flange"
-gravity = [0.0, 0.0, -9.81]
-[impedance]
+URDF_MODEL = urdf_model_head("{file}") + """[impedance]
 stiffness = [50.0, 50.0, 50.0]
 damping = [5.0, 5.0, 5.0]
 [equilibrium]

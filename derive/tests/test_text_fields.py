@@ -27,6 +27,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from toolconf_derive.description import load_model, load_tasks  # noqa: E402
 from toolconf_derive.errors import DescriptionError  # noqa: E402
 from toolconf_derive.files import refused_character  # noqa: E402
+from urdf_model_text import urdf_model_head  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 CASES = int(os.environ.get("TOOLCONF_FUZZ_CASES", "200"))
@@ -121,18 +122,7 @@ URDF = """<?xml version="1.0"?><robot name="three">
     f'<origin xyz="0 0 0.2"/><axis xyz="{"0 0 1" if i == 0 else "0 1 0"}"/>'
     f'<limit lower="-3" upper="3" effort="10" velocity="1"/></joint>' for i in range(3)) + \
     '<joint name="fix" type="fixed"><parent link="l2"/><child link="flange"/></joint></robot>'
-URDF_MODEL = """
-[model]
-name = "three"
-dof = 3
-[dynamics]
-kind = "urdf"
-[urdf]
-file = "three.urdf"
-base = "base"
-flange = "flange"
-gravity = [0.0, 0.0, -9.81]
-source = @urdf_source@
+URDF_MODEL = urdf_model_head("three.urdf") + """source = @urdf_source@
 [impedance]
 stiffness = [50.0, 50.0, 50.0]
 damping = [5.0, 5.0, 5.0]

@@ -41,6 +41,7 @@ from toolconf_derive.numeric import CasadiModel  # noqa: E402
 from toolconf_derive.rigid_body import ChainDynamics, ldl_apply, ldl_factor  # noqa: E402
 from toolconf_derive.urdf import read_chain  # noqa: E402
 from toolconf_derive.urdf_model import UrdfDerivation, _sample_tool  # noqa: E402
+from urdf_model_text import urdf_model_head  # noqa: E402
 
 DERIVE = ROOT / "derive" / "derive.py"
 PANDA = ROOT / "derive" / "models" / "panda.toml"
@@ -77,18 +78,7 @@ GOOD = [_link("base"), _link("a", _inertial(1.0, (0.0, 0.0, 0.1))), _link("b", _
         _joint("j2", "revolute", "a", "b", "0 0 0.2", axis="0 1 0"),
         _joint("j3", "revolute", "b", "c", "0 0 0.2", axis="1 0 0"), _joint("fix", "fixed", "c", "flange", "0 0 0.2")]
 
-MODEL = """
-[model]
-name = "three"
-dof = 3
-[dynamics]
-kind = "urdf"
-[urdf]
-file = "{file}"
-base = "base"
-flange = "flange"
-gravity = [0.0, 0.0, -9.81]
-[impedance]
+MODEL = urdf_model_head("{file}") + """[impedance]
 stiffness = [{k1}, 50.0, 50.0]
 damping = [5.0, 5.0, 5.0]
 [equilibrium]
@@ -590,18 +580,7 @@ XARM = [
     ("joint4", "0.0525 0 0", "1.5708 0 0", -0.19198, 3.927, 5, 1.7269, (0.07047, -0.11575, 0.012),
      (0.005889, 0.00359703, 0.00543244), (0.00137112, 0.00088143, -0.001762155)),
 ]
-XARM_MODEL = """
-[model]
-name = "xarm"
-dof = 4
-[dynamics]
-kind = "urdf"
-[urdf]
-file = "xarm.urdf"
-base = "link_base"
-flange = "link_eef"
-gravity = [0.0, 0.0, -9.81]
-[impedance]
+XARM_MODEL = urdf_model_head("xarm.urdf", "xarm", 4, "link_base", "link_eef") + """[impedance]
 stiffness = [50.0, 50.0, 50.0, 50.0]
 damping = [5.0, 5.0, 5.0, 5.0]
 [equilibrium]

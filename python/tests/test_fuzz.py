@@ -10,7 +10,6 @@ exception.
 the long run (docs/reference/errors.md).
 """
 
-import math
 import os
 
 import numpy as np
@@ -19,10 +18,11 @@ from hypothesis import strategies as st
 
 import toolconf
 
+from fuzz_checks import finite, one_line
+
 CASES = int(os.environ.get("TOOLCONF_FUZZ_CASES", "200"))
 FUZZ = settings(max_examples=CASES, deadline=None,
                 suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
-MAX_MESSAGE = 800
 EXPECTED = (ValueError, TypeError, toolconf.SimulationError, RuntimeError)
 
 numbers = st.one_of(
@@ -71,26 +71,6 @@ params = st.one_of(
     st.sampled_from([np.zeros((0, 4)), np.ones((2, 2, 4)), np.array([0.3, 0.4, 0.5, 0.2])]),
 )
 models = st.one_of(st.sampled_from(list(toolconf.models())), st.text(max_size=12))
-
-
-def one_line(err: BaseException) -> None:
-    message = str(err)
-    assert "\n" not in message, message
-    assert len(message) <= MAX_MESSAGE, message[:200]
-    assert "panicked" not in message, message
-
-
-def finite(out) -> None:
-    if isinstance(out, dict):
-        for v in out.values():
-            finite(v)
-    elif isinstance(out, (list, tuple)):
-        for v in out:
-            finite(v)
-    elif isinstance(out, np.ndarray) and out.dtype.kind == "f":
-        assert np.isfinite(out).all(), out
-    elif isinstance(out, float):
-        assert math.isfinite(out), out
 
 
 def call(fn, *args, **kwargs) -> None:

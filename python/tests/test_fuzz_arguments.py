@@ -26,10 +26,10 @@ import toolconf
 import toolconf.dask as tdask
 
 from conftest import DRAWER
+from fuzz_checks import finite, one_line
 
 CASES = int(os.environ.get("TOOLCONF_FUZZ_CASES", "100"))
 FUZZ = settings(max_examples=CASES, deadline=None, suppress_health_check=list(HealthCheck))
-MAX_MESSAGE = 800
 BAD_INPUT = (ValueError, TypeError, MemoryError)
 FAILED_RUN = (toolconf.SimulationError, RuntimeError)
 
@@ -134,26 +134,6 @@ def short(options):
     except (TypeError, ValueError, OverflowError):
         pass
     return options
-
-
-def one_line(err: BaseException) -> None:
-    message = str(err)
-    assert "\n" not in message, message
-    assert len(message) <= MAX_MESSAGE, message[:200]
-    assert "panicked" not in message, message
-
-
-def finite(out) -> None:
-    if isinstance(out, dict):
-        for v in out.values():
-            finite(v)
-    elif isinstance(out, (list, tuple)):
-        for v in out:
-            finite(v)
-    elif isinstance(out, np.ndarray) and out.dtype.kind == "f":
-        assert np.isfinite(out).all(), out
-    elif isinstance(out, float):
-        assert math.isfinite(out), out
 
 
 def call(fn, *args, may_fail=(), nan_with_error=False, **kwargs) -> None:

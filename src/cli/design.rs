@@ -74,11 +74,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         .map(|s| parse_sweep(s, &names))
         .transpose()
         .map_err(CliError::Usage)?;
-    let setting = Setting {
-        model,
-        task: &task,
-        tasks: &tasks,
-    };
+    let setting = Setting::new(model, &task, &tasks);
     let started = Instant::now();
     let counts = "draws of random tools, {msg} (eta {eta})";
     let bar = toolconf_report::progress::counting(

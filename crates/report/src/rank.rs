@@ -655,7 +655,7 @@ const TIP_PATH_SVG: &str = "tip_paths.svg";
 
 /// The tips' paths projected on the base frame's axes (a, b), with each start and, where the
 /// goal is a point, the goal.
-fn tip_path_panel(
+fn projected_tip_paths(
     paths: &[(&Traced, &[Vec<f64>])],
     (a, b, title): (usize, usize, &str),
     goal_is_point: bool,
@@ -689,16 +689,7 @@ fn tip_path_panel(
         .filter_map(|p| Some((*p.1[a].first()?, *p.1[b].first()?)))
         .collect();
     dots.push(Series::new("start", Colour(190, 190, 190), starts));
-    Panel::Xy(XyPanel {
-        title: title.into(),
-        x_label: format!("tip {} [m]", AXES[a]),
-        y_label: format!("tip {} [m]", AXES[b]),
-        dots,
-        lines,
-        log_y: false,
-        legend: Legend::UpperLeft,
-        headroom: 0.6,
-    })
+    plot::tip_path_panel(title, (a, b), dots, lines)
 }
 
 /// On a tip task, the tip's path of the best and worst tools in two projections of the base
@@ -727,7 +718,7 @@ fn tip_path_figure(
     };
     let panels: Vec<Panel> = projections
         .iter()
-        .map(|&projection| tip_path_panel(&paths, projection, goal_is_point))
+        .map(|&projection| projected_tip_paths(&paths, projection, goal_is_point))
         .collect();
     let svg = plot::save(&dir.join(TIP_PATH_SVG), &panels, (560, 420))?;
     Ok(vec![

@@ -5,7 +5,6 @@ use std::path::Path;
 
 use toolconf::evaluation::trials::{MEASURES, RULES};
 use toolconf::evaluation::{Evaluation, HighlightRun, ToolRecord};
-use toolconf_model::registry::AXES;
 use toolconf_stats::summary;
 
 use crate::experiments::plot::{
@@ -194,16 +193,7 @@ fn tip_paths(runs: &[&HighlightRun], e: &Evaluation, series: &SeriesOf) -> Vec<P
             if !goals.is_empty() {
                 dots.push(Series::new("goal", plot::GOAL_GREY, goals));
             }
-            Panel::Xy(XyPanel {
-                title: title.into(),
-                x_label: format!("tip {} [m]", AXES[a]),
-                y_label: format!("tip {} [m]", AXES[b]),
-                dots,
-                lines,
-                log_y: false,
-                legend: Legend::UpperLeft,
-                headroom: 0.6,
-            })
+            plot::tip_path_panel(title, (a, b), dots, lines)
         })
         .collect()
 }
@@ -237,36 +227,19 @@ pub fn fig5(dir: &Path, e: &Evaluation) -> Result<Option<Figure>, ReproduceError
         return Ok(None);
     }
     let lines = fig5_mean_lines(scales, swept);
-    let ys = |s: &[Series]| -> Vec<f64> {
-        s.iter()
-            .flat_map(|s| s.points.iter().map(|p| p.1))
-            .collect()
-    };
-    let (dot_y, line_y) = (ys(&dots), ys(&lines));
     let panels = [
-        Panel::Xy(XyPanel {
-            title: "|Δ task error| against confidence, by level".into(),
-            x_label: "control confidence ln|Π^U|".into(),
-            y_label: "|task error(s·ΔT) − task error(0)|".into(),
+        plot::scatter_panel(
+            "|Δ task error| against confidence, by level",
+            "control confidence ln|Π^U|",
+            "|task error(s·ΔT) − task error(0)|",
             dots,
-            lines: vec![],
-            log_y: wants_log(&dot_y),
-            legend: Legend::UpperRight,
-            headroom: 0.8,
-        }),
-        Panel::Xy(XyPanel {
-            title: "mean |Δ task error| per level".into(),
-            x_label: "scale s of ΔT".into(),
-            y_label: "mean |Δ task error|".into(),
-            dots: lines
-                .iter()
-                .map(|s| Series::new("", s.colour, s.points.clone()))
-                .collect(),
+        ),
+        plot::means_panel(
+            "mean |Δ task error| per level",
+            "scale s of ΔT",
+            "mean |Δ task error|",
             lines,
-            log_y: wants_log(&line_y),
-            legend: Legend::UpperRight,
-            headroom: 0.3,
-        }),
+        ),
     ];
     save(dir, "fig5_perturbation_sweep.svg", &panels, (620, 460)).map(Some)
 }

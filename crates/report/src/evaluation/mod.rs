@@ -12,7 +12,7 @@ use toolconf::evaluation::tables::tables;
 use toolconf::evaluation::Evaluation;
 use toolconf_files::csv::CsvWriter;
 
-use crate::experiments::{report, write_atomically, ReproduceError};
+use crate::experiments::{remove_if_present, report, write_atomically, ReproduceError};
 
 /// Every file an evaluation writes into its folder.
 pub const FILES: [&str; 16] = [
@@ -72,15 +72,4 @@ pub fn write(dir: &Path, e: &Evaluation, info: &RunInfo) -> Result<[PathBuf; 2],
     write_atomically(&md, &report::to_markdown(&doc))?;
     write_atomically(&html, &report::to_html(&doc))?;
     Ok([md, html])
-}
-
-/// Removes an earlier run's regular file; a link, device or FIFO is the user's and stays.
-fn remove_if_present(path: &Path) -> Result<(), ReproduceError> {
-    if !std::fs::symlink_metadata(path).is_ok_and(|m| m.is_file()) {
-        return Ok(());
-    }
-    match std::fs::remove_file(path) {
-        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(ReproduceError::io(path)(e)),
-        _ => Ok(()),
-    }
 }

@@ -7,7 +7,12 @@ use rayon::prelude::*;
 
 use toolconf_model::closed_loop::{EpisodeOptions, Metrics, Plant};
 use toolconf_model::confidence::control_confidence;
-use toolconf_model::{Arm, Task};
+use toolconf_model::{Arm, Task, TaskKind};
+
+use super::figure_parts::arm_cells;
+use super::{Context, ReproduceError};
+use std::path::Path;
+use toolconf_files::csv::{Cell, CsvWriter};
 
 /// Maps `f` over `items` in parallel; `sink` sees every result in input order as soon as its
 /// chunk is done. The chunk size (4 per thread, at least 8) affects only when rows are written,
@@ -120,6 +125,40 @@ pub fn run_tool(arm: &Arm, task: &Task, options: &[EpisodeOptions], plant: Plant
             })
             .collect(),
     }
+}
+
+/// Every tool on every one of `tasks` under every option set, one row per (task, tool) written
+/// to `path` as the episodes finish: the task, the tool's index, its parameters, then `cells` of
+/// its runs. The results in (task, tool) order.
+pub fn run_every_task(
+    ctx: &Context,
+    tools: &[Arm],
+    tasks: &[TaskKind],
+    (options, path, header): (&[EpisodeOptions], &Path, &[&str]),
+    cells: impl Fn(&ToolRuns) -> Vec<Cell>,
+) -> Result<Vec<(TaskKind, usize, ToolRuns)>, ReproduceError> {
+    let items: Vec<(TaskKind, usize)> = tasks
+        .iter()
+        .flat_map(|&k| (0..tools.len()).map(move |i| (k, i)))
+        .collect();
+    let mut csv = CsvWriter::create(path, header)?;
+    let results = map_ordered(
+        &items,
+        ctx.progress,
+        options.len() as u64,
+        |&(kind, i)| {
+            let runs = run_tool(&tools[i], &Task::paper(kind), options, ctx.plant);
+            (kind, i, runs)
+        },
+        |(kind, i, r)| {
+            let mut row = vec![Cell::from(kind.name()), Cell::from(*i)];
+            row.extend(arm_cells(&r.arm));
+            row.extend(cells(r));
+            csv.row(row).map_err(ReproduceError::from)
+        },
+    )?;
+    csv.finish()?;
+    Ok(results)
 }
 
 #[cfg(test)]

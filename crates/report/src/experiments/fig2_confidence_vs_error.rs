@@ -5,35 +5,26 @@
 //! from `"fig2/bootstrap/<task>"`.
 
 use toolconf::select::draw_tools;
-use toolconf_model::{Task, TaskKind};
+use toolconf_model::TaskKind;
 use toolconf_stats::{fit_exponential, summary};
 
-use super::batch::{map_ordered, run_tool, ToolRuns};
-use super::figure_parts::{arm_cells, files_block, task_label, wants_log, PAPER_TASKS};
+use super::batch::{run_every_task, ToolRuns};
+use super::figure_parts::{columns, files_block, task_label, wants_log, PAPER_TASKS, TOOL_COLUMNS};
 use super::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use super::report::{Block, Outcome, Section, Verdict};
-use super::verdict::{negative_correlation_rule, num, Correlation};
+use super::verdict::{negative_correlation_rule, num, Correlation, CorrelationReport};
 use super::{described, Context, Experiment, Plan, ReproduceError};
-use toolconf_files::csv::{Cell, CsvWriter};
+use toolconf_files::csv::Cell;
 
 pub struct Fig2;
 
 const CSV: &str = "fig2_confidence_vs_error.csv";
 const SVG: &str = "fig2_confidence_vs_error.svg";
-pub const HEADER: [&str; 12] = [
-    "task",
-    "tool",
-    "m1",
-    "m2",
-    "l1",
-    "l2",
-    "logdet",
-    "task_error",
-    "free_energy",
-    "cost_j",
-    "rhs_evals",
-    "error",
-];
+pub const HEADER: [&str; 12] = columns(&[
+    &["task"],
+    &TOOL_COLUMNS,
+    &["task_error", "free_energy", "cost_j", "rhs_evals", "error"],
+]);
 /// Task errors whose coefficient of variation (sd/mean) is at most this count as "similar".
 const SIMILAR_CV: f64 = 0.25;
 
@@ -135,37 +126,24 @@ fn simulate_every_task(
     ctx: &Context,
     tools: &[toolconf_model::Arm],
 ) -> Result<Vec<(TaskKind, usize, ToolRuns)>, ReproduceError> {
-    let items: Vec<(TaskKind, usize)> = PAPER_TASKS
-        .iter()
-        .flat_map(|&k| (0..tools.len()).map(move |i| (k, i)))
-        .collect();
-    let mut csv = CsvWriter::create(&ctx.path(CSV), &HEADER)?;
     let options = [ctx.options];
-    let results = map_ordered(
-        &items,
-        ctx.progress,
-        1,
-        |&(kind, i)| {
-            let runs = run_tool(&tools[i], &Task::paper(kind), &options, ctx.plant);
-            (kind, i, runs)
-        },
-        |(kind, i, r)| {
+    run_every_task(
+        ctx,
+        tools,
+        &PAPER_TASKS,
+        (&options, &ctx.path(CSV), &HEADER),
+        |r| {
             let m = r.metrics(0);
-            let mut row = vec![Cell::from(kind.name()), Cell::from(*i)];
-            row.extend(arm_cells(&r.arm));
-            row.extend([
+            vec![
                 Cell::from(r.logdet()),
                 Cell::from(m.map(|m| m.task_error)),
                 Cell::from(m.map(|m| m.free_energy)),
                 Cell::from(m.map(|m| m.cost_j)),
                 m.map_or(Cell::Empty, |m| Cell::from(m.rhs_evals)),
                 Cell::from(r.error()),
-            ]);
-            csv.row(row).map_err(ReproduceError::from)
+            ]
         },
-    )?;
-    csv.finish()?;
-    Ok(results)
+    )
 }
 
 fn introduction(tools: usize, plan: &Plan) -> Block {
@@ -311,7 +289,7 @@ impl TaskStats {
                 task_label(kind)
             ),
             outcome: corr.negative_outcome(),
-            evidence: format!("{}{}.", corr.describe(), self.failed_note()),
+            evidence: format!("{}{}.", corr.sentence(), self.failed_note()),
             rule: negative_correlation_rule(level),
         }
     }
@@ -355,7 +333,7 @@ impl TaskStats {
                     None => "undefined",
                 },
                 self.failed_note(),
-                corr.describe()
+                corr.sentence()
             ),
             rule: format!(
                 "two parts: equal confidence (max − min of ln|Π^U| ≤ 1e-9 relative) \

@@ -10,7 +10,7 @@ use toolconf_model::confidence::control_confidence;
 use toolconf_model::{Arm, Task, TaskKind, Term};
 
 use super::batch::map_ordered;
-use super::figure_parts::{arm_cells, dt_label, ARM_COLUMNS};
+use super::figure_parts::{arm_cells, columns, dt_label, ARM_COLUMNS, TOOL_COLUMNS};
 use super::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::num;
@@ -22,7 +22,7 @@ pub struct Fig3;
 const TOOLS_CSV: &str = "fig3_tools.csv";
 const CSV: &str = "fig3_trajectories.csv";
 const SVG: &str = "fig3_trajectories.svg";
-pub const TOOLS_HEADER: [&str; 7] = ["tool", "m1", "m2", "l1", "l2", "logdet", "role"];
+pub const TOOLS_HEADER: [&str; 7] = columns(&[&TOOL_COLUMNS, &["role"]]);
 pub const HEADER: [&str; 12] = [
     "role",
     "tool",

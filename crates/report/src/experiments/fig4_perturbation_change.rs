@@ -5,33 +5,25 @@
 //! `"fig4/bootstrap/<task>"`.
 
 use toolconf::select::draw_tools;
-use toolconf_model::{Arm, Task, TaskKind};
+use toolconf_model::{Arm, TaskKind};
 
-use super::batch::{map_ordered, run_tool, ToolRuns};
-use super::figure_parts::{arm_cells, dt_label, files_block, task_label, wants_log};
+use super::batch::{run_every_task, ToolRuns};
+use super::figure_parts::{columns, dt_label, files_block, task_label, wants_log, TOOL_COLUMNS};
 use super::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use super::report::{Block, Section, Verdict};
-use super::verdict::{mean_sd, negative_correlation_rule, Correlation};
+use super::verdict::{mean_sd, negative_correlation_rule, Correlation, CorrelationReport};
 use super::{described, Context, Experiment, Plan, ReproduceError};
-use toolconf_files::csv::{Cell, CsvWriter};
+use toolconf_files::csv::Cell;
 
 pub struct Fig4;
 
 const CSV: &str = "fig4_perturbation_change.csv";
 const SVG: &str = "fig4_perturbation_change.svg";
-pub const HEADER: [&str; 11] = [
-    "task",
-    "tool",
-    "m1",
-    "m2",
-    "l1",
-    "l2",
-    "logdet",
-    "task_error",
-    "task_error_perturbed",
-    "abs_change",
-    "error",
-];
+pub const HEADER: [&str; 11] = columns(&[
+    &["task"],
+    &TOOL_COLUMNS,
+    &["task_error", "task_error_perturbed", "abs_change", "error"],
+]);
 const TASKS: [TaskKind; 2] = [TaskKind::Position, TaskKind::Velocity];
 
 impl Experiment for Fig4 {
@@ -95,35 +87,22 @@ fn simulate(
     ctx: &Context,
     tools: &[Arm],
 ) -> Result<Vec<(TaskKind, usize, ToolRuns)>, ReproduceError> {
-    let items: Vec<(TaskKind, usize)> = TASKS
-        .iter()
-        .flat_map(|&k| (0..tools.len()).map(move |i| (k, i)))
-        .collect();
     let options = [ctx.options, ctx.perturbed(ctx.plan.perturbation)];
-    let mut csv = CsvWriter::create(&ctx.path(CSV), &HEADER)?;
-    let results = map_ordered(
-        &items,
-        ctx.progress,
-        2,
-        |&(kind, i)| {
-            let runs = run_tool(&tools[i], &Task::paper(kind), &options, ctx.plant);
-            (kind, i, runs)
-        },
-        |(kind, i, r)| {
-            let mut row = vec![Cell::from(kind.name()), Cell::from(*i)];
-            row.extend(arm_cells(&r.arm));
-            row.extend([
+    run_every_task(
+        ctx,
+        tools,
+        &TASKS,
+        (&options, &ctx.path(CSV), &HEADER),
+        |r| {
+            vec![
                 Cell::from(r.logdet()),
                 Cell::from(r.task_error(0)),
                 Cell::from(r.task_error(1)),
                 Cell::from(r.abs_change(1)),
                 Cell::from(r.error()),
-            ]);
-            csv.row(row)
+            ]
         },
-    )?;
-    csv.finish()?;
-    Ok(results)
+    )
 }
 
 /// (ln|Π^U|, |change of task error|) of the tools on task `kind` whose episodes both ran.
@@ -171,7 +150,7 @@ fn verdict(kind: TaskKind, corr: &Correlation, failed: usize, plan: &Plan) -> Ve
         outcome: corr.negative_outcome(),
         evidence: format!(
             "{} between ln|Π^U| and |task error(ΔT) − task error(0)|{}.",
-            corr.describe(),
+            corr.sentence(),
             if failed > 0 {
                 format!(" ({failed} tool(s) with a failed episode left out)")
             } else {

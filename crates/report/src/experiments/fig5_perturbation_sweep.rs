@@ -9,10 +9,12 @@ use toolconf_model::{Task, TaskKind};
 use toolconf_stats::summary;
 
 use super::batch::{map_ordered, run_tool, ToolRuns};
-use super::figure_parts::{arm_cells, dt_label, files_block, wants_log};
-use super::plot::{self, diverging, Colour, Legend, Panel, Series, XyPanel};
+use super::figure_parts::{arm_cells, columns, dt_label, files_block, TOOL_COLUMNS};
+use super::plot::{self, diverging, Colour, Series};
 use super::report::{Block, Outcome, Section, Verdict};
-use super::verdict::{mean_sd, negative_correlation_rule, num, p_value, Comparison, Correlation};
+use super::verdict::{
+    mean_sd, negative_correlation_rule, num, p_value, Comparison, Correlation, CorrelationReport,
+};
 use super::{described, Context, Experiment, Plan, ReproduceError};
 use toolconf_files::csv::{Cell, CsvWriter};
 
@@ -20,19 +22,16 @@ pub struct Fig5;
 
 const CSV: &str = "fig5_perturbation_sweep.csv";
 const SVG: &str = "fig5_perturbation_sweep.svg";
-pub const HEADER: [&str; 11] = [
-    "tool",
-    "m1",
-    "m2",
-    "l1",
-    "l2",
-    "logdet",
-    "perturbation",
-    "task_error",
-    "task_error_unperturbed",
-    "abs_change",
-    "error",
-];
+pub const HEADER: [&str; 11] = columns(&[
+    &TOOL_COLUMNS,
+    &[
+        "perturbation",
+        "task_error",
+        "task_error_unperturbed",
+        "abs_change",
+        "error",
+    ],
+]);
 
 /// The non-zero perturbations of the sweep; episode 0 of every tool is the unperturbed one and
 /// episode k + 1 is `sweep[k]`.
@@ -421,39 +420,21 @@ fn figure(
         Colour(60, 60, 60),
         group_line(&ranked),
     ));
-    let ys = |series: &[Series]| -> Vec<f64> {
-        series
-            .iter()
-            .flat_map(|s| s.points.iter().map(|p| p.1))
-            .collect()
-    };
-    let (all_y, line_y) = (ys(&dots), ys(&lines));
     plot::save(
         &ctx.path(SVG),
         &[
-            Panel::Xy(XyPanel {
-                title: "Velocity task: variability against confidence, by ΔT".into(),
-                x_label: "control confidence ln|Π^U|".into(),
-                y_label: "|task error(ΔT) − task error(0)|".into(),
+            plot::scatter_panel(
+                "Velocity task: variability against confidence, by ΔT",
+                "control confidence ln|Π^U|",
+                "|task error(ΔT) − task error(0)|",
                 dots,
-                lines: vec![],
-                log_y: wants_log(&all_y),
-                legend: Legend::UpperRight,
-                headroom: 0.8,
-            }),
-            Panel::Xy(XyPanel {
-                title: "Mean variability per ΔT (negative ΔT opposes the controller)".into(),
-                x_label: "perturbation ΔT [N m]".into(),
-                y_label: "mean |change of task error|".into(),
-                dots: lines
-                    .iter()
-                    .map(|s| Series::new("", s.colour, s.points.clone()))
-                    .collect(),
+            ),
+            plot::means_panel(
+                "Mean variability per ΔT (negative ΔT opposes the controller)",
+                "perturbation ΔT [N m]",
+                "mean |change of task error|",
                 lines,
-                log_y: wants_log(&line_y),
-                legend: Legend::UpperRight,
-                headroom: 0.3,
-            }),
+            ),
         ],
         (640, 480),
     )

@@ -5,12 +5,12 @@
 //! trials run. Every rule of [`decision_rules`] gets a `chosen_by_<id>` column; the grid and the
 //! verdict contrast the first two (F and J), as the paper does.
 
-use toolconf::select::{draw_tools, evaluate, ToolResult};
+use toolconf::select::ToolResult;
 use toolconf_model::{Arm, Task, TaskKind};
 
 use super::batch::map_ordered;
-use super::figure_parts::{arm_cells, files_block, ARM_COLUMNS};
-use super::objectives::{choices, decision_rules, DecisionRule, Trial};
+use super::figure_parts::{arm_cells, files_block, rhs_evals, ARM_COLUMNS};
+use super::objectives::{decision_rules, run_trial, DecisionRule};
 use super::plot::{self, Colour, GridPanel, Panel};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::num;
@@ -114,12 +114,7 @@ impl Experiment for Fig6 {
             title: self.title().into(),
             blocks,
             episodes: (done.len() * plan.fig6_tools) as u64,
-            rhs_evals: done
-                .iter()
-                .flat_map(|t| &t.results)
-                .filter_map(|r| r.episode.as_ref().ok())
-                .map(|m| m.rhs_evals as u64)
-                .sum(),
+            rhs_evals: rhs_evals(done.iter().flat_map(|t| &t.results)),
         })
     }
 }
@@ -144,16 +139,8 @@ impl Fig6 {
             ctx.progress,
             plan.fig6_tools as u64,
             |&k| {
-                let tools = draw_tools(plan.fig6_tools, ctx.seed_for(self, &format!("trial/{k}")));
-                let results = evaluate(&tools, &task, &ctx.options, ctx.plant);
-                let trial = Trial {
-                    task: &task,
-                    tools: &tools,
-                    results: &results,
-                    options: &ctx.options,
-                    plant: ctx.plant,
-                };
-                let chosen = choices(rules, &trial);
+                let (tools, results, chosen) =
+                    run_trial(ctx, self, k, plan.fig6_tools, &task, rules);
                 TrialResult {
                     tools,
                     results,

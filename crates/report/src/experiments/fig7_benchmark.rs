@@ -5,13 +5,13 @@
 //!
 //! Seeds: trial k draws its tools from `"fig7/trial/<k>"`.
 
-use toolconf::select::{draw_tools, evaluate, ToolResult};
+use toolconf::select::{evaluate, ToolResult};
 use toolconf_model::{Arm, Task, TaskKind};
 use toolconf_stats::summary;
 
 use super::batch::map_ordered;
-use super::figure_parts::{arm_cells, dt_label, files_block, ARM_COLUMNS};
-use super::objectives::{choices, decision_rules, DecisionRule, MpcCost, Trial};
+use super::figure_parts::{arm_cells, dt_label, files_block, rhs_evals, ARM_COLUMNS};
+use super::objectives::{decision_rules, run_trial, DecisionRule, MpcCost};
 use super::plot::{self, BoxPanel, Panel};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::{num, Comparison};
@@ -39,14 +39,8 @@ const CSV: &str = "fig7_benchmark.csv";
 const CHOICES_CSV: &str = "fig7_choices.csv";
 const SVG: &str = "fig7_benchmark.svg";
 pub const TASK: TaskKind = TaskKind::Velocity;
-pub const CHOICES_HEADER: [&str; 6] = [
-    "trial",
-    "rule",
-    "tool",
-    "logdet",
-    "task_error",
-    "abs_change",
-];
+/// The choices' columns, those of the evaluation's fig7_choices.csv.
+pub use toolconf::evaluation::tables::CHOICES_HEADER;
 
 /// The per-tool header: parameters, metrics, perturbed task error, one `chosen_by_<rule>` per
 /// rule, error.
@@ -197,12 +191,10 @@ impl Experiment for Fig7 {
             title: self.title().into(),
             blocks,
             episodes: 2 * (done.len() * plan.fig7_tools) as u64,
-            rhs_evals: done
-                .iter()
-                .flat_map(|t| t.results.iter().chain(&t.perturbed))
-                .filter_map(|r| r.episode.as_ref().ok())
-                .map(|m| m.rhs_evals as u64)
-                .sum(),
+            rhs_evals: rhs_evals(
+                done.iter()
+                    .flat_map(|t| t.results.iter().chain(&t.perturbed)),
+            ),
         })
     }
 }
@@ -229,17 +221,9 @@ impl Fig7 {
             ctx.progress,
             2 * plan.fig7_tools as u64,
             |&k| {
-                let tools = draw_tools(plan.fig7_tools, ctx.seed_for(self, &format!("trial/{k}")));
-                let results = evaluate(&tools, &task, &ctx.options, ctx.plant);
+                let (tools, results, chosen) =
+                    run_trial(ctx, self, k, plan.fig7_tools, &task, rules);
                 let perturbed = evaluate(&tools, &task, &perturbed, ctx.plant);
-                let trial = Trial {
-                    task: &task,
-                    tools: &tools,
-                    results: &results,
-                    options: &ctx.options,
-                    plant: ctx.plant,
-                };
-                let chosen = choices(rules, &trial);
                 TrialResult {
                     tools,
                     results,

@@ -1,5 +1,6 @@
 //! Small pieces the figure modules share: labels, tool columns, axis choices.
 
+use toolconf::select::ToolResult;
 use toolconf_model::{Arm, TaskKind};
 
 use super::report::Block;
@@ -25,6 +26,36 @@ pub fn arm_cells(arm: &Arm) -> [Cell; 4] {
 }
 
 pub const ARM_COLUMNS: [&str; 4] = ["m1", "m2", "l1", "l2"];
+
+/// The columns that name a 2-link tool and its confidence in every experiment's CSV: the tool,
+/// its parameters and ln|Π^U|.
+pub const TOOL_COLUMNS: [&str; 6] = ["tool", "m1", "m2", "l1", "l2", "logdet"];
+
+/// `parts` one after the other, `N` their total length (checked when compiling): a CSV header
+/// from its parts.
+pub const fn columns<const N: usize>(parts: &[&[&'static str]]) -> [&'static str; N] {
+    let mut out = [""; N];
+    let (mut i, mut k) = (0, 0);
+    while i < parts.len() {
+        let mut j = 0;
+        while j < parts[i].len() {
+            out[k] = parts[i][j];
+            (j, k) = (j + 1, k + 1);
+        }
+        i += 1;
+    }
+    assert!(k == N, "the parts' lengths add up to N");
+    out
+}
+
+/// The right-hand-side evaluations of those of `results`' episodes that ran.
+pub fn rhs_evals<'a>(results: impl IntoIterator<Item = &'a ToolResult>) -> u64 {
+    results
+        .into_iter()
+        .filter_map(|r| r.episode.as_ref().ok())
+        .map(|m| m.rhs_evals as u64)
+        .sum()
+}
 
 /// A log y axis when the positive values span more than a factor 30 (and none is ≤ 0).
 pub fn wants_log(values: &[f64]) -> bool {

@@ -126,19 +126,8 @@ impl Plan {
     }
 }
 
-/// The sub-seed of `label` under `master`: SplitMix64's finaliser applied to
-/// `master XOR FNV-1a-64(label)`. Labels are `"<experiment>/<stream>"`, e.g. `"fig2/tools"`.
-pub fn derive_seed(master: u64, label: &str) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in label.bytes() {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    let mut z = (master ^ h).wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
+/// The sub-seed of `label` under `master` (the evaluation's, so that both name a stream alike).
+pub use toolconf::evaluation::derive_seed;
 
 /// Why a reproduction stopped (failed episodes and statistics do not stop it).
 #[derive(Debug, thiserror::Error)]
@@ -433,7 +422,7 @@ pub fn reproduce(config: &Config) -> Result<Summary, ReproduceError> {
 
 /// Removes an earlier run's regular file at `path`; a link, a device or a FIFO is the user's, and
 /// stays (it is written through, or in place, by the output rule).
-fn remove_if_present(path: &Path) -> Result<(), ReproduceError> {
+pub(crate) fn remove_if_present(path: &Path) -> Result<(), ReproduceError> {
     if !std::fs::symlink_metadata(path).is_ok_and(|m| m.is_file()) {
         return Ok(());
     }

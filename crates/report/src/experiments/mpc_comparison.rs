@@ -14,30 +14,27 @@ use toolconf_model::{Arm, Task, TaskKind};
 use toolconf_stats::summary;
 
 use super::batch::map_ordered;
-use super::figure_parts::{arm_cells, files_block, task_label, PAPER_TASKS};
+use super::figure_parts::{arm_cells, columns, files_block, task_label, PAPER_TASKS, TOOL_COLUMNS};
 use super::report::{Block, Section};
-use super::verdict::{num, Correlation};
+use super::verdict::{num, Correlation, CorrelationReport};
 use super::{described, Context, Experiment, Plan, ReproduceError};
 use toolconf_files::csv::{Cell, CsvWriter};
 
 pub struct MpcComparison;
 
 const CSV: &str = "mpc_comparison.csv";
-pub const HEADER: [&str; 13] = [
-    "task",
-    "tool",
-    "m1",
-    "m2",
-    "l1",
-    "l2",
-    "logdet",
-    "perturbation",
-    "controller",
-    "task_error",
-    "cost_j",
-    "control_effort",
-    "error",
-];
+pub const HEADER: [&str; 13] = columns(&[
+    &["task"],
+    &TOOL_COLUMNS,
+    &[
+        "perturbation",
+        "controller",
+        "task_error",
+        "cost_j",
+        "control_effort",
+        "error",
+    ],
+]);
 
 /// One controller's episode: metrics (task error, ∫J or J*, effort, ∫F) or the error, and its time.
 struct Run {
@@ -92,7 +89,7 @@ impl Experiment for MpcComparison {
             ranking.push(format!(
                 "{}: ∫F (AIC) against J* (MPC): {}",
                 task_label(kind),
-                rank_agreement(&of, plan, seed).describe()
+                rank_agreement(&of, plan, seed).sentence()
             ));
         }
         let failed = results

@@ -10,9 +10,11 @@
 use plotters::style::RGBColor;
 
 use toolconf::mpc::{MpcOptions, SimulateMpc};
-use toolconf::select::{Objective, ToolResult};
+use toolconf::select::{draw_tools, evaluate, Objective, ToolResult};
 use toolconf_model::closed_loop::{EpisodeOptions, Plant};
 use toolconf_model::{Arm, Task};
+
+use super::{Context, Experiment};
 
 /// One trial of a selection experiment, as the rules see it.
 pub struct Trial<'a> {
@@ -108,4 +110,27 @@ pub fn decision_rules() -> Vec<Box<dyn DecisionRule>> {
 /// One trial's choices, one entry per rule of [`decision_rules`].
 pub fn choices(rules: &[Box<dyn DecisionRule>], trial: &Trial) -> Vec<Option<usize>> {
     rules.iter().map(|r| r.choose(trial)).collect()
+}
+
+/// Trial `k` of `experiment`: `count` tools drawn from its seed, simulated on `task` under the
+/// context's options and plant, and every rule's choice among them.
+pub fn run_trial(
+    ctx: &Context,
+    experiment: &dyn Experiment,
+    k: usize,
+    count: usize,
+    task: &Task,
+    rules: &[Box<dyn DecisionRule>],
+) -> (Vec<Arm>, Vec<ToolResult>, Vec<Option<usize>>) {
+    let tools = draw_tools(count, ctx.seed_for(experiment, &format!("trial/{k}")));
+    let results = evaluate(&tools, task, &ctx.options, ctx.plant);
+    let trial = Trial {
+        task,
+        tools: &tools,
+        results: &results,
+        options: &ctx.options,
+        plant: ctx.plant,
+    };
+    let chosen = choices(rules, &trial);
+    (tools, results, chosen)
 }

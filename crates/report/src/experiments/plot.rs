@@ -9,8 +9,10 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use toolconf_model::registry::AXES;
 use toolconf_stats::{summary, Summary};
 
+use super::figure_parts::wants_log;
 use super::{write_atomically, ReproduceError};
 
 pub use plotters::style::RGBColor as Colour;
@@ -65,6 +67,66 @@ pub struct XyPanel {
     pub legend: Legend,
     /// Extra space above the data, as a fraction of its height (room for the legend).
     pub headroom: f64,
+}
+
+/// Every point's y value, across `series`.
+pub fn all_y(series: &[Series]) -> Vec<f64> {
+    series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.1))
+        .collect()
+}
+
+/// Points against confidence, no lines; log y where they span more than a factor 30.
+pub fn scatter_panel(title: &str, x_label: &str, y_label: &str, dots: Vec<Series>) -> Panel {
+    Panel::Xy(XyPanel {
+        title: title.into(),
+        x_label: x_label.into(),
+        y_label: y_label.into(),
+        log_y: wants_log(&all_y(&dots)),
+        dots,
+        lines: vec![],
+        legend: Legend::UpperRight,
+        headroom: 0.8,
+    })
+}
+
+/// Means per level as `lines`, each mean drawn as a dot too; log y where they span more than a
+/// factor 30.
+pub fn means_panel(title: &str, x_label: &str, y_label: &str, lines: Vec<Series>) -> Panel {
+    Panel::Xy(XyPanel {
+        title: title.into(),
+        x_label: x_label.into(),
+        y_label: y_label.into(),
+        dots: lines
+            .iter()
+            .map(|s| Series::new("", s.colour, s.points.clone()))
+            .collect(),
+        log_y: wants_log(&all_y(&lines)),
+        lines,
+        legend: Legend::UpperRight,
+        headroom: 0.3,
+    })
+}
+
+/// The tool's tip paths (`lines`, with start and goal points as `dots`) in the plane of the
+/// robot's base axes `a` and `b`.
+pub fn tip_path_panel(
+    title: &str,
+    (a, b): (usize, usize),
+    dots: Vec<Series>,
+    lines: Vec<Series>,
+) -> Panel {
+    Panel::Xy(XyPanel {
+        title: title.into(),
+        x_label: format!("tip {} [m]", AXES[a]),
+        y_label: format!("tip {} [m]", AXES[b]),
+        dots,
+        lines,
+        log_y: false,
+        legend: Legend::UpperLeft,
+        headroom: 0.6,
+    })
 }
 
 /// Box plots side by side, one per group (Tukey whiskers at 1.5 IQR, outliers as rings), each

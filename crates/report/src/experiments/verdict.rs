@@ -1,7 +1,7 @@
 //! The statistics the verdicts rest on, the rules that turn them into verdicts, and how numbers
 //! are printed in the report (never as NaN: what cannot be computed is said in words).
 
-use toolconf_stats::{bootstrap_spearman_ci, paired_test, spearman, summary, Interval, PairedTest};
+use toolconf_stats::{paired_test, summary, PairedTest};
 
 use super::report::Outcome;
 
@@ -48,45 +48,39 @@ pub fn p_value(p: f64) -> String {
     }
 }
 
-/// Spearman's ρ with its bootstrap interval, or why either is undefined.
-#[derive(Debug, Clone)]
-pub struct Correlation {
-    pub n: usize,
-    pub rho: Result<f64, String>,
-    pub ci: Result<Interval, String>,
-    pub level: f64,
-}
+/// Spearman's ρ with its bootstrap interval, the evaluation's own type; the report reads it
+/// through [`CorrelationReport`].
+pub use toolconf::evaluation::verdict::Correlation;
 
-impl Correlation {
-    pub fn compute(x: &[f64], y: &[f64], resamples: usize, level: f64, seed: u64) -> Self {
-        let rho = spearman(x, y).map_err(|e| e.to_string());
-        let ci = match &rho {
-            Ok(_) => bootstrap_spearman_ci(x, y, resamples, level, seed).map_err(|e| e.to_string()),
-            Err(e) => Err(e.clone()),
-        };
-        Self {
-            n: x.len(),
-            rho,
-            ci,
-            level,
-        }
-    }
-
+/// How the report computes, prints and judges a [`Correlation`].
+pub trait CorrelationReport: Sized {
     /// Several correlations at once, in parallel (each with its own seed, so the result does not
     /// depend on the thread count): `jobs` are (x, y, seed).
-    pub fn compute_all(
-        jobs: &[(Vec<f64>, Vec<f64>, u64)],
-        resamples: usize,
-        level: f64,
-    ) -> Vec<Self> {
+    fn compute_all(jobs: &[(Vec<f64>, Vec<f64>, u64)], resamples: usize, level: f64) -> Vec<Self>;
+
+    /// "Spearman's ρ = −0.83, 95% bootstrap CI [−0.87, −0.78], n = 300", or the reason it is
+    /// undefined.
+    fn sentence(&self) -> String;
+
+    /// ρ for a table cell, or "undefined".
+    fn rho_cell(&self) -> String;
+
+    /// The interval for a table cell, or "undefined".
+    fn ci_cell(&self) -> String;
+
+    /// The verdict for "higher confidence, lower Y" (see [`negative_correlation_rule`]).
+    fn negative_outcome(&self) -> Outcome;
+}
+
+impl CorrelationReport for Correlation {
+    fn compute_all(jobs: &[(Vec<f64>, Vec<f64>, u64)], resamples: usize, level: f64) -> Vec<Self> {
         use rayon::prelude::*;
         jobs.par_iter()
             .map(|(x, y, seed)| Self::compute(x, y, resamples, level, *seed))
             .collect()
     }
 
-    /// "ρ = −0.83, 95% CI [−0.87, −0.78], n = 300", or the reason it is undefined.
-    pub fn describe(&self) -> String {
+    fn sentence(&self) -> String {
         match (&self.rho, &self.ci) {
             (Ok(r), Ok(ci)) => format!(
                 "Spearman's ρ = {}, {}% bootstrap CI [{}, {}], n = {}",
@@ -105,18 +99,17 @@ impl Correlation {
         }
     }
 
-    pub fn rho_cell(&self) -> String {
+    fn rho_cell(&self) -> String {
         self.rho.as_ref().map_or("undefined".into(), |r| num(*r))
     }
 
-    pub fn ci_cell(&self) -> String {
+    fn ci_cell(&self) -> String {
         self.ci.as_ref().map_or("undefined".into(), |ci| {
             format!("[{}, {}]", num(ci.low), num(ci.high))
         })
     }
 
-    /// The verdict for "higher confidence, lower Y" (see [`negative_correlation_rule`]).
-    pub fn negative_outcome(&self) -> Outcome {
+    fn negative_outcome(&self) -> Outcome {
         match (&self.rho, &self.ci) {
             (Ok(r), Ok(ci)) if ci.high < 0.0 && *r <= -CLEAR_RHO => Outcome::Holds,
             (Ok(_), Ok(ci)) if ci.high < 0.0 => Outcome::Partly,
@@ -249,8 +242,8 @@ mod tests {
     fn constant_x_is_reported_in_words() {
         let c = Correlation::compute(&[1.0; 5], &[1.0, 2.0, 3.0, 4.0, 5.0], 100, 0.95, 1);
         assert_eq!(c.negative_outcome(), Outcome::NotJudged);
-        assert!(c.describe().contains("undefined"), "{}", c.describe());
-        assert!(!c.describe().contains("NaN"));
+        assert!(c.sentence().contains("undefined"), "{}", c.sentence());
+        assert!(!c.sentence().contains("NaN"));
     }
 
     #[test]

@@ -63,6 +63,11 @@ pub struct Setting<'a> {
 }
 
 impl<'a> Setting<'a> {
+    /// A design of a `model` tool for `task`, bound to every model as `tasks`.
+    pub fn new(model: ModelKind, task: &'a TaskSpec, tasks: &'a ModelTasks) -> Self {
+        Self { model, task, tasks }
+    }
+
     /// ln|Π^U| and its gradient over the free parameters at free parameters `x`.
     /// None where ln|Π^U| is undefined, or where its gradient is not finite (Π^U so nearly
     /// singular that the generated tr((Π^U)⁻¹ ∂Π^U/∂p) overflows): the search treats both alike.

@@ -135,11 +135,7 @@ mod tests {
         )))
         .unwrap();
         let tasks = ModelTasks::new(&task);
-        let setting = Setting {
-            model: ModelKind::Panda,
-            task: &task,
-            tasks: &tasks,
-        };
+        let setting = Setting::new(ModelKind::Panda, &task, &tasks);
         let spec = DesignSpec::from_file(
             std::path::Path::new(&format!("{root}/design/panda_tip_length.toml")),
             ModelKind::Panda,

@@ -267,16 +267,19 @@ fn trial_table(e: &Evaluation, name: &'static str, trials: &[Trial], perturbed: 
     t
 }
 
+/// The columns of a benchmark's choices: one row per trial and rule, the chosen tool and its
+/// confidence, task error and |Δ task error| (the paper's reproduction writes the same file).
+pub const CHOICES_HEADER: [&str; 6] = [
+    "trial",
+    "rule",
+    "tool",
+    "logdet",
+    "task_error",
+    "abs_change",
+];
+
 fn fig7_choices(e: &Evaluation) -> Table {
-    let head = [
-        "trial",
-        "rule",
-        "tool",
-        "logdet",
-        "task_error",
-        "abs_change",
-    ];
-    let mut t = Table::new("fig7_choices", head.map(String::from).to_vec());
+    let mut t = Table::new("fig7_choices", CHOICES_HEADER.map(String::from).to_vec());
     for (k, trial) in e.trials.iter().enumerate() {
         for (r, rule) in RULES.iter().enumerate() {
             let tool = trial.chosen_tool(r);
