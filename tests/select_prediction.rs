@@ -71,16 +71,8 @@ fn select_on_a_task_file_gives_each_tools_prediction() {
 }
 
 fn toolconf_text(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_toolconf"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = common::toolconf(args);
+    common::assert_ok(&out);
     String::from_utf8(out.stdout).unwrap()
 }
 
