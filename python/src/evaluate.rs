@@ -203,17 +203,18 @@ fn population_from_py(model: ModelKind, d: &Bound<'_, PyDict>) -> Result<Populat
 ///     ValueError: an unknown model, a bad tools file or row, a tool of another model, a
 ///         population of 0 or more than 10⁶, a box naming a parameter the model lacks.
 #[pyfunction]
-#[pyo3(name = "_reproduce_population", signature = (model, tools=None, sample=None, seed=0, r#box=Vec::new(), source=None))]
+#[pyo3(name = "_reproduce_population", signature = (model, tools=None, sample=None, seed=None, r#box=Vec::new(), source=None))]
 pub fn reproduce_population<'py>(
     py: Python<'py>,
     model: &str,
     tools: Option<&Bound<'py, PyAny>>,
     sample: Option<&Bound<'py, PyAny>>,
-    seed: u64,
+    seed: Option<&Bound<'py, PyAny>>,
     r#box: Vec<String>,
     source: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = self::model(model).map_err(|f| f.into_pyerr(py))?;
+    let seed = seed.map_or(Ok(0), crate::integers::seed).map_err(|f| f.into_pyerr(py))?;
     let p = population(kind, tools, sample, seed, &r#box, source).map_err(|f| f.into_pyerr(py))?;
     population_to_py(py, &p)
 }
@@ -290,11 +291,12 @@ pub fn reproduce_finish<'py>(
     task: &Bound<'py, PyAny>,
     population: &Bound<'py, PyDict>,
     records: Vec<String>,
-    seed: u64,
+    seed: &Bound<'py, PyAny>,
     plan: &str,
     method: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = self::model(model).map_err(|f| f.into_pyerr(py))?;
+    let seed = crate::integers::seed(seed).map_err(|f| f.into_pyerr(py))?;
     let plan = read_plan(plan).map_err(|f| f.into_pyerr(py))?;
     let setup = setup(kind, task, &plan, method)?;
     let population = population_from_py(kind, population).map_err(|f| f.into_pyerr(py))?;
@@ -341,13 +343,14 @@ pub fn reproduce<'py>(
     task: &Bound<'py, PyAny>,
     tools: Option<&Bound<'py, PyAny>>,
     sample: Option<&Bound<'py, PyAny>>,
-    seed: u64,
+    seed: &Bound<'py, PyAny>,
     r#box: Vec<String>,
     plan: &str,
     method: &str,
     source: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = self::model(model).map_err(|f| f.into_pyerr(py))?;
+    let seed = crate::integers::seed(seed).map_err(|f| f.into_pyerr(py))?;
     let plan = read_plan(plan).map_err(|f| f.into_pyerr(py))?;
     let setup = setup(kind, task, &plan, method)?;
     let p = population(kind, tools, sample, seed, &r#box, source).map_err(|f| f.into_pyerr(py))?;

@@ -1,4 +1,4 @@
-//! Integer arguments (`screen`, `first_tool`) as the command line takes its integer flags: a
+//! Integer arguments (`screen`, `first_tool`, `seed`) as the command line takes its integer flags: a
 //! whole number within the flag's range, or one line naming the argument and the value, never
 //! pyo3's `OverflowError` for a number past 64 bits.
 
@@ -43,4 +43,10 @@ pub fn integer(name: &str, value: &Bound<'_, PyAny>, lo: i128, hi: i128) -> Resu
         )));
     }
     Ok(v)
+}
+
+/// A seed: an integer in [0, 2⁶⁴ − 1], as the command line's `--seed`.
+pub fn seed(value: &Bound<'_, PyAny>) -> Result<u64, Failure> {
+    let v = integer("seed", value, 0, u64::MAX.into())?;
+    Ok(u64::try_from(v).expect("within [0, 2^64 - 1]"))
 }

@@ -104,6 +104,9 @@ def test_a_tools_table_is_a_population(tmp_path):
     (dict(model="ur5", task=str(REPO / "examples" / "tasks" / "panda_touch_point.toml"), sample=5),
      "key precision.u"),
     (dict(model="panda", task="tip_position", sample=5, trial_tools=1), "trial_tools = 1 must be"),
+    (dict(model="arm2", task="position", sample=1, seed=-1), "seed = -1: must be at least 0"),
+    (dict(model="arm2", task="position", sample=1, seed=2**64),
+     "seed = 18446744073709551616: must be at most 18446744073709551615"),
 ])
 def test_bad_input_is_one_line(call, message):
     with pytest.raises(ValueError) as raised:
@@ -115,5 +118,7 @@ def test_bad_input_is_one_line(call, message):
 def test_a_count_that_is_not_an_integer_is_a_type_error():
     with pytest.raises(TypeError):
         toolconf.reproduce("panda", "tip_position", sample=5, trials=2.5)
+    with pytest.raises(TypeError, match="seed"):
+        toolconf.reproduce("arm2", "position", sample=1, seed=True)
     with pytest.raises(TypeError):
         toolconf.reproduce("panda", "tip_position", sample=5, trails=3)

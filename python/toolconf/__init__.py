@@ -308,8 +308,9 @@ def reproduce(
     Raises:
         ValueError: bad input, with the command line's message (an unknown model, a task of
             another model, a population of 0 or more than 10⁶, a box naming a parameter the
-            model lacks, a relative goal on a joint task, a count out of range).
-        TypeError: a count or ``sample`` that is not an integer.
+            model lacks, a relative goal on a joint task, a count out of range, a ``seed``
+            outside [0, 2⁶⁴ − 1]).
+        TypeError: a count, ``sample`` or ``seed`` that is not an integer.
         RuntimeError: every tool's episode failed.
     """
     native, source, frame = (None, None, False) if tools is None else native_tools(tools)

@@ -324,7 +324,7 @@ def _reproduce_population(
     model: str,
     tools: Union[None, str, "os.PathLike[str]", ToolColumns] = None,
     sample: Optional[int] = None,
-    seed: int = 0,
+    seed: Optional[int] = None,
     box: Sequence[str] = ...,
     source: Optional[str] = None,
 ) -> Population:
