@@ -214,7 +214,9 @@ pub fn reproduce_population<'py>(
     source: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = self::model(model).map_err(|f| f.into_pyerr(py))?;
-    let seed = seed.map_or(Ok(0), crate::integers::seed).map_err(|f| f.into_pyerr(py))?;
+    let seed = seed
+        .map_or(Ok(0), crate::integers::seed)
+        .map_err(|f| f.into_pyerr(py))?;
     let p = population(kind, tools, sample, seed, &r#box, source).map_err(|f| f.into_pyerr(py))?;
     population_to_py(py, &p)
 }

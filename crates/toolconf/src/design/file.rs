@@ -188,6 +188,9 @@ fn design_objective(name: Option<&str>) -> Result<DesignObjective, String> {
     }
 }
 
+/// Per parameter: its fixed value, if any, and its range.
+type FixedAndBounds = (Vec<Option<f64>>, Vec<(f64, f64)>);
+
 /// Each parameter's fixed value (the file's, else the model's default where the file gives no
 /// bounds either) and its range ((v, v) for a fixed one), each checked against its domain;
 /// `err` makes the error naming a key.
@@ -195,7 +198,7 @@ fn fixed_and_bounds(
     raw: &RawDesign,
     model: ModelKind,
     err: &dyn Fn(&str, String) -> DesignError,
-) -> Result<(Vec<Option<f64>>, Vec<(f64, f64)>), DesignError> {
+) -> Result<FixedAndBounds, DesignError> {
     let names = model.parameter_names();
     let domains = model.parameter_domains();
     let known = |key: String, name: &str| -> Result<usize, DesignError> {
