@@ -6,6 +6,32 @@ mod common;
 use common::toolconf_json as toolconf;
 use serde_json::Value;
 
+/// A selected tool's predicted costs equal those `confidence --model M --params P --task-file F
+/// --json` gives for it alone (1e-12 relative).
+fn assert_predicted_as_alone(t: &Value, model: &str, params: &str, task: &str) {
+    let alone = toolconf(&[
+        "confidence",
+        "--model",
+        model,
+        "--params",
+        params,
+        "--task-file",
+        task,
+        "--json",
+    ]);
+    for key in [
+        "predicted_task_error",
+        "predicted_free_energy",
+        "predicted_cost_j",
+    ] {
+        let (a, b) = (t[key].as_f64().unwrap(), alone[key].as_f64().unwrap());
+        assert!(
+            (a / b - 1.0).abs() < 1e-12,
+            "{key}: select {a}, confidence {b}"
+        );
+    }
+}
+
 #[test]
 fn select_on_a_task_file_gives_each_tools_prediction() {
     let task = "examples/tasks/panda_touch_point.toml";
@@ -43,27 +69,7 @@ fn select_on_a_task_file_gives_each_tools_prediction() {
             .iter()
             .map(|n| format!("{}", t["arm"][n].as_f64().unwrap()))
             .collect();
-        let alone = toolconf(&[
-            "confidence",
-            "--model",
-            "panda",
-            "--params",
-            &params.join(","),
-            "--task-file",
-            task,
-            "--json",
-        ]);
-        for key in [
-            "predicted_task_error",
-            "predicted_free_energy",
-            "predicted_cost_j",
-        ] {
-            let (a, b) = (t[key].as_f64().unwrap(), alone[key].as_f64().unwrap());
-            assert!(
-                (a / b - 1.0).abs() < 1e-12,
-                "{key}: select {a}, confidence {b}"
-            );
-        }
+        assert_predicted_as_alone(t, "panda", &params.join(","), task);
         assert_eq!(t["prediction_note"], Value::Null);
     }
     let builtin = toolconf(&["select", "--task", "velocity", "--tools", "2", "--json"]);
@@ -154,27 +160,7 @@ fn two_link_select_on_a_task_file_predicts_with_the_papers_plant_only() {
     assert_eq!(cells.len(), tools.len());
     for (t, cell) in tools.iter().zip(&cells) {
         let arm = ["m1", "m2", "l1", "l2"].map(|k| format!("{}", t["arm"][k].as_f64().unwrap()));
-        let alone = toolconf(&[
-            "confidence",
-            "--model",
-            "arm2",
-            "--params",
-            &arm.join(","),
-            "--task-file",
-            task,
-            "--json",
-        ]);
-        for key in [
-            "predicted_task_error",
-            "predicted_free_energy",
-            "predicted_cost_j",
-        ] {
-            let (a, b) = (t[key].as_f64().unwrap(), alone[key].as_f64().unwrap());
-            assert!(
-                (a / b - 1.0).abs() < 1e-12,
-                "{key}: select {a}, confidence {b}"
-            );
-        }
+        assert_predicted_as_alone(t, "arm2", &arm.join(","), task);
         let p = t["predicted_task_error"].as_f64().unwrap();
         assert_eq!(*cell, format!("{p:.6e}"));
     }
