@@ -291,11 +291,11 @@ struct Counts {
 }
 
 impl Counts {
-    /// The screen's counts (no bad row skipped).
-    fn of(screen: &Screen) -> Self {
+    /// The screen's counts, with the bad rows skipped before it.
+    fn of(screen: &Screen, skipped: usize) -> Self {
         Counts {
             read: screen.read,
-            skipped: 0,
+            skipped,
             without_confidence: screen.without_confidence,
             without_prediction: screen.without_prediction,
             first_prediction_error: screen.first_prediction_error.clone(),
@@ -327,10 +327,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let objective = Objective::from(args.objective);
     let started = Instant::now();
     let (screen, skipped) = screen_tools(args, &tasks)?;
-    let counts = Counts {
-        skipped,
-        ..Counts::of(&screen)
-    };
+    let counts = Counts::of(&screen, skipped);
     let sample = screen.validation_sample();
     let candidates = screen.finish();
     let confidence = ConfidenceTiming {
