@@ -203,11 +203,7 @@ fn print_selection(args: &Args, s: &Selection) {
         "integration method: {}",
         Method::from(args.method.method).describe()
     );
-    // The built-in tasks have no prediction: their table is unchanged.
-    let predicted = match s.predictions.is_empty() {
-        true => String::new(),
-        false => format!(" {:>14}", "predicted err"),
-    };
+    let predicted = predicted_heading(&s.predictions);
     outln!(
         "{:>5}  {:>7} {:>7} {:>7} {:>7}  {:>12}{predicted} {:>14} {:>14} {:>14}",
         "tool",
@@ -245,6 +241,15 @@ fn print_selection(args: &Args, s: &Selection) {
                 "mpc_cost"
             ),
         }
+    }
+}
+
+/// The table's `predicted err` heading where the tools were predicted; none on the built-in
+/// tasks, which have no prediction, so that their table is unchanged.
+fn predicted_heading(predictions: &[Predicted]) -> String {
+    match predictions.is_empty() {
+        true => String::new(),
+        false => format!(" {:>14}", "predicted err"),
     }
 }
 
@@ -478,11 +483,7 @@ fn print_mixed_selection(args: &Args, s: &MixedSelection) {
     );
     // The model column fits the longest name in this set (at least 10 wide).
     let w = models.iter().map(|m| m.len()).max().unwrap_or(0).max(10);
-    // The built-in tasks have no prediction: their table is unchanged.
-    let predicted = match s.predictions.is_empty() {
-        true => String::new(),
-        false => format!(" {:>14}", "predicted err"),
-    };
+    let predicted = predicted_heading(&s.predictions);
     outln!(
         "{:>5}  {:<w$} {:>12} {:>12}{predicted}  {:>14} {:>14} {:>14}  parameters",
         "tool",
