@@ -78,6 +78,7 @@ fn unit_scaled(x: &[f64]) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_support::is_non_finite;
 
     #[test]
     fn monotone_transforms_give_plus_and_minus_one() {
@@ -136,23 +137,9 @@ mod tests {
             }
         ));
         let e = pearson(&[1.0, f64::INFINITY, 3.0], &[1.0, 2.0, 3.0]).unwrap_err();
-        assert!(matches!(
-            e,
-            StatsError::NonFinite {
-                what: "x",
-                index: 1,
-                ..
-            }
-        ));
+        assert!(is_non_finite(&e, "x", 1), "{e}");
         let e = spearman(&[1.0, 2.0, 3.0], &[1.0, 2.0, f64::NAN]).unwrap_err();
-        assert!(matches!(
-            e,
-            StatsError::NonFinite {
-                what: "y",
-                index: 2,
-                ..
-            }
-        ));
+        assert!(is_non_finite(&e, "y", 2), "{e}");
         let e = spearman(&[4.0, 4.0, 4.0], &[1.0, 2.0, 3.0]).unwrap_err();
         assert!(e.to_string().contains("all 3 x values equal 4"), "{e}");
         let e = pearson(&[1.0, 2.0, 3.0], &[0.1, 0.1, 0.1]).unwrap_err();

@@ -173,10 +173,7 @@ fn levenberg_marquardt(t: &[f64], y: &[f64], start: (f64, f64)) -> Result<(f64, 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn close(a: f64, b: f64, rel: f64) -> bool {
-        (a - b).abs() <= rel * b.abs()
-    }
+    use crate::test_support::{close, is_non_finite, three_hundred_points};
 
     #[test]
     fn recovers_exact_exponentials() {
@@ -237,14 +234,7 @@ mod tests {
         let e = fit_exponential(&[1.0, 2.0, 3.0], &[1.0, 2.0]).unwrap_err();
         assert!(matches!(e, StatsError::Length { .. }));
         let e = fit_exponential(&[1.0, 2.0, f64::NAN], &[1.0, 2.0, 3.0]).unwrap_err();
-        assert!(matches!(
-            e,
-            StatsError::NonFinite {
-                what: "x",
-                index: 2,
-                ..
-            }
-        ));
+        assert!(is_non_finite(&e, "x", 2), "{e}");
         let e = fit_exponential(&[2.0, 2.0, 2.0], &[1.0, 2.0, 3.0]).unwrap_err();
         assert!(e.to_string().contains("all x values equal 2"), "{e}");
         let e = fit_exponential(&[1.0, 2.0, 3.0], &[5.0, 5.0, 5.0]).unwrap_err();
@@ -256,14 +246,11 @@ mod tests {
 
     #[test]
     fn three_hundred_noisy_points_match_scipy_curve_fit() {
-        // Paper-sized sample: x_i = ((7919 i) mod 300)·0.37, y_i = 50 e^{-0.02 x_i} + ((31 i) mod 17) − 8.
+        // The paper-sized sample (x, y) of `three_hundred_points`.
         // scipy 1.17.1: scipy.optimize.curve_fit(lambda x, a, b: a*numpy.exp(b*x), x, y,
         //   p0=(1, -0.1), ftol=1e-15, xtol=1e-15, gtol=1e-15)
         //   -> a = 50.14426941745104, b = -0.020059745275502694
-        let x: Vec<f64> = (0..300).map(|i| ((i * 7919) % 300) as f64 * 0.37).collect();
-        let y: Vec<f64> = (0..300)
-            .map(|i| 50.0 * (-0.02 * x[i]).exp() + ((i * 31) % 17) as f64 - 8.0)
-            .collect();
+        let (x, y) = three_hundred_points();
         let f = fit_exponential(&x, &y).unwrap();
         assert!(close(f.a, 50.14426941745104, 1e-6), "{f:?}");
         assert!(close(f.b, -0.020059745275502694, 1e-6), "{f:?}");

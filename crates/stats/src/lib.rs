@@ -21,6 +21,8 @@ mod paired;
 mod rank;
 mod special;
 mod summary;
+#[cfg(test)]
+mod test_support;
 
 pub use bootstrap::{bootstrap_spearman_ci, Interval};
 pub use correlation::{pearson, spearman};

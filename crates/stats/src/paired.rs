@@ -100,10 +100,7 @@ fn wilcoxon(d: &[f64]) -> Result<(f64, f64), StatsError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn close(a: f64, b: f64, rel: f64) -> bool {
-        (a - b).abs() <= rel * b.abs()
-    }
+    use crate::test_support::{close, is_non_finite, three_hundred_points};
 
     #[test]
     fn wilcoxon_by_hand_with_zero_and_ties() {
@@ -158,15 +155,12 @@ mod tests {
 
     #[test]
     fn matches_scipy_at_three_hundred_pairs() {
-        // a_i = ((7919 i) mod 300)·0.37, b_i = 50 e^{-0.02 a_i} + ((31 i) mod 17) − 8, i < 300.
+        // (a, b) is the paper-sized sample (x, y) of `three_hundred_points`.
         // scipy 1.17.1: scipy.stats.ttest_rel(a, b) -> statistic 13.671406662265714,
         //   pvalue 2.1979822583297454e-33
         // scipy.stats.wilcoxon(a, b, method='approx', correction=False) (zero_method='wilcox')
         //   -> statistic 6534.0, pvalue 1.4471703808725505e-26
-        let a: Vec<f64> = (0..300).map(|i| ((i * 7919) % 300) as f64 * 0.37).collect();
-        let b: Vec<f64> = (0..300)
-            .map(|i| 50.0 * (-0.02 * a[i]).exp() + ((i * 31) % 17) as f64 - 8.0)
-            .collect();
+        let (a, b) = three_hundred_points();
         let r = paired_test(&a, &b).unwrap();
         assert!(close(r.t, 13.671406662265714, 1e-12));
         assert!(close(r.t_p_value, 2.1979822583297454e-33, 1e-9));
@@ -190,14 +184,7 @@ mod tests {
             })
         ));
         let e = paired_test(&[1.0, f64::NAN], &[1.0, 2.0]).unwrap_err();
-        assert!(matches!(
-            e,
-            StatsError::NonFinite {
-                what: "a",
-                index: 1,
-                ..
-            }
-        ));
+        assert!(is_non_finite(&e, "a", 1), "{e}");
         let e = paired_test(&[1.0, 2.0, 3.0], &[1.0, 2.0, 3.0]).unwrap_err();
         assert!(
             e.to_string().contains("all 3 differences a − b equal 0"),

@@ -40,10 +40,7 @@ pub(crate) fn normal_two_sided(z: f64) -> Result<f64, StatsError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn close(a: f64, b: f64, rel: f64) -> bool {
-        (a - b).abs() <= rel * b.abs()
-    }
+    use crate::test_support::close;
 
     #[test]
     fn closed_forms() {
