@@ -12,7 +12,6 @@ use toolconf::design::file::DesignSpec;
 use toolconf::design::sweep::{Sweep, SweepPoint};
 use toolconf::design::DesignResult;
 use toolconf::rank::ModelTasks;
-use toolconf_generated::Read;
 use toolconf_model::registry::{AnyTool, ModelKind};
 
 use crate::view3d;
@@ -212,15 +211,5 @@ fn arm_view(input: &ReportInput) -> Vec<Block> {
             })
         })
         .collect();
-    let goal = shown
-        .first()
-        .filter(|_| matches!(input.tasks.kind.error_term().read(), Read::Tip { order: 0 }))
-        .and_then(|s| {
-            Some([
-                *s.trace.goal.first()?,
-                *s.trace.goal.get(1)?,
-                *s.trace.goal.get(2)?,
-            ])
-        });
-    view3d::section(goal, &shown)
+    view3d::section(view3d::tip_goal(input.tasks.kind, &shown), &shown)
 }

@@ -630,17 +630,7 @@ fn arm_view(input: &ReportInput, ends: &[(usize, usize)], traces: &[Traced]) -> 
             })
         })
         .collect();
-    let goal = shown
-        .first()
-        .filter(|_| matches!(input.spec.kind.error_term().read(), Read::Tip { order: 0 }))
-        .and_then(|s| {
-            Some([
-                *s.trace.goal.first()?,
-                *s.trace.goal.get(1)?,
-                *s.trace.goal.get(2)?,
-            ])
-        });
-    view3d::section(goal, &shown)
+    view3d::section(view3d::tip_goal(input.spec.kind, &shown), &shown)
 }
 
 /// A panel's title: `joint 2`, or `tip y` for a component of a tip term.

@@ -10,6 +10,8 @@ mod three;
 
 use serde_json::json;
 use toolconf::rank::TaskTrace;
+use toolconf_generated::Read;
+use toolconf_model::TaskKind;
 use toolconf_model::registry::skeleton::tip_offset_parameters;
 use toolconf_model::registry::AnyTool;
 
@@ -34,6 +36,20 @@ pub struct Shown<'a> {
     pub label: String,
     pub tool: &'a AnyTool,
     pub trace: &'a TaskTrace,
+}
+
+/// The goal point of a tip position task (`kind`), as the first shown episode has it; none for
+/// another task, whose goal is no point in space.
+pub fn tip_goal(kind: TaskKind, shown: &[Shown]) -> Option<[f64; 3]> {
+    let s = shown.first()?;
+    if !matches!(kind.error_term().read(), Read::Tip { order: 0 }) {
+        return None;
+    }
+    Some([
+        *s.trace.goal.first()?,
+        *s.trace.goal.get(1)?,
+        *s.trace.goal.get(2)?,
+    ])
 }
 
 /// The view's blocks for the best and the worst episode (`shown`, one or two): a heading, a
