@@ -28,6 +28,6 @@ pub use bootstrap::{bootstrap_spearman_ci, Interval};
 pub use correlation::{pearson, spearman};
 pub use error::StatsError;
 pub use fit::{fit_exponential, ExpFit};
-pub use paired::{paired_test, PairedTest};
+pub use paired::{complete_pairs, paired_test, PairedTest};
 pub use rank::ranks;
 pub use summary::{summary, Summary};

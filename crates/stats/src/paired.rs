@@ -21,6 +21,15 @@ pub struct PairedTest {
     pub wilcoxon_p_value: f64,
 }
 
+/// The pairs (a_i, b_i) with both values present, as two samples: what a paired test compares
+/// when an episode that failed left its value out.
+pub fn complete_pairs(a: &[Option<f64>], b: &[Option<f64>]) -> (Vec<f64>, Vec<f64>) {
+    a.iter()
+        .zip(b)
+        .filter_map(|(a, b)| Some(((*a)?, (*b)?)))
+        .unzip()
+}
+
 /// Paired t-test and Wilcoxon signed-rank test of `a` against `b`, both two-sided.
 ///
 /// Wilcoxon variant, the same as `scipy.stats.wilcoxon(a, b, zero_method='wilcox',
@@ -166,6 +175,14 @@ mod tests {
         assert!(close(r.t_p_value, 2.1979822583297454e-33, 1e-9));
         assert_eq!(r.wilcoxon_w, 6534.0);
         assert!(close(r.wilcoxon_p_value, 1.4471703808725505e-26, 1e-9));
+    }
+
+    #[test]
+    fn complete_pairs_keep_the_trials_with_both_values_in_order() {
+        let a = [Some(1.0), None, Some(3.0), Some(4.0), Some(5.0)];
+        let b = [Some(-1.0), Some(-2.0), None, Some(-4.0)];
+        assert_eq!(complete_pairs(&a, &b), (vec![1.0, 4.0], vec![-1.0, -4.0]));
+        assert_eq!(complete_pairs(&[], &b), (vec![], vec![]));
     }
 
     #[test]

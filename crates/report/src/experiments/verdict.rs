@@ -1,7 +1,7 @@
 //! The statistics the verdicts rest on, the rules that turn them into verdicts, and how numbers
 //! are printed in the report (never as NaN: what cannot be computed is said in words).
 
-use toolconf_stats::{paired_test, summary, PairedTest};
+use toolconf_stats::{complete_pairs, paired_test, summary, PairedTest};
 
 use super::report::Outcome;
 
@@ -135,11 +135,7 @@ pub struct Comparison {
 
 impl Comparison {
     pub fn compute(a: &[Option<f64>], b: &[Option<f64>]) -> Self {
-        let (x, y): (Vec<f64>, Vec<f64>) = a
-            .iter()
-            .zip(b)
-            .filter_map(|(a, b)| Some(((*a)?, (*b)?)))
-            .unzip();
+        let (x, y) = complete_pairs(a, b);
         let mean = |v: &[f64]| summary(v).ok().map(|s| s.mean);
         Self {
             n: x.len(),
