@@ -14,8 +14,8 @@ use super::{Context, ReproduceError};
 use std::path::Path;
 use toolconf_files::csv::{Cell, CsvWriter};
 
-/// Maps `f` over `items` in parallel; `sink` sees every result in input order as soon as its
-/// chunk is done. The chunk size (4 per thread, at least 8) affects only when rows are written,
+/// Maps `f` over `items` in parallel; `sink` sees every result, with its item's index, in input
+/// order as soon as its chunk is done. The chunk size (4 per thread, at least 8) affects only when rows are written,
 /// never what is written.
 pub fn map_ordered<T, R, E, F, S>(
     items: &[T],
@@ -28,7 +28,7 @@ where
     T: Sync,
     R: Send,
     F: Fn(&T) -> R + Sync + Send,
-    S: FnMut(&R) -> Result<(), E>,
+    S: FnMut(usize, &R) -> Result<(), E>,
 {
     let chunk = (4 * rayon::current_num_threads()).max(8);
     let mut out = Vec::with_capacity(items.len());
@@ -41,8 +41,8 @@ where
                 r
             })
             .collect();
-        for r in &results {
-            sink(r)?;
+        for (k, r) in results.iter().enumerate() {
+            sink(out.len() + k, r)?;
         }
         out.extend(results);
     }
@@ -150,7 +150,7 @@ pub fn run_every_task(
             let runs = run_tool(&tools[i], &Task::paper(kind), options, ctx.plant);
             (kind, i, runs)
         },
-        |(kind, i, r)| {
+        |_, (kind, i, r)| {
             let mut row = vec![Cell::from(kind.name()), Cell::from(*i)];
             row.extend(arm_cells(&r.arm));
             row.extend(cells(r));
@@ -180,7 +180,8 @@ mod tests {
                     &ProgressBar::hidden(),
                     1,
                     |x| x * x,
-                    |r| {
+                    |k, r| {
+                        assert_eq!(items[k] * items[k], *r);
                         seen.push(*r);
                         Ok::<(), ()>(())
                     },

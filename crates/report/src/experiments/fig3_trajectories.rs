@@ -183,7 +183,7 @@ fn write_sample(
     high: usize,
     low: usize,
 ) -> Result<(), ReproduceError> {
-    let mut tools_csv = CsvWriter::create(&ctx.path(TOOLS_CSV), &TOOLS_HEADER)?;
+    let mut tools_csv = ctx.csv(TOOLS_CSV, &TOOLS_HEADER)?;
     for (i, arm) in tools.iter().enumerate() {
         let role = if i == high {
             "high"
@@ -214,7 +214,7 @@ fn simulate_pair(
         .into_iter()
         .flat_map(|(role, tool)| [0.0, ctx.plan.perturbation].map(|dt| (role, tool, dt)))
         .collect();
-    let mut csv = CsvWriter::create(&ctx.path(CSV), &HEADER)?;
+    let mut csv = ctx.csv(CSV, &HEADER)?;
     let runs = map_ordered(
         &items,
         ctx.progress,
@@ -234,7 +234,7 @@ fn simulate_pair(
                 result,
             }
         },
-        |run| write_run(&mut csv, run),
+        |_, run| write_run(&mut csv, run),
     )?;
     csv.finish()?;
     Ok(runs)

@@ -16,7 +16,7 @@ use super::verdict::{
     mean_sd, negative_correlation_rule, num, p_value, Comparison, Correlation, CorrelationReport,
 };
 use super::{described, Context, Experiment, Plan, ReproduceError};
-use toolconf_files::csv::{Cell, CsvWriter};
+use toolconf_files::csv::Cell;
 
 pub struct Fig5;
 
@@ -156,17 +156,13 @@ fn simulate_sweep(
         .map(|d| ctx.perturbed(d))
         .collect();
     let indices: Vec<usize> = (0..tools.len()).collect();
-    let mut csv = CsvWriter::create(&ctx.path(CSV), &HEADER)?;
-    // The sink sees the tools in order, so a counter names them.
-    let mut next = 0usize;
+    let mut csv = ctx.csv(CSV, &HEADER)?;
     let results = map_ordered(
         &indices,
         ctx.progress,
         options.len() as u64,
         |&i| run_tool(&tools[i], &task, &options, ctx.plant),
-        |r| {
-            let i = next;
-            next += 1;
+        |i, r| {
             for &dt in &listed {
                 let k = episode_of(sweep, dt);
                 let mut row = vec![Cell::from(i)];

@@ -6,11 +6,10 @@
 //! verdict contrast the first two (F and J), as the paper does.
 
 use toolconf::select::ToolResult;
-use toolconf_model::{Arm, Task, TaskKind};
+use toolconf_model::{Arm, TaskKind};
 
-use super::batch::map_ordered;
 use super::figure_parts::{arm_cells, files_block, rhs_evals, ARM_COLUMNS};
-use super::objectives::{decision_rules, run_trial, DecisionRule};
+use super::objectives::{decision_rules, run_trials, DecisionRule, TrialPlan};
 use super::plot::{self, Colour, GridPanel, Panel};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::num;
@@ -127,31 +126,25 @@ impl Fig6 {
         ctx: &Context,
         rules: &[Box<dyn DecisionRule>],
     ) -> Result<Vec<TrialResult>, ReproduceError> {
-        let plan = ctx.plan;
-        let task = Task::paper(TASK);
-        let trials: Vec<usize> = (0..plan.fig6_trials).collect();
         let header = header();
-        let header: Vec<&str> = header.iter().map(String::as_str).collect();
-        let mut csv = CsvWriter::create(&ctx.path(CSV), &header)?;
-        let mut next = 0usize;
-        let done = map_ordered(
-            &trials,
-            ctx.progress,
-            plan.fig6_tools as u64,
-            |&k| {
-                let (tools, results, chosen) =
-                    run_trial(ctx, self, k, plan.fig6_tools, &task, rules);
-                TrialResult {
-                    tools,
-                    results,
-                    chosen,
-                }
+        let mut csv = ctx.csv(CSV, &header)?;
+        let plan = TrialPlan {
+            kind: TASK,
+            trials: ctx.plan.fig6_trials,
+            tools: ctx.plan.fig6_tools,
+            episodes_per_tool: 1,
+        };
+        let done = run_trials(
+            ctx,
+            self,
+            plan,
+            rules,
+            |_, (tools, results, chosen)| TrialResult {
+                tools,
+                results,
+                chosen,
             },
-            |t| {
-                let k = next;
-                next += 1;
-                write_trial(&mut csv, k, t)
-            },
+            |k, t| write_trial(&mut csv, k, t),
         )?;
         csv.finish()?;
         Ok(done)

@@ -6,12 +6,11 @@
 //! Seeds: trial k draws its tools from `"fig7/trial/<k>"`.
 
 use toolconf::select::{evaluate, ToolResult};
-use toolconf_model::{Arm, Task, TaskKind};
+use toolconf_model::{Arm, TaskKind};
 use toolconf_stats::summary;
 
-use super::batch::map_ordered;
 use super::figure_parts::{arm_cells, dt_label, files_block, rhs_evals, ARM_COLUMNS};
-use super::objectives::{decision_rules, run_trial, DecisionRule, MpcCost};
+use super::objectives::{decision_rules, run_trials, DecisionRule, MpcCost, TrialPlan};
 use super::plot::{self, BoxPanel, Panel};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::{num, Comparison};
@@ -207,23 +206,23 @@ impl Fig7 {
         ctx: &Context,
         rules: &[Box<dyn DecisionRule>],
     ) -> Result<Vec<TrialResult>, ReproduceError> {
-        let plan = ctx.plan;
-        let task = Task::paper(TASK);
-        let perturbed = ctx.perturbed(plan.perturbation);
-        let trials: Vec<usize> = (0..plan.fig7_trials).collect();
+        let perturbed = ctx.perturbed(ctx.plan.perturbation);
         let header = header(rules);
-        let header: Vec<&str> = header.iter().map(String::as_str).collect();
-        let mut csv = CsvWriter::create(&ctx.path(CSV), &header)?;
-        let mut choices_csv = CsvWriter::create(&ctx.path(CHOICES_CSV), &CHOICES_HEADER)?;
-        let mut next = 0usize;
-        let done = map_ordered(
-            &trials,
-            ctx.progress,
-            2 * plan.fig7_tools as u64,
-            |&k| {
-                let (tools, results, chosen) =
-                    run_trial(ctx, self, k, plan.fig7_tools, &task, rules);
-                let perturbed = evaluate(&tools, &task, &perturbed, ctx.plant);
+        let mut csv = ctx.csv(CSV, &header)?;
+        let mut choices_csv = ctx.csv(CHOICES_CSV, &CHOICES_HEADER)?;
+        let plan = TrialPlan {
+            kind: TASK,
+            trials: ctx.plan.fig7_trials,
+            tools: ctx.plan.fig7_tools,
+            episodes_per_tool: 2,
+        };
+        let done = run_trials(
+            ctx,
+            self,
+            plan,
+            rules,
+            |task, (tools, results, chosen)| {
+                let perturbed = evaluate(&tools, task, &perturbed, ctx.plant);
                 TrialResult {
                     tools,
                     results,
@@ -231,11 +230,7 @@ impl Fig7 {
                     chosen,
                 }
             },
-            |t| {
-                let k = next;
-                next += 1;
-                write_trial(&mut csv, &mut choices_csv, rules, k, t)
-            },
+            |k, t| write_trial(&mut csv, &mut choices_csv, rules, k, t),
         )?;
         csv.finish()?;
         choices_csv.finish()?;

@@ -47,6 +47,7 @@ use std::time::{Duration, Instant};
 use indicatif::ProgressBar;
 
 pub use report::{Block, Outcome, Section, Verdict};
+use toolconf_files::csv::CsvWriter;
 use toolconf_model::closed_loop::{EpisodeOptions, Plant};
 
 /// How many tools, trials and resamples each experiment uses.
@@ -185,6 +186,16 @@ impl Context<'_> {
 
     pub fn path(&self, file: &str) -> PathBuf {
         self.out_dir.join(format!("{}{file}", self.file_prefix))
+    }
+
+    /// A CSV writer for `file` of the output folder ([`Context::path`]), its columns `header`.
+    pub fn csv<S: AsRef<str>>(
+        &self,
+        file: &str,
+        header: &[S],
+    ) -> Result<CsvWriter, ReproduceError> {
+        let header: Vec<&str> = header.iter().map(AsRef::as_ref).collect();
+        Ok(CsvWriter::create(&self.path(file), &header)?)
     }
 
     /// The paper's options with a constant perturbation ΔT.

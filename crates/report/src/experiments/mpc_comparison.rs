@@ -150,7 +150,7 @@ fn run_both_controllers(ctx: &Context, tools: &[Arm]) -> Result<Vec<Item>, Repro
         .iter()
         .flat_map(|&k| (0..tools.len()).map(move |i| (k, i)))
         .collect();
-    let mut csv = CsvWriter::create(&ctx.path(CSV), &HEADER)?;
+    let mut csv = ctx.csv(CSV, &HEADER)?;
     let done = map_ordered(
         &items,
         ctx.progress,
@@ -172,7 +172,7 @@ fn run_both_controllers(ctx: &Context, tools: &[Arm]) -> Result<Vec<Item>, Repro
                 ],
             }
         },
-        |item| write_item(&mut csv, item, &dts),
+        |_, item| write_item(&mut csv, item, &dts),
     )?;
     csv.finish()?;
     Ok(done)

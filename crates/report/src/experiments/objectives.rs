@@ -12,9 +12,10 @@ use plotters::style::RGBColor;
 use toolconf::mpc::{MpcOptions, SimulateMpc};
 use toolconf::select::{draw_tools, evaluate, Objective, ToolResult};
 use toolconf_model::closed_loop::{EpisodeOptions, Plant};
-use toolconf_model::{Arm, Task};
+use toolconf_model::{Arm, Task, TaskKind};
 
-use super::{Context, Experiment};
+use super::batch::map_ordered;
+use super::{Context, Experiment, ReproduceError};
 
 /// One trial of a selection experiment, as the rules see it.
 pub struct Trial<'a> {
@@ -112,6 +113,51 @@ pub fn choices(rules: &[Box<dyn DecisionRule>], trial: &Trial) -> Vec<Option<usi
     rules.iter().map(|r| r.choose(trial)).collect()
 }
 
+/// What a selection experiment runs: `trials` trials of `tools` tools on the paper task `kind`,
+/// `episodes_per_tool` episodes a tool (for the progress bar).
+pub struct TrialPlan {
+    pub kind: TaskKind,
+    pub trials: usize,
+    pub tools: usize,
+    pub episodes_per_tool: u64,
+}
+
+/// A trial's tools, their results and every rule's choice, as [`run_trial`] gives them.
+pub type Drawn = (Vec<Arm>, Vec<ToolResult>, Vec<Option<usize>>);
+
+/// Every trial of `plan`, in parallel ([`map_ordered`]): [`run_trial`], then `finish` with the
+/// task (what else the experiment runs on the trial's tools, and its result); `sink` sees each
+/// trial's index and result as it finishes, in order.
+pub fn run_trials<E, R, F, S>(
+    ctx: &Context,
+    experiment: &E,
+    plan: TrialPlan,
+    rules: &[Box<dyn DecisionRule>],
+    finish: F,
+    sink: S,
+) -> Result<Vec<R>, ReproduceError>
+where
+    E: Experiment + Sync,
+    R: Send,
+    F: Fn(&Task, Drawn) -> R + Sync + Send,
+    S: FnMut(usize, &R) -> Result<(), ReproduceError>,
+{
+    let task = Task::paper(plan.kind);
+    let trials: Vec<usize> = (0..plan.trials).collect();
+    map_ordered(
+        &trials,
+        ctx.progress,
+        plan.episodes_per_tool * plan.tools as u64,
+        |&k| {
+            finish(
+                &task,
+                run_trial(ctx, experiment, k, plan.tools, &task, rules),
+            )
+        },
+        sink,
+    )
+}
+
 /// Trial `k` of `experiment`: `count` tools drawn from its seed, simulated on `task` under the
 /// context's options and plant, and every rule's choice among them.
 pub fn run_trial(
@@ -121,7 +167,7 @@ pub fn run_trial(
     count: usize,
     task: &Task,
     rules: &[Box<dyn DecisionRule>],
-) -> (Vec<Arm>, Vec<ToolResult>, Vec<Option<usize>>) {
+) -> Drawn {
     let tools = draw_tools(count, ctx.seed_for(experiment, &format!("trial/{k}")));
     let results = evaluate(&tools, task, &ctx.options, ctx.plant);
     let trial = Trial {

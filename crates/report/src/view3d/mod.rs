@@ -11,9 +11,9 @@ mod three;
 use serde_json::json;
 use toolconf::rank::TaskTrace;
 use toolconf_generated::Read;
-use toolconf_model::TaskKind;
 use toolconf_model::registry::skeleton::tip_offset_parameters;
 use toolconf_model::registry::AnyTool;
+use toolconf_model::TaskKind;
 
 use crate::experiments::report::Block;
 
