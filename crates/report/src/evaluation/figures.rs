@@ -5,8 +5,8 @@ use std::path::Path;
 
 use toolconf::evaluation::trials::{MEASURES, RULES};
 use toolconf::evaluation::{Evaluation, HighlightRun, ToolRecord};
-use toolconf_stats::summary;
 
+use crate::experiments::figure_parts::mean_lines;
 use crate::experiments::plot::{
     self, diverging, BoxPanel, Colour, GridPanel, Legend, Panel, Series, XyPanel,
 };
@@ -51,9 +51,20 @@ fn scatter(
         .collect()
 }
 
-fn scatter_panel(title: String, y_label: &str, points: Vec<(f64, f64)>, colour: Colour) -> Panel {
+/// `file`, one panel of `points` against confidence; none where there are no points.
+fn scatter_figure(
+    dir: &Path,
+    file: &'static str,
+    title: String,
+    y_label: &str,
+    points: Vec<(f64, f64)>,
+    colour: Colour,
+) -> Result<Option<Figure>, ReproduceError> {
+    if points.is_empty() {
+        return Ok(None);
+    }
     let ys: Vec<f64> = points.iter().map(|p| p.1).collect();
-    Panel::Xy(XyPanel {
+    let panel = Panel::Xy(XyPanel {
         title,
         x_label: "control confidence ln|Π^U|".into(),
         y_label: y_label.into(),
@@ -62,41 +73,32 @@ fn scatter_panel(title: String, y_label: &str, points: Vec<(f64, f64)>, colour: 
         log_y: wants_log(&ys),
         legend: Legend::UpperRight,
         headroom: 0.0,
-    })
+    });
+    save(dir, file, &[panel], (640, 460)).map(Some)
 }
 
 /// Fig. 2: task error against confidence.
 pub fn fig2(dir: &Path, e: &Evaluation) -> Result<Option<Figure>, ReproduceError> {
-    let points = scatter(e, |r| r.task_error());
-    if points.is_empty() {
-        return Ok(None);
-    }
     let title = format!(
         "{}: {}",
         e.task_title(),
         e.statistics.task_error.describe_short()
     );
-    let panel = scatter_panel(title, "task error", points, Colour(0, 114, 178));
-    save(dir, "fig2_confidence_vs_error.svg", &[panel], (640, 460)).map(Some)
+    let points = scatter(e, |r| r.task_error());
+    let file = "fig2_confidence_vs_error.svg";
+    scatter_figure(dir, file, title, "task error", points, Colour(0, 114, 178))
 }
 
 /// Fig. 4: |Δ task error| under ΔT against confidence.
 pub fn fig4(dir: &Path, e: &Evaluation) -> Result<Option<Figure>, ReproduceError> {
-    let points = scatter(e, |r| r.abs_change());
-    if points.is_empty() {
-        return Ok(None);
-    }
     let title = format!(
         "|Δ task error| under ΔT: {}",
         e.statistics.reliability.describe_short()
     );
-    let panel = scatter_panel(
-        title,
-        "|task error(ΔT) − task error(0)|",
-        points,
-        Colour(213, 94, 0),
-    );
-    save(dir, "fig4_perturbation_change.svg", &[panel], (640, 460)).map(Some)
+    let points = scatter(e, |r| r.abs_change());
+    let y_label = "|task error(ΔT) − task error(0)|";
+    let file = "fig4_perturbation_change.svg";
+    scatter_figure(dir, file, title, y_label, points, Colour(213, 94, 0))
 }
 
 /// Fig. 3: the distance to the goal over time of the two tools without and with ΔT, and on a tip
@@ -246,36 +248,19 @@ pub fn fig5(dir: &Path, e: &Evaluation) -> Result<Option<Figure>, ReproduceError
 
 /// Fig. 5's lines: the mean |Δ task error| per scale of all the swept tools, and (with six
 /// tools or more) of the least and the most confident third.
-fn fig5_mean_lines(scales: &[f64], mut ranked: Vec<&ToolRecord>) -> Vec<Series> {
-    ranked.sort_by(|a, b| {
-        a.logdet()
-            .unwrap_or(0.0)
-            .total_cmp(&b.logdet().unwrap_or(0.0))
-    });
-    let third = ranked.len() / 3;
-    let mean_line = |group: &[&ToolRecord]| -> Vec<(f64, f64)> {
-        (0..scales.len())
-            .filter_map(|k| {
-                let v: Vec<f64> = group.iter().filter_map(|r| r.sweep_change(k)).collect();
-                Some((scales[k], summary(&v).ok()?.mean))
-            })
-            .collect()
-    };
-    let mut lines = vec![Series::new(
-        "all tools",
-        Colour(60, 60, 60),
-        mean_line(&ranked),
-    )];
-    if third >= 2 {
+fn fig5_mean_lines(scales: &[f64], ranked: Vec<&ToolRecord>) -> Vec<Series> {
+    let m = mean_lines(ranked, |r| r.logdet(), scales, |r, k| r.sweep_change(k));
+    let mut lines = vec![Series::new("all tools", Colour(60, 60, 60), m.all)];
+    if let Some((_, least, most)) = m.thirds {
         lines.push(Series::new(
             "least confident third",
             Colour(200, 30, 30),
-            mean_line(&ranked[..third]),
+            least,
         ));
         lines.push(Series::new(
             "most confident third",
             Colour(30, 80, 200),
-            mean_line(&ranked[ranked.len() - third..]),
+            most,
         ));
     }
     lines

@@ -6,10 +6,9 @@
 
 use toolconf::select::draw_tools;
 use toolconf_model::{Task, TaskKind};
-use toolconf_stats::summary;
 
 use super::batch::{map_ordered, run_tool, ToolRuns};
-use super::figure_parts::{arm_cells, columns, dt_label, files_block, TOOL_COLUMNS};
+use super::figure_parts::{arm_cells, columns, dt_label, files_block, mean_lines, TOOL_COLUMNS};
 use super::plot::{self, diverging, Colour, Series};
 use super::report::{Block, Outcome, Section, Verdict};
 use super::verdict::{
@@ -382,40 +381,20 @@ fn figure(
     sweep: &[f64],
     dots: Vec<Series>,
 ) -> Result<String, ReproduceError> {
-    let mut ranked: Vec<&ToolRuns> = results.iter().filter(|r| r.logdet().is_some()).collect();
-    ranked.sort_by(|a, b| {
-        a.logdet()
-            .unwrap_or(0.0)
-            .total_cmp(&b.logdet().unwrap_or(0.0))
-    });
-    let third = ranked.len() / 3;
-    let group_line = |group: &[&ToolRuns]| -> Vec<(f64, f64)> {
-        sweep
-            .iter()
-            .filter_map(|&dt| {
-                let v: Vec<f64> = group.iter().filter_map(|r| change(r, sweep, dt)).collect();
-                Some((dt, summary(&v).ok()?.mean))
-            })
-            .collect()
-    };
+    let ranked: Vec<&ToolRuns> = results.iter().filter(|r| r.logdet().is_some()).collect();
+    let m = mean_lines(
+        ranked,
+        |r| r.logdet(),
+        sweep,
+        |r, k| change(r, sweep, sweep[k]),
+    );
     let mut lines = Vec::new();
-    if third >= 2 {
-        lines.push(Series::new(
-            format!("lowest-confidence third ({third} tools)"),
-            Colour(200, 30, 30),
-            group_line(&ranked[..third]),
-        ));
-        lines.push(Series::new(
-            format!("highest-confidence third ({third} tools)"),
-            Colour(30, 80, 200),
-            group_line(&ranked[ranked.len() - third..]),
-        ));
+    if let Some((third, least, most)) = m.thirds {
+        let label = |which: &str| format!("{which}-confidence third ({third} tools)");
+        lines.push(Series::new(label("lowest"), Colour(200, 30, 30), least));
+        lines.push(Series::new(label("highest"), Colour(30, 80, 200), most));
     }
-    lines.push(Series::new(
-        "all tools",
-        Colour(60, 60, 60),
-        group_line(&ranked),
-    ));
+    lines.push(Series::new("all tools", Colour(60, 60, 60), m.all));
     plot::save(
         &ctx.path(SVG),
         &[

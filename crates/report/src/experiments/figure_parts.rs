@@ -2,6 +2,7 @@
 
 use toolconf::select::ToolResult;
 use toolconf_model::{Arm, TaskKind};
+use toolconf_stats::summary;
 
 use super::report::Block;
 use toolconf_files::csv::Cell;
@@ -17,6 +18,45 @@ pub const PAPER_TASKS: [TaskKind; 3] = [
 /// "task 1 (position)".
 pub fn task_label(kind: TaskKind) -> String {
     format!("task {} ({})", kind.paper_index(), kind.name())
+}
+
+/// Fig. 5's mean lines: the mean of `change(tool, k)` at each `xs[k]` over all the tools, and
+/// over the least and the most confident third ([`mean_lines`]).
+pub struct MeanLines {
+    pub all: Vec<(f64, f64)>,
+    /// How many tools a third is, the least and the most confident third's lines; none with
+    /// fewer than six tools.
+    pub thirds: Option<(usize, Vec<(f64, f64)>, Vec<(f64, f64)>)>,
+}
+
+/// [`MeanLines`] of `tools`, ordered by their confidence ln|Π^U| (`logdet`; a missing one as 0).
+pub fn mean_lines<T>(
+    mut tools: Vec<T>,
+    logdet: impl Fn(&T) -> Option<f64>,
+    xs: &[f64],
+    change: impl Fn(&T, usize) -> Option<f64>,
+) -> MeanLines {
+    tools.sort_by(|a, b| {
+        logdet(a)
+            .unwrap_or(0.0)
+            .total_cmp(&logdet(b).unwrap_or(0.0))
+    });
+    let line = |group: &[T]| -> Vec<(f64, f64)> {
+        (0..xs.len())
+            .filter_map(|k| {
+                let v: Vec<f64> = group.iter().filter_map(|t| change(t, k)).collect();
+                Some((xs[k], summary(&v).ok()?.mean))
+            })
+            .collect()
+    };
+    let third = tools.len() / 3;
+    MeanLines {
+        all: line(&tools),
+        thirds: (third >= 2).then(|| {
+            let most = &tools[tools.len() - third..];
+            (third, line(&tools[..third]), line(most))
+        }),
+    }
 }
 
 /// The four parameter cells m1, m2, l1, l2 of a tool.
