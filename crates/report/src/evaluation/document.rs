@@ -2,7 +2,7 @@
 //! its data, statistics and figure.
 
 use toolconf::evaluation::trials::{MEASURES, RULES};
-use toolconf::evaluation::{Claim, ClaimVerdict, Evaluation, Finding};
+use toolconf::evaluation::{Claim, ClaimVerdict, Evaluation, Finding, HighlightRun};
 use toolconf_stats::summary;
 
 use super::figures::Figure;
@@ -10,7 +10,6 @@ use super::RunInfo;
 use crate::experiments::report::{Block, Outcome, Verdict};
 use crate::experiments::verdict::num;
 use crate::view3d;
-use toolconf_generated::Read;
 
 fn outcome(f: Finding) -> Outcome {
     match f {
@@ -210,28 +209,27 @@ fn fig2_section(e: &Evaluation, figures: &[Option<Figure>]) -> Vec<Block> {
     ]
 }
 
+/// Fig. 3's table row of one run: which, its confidence, ΔT, its distance to the goal at the
+/// start and at the end (or why it has none).
+fn highlight_row(r: &HighlightRun) -> Vec<String> {
+    let d = r.distance();
+    let first = d.as_ref().and_then(|d| d.first().map(|p| num(p.1)));
+    let last = d.as_ref().and_then(|d| d.last().map(|p| num(p.1)));
+    vec![
+        format!("{} (tool {})", r.role, r.tool),
+        num(r.logdet),
+        if r.perturbed {
+            "ΔT".into()
+        } else {
+            "0".into()
+        },
+        first.unwrap_or_else(|| "-".into()),
+        last.unwrap_or_else(|| r.trace.as_ref().err().cloned().unwrap_or_default()),
+    ]
+}
+
 fn fig3_section(e: &Evaluation, figures: &[Option<Figure>]) -> Vec<Block> {
-    let rows: Vec<Vec<String>> = e
-        .highlight
-        .runs
-        .iter()
-        .map(|r| {
-            let d = r.distance();
-            let first = d.as_ref().and_then(|d| d.first().map(|p| num(p.1)));
-            let last = d.as_ref().and_then(|d| d.last().map(|p| num(p.1)));
-            vec![
-                format!("{} (tool {})", r.role, r.tool),
-                num(r.logdet),
-                if r.perturbed {
-                    "ΔT".into()
-                } else {
-                    "0".into()
-                },
-                first.unwrap_or_else(|| "-".into()),
-                last.unwrap_or_else(|| r.trace.as_ref().err().cloned().unwrap_or_default()),
-            ]
-        })
-        .collect();
+    let rows: Vec<Vec<String>> = e.highlight.runs.iter().map(highlight_row).collect();
     vec![
         Block::Heading(2, "Fig. 3: the most and least confident tool under ΔT".into()),
         Block::p(format!(
@@ -277,18 +275,7 @@ fn fig3_view(e: &Evaluation) -> Vec<Block> {
             })
         })
         .collect();
-    let tip_point = matches!(
-        e.setup.spec.kind.error_term().read(),
-        Read::Tip { order: 0 }
-    );
-    let goal = shown.first().filter(|_| tip_point).and_then(|s| {
-        Some([
-            *s.trace.goal.first()?,
-            *s.trace.goal.get(1)?,
-            *s.trace.goal.get(2)?,
-        ])
-    });
-    view3d::section(goal, &shown)
+    view3d::section(view3d::tip_goal(e.setup.spec.kind, &shown), &shown)
 }
 
 fn fig4_section(e: &Evaluation, figures: &[Option<Figure>]) -> Vec<Block> {
