@@ -11,6 +11,7 @@ use toolconf_model::registry::ModelKind;
 
 use crate::errors::{detached, Failure};
 use crate::models::model_kind;
+use crate::simulate::{COUNTS, MEASURES};
 use crate::task::{portable_spec, task_spec};
 
 /// Every tool of `params` (k × NP, row major) under every task of `specs` (one per
@@ -72,80 +73,80 @@ pub fn batch(
     Ok(rows)
 }
 
-/// The episodes of many tools, each under every perturbation: one row of metrics per
-/// (tool, perturbation), tool by tool.
-///
-/// Every episode is ``toolconf.simulate``'s, with the same numbers: this equals a loop of
-/// ``simulate(model, params[i], task, method, **episode_options, perturbation=p)`` over the tools
-/// and, for each, over ``perturbations``, except that a failed episode does not stop the batch:
-/// its row carries the error (the message ``simulate`` raises) and NaN metrics. Episodes run on
-/// rayon's threads without the GIL; results do not depend on the number of threads.
-///
-/// Args:
-///     model: a generated model's name (``toolconf.models()``).
-///     params: a 2-D array, one tool per row, in the model's parameter order (a 1-D array is one
-///         tool).
-///     task: a built-in task name, a task file's path, or a dict with a task file's keys.
-///     perturbations: the constant torques ΔT (N m) to run every tool under, each one number
-///         (every joint) or one per joint; e.g. ``[-0.8, 0.0, 0.8]`` or a 2-D array. ``None``
-///         runs each tool once under the task's own ``perturbation``.
-///     method: the integrator, as in ``simulate``.
-///     first_tool: the index of ``params``' first row in a larger array, for the ``tool``
-///         column and errors (``toolconf.dask.simulate_batch`` sends chunks); 0 by default (or None),
-///         an integer in [0, 2⁶³ − 1 − the number of tools] (``tool`` is int64).
-///     **episode_options: ``simulate``'s (the keys of a task file's ``[episode]`` table), for
-///         every episode; ``perturbation`` only when ``perturbations`` is not given.
-///
-/// Returns:
-///     dict of arrays, one entry per (tool, perturbation), tool-major (row ``i * P + j`` is
-///     tool ``i`` under perturbation ``j``): ``tool`` and ``perturbation`` (the 0-based indices),
-///     ``task_error``, ``free_energy``, ``cost_j``, ``logdet``, ``control_effort`` (NaN for a
-///     failed episode), on a position task (joint or tip) ``progress`` (1 − e(T)/e(0), NaN
-///     for a failed episode), ``rhs_evals``, ``steps``, ``rejected_steps``, ``jacobian_evals``,
-///     ``factorisations`` (-1 for one) and ``error`` (a list: None, or why the episode failed).
-///
-/// Raises:
-///     ValueError: bad input (model, parameters, task, perturbation or episode option), naming
-///         the tool's row or the key, before any episode runs.
-///     TypeError: a ``params`` of booleans, complex numbers or text; a ``first_tool`` that is
-///         not an integer.
-///     MemoryError: rows for every (tool, perturbation) that do not fit in memory, before any
-///         episode runs.
-#[pyfunction]
-#[pyo3(signature = (model, params, task, perturbations=None, method="fast", first_tool=None, **episode_options))]
-#[allow(clippy::too_many_arguments)]
-pub fn simulate_batch<'py>(
-    py: Python<'py>,
-    model: &str,
-    params: &Bound<'py, PyAny>,
-    task: &Bound<'py, PyAny>,
-    perturbations: Option<&Bound<'py, PyAny>>,
-    method: &str,
-    first_tool: Option<&Bound<'py, PyAny>>,
-    episode_options: Option<&Bound<'py, PyDict>>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let arguments = (model, params, task, perturbations, method, first_tool);
-    run(py, arguments, episode_options, task_spec)
+/// `simulate_batch`'s entry points: one signature and one run, `$spec` reading the task.
+macro_rules! simulate_batch_entry {
+    ($(#[$attr:meta])* fn $name:ident, $spec:ident) => {
+        #[pyfunction]
+        $(#[$attr])*
+        #[pyo3(signature = (model, params, task, perturbations=None, method="fast", first_tool=None, **episode_options))]
+        #[allow(clippy::too_many_arguments)]
+        pub fn $name<'py>(
+            py: Python<'py>,
+            model: &str,
+            params: &Bound<'py, PyAny>,
+            task: &Bound<'py, PyAny>,
+            perturbations: Option<&Bound<'py, PyAny>>,
+            method: &str,
+            first_tool: Option<&Bound<'py, PyAny>>,
+            episode_options: Option<&Bound<'py, PyDict>>,
+        ) -> PyResult<Bound<'py, PyDict>> {
+            let arguments = (model, params, task, perturbations, method, first_tool);
+            run(py, arguments, episode_options, $spec)
+        }
+    };
 }
 
-/// ``simulate_batch`` on a block of tools of ``toolconf.dask.simulate_batch``: the same, with
-/// the task as ``_portable_task`` sent it (a task file as its text).
-#[pyfunction]
-#[pyo3(name = "_simulate_batch", signature = (model, params, task, perturbations=None, method="fast", first_tool=None, **episode_options))]
-#[allow(clippy::too_many_arguments)]
-pub fn simulate_batch_block<'py>(
-    py: Python<'py>,
-    model: &str,
-    params: &Bound<'py, PyAny>,
-    task: &Bound<'py, PyAny>,
-    perturbations: Option<&Bound<'py, PyAny>>,
-    method: &str,
-    first_tool: Option<&Bound<'py, PyAny>>,
-    episode_options: Option<&Bound<'py, PyDict>>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let arguments = (model, params, task, perturbations, method, first_tool);
-    run(py, arguments, episode_options, portable_spec)
-}
+simulate_batch_entry!(
+    /// The episodes of many tools, each under every perturbation: one row of metrics per
+    /// (tool, perturbation), tool by tool.
+    ///
+    /// Every episode is ``toolconf.simulate``'s, with the same numbers: this equals a loop of
+    /// ``simulate(model, params[i], task, method, **episode_options, perturbation=p)`` over the tools
+    /// and, for each, over ``perturbations``, except that a failed episode does not stop the batch:
+    /// its row carries the error (the message ``simulate`` raises) and NaN metrics. Episodes run on
+    /// rayon's threads without the GIL; results do not depend on the number of threads.
+    ///
+    /// Args:
+    ///     model: a generated model's name (``toolconf.models()``).
+    ///     params: a 2-D array, one tool per row, in the model's parameter order (a 1-D array is one
+    ///         tool).
+    ///     task: a built-in task name, a task file's path, or a dict with a task file's keys.
+    ///     perturbations: the constant torques ΔT (N m) to run every tool under, each one number
+    ///         (every joint) or one per joint; e.g. ``[-0.8, 0.0, 0.8]`` or a 2-D array. ``None``
+    ///         runs each tool once under the task's own ``perturbation``.
+    ///     method: the integrator, as in ``simulate``.
+    ///     first_tool: the index of ``params``' first row in a larger array, for the ``tool``
+    ///         column and errors (``toolconf.dask.simulate_batch`` sends chunks); 0 by default (or None),
+    ///         an integer in [0, 2⁶³ − 1 − the number of tools] (``tool`` is int64).
+    ///     **episode_options: ``simulate``'s (the keys of a task file's ``[episode]`` table), for
+    ///         every episode; ``perturbation`` only when ``perturbations`` is not given.
+    ///
+    /// Returns:
+    ///     dict of arrays, one entry per (tool, perturbation), tool-major (row ``i * P + j`` is
+    ///     tool ``i`` under perturbation ``j``): ``tool`` and ``perturbation`` (the 0-based indices),
+    ///     ``task_error``, ``free_energy``, ``cost_j``, ``logdet``, ``control_effort`` (NaN for a
+    ///     failed episode), on a position task (joint or tip) ``progress`` (1 − e(T)/e(0), NaN
+    ///     for a failed episode), ``rhs_evals``, ``steps``, ``rejected_steps``, ``jacobian_evals``,
+    ///     ``factorisations`` (-1 for one) and ``error`` (a list: None, or why the episode failed).
+    ///
+    /// Raises:
+    ///     ValueError: bad input (model, parameters, task, perturbation or episode option), naming
+    ///         the tool's row or the key, before any episode runs.
+    ///     TypeError: a ``params`` of booleans, complex numbers or text; a ``first_tool`` that is
+    ///         not an integer.
+    ///     MemoryError: rows for every (tool, perturbation) that do not fit in memory, before any
+    ///         episode runs.
+    fn simulate_batch,
+    task_spec
+);
+
+simulate_batch_entry!(
+    /// ``simulate_batch`` on a block of tools of ``toolconf.dask.simulate_batch``: the same, with
+    /// the task as ``_portable_task`` sent it (a task file as its text).
+    #[pyo3(name = "_simulate_batch")]
+    fn simulate_batch_block,
+    portable_spec
+);
 
 /// `simulate_batch`'s positional arguments: model, params, task, perturbations, method and
 /// first_tool.
@@ -250,9 +251,6 @@ fn episode_tables<'py>(
         .collect()
 }
 
-/// A metric's column: its key and how it is read.
-type Column<T> = (&'static str, fn(&Metrics) -> T);
-
 fn to_dict(
     py: Python<'_>,
     rows: Vec<Result<Metrics, String>>,
@@ -272,14 +270,7 @@ fn to_dict(
     };
     set("tool", ints(&|i, _| (first_tool + i / p) as i64)?)?;
     set("perturbation", ints(&|i, _| (i % p) as i64)?)?;
-    let floats: [Column<f64>; 5] = [
-        ("task_error", |m| m.task_error),
-        ("free_energy", |m| m.free_energy),
-        ("cost_j", |m| m.cost_j),
-        ("logdet", |m| m.logdet),
-        ("control_effort", |m| m.control_effort),
-    ];
-    for (key, f) in floats {
+    for (key, f) in MEASURES {
         let column = rows.iter().map(|r| r.as_ref().map_or(f64::NAN, f));
         let column = crate::arrays::collect(column, &what)?;
         set(key, PyArray1::from_vec(py, column).into_any())?;
@@ -295,14 +286,7 @@ fn to_dict(
         let column = crate::arrays::collect(column, &what)?;
         set("progress", PyArray1::from_vec(py, column).into_any())?;
     }
-    let counts: [Column<usize>; 5] = [
-        ("rhs_evals", |m| m.rhs_evals),
-        ("steps", |m| m.steps),
-        ("rejected_steps", |m| m.rejected_steps),
-        ("jacobian_evals", |m| m.jacobian_evals),
-        ("factorisations", |m| m.factorisations),
-    ];
-    for (key, f) in counts {
+    for (key, f) in COUNTS {
         set(key, ints(&|_, r| r.as_ref().map_or(-1, |m| f(m) as i64))?)?;
     }
     let errors: Vec<Option<&str>> = crate::arrays::collect(

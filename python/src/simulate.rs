@@ -107,26 +107,37 @@ pub fn simulate<'py>(
     to_dict(py, e)
 }
 
+/// A metric: its key in the results and how it is read.
+pub type Column<T> = (&'static str, fn(&Metrics) -> T);
+
+/// A [`Column`] for each of these fields of [`Metrics`], keyed by the field's name.
+macro_rules! columns {
+    ($($field:ident),*) => {
+        [$((stringify!($field), |m: &Metrics| m.$field)),*]
+    };
+}
+
+/// The episode's measures, in the order the results list them.
+pub const MEASURES: [Column<f64>; 5] =
+    columns!(task_error, free_energy, cost_j, logdet, control_effort);
+
+/// The integrator's counts, in the order the results list them.
+pub const COUNTS: [Column<usize>; 5] = columns!(
+    rhs_evals,
+    steps,
+    rejected_steps,
+    jacobian_evals,
+    factorisations
+);
+
 fn to_dict(py: Python<'_>, e: Episode) -> PyResult<Bound<'_, PyDict>> {
     let m = &e.metrics;
     let out = PyDict::new(py);
-    for (key, value) in [
-        ("task_error", m.task_error),
-        ("free_energy", m.free_energy),
-        ("cost_j", m.cost_j),
-        ("logdet", m.logdet),
-        ("control_effort", m.control_effort),
-    ] {
-        out.set_item(key, value)?;
+    for (key, f) in MEASURES {
+        out.set_item(key, f(m))?;
     }
-    for (key, value) in [
-        ("rhs_evals", m.rhs_evals),
-        ("steps", m.steps),
-        ("rejected_steps", m.rejected_steps),
-        ("jacobian_evals", m.jacobian_evals),
-        ("factorisations", m.factorisations),
-    ] {
-        out.set_item(key, value)?;
+    for (key, f) in COUNTS {
+        out.set_item(key, f(m))?;
     }
     let points = e.t.len();
     out.set_item("t", PyArray1::from_vec(py, e.t))?;
