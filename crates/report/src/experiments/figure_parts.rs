@@ -23,11 +23,14 @@ pub fn task_label(kind: TaskKind) -> String {
 /// Fig. 5's mean lines: the mean of `change(tool, k)` at each `xs[k]` over all the tools, and
 /// over the least and the most confident third ([`mean_lines`]).
 pub struct MeanLines {
-    pub all: Vec<(f64, f64)>,
+    pub all: Line,
     /// How many tools a third is, the least and the most confident third's lines; none with
     /// fewer than six tools.
-    pub thirds: Option<(usize, Vec<(f64, f64)>, Vec<(f64, f64)>)>,
+    pub thirds: Option<(usize, Line, Line)>,
 }
+
+/// A line's points (x, y).
+pub type Line = Vec<(f64, f64)>;
 
 /// [`MeanLines`] of `tools`, ordered by their confidence ln|Π^U| (`logdet`; a missing one as 0).
 pub fn mean_lines<T>(
@@ -41,7 +44,7 @@ pub fn mean_lines<T>(
             .unwrap_or(0.0)
             .total_cmp(&logdet(b).unwrap_or(0.0))
     });
-    let line = |group: &[T]| -> Vec<(f64, f64)> {
+    let line = |group: &[T]| -> Line {
         (0..xs.len())
             .filter_map(|k| {
                 let v: Vec<f64> = group.iter().filter_map(|t| change(t, k)).collect();
