@@ -298,23 +298,11 @@ class _Tree:
         if len(root.findall("link")) > MAX_LINKS:
             raise DescriptionError(path, "", f"{len(root.findall('link'))} links; a URDF the derivation reads has at "
                                              f"most {MAX_LINKS}")
-        self.links = {}
-        for link in root.findall("link"):
-            name = link.get("name")
-            if not name:
-                raise DescriptionError(path, "link", "a <link> has no name")
-            if name in self.links:
-                raise DescriptionError(path, f"link '{name}'", "is defined twice")
-            self.links[name] = link
+        self.links = dict(_each_named(path, root, "link"))
         self.joints = {}
         self.parent_joint = {}
         self.child_joints: dict[str, list] = {name: [] for name in self.links}
-        for joint in root.findall("joint"):
-            name = joint.get("name")
-            if not name:
-                raise DescriptionError(path, "joint", "a <joint> has no name")
-            if name in self.joints:
-                raise DescriptionError(path, f"joint '{name}'", "is defined twice")
+        for name, joint in _each_named(path, root, "joint"):
             parent, child = joint.find("parent"), joint.find("child")
             parent = parent.get("link") if parent is not None else None
             child = child.get("link") if child is not None else None
@@ -416,6 +404,20 @@ def _base_side_branches(tree: _Tree, link: str, on_path: set[str], flange: str) 
             continue
         _side_joint(tree, joint, link, flange)
         _base_side_branches(tree, child, on_path, flange)
+
+
+def _each_named(path: Path, root, tag: str):
+    """Each <tag> element of `root`, in order, with its name: one without a name, or with the
+    name of one before it, is refused."""
+    seen: set[str] = set()
+    for element in root.findall(tag):
+        name = element.get("name")
+        if not name:
+            raise DescriptionError(path, tag, f"a <{tag}> has no name")
+        if name in seen:
+            raise DescriptionError(path, f"{tag} '{name}'", "is defined twice")
+        seen.add(name)
+        yield name, element
 
 
 def _check_joint(path: Path, joint) -> None:
