@@ -280,17 +280,22 @@ def check_arguments(command: str, given: list[tuple[str, Path | str | None]]) ->
 
 
 class Arguments(argparse.ArgumentParser):
-    """Argument errors as one line and status 2, as every other refusal."""
+    """Argument errors as one line and status 2, as every other refusal: `command`'s message and
+    its make usage."""
+
+    def __init__(self, command: str, make_usage: str, description: str | None):
+        super().__init__(description=description, formatter_class=argparse.RawDescriptionHelpFormatter)
+        self.command, self.make_usage = command, make_usage
 
     def error(self, message: str):
-        print(f"{COMMAND}: {message} (usage: make crate MODELS=<folder of model descriptions> OUT=<folder> "
-              "[TASKS=<file>] [NAME=<crate>])", file=sys.stderr)
+        print(f"{self.command}: {message} (usage: {self.make_usage})", file=sys.stderr)
         raise SystemExit(2)
 
 
 def main() -> int:
     argv = make_arguments([("MODELS", "--models"), ("OUT", "--out"), ("TASKS", "--tasks"), ("NAME", "--name")])
-    ap = Arguments(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = Arguments(COMMAND, "make crate MODELS=<folder of model descriptions> OUT=<folder> [TASKS=<file>] "
+                   "[NAME=<crate>]", __doc__)
     ap.add_argument("--models", type=Path, required=True, help="folder of model descriptions (*.toml)")
     ap.add_argument("--out", type=Path, required=True, help="the crate's folder (new, empty, or made by this)")
     ap.add_argument("--tasks", type=Path, default=TASKS, help="task definitions (default derive/tasks.toml)")

@@ -62,7 +62,6 @@ def _interrupted_while_starting(*_) -> None:
 signal.signal(signal.SIGINT, _interrupted_while_starting)
 signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
-import argparse  # noqa: E402
 import fcntl  # noqa: E402
 import json  # noqa: E402
 import os  # noqa: E402
@@ -355,19 +354,11 @@ def make_model(desc: Path | None, ir: Path | None, out: Path, tasks: Path) -> in
     return 0
 
 
-class Arguments(argparse.ArgumentParser):
-    """Argument errors as one line and status 2, as every other refusal."""
-
-    def error(self, message: str):
-        print(f"{COMMAND}: {message} (usage: make model DESC=<description> OUT=<folder> [TASKS=<file>], "
-              "or IR=<model.json> OUT=<folder>)", file=sys.stderr)
-        raise SystemExit(2)
-
-
 def main() -> int:
     # make's arguments come in the environment, as typed (the Makefile's `model` target).
     argv = make_arguments([("DESC", "--desc"), ("IR", "--ir"), ("OUT", "--out"), ("TASKS", "--tasks")])
-    ap = Arguments(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = make_crate.Arguments(COMMAND, "make model DESC=<description> OUT=<folder> [TASKS=<file>], "
+                              "or IR=<model.json> OUT=<folder>", __doc__)
     source = ap.add_mutually_exclusive_group(required=True)
     source.add_argument("--desc", type=Path, help="the model description (TOML)")
     source.add_argument("--ir", type=Path, help="a model's IR derived before (generated/<model>.json)")

@@ -78,18 +78,13 @@ def urdf_names(path: Path, top: Table):
 
 TOOL_PARAMETERS = [
     Named("tool_mass", "m_t", "kg", "mass of the tool"),
-    Named("tool_com_x", "c_x", "m", "tool's centre of mass, x in the flange frame"),
-    Named("tool_com_y", "c_y", "m", "tool's centre of mass, y in the flange frame"),
-    Named("tool_com_z", "c_z", "m", "tool's centre of mass, z in the flange frame"),
-    Named("tool_ixx", "I_{xx}", "kg m^2", "tool's principal moment about its centre of mass, flange x axis"),
-    Named("tool_iyy", "I_{yy}", "kg m^2", "tool's principal moment about its centre of mass, flange y axis"),
-    Named("tool_izz", "I_{zz}", "kg m^2", "tool's principal moment about its centre of mass, flange z axis"),
-    Named("tool_ixy", "I_{xy}", "kg m^2", "tool's product of inertia about its centre of mass, flange axes (URDF's ixy)"),
-    Named("tool_ixz", "I_{xz}", "kg m^2", "tool's product of inertia about its centre of mass, flange axes (URDF's ixz)"),
-    Named("tool_iyz", "I_{yz}", "kg m^2", "tool's product of inertia about its centre of mass, flange axes (URDF's iyz)"),
-    Named("tool_tip_x", "t_x", "m", "tool's tip (tool-centre point), x in the flange frame"),
-    Named("tool_tip_y", "t_y", "m", "tool's tip (tool-centre point), y in the flange frame"),
-    Named("tool_tip_z", "t_z", "m", "tool's tip (tool-centre point), z in the flange frame"),
+    *(Named(f"tool_com_{a}", f"c_{a}", "m", f"tool's centre of mass, {a} in the flange frame") for a in "xyz"),
+    *(Named(f"tool_i{a}{a}", f"I_{{{a}{a}}}", "kg m^2",
+            f"tool's principal moment about its centre of mass, flange {a} axis") for a in "xyz"),
+    *(Named(f"tool_i{ab}", f"I_{{{ab}}}", "kg m^2",
+            f"tool's product of inertia about its centre of mass, flange axes (URDF's i{ab})")
+      for ab in ("xy", "xz", "yz")),
+    *(Named(f"tool_tip_{a}", f"t_{a}", "m", f"tool's tip (tool-centre point), {a} in the flange frame") for a in "xyz"),
 ]
 # What a tools file that leaves a column out means: a tool whose inertia tensor is diagonal in
 # flange axes (files written before the products were parameters), and a tip at the flange.
