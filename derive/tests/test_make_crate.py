@@ -39,6 +39,23 @@ def files_under(folder: Path) -> dict[str, bytes]:
     return out
 
 
+def assert_terminated_cleanly(test: unittest.TestCase, what: str, command: list[str], base: Path, out: Path,
+                              partial: str) -> None:
+    """`command` (`what`, run in `base`, making `out` anew) terminated by SIGTERM once its
+    temporary folder (`partial` and a suffix, in `base`) is there: it ends with the signal's
+    status and leaves what is under `out` as it was."""
+    kept = files_under(out)
+    run = subprocess.Popen(command, cwd=base, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 120
+    while not any(p.name.startswith(partial) for p in base.iterdir()):
+        test.assertIsNone(run.poll(), f"{what} ended before it was signalled")
+        test.assertLess(time.monotonic(), deadline)
+        time.sleep(0.01)
+    run.send_signal(signal.SIGTERM)
+    test.assertEqual(run.wait(timeout=300), 128 + signal.SIGTERM)
+    test.assertEqual(files_under(out), kept)
+
+
 class MakeCrate(unittest.TestCase):
     def setUp(self):
         tmp = tempfile.TemporaryDirectory(prefix="toolconf-make-crate-")
@@ -109,17 +126,8 @@ class MakeCrate(unittest.TestCase):
         if before is not None:
             self.assertEqual(git_status(), before)
         # Terminated while making it anew: the old crate is as it was, and no temporary is left.
-        kept = files_under(out)
-        run = subprocess.Popen([*MAKE_CRATE, "--models", str(self.models), "--out", str(out)], cwd=self.base,
-                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        deadline = time.monotonic() + 120
-        while not any(p.name.startswith(".my-pendulum-partial-") for p in self.base.iterdir()):
-            self.assertIsNone(run.poll(), "make crate ended before it was signalled")
-            self.assertLess(time.monotonic(), deadline)
-            time.sleep(0.01)
-        run.send_signal(signal.SIGTERM)
-        self.assertEqual(run.wait(timeout=300), 128 + signal.SIGTERM)
-        self.assertEqual(files_under(out), kept)
+        assert_terminated_cleanly(self, "make crate", [*MAKE_CRATE, "--models", str(self.models), "--out", str(out)],
+                                  self.base, out, ".my-pendulum-partial-")
         self.assertEqual(sorted(p.name for p in self.base.iterdir()), ["descriptions", "my-pendulum"])
         # A file of the user's in it, or a file of the crate the user changed: not replaced.
         (out / "notes.txt").write_text("mine")

@@ -14,7 +14,6 @@ import signal
 import subprocess
 import sys
 import tempfile
-import time
 import unittest
 from pathlib import Path
 
@@ -23,7 +22,7 @@ MAKE_MODEL = [sys.executable, str(ROOT / "derive" / "make_model.py")]
 PENDULUM = ROOT / "tests" / "fixtures" / "pendulum.toml"
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_make_crate import files_under, git_status  # noqa: E402
+from test_make_crate import assert_terminated_cleanly, files_under, git_status  # noqa: E402
 
 # make's own line about a recipe that failed, `make: *** ...`, or `make[1]: *** ...` when these
 # tests run under another make (make test).
@@ -345,17 +344,8 @@ class MakeModel(unittest.TestCase):
         # is as it was, and no temporary folder is left.
         again = self.run_make_model("--desc", str(self.desc), "--out", str(out))
         self.assertEqual(again.returncode, 0, again.stderr)
-        kept = files_under(out)
-        run = subprocess.Popen([*MAKE_MODEL, "--desc", str(self.desc), "--out", str(out)], cwd=self.base,
-                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        deadline = time.monotonic() + 120
-        while not any(p.name.startswith(".pendulum-lib-partial-") for p in self.base.iterdir()):
-            self.assertIsNone(run.poll(), "make model ended before it was signalled")
-            self.assertLess(time.monotonic(), deadline)
-            time.sleep(0.01)
-        run.send_signal(signal.SIGTERM)
-        self.assertEqual(run.wait(timeout=300), 128 + signal.SIGTERM)
-        self.assertEqual(files_under(out), kept)
+        assert_terminated_cleanly(self, "make model", [*MAKE_MODEL, "--desc", str(self.desc), "--out", str(out)],
+                                  self.base, out, ".pendulum-lib-partial-")
         self.assertEqual(sorted(p.name for p in self.base.iterdir()), ["my_pendulum.toml", "pendulum-lib"])
         # A file of the user's in it: not replaced.
         (out / "notes.txt").write_text("mine")

@@ -323,6 +323,25 @@ class PlanarRods(unittest.TestCase):
         self.assertLess(worst, TOLERANCE, f"worst normwise relative difference {worst:.2e}")
 
 
+def _worst_against_pinocchio(pm, dynamics, tool, samples, q_pin=lambda q: q) -> float:
+    """The worst normwise relative difference of `dynamics` (fd, crba, bias of _raw_dynamics, with
+    `tool`) from Pinocchio's aba, crba and rnea on model `pm`, over `samples` (q, q_dot, tau);
+    `q_pin` is Pinocchio's configuration of q."""
+    import pinocchio as pin
+    fd, crba, bias = dynamics
+    data = pm.createData()
+    worst = 0.0
+    for q, qd, tau in samples:
+        qp = q_pin(q)
+        m_pin = pin.crba(pm, data, qp)
+        m_pin = np.triu(m_pin) + np.triu(m_pin, 1).T
+        for got, want in ((crba(q, tool), m_pin), (bias(q, qd, tool), pin.rnea(pm, data, qp, qd, np.zeros(len(qd)))),
+                          (fd(q, qd, tau, tool), pin.aba(pm, data, qp, qd, tau))):
+            got = np.array(got, dtype=float).reshape(np.shape(want))
+            worst = max(worst, float(np.max(np.abs(got - want)) / np.max(np.abs(want))))
+    return worst
+
+
 def _rk4(f, x, u, h):
     k1 = f(x, u)
     k2 = f(x + h / 2 * k1, u)
@@ -545,18 +564,11 @@ class Pinocchio(PinocchioCheck, unittest.TestCase):
         dyn = ChainDynamics(read_chain(tmp / "slide.urdf", "base", "flange"), [0.0, 0.0, -9.81])
         fd, crba, bias = _raw_dynamics(dyn, tool=True)
         pm = pin.buildModelFromXML(_robot(*links, *joints, *tool_link))
-        data = pm.createData()
         rng = np.random.default_rng(11)
-        worst = 0.0
-        for _ in range(100):
-            q, qd, tau = rng.uniform(-math.pi, math.pi, 3), rng.uniform(-3, 3, 3), rng.uniform(-5, 5, 3)
-            q_pin = np.array([math.cos(q[0]), math.sin(q[0]), q[1], q[2]])   # continuous: (cos, sin)
-            m_pin = pin.crba(pm, data, q_pin)
-            m_pin = np.triu(m_pin) + np.triu(m_pin, 1).T
-            for got, want in ((crba(q, tool), m_pin), (bias(q, qd, tool), pin.rnea(pm, data, q_pin, qd, np.zeros(3))),
-                              (fd(q, qd, tau, tool), pin.aba(pm, data, q_pin, qd, tau))):
-                got = np.array(got, dtype=float).reshape(np.shape(want))
-                worst = max(worst, float(np.max(np.abs(got - want)) / np.max(np.abs(want))))
+        samples = [(rng.uniform(-math.pi, math.pi, 3), rng.uniform(-3, 3, 3), rng.uniform(-5, 5, 3)) for _ in range(100)]
+        worst = _worst_against_pinocchio(pm, (fd, crba, bias), tool, samples,
+                                         # continuous: (cos, sin)
+                                         q_pin=lambda q: np.array([math.cos(q[0]), math.sin(q[0]), q[1], q[2]]))
         self.assertLess(worst, TOLERANCE, f"worst normwise relative difference {worst:.2e}")
 
     def test_panda(self):
@@ -678,19 +690,10 @@ class HowAUrdfIsRead(PinocchioCheck, unittest.TestCase):
             self.assertLess(_orthonormality(b.rotation), 1e-15, b.joint)
         fd, crba, bias = _raw_dynamics(ChainDynamics(chain, [0.0, 0.0, -9.81]))
         pm = pin.buildModelFromUrdf(str(urdf))      # the literal file
-        data = pm.createData()
         self.assertEqual(pm.nq, 4)
         rng = np.random.default_rng(31)
-        worst = 0.0
-        for _ in range(100):
-            q, qd, tau = rng.uniform(-math.pi, math.pi, 4), rng.uniform(-3, 3, 4), rng.uniform(-20, 20, 4)
-            m_pin = pin.crba(pm, data, q)
-            m_pin = np.triu(m_pin) + np.triu(m_pin, 1).T
-            zero = np.zeros(7)
-            for got, want in ((crba(q, zero), m_pin), (bias(q, qd, zero), pin.rnea(pm, data, q, qd, np.zeros(4))),
-                              (fd(q, qd, tau, zero), pin.aba(pm, data, q, qd, tau))):
-                got = np.array(got, dtype=float).reshape(np.shape(want))
-                worst = max(worst, float(np.max(np.abs(got - want)) / np.max(np.abs(want))))
+        samples = [(rng.uniform(-math.pi, math.pi, 4), rng.uniform(-3, 3, 4), rng.uniform(-20, 20, 4)) for _ in range(100)]
+        worst = _worst_against_pinocchio(pm, (fd, crba, bias), np.zeros(7), samples)
         self.assertLess(worst, TOLERANCE, f"worst normwise relative difference {worst:.2e}")
 
     def test_xarm7_style_chain_derives_and_its_plant_matches_pinocchio(self):
