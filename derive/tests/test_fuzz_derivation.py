@@ -40,6 +40,8 @@ TASKS = (ROOT / "derive" / "tasks.toml").read_text()
 CASES = int(os.environ.get("TOOLCONF_FUZZ_CASES", "100"))
 SECONDS = 5.0
 MAX_MESSAGE = 600
+# What timed_or_refused gives for a file the reader refuses.
+REFUSED = object()
 CANARY = Path(tempfile.gettempdir()) / f"toolconf-fuzz-canary-{os.getpid()}"
 RUN = f'__import__("os").system("touch {CANARY}")'
 # Tokens of the grammar, of Python, and numbers at and past every bound.
@@ -156,6 +158,14 @@ class DerivationReaderFuzz(unittest.TestCase):
         finally:
             self.assertLess(time.monotonic() - start, SECONDS)
 
+    def timed_or_refused(self, call, path: Path):
+        """`call`'s value (in time), or REFUSED where it refuses `path` in one line naming it."""
+        try:
+            return self.timed(call)
+        except DescriptionError as err:
+            self.one_line(err, path)
+            return REFUSED
+
     @settings(max_examples=CASES, deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(st.sampled_from(sorted(PLACES)), expressions())
     def test_expressions_in_a_description(self, key: str, text: str) -> None:
@@ -164,16 +174,11 @@ class DerivationReaderFuzz(unittest.TestCase):
             path = Path(tmp) / "fuzz.toml"
             path.write_text(replace_once(PENDULUM, old, new.format(toml_string(text))), encoding="utf-8",
                             errors="surrogateescape")
-            try:
-                model = self.timed(lambda: load_model(path))
-            except DescriptionError as err:
-                self.one_line(err, path)
+            model = self.timed_or_refused(lambda: load_model(path), path)
+            if model is REFUSED:
                 return
             # Read: it is an expression of the grammar, and both arithmetics build it.
-            try:
-                self.timed(lambda: self.build(model))
-            except DescriptionError as err:
-                self.one_line(err, path)
+            self.timed_or_refused(lambda: self.build(model), path)
 
     @staticmethod
     def build(model) -> None:
@@ -196,15 +201,11 @@ class DerivationReaderFuzz(unittest.TestCase):
             path = Path(tmp) / "tasks.toml"
             path.write_text(replace_once(TASKS, old, f"sensitivity.{term} = {toml_string(text)}"),
                             encoding="utf-8", errors="surrogateescape")
-            try:
-                tasks = self.timed(lambda: load_tasks(path))
-            except DescriptionError as err:
-                self.one_line(err, path)
+            tasks = self.timed_or_refused(lambda: load_tasks(path), path)
+            if tasks is REFUSED:
                 return
-            try:
-                value = self.timed(lambda: sensitivity(tasks[0], term, numpy_namespace()))
-            except DescriptionError as err:
-                self.one_line(err, path)
+            value = self.timed_or_refused(lambda: sensitivity(tasks[0], term, numpy_namespace()), path)
+            if value is REFUSED:
                 return
             # Read and built: a finite matrix (numbers in a formula are bounded, its degree too).
             self.assertTrue(np.all(np.isfinite(np.asarray(value, dtype=float))), (text, value))
