@@ -427,15 +427,25 @@ def commit() -> str:
     return head.stdout.strip() + (" (with local changes)" if dirty else "")
 
 
-def render_population(results: dict, args, n_tools: int) -> str:
+def opening(begin: str, measured_on: str, tools: int, seed: int, setup: str) -> list[str]:
+    """A table block's first lines: its `begin` marker, when and where it was measured, and the
+    command, the tools `toolconf select` drew and the `setup` of the episodes, in one paragraph."""
     cmd = "benches/peers/run.sh" + "".join(" " + shlex.quote(a) for a in sys.argv[1:])
-    out = [
-        POP_BEGIN,
+    return [
+        begin,
         "",
-        f"Measured {dt.date.today().isoformat()} on {machine()}, commit {commit()}; {versions()}.",
+        f"Measured {dt.date.today().isoformat()} on {measured_on}.",
         "",
         f"Command: `{cmd}` (from the repository root). Tools: `toolconf select --task position "
-        f"--tools {n_tools} --seed {args.seed} --json` (`draw_tools({n_tools}, {args.seed})`, the population "
+        f"--tools {tools} --seed {seed} --json`" + setup,
+        "",
+    ]
+
+
+def render_population(results: dict, args, n_tools: int) -> str:
+    out = opening(
+        POP_BEGIN, f"{machine()}, commit {commit()}; {versions()}", n_tools, args.seed,
+        f" (`draw_tools({n_tools}, {args.seed})`, the population "
         "of `benches/population.sh`), every episode as in the tables above (rtol 1e-3, atol 1e-6, "
         "101 output points). On a subsample (stride N > 1: tools 0, N, 2N, … of the population, "
         "the same tools for every row) the means are over the subsample. Time per tool on one "
@@ -446,9 +456,7 @@ def render_population(results: dict, args, n_tools: int) -> str:
         "over tools of the per-tool time, its percentiles (the element at round((n − 1) q) of the "
         "sorted times, as `benches/timing/population.rs`), mean RHS (and Jacobian) evaluations per tool "
         "(counted as in the tables above), the mean time over toolconf `fast`'s mean on the same "
-        "tools, and the task error's relative difference from toolconf `explicit` (median / max).",
-        "",
-    ]
+        "tools, and the task error's relative difference from toolconf `explicit` (median / max).")
     labels = (("fast", "toolconf `--method fast` (default)"),
               ("explicit", "toolconf `--method explicit` (ode45 DP5)"),
               ("scipy", "SciPy `solve_ivp` RK45"),
@@ -503,14 +511,9 @@ def versions() -> str:
 
 
 def render(results: dict, tight: dict, args) -> str:
-    cmd = "benches/peers/run.sh" + "".join(" " + shlex.quote(a) for a in sys.argv[1:])
-    out = [
-        BEGIN,
-        "",
-        f"Measured {dt.date.today().isoformat()} on {machine()}; {versions()}.",
-        "",
-        f"Command: `{cmd}` (from the repository root). Tools: `toolconf select --task position "
-        f"--tools {args.tools} --seed {args.seed} --json`. Every episode: the paper's closed loop at "
+    out = opening(
+        BEGIN, f"{machine()}; {versions()}", args.tools, args.seed,
+        ". Every episode: the paper's closed loop at "
         "the defaults (X0 = [-π/2 -π/2 0 0], U0 = [0.1 0.1], γ = 1, ΔT = 0), t ∈ [0, 5] with output "
         "every 0.05 s (101 points), rtol 1e-3, atol 1e-6; toolconf with "
         + ("`EpisodeOptions::default()`, i.e. the library's default integration method, `--method auto` "
@@ -525,9 +528,7 @@ def render(results: dict, tight: dict, args) -> str:
         "plus its Jacobian evaluations if any; "
         "SciPy: `sol.nfev`; cvodes: `nfevals` from `stats()`, which excludes its Jacobian evaluations, "
         "given separately). Agreement: |e_toolconf − e_peer| / |e_peer| of the task error "
-        "(Σ over the 101 grid points of the task's weighted error).",
-        "",
-    ]
+        "(Σ over the 101 grid points of the task's weighted error).")
     for index, name in enumerate(("position", "velocity", "acceleration"), start=1):
         rows = results[name]
         tc_t = statistics.median(r["toolconf_s"] for r in rows)

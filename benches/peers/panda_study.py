@@ -204,15 +204,20 @@ def table(results, count) -> str:
     return "\n".join(lines) + "\n"
 
 
+def write_between(doc: Path, begin: str, end: str, text: str) -> None:
+    """`text` in place of what stands between the markers `begin` and `end` of page `doc`."""
+    page = doc.read_text()
+    if begin not in page or end not in page:
+        raise SystemExit(f"{doc}: no {begin} ... {end} markers")
+    head, rest = page.split(begin, 1)
+    _, tail = rest.split(end, 1)
+    doc.write_text(head + begin + "\n" + text + end + tail)
+
+
 def write(text: str, sweep: str) -> None:
     begin, end = (BEGIN, END) if sweep == "impedance" else (BEGIN.replace("impedance", "precision"),
                                                              END.replace("impedance", "precision"))
-    doc = DOC.read_text()
-    if begin not in doc or end not in doc:
-        raise SystemExit(f"{DOC}: no {begin} ... {end} markers")
-    head, rest = doc.split(begin, 1)
-    _, tail = rest.split(end, 1)
-    DOC.write_text(head + begin + "\n" + text + end + tail)
+    write_between(DOC, begin, end, text)
 
 
 def main() -> int:

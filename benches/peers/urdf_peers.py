@@ -46,7 +46,7 @@ import pinocchio as pin
 import scipy
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from panda_study import random_tools  # noqa: E402
+from panda_study import random_tools, write_between  # noqa: E402
 from pin_robot import ROOT, model_with_tool  # noqa: E402
 from urdf_loop import ClosedLoop, Task  # noqa: E402
 
@@ -206,15 +206,6 @@ def report(args, results, aba, checks) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write(text: str) -> None:
-    doc = DOC.read_text()
-    if BEGIN not in doc or END not in doc:
-        raise SystemExit(f"{DOC}: no {BEGIN} ... {END} markers")
-    head, rest = doc.split(BEGIN, 1)
-    _, tail = rest.split(END, 1)
-    DOC.write_text(head + BEGIN + "\n" + text + END + tail)
-
-
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--tools", type=int, default=100)
@@ -244,7 +235,7 @@ def main() -> int:
     text = report(args, results, aba, checks)
     print(text)
     if args.write:
-        write(text)
+        write_between(DOC, BEGIN, END, text)
     return 0
 
 
