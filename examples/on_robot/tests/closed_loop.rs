@@ -239,16 +239,41 @@ fn the_confidence_is_the_closed_form_and_arm3_ticks_too() {
     assert!(last.iter().all(|u| u.is_finite() && u.abs() < 50.0));
 }
 
+/// The 2-link tool (m1, m2, l1, l2) and the state (θ, θ̇) the tip tests tick at.
+const TIP_TOOL: [f64; 4] = [0.3, 0.4, 0.5, 0.2];
+
+fn tip_state() -> nalgebra::Vector4<f64> {
+    nalgebra::Vector4::new(-1.4, -1.9, 0.3, -0.2)
+}
+
+/// TIP_TOOL, the paper's task `kind` and a controller on it: γ = 1, U = (0.1, 0.1), 1 kHz.
+fn tip_controller(kind: TaskKind) -> (Arm2Tool, TaskN<2>, Arm2Controller) {
+    let tool = Arm2Tool::new(TIP_TOOL).unwrap();
+    let task = Arm2::paper_task(kind);
+    let controller = Arm2Controller::new(&tool, &task, 1.0, [0.1; 2], 1000.0).unwrap();
+    (tool, task, controller)
+}
+
+/// The tick's `torque` is one step U − period·∂F/∂U of the controller from `u` (period 1 ms),
+/// to 1e-12 relative (absolute below 1).
+fn assert_one_step(torque: [f64; 2], u: nalgebra::Vector2<f64>, gradient: nalgebra::Vector2<f64>) {
+    let expected = u - gradient * 1e-3;
+    for i in 0..2 {
+        let scale = expected[i].abs().max(1.0);
+        assert!(
+            (torque[i] - expected[i]).abs() <= 1e-12 * scale,
+            "{torque:?} vs {expected}"
+        );
+    }
+}
+
 /// On a task on the tool's tip a tick reads the tip: its torque is U + period·U̇ with
 /// U̇ = −γ(Σ Sᵀ P (term − goal) + P^U U) over y and ẏ written out from the arm's closed form
 /// (y = (l1 cos θ1 + l2 cos θ2, l1 sin θ1 + l2 sin θ2), angles absolute), not the generated tip.
 #[test]
 fn a_tick_on_a_tip_task_reads_the_tips_closed_form() {
-    let p = [0.3, 0.4, 0.5, 0.2];
-    let tool = Arm2Tool::new(p).unwrap();
-    let task = Arm2::paper_task(TaskKind::TipPosition);
-    let mut controller = Arm2Controller::new(&tool, &task, 1.0, [0.1; 2], 1000.0).unwrap();
-    let x = nalgebra::Vector4::new(-1.4, -1.9, 0.3, -0.2);
+    let (p, x) = (TIP_TOOL, tip_state());
+    let (tool, task, mut controller) = tip_controller(TaskKind::TipPosition);
     let torque = controller.tick(&x.into()).unwrap().torque;
 
     let (l1, l2) = (p[2], p[3]);
@@ -265,14 +290,7 @@ fn a_tick_on_a_tip_task_reads_the_tips_closed_form() {
             k * (v - task.goal[term.index()])
         })
         .fold(task.precision[Term::U.index()] * u, |a, b| a + b);
-    let expected = u - gradient * 1e-3;
-    for i in 0..2 {
-        let scale = expected[i].abs().max(1.0);
-        assert!(
-            (torque[i] - expected[i]).abs() <= 1e-12 * scale,
-            "{torque:?} vs {expected}"
-        );
-    }
+    assert_one_step(torque, u, gradient);
 }
 
 /// On the tip acceleration task a tick with a measured θ̈ reads ÿ = J q̈ + J̇ q̇ from the arm's
@@ -280,11 +298,8 @@ fn a_tick_on_a_tip_task_reads_the_tips_closed_form() {
 /// not the generated tip and its bias.
 #[test]
 fn a_tick_on_the_tip_acceleration_task_reads_the_tips_closed_form() {
-    let p = [0.3, 0.4, 0.5, 0.2];
-    let tool = Arm2Tool::new(p).unwrap();
-    let task = Arm2::paper_task(TaskKind::TipAcceleration);
-    let mut controller = Arm2Controller::new(&tool, &task, 1.0, [0.1; 2], 1000.0).unwrap();
-    let x = nalgebra::Vector4::new(-1.4, -1.9, 0.3, -0.2);
+    let (p, x) = (TIP_TOOL, tip_state());
+    let (tool, task, mut controller) = tip_controller(TaskKind::TipAcceleration);
     let q_ddot = [2.5, -4.0];
     let torque = controller
         .tick_with_acceleration(&x.into(), &q_ddot)
@@ -300,14 +315,7 @@ fn a_tick_on_the_tip_acceleration_task_reads_the_tips_closed_form() {
     let s = tool.sensitivities(TaskKind::TipAcceleration);
     let k = s.of(Term::TipDdot).unwrap().transpose() * task.precision[Term::TipDdot.index()];
     let u = nalgebra::Vector2::new(0.1, 0.1);
-    let gradient = k * (y_ddot - task.goal[Term::TipDdot.index()])
-        + task.precision[Term::U.index()] * u;
-    let expected = u - gradient * 1e-3;
-    for i in 0..2 {
-        let scale = expected[i].abs().max(1.0);
-        assert!(
-            (torque[i] - expected[i]).abs() <= 1e-12 * scale,
-            "{torque:?} vs {expected}"
-        );
-    }
+    let gradient =
+        k * (y_ddot - task.goal[Term::TipDdot.index()]) + task.precision[Term::U.index()] * u;
+    assert_one_step(torque, u, gradient);
 }

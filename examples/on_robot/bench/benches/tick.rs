@@ -17,46 +17,55 @@ const TICKS: u64 = 1000;
 fn arm2(c: &mut Criterion) {
     let tool = Arm2Tool::new([0.3, 0.4, 0.5, 0.2]).unwrap();
     let xe = Arm2::equilibrium_state();
-    let mut group = c.benchmark_group("tick/arm2");
-    group.throughput(Throughput::Elements(TICKS));
-    for kind in [TaskKind::Position, TaskKind::Velocity] {
-        let mut controller = Arm2Controller::paper(&tool, kind).unwrap();
-        group.bench_function(kind.name(), |b| {
-            b.iter(|| {
-                let mut last = 0.0;
-                for i in 0..TICKS {
-                    let s = i as f64 * 1e-3;
-                    let x = [xe[0] + s, xe[1] - 0.5 * s, 0.1 + s, -0.2];
-                    last = controller.tick(black_box(&x)).unwrap().torque[0];
-                }
-                last
-            })
-        });
-    }
-    group.finish();
+    ticks(
+        c,
+        "tick/arm2",
+        |kind| Arm2Controller::paper(&tool, kind).unwrap(),
+        |controller, x| controller.tick(x).unwrap().torque[0],
+        |s| [xe[0] + s, xe[1] - 0.5 * s, 0.1 + s, -0.2],
+    );
 }
 
 fn arm3(c: &mut Criterion) {
     let tool = Arm3Tool::new([0.3, 0.25, 0.2, 0.4, 0.35, 0.3]).unwrap();
     let xe = Arm3::equilibrium_state();
-    let mut group = c.benchmark_group("tick/arm3");
+    ticks(
+        c,
+        "tick/arm3",
+        |kind| Arm3Controller::paper(&tool, kind).unwrap(),
+        |controller, x| controller.tick(x).unwrap().torque[0],
+        |s| {
+            [
+                xe[0] + s,
+                xe[1] - 0.5 * s,
+                xe[2] + 0.3 * s,
+                0.1 + s,
+                -0.2,
+                0.05,
+            ]
+        },
+    );
+}
+
+/// Group `name`: on each task, TICKS ticks of `controller(kind)` (`tick`: one tick, its first
+/// torque) at the states `state(s)` of a slow sweep s = 0, 0.001, ...
+fn ticks<C, const N: usize>(
+    c: &mut Criterion,
+    name: &str,
+    controller: impl Fn(TaskKind) -> C,
+    mut tick: impl FnMut(&mut C, &[f64; N]) -> f64,
+    state: impl Fn(f64) -> [f64; N],
+) {
+    let mut group = c.benchmark_group(name);
     group.throughput(Throughput::Elements(TICKS));
     for kind in [TaskKind::Position, TaskKind::Velocity] {
-        let mut controller = Arm3Controller::paper(&tool, kind).unwrap();
+        let mut controller = controller(kind);
         group.bench_function(kind.name(), |b| {
             b.iter(|| {
                 let mut last = 0.0;
                 for i in 0..TICKS {
-                    let s = i as f64 * 1e-3;
-                    let x = [
-                        xe[0] + s,
-                        xe[1] - 0.5 * s,
-                        xe[2] + 0.3 * s,
-                        0.1 + s,
-                        -0.2,
-                        0.05,
-                    ];
-                    last = controller.tick(black_box(&x)).unwrap().torque[0];
+                    let x = state(i as f64 * 1e-3);
+                    last = tick(&mut controller, black_box(&x));
                 }
                 last
             })
