@@ -17,31 +17,38 @@ pub fn load_templates(dir: &Path) -> Result<Vec<(String, String)>, RenderError> 
 
 /// Every `*.tera` file directly in `dir`, in name order.
 fn load_folder(dir: &Path) -> Result<Vec<(String, String)>, RenderError> {
-    let io = |source| RenderError::Io {
-        path: dir.into(),
-        source,
-    };
-    let mut names: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map_err(io)?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "tera"))
-        .collect();
-    names.sort();
-    names
+    entries(dir, |p| p.extension().is_some_and(|x| x == "tera"))?
         .into_iter()
         .map(|p| {
             let text = std::fs::read_to_string(&p).map_err(|source| RenderError::Io {
                 path: p.clone(),
                 source,
             })?;
-            let name = p
-                .file_name()
-                .unwrap_or_default()
-                .to_string_lossy()
-                .into_owned();
-            Ok((name, text))
+            Ok((file_name(&p), text))
         })
         .collect()
+}
+
+/// The paths in `dir` that `keep` keeps, in order.
+fn entries(dir: &Path, keep: impl Fn(&Path) -> bool) -> Result<Vec<PathBuf>, RenderError> {
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|source| RenderError::Io {
+            path: dir.into(),
+            source,
+        })?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| keep(p))
+        .collect();
+    paths.sort();
+    Ok(paths)
+}
+
+/// The last part of `path`, as text.
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .unwrap_or_default()
+        .to_string_lossy()
+        .into_owned()
 }
 
 /// Loads every `*.tera` file under `dir` and its sub-folders, in path order, each named by its
@@ -96,27 +103,14 @@ pub const TREES: [&str; 2] = ["registry", "cabi"];
 /// Every `*.tera` file in the sub-folders of `dir` other than the [`TREES`], named
 /// `<folder>/<file>`.
 fn load_variants(dir: &Path) -> Result<Vec<(String, String)>, RenderError> {
-    let io = |source| RenderError::Io {
-        path: dir.into(),
-        source,
-    };
-    let mut folders: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map_err(io)?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            p.is_dir()
-                && p.file_name()
-                    .is_some_and(|n| !TREES.iter().any(|t| n == *t))
-        })
-        .collect();
-    folders.sort();
+    let folders = entries(dir, |p| {
+        p.is_dir()
+            && p.file_name()
+                .is_some_and(|n| !TREES.iter().any(|t| n == *t))
+    })?;
     let mut out = Vec::new();
     for folder in folders {
-        let prefix = folder
-            .file_name()
-            .unwrap_or_default()
-            .to_string_lossy()
-            .into_owned();
+        let prefix = file_name(&folder);
         for (name, text) in load_folder(&folder)? {
             out.push((format!("{prefix}/{name}"), text));
         }
