@@ -3,6 +3,7 @@
 import json
 import os
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -10,6 +11,18 @@ import pytest
 REPO = Path(__file__).resolve().parents[2]
 DRAWER = REPO / "examples" / "tools" / "drawer.csv"
 REACH_45 = REPO / "examples" / "tasks" / "reach_45.toml"
+
+
+def stdout_per_thread_count(script, *args):
+    """``script`` (with ``args``) run by this Python on one and on two rayon threads
+    (``RAYON_NUM_THREADS``): its output each time."""
+    outputs = []
+    for threads in ("1", "2"):
+        env = dict(os.environ, RAYON_NUM_THREADS=threads)
+        out = subprocess.run([sys.executable, "-c", script, *args], env=env, capture_output=True,
+                             text=True, check=True)
+        outputs.append(out.stdout)
+    return outputs
 
 
 @pytest.fixture(scope="session")

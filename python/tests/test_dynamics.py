@@ -56,6 +56,14 @@ def random_full_tool(rng, name):
     return [*tool[:4], tensor[0, 0], tensor[1, 1], tensor[2, 2], tensor[0, 1], tensor[0, 2], tensor[1, 2], *tip]
 
 
+def random_tools_in_pinocchio(rng, name, count):
+    """``count`` random_full_tools of the model, each with Pinocchio's model and data of the
+    robot with it (pinocchio_model)."""
+    for _ in range(count):
+        tool = random_full_tool(rng, name)
+        yield (tool, *pinocchio_model(name, tool))
+
+
 def relative(got, want):
     return float(np.max(np.abs(got - want)) / np.max(np.abs(want)))
 
@@ -159,9 +167,7 @@ def test_full_inertia_tensor_dynamics_equals_pinocchio_aba(name):
     rng = np.random.default_rng(29)
     n = toolconf.models()[name]["dof"]
     worst = 0.0
-    for _ in range(30):
-        tool = random_full_tool(rng, name)
-        model, data = pinocchio_model(name, tool)
+    for tool, model, data in random_tools_in_pinocchio(rng, name, 30):
         q, qd, u = rng.uniform(-math.pi, math.pi, n), rng.uniform(-3.0, 3.0, n), rng.uniform(-20.0, 20.0, n)
         got = toolconf.dynamics(name, tool, np.concatenate([q, qd]), u)
         worst = max(worst, relative(got, np.concatenate([qd, pin.aba(model, data, q, qd, u)])))
@@ -176,9 +182,7 @@ def test_tip_equals_pinocchio_frame_placement_and_jacobian(name):
     rng = np.random.default_rng(31)
     n = toolconf.models()[name]["dof"]
     tools, qs, positions, jacobians = [], [], [], []
-    for _ in range(100):
-        tool = random_full_tool(rng, name)
-        model, data = pinocchio_model(name, tool)
+    for tool, model, data in random_tools_in_pinocchio(rng, name, 100):
         frame = model.getFrameId("tool_tip")
         q = rng.uniform(-math.pi, math.pi, n)
         pin.framesForwardKinematics(model, data, q)
@@ -204,9 +208,7 @@ def test_tip_bias_equals_pinocchio_frame_classical_acceleration(name):
     rng = np.random.default_rng(37)
     n = toolconf.models()[name]["dof"]
     tools, qs, vs, biases = [], [], [], []
-    for _ in range(100):
-        tool = random_full_tool(rng, name)
-        model, data = pinocchio_model(name, tool)
+    for tool, model, data in random_tools_in_pinocchio(rng, name, 100):
         frame = model.getFrameId("tool_tip")
         q, v = rng.uniform(-math.pi, math.pi, n), rng.uniform(-3.0, 3.0, n)
         pin.forwardKinematics(model, data, q, v, np.zeros(n))

@@ -3,9 +3,6 @@ both screens, and the command line's note as a warning."""
 
 import json
 import math
-import os
-import subprocess
-import sys
 import warnings
 
 import numpy as np
@@ -13,7 +10,7 @@ import pytest
 
 import toolconf
 
-from conftest import DRAWER, REACH_45, REPO
+from conftest import DRAWER, REACH_45, REPO, stdout_per_thread_count
 
 PANDA_TOOLS = REPO / "examples" / "tools" / "panda_tools.csv"
 TOUCH = REPO / "examples" / "tasks" / "panda_touch_point.toml"
@@ -123,12 +120,7 @@ def test_results_do_not_depend_on_the_number_of_threads(tmp_path):
         "print(json.dumps({'rank': {k: list(map(repr, v)) for k, v in r.items()},"
         " 'logdet': list(map(repr, c['logdet']))}))\n"
     )
-    outputs = []
-    for threads in ("1", "2"):
-        env = dict(os.environ, RAYON_NUM_THREADS=threads)
-        out = subprocess.run([sys.executable, "-c", script, str(DRAWER)], env=env,
-                             capture_output=True, text=True, check=True)
-        outputs.append(out.stdout)
+    outputs = stdout_per_thread_count(script, str(DRAWER))
     assert outputs[0] == outputs[1]
 
 

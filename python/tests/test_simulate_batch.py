@@ -2,9 +2,6 @@
 has simulate's metrics digit for digit, or the message simulate raises; one failed tool never
 stops the batch; the rows do not depend on the number of threads."""
 
-import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -81,12 +78,7 @@ def test_rows_do_not_depend_on_the_number_of_threads():
         "b = toolconf.simulate_batch('arm2', p, 'velocity', [-1.0, 0.0, 1.0])\n"
         "print(repr({k: (v.tolist() if hasattr(v, 'tolist') else v) for k, v in b.items()}))\n"
     )
-    outputs = []
-    for threads in ("1", "2"):
-        env = dict(os.environ, RAYON_NUM_THREADS=threads)
-        out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True,
-                             text=True, check=True)
-        outputs.append(out.stdout)
+    outputs = stdout_per_thread_count(script)
     assert outputs[0] == outputs[1]
 
 
