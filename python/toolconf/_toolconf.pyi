@@ -9,6 +9,8 @@ output sized by the input does not fit in memory.
 import os
 from typing import Any, Literal, Mapping, Optional, Sequence, TypedDict, Union
 
+from typing_extensions import Unpack
+
 import numpy as np
 import numpy.typing as npt
 
@@ -18,6 +20,18 @@ a task file's path, or a dict with a task file's keys (``kind``, ``goal``, ``pre
 ``episode``)."""
 
 Params = Union[npt.ArrayLike, Sequence[float], Sequence[Sequence[float]]]
+
+class EpisodeOptions(TypedDict, total=False):
+    """The episode's settings a call may override (a task file's ``[episode]`` keys)."""
+    t_end: Optional[float]
+    dt: Optional[float]
+    perturbation: Optional[Union[float, Sequence[float]]]
+    learning_rate: Optional[float]
+    initial_theta: Optional[Sequence[float]]
+    initial_theta_dot: Optional[Sequence[float]]
+    initial_torque: Optional[Union[float, Sequence[float]]]
+    rtol: Optional[float]
+    atol: Optional[float]
 
 class Equilibrium(TypedDict):
     q: list[float]
@@ -158,16 +172,7 @@ def simulate(
     params: Params,
     task: Task,
     method: Literal["fast", "explicit", "auto", "stiff"] = "fast",
-    *,
-    t_end: Optional[float] = ...,
-    dt: Optional[float] = ...,
-    perturbation: Optional[Union[float, Sequence[float]]] = ...,
-    learning_rate: Optional[float] = ...,
-    initial_theta: Optional[Sequence[float]] = ...,
-    initial_theta_dot: Optional[Sequence[float]] = ...,
-    initial_torque: Optional[Union[float, Sequence[float]]] = ...,
-    rtol: Optional[float] = ...,
-    atol: Optional[float] = ...,
+    **episode_options: Unpack[EpisodeOptions],
 ) -> dict[str, Any]:
     """One closed-loop episode: metrics (``task_error``, ``free_energy``, ``cost_j``,
     ``logdet``, ``control_effort``, counters) and the trajectory (``t`` and one array per
@@ -208,16 +213,7 @@ def simulate_batch(
     perturbations: Optional[Union[Sequence[Union[float, Sequence[float]]], npt.ArrayLike]] = None,
     method: Literal["fast", "explicit", "auto", "stiff"] = "fast",
     first_tool: Optional[int] = 0,
-    *,
-    t_end: Optional[float] = ...,
-    dt: Optional[float] = ...,
-    perturbation: Optional[Union[float, Sequence[float]]] = ...,
-    learning_rate: Optional[float] = ...,
-    initial_theta: Optional[Sequence[float]] = ...,
-    initial_theta_dot: Optional[Sequence[float]] = ...,
-    initial_torque: Optional[Union[float, Sequence[float]]] = ...,
-    rtol: Optional[float] = ...,
-    atol: Optional[float] = ...,
+    **episode_options: Unpack[EpisodeOptions],
 ) -> Columns:
     """The episodes of every tool (a row of ``params``) under every perturbation: one row of
     metrics per (tool, perturbation), tool-major, equal to a loop of ``simulate``: ``tool``,
