@@ -58,9 +58,7 @@ def assert_terminated_cleanly(test: unittest.TestCase, what: str, command: list[
 
 class MakeCrate(unittest.TestCase):
     def setUp(self):
-        tmp = tempfile.TemporaryDirectory(prefix="toolconf-make-crate-")
-        self.addCleanup(tmp.cleanup)
-        self.base = Path(tmp.name)
+        self.base = Path(self.enterContext(tempfile.TemporaryDirectory(prefix="toolconf-make-crate-")))
         self.models = self.base / "descriptions"
         self.models.mkdir()
 

@@ -40,9 +40,7 @@ def interruptible() -> None:
 
 class MakeModel(unittest.TestCase):
     def setUp(self):
-        tmp = tempfile.TemporaryDirectory(prefix="toolconf-make-model-")
-        self.addCleanup(tmp.cleanup)
-        self.base = Path(tmp.name)
+        self.base = Path(self.enterContext(tempfile.TemporaryDirectory(prefix="toolconf-make-model-")))
         self.desc = self.base / "my_pendulum.toml"
         shutil.copy(PENDULUM, self.desc)
 

@@ -675,9 +675,12 @@ class HowAUrdfIsRead(PinocchioCheck, unittest.TestCase):
             (tmp / "xarm.toml").write_text(model)
         return tmp / name, (tmp / "xarm.toml" if model is not None else None)
 
-    def derive(self, model: Path) -> subprocess.CompletedProcess:
-        return subprocess.run([sys.executable, str(DERIVE), str(model), "--out", str(model.with_suffix(".json")),
-                               "--vectors", "1"], capture_output=True, text=True)
+    def derive(self, model: Path, status: int) -> list[str]:
+        """The derivation of `model`, which must end with `status`: its lines on stderr."""
+        r = subprocess.run([sys.executable, str(DERIVE), str(model), "--out", str(model.with_suffix(".json")),
+                            "--vectors", "1"], capture_output=True, text=True)
+        self.assertEqual(r.returncode, status, r.stderr)
+        return r.stderr.splitlines()
 
     def test_xarm7_style_angles_are_literal_and_match_pinocchio_on_the_file(self):
         import pinocchio as pin
@@ -698,10 +701,8 @@ class HowAUrdfIsRead(PinocchioCheck, unittest.TestCase):
 
     def test_xarm7_style_chain_derives_and_its_plant_matches_pinocchio(self):
         urdf, model = self.files(_xarm_urdf(), "xarm.urdf", XARM_MODEL.format(q2="0.3"))
-        r = self.derive(model)
-        self.assertEqual(r.returncode, 0, r.stderr)
         # The URDF's <dynamics> are not the plant's damping: said once, on stderr.
-        self.assertEqual(r.stderr.splitlines(), [
+        self.assertEqual(self.derive(model, 0), [
             f"derive: {urdf}: note: <dynamics> damping/friction of joints joint1, joint2, joint3, joint4 ignored: "
             "the plant's joint damping is the description's [impedance]"])
         self.check_robot(model, states=20)
@@ -756,9 +757,7 @@ class HowAUrdfIsRead(PinocchioCheck, unittest.TestCase):
 
     def test_an_equilibrium_outside_the_joint_limits_is_refused(self):
         urdf, model = self.files(_xarm_urdf(), "xarm.urdf", XARM_MODEL.format(q2="2.5"))
-        r = self.derive(model)
-        self.assertEqual(r.returncode, 2, r.stderr)
-        self.assertEqual(r.stderr.splitlines(), [
+        self.assertEqual(self.derive(model, 2), [
             f"derive: {model}: equilibrium.q[1]: '2.5' = 2.5 is outside joint 'joint2''s limits [-2.059, 2.0944] "
             f"({urdf} <limit lower upper>)"])
         # A limit's absent side is 0, as the URDF specification has it.
