@@ -263,15 +263,14 @@ fn write_trial(
         csv.row(row)?;
     }
     for (rule, c) in rules.iter().zip(&t.chosen) {
-        let at = |m: usize| c.and_then(|i| metric(t, m, i));
-        choices_csv.row(vec![
+        // The trial, the rule, its tool and the tool's METRICS: CHOICES_HEADER's columns.
+        let mut row = vec![
             Cell::from(k),
             Cell::from(rule.id()),
             c.map_or(Cell::Empty, Cell::from),
-            Cell::from(at(0)),
-            Cell::from(at(1)),
-            Cell::from(at(2)),
-        ])?;
+        ];
+        row.extend((0..METRICS.len()).map(|m| Cell::from(c.and_then(|i| metric(t, m, i)))));
+        choices_csv.row(row)?;
     }
     Ok(())
 }
