@@ -8,6 +8,8 @@ import pytest
 
 import toolconf
 
+from conftest import stdout_per_thread_count
+
 METRICS = ["task_error", "free_energy", "cost_j", "logdet", "control_effort", "rhs_evals",
            "steps", "rejected_steps", "jacobian_evals", "factorisations"]
 # Its episode diverges on the position task (|state| > 1e6 at t = 0.55 s).
