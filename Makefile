@@ -21,21 +21,41 @@ bench:
 	cargo bench -p toolconf-cabi --bench tick
 	cargo bench --manifest-path examples/on_robot/bench/Cargo.toml
 
-## make test: the whole suite: `make derive` reproduces generated/ byte for byte (on this CPU and
-## on an imitated older one; it builds the renderer in release, what make crate and make model run,
-## before their tests time them), the derivation's own tests, the crates', the Python package's, then
-## the tests that load a model library, on libraries built once for all of them
-## (scripts/model_libraries.sh: every committed model and the xArm7).
+## make test: the whole suite, in two lanes at once (make -j2), each printing its output when it
+## ends, then the tests that need both:
+## - the derivation's lane: `make derive` reproduces generated/ byte for byte (on this CPU and on an
+##   imitated older one: make drift-check), the derivation's own tests, then the model libraries the
+##   tests that load one use (scripts/model_libraries.sh: every committed model and the xArm7);
+## - the crates' lane: every crate's tests compiled, the Python package built (maturin develop),
+##   the on-robot crate's tests (make on-robot-test), then the crates' tests run and the Python
+##   package's (on both cores: pytest -n 2).
+## Then the tests that load a model library, on the libraries built once for all of them. The
+## Python crate is built by maturin alone (it has no Rust tests: `cargo test --workspace` would
+## only build it a second time). The derivation's lane builds in target/derive-lane/ (the renderer,
+## and the model libraries under make-model/): cargo locks a whole target folder while it builds,
+## so neither lane waits for the other's cargo.
 ## The fuzzers of every parser run in it with bounded case counts (TOOLCONF_FUZZ_CASES raises
 ## them: docs/reference/errors.md), and so does the sweep of hostile inputs (tests/hostile.rs).
-test: drift-check $(PY_DEV)
-	$(PY) -m unittest discover --start-directory derive/tests
-	cargo test --workspace --quiet
-	$(MAKE) --no-print-directory on-robot-test
-	$(PYTHON_BUILD)
-	$(PYTHON_TESTS)
-	@d=$$(mktemp -d) && trap 'rm -rf "$$d"' EXIT && scripts/model_libraries.sh $(PY) $$d && \
+CARGO_TESTS = cargo test --workspace --exclude toolconf-python --quiet
+test: $(PY_DEV)
+	@d=$$(mktemp -d) && trap 'rm -rf "$$d"' EXIT && \
+	$(MAKE) --no-print-directory -j2 --output-sync=target derive-lane crates-lane TEST_LIBRARY_DIR=$$d && \
 	TOOLCONF_TEST_LIBRARIES=$$d $(MAKE) --no-print-directory c-example-test loaded-models-test mujoco-test
+
+# make test's lanes (TEST_LIBRARY_DIR: the folder the model libraries go to).
+.PHONY: derive-lane crates-lane
+derive-lane: export CARGO_TARGET_DIR = $(CURDIR)/target/derive-lane
+derive-lane: $(PY_DEV)
+	$(MAKE) --no-print-directory drift-check
+	$(PY) -m unittest discover --start-directory derive/tests
+	scripts/model_libraries.sh $(PY) $(TEST_LIBRARY_DIR)
+
+crates-lane: $(PY_DEV)
+	$(CARGO_TESTS) --no-run
+	$(PYTHON_BUILD)
+	$(MAKE) --no-print-directory on-robot-test
+	$(CARGO_TESTS)
+	$(PYTHON_TESTS)
 
 ## make check: the inner loop, after each edit (under 3 min warm): rustfmt over the workspace; clippy
 ## (warnings are errors) and the unit tests of each package the working tree changes against main
@@ -71,7 +91,7 @@ loaded-models-test: $(PY_DEV)
 	cargo test --quiet --test loaded_models -- --include-ignored && \
 	cargo test --quiet --test examples -- --ignored && \
 	cargo test --quiet --test view3d -- --ignored && \
-	$(PY) -m pytest -q python/loaded_tests
+	$(PY) -m pytest -q -n 2 python/loaded_tests
 
 ## make mujoco-test: the on-robot controller on MuJoCo (examples/mujoco/, docs/tutorials/mujoco.md). Installs the example's
 ## pinned requirements (examples/mujoco/requirements.txt) into derive/.venv, builds the Panda's model library from
@@ -96,7 +116,7 @@ $(MUJOCO_INSTALLED): examples/mujoco/requirements.txt $(PY)
 ## with maturin (debug profile, in the workspace's target/, so the crate is not built twice),
 ## then runs its pytest suite against the command line's JSON.
 PYTHON_BUILD = VIRTUAL_ENV=$(abspath $(VENV)) $(VENV)/bin/maturin develop --quiet --manifest-path python/Cargo.toml
-PYTHON_TESTS = $(PY) -m pytest -q python/tests
+PYTHON_TESTS = $(PY) -m pytest -q -n 2 python/tests
 python-test: $(PY_DEV)
 	$(PYTHON_BUILD)
 	$(PYTHON_TESTS)
