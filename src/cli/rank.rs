@@ -358,25 +358,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         order: &order,
         timing: &timing,
     };
-    if args.json {
-        let mut out = rank_json(ranked);
-        if let Some((check, prediction)) = &checks {
-            out["confidence_check"] = check.json();
-            if let Some(p) = prediction {
-                out["prediction_check"] = p.json();
-            }
-        }
-        out["notes"] = json!(notes);
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&out).expect("finite numbers")
-        );
-    } else {
-        print_text(ranked);
-        for note in &notes {
-            outln!("note: {note}");
-        }
-    }
+    print_ranking(ranked, checks.as_ref(), &notes);
     if let Some(dir) = &args.report {
         let command: Vec<String> = std::env::args().collect();
         let input = ReportInput {
@@ -582,6 +564,34 @@ struct Ranked<'a> {
     results: &'a [RankedTool],
     order: &'a [usize],
     timing: &'a StageTimings,
+}
+
+/// The ranking on stdout: its JSON (with the validation checks and the notes) or its text
+/// (with the notes).
+fn print_ranking(
+    ranked: Ranked,
+    checks: Option<&(ConfidenceCheck, Option<PredictionCheck>)>,
+    notes: &[String],
+) {
+    if ranked.args.json {
+        let mut out = rank_json(ranked);
+        if let Some((check, prediction)) = checks {
+            out["confidence_check"] = check.json();
+            if let Some(p) = prediction {
+                out["prediction_check"] = p.json();
+            }
+        }
+        out["notes"] = json!(notes);
+        outln!(
+            "{}",
+            serde_json::to_string_pretty(&out).expect("finite numbers")
+        );
+    } else {
+        print_text(ranked);
+        for note in notes {
+            outln!("note: {note}");
+        }
+    }
 }
 
 fn rank_json(r: Ranked) -> Value {
