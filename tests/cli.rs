@@ -7,6 +7,9 @@ use std::process::Command;
 use common::toolconf;
 use serde_json::Value;
 
+/// The arm of the command line's examples: m1, m2, l1, l2.
+const ARM: &str = "0.3,0.4,0.5,0.2";
+
 #[test]
 fn confidence_json_has_the_documented_keys() {
     let out = toolconf(&[
@@ -21,18 +24,13 @@ fn confidence_json_has_the_documented_keys() {
     for key in ["a", "b", "pi_u", "logdet", "task", "arm"] {
         assert!(v.get(key).is_some(), "missing key {key}");
     }
-    assert_eq!(v["a"].as_array().unwrap().len(), 4);
-    assert!(v["a"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .all(|r| r.as_array().unwrap().len() == 4));
-    assert_eq!(v["b"].as_array().unwrap().len(), 4);
-    assert!(v["b"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .all(|r| r.as_array().unwrap().len() == 2));
+    // Each matrix's row lengths: A is 4 × 4, B 4 × 2.
+    let row_lengths = |key: &str| -> Vec<usize> {
+        let rows = v[key].as_array().unwrap();
+        rows.iter().map(|r| r.as_array().unwrap().len()).collect()
+    };
+    assert_eq!(row_lengths("a"), [4; 4]);
+    assert_eq!(row_lengths("b"), [2; 4]);
     assert_eq!(v["task"], "velocity");
     assert_eq!(v["arm"]["l1"], 0.5);
     let pi = &v["pi_u"];
@@ -62,46 +60,48 @@ fn confidence_text_names_every_part() {
 
 #[test]
 fn bad_input_exits_2_with_a_message_naming_the_value() {
-    for (args, needle) in [
-        (
-            vec![
-                "confidence",
-                "--arm",
-                "0.3,-0.4,0.5,0.2",
-                "--task",
-                "velocity",
-            ],
-            "m2 = -0.4",
-        ),
-        (
-            vec![
-                "confidence",
-                "--arm",
-                "0.3,nan,0.5,0.2",
-                "--task",
-                "velocity",
-            ],
-            "m2 = NaN",
-        ),
-        (
-            vec!["confidence", "--arm", "0.3,0.4,0.5", "--task", "velocity"],
-            "got 3 values",
-        ),
-        (
-            vec!["confidence", "--arm", "0.3,0.4,0.5,0.2", "--task", "jump"],
-            "unknown task 'jump'",
-        ),
-        (vec!["confidence", "--arm", "0.3,0.4,0.5,0.2"], "--task"),
+    for (arm, task, needle) in [
+        ("0.3,-0.4,0.5,0.2", "velocity", "m2 = -0.4"),
+        ("0.3,nan,0.5,0.2", "velocity", "m2 = NaN"),
+        ("0.3,0.4,0.5", "velocity", "got 3 values"),
+        (ARM, "jump", "unknown task 'jump'"),
     ] {
-        let out = toolconf(&args);
-        assert_eq!(out.status.code(), Some(2), "{args:?}");
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(
-            err.contains(needle),
-            "{args:?}: stderr lacks '{needle}':\n{err}"
-        );
+        let out = assert_refused(&["confidence", "--arm", arm, "--task", task], needle);
         assert!(out.stdout.is_empty());
     }
+    let out = assert_refused(&["confidence", "--arm", ARM], "--task");
+    assert!(out.stdout.is_empty());
+}
+
+/// Runs `toolconf ARGS` and checks that it exits with status 2 and a message holding `needle`.
+#[track_caller]
+fn assert_refused(args: &[&str], needle: &str) -> std::process::Output {
+    let out = toolconf(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+    assert!(
+        err.contains(needle),
+        "{args:?}: stderr lacks '{needle}':\n{err}"
+    );
+    out
+}
+
+/// Keys every episode's JSON has: its metrics and the integrator's work.
+const EPISODE_KEYS: [&str; 5] = ["task_error", "free_energy", "cost_j", "logdet", "rhs_evals"];
+
+/// `toolconf simulate TOOL --task position --json --csv CSV`'s JSON, the run having succeeded;
+/// `tool` names the tool (`--arm …`, `--model … --params …`) and may add options.
+fn simulate_position(tool: &[&str], csv: &std::path::Path) -> Value {
+    let mut args = vec!["simulate"];
+    args.extend(tool);
+    args.extend([
+        "--task",
+        "position",
+        "--json",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    common::json_ok(&toolconf(&args))
 }
 
 #[test]
@@ -110,29 +110,8 @@ fn simulate_json_and_csv() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     let csv = dir.join("trajectory.csv");
-    let out = toolconf(&[
-        "simulate",
-        "--arm",
-        "0.3,0.4,0.5,0.2",
-        "--task",
-        "position",
-        "--perturb",
-        "-0.8",
-        "--json",
-        "--csv",
-        csv.to_str().unwrap(),
-    ]);
-    let v: Value = common::json_ok(&out);
-    for key in [
-        "task_error",
-        "free_energy",
-        "cost_j",
-        "logdet",
-        "rhs_evals",
-        "arm",
-        "task",
-        "perturb",
-    ] {
+    let v = simulate_position(&["--arm", ARM, "--perturb", "-0.8"], &csv);
+    for key in EPISODE_KEYS.iter().chain(&["arm", "task", "perturb"]) {
         assert!(v.get(key).is_some(), "missing key {key}");
     }
     assert_eq!(v["perturb"], -0.8);
@@ -195,47 +174,18 @@ fn select_chooses_by_each_objective() {
 
 #[test]
 fn simulate_and_select_reject_bad_input() {
+    // `simulate --arm A --task position ARGS`.
+    let simulate = |arm: &'static str, args: &[&'static str]| {
+        [&["simulate", "--arm", arm, "--task", "position"][..], args].concat()
+    };
     for (args, needle) in [
+        (simulate("0.3,0.4,0.5,0", &[]), "l2 = 0"),
         (
-            vec!["simulate", "--arm", "0.3,0.4,0.5,0", "--task", "position"],
-            "l2 = 0",
-        ),
-        (
-            vec![
-                "simulate",
-                "--arm",
-                "0.3,0.4,0.5,0.2",
-                "--task",
-                "position",
-                "--perturb",
-                "nan",
-            ],
+            simulate(ARM, &["--perturb", "nan"]),
             "--perturb: NaN must be a number in [-1e6, 1e6] N m",
         ),
-        (
-            vec![
-                "simulate",
-                "--arm",
-                "0.3,0.4,0.5,0.2",
-                "--task",
-                "position",
-                "--dt",
-                "0",
-            ],
-            "dt",
-        ),
-        (
-            vec![
-                "simulate",
-                "--arm",
-                "0.3,0.4,0.5,0.2",
-                "--task",
-                "position",
-                "--rtol",
-                "-1",
-            ],
-            "rtol",
-        ),
+        (simulate(ARM, &["--dt", "0"]), "dt"),
+        (simulate(ARM, &["--rtol", "-1"]), "rtol"),
         (
             vec!["select", "--task", "velocity", "--tools", "0"],
             "--tools",
@@ -245,18 +195,7 @@ fn simulate_and_select_reject_bad_input() {
             "unknown task",
         ),
     ] {
-        let out = toolconf(&args);
-        assert_eq!(
-            out.status.code(),
-            Some(2),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(
-            err.contains(needle),
-            "{args:?}: stderr lacks '{needle}':\n{err}"
-        );
+        assert_refused(&args, needle);
     }
 }
 
@@ -314,40 +253,14 @@ fn a_reader_that_stops_early_ends_the_run_quietly() {
 #[test]
 fn simulate_model_arm2_equals_simulate_arm_on_every_task() {
     for task in ["position", "velocity", "acceleration"] {
-        let json = |args: &[&str]| -> Value {
-            let out = toolconf(args);
-            common::json_ok(&out)
+        // `simulate TOOL --task TASK --perturb -0.4 --json`, the tool named by `tool`.
+        let json = |tool: &[&str]| -> Value {
+            let rest = ["--task", task, "--perturb", "-0.4", "--json"];
+            common::json_ok(&toolconf(&[&["simulate"][..], tool, &rest].concat()))
         };
-        let by_model = json(&[
-            "simulate",
-            "--model",
-            "arm2",
-            "--params",
-            "0.3,0.4,0.5,0.2",
-            "--task",
-            task,
-            "--perturb",
-            "-0.4",
-            "--json",
-        ]);
-        let by_arm = json(&[
-            "simulate",
-            "--arm",
-            "0.3,0.4,0.5,0.2",
-            "--task",
-            task,
-            "--perturb",
-            "-0.4",
-            "--json",
-        ]);
-        for key in [
-            "task_error",
-            "free_energy",
-            "cost_j",
-            "logdet",
-            "rhs_evals",
-            "steps",
-        ] {
+        let by_model = json(&["--model", "arm2", "--params", ARM]);
+        let by_arm = json(&["--arm", ARM]);
+        for key in EPISODE_KEYS.iter().chain(&["steps"]) {
             assert_eq!(by_model[key], by_arm[key], "{task}: {key}");
         }
         assert_eq!(by_model["params"]["l2"], 0.2);
@@ -369,19 +282,7 @@ fn simulate_model_runs_the_payload_arm_and_the_mass_spring_damper() {
         ("msd", "1.0,2.0,0.5", "t,theta1,theta1_dot,theta1_ddot,u1"),
     ] {
         let csv = dir.join(format!("{model}.csv"));
-        let out = toolconf(&[
-            "simulate",
-            "--model",
-            model,
-            "--params",
-            params,
-            "--task",
-            "position",
-            "--json",
-            "--csv",
-            csv.to_str().unwrap(),
-        ]);
-        let v: Value = common::json_ok(&out);
+        let v = simulate_position(&["--model", model, "--params", params], &csv);
         assert_eq!(v["model"], model);
         assert!(v["task_error"].as_f64().unwrap().is_finite());
         let text = std::fs::read_to_string(&csv).unwrap();
@@ -394,35 +295,21 @@ fn simulate_model_runs_the_payload_arm_and_the_mass_spring_damper() {
 
 #[test]
 fn simulate_model_rejects_bad_parameters_and_two_link_only_options() {
-    for (args, needle) in [
-        (
-            vec!["--model", "arm3", "--params", "1,2"],
-            "arm3 takes 6 parameters",
-        ),
-        (
-            vec!["--model", "msd", "--params", "1,x,2"],
-            "'x' is not a number",
-        ),
-        (vec!["--model", "msd", "--params", "1,-2,2"], "-2"),
-        (
-            vec!["--model", "msd", "--params", "1,2,2", "--controller", "mpc"],
-            "--arm",
-        ),
-        (
-            vec!["--model", "msd", "--params", "1,2,2", "--plant", "exact"],
-            "--arm",
-        ),
-        (
-            vec!["--model", "nope", "--params", "1"],
-            "unknown model 'nope'",
-        ),
-    ] {
-        let mut all = vec!["simulate", "--task", "position"];
-        all.extend(args.iter().copied());
-        let out = toolconf(&all);
+    let cases: [(&str, &str, &[&str], &str); 6] = [
+        ("arm3", "1,2", &[], "arm3 takes 6 parameters"),
+        ("msd", "1,x,2", &[], "'x' is not a number"),
+        ("msd", "1,-2,2", &[], "-2"),
+        ("msd", "1,2,2", &["--controller", "mpc"], "--arm"),
+        ("msd", "1,2,2", &["--plant", "exact"], "--arm"),
+        ("nope", "1", &[], "unknown model 'nope'"),
+    ];
+    for (model, params, extra, needle) in cases {
+        let mut args = vec![
+            "simulate", "--task", "position", "--model", model, "--params", params,
+        ];
+        args.extend(extra);
+        let out = assert_refused(&args, needle);
         let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
-        assert!(err.contains(needle), "{args:?}: {err}");
         assert!(!err.contains("panicked"), "{err}");
     }
 }

@@ -143,14 +143,12 @@ fn bad_input_is_one_line_and_status_2() {
 /// optimum that did not converge does too: tests/design.rs finds one).
 #[test]
 fn a_thin_set_is_warned_about() {
-    let dir = common::fresh_dir("design-warn");
-    let thin = dir.join("thin.toml");
-    std::fs::write(
-        &thin,
+    let thin = common::fresh_file(
+        "design-warn",
+        "thin.toml",
         "constraints = [\"m1 + m2 <= 0.2000001\", \"m1 + m2 >= 0.2\"]\n[bounds]\n\
          m1 = [0.1, 0.6]\nm2 = [0.1, 0.6]\nl1 = [0.1, 0.6]\nl2 = [0.1, 0.6]\n[search]\nsamples = 50\n",
-    )
-    .unwrap();
+    );
     let out = toolconf(
         &[
             "design",
@@ -168,5 +166,5 @@ fn a_thin_set_is_warned_about() {
             && stderr.contains("in 50000 draws"),
         "{stderr}"
     );
-    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(thin.parent().unwrap()).unwrap();
 }

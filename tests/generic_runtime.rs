@@ -253,14 +253,7 @@ fn invalid_tasks_give_typed_errors() {
     // All-zero precisions: Π^U = 0 for every tool, refused as such.
     let mut task = Arm3::paper_task(TaskKind::Acceleration);
     task.precision[Term::ThetaDdot.index()] = SMatrix::zeros();
-    assert!(matches!(
-        control_confidence(&tool, &task),
-        Err(model::Error::ConfidenceRank {
-            rank: 0,
-            joints: 3,
-            ..
-        })
-    ));
+    common::assert_rank_zero(control_confidence(&tool, &task), 3);
     // Rank 2 of 3 in all is still singular for every tool.
     task.precision[Term::ThetaDdot.index()] =
         SMatrix::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, 0.0));

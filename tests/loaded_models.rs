@@ -183,26 +183,23 @@ fn every_model_loaded_equals_built_in_bit_for_bit() {
     let panda = folder.join("panda");
     let again = loaded::load(&panda, Some("panda_loaded")).unwrap();
     assert_eq!(again.name(), "panda_loaded");
-    let taken = loaded::load(&panda, None).unwrap_err().to_string();
+    let refusal = |library: &std::path::Path, name: Option<&str>| {
+        loaded::load(library, name).unwrap_err().to_string()
+    };
+    let taken = refusal(&panda, None);
     assert!(taken.contains("'panda' is already built in"), "{taken}");
-    let again = loaded::load(&folder.join("ur5"), Some("panda_loaded"))
-        .unwrap_err()
-        .to_string();
+    let again = refusal(&folder.join("ur5"), Some("panda_loaded"));
     assert!(
         again.contains("'panda_loaded' is already loaded from"),
         "{again}"
     );
-    let bad = loaded::load(&panda, Some("Bad Name"))
-        .unwrap_err()
-        .to_string();
+    let bad = refusal(&panda, Some("Bad Name"));
     assert!(
         bad.contains("the model name 'Bad Name' is not one"),
         "{bad}"
     );
     // A name in capitals is refused as given, never lower-cased into another model's name.
-    let upper = loaded::load(&panda, Some("Panda_C"))
-        .unwrap_err()
-        .to_string();
+    let upper = refusal(&panda, Some("Panda_C"));
     assert!(
         upper.contains("the model name 'Panda_C' is not one") && upper.contains("('panda_c' is)"),
         "{upper}"

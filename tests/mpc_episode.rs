@@ -3,9 +3,19 @@
 use std::f64::consts::FRAC_PI_2;
 use toolconf_model::Term;
 
-use toolconf::mpc::{simulate_mpc, Mpc, MpcEpisodeError, MpcModel, MpcOptions};
+use toolconf::mpc::{simulate_mpc, Mpc, MpcEpisode, MpcEpisodeError, MpcModel, MpcOptions};
 use toolconf_model::closed_loop::EpisodeOptions;
 use toolconf_model::{Arm, Task, TaskKind, Vector2};
+
+/// The timing programs' shared part, for its median.
+#[path = "../benches/timing/common.rs"]
+mod timing;
+
+/// The episodes near the equilibrium: the paper's arm on [`near_task`] with `options` and the
+/// default MPC.
+fn near_episode(options: &EpisodeOptions) -> Result<MpcEpisode, MpcEpisodeError> {
+    simulate_mpc(&arm(), &near_task(), options, &MpcOptions::default())
+}
 
 fn arm() -> Arm {
     Arm::new([0.3, 0.4, 0.5, 0.2]).unwrap()
@@ -59,7 +69,7 @@ fn the_first_torque_is_the_controllers_answer_at_the_initial_state() {
         record_trajectory: true,
         ..EpisodeOptions::default()
     };
-    let episode = simulate_mpc(&arm(), &near_task(), &options, &MpcOptions::default()).unwrap();
+    let episode = near_episode(&options).unwrap();
     let mut mpc = Mpc::new(&arm(), &near_task(), &MpcOptions::default()).unwrap();
     assert_eq!(
         episode.trajectory.unwrap().of(Term::U)[0],
@@ -73,8 +83,8 @@ fn mpc_episodes_are_deterministic() {
         perturbation: 0.0,
         ..EpisodeOptions::default()
     };
-    let a = simulate_mpc(&arm(), &near_task(), &options, &MpcOptions::default()).unwrap();
-    let b = simulate_mpc(&arm(), &near_task(), &options, &MpcOptions::default()).unwrap();
+    let a = near_episode(&options).unwrap();
+    let b = near_episode(&options).unwrap();
     assert_eq!(a.metrics.task_error, b.metrics.task_error);
     assert_eq!(a.metrics.cost_j, b.metrics.cost_j);
     assert_eq!(a.metrics.qp_iterations, b.metrics.qp_iterations);
@@ -86,7 +96,7 @@ fn grids_that_do_not_fit_the_control_period_are_rejected() {
         dt: 0.07,
         ..EpisodeOptions::default()
     };
-    let err = simulate_mpc(&arm(), &near_task(), &options, &MpcOptions::default()).unwrap_err();
+    let err = near_episode(&options).unwrap_err();
     assert!(matches!(err, MpcEpisodeError::Input(_)), "{err}");
     assert!(err.to_string().contains("output step dt"), "{err}");
 }
@@ -187,13 +197,7 @@ fn measure_model_and_observer_choices() {
         if v.is_empty() {
             return f64::NAN;
         }
-        v.sort_by(f64::total_cmp);
-        let n = v.len();
-        if n % 2 == 1 {
-            v[n / 2]
-        } else {
-            0.5 * (v[n / 2 - 1] + v[n / 2])
-        }
+        timing::median(v)
     };
     println!("| model | observer (L) | ΔT | task | success | median task error | median ∫J | median time per step (µs) |");
     println!("|---|---|---|---|---|---|---|---|");

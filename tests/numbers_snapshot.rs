@@ -65,38 +65,47 @@ fn lagrangian_models_table() {
     }
 
     let mut out = String::new();
-    for p in [[0.3, 0.4, 0.5, 0.2], [0.1, 0.6, 0.6, 0.1]] {
-        let p = SVector::<f64, 4>::from(p);
-        writeln!(out, "arm2_exact {:?}", p.as_slice()).unwrap();
-        out += &rows("A", &arm2_exact::state_matrix(&p));
-        out += &rows("B", &arm2_exact::input_matrix(&p));
-        let eye = SMatrix::<f64, 2, 2>::identity();
-        out += &rows(
-            "Pi^U position",
-            &arm2_exact::position_control_confidence(&p, &(100.0 * eye), &(50.0 * eye), &eye, &eye),
-        );
-        out += &rows(
-            "Pi^U velocity",
-            &arm2_exact::velocity_control_confidence(&p, &(50.0 * eye), &eye, &eye),
-        );
+    // A model's A, B and Π^U rows at each parameter vector: the generated module, its joint
+    // count and its parameter count.
+    macro_rules! model_rows {
+        ($model:ident, $n:literal, $np:literal, $params:expr) => {
+            for p in $params {
+                let p = SVector::<f64, $np>::from(p);
+                writeln!(out, "{} {:?}", stringify!($model), p.as_slice()).unwrap();
+                out += &rows("A", &$model::state_matrix(&p));
+                out += &rows("B", &$model::input_matrix(&p));
+                let eye = SMatrix::<f64, $n, $n>::identity();
+                out += &rows(
+                    "Pi^U position",
+                    &$model::position_control_confidence(
+                        &p,
+                        &(100.0 * eye),
+                        &(50.0 * eye),
+                        &eye,
+                        &eye,
+                    ),
+                );
+                out += &rows(
+                    "Pi^U velocity",
+                    &$model::velocity_control_confidence(&p, &(50.0 * eye), &eye, &eye),
+                );
+            }
+        };
     }
-    for p in [
-        [0.3, 0.4, 0.2, 0.5, 0.2, 0.35],
-        [0.6, 0.1, 0.3, 0.1, 0.6, 0.2],
-    ] {
-        let p = SVector::<f64, 6>::from(p);
-        writeln!(out, "arm3 {:?}", p.as_slice()).unwrap();
-        out += &rows("A", &arm3::state_matrix(&p));
-        out += &rows("B", &arm3::input_matrix(&p));
-        let eye = SMatrix::<f64, 3, 3>::identity();
-        out += &rows(
-            "Pi^U position",
-            &arm3::position_control_confidence(&p, &(100.0 * eye), &(50.0 * eye), &eye, &eye),
-        );
-        out += &rows(
-            "Pi^U velocity",
-            &arm3::velocity_control_confidence(&p, &(50.0 * eye), &eye, &eye),
-        );
-    }
+    model_rows!(
+        arm2_exact,
+        2,
+        4,
+        [[0.3, 0.4, 0.5, 0.2], [0.1, 0.6, 0.6, 0.1]]
+    );
+    model_rows!(
+        arm3,
+        3,
+        6,
+        [
+            [0.3, 0.4, 0.2, 0.5, 0.2, 0.35],
+            [0.6, 0.1, 0.3, 0.1, 0.6, 0.2],
+        ]
+    );
     insta::assert_snapshot!(out);
 }

@@ -15,6 +15,8 @@ use toolconf_model::TaskKind;
 const DRAWER: &str = "examples/tools/drawer.csv";
 const PAPER_TASK: &str = "examples/tasks/paper_position.toml";
 const REACH_TASK: &str = "examples/tasks/reach_45.toml";
+/// The arm of the command line's examples: m1, m2, l1, l2.
+const ARM: &str = "0.3,0.4,0.5,0.2";
 
 fn run(args: &[&str], threads: Option<&str>) -> Output {
     let mut cmd = common::toolconf_command();
@@ -35,9 +37,29 @@ fn scratch(test: &str) -> PathBuf {
 }
 
 fn write(dir: &Path, name: &str, text: &str) -> String {
-    let path = dir.join(name);
-    std::fs::write(&path, text).unwrap();
-    path.display().to_string()
+    common::write_file(dir, name, text).display().to_string()
+}
+
+/// `toolconf rank --tools TOOLS --task TASK --json ARGS…`'s JSON, the run having succeeded.
+fn rank_json(tools: &str, task: &str, args: &[&str]) -> Value {
+    let mut all = vec!["rank", "--tools", tools, "--task", task, "--json"];
+    all.extend(args);
+    common::json_ok(&toolconf(&all))
+}
+
+/// `toolconf COMMAND --arm ARM --json ARGS…`'s JSON (`simulate`, `confidence`), the run having
+/// succeeded.
+fn arm_json(command: &str, arm: &str, args: &[&str]) -> Value {
+    let mut all = vec![command, "--arm", arm, "--json"];
+    all.extend(args);
+    common::json_ok(&toolconf(&all))
+}
+
+/// `toolconf select --json ARGS…`'s JSON, the run having succeeded.
+fn select_json(args: &[&str]) -> Value {
+    let mut all = vec!["select", "--json"];
+    all.extend(args);
+    common::json_ok(&toolconf(&all))
 }
 
 fn f(v: &Value, key: &str) -> f64 {
@@ -48,9 +70,7 @@ fn f(v: &Value, key: &str) -> f64 {
 
 #[test]
 fn the_readme_example_ranks_every_tool_by_free_energy() {
-    let v = common::json_ok(&toolconf(&[
-        "rank", "--tools", DRAWER, "--task", REACH_TASK, "--json",
-    ]));
+    let v = rank_json(DRAWER, REACH_TASK, &[]);
     let tools = v["tools"].as_array().unwrap();
     assert_eq!(tools.len(), 12);
     assert_eq!(v["tools_read"], 12);
@@ -92,12 +112,8 @@ fn the_readme_example_ranks_every_tool_by_free_energy() {
 /// gives for every tool, arm2_exact ones included).
 #[test]
 fn the_paper_task_as_a_file_equals_simulate_for_every_tool() {
-    let from_file = common::json_ok(&toolconf(&[
-        "rank", "--tools", DRAWER, "--task", PAPER_TASK, "--json",
-    ]));
-    let builtin = common::json_ok(&toolconf(&[
-        "rank", "--tools", DRAWER, "--task", "position", "--json",
-    ]));
+    let from_file = rank_json(DRAWER, PAPER_TASK, &[]);
+    let builtin = rank_json(DRAWER, "position", &[]);
     assert_eq!(from_file["tools"], builtin["tools"]);
     let mut compared = 0;
     for t in from_file["tools"].as_array().unwrap() {
@@ -106,9 +122,7 @@ fn the_paper_task_as_a_file_equals_simulate_for_every_tool() {
         }
         let p = &t["parameters"];
         let arm = format!("{},{},{},{}", p["m1"], p["m2"], p["l1"], p["l2"]);
-        let s = common::json_ok(&toolconf(&[
-            "simulate", "--arm", &arm, "--task", "position", "--json",
-        ]));
+        let s = arm_json("simulate", &arm, &["--task", "position"]);
         for key in ["task_error", "free_energy", "cost_j", "logdet"] {
             assert_eq!(f(t, key), f(&s, key), "{key} of {arm}");
         }
@@ -205,9 +219,7 @@ fn a_custom_goal_and_precision_agree_with_a_fine_step_integration() {
         ("default.toml", CUSTOM_TASK, 1e-3),
     ] {
         let task = write(&dir, file, text);
-        let v = common::json_ok(&toolconf(&[
-            "rank", "--tools", &tools, "--task", &task, "--json",
-        ]));
+        let v = rank_json(&tools, &task, &[]);
         for t in v["tools"].as_array().unwrap() {
             let p = &t["parameters"];
             let arm = ["m1", "m2", "l1", "l2"].map(|k| p[k].as_f64().unwrap());
@@ -298,28 +310,12 @@ fn results_do_not_depend_on_the_number_of_threads() {
 /// `--screen K` simulates the K tools with the largest ln|Π^U|, which `confidence` computes.
 #[test]
 fn the_screen_keeps_the_most_confident_tools() {
-    let all = common::json_ok(&toolconf(&[
-        "rank",
-        "--tools",
+    let all = rank_json(DRAWER, "velocity", &["--objective", "confidence"]);
+    let screened = rank_json(
         DRAWER,
-        "--task",
         "velocity",
-        "--json",
-        "--objective",
-        "confidence",
-    ]));
-    let screened = common::json_ok(&toolconf(&[
-        "rank",
-        "--tools",
-        DRAWER,
-        "--task",
-        "velocity",
-        "--json",
-        "--screen",
-        "4",
-        "--objective",
-        "confidence",
-    ]));
+        &["--screen", "4", "--objective", "confidence"],
+    );
     let names = |v: &Value, n: usize| -> Vec<Value> {
         v["tools"].as_array().unwrap()[..n]
             .iter()
@@ -333,14 +329,7 @@ fn the_screen_keeps_the_most_confident_tools() {
     let p = &top["parameters"];
     if top["model"] == "arm2" {
         let arm = format!("{},{},{},{}", p["m1"], p["m2"], p["l1"], p["l2"]);
-        let c = common::json_ok(&toolconf(&[
-            "confidence",
-            "--arm",
-            &arm,
-            "--task",
-            "velocity",
-            "--json",
-        ]));
+        let c = arm_json("confidence", &arm, &["--task", "velocity"]);
         assert_eq!(f(&c, "logdet"), f(top, "logdet"));
     }
 }
@@ -418,22 +407,8 @@ fn a_json_tools_file_gives_what_the_same_csv_gives() {
         r#"[{"name": "x", "m1": 0.3, "m2": 0.4, "l1": 0.5, "l2": 0.2},
             {"name": "y", "model": "arm3", "m1": 0.3, "m2": 0.25, "m3": 0.2, "l1": 0.4, "l2": 0.35, "l3": 0.3}]"#,
     );
-    let a = common::json_ok(&toolconf(&[
-        "rank",
-        "--tools",
-        &csv,
-        "--task",
-        "acceleration",
-        "--json",
-    ]));
-    let b = common::json_ok(&toolconf(&[
-        "rank",
-        "--tools",
-        &json,
-        "--task",
-        "acceleration",
-        "--json",
-    ]));
+    let a = rank_json(&csv, "acceleration", &[]);
+    let b = rank_json(&json, "acceleration", &[]);
     assert_eq!(a["tools"], b["tools"]);
     assert_eq!(a["tools"].as_array().unwrap().len(), 2);
 }
@@ -485,9 +460,7 @@ fn a_failed_tool_keeps_its_error_and_goes_last() {
         "kind = \"position\"\n[precision]\ntheta = [[1.0, 0.0], [0.0, 0.0]]\ntheta_dot = 0.0\n\
          theta_ddot = 0.0\nu = [[0.0, 0.0], [0.0, 1.0]]\n[episode]\nt_end = 0.5\n",
     );
-    let v = common::json_ok(&toolconf(&[
-        "rank", "--tools", &tools, "--task", &singular, "--json",
-    ]));
+    let v = rank_json(&tools, &singular, &[]);
     let tools_json = v["tools"].as_array().unwrap();
     assert_eq!(tools_json.len(), 3);
     assert_eq!(tools_json[2]["name"], "singular");
@@ -738,79 +711,30 @@ fn every_bad_task_file_is_refused_naming_file_key_and_value() {
 
 #[test]
 fn simulate_and_confidence_take_a_task_file() {
-    let p = common::json_ok(&toolconf(&[
-        "simulate",
-        "--arm",
-        "0.3,0.4,0.5,0.2",
-        "--task-file",
-        PAPER_TASK,
-        "--json",
-    ]));
-    let q = common::json_ok(&toolconf(&[
-        "simulate",
-        "--arm",
-        "0.3,0.4,0.5,0.2",
-        "--task",
-        "position",
-        "--json",
-    ]));
+    let p = arm_json("simulate", ARM, &["--task-file", PAPER_TASK]);
+    let q = arm_json("simulate", ARM, &["--task", "position"]);
     for key in ["task_error", "free_energy", "cost_j", "logdet"] {
         assert_eq!(f(&p, key), f(&q, key), "{key}");
     }
-    let c = common::json_ok(&toolconf(&[
-        "confidence",
-        "--arm",
-        "0.3,0.4,0.5,0.2",
-        "--task-file",
-        REACH_TASK,
-        "--json",
-    ]));
+    let c = arm_json("confidence", ARM, &["--task-file", REACH_TASK]);
     // Π^U of the file's precisions differs from the paper's task 1 (P^θ is not 100·I).
-    let paper = common::json_ok(&toolconf(&[
-        "confidence",
-        "--arm",
-        "0.3,0.4,0.5,0.2",
-        "--task",
-        "position",
-        "--json",
-    ]));
+    let paper = arm_json("confidence", ARM, &["--task", "position"]);
     assert_ne!(c["logdet"], paper["logdet"]);
     // A command-line flag overrides the file's [episode].
-    let shorter = common::json_ok(&toolconf(&[
+    let shorter = arm_json(
         "simulate",
-        "--arm",
-        "0.3,0.4,0.5,0.2",
-        "--task-file",
-        REACH_TASK,
-        "--t-end",
-        "1",
-        "--json",
-    ]));
-    let full = common::json_ok(&toolconf(&[
-        "simulate",
-        "--arm",
-        "0.3,0.4,0.5,0.2",
-        "--task-file",
-        REACH_TASK,
-        "--json",
-    ]));
+        ARM,
+        &["--task-file", REACH_TASK, "--t-end", "1"],
+    );
+    let full = arm_json("simulate", ARM, &["--task-file", REACH_TASK]);
     assert!(f(&shorter, "rhs_evals") < f(&full, "rhs_evals"));
     assert_eq!(full["perturb"], serde_json::json!([0.3, -0.2]));
 }
 
 #[test]
 fn select_takes_a_task_file_for_each_drawn_model() {
-    let s = common::json_ok(&toolconf(&[
-        "select",
-        "--task-file",
-        PAPER_TASK,
-        "--tools",
-        "3",
-        "--json",
-    ]));
-    let t = common::json_ok(&toolconf(&[
-        "select", "--task", "position", "--tools", "3", "--json",
-    ]));
+    let s = select_json(&["--task-file", PAPER_TASK, "--tools", "3"]);
+    let t = select_json(&["--task", "position", "--tools", "3"]);
     // The same episodes; the task file adds each tool's prediction.
     let mut from_file = s["tools"].clone();
     for tool in from_file.as_array_mut().unwrap() {
@@ -820,16 +744,14 @@ fn select_takes_a_task_file_for_each_drawn_model() {
     }
     assert_eq!(from_file, t["tools"]);
     // Drawn tools of several models each run the file's task bound to their model...
-    let mixed = common::json_ok(&toolconf(&[
-        "select",
+    let mixed = select_json(&[
         "--task-file",
         REACH_TASK,
         "--models",
         "arm2,arm2_exact",
         "--tools",
         "4",
-        "--json",
-    ]));
+    ]);
     assert_eq!(mixed["tools"].as_array().unwrap().len(), 4);
     assert!(mixed["tools"]
         .as_array()
@@ -859,7 +781,7 @@ fn a_task_file_that_does_not_fit_the_arm_is_refused() {
         "three.toml",
         "kind = \"position\"\n[goal]\ntheta = [0.1, 0.2, 0.3]\n",
     );
-    let out = toolconf(&["simulate", "--arm", "0.3,0.4,0.5,0.2", "--task-file", &task]);
+    let out = toolconf(&["simulate", "--arm", ARM, "--task-file", &task]);
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
@@ -880,13 +802,7 @@ fn an_episode_too_long_to_hold_is_refused_up_front() {
         &["--csv", "/dev/null"][..],
     ] {
         let mut args = vec![
-            "simulate",
-            "--arm",
-            "0.3,0.4,0.5,0.2",
-            "--task",
-            "position",
-            "--t-end",
-            "1e5",
+            "simulate", "--arm", ARM, "--task", "position", "--t-end", "1e5",
         ];
         args.extend(extra);
         let out = toolconf(&args);

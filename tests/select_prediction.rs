@@ -50,22 +50,8 @@ fn select_on_a_task_file_gives_each_tools_prediction() {
     let tools = v["tools"].as_array().unwrap();
     assert_eq!(tools.len(), 3);
     for t in tools {
-        let names = [
-            "tool_mass",
-            "tool_com_x",
-            "tool_com_y",
-            "tool_com_z",
-            "tool_ixx",
-            "tool_iyy",
-            "tool_izz",
-            "tool_ixy",
-            "tool_ixz",
-            "tool_iyz",
-            "tool_tip_x",
-            "tool_tip_y",
-            "tool_tip_z",
-        ];
-        let params: Vec<String> = names
+        // The Panda's tool parameters, in the model's order.
+        let params: Vec<String> = toolconf_generated::panda::PARAMETER_NAMES
             .iter()
             .map(|n| format!("{}", t["arm"][n].as_f64().unwrap()))
             .collect();

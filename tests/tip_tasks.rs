@@ -271,6 +271,17 @@ fn the_tip_sensitivities_are_the_tip_jacobian_times_the_joints() {
     }
 }
 
+/// Why the task file `t.toml` holding `text` is refused for the model `M`.
+fn task_refusal<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    text: &str,
+) -> String
+where
+    M: ArmModel<N, NX, NP, NZ>,
+{
+    let spec = TaskSpec::parse(text, "t.toml").unwrap();
+    spec.task::<M, N, NX, NP, NZ>().unwrap_err().to_string()
+}
+
 #[test]
 fn task_files_give_tip_goals_with_the_tips_components() {
     let spec = TaskSpec::parse(
@@ -293,27 +304,16 @@ fn task_files_give_tip_goals_with_the_tips_components() {
     );
     assert_eq!(term_components(Term::Tip, 7, Panda::tip_dim()), 3);
 
-    let e = TaskSpec::parse(
-        "kind = \"tip_position\"\n[goal]\ntip = [0.5, 0.0]\n",
-        "t.toml",
-    )
-    .unwrap()
-    .task::<Panda, 7, 14, 13, 21>()
-    .unwrap_err()
-    .to_string();
+    let e =
+        task_refusal::<Panda, 7, 14, 13, 21>("kind = \"tip_position\"\n[goal]\ntip = [0.5, 0.0]\n");
     assert!(
         e.contains("t.toml, key goal.tip: 2 values") && e.contains("has 3 components (x, y, z)"),
         "{e}"
     );
     // The planar arm's tip has its plane's two components.
-    let e = TaskSpec::parse(
+    let e = task_refusal::<Arm2, 2, 4, 4, 6>(
         "kind = \"tip_position\"\n[goal]\ntip = [0.5, 0.0, 0.4]\n",
-        "t.toml",
-    )
-    .unwrap()
-    .task::<Arm2, 2, 4, 4, 6>()
-    .unwrap_err()
-    .to_string();
+    );
     assert!(e.contains("has 2 components (x, y)"), "{e}");
 }
 
@@ -344,15 +344,13 @@ fn a_tip_position_episode_reaches_its_goal_on_every_catalogue_tool() {
 
 #[test]
 fn a_tip_task_refuses_a_tools_file_row_without_a_tip() {
-    let dir = common::fresh_dir("tip-tasks");
-    let path = dir.join("no_tips.csv");
-    std::fs::write(
-        &path,
+    let path = common::fresh_file(
+        "tip-tasks",
+        "no_tips.csv",
         "name,model,tool_mass,tool_com_x,tool_com_y,tool_com_z,tool_ixx,tool_iyy,tool_izz\n\
          plate,panda,0.5,0,0,0.01,1e-3,1e-3,1e-3\n\
          probe,panda,0.2,0,0,0.05,1e-4,1e-4,1e-4\n",
-    )
-    .unwrap();
+    );
     let tip = ModelTasks::new(&TaskSpec::builtin(TaskKind::TipPosition));
     let all_refused = screen_file(&path, &tip, "tip_position", None, false, |_| {})
         .err()
@@ -361,7 +359,7 @@ fn a_tip_task_refuses_a_tools_file_row_without_a_tip() {
     // A joint task takes the same rows, their tips at the flange.
     let joint = ModelTasks::new(&TaskSpec::builtin(TaskKind::Velocity));
     let joint_screen = screen_file(&path, &joint, "velocity", None, false, |_| {});
-    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
     assert!(
         all_refused.contains("no_tips.csv, tool 1: the tip_position task reads the tool's tip")
             && all_refused.contains("leaves out tool_tip_x, tool_tip_y, tool_tip_z"),

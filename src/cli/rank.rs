@@ -349,25 +349,16 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let by = screen_by(args);
     let checks = (!sample.is_empty()).then(|| validation_checks(sample, &results, &tasks, by));
     let notes = notes(&spec, checks.as_ref(), by, &counts, &results);
-    if args.json {
-        let mut out = rank_json(args, &spec, objective, &counts, &results, &order, &timing);
-        if let Some((check, prediction)) = &checks {
-            out["confidence_check"] = check.json();
-            if let Some(p) = prediction {
-                out["prediction_check"] = p.json();
-            }
-        }
-        out["notes"] = json!(notes);
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&out).expect("finite numbers")
-        );
-    } else {
-        print_text(args, &spec, objective, &counts, &results, &order, &timing);
-        for note in &notes {
-            outln!("note: {note}");
-        }
-    }
+    let ranked = Ranked {
+        args,
+        spec: &spec,
+        objective,
+        counts: &counts,
+        results: &results,
+        order: &order,
+        timing: &timing,
+    };
+    print_ranking(ranked, checks.as_ref(), &notes);
     if let Some(dir) = &args.report {
         let command: Vec<String> = std::env::args().collect();
         let input = ReportInput {
@@ -563,38 +554,70 @@ fn notes(
         .collect()
 }
 
-fn rank_json(
-    args: &Args,
-    spec: &TaskSpec,
+/// What a ranking run's output (its JSON or its text) is written from.
+#[derive(Clone, Copy)]
+struct Ranked<'a> {
+    args: &'a Args,
+    spec: &'a TaskSpec,
     objective: Objective,
-    counts: &Counts,
-    results: &[RankedTool],
-    order: &[usize],
-    timing: &StageTimings,
-) -> Value {
+    counts: &'a Counts,
+    results: &'a [RankedTool],
+    order: &'a [usize],
+    timing: &'a StageTimings,
+}
+
+/// The ranking on stdout: its JSON (with the validation checks and the notes) or its text
+/// (with the notes).
+fn print_ranking(
+    ranked: Ranked,
+    checks: Option<&(ConfidenceCheck, Option<PredictionCheck>)>,
+    notes: &[String],
+) {
+    if ranked.args.json {
+        let mut out = rank_json(ranked);
+        if let Some((check, prediction)) = checks {
+            out["confidence_check"] = check.json();
+            if let Some(p) = prediction {
+                out["prediction_check"] = p.json();
+            }
+        }
+        out["notes"] = json!(notes);
+        outln!(
+            "{}",
+            serde_json::to_string_pretty(&out).expect("finite numbers")
+        );
+    } else {
+        print_text(ranked);
+        for note in notes {
+            outln!("note: {note}");
+        }
+    }
+}
+
+fn rank_json(r: Ranked) -> Value {
     let mut v = json!({
-        "task": spec.kind,
-        "task_file": (!spec.file.is_empty()).then_some(&spec.file),
-        "tools_file": args.tools,
-        "objective": objective.name(),
-        "method": spec.episode.method.unwrap_or_default().describe(),
-        "tools_read": counts.read,
-        "skipped_rows": counts.skipped,
-        "screen": args.screen,
-        "without_confidence": counts.without_confidence,
-        "simulated": results.len(),
-        "timing": timing_json(timing),
-        "tools": order
+        "task": r.spec.kind,
+        "task_file": (!r.spec.file.is_empty()).then_some(&r.spec.file),
+        "tools_file": r.args.tools,
+        "objective": r.objective.name(),
+        "method": r.spec.episode.method.unwrap_or_default().describe(),
+        "tools_read": r.counts.read,
+        "skipped_rows": r.counts.skipped,
+        "screen": r.args.screen,
+        "without_confidence": r.counts.without_confidence,
+        "simulated": r.results.len(),
+        "timing": timing_json(r.timing),
+        "tools": r.order
             .iter()
             .enumerate()
-            .map(|(k, &i)| tool_json(k + 1, &results[i]))
+            .map(|(k, &i)| tool_json(k + 1, &r.results[i]))
             .collect::<Vec<_>>(),
-        "goal": spec.tip_goal.kind_name(),
+        "goal": r.spec.tip_goal.kind_name(),
     });
     // Only with a screen, so that the output without one is unchanged.
-    if args.screen.is_some() {
-        v["screen_by"] = json!(screen_by(args).name());
-        v["without_prediction"] = json!(counts.without_prediction);
+    if r.args.screen.is_some() {
+        v["screen_by"] = json!(screen_by(r.args).name());
+        v["without_prediction"] = json!(r.counts.without_prediction);
     }
     v
 }
@@ -607,46 +630,39 @@ fn predicted_name(objective: Objective) -> &'static str {
     }
 }
 
-fn print_text(
-    args: &Args,
-    spec: &TaskSpec,
-    objective: Objective,
-    counts: &Counts,
-    results: &[RankedTool],
-    order: &[usize],
-    timing: &StageTimings,
-) {
+fn print_text(r: Ranked) {
     outln!(
         "tools: {}    task: {}    ranked by: {}",
-        args.tools.display(),
-        spec.label(),
-        objective.name()
+        r.args.tools.display(),
+        r.spec.label(),
+        r.objective.name()
     );
     outln!(
         "integration method: {}",
-        spec.episode.method.unwrap_or_default().describe()
+        r.spec.episode.method.unwrap_or_default().describe()
     );
-    let screened = args
+    let screened = r
+        .args
         .screen
-        .map_or(String::new(), |k| match screen_by(args) {
+        .map_or(String::new(), |k| match screen_by(r.args) {
             ScreenBy::Confidence => format!(
                 "    screened to the {k} most confident ({} without a confidence)",
-                counts.without_confidence
+                r.counts.without_confidence
             ),
             ScreenBy::Predicted(o) => format!(
             "    screened to the {k} with the lowest predicted {} ({} without a confidence, {} \
              without a prediction)",
             predicted_name(o),
-            counts.without_confidence,
-            counts.without_prediction
+            r.counts.without_confidence,
+            r.counts.without_prediction
         ),
         });
     outln!(
         "read {} tools    skipped {} bad rows    simulated {}{screened}",
-        counts.read,
-        counts.skipped,
-        results.len()
+        r.counts.read,
+        r.counts.skipped,
+        r.results.len()
     );
-    print_table(results, order);
-    outln!("{}", timing_text(timing));
+    print_table(r.results, r.order);
+    outln!("{}", timing_text(r.timing));
 }

@@ -84,21 +84,23 @@ pub fn run(args: &Args) -> Result<(), CliError> {
         return run_mixed(args);
     }
     let selection = select(args)?;
-    let errors = selection
-        .results
-        .iter()
-        .filter_map(|r| r.episode.as_ref().err());
-    let outcome = every_tool_failed(selection.results.len(), errors);
     emit(
         args,
+        selection.results.iter().map(|r| r.episode.as_ref().err()),
         || selection_json(args, &selection),
         || print_selection(args, &selection),
-    );
-    outcome
+    )
 }
 
-/// A selection's output: the `--json` object `json` builds, or the table `table` prints.
-fn emit(args: &Args, json: impl FnOnce() -> Value, table: impl FnOnce()) {
+/// A selection's output: the `--json` object `json` builds, or the table `table` prints; then
+/// the run's outcome, [`every_tool_failed`] of the tools' episodes (each one's error, if any).
+fn emit<'a, E: std::fmt::Display + 'a>(
+    args: &Args,
+    episodes: impl ExactSizeIterator<Item = Option<&'a E>>,
+    json: impl FnOnce() -> Value,
+    table: impl FnOnce(),
+) -> Result<(), CliError> {
+    let outcome = every_tool_failed(episodes.len(), episodes.flatten());
     if args.json {
         outln!(
             "{}",
@@ -107,6 +109,7 @@ fn emit(args: &Args, json: impl FnOnce() -> Value, table: impl FnOnce()) {
     } else {
         table();
     }
+    outcome
 }
 
 /// Draws the tools and runs each one's episode (and MPC episode, with `--mpc`).
@@ -389,17 +392,12 @@ struct MixedSelection {
 /// Selection over tools of several models (each on its own model's paper-style task).
 fn run_mixed(args: &Args) -> Result<(), CliError> {
     let selection = select_mixed(args)?;
-    let errors = selection
-        .results
-        .iter()
-        .filter_map(|r| r.episode.as_ref().err());
-    let outcome = every_tool_failed(selection.results.len(), errors);
     emit(
         args,
+        selection.results.iter().map(|r| r.episode.as_ref().err()),
         || mixed_selection_json(args, &selection),
         || print_mixed_selection(args, &selection),
-    );
-    outcome
+    )
 }
 
 /// Draws the tools of the models and runs each one's episode.

@@ -59,6 +59,34 @@ pub fn fresh_dir(name: &str) -> std::path::PathBuf {
     dir
 }
 
+/// Writes `text` to the file `name` in `dir`: its path.
+pub fn write_file(dir: &std::path::Path, name: &str, text: &str) -> std::path::PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// A [`fresh_dir`] `dir` holding one file, `name` with `text`: the file's path.
+pub fn fresh_file(dir: &str, name: &str, text: &str) -> std::path::PathBuf {
+    write_file(&fresh_dir(dir), name, text)
+}
+
+/// `result` is the refusal of precisions under which Π^U has rank 0 for every tool of `joints`
+/// joints.
+#[track_caller]
+pub fn assert_rank_zero<T: std::fmt::Debug>(
+    result: Result<T, toolconf_model::model::Error>,
+    joints: usize,
+) {
+    assert!(
+        matches!(
+            &result,
+            Err(toolconf_model::model::Error::ConfidenceRank { rank: 0, joints: j, .. }) if *j == joints
+        ),
+        "{result:?}"
+    );
+}
+
 /// Caps `cmd`'s address space at 2 GB, so that an allocation beyond it aborts the run rather
 /// than taking the machine's memory.
 pub fn limit_memory(cmd: &mut Command) -> &mut Command {

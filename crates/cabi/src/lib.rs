@@ -76,6 +76,23 @@ pub extern "C" fn tasks_fingerprint() -> *const c_char {
     fingerprint::c_hex().as_ptr()
 }
 
+/// The exports [`export_model!`] forwards to its model's `ToolconfBodies`: for each, its doc,
+/// its C name, the body it calls and its arguments (each written once, for the signature and
+/// the call).
+#[doc(hidden)]
+#[macro_export]
+macro_rules! export_forwards {
+    ($($(#[$doc:meta])* $export:ident => $body:ident($($arg:ident: $ty:ty),* $(,)?);)*) => {
+        $(
+            $(#[$doc])*
+            #[no_mangle]
+            pub unsafe extern "C" fn $export($($arg: $ty),*) -> i32 {
+                ToolconfBodies::$body($($arg),*)
+            }
+        )*
+    };
+}
+
 /// Defines the exports of a model library for one generated model: `export_model!(Panda,
 /// panda)` with the marker type of toolconf-core (`toolconf_core::Panda`) and the model's module
 /// in the generated crate. It also defines `EXPORTS`, the same functions as an [`Exports`] table
@@ -134,204 +151,78 @@ macro_rules! export_model {
             $crate::status_name(status)
         }
 
-        /// Whether `params` is a valid tool by the model's rule.
-        #[no_mangle]
-        pub unsafe extern "C" fn toolconf_check_tool(params: *const f64) -> i32 {
-            ToolconfBodies::check_tool(params)
-        }
-
-        /// Ẋ = f(X, U; p).
-        #[no_mangle]
-        pub unsafe extern "C" fn toolconf_dynamics(
-            x: *const f64,
-            u: *const f64,
-            params: *const f64,
-            x_dot: *mut f64,
-        ) -> i32 {
-            ToolconfBodies::dynamics(x, u, params, x_dot)
-        }
-
-        /// (∂f/∂X, ∂f/∂U) at (X, U).
-        #[no_mangle]
-        pub unsafe extern "C" fn toolconf_dynamics_jacobian(
-            x: *const f64,
-            u: *const f64,
-            params: *const f64,
-            f_x: *mut f64,
-            f_u: *mut f64,
-        ) -> i32 {
-            ToolconfBodies::dynamics_jacobian(x, u, params, f_x, f_u)
-        }
-
-        /// The rigid-body dynamics alone, U the joint torques.
-        #[no_mangle]
-        pub unsafe extern "C" fn toolconf_rigid_body_dynamics(
-            x: *const f64,
-            u: *const f64,
-            params: *const f64,
-            x_dot: *mut f64,
-        ) -> i32 {
-            ToolconfBodies::rigid_body_dynamics(x, u, params, x_dot)
-        }
-
-        /// The tool tip y(q) and its Jacobian ∂y/∂q (3 × N).
-        #[no_mangle]
-        pub unsafe extern "C" fn toolconf_tip(
-            q: *const f64,
-            params: *const f64,
-            position: *mut f64,
-            jacobian: *mut f64,
-        ) -> i32 {
-            ToolconfBodies::tip(q, params, position, jacobian)
-        }
-
-        /// The tip's acceleration at q̈ = 0, J̇(q, q̇) q̇ (3).
-        #[no_mangle]
-        pub unsafe extern "C" fn toolconf_tip_bias(
-            q: *const f64,
-            q_dot: *const f64,
-            params: *const f64,
-            bias: *mut f64,
-        ) -> i32 {
-            ToolconfBodies::tip_bias(q, q_dot, params, bias)
-        }
-
-        /// A = ∂f/∂X at the equilibrium.
-        #[no_mangle]
-        pub unsafe extern "C" fn toolconf_state_matrix(params: *const f64, a: *mut f64) -> i32 {
-            ToolconfBodies::state_matrix(params, a)
-        }
-
-        /// B = ∂f/∂U at the equilibrium.
-        #[no_mangle]
-        pub unsafe extern "C" fn toolconf_input_matrix(params: *const f64, b: *mut f64) -> i32 {
-            ToolconfBodies::input_matrix(params, b)
-        }
-
-        /// The model's default goals and precisions of a task.
-        #[no_mangle]
-        pub unsafe extern "C" fn toolconf_task_defaults(
-            task: u32,
-            goals: *mut f64,
-            precisions: *mut f64,
-        ) -> i32 {
-            ToolconfBodies::task_defaults(task, goals, precisions)
-        }
-
-        /// A task's sensitivities ∂(term)/∂U.
-        #[no_mangle]
-        pub unsafe extern "C" fn toolconf_sensitivities(
-            task: u32,
-            params: *const f64,
-            sensitivities: *mut f64,
-            used: *mut i32,
-        ) -> i32 {
-            ToolconfBodies::sensitivities(task, params, sensitivities, used)
-        }
-
-        /// Π^U of a task for a tool, given the precisions (the closed form, unvalidated).
-        #[no_mangle]
-        pub unsafe extern "C" fn toolconf_pi_u(
-            task: u32,
-            params: *const f64,
-            precisions: *const f64,
-            pi_u: *mut f64,
-        ) -> i32 {
-            ToolconfBodies::pi_u(task, params, precisions, pi_u)
-        }
-
-        /// ∂ln|Π^U|/∂p (the closed form, unvalidated).
-        #[no_mangle]
-        pub unsafe extern "C" fn toolconf_logdet_gradient(
-            task: u32,
-            params: *const f64,
-            precisions: *const f64,
-            gradient: *mut f64,
-        ) -> i32 {
-            ToolconfBodies::logdet_gradient(task, params, precisions, gradient)
-        }
-
-        /// Π^U and ln|Π^U| of a valid tool on a valid task.
-        #[no_mangle]
-        pub unsafe extern "C" fn toolconf_control_confidence(
-            task: u32,
-            params: *const f64,
-            goals: *const f64,
-            precisions: *const f64,
-            pi_u: *mut f64,
-            logdet: *mut f64,
-        ) -> i32 {
-            ToolconfBodies::control_confidence(task, params, goals, precisions, pi_u, logdet)
-        }
-
-        /// A controller of a tool for a task (the on-robot controller), into `*controller`.
-        #[no_mangle]
-        pub unsafe extern "C" fn toolconf_controller_create(
-            params: *const f64,
-            task: u32,
-            goals: *const f64,
-            precisions: *const f64,
-            learning_rate: f64,
-            initial_torque: *const f64,
-            rate_hz: f64,
-            controller: *mut *mut $crate::bodies::Controller,
-        ) -> i32 {
-            ToolconfBodies::controller_create(
-                params,
-                task,
-                goals,
-                precisions,
-                learning_rate,
-                initial_torque,
-                rate_hz,
-                controller,
-            )
-        }
-
-        /// Frees a controller (NULL: nothing).
-        #[no_mangle]
-        pub unsafe extern "C" fn toolconf_controller_destroy(
-            controller: *mut $crate::bodies::Controller,
-        ) -> i32 {
-            ToolconfBodies::controller_destroy(controller)
-        }
-
-        /// One tick: the measured state in, the torque and ln|Π^U| out.
-        #[no_mangle]
-        pub unsafe extern "C" fn toolconf_controller_tick(
-            controller: *mut $crate::bodies::Controller,
-            state: *const f64,
-            torque: *mut f64,
-            confidence: *mut f64,
-        ) -> i32 {
-            ToolconfBodies::controller_tick(controller, state, torque, confidence)
-        }
-
-        /// One tick with the joint accelerations measured too.
-        #[no_mangle]
-        pub unsafe extern "C" fn toolconf_controller_tick_with_acceleration(
-            controller: *mut $crate::bodies::Controller,
-            state: *const f64,
-            acceleration: *const f64,
-            torque: *mut f64,
-            confidence: *mut f64,
-        ) -> i32 {
-            ToolconfBodies::controller_tick_with_acceleration(
-                controller,
-                state,
-                acceleration,
-                torque,
-                confidence,
-            )
-        }
-
-        /// The controller's Π^U (N × N).
-        #[no_mangle]
-        pub unsafe extern "C" fn toolconf_controller_pi_u(
-            controller: *const $crate::bodies::Controller,
-            pi_u: *mut f64,
-        ) -> i32 {
-            ToolconfBodies::controller_pi_u(controller, pi_u)
+        $crate::export_forwards! {
+            /// Whether `params` is a valid tool by the model's rule.
+            toolconf_check_tool => check_tool(params: *const f64);
+            /// Ẋ = f(X, U; p).
+            toolconf_dynamics => dynamics(
+                x: *const f64, u: *const f64, params: *const f64, x_dot: *mut f64,
+            );
+            /// (∂f/∂X, ∂f/∂U) at (X, U).
+            toolconf_dynamics_jacobian => dynamics_jacobian(
+                x: *const f64, u: *const f64, params: *const f64, f_x: *mut f64, f_u: *mut f64,
+            );
+            /// The rigid-body dynamics alone, U the joint torques.
+            toolconf_rigid_body_dynamics => rigid_body_dynamics(
+                x: *const f64, u: *const f64, params: *const f64, x_dot: *mut f64,
+            );
+            /// The tool tip y(q) and its Jacobian ∂y/∂q (3 × N).
+            toolconf_tip => tip(
+                q: *const f64, params: *const f64, position: *mut f64, jacobian: *mut f64,
+            );
+            /// The tip's acceleration at q̈ = 0, J̇(q, q̇) q̇ (3).
+            toolconf_tip_bias => tip_bias(
+                q: *const f64, q_dot: *const f64, params: *const f64, bias: *mut f64,
+            );
+            /// A = ∂f/∂X at the equilibrium.
+            toolconf_state_matrix => state_matrix(params: *const f64, a: *mut f64);
+            /// B = ∂f/∂U at the equilibrium.
+            toolconf_input_matrix => input_matrix(params: *const f64, b: *mut f64);
+            /// The model's default goals and precisions of a task.
+            toolconf_task_defaults => task_defaults(
+                task: u32, goals: *mut f64, precisions: *mut f64,
+            );
+            /// A task's sensitivities ∂(term)/∂U.
+            toolconf_sensitivities => sensitivities(
+                task: u32, params: *const f64, sensitivities: *mut f64, used: *mut i32,
+            );
+            /// Π^U of a task for a tool, given the precisions (the closed form, unvalidated).
+            toolconf_pi_u => pi_u(
+                task: u32, params: *const f64, precisions: *const f64, pi_u: *mut f64,
+            );
+            /// ∂ln|Π^U|/∂p (the closed form, unvalidated).
+            toolconf_logdet_gradient => logdet_gradient(
+                task: u32, params: *const f64, precisions: *const f64, gradient: *mut f64,
+            );
+            /// Π^U and ln|Π^U| of a valid tool on a valid task.
+            toolconf_control_confidence => control_confidence(
+                task: u32, params: *const f64, goals: *const f64, precisions: *const f64,
+                pi_u: *mut f64, logdet: *mut f64,
+            );
+            /// A controller of a tool for a task (the on-robot controller), into `*controller`.
+            toolconf_controller_create => controller_create(
+                params: *const f64, task: u32, goals: *const f64, precisions: *const f64,
+                learning_rate: f64, initial_torque: *const f64, rate_hz: f64,
+                controller: *mut *mut $crate::bodies::Controller,
+            );
+            /// Frees a controller (NULL: nothing).
+            toolconf_controller_destroy => controller_destroy(
+                controller: *mut $crate::bodies::Controller,
+            );
+            /// One tick: the measured state in, the torque and ln|Π^U| out.
+            toolconf_controller_tick => controller_tick(
+                controller: *mut $crate::bodies::Controller, state: *const f64, torque: *mut f64,
+                confidence: *mut f64,
+            );
+            /// One tick with the joint accelerations measured too.
+            toolconf_controller_tick_with_acceleration => controller_tick_with_acceleration(
+                controller: *mut $crate::bodies::Controller, state: *const f64,
+                acceleration: *const f64, torque: *mut f64, confidence: *mut f64,
+            );
+            /// The controller's Π^U (N × N).
+            toolconf_controller_pi_u => controller_pi_u(
+                controller: *const $crate::bodies::Controller, pi_u: *mut f64,
+            );
         }
 
         /// Every export as a table of function pointers (the library's own tests go through it).

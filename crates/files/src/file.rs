@@ -266,38 +266,39 @@ pub fn create_streaming(path: &Path) -> io::Result<Streaming> {
 mod tests {
     use super::*;
 
-    fn scratch(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("toolconf-out-{name}-{}", std::process::id()));
-        let _ = fs::remove_dir_all(&dir);
-        fs::create_dir_all(&dir).unwrap();
-        dir
+    use crate::test_support::entries;
+
+    fn scratch(name: &str) -> crate::test_support::Scratch {
+        crate::test_support::scratch("out", name)
     }
 
-    fn entries(dir: &Path) -> Vec<String> {
-        let mut names: Vec<String> = fs::read_dir(dir)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .collect();
-        names.sort();
-        names
+    /// [`scratch`] and the path of a file `file` in it.
+    fn scratch_file(name: &str, file: &str) -> (crate::test_support::Scratch, PathBuf) {
+        let dir = scratch(name);
+        let path = dir.join(file);
+        (dir, path)
+    }
+
+    /// `path` holds `bytes` and is all `dir` holds: no temporary file left beside it.
+    #[track_caller]
+    fn assert_alone(dir: &Path, path: &Path, bytes: &[u8]) {
+        assert_eq!(fs::read(path).unwrap(), bytes);
+        let name = path.file_name().unwrap().to_string_lossy();
+        assert_eq!(entries(dir), [name]);
     }
 
     #[test]
     fn new_and_regular_files_are_replaced_whole() {
-        let dir = scratch("regular");
-        let path = dir.join("a.csv");
+        let (dir, path) = scratch_file("regular", "a.csv");
         write_whole(&path, b"one\n").unwrap();
         write_whole(&path, b"two\n").unwrap();
-        assert_eq!(fs::read(&path).unwrap(), b"two\n");
-        assert_eq!(entries(&dir), ["a.csv"]);
-        fs::remove_dir_all(&dir).unwrap();
+        assert_alone(&dir, &path, b"two\n");
     }
 
     #[cfg(unix)]
     #[test]
     fn a_link_is_written_through_and_stays_a_link() {
-        let dir = scratch("link");
-        let target = dir.join("target.csv");
+        let (dir, target) = scratch_file("link", "target.csv");
         fs::write(&target, b"old").unwrap();
         let link = dir.join("link.csv");
         std::os::unix::fs::symlink(&target, &link).unwrap();
@@ -320,13 +321,11 @@ mod tests {
         );
         assert_eq!(check_folder(&dangling), Err(e.to_string()));
         assert_eq!(entries(&dir), ["dangling.csv", "link.csv", "target.csv"]);
-        fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
     fn a_folder_is_refused_and_leaves_nothing_behind() {
-        let dir = scratch("folder");
-        let sub = dir.join("sub");
+        let (dir, sub) = scratch_file("folder", "sub");
         fs::create_dir(&sub).unwrap();
         assert_eq!(
             write_whole(&sub, b"x").unwrap_err().to_string(),
@@ -343,7 +342,6 @@ mod tests {
             "is a file, not a folder"
         );
         assert_eq!(entries(&dir), ["file", "sub"]);
-        fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
@@ -360,29 +358,24 @@ mod tests {
 
     #[test]
     fn rows_go_to_the_temporary_and_an_unfinished_file_keeps_the_old_one() {
-        let dir = scratch("streaming");
-        let path = dir.join("rows.csv");
+        let (dir, path) = scratch_file("streaming", "rows.csv");
         fs::write(&path, b"old\n").unwrap();
         let mut out = create_streaming(&path).unwrap();
         out.write_all(b"row 1\n").unwrap();
         assert_eq!(fs::read(&path).unwrap(), b"old\n");
         assert_eq!(entries(&dir).len(), 2, "{:?}", entries(&dir));
         drop(out);
-        assert_eq!(fs::read(&path).unwrap(), b"old\n");
-        assert_eq!(entries(&dir), ["rows.csv"]);
+        assert_alone(&dir, &path, b"old\n");
         let mut out = create_streaming(&path).unwrap();
         out.write_all(b"row 1\nrow 2\n").unwrap();
         out.finish().unwrap();
-        assert_eq!(fs::read(&path).unwrap(), b"row 1\nrow 2\n");
-        assert_eq!(entries(&dir), ["rows.csv"]);
-        fs::remove_dir_all(&dir).unwrap();
+        assert_alone(&dir, &path, b"row 1\nrow 2\n");
     }
 
     #[cfg(unix)]
     #[test]
     fn a_fifo_nothing_reads_is_refused_not_waited_on() {
-        let dir = scratch("fifo");
-        let fifo = dir.join("report.md");
+        let (dir, fifo) = scratch_file("fifo", "report.md");
         let c = std::ffi::CString::new(fifo.as_os_str().as_encoded_bytes()).unwrap();
         // SAFETY: a NUL-terminated path.
         assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o644) }, 0);
@@ -408,7 +401,6 @@ mod tests {
         use std::os::unix::fs::FileTypeExt;
         assert!(fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo());
         assert_eq!(entries(&dir), ["report.md"]);
-        fs::remove_dir_all(&dir).unwrap();
     }
 
     #[cfg(target_os = "linux")]

@@ -580,6 +580,8 @@ impl Drop for BlockedInterrupts {
 mod tests {
     use super::*;
 
+    use crate::test_support::entries;
+
     const COMMAND: &str = "make crate";
 
     /// A scratch folder holding `models/m.toml`, an input.
@@ -591,11 +593,30 @@ mod tests {
         (base, models)
     }
 
+    /// [`scratch`] with the crate already made by the rule at `mine`, its OUT.
+    fn made() -> (tempfile::TempDir, PathBuf, PathBuf) {
+        let (base, models) = scratch();
+        let out = base.path().join("mine");
+        make(&rule(&out, &models), &CRATE).unwrap();
+        (base, models, out)
+    }
+
     fn rule(out: &Path, models: &Path) -> CrateFolder {
         let mut rule = CrateFolder::new("OUT", out, COMMAND).unwrap();
         rule.input("MODELS=models", models)
             .input("description m.toml", &models.join("m.toml"));
         rule
+    }
+
+    /// The file at `path` holds `text`.
+    #[track_caller]
+    fn assert_holds(path: &Path, text: &str) {
+        assert_eq!(
+            fs::read_to_string(path).unwrap(),
+            text,
+            "{}",
+            path.display()
+        );
     }
 
     /// Makes the crate `files` (name, contents) at OUT by the rule.
@@ -609,15 +630,6 @@ mod tests {
         rule.install_staged(staging)
     }
 
-    fn names(dir: &Path) -> Vec<String> {
-        let mut names: Vec<String> = fs::read_dir(dir)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .collect();
-        names.sort();
-        names
-    }
-
     fn refusal(result: Result<impl std::fmt::Debug, FolderError>) -> String {
         match result {
             Err(FolderError::Refused(m)) => m,
@@ -629,9 +641,7 @@ mod tests {
 
     #[test]
     fn a_new_folder_is_made_with_its_manifest_and_the_users_permissions() {
-        let (base, models) = scratch();
-        let out = base.path().join("mine");
-        make(&rule(&out, &models), &CRATE).unwrap();
+        let (base, models, out) = made();
         let manifest = fs::read_to_string(out.join(MANIFEST)).unwrap();
         let lines: Vec<&str> = manifest.lines().collect();
         assert_eq!(lines[0], rule(&out, &models).header());
@@ -652,14 +662,12 @@ mod tests {
             let expected = 0o777 & !u32::from(mask);
             assert_eq!(mode, expected);
         }
-        assert_eq!(names(base.path()), ["mine", "models"]);
+        assert_eq!(entries(base.path()), ["mine", "models"]);
     }
 
     #[test]
     fn a_folder_of_ours_is_replaced_and_cargos_products_are_kept() {
-        let (base, models) = scratch();
-        let out = base.path().join("mine");
-        make(&rule(&out, &models), &CRATE).unwrap();
+        let (base, models, out) = made();
         fs::write(out.join("Cargo.lock"), "lock").unwrap();
         fs::create_dir_all(out.join("target/debug")).unwrap();
         fs::write(out.join("target/debug/build"), "built").unwrap();
@@ -669,17 +677,14 @@ mod tests {
         )
         .unwrap();
         assert_eq!(
-            names(&out),
+            entries(&out),
             [MANIFEST, "Cargo.lock", "Cargo.toml", "src", "target"]
         );
-        assert_eq!(names(&out.join("src")), ["new.rs"]);
-        assert_eq!(fs::read_to_string(out.join("Cargo.lock")).unwrap(), "lock");
-        assert_eq!(
-            fs::read_to_string(out.join("target/debug/build")).unwrap(),
-            "built"
-        );
+        assert_eq!(entries(&out.join("src")), ["new.rs"]);
+        assert_holds(&out.join("Cargo.lock"), "lock");
+        assert_holds(&out.join("target/debug/build"), "built");
         // No temporary or old folder is left beside it.
-        assert_eq!(names(base.path()), ["mine", "models"]);
+        assert_eq!(entries(base.path()), ["mine", "models"]);
         // An empty folder is replaced too.
         let empty = base.path().join("empty");
         fs::create_dir(&empty).unwrap();
@@ -689,9 +694,7 @@ mod tests {
 
     #[test]
     fn cargos_products_that_cannot_be_moved_stay_in_the_old_folder_which_is_named() {
-        let (base, models) = scratch();
-        let out = base.path().join("mine");
-        make(&rule(&out, &models), &CRATE).unwrap();
+        let (_base, models, out) = made();
         fs::create_dir_all(out.join("target/debug")).unwrap();
         fs::write(out.join("target/debug/build"), "built").unwrap();
         // A new crate with a target/ of its own, which the old one's cannot replace.
@@ -709,10 +712,7 @@ mod tests {
             message.contains("target could not be moved into it"),
             "{message}"
         );
-        assert_eq!(
-            fs::read_to_string(kept.join("target/debug/build")).unwrap(),
-            "built"
-        );
+        assert_holds(&kept.join("target/debug/build"), "built");
         assert!(out.join("target/own").is_file());
     }
 
@@ -734,19 +734,14 @@ mod tests {
             e.contains("notes.txt was not written by `make crate`"),
             "{e}"
         );
-        assert_eq!(
-            fs::read_to_string(out.join("thesis.tex")).unwrap(),
-            "years of work"
-        );
-        assert_eq!(fs::read_to_string(mine.join("notes.txt")).unwrap(), "mine");
-        assert_eq!(names(base.path()), ["mine", "models", "theirs"]);
+        assert_holds(&out.join("thesis.tex"), "years of work");
+        assert_holds(&mine.join("notes.txt"), "mine");
+        assert_eq!(entries(base.path()), ["mine", "models", "theirs"]);
     }
 
     #[test]
     fn an_edited_file_is_refused_and_kept() {
-        let (base, models) = scratch();
-        let out = base.path().join("mine");
-        make(&rule(&out, &models), &CRATE).unwrap();
+        let (base, models, out) = made();
         fs::write(out.join("src/lib.rs"), "// one\n// my change\n").unwrap();
         let e = refusal(make(&rule(&out, &models), &CRATE));
         assert!(
@@ -759,7 +754,7 @@ mod tests {
         // A manifest edited by hand is no manifest of ours.
         fs::write(out.join(MANIFEST), "# mine\n").unwrap();
         assert!(refusal(rule(&out, &models).check()).contains("other files"));
-        assert_eq!(names(base.path()), ["mine", "models"]);
+        assert_eq!(entries(base.path()), ["mine", "models"]);
     }
 
     #[cfg(unix)]
@@ -787,7 +782,7 @@ mod tests {
         // SAFETY: a NUL-terminated path.
         assert_eq!(unsafe { libc::mkfifo(c.unwrap().as_ptr(), 0o644) }, 0);
         assert!(refusal(rule(&out, &models).check()).contains("Cargo.toml was not written by"));
-        assert_eq!(names(base.path()), ["link", "mine", "models", "real"]);
+        assert_eq!(entries(base.path()), ["link", "mine", "models", "real"]);
     }
 
     #[test]
@@ -811,7 +806,7 @@ mod tests {
             e.contains("Cargo.toml is the same file as TASKS=tasks.toml"),
             "{e}"
         );
-        assert_eq!(names(base.path()), ["mine", "models", "tasks.toml"]);
+        assert_eq!(entries(base.path()), ["mine", "models", "tasks.toml"]);
     }
 
     #[test]
@@ -830,8 +825,8 @@ mod tests {
             let e = refusal(r.check());
             assert!(e.contains("inside the repository"), "{e}");
         }
-        assert_eq!(names(base.path()), ["models", "repo"]);
-        assert!(names(&repo).is_empty());
+        assert_eq!(entries(base.path()), ["models", "repo"]);
+        assert!(entries(&repo).is_empty());
     }
 
     #[test]
@@ -854,7 +849,7 @@ mod tests {
         fs::create_dir(&out).unwrap();
         fs::write(out.join("x"), "").unwrap();
         assert!(refusal(r.install_staged(staging)).contains("other files"));
-        assert_eq!(names(base.path()), ["file", "late", "models"]);
+        assert_eq!(entries(base.path()), ["file", "late", "models"]);
         // Only a folder beside OUT, holding no input, is moved there.
         fs::create_dir(base.path().join("sub")).unwrap();
         let not_beside = "models is not a folder beside it to make the crate in";

@@ -17,6 +17,8 @@ pub mod folder;
 pub mod input;
 pub mod partial;
 pub mod run_files;
+#[cfg(test)]
+mod test_support;
 
 use std::path::{Path, PathBuf};
 

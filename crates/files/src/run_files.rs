@@ -194,11 +194,8 @@ impl RunFiles {
 mod tests {
     use super::*;
 
-    fn scratch(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("toolconf-run-{name}-{}", std::process::id()));
-        let _ = fs::remove_dir_all(&dir);
-        fs::create_dir_all(&dir).unwrap();
-        dir
+    fn scratch(name: &str) -> crate::test_support::Scratch {
+        crate::test_support::scratch("run", name)
     }
 
     #[test]
@@ -255,7 +252,6 @@ mod tests {
                 .check(),
             Ok(())
         );
-        fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
@@ -287,6 +283,5 @@ mod tests {
                 .check(),
             Ok(())
         );
-        fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -6,6 +6,7 @@
 use nalgebra::SVector;
 
 use super::grid::{eps_at, Settings};
+use super::options::{IntegrationError, Stats};
 
 /// The first step size from `(t, y)` with `f = f(t, y)`: the caller's `given` step as
 /// `min(hmax, max(hmin, h))`, else `ode45`'s heuristic `h = min(hmax, gap)` reduced to `1/rh`
@@ -87,4 +88,25 @@ pub(super) fn after_success(abs_h: f64, err: f64, rtol: f64, exponent: f64) -> f
     } else {
         5.0 * abs_h
     }
+}
+
+/// The budget of step attempts ([`Settings::max_steps`]): [`IntegrationError::TooManySteps`] at
+/// `(t, y)` with the step `abs_h` about to be tried once `stats` has used it up.
+#[inline]
+pub(super) fn attempts_left<const D: usize>(
+    stats: &Stats,
+    s: &Settings,
+    t: f64,
+    abs_h: f64,
+    y: &SVector<f64, D>,
+) -> Result<(), IntegrationError> {
+    if stats.steps + stats.rejected >= s.max_steps {
+        return Err(IntegrationError::TooManySteps {
+            t,
+            max_steps: s.max_steps,
+            h: abs_h,
+            state: y.as_slice().to_vec(),
+        });
+    }
+    Ok(())
 }

@@ -2,7 +2,7 @@
 
 use nalgebra::SVector;
 
-use super::control::{after_rejection, after_success, error_norm, first_step};
+use super::control::{after_rejection, after_success, attempts_left, error_norm, first_step};
 use super::stiffness::StiffnessDetector;
 use super::{eps_at, IntegrationError, Settings, Stats};
 
@@ -187,14 +187,7 @@ where
 
         let mut no_failures = true;
         let (step, err) = loop {
-            if stats.steps + stats.rejected >= s.max_steps {
-                return Err(IntegrationError::TooManySteps {
-                    t,
-                    max_steps: s.max_steps,
-                    h: abs_h,
-                    state: y.as_slice().to_vec(),
-                });
-            }
+            attempts_left(&stats, s, t, abs_h, &y)?;
             let t_new = if done { tf } else { t + h };
             let step = attempt(&mut rhs, t, &y, &k1, h, t_new);
             stats.rhs_evals += 6;

@@ -43,7 +43,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use super::control::{after_rejection, after_success, error_norm, first_step};
+use super::control::{after_rejection, after_success, attempts_left, error_norm, first_step};
 use super::{eps_at, IntegrationError, Settings, Stats};
 
 /// What the stiff stepper needs of the problem.
@@ -172,14 +172,7 @@ where
 
         let mut no_failures = true;
         let (t_new, mut step, err) = loop {
-            if stats.steps + stats.rejected >= s.max_steps {
-                return Err(IntegrationError::TooManySteps {
-                    t,
-                    max_steps: s.max_steps,
-                    h: abs_h,
-                    state: y.as_slice().to_vec(),
-                });
-            }
+            attempts_left(&stats, s, t, abs_h, &y)?;
             let t_new = if done { tf } else { t + abs_h };
             // The matrix uses the step actually taken, t_new − t.
             let mut e = -jacobian;

@@ -16,18 +16,29 @@ pub struct ShortList<'a>(pub &'a [f64]);
 
 impl fmt::Display for ShortList<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str("[")?;
-        for (i, x) in self.0.iter().take(LIST_VALUES).enumerate() {
-            if i > 0 {
-                f.write_str(", ")?;
-            }
-            write!(f, "{}", Short(*x))?;
-        }
-        if self.0.len() > LIST_VALUES {
-            write!(f, ", … ({} values)", self.0.len())?;
-        }
-        f.write_str("]")
+        write_clipped(f, self.0, "values", |f, x| write!(f, "{}", Short(*x)))
     }
+}
+
+/// `[a, b, …]`: the first [`LIST_VALUES`] of `items`, each by `each`, then how many `items`
+/// (counted as `unit`) there are when that is more.
+fn write_clipped<T>(
+    f: &mut fmt::Formatter<'_>,
+    items: &[T],
+    unit: &str,
+    each: impl Fn(&mut fmt::Formatter<'_>, &T) -> fmt::Result,
+) -> fmt::Result {
+    f.write_str("[")?;
+    for (i, item) in items.iter().take(LIST_VALUES).enumerate() {
+        if i > 0 {
+            f.write_str(", ")?;
+        }
+        each(f, item)?;
+    }
+    if items.len() > LIST_VALUES {
+        write!(f, ", … ({} {unit})", items.len())?;
+    }
+    f.write_str("]")
 }
 
 /// A matrix given row by row, as a message shows it: `[[80, 5], [1, 80]]`, clipped as
@@ -36,17 +47,7 @@ pub struct ShortRows<'a>(pub &'a [Vec<f64>]);
 
 impl fmt::Display for ShortRows<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str("[")?;
-        for (i, row) in self.0.iter().take(LIST_VALUES).enumerate() {
-            if i > 0 {
-                f.write_str(", ")?;
-            }
-            write!(f, "{}", ShortList(row))?;
-        }
-        if self.0.len() > LIST_VALUES {
-            write!(f, ", … ({} rows)", self.0.len())?;
-        }
-        f.write_str("]")
+        write_clipped(f, self.0, "rows", |f, row| write!(f, "{}", ShortList(row)))
     }
 }
 

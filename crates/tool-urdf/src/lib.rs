@@ -386,18 +386,14 @@ mod tests {
     #[test]
     fn a_rotated_inertial_origin_is_rotated_into_link_axes() {
         let (l, t) = (0.02, 0.001);
-        let link = |rpy: &str| {
-            format!(
-                r#"<robot name="rod"><link name="rod"><inertial><origin xyz="0.1 0.2 0.3" rpy="{rpy}"/><mass value="2"/><inertia ixx="{t}" iyy="{l}" izz="{l}" ixy="0" ixz="0" iyz="0"/></inertial></link></robot>"#
-            )
+        // The rod turned by `yaw` about z.
+        let turned = |yaw: f64| {
+            let urdf = format!(
+                r#"<robot name="rod"><link name="rod"><inertial><origin xyz="0.1 0.2 0.3" rpy="0 0 {yaw}"/><mass value="2"/><inertia ixx="{t}" iyy="{l}" izz="{l}" ixy="0" ixz="0" iyz="0"/></inertial></link></robot>"#
+            );
+            tool_from_urdf(&urdf, "rod.urdf", &request("rod", "rod")).unwrap()
         };
-        let q = std::f64::consts::FRAC_PI_2;
-        let tool = tool_from_urdf(
-            &link(&format!("0 0 {q}")),
-            "rod.urdf",
-            &request("rod", "rod"),
-        )
-        .unwrap();
+        let tool = turned(std::f64::consts::FRAC_PI_2);
         let i = tool.inertia;
         assert!(
             close(i[0][0], l) && close(i[1][1], t) && close(i[2][2], l),
@@ -406,14 +402,7 @@ mod tests {
         assert!(i[0][1].abs() < 1e-17 && i[0][2].abs() < 1e-17 && i[1][2].abs() < 1e-17);
         assert_eq!(tool.com, [0.1, 0.2, 0.3]);
         assert_eq!(tool.mass, 2.0);
-        let e = std::f64::consts::FRAC_PI_4;
-        let tool = tool_from_urdf(
-            &link(&format!("0 0 {e}")),
-            "rod.urdf",
-            &request("rod", "rod"),
-        )
-        .unwrap();
-        let i = tool.inertia;
+        let i = turned(std::f64::consts::FRAC_PI_4).inertia;
         assert!(
             close(i[0][0], (l + t) / 2.0) && close(i[1][1], (l + t) / 2.0),
             "{i:?}"

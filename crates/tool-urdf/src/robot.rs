@@ -115,20 +115,8 @@ impl<'a, 'input> Robot<'a, 'input> {
     ) -> Result<(), UrdfToolError> {
         let robot = self;
         for node in root.children().filter(|n| is(n, "link")) {
-            let name = node
-                .attribute("name")
-                .ok_or_else(|| src.at(node, "a <link> has no name attribute"))?;
-            let owner = format!("link '{}': ", Clip(name));
-            if let Some(&before) = robot.link_index.get(name) {
-                return Err(src.at(
-                    node,
-                    format!(
-                        "a second link named '{}' (the first is on line {})",
-                        Clip(name),
-                        src.line(robot.links[before].node)
-                    ),
-                ));
-            }
+            let first = |i: usize| robot.links[i].node;
+            let (name, owner) = unique_name(src, node, "link", &robot.link_index, first)?;
             let inertial = match only_child(src, node, &owner, "inertial")? {
                 None => None,
                 Some(inertial) => Some(read_inertial(src, inertial, &owner)?),
@@ -153,20 +141,8 @@ impl<'a, 'input> Robot<'a, 'input> {
         robot.parent_joint = vec![None; robot.links.len()];
         robot.child_joints = vec![Vec::new(); robot.links.len()];
         for node in root.children().filter(|n| is(n, "joint")) {
-            let name = node
-                .attribute("name")
-                .ok_or_else(|| src.at(node, "a <joint> has no name attribute"))?;
-            let owner = format!("joint '{}': ", Clip(name));
-            if let Some(&before) = robot.joint_index.get(name) {
-                return Err(src.at(
-                    node,
-                    format!(
-                        "a second joint named '{}' (the first is on line {})",
-                        Clip(name),
-                        src.line(robot.joints[before].node)
-                    ),
-                ));
-            }
+            let first = |i: usize| robot.joints[i].node;
+            let (name, owner) = unique_name(src, node, "joint", &robot.joint_index, first)?;
             let joint = robot.read_joint(src, node, name, &owner)?;
             let index = robot.joints.len();
             if let Some(other) = robot.parent_joint[joint.child] {
@@ -204,15 +180,8 @@ impl<'a, 'input> Robot<'a, 'input> {
                 };
                 if walk[link] == start + 1 {
                     let last = walked[walked.len() - 1];
-                    let joint = &self.joints[self.parent_joint[last].expect("walked up")];
-                    return Err(src.at(
-                        joint.node,
-                        format!(
-                            "joint '{}' leads back to link '{}': the links form a loop",
-                            Clip(joint.name),
-                            Clip(self.links[link].name)
-                        ),
-                    ));
+                    let joint = self.parent_joint[last].expect("walked up");
+                    return Err(self.loop_at(src, joint, link));
                 }
                 walk[link] = start + 1;
                 walked.push(link);
@@ -318,6 +287,19 @@ impl<'a, 'input> Robot<'a, 'input> {
         })
     }
 
+    /// Joint `joint` leading back to link `link`: the links form a loop.
+    fn loop_at(&self, src: &Source, joint: usize, link: usize) -> UrdfToolError {
+        let joint = &self.joints[joint];
+        src.at(
+            joint.node,
+            format!(
+                "joint '{}' leads back to link '{}': the links form a loop",
+                Clip(joint.name),
+                Clip(self.links[link].name)
+            ),
+        )
+    }
+
     /// The root and the links below it, depth first in file order, each with the joint
     /// leading to it (None for the root); a loop back to a link already reached is refused.
     pub(crate) fn subtree(
@@ -330,15 +312,8 @@ impl<'a, 'input> Robot<'a, 'input> {
         let mut stack = vec![(root, None)];
         while let Some((link, via)) = stack.pop() {
             if seen[link] {
-                let joint: &Joint = &self.joints[via.expect("the root is reached first")];
-                return Err(src.at(
-                    joint.node,
-                    format!(
-                        "joint '{}' leads back to link '{}': the links form a loop",
-                        Clip(joint.name),
-                        Clip(self.links[link].name)
-                    ),
-                ));
+                let joint = via.expect("the root is reached first");
+                return Err(self.loop_at(src, joint, link));
             }
             seen[link] = true;
             order.push((link, via));
@@ -520,4 +495,30 @@ fn read_mimic<'a>(
             offset: number(src, element, owner, "offset", Some(0.0))?,
         }),
     })
+}
+
+/// The name of `node`, a `<kind>` element, and its owner prefix for later messages (`kind
+/// 'name': `); refused when missing, or when `index` holds it already (`first` giving that
+/// element's node, to name its line).
+fn unique_name<'a, 'input>(
+    src: &Source<'a, 'input>,
+    node: roxmltree::Node<'a, 'input>,
+    kind: &str,
+    index: &HashMap<&'a str, usize>,
+    first: impl Fn(usize) -> roxmltree::Node<'a, 'input>,
+) -> Result<(&'a str, String), UrdfToolError> {
+    let name = node
+        .attribute("name")
+        .ok_or_else(|| src.at(node, format!("a <{kind}> has no name attribute")))?;
+    if let Some(&before) = index.get(name) {
+        return Err(src.at(
+            node,
+            format!(
+                "a second {kind} named '{}' (the first is on line {})",
+                Clip(name),
+                src.line(first(before))
+            ),
+        ));
+    }
+    Ok((name, format!("{kind} '{}': ", Clip(name))))
 }

@@ -66,6 +66,11 @@ impl Case<'_> {
         }
     }
 
+    /// As [`Case::outputs`] for a function with one output, named as the function is.
+    fn output(&mut self, what: &str, code: i32, got: &[f64], want: &[f64]) {
+        self.outputs(what, code, &[(what, got, want)]);
+    }
+
     /// As [`Case::outputs`] when the direct call has a result (`want`); else `code` is `refused`.
     fn optional(&mut self, what: &str, code: i32, want: Option<Vec<Compared>>, refused: i32) {
         match want {
@@ -138,7 +143,7 @@ fn state_functions<M, const N: usize, const NX: usize, const NP: usize, const NZ
     // SAFETY (every call below): each pointer points to the documented number of values.
     let code = unsafe { (e.dynamics)(x.as_ptr(), u.as_ptr(), p.as_ptr(), x_dot.as_mut_ptr()) };
     let want = M::dynamics(x, u, p);
-    c.outputs("dynamics", code, &[("dynamics", &x_dot, want.as_slice())]);
+    c.output("dynamics", code, &x_dot, want.as_slice());
     let (mut f_x, mut f_u) = (vec![0.0; NX * NX], vec![0.0; NX * N]);
     let code = unsafe {
         let (x, u, p) = (x.as_ptr(), u.as_ptr(), p.as_ptr());
@@ -153,24 +158,15 @@ fn state_functions<M, const N: usize, const NX: usize, const NP: usize, const NZ
     let code =
         unsafe { (e.rigid_body_dynamics)(x.as_ptr(), u.as_ptr(), p.as_ptr(), x_dot.as_mut_ptr()) };
     let want = M::rigid_body_dynamics(x, u, p);
-    let what = "rigid_body_dynamics";
-    c.outputs(what, code, &[(what, &x_dot, want.as_slice())]);
+    c.output("rigid_body_dynamics", code, &x_dot, want.as_slice());
     let mut a_e = vec![0.0; NX * NX];
     let code = unsafe { (e.state_matrix)(p.as_ptr(), a_e.as_mut_ptr()) };
     let want = M::state_matrix(p);
-    c.outputs(
-        "state_matrix",
-        code,
-        &[("state_matrix", &a_e, want.as_slice())],
-    );
+    c.output("state_matrix", code, &a_e, want.as_slice());
     let mut b_e = vec![0.0; NX * N];
     let code = unsafe { (e.input_matrix)(p.as_ptr(), b_e.as_mut_ptr()) };
     let want = M::input_matrix(p);
-    c.outputs(
-        "input_matrix",
-        code,
-        &[("input_matrix", &b_e, want.as_slice())],
-    );
+    c.output("input_matrix", code, &b_e, want.as_slice());
 }
 
 /// The tip and its bias, or NO_TIP for a model without a tip.

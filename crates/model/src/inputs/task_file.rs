@@ -179,7 +179,7 @@ impl<'de, V: Deserialize<'de>, const GOALS: bool> Deserialize<'de> for TermTable
             ) -> Result<Self::Value, A::Error> {
                 let names = TermTable::<V, GOALS>::NAMES;
                 let mut table = TermTable::default();
-                while let Some(term) = map.next_key_seed(TermKey(names))? {
+                while let Some(term) = map.next_key_seed(term_key(names))? {
                     if table.values[term.index()].is_some() {
                         return Err(serde::de::Error::duplicate_field(term.name()));
                     }
@@ -193,26 +193,36 @@ impl<'de, V: Deserialize<'de>, const GOALS: bool> Deserialize<'de> for TermTable
     }
 }
 
-/// A `[goal]`/`[precision]` key, refused while the key itself is read (as serde's derived field
-/// identifiers are), so that the file's reader points the message at the key's line, not the
-/// table's.
-struct TermKey(&'static [&'static str]);
+/// A table's key, read as serde's derived field identifiers are: `read` gives its meaning, and
+/// a key it does not know is refused, as one of `known`, while the key itself is read, so that
+/// the file's reader points the message at the key's line, not the table's.
+struct Key<F> {
+    read: F,
+    known: &'static [&'static str],
+}
 
-impl<'de> serde::de::DeserializeSeed<'de> for TermKey {
-    type Value = Term;
-    fn deserialize<D: serde::Deserializer<'de>>(self, deserializer: D) -> Result<Term, D::Error> {
+impl<'de, T, F: FnOnce(&str) -> Option<T>> serde::de::DeserializeSeed<'de> for Key<F> {
+    type Value = T;
+    fn deserialize<D: serde::Deserializer<'de>>(self, deserializer: D) -> Result<T, D::Error> {
         deserializer.deserialize_identifier(self)
     }
 }
 
-impl<'de> serde::de::Visitor<'de> for TermKey {
-    type Value = Term;
+impl<'de, T, F: FnOnce(&str) -> Option<T>> serde::de::Visitor<'de> for Key<F> {
+    type Value = T;
     fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
         f.write_str("field identifier")
     }
-    fn visit_str<E: serde::de::Error>(self, key: &str) -> Result<Term, E> {
-        let term = Term::from_name(key).filter(|t| self.0.contains(&t.name()));
-        term.ok_or_else(|| E::unknown_field(key, self.0))
+    fn visit_str<E: serde::de::Error>(self, key: &str) -> Result<T, E> {
+        (self.read)(key).ok_or_else(|| E::unknown_field(key, self.known))
+    }
+}
+
+/// A `[goal]`/`[precision]` key: a term among `names`.
+fn term_key(names: &'static [&'static str]) -> Key<impl FnOnce(&str) -> Option<Term>> {
+    Key {
+        read: move |key: &str| Term::from_name(key).filter(|t| names.contains(&t.name())),
+        known: names,
     }
 }
 
@@ -250,7 +260,7 @@ impl<'de> Deserialize<'de> for RawGoal {
                 mut map: A,
             ) -> Result<RawGoal, A::Error> {
                 let mut goal = RawGoal::default();
-                while let Some(key) = map.next_key_seed(GoalKey)? {
+                while let Some(key) = map.next_key_seed(goal_key())? {
                     goal.take(key, &mut map)?;
                 }
                 Ok(goal)
@@ -298,28 +308,18 @@ enum GoalKeyName {
 }
 
 /// Reads a `[goal]` key, refusing an unknown one at its own line.
-struct GoalKey;
-
-impl<'de> serde::de::DeserializeSeed<'de> for GoalKey {
-    type Value = GoalKeyName;
-    fn deserialize<D: serde::Deserializer<'de>>(self, d: D) -> Result<GoalKeyName, D::Error> {
-        d.deserialize_identifier(self)
-    }
-}
-
-impl<'de> serde::de::Visitor<'de> for GoalKey {
-    type Value = GoalKeyName;
-    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-        f.write_str("field identifier")
-    }
-    fn visit_str<E: serde::de::Error>(self, key: &str) -> Result<GoalKeyName, E> {
-        if let Some(t) = Term::from_name(key).filter(|t| Term::GOAL_NAMES.contains(&t.name())) {
-            return Ok(GoalKeyName::Term(t));
-        }
-        match RELATIVE_KEYS.iter().position(|k| *k == key) {
-            Some(i) => Ok(GoalKeyName::Relative(i)),
-            None => Err(E::unknown_field(key, goal_keys())),
-        }
+fn goal_key() -> Key<impl FnOnce(&str) -> Option<GoalKeyName>> {
+    Key {
+        read: |key: &str| {
+            if let Some(t) = Term::from_name(key).filter(|t| Term::GOAL_NAMES.contains(&t.name())) {
+                return Some(GoalKeyName::Term(t));
+            }
+            RELATIVE_KEYS
+                .iter()
+                .position(|k| *k == key)
+                .map(GoalKeyName::Relative)
+        },
+        known: goal_keys(),
     }
 }
 
@@ -665,16 +665,9 @@ impl TaskSpec {
         }
         let d = term_components(term, N, M::tip_dim());
         if v.len() != d {
-            return Err(self.error(
-                key,
-                format!(
-                    "{} values {}, but the tip of model {} has {d} components ({})",
-                    v.len(),
-                    ShortList(v),
-                    M::name(),
-                    crate::registry::AXES[..d.min(3)].join(", ")
-                ),
-            ));
+            let axes = crate::registry::AXES[..d.min(3)].join(", ");
+            let tip = format!("the tip of model {} has {d} components ({axes})", M::name());
+            return Err(self.wrong_count(key, v, &tip));
         }
         Ok(SVector::from_fn(|i, _| if i < d { v[i] } else { 0.0 }))
     }
@@ -688,17 +681,16 @@ impl TaskSpec {
         M: ArmModel<N, NX, NP, NZ>,
     {
         if v.len() != N {
-            return Err(self.error(
-                key,
-                format!(
-                    "{} values {}, but model {} has {N} joints",
-                    v.len(),
-                    ShortList(v),
-                    M::name()
-                ),
-            ));
+            let joints = format!("model {} has {N} joints", M::name());
+            return Err(self.wrong_count(key, v, &joints));
         }
         Ok(SVector::from_column_slice(v))
+    }
+
+    /// `key`'s list `v` has the wrong length: "3 values [..], but `expected`".
+    fn wrong_count(&self, key: &str, v: &[f64], expected: &str) -> TaskFileError {
+        let given = format!("{} values {}", v.len(), ShortList(v));
+        self.error(key, format!("{given}, but {expected}"))
     }
 
     fn per_joint<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(

@@ -32,6 +32,15 @@ fn panda_task(text: &str) -> (TaskN<7>, EpisodeOptionsN<7, 14>) {
     (task, spec.episode::<Panda, 7, 14, 13, 21>().unwrap())
 }
 
+/// The linearised loop of `tool` with γ = 1 on each task, [`TOUCH`] and [`PUSH`].
+fn linear_loops(tool: &PandaTool) -> [(TaskN<7>, LinearLoop<7, 14, 21>); 2] {
+    [TOUCH, PUSH].map(|text| {
+        let (task, _) = panda_task(text);
+        let linear = LinearLoop::<7, 14, 21>::new(tool, &task, 1.0).unwrap();
+        (task, linear)
+    })
+}
+
 const TOUCH: &str = "kind = \"tip_position\"\n[goal]\ntip = [0.357, 0.030, 0.390]\n\
     [precision]\ntip = 1e6\ntip_dot = 4e4\nu = 0.0132\n[episode]\ninitial_torque = 0.0\n";
 const PUSH: &str = "kind = \"tip_acceleration\"\n[goal]\ntip_ddot = [0.2, 0.0, 0.0]\n\
@@ -55,9 +64,7 @@ fn assert_close<const R: usize, const C: usize>(
 #[test]
 fn m_is_the_runtimes_closed_loop_jacobian_at_the_equilibrium() {
     let tool = franka_hand();
-    for text in [TOUCH, PUSH] {
-        let (task, _) = panda_task(text);
-        let linear = LinearLoop::<7, 14, 21>::new(&tool, &task, 1.0).unwrap();
+    for (task, linear) in linear_loops(&tool) {
         let system = ClosedLoopN::<Panda, 7, 14, 13, 21>::new(&tool, &task, 1.0, 0.0).unwrap();
         let mut z_e = SVector::<f64, 21>::zeros();
         z_e.fixed_rows_mut::<14>(0)
@@ -73,9 +80,7 @@ fn m_is_the_runtimes_closed_loop_jacobian_at_the_equilibrium() {
 #[test]
 fn z_dot_is_the_runtimes_at_the_equilibrium_for_any_torque_and_perturbation() {
     let tool = franka_hand();
-    for text in [TOUCH, PUSH] {
-        let (task, _) = panda_task(text);
-        let linear = LinearLoop::<7, 14, 21>::new(&tool, &task, 1.0).unwrap();
+    for (task, linear) in linear_loops(&tool) {
         for (u, dt) in [(0.3, 0.0), (-1.2, 0.7), (2.0, -0.4)] {
             let perturbation = SVector::<f64, 7>::from_fn(|i, _| dt * (i as f64 - 3.0));
             let system = ClosedLoopN::<Panda, 7, 14, 13, 21>::with_perturbation(

@@ -29,6 +29,14 @@ pub fn sample_key(row: usize) -> u64 {
     derive_seed(row as u64, "validation/row")
 }
 
+/// Spearman's ρ of a validation sample's `points` with its 95 % bootstrap interval, the
+/// resamples drawn from the seed of the stream `stream`.
+pub(super) fn sample_correlation(points: &[(f64, f64)], stream: &str) -> Correlation {
+    let (x, y): (Vec<f64>, Vec<f64>) = points.iter().copied().unzip();
+    let seed = derive_seed(0, stream);
+    Correlation::compute(&x, &y, RESAMPLES, 0.95, seed)
+}
+
 /// Claim (a) on the sample: ρ(ln|Π^U|, task error) and the verdict by its rule.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ConfidenceCheck {
@@ -50,9 +58,7 @@ impl ConfidenceCheck {
         episodes: usize,
         population: &str,
     ) -> Self {
-        let (x, y): (Vec<f64>, Vec<f64>) = points.iter().copied().unzip();
-        let seed = derive_seed(0, "validation/bootstrap");
-        let correlation = Correlation::compute(&x, &y, RESAMPLES, 0.95, seed);
+        let correlation = sample_correlation(points, "validation/bootstrap");
         Self {
             finding: correlation.finding(),
             correlation,

@@ -8,11 +8,8 @@
 
 use serde_json::{json, Value};
 
-use super::seeds::derive_seed;
+use super::check::sample_correlation;
 use super::verdict::{Correlation, Finding};
-
-/// Bootstrap resamples of the check's interval (as the confidence check's).
-const RESAMPLES: usize = 2000;
 
 /// ρ(predicted, simulated task error) on the sample, and the verdict by the rule above.
 #[derive(Debug, Clone, PartialEq)]
@@ -34,9 +31,7 @@ impl PredictionCheck {
         without_prediction: usize,
         population: &str,
     ) -> Self {
-        let (x, y): (Vec<f64>, Vec<f64>) = points.iter().copied().unzip();
-        let seed = derive_seed(0, "validation/prediction");
-        let correlation = Correlation::compute(&x, &y, RESAMPLES, 0.95, seed);
+        let correlation = sample_correlation(points, "validation/prediction");
         let finding = match &correlation.ci {
             Ok(ci) if ci.low > 0.0 => Finding::Holds,
             Ok(ci) if ci.high < 0.0 => Finding::Reversed,

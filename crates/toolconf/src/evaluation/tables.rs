@@ -49,6 +49,24 @@ fn header(lead: &[&str], e: &Evaluation, tail: &[&str]) -> Vec<String> {
         .collect()
 }
 
+/// A table of rows about tools: each row the tool's index, row, name and parameters
+/// ([`tool_cells`]), then its cells under the columns `tail`; `rows` gives each row's tool and
+/// cells.
+fn tools_table(
+    e: &Evaluation,
+    name: &'static str,
+    tail: &[&str],
+    rows: impl Iterator<Item = (usize, Vec<Cell>)>,
+) -> Table {
+    let mut t = Table::new(name, header(&["tool", "row", "name"], e, tail));
+    for (tool, cells) in rows {
+        let mut row = tool_cells(e, tool);
+        row.extend(cells);
+        t.rows.push(row);
+    }
+    t
+}
+
 /// Tool i's lead cells: its index, row and name, then its parameters.
 fn tool_cells(e: &Evaluation, i: usize) -> Vec<Cell> {
     let p = &e.population;
@@ -90,37 +108,26 @@ fn fig2(e: &Evaluation) -> Table {
         "rhs_evals",
         "error",
     ];
-    let mut t = Table::new(
-        "fig2_confidence_vs_error",
-        header(&["tool", "row", "name"], e, &tail),
-    );
-    for r in &e.records {
-        let mut row = tool_cells(e, r.index);
-        row.push(Cell::from(r.logdet()));
-        row.extend(run_cells(&r.base));
-        row.push(Cell::from(r.error_of_base()));
-        t.rows.push(row);
-    }
-    t
+    let rows = e.records.iter().map(|r| {
+        let mut cells = vec![Cell::from(r.logdet())];
+        cells.extend(run_cells(&r.base));
+        cells.push(Cell::from(r.error_of_base()));
+        (r.index, cells)
+    });
+    tools_table(e, "fig2_confidence_vs_error", &tail, rows)
 }
 
 fn fig3_tools(e: &Evaluation) -> Table {
-    let mut t = Table::new(
-        "fig3_tools",
-        header(&["tool", "row", "name"], e, &["logdet", "role"]),
-    );
-    for r in &e.records[..e.highlight.sample] {
+    let rows = e.records[..e.highlight.sample].iter().map(|r| {
         let role = e
             .highlight
             .runs
             .iter()
             .find(|h| h.tool == r.index)
             .map_or("", |h| h.role);
-        let mut row = tool_cells(e, r.index);
-        row.extend([Cell::from(r.logdet()), Cell::from(role)]);
-        t.rows.push(row);
-    }
-    t
+        (r.index, vec![Cell::from(r.logdet()), Cell::from(role)])
+    });
+    tools_table(e, "fig3_tools", &["logdet", "role"], rows)
 }
 
 /// The four runs on the output grid: the task variable's components, its distance to the goal,
@@ -178,22 +185,17 @@ fn fig4(e: &Evaluation) -> Table {
         "abs_change",
         "error",
     ];
-    let mut t = Table::new(
-        "fig4_perturbation_change",
-        header(&["tool", "row", "name"], e, &tail),
-    );
-    for r in &e.records {
-        let mut row = tool_cells(e, r.index);
-        row.extend([
+    let rows = e.records.iter().map(|r| {
+        let cells = vec![
             Cell::from(r.logdet()),
             Cell::from(r.task_error()),
             Cell::from(r.perturbed_error()),
             Cell::from(r.abs_change()),
             Cell::from(r.error()),
-        ]);
-        t.rows.push(row);
-    }
-    t
+        ];
+        (r.index, cells)
+    });
+    tools_table(e, "fig4_perturbation_change", &tail, rows)
 }
 
 fn fig5(e: &Evaluation) -> Table {
@@ -205,25 +207,21 @@ fn fig5(e: &Evaluation) -> Table {
         "abs_change",
         "error",
     ];
-    let mut t = Table::new(
-        "fig5_perturbation_sweep",
-        header(&["tool", "row", "name"], e, &tail),
-    );
-    for r in e.records.iter().filter(|r| !r.sweep.is_empty()) {
-        for (k, run) in r.sweep.iter().enumerate() {
-            let mut row = tool_cells(e, r.index);
-            row.extend([
+    let swept = e.records.iter().filter(|r| !r.sweep.is_empty());
+    let rows = swept.flat_map(|r| {
+        r.sweep.iter().enumerate().map(move |(k, run)| {
+            let cells = vec![
                 Cell::from(r.logdet()),
                 Cell::from(e.setup.scales[k]),
                 Cell::from(run.as_ref().ok().map(|n| n.task_error)),
                 Cell::from(r.task_error()),
                 Cell::from(r.sweep_change(k)),
                 Cell::from(run.as_ref().err().cloned().unwrap_or_default()),
-            ]);
-            t.rows.push(row);
-        }
-    }
-    t
+            ];
+            (r.index, cells)
+        })
+    });
+    tools_table(e, "fig5_perturbation_sweep", &tail, rows)
 }
 
 /// A selection experiment: one row per trial and tool, with a 0/1 column per rule.

@@ -77,10 +77,8 @@ impl Correlation {
     pub fn describe(&self) -> String {
         match (&self.rho, &self.ci) {
             (Ok(r), Ok(ci)) => format!(
-                "ρ = {} [{}, {}] ({:.0} % bootstrap interval), n = {}",
-                signed(*r),
-                signed(ci.low),
-                signed(ci.high),
+                "{} ({:.0} % bootstrap interval), n = {}",
+                rho_with_interval(*r, ci),
                 self.level * 100.0,
                 self.n
             ),
@@ -92,12 +90,7 @@ impl Correlation {
     /// "ρ = −0.41 [−0.49, −0.32]" (a figure's title), or "ρ undefined".
     pub fn describe_short(&self) -> String {
         match (&self.rho, &self.ci) {
-            (Ok(r), Ok(ci)) => format!(
-                "ρ = {} [{}, {}]",
-                signed(*r),
-                signed(ci.low),
-                signed(ci.high)
-            ),
+            (Ok(r), Ok(ci)) => rho_with_interval(*r, ci),
             (Ok(r), Err(_)) => format!("ρ = {}", signed(*r)),
             (Err(_), _) => "ρ undefined".into(),
         }
@@ -122,6 +115,16 @@ impl Correlation {
 /// "+0.41" / "−0.41": two decimals with the sign, as the claims table prints ρ.
 pub fn signed(x: f64) -> String {
     format!("{x:+.2}").replace('-', "−")
+}
+
+/// "ρ = −0.41 [−0.49, −0.32]": ρ and its interval, [`signed`].
+fn rho_with_interval(rho: f64, ci: &Interval) -> String {
+    format!(
+        "ρ = {} [{}, {}]",
+        signed(rho),
+        signed(ci.low),
+        signed(ci.high)
+    )
 }
 
 /// Two paired samples compared (the tools two rules chose, trial by trial): a − b.

@@ -176,6 +176,19 @@ fn dynamics_values<const N: usize, const NX: usize>(
     })
 }
 
+/// `values` refilled with one stage's entries, `stage()`, for each of the `horizon` stages (the
+/// order of the matching index lists).
+fn fill_per_stage<I: Iterator<Item = f64>>(
+    values: &mut Vec<f64>,
+    horizon: usize,
+    stage: impl Fn() -> I,
+) {
+    values.clear();
+    for _ in 0..horizon {
+        values.extend(stage());
+    }
+}
+
 /// Sparse assembly buffer. Exact zeros are kept: they are structural entries a later model may
 /// fill, and Clarabel's data update can only overwrite entries that exist.
 #[derive(Default)]
@@ -369,17 +382,11 @@ impl<const N: usize, const NX: usize, const NZ: usize> QpSolver<N, NX, NZ> {
     ) -> Result<(), String> {
         let horizon = self.layout.horizon;
         if matrices {
-            self.values.clear();
-            for _ in 0..horizon {
-                self.values.extend(stage_values(cost));
-            }
+            fill_per_stage(&mut self.values, horizon, || stage_values(cost));
             self.solver
                 .update_P(&zip(self.p_index.iter(), self.values.iter()))
                 .map_err(|e| format!("Clarabel update_P: {e}"))?;
-            self.values.clear();
-            for _ in 0..horizon {
-                self.values.extend(dynamics_values(model));
-            }
+            fill_per_stage(&mut self.values, horizon, || dynamics_values(model));
             self.solver
                 .update_A(&zip(self.a_index.iter(), self.values.iter()))
                 .map_err(|e| format!("Clarabel update_A: {e}"))?;
@@ -388,10 +395,7 @@ impl<const N: usize, const NX: usize, const NZ: usize> QpSolver<N, NX, NZ> {
         self.solver
             .update_q(&self.q)
             .map_err(|e| format!("Clarabel update_q: {e}"))?;
-        self.values.clear();
-        for _ in 0..horizon {
-            self.values.extend(model.cd.iter());
-        }
+        fill_per_stage(&mut self.values, horizon, || model.cd.iter().copied());
         self.solver
             .update_b(&zip(self.b_index.iter(), self.values.iter()))
             .map_err(|e| format!("Clarabel update_b: {e}"))?;

@@ -25,6 +25,7 @@
 //! last joint). Every episode starts at its model's hanging equilibrium with U0 = 0.1 on every
 //! joint.
 
+use super::Objective;
 use rand::{RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -197,22 +198,27 @@ impl MixedObjective {
         MixedObjective::NormalisedConfidence,
     ];
 
-    pub fn name(self) -> &'static str {
+    /// The objective of the same name among the 2-link selection's ([`Objective`]), for all but
+    /// the per-joint confidence.
+    fn shared(self) -> Option<Objective> {
         match self {
-            MixedObjective::FreeEnergy => "free_energy",
-            MixedObjective::CostJ => "cost_j",
-            MixedObjective::Confidence => "confidence",
-            MixedObjective::NormalisedConfidence => "normalised_confidence",
+            MixedObjective::FreeEnergy => Some(Objective::FreeEnergy),
+            MixedObjective::CostJ => Some(Objective::CostJ),
+            MixedObjective::Confidence => Some(Objective::Confidence),
+            MixedObjective::NormalisedConfidence => None,
         }
+    }
+
+    pub fn name(self) -> &'static str {
+        self.shared()
+            .map_or("normalised_confidence", Objective::name)
     }
 
     /// The value to minimise for a tool, if the tool has one.
     pub fn score(self, r: &MixedResult) -> Option<f64> {
-        match self {
-            MixedObjective::FreeEnergy => r.episode.as_ref().ok().map(|m| m.free_energy),
-            MixedObjective::CostJ => r.episode.as_ref().ok().map(|m| m.cost_j),
-            MixedObjective::Confidence => r.logdet.as_ref().ok().map(|l| -l),
-            MixedObjective::NormalisedConfidence => r.logdet_per_joint().map(|l| -l),
+        match self.shared() {
+            Some(o) => o.score_of(r.episode.as_ref().ok(), r.logdet.as_ref().ok()),
+            None => r.logdet_per_joint().map(|l| -l),
         }
     }
 
@@ -222,7 +228,7 @@ impl MixedObjective {
         super::first_argmin(
             results
                 .iter()
-                .filter_map(|r| self.score(r).map(|s| (r.index, s))),
+                .filter_map(|r| Some((r.index, self.score(r)?))),
         )
     }
 }

@@ -165,10 +165,16 @@ impl Objective {
 
     /// The value to minimise for a tool, if the tool has one.
     pub fn score(self, r: &ToolResult) -> Option<f64> {
+        self.score_of(r.episode.as_ref().ok(), r.logdet.as_ref().ok())
+    }
+
+    /// The value to minimise for a tool with this episode's metrics and this ln|Π^U|, where the
+    /// objective's one is there.
+    pub(crate) fn score_of(self, episode: Option<&Metrics>, logdet: Option<&f64>) -> Option<f64> {
         match self {
-            Objective::FreeEnergy => r.episode.as_ref().ok().map(|m| m.free_energy),
-            Objective::CostJ => r.episode.as_ref().ok().map(|m| m.cost_j),
-            Objective::Confidence => r.logdet.as_ref().ok().map(|l| -l),
+            Objective::FreeEnergy => episode.map(|m| m.free_energy),
+            Objective::CostJ => episode.map(|m| m.cost_j),
+            Objective::Confidence => logdet.map(|l| -l),
         }
     }
 
@@ -177,7 +183,7 @@ impl Objective {
         first_argmin(
             results
                 .iter()
-                .filter_map(|r| self.score(r).map(|s| (r.index, s))),
+                .filter_map(|r| Some((r.index, self.score(r)?))),
         )
     }
 }

@@ -23,6 +23,20 @@ fn goal_blocks<const N: usize>(a: &Array) -> [SVector<f64, N>; TERMS] {
     core::array::from_fn(|t| SVector::from_column_slice(&v[t * N..(t + 1) * N]))
 }
 
+/// The task the arrays describe: task `t`, the goals (zero for an export that takes none) and
+/// the precisions, block by block as the C ABI lays them out.
+pub(super) fn task_of<const N: usize>(
+    t: u32,
+    goals: Option<&Array>,
+    precisions: &Array,
+) -> TaskN<N> {
+    TaskN {
+        kind: TaskKind::ALL[t as usize],
+        goal: goals.map_or([SVector::zeros(); TERMS], goal_blocks::<N>),
+        precision: blocks::<N>(precisions),
+    }
+}
+
 impl<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>
     Fuzz<'_, M, N, NX, NP, NZ>
 where
@@ -285,11 +299,7 @@ where
             Some(w) => Err(w),
             None => {
                 let pv = vector::<NP>(&p);
-                let task = TaskN {
-                    kind: TaskKind::ALL[t as usize],
-                    goal: [SVector::zeros(); TERMS],
-                    precision: blocks::<N>(&pr),
-                };
+                let task = task_of::<N>(t, None, &pr);
                 let v = match gradient {
                     false => M::pi_u(&task, &pv).as_slice().to_vec(),
                     true => M::logdet_gradient(&task, &pv).as_slice().to_vec(),
@@ -327,11 +337,7 @@ where
             Some(w) => Err(w),
             None => {
                 let pv = vector::<NP>(&p);
-                let task = TaskN {
-                    kind: TaskKind::ALL[t as usize],
-                    goal: goal_blocks::<N>(&g),
-                    precision: blocks::<N>(&pr),
-                };
+                let task = task_of::<N>(t, Some(&g), &pr);
                 ToolN::<M, N, NX, NP, NZ>::new(pv.into())
                     .and_then(|tool| control_confidence(&tool, &task))
                     .map_err(|e| (status_of(&e), String::new()))

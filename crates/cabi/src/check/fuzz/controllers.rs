@@ -5,8 +5,9 @@
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use toolconf_core::{ArmController, ArmModel, TaskKind, TaskN, ToolN};
+use toolconf_core::{ArmController, ArmModel, ToolN};
 
+use super::calls::task_of;
 use super::{rules, Fuzz, Handle, Want};
 use crate::bodies::{status_of, Controller};
 use crate::{status, Exports};
@@ -119,17 +120,7 @@ where
         let direct = match rules(&pointers, Some((t, self.offered)), &inputs) {
             Some(w) => Err(w),
             None => {
-                let task = TaskN {
-                    kind: TaskKind::ALL[t as usize],
-                    goal: core::array::from_fn(|k| {
-                        nalgebra::SVector::from_column_slice(&g.values()[k * N..(k + 1) * N])
-                    }),
-                    precision: core::array::from_fn(|k| {
-                        nalgebra::SMatrix::from_column_slice(
-                            &pr.values()[k * N * N..(k + 1) * N * N],
-                        )
-                    }),
-                };
+                let task = task_of::<N>(t, Some(&g), &pr);
                 let u0: [f64; N] = core::array::from_fn(|k| u0.values()[k]);
                 ToolN::<M, N, NX, NP, NZ>::new(core::array::from_fn(|k| p.values()[k]))
                     .and_then(|tool| ArmController::new(&tool, &task, gamma, u0, rate))
