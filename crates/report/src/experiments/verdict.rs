@@ -183,11 +183,7 @@ impl Comparison {
 
     /// "mean difference +1.2 (t = 3.4, p = 0.002; Wilcoxon W = 120, p = 0.003; n = 50)".
     pub fn describe(&self) -> String {
-        let dropped = if self.dropped > 0 {
-            format!(", {} pair(s) dropped for a failed episode", self.dropped)
-        } else {
-            String::new()
-        };
+        let dropped = toolconf::evaluation::verdict::dropped_clause(self.dropped);
         if self.identical() {
             return format!(
                 "identical in all {} pairs (the same tool was chosen every time){dropped}",

@@ -180,10 +180,7 @@ impl Paired {
 
     /// "mean difference +1.2e-3 (Wilcoxon p = 0.003, n = 50, 12 ties)".
     pub fn describe(&self) -> String {
-        let dropped = match self.dropped {
-            0 => String::new(),
-            d => format!(", {d} pair(s) dropped for a failed episode"),
-        };
+        let dropped = dropped_clause(self.dropped);
         if self.identical() {
             return format!(
                 "identical in all {} pairs (the same tool every time){dropped}",
@@ -325,6 +322,15 @@ impl ClaimVerdict {
             "rule": self.rule,
             "statistic": self.statistic,
         })
+    }
+}
+
+/// ", 3 pair(s) dropped for a failed episode", or nothing when no pair was dropped: the clause
+/// a paired comparison's description ends with (here and in the report's).
+pub fn dropped_clause(dropped: usize) -> String {
+    match dropped {
+        0 => String::new(),
+        d => format!(", {d} pair(s) dropped for a failed episode"),
     }
 }
 
