@@ -573,35 +573,41 @@ fn a_truncated_model_library_is_one_line_and_status_2_never_a_crash() {
 #[test]
 #[ignore = "needs the model libraries: make loaded-models-test"]
 fn each_librarys_c_abi_refuses_the_others_handles_under_fuzzing() {
-    use toolconf_cabi::check::{self, cases::controller_through, Foreign};
+    use toolconf_cabi::check::{self, cases::controller_through};
     use toolconf_cabi::toolconf_core::{Arm2, Arm3, ArmModel as _};
     let folder = libraries();
     let arm2 = loaded::open_exports(&folder.join("arm2")).unwrap();
     let arm3 = loaded::open_exports(&folder.join("arm3")).unwrap();
     let cases = check::fuzz_cases(3000);
-    // SAFETY (both destroys): any handle value is checked.
-    let (create3, destroy3) = (
-        || controller_through::<Arm3, 3, 6, 6, 9>(&arm3),
-        |h| unsafe { (arm3.controller_destroy)(h) },
-    );
-    let foreign = Foreign {
-        create: &create3,
-        destroy: &destroy3,
-    };
-    let (calls, seen) = check::fuzz::<Arm2, 2, 4, 4, 6>(&arm2, &foreign, cases, 3);
+    let create3 = || controller_through::<Arm3, 3, 6, 6, 9>(&arm3);
+    let (calls, seen) = fuzz_against::<Arm2, 2, 4, 4, 6>(&arm2, &arm3, &create3, cases, 3);
     assert!(calls >= cases && seen[toolconf_cabi::status::BAD_HANDLE as usize] > 0);
-    let (create2, destroy2) = (
-        || controller_through::<Arm2, 2, 4, 4, 6>(&arm2),
-        |h| unsafe { (arm2.controller_destroy)(h) },
-    );
-    let foreign = Foreign {
-        create: &create2,
-        destroy: &destroy2,
-    };
-    check::fuzz::<Arm3, 3, 6, 6, 9>(&arm3, &foreign, cases, 4);
+    let create2 = || controller_through::<Arm2, 2, 4, 4, 6>(&arm2);
+    fuzz_against::<Arm3, 3, 6, 6, 9>(&arm3, &arm2, &create2, cases, 4);
     let state = Arm2::equilibrium_state();
     let own = || controller_through::<Arm2, 2, 4, 4, 6>(&arm2);
     check::fuzz_threads(&arm2, &own, state.as_slice(), 2, 4, cases / 8);
+}
+
+/// [`toolconf_cabi::check::fuzz`] of library `own` (model `M`) with library `other`'s
+/// controllers, made by `create` and destroyed through `other`, as the foreign handles.
+fn fuzz_against<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
+    own: &toolconf_cabi::Exports,
+    other: &toolconf_cabi::Exports,
+    create: &dyn Fn() -> *mut toolconf_cabi::bodies::Controller,
+    cases: usize,
+    seed: u64,
+) -> (usize, [usize; toolconf_cabi::status::NAMES.len()])
+where
+    M: toolconf_cabi::toolconf_core::ArmModel<N, NX, NP, NZ> + 'static,
+{
+    // SAFETY: any handle value is checked.
+    let destroy = |h| unsafe { (other.controller_destroy)(h) };
+    let foreign = toolconf_cabi::check::Foreign {
+        create,
+        destroy: &destroy,
+    };
+    toolconf_cabi::check::fuzz::<M, N, NX, NP, NZ>(own, &foreign, cases, seed)
 }
 
 proptest::proptest! {
