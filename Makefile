@@ -28,7 +28,7 @@ bench:
 ##   tests that load one use (scripts/model_libraries.sh: every committed model and the xArm7);
 ## - the crates' lane: every crate's tests compiled, the Python package built (maturin develop),
 ##   the on-robot crate's tests (make on-robot-test), then the crates' tests run and the Python
-##   package's (on both cores: pytest -n 2).
+##   package's.
 ## Then the tests that load a model library, on the libraries built once for all of them. The
 ## Python crate is built by maturin alone (it has no Rust tests: `cargo test --workspace` would
 ## only build it a second time). The derivation's lane builds in target/derive-lane/ (the renderer,
@@ -91,7 +91,7 @@ loaded-models-test: $(PY_DEV)
 	cargo test --quiet --test loaded_models -- --include-ignored && \
 	cargo test --quiet --test examples -- --ignored && \
 	cargo test --quiet --test view3d -- --ignored && \
-	$(PY) -m pytest -q -n 2 python/loaded_tests
+	$(PY) -m pytest -q python/loaded_tests
 
 ## make mujoco-test: the on-robot controller on MuJoCo (examples/mujoco/, docs/tutorials/mujoco.md). Installs the example's
 ## pinned requirements (examples/mujoco/requirements.txt) into derive/.venv, builds the Panda's model library from
@@ -116,7 +116,7 @@ $(MUJOCO_INSTALLED): examples/mujoco/requirements.txt $(PY)
 ## with maturin (debug profile, in the workspace's target/, so the crate is not built twice),
 ## then runs its pytest suite against the command line's JSON.
 PYTHON_BUILD = VIRTUAL_ENV=$(abspath $(VENV)) $(VENV)/bin/maturin develop --quiet --manifest-path python/Cargo.toml
-PYTHON_TESTS = $(PY) -m pytest -q -n 2 python/tests
+PYTHON_TESTS = $(PY) -m pytest -q python/tests
 python-test: $(PY_DEV)
 	$(PYTHON_BUILD)
 	$(PYTHON_TESTS)

@@ -21,6 +21,9 @@ MAKE_CRATE = [sys.executable, str(ROOT / "derive" / "make_crate.py")]
 PENDULUM = ROOT / "tests" / "fixtures" / "pendulum.toml"
 # The crates' builds share one folder under target/ (ignored by git), so a second run is quick.
 TARGET = ROOT / "target" / "make-crate-test"
+# `make` as a user runs it, without a parent make's flags: make test runs these tests in a lane of
+# `make -j2`, whose jobserver a child make cannot reach (it would warn on stderr).
+MAKE_ENV = {k: v for k, v in os.environ.items() if k not in ("MAKEFLAGS", "MFLAGS", "MAKELEVEL")}
 
 
 def git_status() -> str | None:
@@ -261,7 +264,7 @@ class MakeCrate(unittest.TestCase):
 
     def test_make_without_models_or_out_is_a_usage_line(self):
         r = subprocess.run(["make", "--no-print-directory", "crate", f"OUT={self.base / 'x'}"], cwd=ROOT,
-                           capture_output=True, text=True)
+                           capture_output=True, text=True, env=MAKE_ENV)
         self.assertEqual(r.returncode, 2)
         self.assertIn("usage: make crate MODELS=", r.stderr)
 

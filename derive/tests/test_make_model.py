@@ -23,7 +23,7 @@ MAKE_MODEL = [sys.executable, str(ROOT / "derive" / "make_model.py")]
 PENDULUM = ROOT / "tests" / "fixtures" / "pendulum.toml"
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_make_crate import assert_terminated_cleanly, files_under, git_status  # noqa: E402
+from test_make_crate import MAKE_ENV, assert_terminated_cleanly, files_under, git_status  # noqa: E402
 
 # make's own line about a recipe that failed, `make: *** ...`, or `make[1]: *** ...` when these
 # tests run under another make (make test).
@@ -76,7 +76,7 @@ class MakeModel(unittest.TestCase):
     def test_make_without_desc_or_out_is_a_usage_line(self):
         for args in ([f"OUT={self.base / 'x'}"], [f"DESC={self.desc}"], []):
             r = subprocess.run(["make", "--no-print-directory", "-s", "model", *args], cwd=ROOT, capture_output=True,
-                               text=True)
+                               text=True, env=MAKE_ENV)
             self.assertEqual(r.returncode, 2, r.stderr)
             self.assertIn("usage: make model DESC=", r.stderr)
         self.assertFalse((self.base / "x").exists())
@@ -143,7 +143,8 @@ class MakeModel(unittest.TestCase):
                             kept=kept)
 
     def run_make(self, *args: str) -> subprocess.CompletedProcess:
-        return subprocess.run(["make", "--no-print-directory", "-s", *args], cwd=ROOT, capture_output=True, text=True)
+        return subprocess.run(["make", "--no-print-directory", "-s", *args], cwd=ROOT, capture_output=True, text=True,
+                              env=MAKE_ENV)
 
     def own_lines(self, r: subprocess.CompletedProcess, command: str = "make model") -> list[str]:
         """stderr's lines but make's own (`make: *** [...] Error 2`), each checked to be the command's."""
@@ -231,7 +232,7 @@ class MakeModel(unittest.TestCase):
         for delay in (0.0, 0.01, 0.02, 0.04, 0.06, 0.08, 0.1):
             run = subprocess.Popen(["make", "--no-print-directory", "-s", "model", f"DESC={self.desc}",
                                     f"OUT={self.base / 'out'}"], cwd=ROOT, stderr=subprocess.PIPE, text=True,
-                                   start_new_session=True, preexec_fn=interruptible)
+                                   env=MAKE_ENV, start_new_session=True, preexec_fn=interruptible)
             time.sleep(delay)
             os.killpg(run.pid, signal.SIGINT)
             stderr = run.communicate(timeout=300)[1]
