@@ -26,7 +26,8 @@ bench:
 ## - the derivation's lane: `make derive` reproduces generated/ byte for byte (on this CPU and on an
 ##   imitated older one: make drift-check), the derivation's own tests, then the model libraries the
 ##   tests that load one use (scripts/model_libraries.sh: every committed model and the xArm7);
-## - the crates' lane: every crate's tests compiled, the Python package built (maturin develop),
+## - the crates' lane: every crate's tests compiled (while the Python environment is made), the
+##   Python package built (maturin develop, reusing the tests' builds: crates/workspace-hack),
 ##   the on-robot crate's tests (make on-robot-test), then the crates' tests run and the Python
 ##   package's.
 ## Then the tests that load a model library, on the libraries built once for all of them. The
@@ -37,25 +38,34 @@ bench:
 ## The fuzzers of every parser run in it with bounded case counts (TOOLCONF_FUZZ_CASES raises
 ## them: docs/reference/errors.md), and so does the sweep of hostile inputs (tests/hostile.rs).
 CARGO_TESTS = cargo test --workspace --exclude toolconf-python --quiet
-test: $(PY_DEV)
+# The command line that $(CARGO_TESTS) --no-run built for the integration tests (their
+# CARGO_BIN_EXE_toolconf), which the Python and MuJoCo tests run: a `cargo build --bin toolconf`
+# or a `cargo test --test NAME` selects fewer packages, so cargo unifies other features for the
+# dependencies they share and compiles the model layer and the runtime again (measured: 151 and
+# 318 CPU-seconds on a warm target/).
+TEST_BIN = $(or $(CARGO_TARGET_DIR),$(CURDIR)/target)/debug/toolconf
+test:
 	@d=$$(mktemp -d) && trap 'rm -rf "$$d"' EXIT && \
 	$(MAKE) --no-print-directory -j2 --output-sync=target derive-lane crates-lane TEST_LIBRARY_DIR=$$d && \
-	TOOLCONF_TEST_LIBRARIES=$$d $(MAKE) --no-print-directory c-example-test loaded-models-test mujoco-test
+	TOOLCONF_TEST_LIBRARIES=$$d TOOLCONF_BIN=$(TEST_BIN) $(MAKE) --no-print-directory c-example-test loaded-models-test mujoco-test
 
-# make test's lanes (TEST_LIBRARY_DIR: the folder the model libraries go to).
-.PHONY: derive-lane crates-lane
+# make test's lanes (TEST_LIBRARY_DIR: the folder the model libraries go to). The tests compile
+# while the Python environment is made (derive/.venv), which the derivation's lane waits for.
+.PHONY: derive-lane crates-lane tests-compiled
+tests-compiled:
+	$(CARGO_TESTS) --no-run
+
 derive-lane: export CARGO_TARGET_DIR = $(CURDIR)/target/derive-lane
 derive-lane: $(PY_DEV)
 	$(MAKE) --no-print-directory drift-check
 	$(PY) -m unittest discover --start-directory derive/tests
 	scripts/model_libraries.sh $(PY) $(TEST_LIBRARY_DIR)
 
-crates-lane: $(PY_DEV)
-	$(CARGO_TESTS) --no-run
+crates-lane: tests-compiled $(PY_DEV)
 	$(PYTHON_BUILD)
 	$(MAKE) --no-print-directory on-robot-test
 	$(CARGO_TESTS)
-	$(PYTHON_TESTS)
+	TOOLCONF_BIN=$(TEST_BIN) $(PYTHON_TESTS)
 
 ## make check: the inner loop, after each edit (under 3 min warm): rustfmt over the workspace; clippy
 ## (warnings are errors) and the unit tests of each package the working tree changes against main
@@ -84,13 +94,13 @@ c-example-test: $(PY)
 ## (tests/loaded_models.rs), that rank's 3-D view of the xArm7 works in headless Chromium (tests/view3d.rs), in Python and on Dask's workers (python/loaded_tests/), and the xArm7's
 ## dynamics against Pinocchio's aba; and runs the examples that load a library (examples/load_model.rs,
 ## examples/python/load_model.py) on the Panda's. Needs the Python package installed (make python-test does it).
-loaded-models-test: $(PY_DEV)
+loaded-models-test:
 	@d=$$(mktemp -d) && trap 'rm -rf "$$d"' EXIT && \
 	if [ -z "$$TOOLCONF_TEST_LIBRARIES" ]; then scripts/model_libraries.sh $(PY) $$d && export TOOLCONF_TEST_LIBRARIES=$$d; fi && \
 	echo "loaded-models-test: $$(ls -d $$TOOLCONF_TEST_LIBRARIES/*/ | wc -l) model libraries" && \
-	cargo test --quiet --test loaded_models -- --include-ignored && \
-	cargo test --quiet --test examples -- --ignored && \
-	cargo test --quiet --test view3d -- --ignored && \
+	$(CARGO_TESTS) --test loaded_models -- --include-ignored && \
+	$(CARGO_TESTS) --test examples -- --ignored && \
+	$(CARGO_TESTS) --test view3d -- --ignored && \
 	$(PY) -m pytest -q python/loaded_tests
 
 ## make mujoco-test: the on-robot controller on MuJoCo (examples/mujoco/, docs/tutorials/mujoco.md). Installs the example's
@@ -99,7 +109,7 @@ loaded-models-test: $(PY_DEV)
 ## example's comparison (compare.py) of the catalogue's touch task against toolconf simulate and asserts its bounds
 ## and ranking (examples/mujoco/test_mujoco.py). Where mujoco cannot be installed, one line says so and it is skipped.
 MUJOCO_INSTALLED := $(VENV)/.mujoco-installed
-mujoco-test: $(PY_DEV)
+mujoco-test:
 	@d=$$(mktemp -d) && trap 'rm -rf "$$d"' EXIT && \
 	if ! $(MAKE) --no-print-directory $(MUJOCO_INSTALLED) >$$d/install.log 2>&1; then \
 	  echo "mujoco-test: skipped: mujoco cannot be installed here: $$(grep -m 1 -i 'error' $$d/install.log || tail -n 1 $$d/install.log)"; \

@@ -276,6 +276,8 @@ const LAYERS: &[(&str, &str, &[&str])] = &[
             "toolconf-messages",
             "toolconf-model",
             "toolconf-tool-urdf",
+            // Not imported: it only sets features (crates/workspace-hack/Cargo.toml).
+            "toolconf-workspace-hack",
         ],
     ),
     (
@@ -358,4 +360,57 @@ fn no_crate_root_reexports_another_crates_modules() {
             assert!(!reexport, "{lib}: {line}");
         }
     }
+}
+
+/// Each dependency of the Python extension, with its features, as `cargo tree` resolves it for
+/// `maturin develop` (the extension alone), and the same for `cargo test --workspace` (make test's
+/// build of every test): what the extension asks for, each with the features the tests' build
+/// gave it.
+fn features(args: &[&str]) -> BTreeSet<String> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+        .current_dir(root)
+        .args(["tree", "--prefix", "none", "--format", "{p} [{f}]"])
+        .args(args)
+        .output()
+        .expect("run cargo tree");
+    common::assert_ok_with(&out, "cargo tree: ");
+    String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| l.trim_end_matches(" (*)").to_string())
+        .collect()
+}
+
+/// make test builds every crate's tests, then the Python extension alone (maturin): a dependency
+/// the two ask for with different features is compiled twice, with all that is above it (the
+/// model layer and the runtime: 329 CPU-seconds). crates/workspace-hack gives both the same
+/// features (and Cargo.toml's build-override the same debug information to the proc macros).
+#[test]
+fn the_python_extension_reuses_the_tests_builds_of_its_dependencies() {
+    let python = features(&["-p", "toolconf-python", "-e", "normal,build"]);
+    let tests = features(&[
+        "--workspace",
+        "--exclude",
+        "toolconf-python",
+        "-e",
+        "normal,build,dev",
+    ]);
+    // "name vX.Y.Z": the packages both builds compile (pyo3 and numpy are the extension's alone).
+    let package = |line: &str| {
+        line.split(" [")
+            .next()
+            .unwrap_or(line)
+            .replace(" (proc-macro)", "")
+    };
+    let shared: BTreeSet<String> = tests.iter().map(|l| package(l)).collect();
+    let apart: Vec<&String> = python
+        .iter()
+        .filter(|p| shared.contains(&package(p)) && !tests.contains(*p))
+        .collect();
+    assert!(
+        apart.is_empty(),
+        "the Python extension's build asks for these with features the tests' build does not \
+         (add them to crates/workspace-hack/Cargo.toml): {apart:#?}"
+    );
 }

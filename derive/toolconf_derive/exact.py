@@ -7,8 +7,9 @@ on another, and the drift check fails for a user whose CPU is not the committer'
 
 - `ExactFunction` evaluates a CasADi function by walking CasADi's own instruction list (the
   expression graph its algorithmic differentiation built) in 50-digit mpmath arithmetic. mpmath
-  is integer arithmetic in pure Python: the result is the same on every machine, and rounding it
-  to double (`float(mpf)`, correctly rounded) gives the same bits everywhere. CasADi's double
+  is integer arithmetic (in Python, or GMP through gmpy2 where installed: the same integers): the
+  result is the same on every machine, and rounding it to double (`float(mpf)`, correctly
+  rounded) gives the same bits everywhere. CasADi's double
   evaluation is still run, but only to check this interpreter (`check_interpreter`); it never
   reaches a file.
 - `Exact` is a 50-digit matrix with the operators the task formulas use (A⁻¹, products, [I O]).
@@ -73,32 +74,37 @@ class ExactFunction:
             if op not in self.unary and op not in self.binary and op not in (ca.OP_CONST, ca.OP_INPUT, ca.OP_OUTPUT):
                 raise ExactEvaluationError(f"{f.name()}: CasADi operation {op} has no exact evaluation")
 
-    def __call__(self, *args) -> list["Exact"]:
+    def __call__(self, *args, track_largest: bool = False) -> list["Exact"]:
         """Evaluates at `args`, arrays of doubles (each taken exactly)."""
         with mpmath.workdps(DIGITS):
-            return self.exact_at([self._input_nonzeros(i, a) for i, a in enumerate(args)])
+            return self.exact_at([self._input_nonzeros(i, a) for i, a in enumerate(args)], track_largest)
 
-    def exact_at(self, inputs: list[list]) -> list["Exact"]:
-        """Evaluates at inputs given exactly: each input's non-zeros as mpmath numbers."""
+    def exact_at(self, inputs: list[list], track_largest: bool = False) -> list["Exact"]:
+        """Evaluates at inputs given exactly: each input's non-zeros as mpmath numbers. With
+        `track_largest`, also the largest intermediate's magnitude (`largest_intermediate`): a third
+        of the evaluation's time in the derivation's profile, so only where a check needs it."""
         with mpmath.workdps(DIGITS):
             outputs = [mpmath.zeros(r, c) for r, c in self.out_shapes]
             w: list = [None] * max(self.work_size, 1)
             largest = mpmath.mpf(0)
+            binary, unary, out_nz = self.binary, self.unary, self.out_nz
             for op, ins, outs, const in self.program:
-                if op == ca.OP_CONST:
-                    w[outs[0]] = mpmath.mpf(const)
+                if op in binary:
+                    v = binary[op](w[ins[0]], w[ins[1]])
+                elif op == ca.OP_CONST:
+                    v = mpmath.mpf(const)
                 elif op == ca.OP_INPUT:
-                    w[outs[0]] = inputs[ins[0]][ins[1]]
+                    v = inputs[ins[0]][ins[1]]
                 elif op == ca.OP_OUTPUT:
-                    r, c = self.out_nz[outs[0]][outs[1]]
+                    r, c = out_nz[outs[0]][outs[1]]
                     outputs[outs[0]][r, c] = w[ins[0]]
-                elif op in self.binary:
-                    w[outs[0]] = self.binary[op](w[ins[0]], w[ins[1]])
+                    continue
                 else:
-                    w[outs[0]] = self.unary[op](w[ins[0]])
-                if op != ca.OP_OUTPUT:
-                    largest = max(largest, abs(w[outs[0]]))
-            self.largest_intermediate = float(largest)
+                    v = unary[op](w[ins[0]])
+                w[outs[0]] = v
+                if track_largest:
+                    largest = max(largest, abs(v))
+            self.largest_intermediate = float(largest) if track_largest else float("nan")
             return [Exact(o) for o in outputs]
 
     def _input_nonzeros(self, i: int, a) -> list:
@@ -110,7 +116,7 @@ class ExactFunction:
         (normwise relative per output): a check of this interpreter. CasADi's doubles are only
         compared, never returned. `cancelling`: the outputs may cancel to far below the graph's
         intermediates, so the bound also allows INTERMEDIATE_TOLERANCE times the largest of them."""
-        exact = self(*args)
+        exact = self(*args, track_largest=cancelling)
         floor = INTERMEDIATE_TOLERANCE * self.largest_intermediate if cancelling else 0.0
         doubles = self.f(*[np.asarray(a, dtype=float) for a in args])
         doubles = [doubles] if self.f.n_out() == 1 else doubles

@@ -27,13 +27,15 @@ def stdout_per_thread_count(script, *args):
 
 @pytest.fixture(scope="session")
 def cli():
-    """Runs ``toolconf ARGS``; returns (exit status, stdout, stderr). The binary is the one
-    cargo builds in the workspace's target directory (up to date after ``cargo test``)."""
-    subprocess.run(
-        ["cargo", "build", "--quiet", "--bin", "toolconf"], cwd=REPO, check=True
-    )
-    target = Path(os.environ.get("CARGO_TARGET_DIR", REPO / "target"))
-    binary = target / "debug" / "toolconf"
+    """Runs ``toolconf ARGS``; returns (exit status, stdout, stderr). The binary is TOOLCONF_BIN
+    (make test: the one its ``cargo test --workspace`` built) or the one ``cargo build`` makes in
+    the workspace's target directory."""
+    given = os.environ.get("TOOLCONF_BIN")
+    if given:
+        binary = Path(given)
+    else:
+        subprocess.run(["cargo", "build", "--quiet", "--bin", "toolconf"], cwd=REPO, check=True)
+        binary = Path(os.environ.get("CARGO_TARGET_DIR", REPO / "target")) / "debug" / "toolconf"
 
     def run(*args):
         out = subprocess.run(

@@ -1,0 +1,2 @@
+//! Empty: it makes cargo build this crate's build-dependencies (Cargo.toml).
+fn main() {}
