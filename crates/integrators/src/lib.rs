@@ -178,7 +178,7 @@ where
                     ..Stats::default()
                 },
             };
-            return rodas5p::integrate(&mut problem, start, grid, settings, output);
+            return rodas5p::integrate(&mut problem, start, grid, settings, output, false);
         }
     };
     let rhs = |t: f64, y: &SVector<f64, D>| problem.rhs(t, y);
@@ -193,11 +193,8 @@ where
                 next: at.next,
                 stats: at.stats,
             };
-            if method == Method::Fast {
-                rodas_lean::integrate(&mut problem, start, grid, settings, output)
-            } else {
-                rodas5p::integrate(&mut problem, start, grid, settings, output)
-            }
+            let lean = method == Method::Fast;
+            rodas5p::integrate(&mut problem, start, grid, settings, output, lean)
         }
     }
 }

@@ -21,6 +21,7 @@
 use nalgebra::{SMatrix, SVector};
 use toolconf_core::linalg::Lu;
 
+use super::rodas_lean::Lean;
 use super::rosenbrock::{run, Problem, Start, Stepper, Tableau};
 use super::{IntegrationError, Settings, Stats};
 
@@ -182,27 +183,33 @@ impl<const D: usize, const S: usize> Stepper<D, S> for Standard<'_, S> {
     }
 }
 
-/// The Rodas5P main loop from `start` over a validated grid and settings.
+/// The Rodas5P main loop from `start` over a validated grid and settings: with the published step,
+/// or with `lean`, the lean one of [`super::rodas_lean`] ([`super::Method::Fast`]).
 pub(super) fn integrate<const D: usize, P, O>(
     problem: &mut P,
     start: Start<D>,
     grid: &[f64],
     s: &Settings,
     output: O,
+    lean: bool,
 ) -> Result<Stats, IntegrationError>
 where
     P: Problem<D>,
     O: FnMut(usize, f64, &SVector<f64, D>),
 {
-    run(
-        &RODAS5P,
-        &Standard(&RODAS5P),
-        problem,
-        start,
-        grid,
-        s,
-        output,
-    )
+    if lean {
+        run(&RODAS5P, &Lean, problem, start, grid, s, output)
+    } else {
+        run(
+            &RODAS5P,
+            &Standard(&RODAS5P),
+            problem,
+            start,
+            grid,
+            s,
+            output,
+        )
+    }
 }
 
 #[cfg(test)]

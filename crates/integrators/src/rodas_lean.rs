@@ -21,8 +21,7 @@ use nalgebra::{SMatrix, SVector};
 use toolconf_core::linalg::Lu;
 
 use super::rodas5p::RODAS5P;
-use super::rosenbrock::{run, Problem, Start, Stepper, Tableau};
-use super::{IntegrationError, Settings, Stats};
+use super::rosenbrock::{Problem, Stepper, Tableau};
 
 /// Stages of Rodas5P.
 const S: usize = 8;
@@ -59,14 +58,14 @@ fn dense_rows<const D: usize>(k: &[SVector<f64, D>; S]) -> [SVector<f64, D>; 3] 
 
 /// An attempt: the stages, the new solution and, once the step has output points inside it,
 /// its dense output's rows.
-struct LeanStep<const D: usize> {
+pub(super) struct LeanStep<const D: usize> {
     k: [SVector<f64, D>; S],
     y_new: SVector<f64, D>,
     dense: Option<[SVector<f64, D>; 3]>,
 }
 
 /// The lean Rodas5P step inside [`super::rosenbrock::run`].
-struct Lean;
+pub(super) struct Lean;
 
 impl<const D: usize> Stepper<D, S> for Lean {
     type Lu = Lu<D>;
@@ -157,23 +156,10 @@ impl<const D: usize> Stepper<D, S> for Lean {
     }
 }
 
-/// Rodas5P from `start` over a validated grid and settings, with the lean step.
-pub(super) fn integrate<const D: usize, P, O>(
-    problem: &mut P,
-    start: Start<D>,
-    grid: &[f64],
-    s: &Settings,
-    output: O,
-) -> Result<Stats, IntegrationError>
-where
-    P: Problem<D>,
-    O: FnMut(usize, f64, &SVector<f64, D>),
-{
-    run(&RODAS5P, &Lean, problem, start, grid, s, output)
-}
-
 #[cfg(test)]
 mod tests {
+    use super::super::rosenbrock::Start;
+    use super::super::Stats;
     use super::*;
 
     #[test]
@@ -220,11 +206,14 @@ mod tests {
             };
             let mut out = Vec::new();
             let output = |_, _, y: &SVector<f64, 2>| out.push(*y);
-            let stats = if lean {
-                integrate(&mut VanDerPol, start, &grid, &settings, output)
-            } else {
-                super::super::rodas5p::integrate(&mut VanDerPol, start, &grid, &settings, output)
-            }
+            let stats = super::super::rodas5p::integrate(
+                &mut VanDerPol,
+                start,
+                &grid,
+                &settings,
+                output,
+                lean,
+            )
             .unwrap();
             (stats, out)
         };
