@@ -11,10 +11,10 @@
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use toolconf::design::file::DesignSpec;
 use toolconf::design::polytope::Polytope;
 use toolconf::design::{confidence_optimum, verify, Setting};
 use toolconf::rank::ModelTasks;
+use toolconf_model::inputs::design_file::DesignSpec;
 use toolconf_model::inputs::task_file::TaskSpec;
 use toolconf_model::registry::{AnyTool, ModelKind};
 use toolconf_model::TaskKind;

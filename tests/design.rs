@@ -2,10 +2,10 @@
 //! hand-derived closed form, a constrained optimum known in closed form, the paper's arm under
 //! the stated constraints against 10^5 random feasible tools, infeasibility and determinism.
 
-use toolconf::design::file::DesignSpec;
 use toolconf::design::{confidence_optimum, design, DesignError, Setting};
 use toolconf::rank::ModelTasks;
 use toolconf::select::mixed::MixedSampler;
+use toolconf_model::inputs::design_file::DesignSpec;
 use toolconf_model::inputs::task_file::TaskSpec;
 use toolconf_model::registry::{AnyTool, ModelKind};
 use toolconf_model::TaskKind;

@@ -13,11 +13,11 @@
 
 use proptest::prelude::*;
 use proptest::test_runner::{Config, FileFailurePersistence};
-use toolconf::design::constraint::parse_constraint;
-use toolconf::design::file::DesignSpec;
 use toolconf::design::polytope::Polytope;
 use toolconf::design::sweep::parse_sweep;
 use toolconf::rank::ModelTasks;
+use toolconf_model::inputs::design_file::constraint::parse_constraint;
+use toolconf_model::inputs::design_file::DesignSpec;
 use toolconf_model::inputs::task_file::TaskSpec;
 use toolconf_model::inputs::tools_file::read_tools_from;
 use toolconf_model::registry::ModelKind;

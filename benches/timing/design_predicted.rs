@@ -17,10 +17,10 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 use serde_json::json;
-use toolconf::design::file::{DesignObjective, DesignSpec};
 use toolconf::design::polytope::{FeasibleSampler, Polytope};
 use toolconf::design::{design, parameters_text, Setting};
 use toolconf::rank::ModelTasks;
+use toolconf_model::inputs::design_file::{DesignObjective, DesignSpec};
 use toolconf_model::inputs::task_file::TaskSpec;
 use toolconf_model::registry::{lookup, AnyTool};
 

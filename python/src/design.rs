@@ -6,11 +6,11 @@ use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use serde_json::Value;
-use toolconf::design::file::DesignSpec;
 use toolconf::design::json::design_json;
 use toolconf::design::sweep::{parse_sweep, run_sweep};
 use toolconf::design::{design as run_design, DesignError, Setting};
 use toolconf::rank::ModelTasks;
+use toolconf_model::inputs::design_file::DesignSpec;
 
 use crate::models::model_kind;
 use crate::task::{table, task_spec};
@@ -78,7 +78,7 @@ pub fn design<'py>(
             crate::tools::short_repr(design)
         )));
     }
-    .map_err(raise)?;
+    .map_err(|e| raise(e.into()))?;
     let sweep = sweep
         .map(|s| parse_sweep(s, &names))
         .transpose()

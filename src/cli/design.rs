@@ -5,12 +5,12 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use toolconf::design::file::DesignSpec;
 use toolconf::design::json::design_json;
 use toolconf::design::solver::KKT_TOLERANCE;
 use toolconf::design::sweep::{parse_sweep, run_sweep, Sweep, SweepPoint};
 use toolconf::design::{design_with_progress, DesignError, DesignResult, Setting};
 use toolconf::rank::ModelTasks;
+use toolconf_model::inputs::design_file::DesignSpec;
 use toolconf_model::registry::ModelKind;
 use toolconf_report::design::{parameters_text, write_report, ReportInput};
 
@@ -67,7 +67,7 @@ pub fn run(args: &Args) -> Result<(), CliError> {
     let tasks = ModelTasks::new(&task);
     tasks.check(model)?;
     let names: Vec<&'static str> = model.parameter_names().to_vec();
-    let spec = DesignSpec::from_file(&args.design, model)?;
+    let spec = DesignSpec::from_file(&args.design, model).map_err(DesignError::from)?;
     let sweep = args
         .sweep
         .as_deref()
@@ -181,9 +181,12 @@ fn spec_params(spec: &DesignSpec, o: &toolconf::design::solver::Optimum) -> Vec<
 }
 
 /// The predicted cost from the SQP's value: it maximised −ln(task error) or −∫F dt.
-fn predicted_value(objective: toolconf::design::file::DesignObjective, value: f64) -> f64 {
+fn predicted_value(
+    objective: toolconf_model::inputs::design_file::DesignObjective,
+    value: f64,
+) -> f64 {
     match objective {
-        toolconf::design::file::DesignObjective::PredictedTaskError => (-value).exp(),
+        toolconf_model::inputs::design_file::DesignObjective::PredictedTaskError => (-value).exp(),
         _ => -value,
     }
 }
@@ -208,7 +211,8 @@ fn print_text(spec: &DesignSpec, r: &DesignResult, seconds: f64) {
         outln!(
             "  predicted {}: {:.6e} (KKT residual {:.2e}, {} SQP iterations from start {})",
             match r.objective {
-                toolconf::design::file::DesignObjective::PredictedTaskError => "task error",
+                toolconf_model::inputs::design_file::DesignObjective::PredictedTaskError =>
+                    "task error",
                 _ => "int F dt",
             },
             predicted_value(r.objective, p.value),

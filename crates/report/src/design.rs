@@ -8,10 +8,10 @@ use crate::experiments::plot::{self, Colour, Legend, Panel, Series, XyPanel};
 use crate::experiments::report::{to_html, to_markdown, Block};
 use crate::experiments::{write_atomically, ReproduceError};
 
-use toolconf::design::file::DesignSpec;
 use toolconf::design::sweep::{Sweep, SweepPoint};
 use toolconf::design::DesignResult;
 use toolconf::rank::ModelTasks;
+use toolconf_model::inputs::design_file::DesignSpec;
 use toolconf_model::registry::{AnyTool, ModelKind};
 
 use crate::view3d;

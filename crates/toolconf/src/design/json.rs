@@ -3,10 +3,10 @@
 
 use serde_json::{json, Map, Value};
 
-use super::file::DesignSpec;
 use super::polytope::Polytope;
 use super::sweep::SweepPoint;
 use super::DesignResult;
+use toolconf_model::inputs::design_file::DesignSpec;
 use toolconf_model::registry::ModelKind;
 
 /// The design `r` of `model` on the task named `task` (as the user gave it), with the sweep's
@@ -102,7 +102,9 @@ fn result_json(spec: &DesignSpec, r: &DesignResult) -> Value {
     // Only for a predicted objective, so that the other objectives' output is unchanged.
     if let Some(p) = &r.predicted_optimum {
         let value = match r.objective {
-            super::file::DesignObjective::PredictedTaskError => (-p.value).exp(),
+            toolconf_model::inputs::design_file::DesignObjective::PredictedTaskError => {
+                (-p.value).exp()
+            }
             _ => -p.value,
         };
         v["predicted_optimum"] = json!({

@@ -1,5 +1,6 @@
 //! Tool design by control confidence (`toolconf design`): which tool to build for a task, under
-//! bounds, linear constraints and fixed parameters from a design file ([`mod@file`]).
+//! bounds, linear constraints and fixed parameters from a design file
+//! ([`toolconf_model::inputs::design_file`]).
 //!
 //! Flow: the design file → the feasible polytope over the free parameters ([`polytope`]) → a
 //! multi-start SQP on ln|Π^U| with the derived gradient ∂ln|Π^U|/∂p = tr((Π^U)⁻¹ ∂Π^U/∂p)
@@ -12,8 +13,6 @@
 //! the multi-start runs in start order; simulations run in parallel but are collected in input
 //! order. The same file and seed give the same design on any number of threads.
 
-pub mod constraint;
-pub mod file;
 pub mod free_energy;
 pub mod json;
 pub mod polytope;
@@ -24,11 +23,11 @@ pub mod sweep;
 pub mod verify;
 
 use crate::rank::ModelTasks;
+use toolconf_model::inputs::design_file::{DesignFileError, DesignObjective, DesignSpec};
 use toolconf_model::inputs::task_file::TaskSpec;
 use toolconf_model::prediction::derivative::PredictedCost;
 use toolconf_model::registry::{AnyTool, ModelKind};
 
-use file::{DesignObjective, DesignSpec};
 use polytope::{FeasibleSampler, Polytope, Spread};
 use solver::Optimum;
 use verify::{RandomTools, ToolCheck};
@@ -45,13 +44,9 @@ pub enum DesignError {
     Failed(String),
 }
 
-impl DesignError {
-    pub fn input(file: &str, place: &str, message: String) -> Self {
-        if place.is_empty() {
-            DesignError::Input(format!("{file}: {message}"))
-        } else {
-            DesignError::Input(format!("{file}, {place}: {message}"))
-        }
+impl From<DesignFileError> for DesignError {
+    fn from(e: DesignFileError) -> Self {
+        DesignError::Input(e.to_string())
     }
 }
 

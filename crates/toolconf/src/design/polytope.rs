@@ -6,11 +6,11 @@
 use rand::{RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::constraint::dot;
-use super::file::DesignSpec;
 use super::qp::{self, QpOutcome};
 use super::DesignError;
 use toolconf_messages::Clip;
+use toolconf_model::inputs::design_file::constraint::dot;
+use toolconf_model::inputs::design_file::DesignSpec;
 
 /// Points within this (absolute, in parameter units) of a constraint count as on it.
 pub const FEASIBILITY_TOLERANCE: f64 = 1e-9;

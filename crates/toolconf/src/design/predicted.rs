@@ -13,10 +13,10 @@
 //!
 //! Checked against central differences of the whole prediction (the tests below).
 
-use super::file::DesignSpec;
 use super::polytope::Polytope;
 use super::solver::{self, Optimum};
 use super::{DesignError, Setting};
+use toolconf_model::inputs::design_file::DesignSpec;
 use toolconf_model::prediction::derivative::{
     costs_and_derivatives, Costs, DenseSystem, PredictedCost,
 };
@@ -118,9 +118,9 @@ pub fn optimum(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::design::file::DesignSpec;
     use crate::design::polytope::Polytope;
     use crate::rank::ModelTasks;
+    use toolconf_model::inputs::design_file::DesignSpec;
     use toolconf_model::inputs::task_file::TaskSpec;
     use toolconf_model::registry::ModelKind;
 

@@ -24,9 +24,9 @@
 //! scale of x_j would freeze it (d_j = σ_j x_j = 0) and make c/x_j² infinite: its scale is
 //! max(|x_j|, 10⁻³ of its box's width) instead ([`scales`]). The others keep x_j.
 
-use super::constraint::dot;
 use super::polytope::Polytope;
 use super::qp::{self, QpOutcome};
+use toolconf_model::inputs::design_file::constraint::dot;
 
 const MAX_ITERATIONS: usize = 200;
 const STEP_TOLERANCE: f64 = 1e-10;

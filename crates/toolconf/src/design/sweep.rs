@@ -2,9 +2,9 @@
 //! the constraint's right side at K evenly spaced values from A to B, replacing the design file's
 //! constraint with the same left side (or adding it). Infeasible budgets are kept as such.
 
-use super::constraint::{parse_constraint, split_comparison};
-use super::file::DesignSpec;
 use super::{confidence_optimum, DesignError, Setting};
+use toolconf_model::inputs::design_file::constraint::{parse_constraint, split_comparison};
+use toolconf_model::inputs::design_file::DesignSpec;
 
 /// A parsed `--sweep`: the constraint text at each value.
 #[derive(Debug, Clone, PartialEq)]
@@ -27,7 +27,10 @@ pub struct SweepPoint {
 pub fn parse_sweep(text: &str, names: &[&str]) -> Result<Sweep, String> {
     let bad = |why: &str| format!("--sweep '{}': {why}", toolconf_messages::Clip(text));
     let (left, sense, right) = split_comparison(text).map_err(|e| bad(&e))?;
-    let op = if matches!(sense, super::constraint::Sense::AtMost) {
+    let op = if matches!(
+        sense,
+        toolconf_model::inputs::design_file::constraint::Sense::AtMost
+    ) {
         "<="
     } else {
         ">="

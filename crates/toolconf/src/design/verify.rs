@@ -210,7 +210,7 @@ fn simulate(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::design::file::DesignSpec;
+    use toolconf_model::inputs::design_file::DesignSpec;
     use toolconf_model::inputs::task_file::TaskSpec;
     use toolconf_model::TaskKind;
 

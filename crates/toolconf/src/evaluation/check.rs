@@ -17,9 +17,7 @@ use serde_json::{json, Value};
 use super::seeds::derive_seed;
 use super::verdict::{Correlation, Finding};
 
-/// Tools simulated alongside to check claim (a) (`rank --validation`, design's `[search]
-/// validation`).
-pub const VALIDATION_TOOLS: usize = 100;
+pub use toolconf_model::inputs::design_file::VALIDATION_TOOLS;
 /// Bootstrap resamples of the check's interval.
 const RESAMPLES: usize = 2000;
 

@@ -7,8 +7,8 @@
 
 use std::fmt;
 
+use crate::validate::{CONSTRAINT_BOUND, CONSTRAINT_COEFFICIENT};
 use toolconf_messages::Clip;
-use toolconf_model::validate::{CONSTRAINT_BOUND, CONSTRAINT_COEFFICIENT};
 
 /// a·p ≤ b over a model's parameters (in the model's order), with the text it came from.
 #[derive(Debug, Clone, PartialEq)]

@@ -18,18 +18,53 @@
 //!                                     # predicts the task error here (0: no check)
 //! ```
 //!
-//! Every mistake is a [`DesignError::Input`] naming the file and the key.
+//! Every mistake is a [`DesignFileError`] naming the file and the key.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
 use serde::Deserialize;
 
-use super::constraint::{parse_constraint, LinearConstraint};
-use super::DesignError;
+use crate::registry::ModelKind;
 use toolconf_generated::validity::ParameterDomain;
 use toolconf_messages::{Clip, ClipMessage, ClipPath, ShortList};
-use toolconf_model::registry::ModelKind;
+
+pub mod constraint;
+use constraint::{parse_constraint, LinearConstraint};
+
+/// Tools simulated alongside to check claim (a) by default (`rank --validation`, design's
+/// `[search] validation`; the check is `toolconf::evaluation::check`).
+pub const VALIDATION_TOOLS: usize = 100;
+
+/// A bad design file (or design dict): the file, where in it (a key or a line), and what is
+/// wrong.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub struct DesignFileError {
+    pub file: String,
+    /// `key bounds.m1`, `line 4`, or empty when the whole file is meant.
+    pub place: String,
+    pub message: String,
+}
+
+impl DesignFileError {
+    fn new(file: &str, place: &str, message: String) -> Self {
+        Self {
+            file: file.into(),
+            place: place.into(),
+            message,
+        }
+    }
+}
+
+impl std::fmt::Display for DesignFileError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.place.is_empty() {
+            write!(f, "{}: {}", self.file, self.message)
+        } else {
+            write!(f, "{}, {}: {}", self.file, self.place, self.message)
+        }
+    }
+}
 
 /// What the design optimises.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -39,7 +74,7 @@ pub enum DesignObjective {
     /// Minimise ∫F dt by simulation, started from the confidence optimum.
     FreeEnergy,
     /// Minimise the predicted task error of the closed loop linearised at the equilibrium
-    /// ([`toolconf_model::prediction`]; its gradient in [`super::predicted`]).
+    /// ([`crate::prediction`]; its gradient in `toolconf::design::predicted`).
     PredictedTaskError,
     /// Minimise the predicted ∫F dt of the same linearised loop.
     PredictedFreeEnergy,
@@ -65,7 +100,7 @@ pub struct SearchSettings {
     pub simulate: usize,
     pub perturbation: f64,
     /// The first this many random feasible tools are simulated to check claim (a) on the
-    /// design's feasible set ([`crate::evaluation::check`]).
+    /// design's feasible set (`toolconf::evaluation::check`).
     pub validation: usize,
 }
 
@@ -77,7 +112,7 @@ impl Default for SearchSettings {
             samples: 100_000,
             simulate: 5,
             perturbation: -0.8,
-            validation: crate::evaluation::VALIDATION_TOOLS,
+            validation: VALIDATION_TOOLS,
         }
     }
 }
@@ -123,30 +158,30 @@ struct RawSearch {
 
 impl DesignSpec {
     /// Reads and checks a design file for a tool of `model`.
-    pub fn from_file(path: &Path, model: ModelKind) -> Result<Self, DesignError> {
+    pub fn from_file(path: &Path, model: ModelKind) -> Result<Self, DesignFileError> {
         let file = ClipPath(&path.to_string_lossy()).to_string();
-        let text = toolconf_model::inputs::bounded_read::read_text_file(path, "design file")
-            .map_err(|message| DesignError::input(&file, "", message))?;
+        let text = super::bounded_read::read_text_file(path, "design file")
+            .map_err(|message| DesignFileError::new(&file, "", message))?;
         Self::parse(&text, &file, model)
     }
 
     /// Parses and checks design-file text for a tool of `model`; `file` names it in errors.
     /// Bounds and fixed values must lie in each parameter's domain, and the model's own
     /// constraints (a URDF tool's triangle inequality, `generated::validity`) join the file's.
-    pub fn parse(text: &str, file: &str, model: ModelKind) -> Result<Self, DesignError> {
+    pub fn parse(text: &str, file: &str, model: ModelKind) -> Result<Self, DesignFileError> {
         let raw: RawDesign = toml::from_str(text).map_err(|e| {
             let line = e.span().map(|s| 1 + text[..s.start].matches('\n').count());
             let place = line.map(|l| format!("line {l}")).unwrap_or_default();
             let message = e.message().trim().replace('\n', " ");
-            DesignError::input(file, &place, ClipMessage(&message).to_string())
+            DesignFileError::new(file, &place, ClipMessage(&message).to_string())
         })?;
         Self::from_raw(raw, file, model)
     }
 
-    fn from_raw(raw: RawDesign, file: &str, model: ModelKind) -> Result<Self, DesignError> {
+    fn from_raw(raw: RawDesign, file: &str, model: ModelKind) -> Result<Self, DesignFileError> {
         let names = model.parameter_names();
         let err =
-            |key: &str, message: String| DesignError::input(file, &format!("key {key}"), message);
+            |key: &str, message: String| DesignFileError::new(file, &format!("key {key}"), message);
         let objective =
             design_objective(raw.objective.as_deref()).map_err(|m| err("objective", m))?;
         let (fixed, bounds) = fixed_and_bounds(&raw, model, &err)?;
@@ -197,11 +232,11 @@ type FixedAndBounds = (Vec<Option<f64>>, Vec<(f64, f64)>);
 fn fixed_and_bounds(
     raw: &RawDesign,
     model: ModelKind,
-    err: &dyn Fn(&str, String) -> DesignError,
-) -> Result<FixedAndBounds, DesignError> {
+    err: &dyn Fn(&str, String) -> DesignFileError,
+) -> Result<FixedAndBounds, DesignFileError> {
     let names = model.parameter_names();
     let domains = model.parameter_domains();
-    let known = |key: String, name: &str| -> Result<usize, DesignError> {
+    let known = |key: String, name: &str| -> Result<usize, DesignFileError> {
         names.iter().position(|n| *n == name).ok_or_else(|| {
             err(
                 &Clip(&key).to_string(),
@@ -216,7 +251,7 @@ fn fixed_and_bounds(
     let mut fixed = vec![None; names.len()];
     for (name, &value) in &raw.fixed {
         let k = known(format!("fixed.{name}"), name)?;
-        if let Err(why) = toolconf_model::validate::tool_parameter(&domains[k], value) {
+        if let Err(why) = crate::validate::tool_parameter(&domains[k], value) {
             return Err(err(&format!("fixed.{name}"), why));
         }
         fixed[k] = Some(value);
@@ -294,7 +329,7 @@ fn check_bounds(range: &[f64], domain: &ParameterDomain) -> Result<(f64, f64), S
     };
     let shown = ShortList(range);
     if domain.is_positive() {
-        let valid = toolconf_model::validate::TOOL_PARAMETER;
+        let valid = crate::validate::TOOL_PARAMETER;
         if lo <= 0.0 {
             return Err(format!(
                 "{shown} admits values <= 0; masses and lengths must be > 0 (give lo > 0)"
@@ -339,7 +374,7 @@ fn search_settings(raw: &RawSearch) -> Result<SearchSettings, (&'static str, Str
     if s.simulate > 1000 {
         return Err(("simulate", format!("{} is more than 1000", s.simulate)));
     }
-    toolconf_model::validate::TORQUE
+    crate::validate::TORQUE
         .check(s.perturbation)
         .map_err(|m| ("perturbation", m))?;
     Ok(s)
@@ -354,7 +389,7 @@ impl DesignSpec {
         table: toml::Table,
         source: &str,
         model: ModelKind,
-    ) -> Result<Self, DesignError> {
+    ) -> Result<Self, DesignFileError> {
         let raw: RawDesign = table.try_into().map_err(|e| {
             // As TaskSpec::from_table: toml names the place as a last line "in `bounds.m1`".
             let text = e.to_string();
@@ -362,7 +397,7 @@ impl DesignSpec {
                 Some((message, key)) => (message, format!("key {}", key.trim_end_matches('`'))),
                 None => (text.trim_end(), String::new()),
             };
-            DesignError::input(source, &place, message.trim().replace('\n', " "))
+            DesignFileError::new(source, &place, message.trim().replace('\n', " "))
         })?;
         Self::from_raw(raw, source, model)
     }
