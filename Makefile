@@ -30,8 +30,8 @@ bench:
 ##   Python package built (maturin develop, reusing the tests' builds: crates/workspace-hack),
 ##   the on-robot crate's tests (make on-robot-test), then the crates' tests run and the Python
 ##   package's.
-## Then the tests that load a model library, on the libraries built once for all of them. The
-## Python crate is built by maturin alone (it has no Rust tests: `cargo test --workspace` would
+## Then the tests that load a model library, on the libraries built once for all of them, two at a
+## time. The Python crate is built by maturin alone (it has no Rust tests: `cargo test --workspace` would
 ## only build it a second time). The derivation's lane builds in target/derive-lane/ (the renderer,
 ## and the model libraries under make-model/): cargo locks a whole target folder while it builds,
 ## so neither lane waits for the other's cargo.
@@ -47,7 +47,8 @@ TEST_BIN = $(or $(CARGO_TARGET_DIR),$(CURDIR)/target)/debug/toolconf
 test:
 	@d=$$(mktemp -d) && trap 'rm -rf "$$d"' EXIT && \
 	$(MAKE) --no-print-directory -j2 --output-sync=target derive-lane crates-lane TEST_LIBRARY_DIR=$$d && \
-	TOOLCONF_TEST_LIBRARIES=$$d TOOLCONF_BIN=$(TEST_BIN) $(MAKE) --no-print-directory c-example-test loaded-models-test mujoco-test
+	TOOLCONF_TEST_LIBRARIES=$$d TOOLCONF_BIN=$(TEST_BIN) $(MAKE) --no-print-directory -j2 --output-sync=target \
+	  c-example-test loaded-models-test mujoco-test
 
 # make test's lanes (TEST_LIBRARY_DIR: the folder the model libraries go to). The tests compile
 # while the Python environment is made (derive/.venv), which the derivation's lane waits for.
@@ -61,11 +62,15 @@ derive-lane: $(PY_DEV)
 	$(PY) -m unittest discover --start-directory derive/tests
 	scripts/model_libraries.sh $(PY) $(TEST_LIBRARY_DIR)
 
+# The crates' lane ends by installing MuJoCo's packages, while the other lane still works: the tests
+# that load a model library then run two at a time without pip changing derive/.venv under them
+# (mujoco-test tries a failed install again, and says so).
 crates-lane: tests-compiled $(PY_DEV)
 	$(PYTHON_BUILD)
 	$(MAKE) --no-print-directory on-robot-test
 	$(CARGO_TESTS)
 	TOOLCONF_BIN=$(TEST_BIN) $(PYTHON_TESTS)
+	@$(MAKE) --no-print-directory $(MUJOCO_INSTALLED) >/dev/null 2>&1 || true
 
 ## make check: the inner loop, after each edit (under 3 min warm): rustfmt over the workspace; clippy
 ## (warnings are errors) and the unit tests of each package the working tree changes against main
