@@ -33,15 +33,19 @@ control character is refused (check_arguments).
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
 
 
 def _interrupted_while_starting(*_) -> None:
     """Ctrl-C while the derivation's modules load, before the run has started: one line and the
-    shell's status for an interrupt, no traceback."""
+    shell's status for an interrupt, no traceback. It exits at once (os._exit): the handler can
+    run inside a library's import, whose bare `except:` would swallow a SystemExit and let the run
+    go on; nothing has been made yet."""
     print("make crate: interrupted; nothing changed", file=sys.stderr)
-    raise SystemExit(130)
+    sys.stderr.flush()
+    os._exit(130)
 
 
 # First, before the imports that take a second: an interrupt during them is the line above. make
@@ -52,7 +56,6 @@ if __name__ == "__main__":
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 import argparse  # noqa: E402
-import os  # noqa: E402
 import re  # noqa: E402
 import shutil  # noqa: E402
 import subprocess  # noqa: E402

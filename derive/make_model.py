@@ -43,6 +43,7 @@ its exports run the very code the command line and the on-robot controller run.
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
 
@@ -51,9 +52,12 @@ COMMAND = "make model"
 
 def _interrupted_while_starting(*_) -> None:
     """Ctrl-C while the derivation's modules load, before the run has started: one line and the
-    shell's status for an interrupt, no traceback."""
+    shell's status for an interrupt, no traceback. It exits at once (os._exit): the handler can
+    run inside a library's import, whose bare `except:` would swallow a SystemExit and let the run
+    go on; nothing has been made yet."""
     print(f"{COMMAND}: interrupted; nothing changed", file=sys.stderr)
-    raise SystemExit(130)
+    sys.stderr.flush()
+    os._exit(130)
 
 
 # First, before the imports that take a second: an interrupt during them is the line above. make
@@ -64,7 +68,6 @@ signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 import fcntl  # noqa: E402
 import json  # noqa: E402
-import os  # noqa: E402
 import re  # noqa: E402
 import shutil  # noqa: E402
 import stat  # noqa: E402
