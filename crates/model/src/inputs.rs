@@ -7,3 +7,18 @@ pub mod bounded_read;
 pub mod design_file;
 pub mod task_file;
 pub mod tools_file;
+
+/// How a bad input file is named in a message: `file: message`, or `file, place: message` where a
+/// key or a line is meant ([`task_file::TaskFileError`], [`design_file::DesignFileError`]).
+fn write_located(
+    f: &mut std::fmt::Formatter<'_>,
+    file: &str,
+    place: &str,
+    message: &str,
+) -> std::fmt::Result {
+    if place.is_empty() {
+        write!(f, "{file}: {message}")
+    } else {
+        write!(f, "{file}, {place}: {message}")
+    }
+}

@@ -58,11 +58,7 @@ impl DesignFileError {
 
 impl std::fmt::Display for DesignFileError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        if self.place.is_empty() {
-            write!(f, "{}: {}", self.file, self.message)
-        } else {
-            write!(f, "{}, {}: {}", self.file, self.place, self.message)
-        }
+        super::write_located(f, &self.file, &self.place, &self.message)
     }
 }
 

@@ -60,11 +60,7 @@ pub struct TaskFileError {
 
 impl fmt::Display for TaskFileError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if self.place.is_empty() {
-            write!(f, "{}: {}", self.file, self.message)
-        } else {
-            write!(f, "{}, {}: {}", self.file, self.place, self.message)
-        }
+        super::write_located(f, &self.file, &self.place, &self.message)
     }
 }
 
