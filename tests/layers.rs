@@ -208,93 +208,38 @@ fn the_on_robot_controller_builds_for_a_bare_metal_target() {
 }
 
 /// The toolconf crates each crate depends on directly (normal edges): (manifest, package, the
-/// toolconf packages it may import). One direction of flow, each part of the runtime's former
-/// whole on only what is below it. A new edge is a decision about the layers, taken here.
+/// toolconf packages it may import), every name but the runtime's `toolconf` without its
+/// `toolconf-` prefix. One direction of flow, each part of the runtime's former whole on only
+/// what is below it. A new edge is a decision about the layers, taken here. The Python
+/// package's `workspace-hack` is not imported: it only sets features
+/// (crates/workspace-hack/Cargo.toml).
+#[rustfmt::skip]
 const LAYERS: &[(&str, &str, &[&str])] = &[
-    ("crates/files/Cargo.toml", "toolconf-files", &[]),
-    ("crates/stats/Cargo.toml", "toolconf-stats", &[]),
-    (
-        "crates/messages/Cargo.toml",
-        "toolconf-messages",
-        &["toolconf-core"],
-    ),
-    (
-        "crates/integrators/Cargo.toml",
-        "toolconf-integrators",
-        &["toolconf-core"],
-    ),
-    (
-        "crates/tool-urdf/Cargo.toml",
-        "toolconf-tool-urdf",
-        &["toolconf-files", "toolconf-messages"],
-    ),
-    (
-        "crates/model/Cargo.toml",
-        "toolconf-model",
-        &[
-            "toolconf-cabi",
-            "toolconf-core",
-            "toolconf-files",
-            "toolconf-generated",
-            "toolconf-integrators",
-            "toolconf-messages",
-        ],
-    ),
-    (
-        "crates/toolconf/Cargo.toml",
-        "toolconf",
-        &[
-            "toolconf-core",
-            "toolconf-files",
-            "toolconf-generated",
-            "toolconf-integrators",
-            "toolconf-messages",
-            "toolconf-model",
-            "toolconf-stats",
-        ],
-    ),
-    (
-        "crates/report/Cargo.toml",
-        "toolconf-report",
-        &[
-            "toolconf",
-            "toolconf-files",
-            "toolconf-generated",
-            "toolconf-integrators",
-            "toolconf-model",
-            "toolconf-stats",
-        ],
-    ),
-    (
-        "python/Cargo.toml",
-        "toolconf-python",
-        &[
-            "toolconf",
-            "toolconf-files",
-            "toolconf-generated",
-            "toolconf-integrators",
-            "toolconf-messages",
-            "toolconf-model",
-            "toolconf-tool-urdf",
-            // Not imported: it only sets features (crates/workspace-hack/Cargo.toml).
-            "toolconf-workspace-hack",
-        ],
-    ),
-    (
-        "Cargo.toml",
-        "toolconf-cli",
-        &[
-            "toolconf",
-            "toolconf-files",
-            "toolconf-generated",
-            "toolconf-integrators",
-            "toolconf-messages",
-            "toolconf-model",
-            "toolconf-report",
-            "toolconf-tool-urdf",
-        ],
-    ),
+    ("crates/files", "files", &[]),
+    ("crates/stats", "stats", &[]),
+    ("crates/messages", "messages", &["core"]),
+    ("crates/integrators", "integrators", &["core"]),
+    ("crates/tool-urdf", "tool-urdf", &["files", "messages"]),
+    ("crates/model", "model", &["cabi", "core", "files", "generated", "integrators", "messages"]),
+    ("crates/toolconf", "toolconf",
+        &["core", "files", "generated", "integrators", "messages", "model", "stats"]),
+    ("crates/report", "report",
+        &["toolconf", "files", "generated", "integrators", "model", "stats"]),
+    ("python", "python",
+        &["toolconf", "files", "generated", "integrators", "messages", "model", "tool-urdf",
+          "workspace-hack"]),
+    (".", "cli",
+        &["toolconf", "files", "generated", "integrators", "messages", "model", "report",
+          "tool-urdf"]),
 ];
+
+/// `toolconf` for the runtime, `toolconf-NAME` for every other short name of [`LAYERS`].
+fn package(name: &str) -> String {
+    match name {
+        "toolconf" => name.to_string(),
+        _ => format!("toolconf-{name}"),
+    }
+}
 
 /// The crates that carry nothing heavy ([`HEAVY`]): the integrators, the statistics, the
 /// messages and the URDF reader.
@@ -309,14 +254,14 @@ const LIGHT: [&str; 4] = [
 /// crates' whole trees hold nothing [`HEAVY`].
 #[test]
 fn each_crate_imports_only_the_layers_below_it() {
-    for &(manifest, package, expected) in LAYERS {
-        let direct = tree(manifest, &["-e", "normal", "--depth", "1"]);
-        let ours: BTreeSet<&str> = direct
-            .iter()
-            .filter(|p| p.starts_with("toolconf") && p.as_str() != package)
-            .map(String::as_str)
+    for &(dir, name, expected) in LAYERS {
+        let manifest = format!("{dir}/Cargo.toml");
+        let direct = tree(&manifest, &["-e", "normal", "--depth", "1"]);
+        let ours: BTreeSet<String> = direct
+            .into_iter()
+            .filter(|p| p.starts_with("toolconf") && *p != package(name))
             .collect();
-        let expected: BTreeSet<&str> = expected.iter().copied().collect();
+        let expected: BTreeSet<String> = expected.iter().map(|e| package(e)).collect();
         assert_eq!(ours, expected, "{manifest}'s toolconf dependencies");
     }
     for manifest in LIGHT {

@@ -146,3 +146,18 @@ pub fn each_tool<T>(v: &Value, each: impl FnMut(&Value) -> T) -> Vec<T> {
         .map(each)
         .collect()
 }
+
+/// The generated 2-link Ẋ's accelerations (its last two entries) against a textbook's q̈, to
+/// 1e-11 of max(|q̈|, 1): the two formulas differ only in the order of their operations.
+pub fn accelerations_match_the_textbook(
+    x_dot: &nalgebra::SVector<f64, 4>,
+    q_ddot: &nalgebra::Vector2<f64>,
+) -> Result<(), proptest::test_runner::TestCaseError> {
+    let scale = q_ddot.amax().max(1.0);
+    proptest::prop_assert!(
+        (x_dot[2] - q_ddot[0]).abs() <= 1e-11 * scale
+            && (x_dot[3] - q_ddot[1]).abs() <= 1e-11 * scale,
+        "generated {x_dot} vs textbook {q_ddot}"
+    );
+    Ok(())
+}

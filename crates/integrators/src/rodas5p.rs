@@ -22,7 +22,7 @@ use nalgebra::{SMatrix, SVector};
 use toolconf_core::linalg::Lu;
 
 use super::rodas_lean::Lean;
-use super::rosenbrock::{run, Problem, Start, Stepper, Tableau};
+use super::rosenbrock::{run, Problem, Span, Start, Stepper, Tableau};
 use super::{IntegrationError, Settings, Stats};
 
 /// Rodas5P (Steinebach 2023). Rows i = 1…8 of `a` and `c` list the coefficients of k_1…k_{i−1}.
@@ -117,16 +117,8 @@ impl<const D: usize, const S: usize> Stepper<D, S> for Standard<'_, S> {
     }
 
     #[inline(always)]
-    fn attempt<P: Problem<D>>(
-        &self,
-        problem: &mut P,
-        lu: &Lu<D>,
-        t: f64,
-        y: &SVector<f64, D>,
-        f0: &SVector<f64, D>,
-        dfdt: &SVector<f64, D>,
-        t_new: f64,
-    ) -> Attempt<D, S> {
+    fn attempt<P: Problem<D>>(&self, problem: &mut P, lu: &Lu<D>, span: Span<D>) -> Attempt<D, S> {
+        let (t, t_new, y, f0, dfdt) = (span.t, span.t_new, span.y, span.f0, span.dfdt);
         let tab = self.0;
         let h = t_new - t;
         let r = 1.0 / h;

@@ -21,7 +21,7 @@ use nalgebra::{SMatrix, SVector};
 use toolconf_core::linalg::Lu;
 
 use super::rodas5p::RODAS5P;
-use super::rosenbrock::{Problem, Stepper, Tableau};
+use super::rosenbrock::{Problem, Span, Stepper, Tableau};
 
 /// Stages of Rodas5P.
 const S: usize = 8;
@@ -78,16 +78,8 @@ impl<const D: usize> Stepper<D, S> for Lean {
     #[inline(always)]
     // k[j] and the tableau's a[i][j], c[i][j] are indexed together, as in the formulas.
     #[allow(clippy::needless_range_loop)]
-    fn attempt<P: Problem<D>>(
-        &self,
-        problem: &mut P,
-        lu: &Lu<D>,
-        t: f64,
-        y: &SVector<f64, D>,
-        f0: &SVector<f64, D>,
-        dfdt: &SVector<f64, D>,
-        t_new: f64,
-    ) -> LeanStep<D> {
+    fn attempt<P: Problem<D>>(&self, problem: &mut P, lu: &Lu<D>, span: Span<D>) -> LeanStep<D> {
+        let (t, t_new, y, f0, dfdt) = (span.t, span.t_new, span.y, span.f0, span.dfdt);
         let tab: &Tableau<S> = &RODAS5P;
         let dfdt = (!dfdt.iter().all(|&v| v == 0.0)).then_some(dfdt);
         let h = t_new - t;

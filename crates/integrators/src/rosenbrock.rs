@@ -92,6 +92,17 @@ pub(super) struct Tableau<const S: usize> {
     pub(super) exponent: f64,
 }
 
+/// The step an attempt takes: from `(t, y)`, where f = `f0` and ∂f/∂t = `dfdt`, to `t_new`
+/// (its size `h = t_new − t`).
+#[derive(Clone, Copy)]
+pub(super) struct Span<'a, const D: usize> {
+    pub t: f64,
+    pub t_new: f64,
+    pub y: &'a SVector<f64, D>,
+    pub f0: &'a SVector<f64, D>,
+    pub dfdt: &'a SVector<f64, D>,
+}
+
 /// What a Rosenbrock stepper does inside the shared main loop [`run`]: factor the iteration
 /// matrix `E = I/(h·γ) − J`, take an attempt with it, and interpolate inside an accepted step.
 /// `rodas5p`'s `Standard` is `rodas.f`'s form for any [`Tableau`]; `rodas_lean` is the other.
@@ -100,18 +111,8 @@ pub(super) trait Stepper<const D: usize, const S: usize> {
     /// An attempt's stages, its new solution and whatever its dense output keeps.
     type Step;
     fn factor(e: SMatrix<f64, D, D>) -> Option<Self::Lu>;
-    /// The stages of a step of size `h = t_new − t`; `S − 1` right-hand-side evaluations.
-    #[allow(clippy::too_many_arguments)]
-    fn attempt<P: Problem<D>>(
-        &self,
-        problem: &mut P,
-        lu: &Self::Lu,
-        t: f64,
-        y: &SVector<f64, D>,
-        f0: &SVector<f64, D>,
-        dfdt: &SVector<f64, D>,
-        t_new: f64,
-    ) -> Self::Step;
+    /// The stages of the step `span`; `S − 1` right-hand-side evaluations.
+    fn attempt<P: Problem<D>>(&self, problem: &mut P, lu: &Self::Lu, span: Span<D>) -> Self::Step;
     fn y_new(step: &Self::Step) -> &SVector<f64, D>;
     /// The last stage, the error estimate.
     fn estimate(step: &Self::Step) -> &SVector<f64, D>;
@@ -182,7 +183,14 @@ where
             }
             stats.factorisations += 1;
             let attempted = if let Some(lu) = M::factor(e) {
-                let step = stepper.attempt(problem, &lu, t, &y, &f0, &dfdt, t_new);
+                let span = Span {
+                    t,
+                    t_new,
+                    y: &y,
+                    f0: &f0,
+                    dfdt: &dfdt,
+                };
+                let step = stepper.attempt(problem, &lu, span);
                 stats.rhs_evals += S - 1;
                 let (err, finite) = error_norm(&y, M::y_new(&step), M::estimate(&step), threshold);
                 if !finite {

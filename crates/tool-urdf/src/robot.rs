@@ -113,16 +113,15 @@ impl<'a, 'input> Robot<'a, 'input> {
         src: &Source<'a, 'input>,
         root: roxmltree::Node<'a, 'input>,
     ) -> Result<(), UrdfToolError> {
-        let robot = self;
         for node in root.children().filter(|n| is(n, "link")) {
-            let first = |i: usize| robot.links[i].node;
-            let (name, owner) = unique_name(src, node, "link", &robot.link_index, first)?;
+            let first = |i: usize| self.links[i].node;
+            let (name, owner) = unique_name(src, node, "link", &self.link_index, first)?;
             let inertial = match only_child(src, node, &owner, "inertial")? {
                 None => None,
                 Some(inertial) => Some(read_inertial(src, inertial, &owner)?),
             };
-            robot.link_index.insert(name, robot.links.len());
-            robot.links.push(Link {
+            self.link_index.insert(name, self.links.len());
+            self.links.push(Link {
                 name,
                 node,
                 inertial,
@@ -137,30 +136,29 @@ impl<'a, 'input> Robot<'a, 'input> {
         src: &Source<'a, 'input>,
         root: roxmltree::Node<'a, 'input>,
     ) -> Result<(), UrdfToolError> {
-        let robot = self;
-        robot.parent_joint = vec![None; robot.links.len()];
-        robot.child_joints = vec![Vec::new(); robot.links.len()];
+        self.parent_joint = vec![None; self.links.len()];
+        self.child_joints = vec![Vec::new(); self.links.len()];
         for node in root.children().filter(|n| is(n, "joint")) {
-            let first = |i: usize| robot.joints[i].node;
-            let (name, owner) = unique_name(src, node, "joint", &robot.joint_index, first)?;
-            let joint = robot.read_joint(src, node, name, &owner)?;
-            let index = robot.joints.len();
-            if let Some(other) = robot.parent_joint[joint.child] {
+            let first = |i: usize| self.joints[i].node;
+            let (name, owner) = unique_name(src, node, "joint", &self.joint_index, first)?;
+            let joint = self.read_joint(src, node, name, &owner)?;
+            let index = self.joints.len();
+            if let Some(other) = self.parent_joint[joint.child] {
                 return Err(src.at(
                     node,
                     format!(
                         "{owner}link '{}' has two parents: it is the child of joint '{}' \
                          (line {}) too",
-                        Clip(robot.links[joint.child].name),
-                        Clip(robot.joints[other].name),
-                        src.line(robot.joints[other].node)
+                        Clip(self.links[joint.child].name),
+                        Clip(self.joints[other].name),
+                        src.line(self.joints[other].node)
                     ),
                 ));
             }
-            robot.parent_joint[joint.child] = Some(index);
-            robot.child_joints[joint.parent].push(index);
-            robot.joint_index.insert(name, index);
-            robot.joints.push(joint);
+            self.parent_joint[joint.child] = Some(index);
+            self.child_joints[joint.parent].push(index);
+            self.joint_index.insert(name, index);
+            self.joints.push(joint);
         }
         Ok(())
     }

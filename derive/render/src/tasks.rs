@@ -10,7 +10,7 @@
 use serde::Serialize;
 
 use crate::escape::comment;
-use crate::ir::{ChosenBy, Formulation, Ir, Source, Task, Term};
+use crate::ir::{ChosenBy, Formulation, Goal, Ir, Precision, Source, Task, Term};
 use crate::RenderError;
 
 /// `arm2_exact` → `Arm2Exact`, `position` → `Position`.
@@ -179,12 +179,33 @@ pub struct GoalView<'a> {
     pub values: &'a [String],
 }
 
+impl<'a> GoalView<'a> {
+    fn of(goal: &'a Goal) -> Self {
+        GoalView {
+            term: &goal.term,
+            constant: goal_constant(&goal.term),
+            count: goal.rust.len(),
+            values: &goal.rust,
+        }
+    }
+}
+
 /// `pub const PRECISION_THETA: f64 = rust;` of a task's module.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PrecisionView<'a> {
     pub term: &'a str,
     pub constant: String,
     pub rust: &'a str,
+}
+
+impl<'a> PrecisionView<'a> {
+    fn of(precision: &'a Precision) -> Self {
+        PrecisionView {
+            term: &precision.term,
+            constant: precision_constant(&precision.term),
+            rust: &precision.rust,
+        }
+    }
 }
 
 /// Checks a task's terms against the term list: known names, sensitivities only of terms that
@@ -265,8 +286,8 @@ pub fn task_view<'a>(task: &'a Task, terms: &'a [Term]) -> Result<TaskView<'a>, 
         doc: comment(&task.doc),
         terms: task.terms.iter().map(String::as_str).collect(),
         term_count: task.terms.len(),
-        goals: goal_views(task),
-        precisions: precision_views(task),
+        goals: task.goals.iter().map(GoalView::of).collect(),
+        precisions: task.precisions.iter().map(PrecisionView::of).collect(),
         confidence_function: &task.confidence_function,
         gradient_function: &task.gradient_function,
         variant: camel_case(name),
@@ -324,31 +345,6 @@ fn per_term(
             } else {
                 none.to_string()
             }
-        })
-        .collect()
-}
-
-/// The task's goals, each a constant of the task's module.
-fn goal_views(task: &Task) -> Vec<GoalView<'_>> {
-    task.goals
-        .iter()
-        .map(|g| GoalView {
-            term: &g.term,
-            constant: goal_constant(&g.term),
-            count: g.rust.len(),
-            values: &g.rust,
-        })
-        .collect()
-}
-
-/// The task's precisions, each a constant of the task's module.
-fn precision_views(task: &Task) -> Vec<PrecisionView<'_>> {
-    task.precisions
-        .iter()
-        .map(|p| PrecisionView {
-            term: &p.term,
-            constant: precision_constant(&p.term),
-            rust: &p.rust,
         })
         .collect()
 }

@@ -43,6 +43,9 @@ pub struct Loaded<const N: usize, const NP: usize, const S: usize>;
 /// `toolconf_dynamics` and `toolconf_rigid_body_dynamics`: (X, U, params) in, Ẋ out.
 type XDot = unsafe extern "C" fn(*const f64, *const f64, *const f64, *mut f64) -> i32;
 
+/// `toolconf_pi_u` and `toolconf_logdet_gradient`: (task, params, the task's precisions) in.
+type OfTask = unsafe extern "C" fn(u32, *const f64, *const f64, *mut f64) -> i32;
+
 /// The index of `kind` in the C ABI (`TaskKind::ALL`, the same list by the fingerprint).
 fn task_index(kind: TaskKind) -> u32 {
     TaskKind::ALL
@@ -246,31 +249,33 @@ impl<const N: usize, const NX: usize, const NP: usize> Table<N, NX, NP> {
     }
 
     fn pi_u(&self, task: &TaskN<N>, p: &SVector<f64, NP>) -> SMatrix<f64, N, N> {
-        let mut pi = SMatrix::<f64, N, N>::zeros();
-        // SAFETY: as in `sensitivities`, for the precisions.
-        let code = unsafe {
-            (self.exports.pi_u)(
-                task_index(task.kind),
-                p.as_ptr(),
-                task.precision.as_ptr().cast::<f64>(),
-                pi.as_mut_ptr(),
-            )
-        };
-        checked(code, pi)
+        self.of_task(self.exports.pi_u, task, p)
     }
 
     fn logdet_gradient(&self, task: &TaskN<N>, p: &SVector<f64, NP>) -> SVector<f64, NP> {
-        let mut g = SVector::<f64, NP>::zeros();
-        // SAFETY: as in `pi_u`.
+        self.of_task(self.exports.logdet_gradient, task, p)
+    }
+
+    /// What `export` (`toolconf_pi_u` or `toolconf_logdet_gradient`) gives for `task`'s kind
+    /// and precisions and the tool's parameters `p`: an R × C matrix, NaN if the call failed.
+    fn of_task<const R: usize, const C: usize>(
+        &self,
+        export: OfTask,
+        task: &TaskN<N>,
+        p: &SVector<f64, NP>,
+    ) -> SMatrix<f64, R, C> {
+        let mut out = SMatrix::<f64, R, C>::zeros();
+        // SAFETY: as in `sensitivities`, for the precisions; `out` is the export's output size
+        // (N × N for Π^U, NP for the gradient), as the callers' types say.
         let code = unsafe {
-            (self.exports.logdet_gradient)(
+            export(
                 task_index(task.kind),
                 p.as_ptr(),
                 task.precision.as_ptr().cast::<f64>(),
-                g.as_mut_ptr(),
+                out.as_mut_ptr(),
             )
         };
-        checked(code, g)
+        checked(code, out)
     }
 }
 

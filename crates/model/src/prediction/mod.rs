@@ -118,19 +118,6 @@ where
     )?)
 }
 
-/// The linear system [`predict`] steps, with run-time sizes ([`LinearSystem`]).
-pub fn linear_system<M, const N: usize, const NX: usize, const NP: usize, const NZ: usize>(
-    tool: &ToolN<M, N, NX, NP, NZ>,
-    task: &TaskN<N>,
-    options: &EpisodeOptionsN<N, NX>,
-) -> Result<LinearSystem, PredictionError>
-where
-    M: ArmModel<N, NX, NP, NZ>,
-{
-    let linear = linearise(tool, task, options)?;
-    Ok(LinearSystem::new(&linear, task, options))
-}
-
 /// max Re λ(M), or [`PredictionError::Unstable`].
 fn spectral_abscissa<const N: usize, const NX: usize, const NZ: usize>(
     linear: &LinearLoop<N, NX, NZ>,

@@ -196,7 +196,7 @@ fn the_scipy_fixture_is_what_the_code_gives() {
         options.perturbation = dt;
         cases.push((
             name,
-            linear_system(&tool, &task, &options).unwrap(),
+            LinearSystem::new(&linearise(&tool, &task, &options).unwrap(), &task, &options),
             predict(&tool, &task, &options).unwrap(),
         ));
     }
@@ -206,7 +206,7 @@ fn the_scipy_fixture_is_what_the_code_gives() {
     options.t_end = 1.03;
     cases.push((
         "arm2 position, t_end 1.03",
-        linear_system(&arm, &task, &options).unwrap(),
+        LinearSystem::new(&linearise(&arm, &task, &options).unwrap(), &task, &options),
         predict(&arm, &task, &options).unwrap(),
     ));
     let json: Vec<serde_json::Value> = cases

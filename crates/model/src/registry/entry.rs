@@ -399,7 +399,8 @@ where
     fn linear_system(&self, params: &[f64]) -> Result<LinearSystem, PredictionError> {
         let tool = tool::<M, N, NX, NP, NZ>(params)?;
         let (task, options) = self.prediction_inputs(&tool)?;
-        prediction::linear_system(&tool, &task, options)
+        let linear = prediction::linearise(&tool, &task, options)?;
+        Ok(LinearSystem::new(&linear, &task, options))
     }
 
     fn confidences(&self, params: &[f64]) -> Result<Confidences, BatchError> {

@@ -425,34 +425,40 @@ fn graded(judged: bool, holds: bool, partly: bool) -> Outcome {
 
 /// C4: J's tools have the lower confidence (`conf`: F's − J's).
 fn confidence_verdict(conf: &Comparison, alpha: f64, significant: &str) -> Verdict {
-    Verdict {
-        claim: "C4, confidence".into(),
-        statement: "\"The tools selected by J showed lower control confidence\" than those \
-                    selected by F."
-            .into(),
-        outcome: directional(conf.a_greater(alpha)),
-        evidence: format!(
-            "ln|Π^U| of F's tool − J's tool: {}.",
-            conf.describe()
-        ),
-        rule: format!("holds if F's tools have the higher confidence with {significant}; does not hold otherwise."),
-    }
+    greater_verdict(
+        "C4, confidence",
+        "\"The tools selected by J showed lower control confidence\" than those selected by F.",
+        (conf, alpha, "ln|Π^U| of F's tool − J's tool"),
+        &format!("F's tools have the higher confidence with {significant}"),
+    )
 }
 
 /// C4: F's tools are the less sensitive to a perturbation (`sens`: J's − F's).
 fn sensitivity_verdict(sens: &Comparison, alpha: f64, significant: &str) -> Verdict {
+    greater_verdict(
+        "C4, sensitivity",
+        "\"The tool selected using F has a superior tolerance to control perturbations than the \
+         tool selected using J\": J's tools have the higher sensitivity to a constant \
+         perturbation.",
+        (sens, alpha, "|change of task error| of J's tool − F's tool"),
+        &format!("J's tools are the more sensitive with {significant}"),
+    )
+}
+
+/// The verdict on `claim` (`statement`) that the first sample of `comparison` (a − b, at level
+/// alpha, in words `of`) exceeds the second: it holds `holds_if` so, and does not otherwise.
+fn greater_verdict(
+    claim: &str,
+    statement: &str,
+    (comparison, alpha, of): (&Comparison, f64, &str),
+    holds_if: &str,
+) -> Verdict {
     Verdict {
-        claim: "C4, sensitivity".into(),
-        statement: "\"The tool selected using F has a superior tolerance to control \
-                    perturbations than the tool selected using J\": J's tools have the higher \
-                    sensitivity to a constant perturbation."
-            .into(),
-        outcome: directional(sens.a_greater(alpha)),
-        evidence: format!(
-            "|change of task error| of J's tool − F's tool: {}.",
-            sens.describe()
-        ),
-        rule: format!("holds if J's tools are the more sensitive with {significant}; does not hold otherwise."),
+        claim: claim.into(),
+        statement: statement.into(),
+        outcome: directional(comparison.a_greater(alpha)),
+        evidence: format!("{of}: {}.", comparison.describe()),
+        rule: format!("holds if {holds_if}; does not hold otherwise."),
     }
 }
 
@@ -469,7 +475,7 @@ fn task_error_verdict(
         others.iter().map(|&r| (r, compare(1, r, f))).collect();
     let lowest = error_cmp
         .iter()
-        .all(|(_, c)| c.mean_difference().is_some_and(|d| d > 0.0) || c.identical());
+        .all(|(_, c)| c.mean_difference().is_some_and(|d| d > 0.0) || c.paired.identical());
     let all_significant = error_cmp
         .iter()
         .all(|(_, c)| c.a_greater(alpha) == Some(true));

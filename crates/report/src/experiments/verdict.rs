@@ -1,7 +1,8 @@
 //! The statistics the verdicts rest on, the rules that turn them into verdicts, and how numbers
 //! are printed in the report (never as NaN: what cannot be computed is said in words).
 
-use toolconf_stats::{complete_pairs, paired_test, summary, PairedTest};
+use toolconf::evaluation::verdict::Paired;
+use toolconf_stats::{complete_pairs, summary};
 
 use super::report::Outcome;
 
@@ -119,18 +120,13 @@ impl CorrelationReport for Correlation {
     }
 }
 
-/// Two paired samples (e.g. the tools two objectives chose, trial by trial) compared.
+/// Two paired samples (e.g. the tools two objectives chose, trial by trial) compared: the
+/// runtime's [`Paired`] (n, dropped pairs, ties, the tests) and each sample's mean.
 #[derive(Debug, Clone)]
 pub struct Comparison {
-    /// Pairs with both values present.
-    pub n: usize,
-    /// Pairs dropped because a value was missing (a failed episode).
-    pub dropped: usize,
+    pub paired: Paired,
     pub mean_a: Option<f64>,
     pub mean_b: Option<f64>,
-    /// Pairs with a == b exactly (both objectives chose the same tool).
-    pub ties: usize,
-    pub test: Result<PairedTest, String>,
 }
 
 impl Comparison {
@@ -138,36 +134,28 @@ impl Comparison {
         let (x, y) = complete_pairs(a, b);
         let mean = |v: &[f64]| summary(v).ok().map(|s| s.mean);
         Self {
-            n: x.len(),
-            dropped: a.len().max(b.len()) - x.len(),
+            paired: Paired::compute(a, b),
             mean_a: mean(&x),
             mean_b: mean(&y),
-            ties: x.iter().zip(&y).filter(|(a, b)| a == b).count(),
-            test: paired_test(&x, &y).map_err(|e| e.to_string()),
         }
     }
 
     /// Mean of a − b over the pairs.
     pub fn mean_difference(&self) -> Option<f64> {
-        match &self.test {
+        match &self.paired.test {
             Ok(t) => Some(t.mean_difference),
             Err(_) => Some(self.mean_a? - self.mean_b?),
         }
     }
 
-    /// All pairs equal: the two samples are identical (the test is undefined, the answer is not).
-    pub fn identical(&self) -> bool {
-        self.n > 0 && self.ties == self.n
-    }
-
     /// Two-sided Wilcoxon signed-rank p-value, the one the verdicts use.
     pub fn p(&self) -> Option<f64> {
-        self.test.as_ref().ok().map(|t| t.wilcoxon_p_value)
+        self.paired.test.as_ref().ok().map(|t| t.wilcoxon_p_value)
     }
 
     /// Does a exceed b significantly (Wilcoxon p < alpha and mean(a − b) > 0)?
     pub fn a_greater(&self, alpha: f64) -> Option<bool> {
-        if self.identical() {
+        if self.paired.identical() {
             return Some(false);
         }
         Some(self.p()? < alpha && self.mean_difference()? > 0.0)
@@ -175,7 +163,7 @@ impl Comparison {
 
     /// Is there no significant difference (p ≥ alpha, or identical)?
     pub fn similar(&self, alpha: f64) -> Option<bool> {
-        if self.identical() {
+        if self.paired.identical() {
             return Some(true);
         }
         Some(self.p()? >= alpha)
@@ -183,27 +171,21 @@ impl Comparison {
 
     /// "mean difference +1.2 (t = 3.4, p = 0.002; Wilcoxon W = 120, p = 0.003; n = 50)".
     pub fn describe(&self) -> String {
-        let dropped = toolconf::evaluation::verdict::dropped_clause(self.dropped);
-        if self.identical() {
-            return format!(
-                "identical in all {} pairs (the same tool was chosen every time){dropped}",
-                self.n
-            );
-        }
-        match &self.test {
-            Ok(t) => format!(
-                "mean difference {} (paired t = {}, p = {}; Wilcoxon W = {}, p = {}; n = {}, {} \
-                 tie(s)){dropped}",
-                num(t.mean_difference),
-                num(t.t),
-                p_value(t.t_p_value),
-                num(t.wilcoxon_w),
-                p_value(t.wilcoxon_p_value),
-                t.n,
-                self.ties
-            ),
-            Err(e) => format!("no paired test (n = {}): {e}{dropped}", self.n),
-        }
+        let ties = self.paired.ties;
+        self.paired
+            .describe_with("the same tool was chosen every time", |t| {
+                format!(
+                    "mean difference {} (paired t = {}, p = {}; Wilcoxon W = {}, p = {}; n = {}, \
+                     {} tie(s))",
+                    num(t.mean_difference),
+                    num(t.t),
+                    p_value(t.t_p_value),
+                    num(t.wilcoxon_w),
+                    p_value(t.wilcoxon_p_value),
+                    t.n,
+                    ties
+                )
+            })
     }
 }
 
@@ -242,8 +224,8 @@ mod tests {
     fn comparison_handles_identical_and_missing_pairs() {
         let a = [Some(1.0), Some(2.0), None, Some(4.0)];
         let c = Comparison::compute(&a, &a);
-        assert!(c.identical());
-        assert_eq!((c.n, c.dropped), (3, 1));
+        assert!(c.paired.identical());
+        assert_eq!((c.paired.n, c.paired.dropped), (3, 1));
         assert_eq!(c.similar(0.05), Some(true));
         assert_eq!(c.a_greater(0.05), Some(false));
         assert!(c.describe().starts_with("identical in all 3 pairs"));

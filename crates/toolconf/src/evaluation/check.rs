@@ -27,25 +27,64 @@ pub fn sample_key(row: usize) -> u64 {
     derive_seed(row as u64, "validation/row")
 }
 
-/// Spearman's ρ of a validation sample's `points` with its 95 % bootstrap interval, the
-/// resamples drawn from the seed of the stream `stream`.
-pub(super) fn sample_correlation(points: &[(f64, f64)], stream: &str) -> Correlation {
-    let (x, y): (Vec<f64>, Vec<f64>) = points.iter().copied().unzip();
-    let seed = derive_seed(0, stream);
-    Correlation::compute(&x, &y, RESAMPLES, 0.95, seed)
+/// What a validation check knows of its sample: Spearman's ρ of its `points` with the 95 %
+/// bootstrap interval (resamples from the seed of the check's stream), the tools sampled
+/// (`correlation.n` counts those with both numbers) and the population they were drawn from
+/// ("of the tools file", "of the design's feasible set").
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sample {
+    pub correlation: Correlation,
+    pub sampled: usize,
+    pub population: String,
+}
+
+impl Sample {
+    pub(super) fn new(
+        points: &[(f64, f64)],
+        sampled: usize,
+        population: &str,
+        stream: &str,
+    ) -> Self {
+        let (x, y): (Vec<f64>, Vec<f64>) = points.iter().copied().unzip();
+        let seed = derive_seed(0, stream);
+        Self {
+            correlation: Correlation::compute(&x, &y, RESAMPLES, 0.95, seed),
+            sampled,
+            population: population.into(),
+        }
+    }
+
+    /// "`what` (ρ …, N tools sampled POPULATION and simulated alongside; `extra`): `consequence`",
+    /// the one line a check's note is.
+    pub(super) fn note(&self, what: &str, extra: &str, consequence: &str) -> String {
+        format!(
+            "{what} ({}, {} tools sampled {} and simulated alongside; {extra}): {consequence}",
+            self.correlation.describe_short(),
+            self.sampled,
+            self.population,
+        )
+    }
+
+    /// The check's JSON: its `finding`'s verdict, the correlation, the sample, and `extra`.
+    pub(super) fn json(&self, finding: Finding, extra: (&str, usize)) -> Value {
+        let mut v = json!({
+            "verdict": finding.words(),
+            "correlation": self.correlation.json(),
+            "sampled": self.sampled,
+            "population": self.population,
+        });
+        v[extra.0] = json!(extra.1);
+        v
+    }
 }
 
 /// Claim (a) on the sample: ρ(ln|Π^U|, task error) and the verdict by its rule.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ConfidenceCheck {
-    pub correlation: Correlation,
+    pub sample: Sample,
     pub finding: Finding,
-    /// Tools sampled (some may have failed: `correlation.n` counts those with both numbers).
-    pub sampled: usize,
     /// Extra episodes it cost (the sampled tools not simulated anyway).
     pub episodes: usize,
-    /// "of the tools file", "of the design's feasible set".
-    pub population: String,
 }
 
 impl ConfidenceCheck {
@@ -56,43 +95,30 @@ impl ConfidenceCheck {
         episodes: usize,
         population: &str,
     ) -> Self {
-        let correlation = sample_correlation(points, "validation/bootstrap");
+        let sample = Sample::new(points, sampled, population, "validation/bootstrap");
         Self {
-            finding: correlation.finding(),
-            correlation,
-            sampled,
+            finding: sample.correlation.finding(),
+            sample,
             episodes,
-            population: population.into(),
         }
     }
 
     /// The one line `rank` and `design` print when confidence does not predict the task error
     /// here (`None` when it does); `consequence` says what that means for the command.
     pub fn note(&self, consequence: &str) -> Option<String> {
-        if self.finding == Finding::Holds {
-            return None;
-        }
         let what = match self.finding {
+            Finding::Holds => return None,
             Finding::Reversed => "more confident tools do the task worse here",
             Finding::NoRelation => "confidence says nothing about the task error here",
-            _ => "whether confidence predicts the task error here cannot be judged",
+            Finding::NotJudged => {
+                "whether confidence predicts the task error here cannot be judged"
+            }
         };
-        Some(format!(
-            "{what} ({}, {} tools sampled {} and simulated alongside; claim (a): {}): {consequence}",
-            self.correlation.describe_short(),
-            self.sampled,
-            self.population,
-            self.finding.words()
-        ))
+        let extra = format!("claim (a): {}", self.finding.words());
+        Some(self.sample.note(what, &extra, consequence))
     }
 
     pub fn json(&self) -> Value {
-        json!({
-            "verdict": self.finding.words(),
-            "correlation": self.correlation.json(),
-            "sampled": self.sampled,
-            "episodes": self.episodes,
-            "population": self.population,
-        })
+        self.sample.json(self.finding, ("episodes", self.episodes))
     }
 }

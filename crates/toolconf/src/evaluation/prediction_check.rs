@@ -6,21 +6,18 @@
 //! interval lies above 0 (tools predicted worse do worse), **reversed** below 0, **no
 //! relation** where it contains 0.
 
-use serde_json::{json, Value};
+use serde_json::Value;
 
-use super::check::sample_correlation;
-use super::verdict::{Correlation, Finding};
+use super::check::Sample;
+use super::verdict::Finding;
 
 /// ρ(predicted, simulated task error) on the sample, and the verdict by the rule above.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PredictionCheck {
-    pub correlation: Correlation,
+    pub sample: Sample,
     pub finding: Finding,
-    /// Tools sampled (`correlation.n` counts those with a prediction and an episode).
-    pub sampled: usize,
     /// Sampled tools without a prediction (an unstable linearised loop).
     pub without_prediction: usize,
-    pub population: String,
 }
 
 impl PredictionCheck {
@@ -31,19 +28,17 @@ impl PredictionCheck {
         without_prediction: usize,
         population: &str,
     ) -> Self {
-        let correlation = sample_correlation(points, "validation/prediction");
-        let finding = match &correlation.ci {
+        let sample = Sample::new(points, sampled, population, "validation/prediction");
+        let finding = match &sample.correlation.ci {
             Ok(ci) if ci.low > 0.0 => Finding::Holds,
             Ok(ci) if ci.high < 0.0 => Finding::Reversed,
             Ok(_) => Finding::NoRelation,
             Err(_) => Finding::NotJudged,
         };
         Self {
-            correlation,
+            sample,
             finding,
-            sampled,
             without_prediction,
-            population: population.into(),
         }
     }
 
@@ -58,24 +53,13 @@ impl PredictionCheck {
                 "whether the prediction predicts the task error here cannot be judged"
             }
         };
-        Some(format!(
-            "{what} ({}, {} tools sampled {} and simulated alongside; {} without a prediction): \
-             {consequence}",
-            self.correlation.describe_short(),
-            self.sampled,
-            self.population,
-            self.without_prediction
-        ))
+        let extra = format!("{} without a prediction", self.without_prediction);
+        Some(self.sample.note(what, &extra, consequence))
     }
 
     pub fn json(&self) -> Value {
-        json!({
-            "verdict": self.finding.words(),
-            "correlation": self.correlation.json(),
-            "sampled": self.sampled,
-            "without_prediction": self.without_prediction,
-            "population": self.population,
-        })
+        let extra = ("without_prediction", self.without_prediction);
+        self.sample.json(self.finding, extra)
     }
 }
 
@@ -88,7 +72,7 @@ mod tests {
         let up: Vec<(f64, f64)> = (0..40).map(|i| (i as f64, (i * i) as f64)).collect();
         let check = PredictionCheck::compute(&up, 40, 0, "of x");
         assert_eq!(check.finding, Finding::Holds);
-        assert_eq!(check.correlation.rho, Ok(1.0));
+        assert_eq!(check.sample.correlation.rho, Ok(1.0));
         assert_eq!(check.note("c"), None);
         let down: Vec<(f64, f64)> = up.iter().map(|&(x, y)| (-x, y)).collect();
         let check = PredictionCheck::compute(&down, 41, 1, "of x");

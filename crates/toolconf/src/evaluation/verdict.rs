@@ -15,7 +15,9 @@
 
 use serde_json::{json, Value};
 
-use toolconf_stats::{bootstrap_spearman_ci, paired_test, spearman, Interval, PairedTest};
+use toolconf_stats::{
+    bootstrap_spearman_ci, complete_pairs, paired_test, spearman, Interval, PairedTest,
+};
 
 /// A claim's verdict.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -142,11 +144,7 @@ pub struct Paired {
 
 impl Paired {
     pub fn compute(a: &[Option<f64>], b: &[Option<f64>]) -> Self {
-        let (x, y): (Vec<f64>, Vec<f64>) = a
-            .iter()
-            .zip(b)
-            .filter_map(|(a, b)| Some(((*a)?, (*b)?)))
-            .unzip();
+        let (x, y) = complete_pairs(a, b);
         let n = x.len();
         let mean_difference =
             (n > 0).then(|| x.iter().zip(&y).map(|(a, b)| a - b).sum::<f64>() / n as f64);
@@ -180,23 +178,29 @@ impl Paired {
 
     /// "mean difference +1.2e-3 (Wilcoxon p = 0.003, n = 50, 12 ties)".
     pub fn describe(&self) -> String {
-        let dropped = dropped_clause(self.dropped);
-        if self.identical() {
-            return format!(
-                "identical in all {} pairs (the same tool every time){dropped}",
-                self.n
-            );
-        }
-        match &self.test {
-            Ok(t) => format!(
+        self.describe_with("the same tool every time", |t| {
+            format!(
                 "mean difference {:+.3e} (Wilcoxon signed-rank p = {}, paired t p = {}; n = {}, \
-                 {} tie(s)){dropped}",
+                 {} tie(s))",
                 t.mean_difference,
                 p_value(t.wilcoxon_p_value),
                 p_value(t.t_p_value),
                 t.n,
                 self.ties
-            ),
+            )
+        })
+    }
+
+    /// The frame of every paired comparison's description, here and in the report's: identical
+    /// samples ("identical in all n pairs (`same`)"), an undefined test, or the test's `numbers`;
+    /// then the [`dropped_clause`].
+    pub fn describe_with(&self, same: &str, numbers: impl FnOnce(&PairedTest) -> String) -> String {
+        let dropped = dropped_clause(self.dropped);
+        if self.identical() {
+            return format!("identical in all {} pairs ({same}){dropped}", self.n);
+        }
+        match &self.test {
+            Ok(t) => format!("{}{dropped}", numbers(t)),
             Err(e) => format!("no paired test (n = {}): {e}{dropped}", self.n),
         }
     }
