@@ -513,7 +513,9 @@ pub fn dynamics(
 /// [`dynamics`] with the tool's [`DynamicsCoefficients`] computed beforehand.
 ///
 /// Cost per call: 28 operations, weighted 30 (7 ADD, 17 MUL, 2 POW, 2 SUB), plus 2 `sin_cos` (derive/toolconf_derive/cost.py).
-#[inline]
+// Always inlined: so cheap that a call would be a cost of its own (the renderer's
+// ALWAYS_INLINED_COST says where that ends).
+#[inline(always)]
 #[must_use]
 pub fn dynamics_with(
     x: &SVector<f64, 4>,
@@ -619,7 +621,9 @@ pub fn dynamics_jacobian(
 /// [`dynamics_jacobian`] with the tool's [`DynamicsJacobianCoefficients`] computed beforehand.
 ///
 /// Cost per call: 32 operations, weighted 34 (5 ADD, 21 MUL, 1 NEG, 2 POW, 3 SUB), plus 2 `sin_cos` (derive/toolconf_derive/cost.py).
-#[inline]
+// Always inlined: so cheap that a call would be a cost of its own (the renderer's
+// ALWAYS_INLINED_COST says where that ends).
+#[inline(always)]
 #[must_use]
 pub fn dynamics_jacobian_with(
     x: &SVector<f64, 4>,

@@ -515,7 +515,9 @@ pub fn dynamics(
 /// [`dynamics`] with the tool's [`DynamicsCoefficients`] computed beforehand.
 ///
 /// Cost per call: 36 operations, weighted 46 (9 ADD, 1 DIV, 21 MUL, 3 POW, 2 SUB), plus 2 `sin_cos` (derive/toolconf_derive/cost.py).
-#[inline]
+// Always inlined: so cheap that a call would be a cost of its own (the renderer's
+// ALWAYS_INLINED_COST says where that ends).
+#[inline(always)]
 #[must_use]
 pub fn dynamics_with(
     x: &SVector<f64, 4>,
@@ -652,7 +654,9 @@ pub fn dynamics_jacobian(
 /// [`dynamics_jacobian`] with the tool's [`DynamicsJacobianCoefficients`] computed beforehand.
 ///
 /// Cost per call: 100 operations, weighted 118 (16 ADD, 2 DIV, 64 MUL, 2 NEG, 4 POW, 12 SUB), plus 2 `sin_cos` (derive/toolconf_derive/cost.py).
-#[inline]
+// Always inlined: so cheap that a call would be a cost of its own (the renderer's
+// ALWAYS_INLINED_COST says where that ends).
+#[inline(always)]
 #[must_use]
 pub fn dynamics_jacobian_with(
     x: &SVector<f64, 4>,

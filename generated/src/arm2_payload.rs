@@ -526,7 +526,9 @@ pub fn dynamics(
 /// [`dynamics`] with the tool's [`DynamicsCoefficients`] computed beforehand.
 ///
 /// Cost per call: 48 operations, weighted 58 (15 ADD, 1 DIV, 27 MUL, 3 POW, 2 SUB), plus 2 `sin_cos` (derive/toolconf_derive/cost.py).
-#[inline]
+// Always inlined: so cheap that a call would be a cost of its own (the renderer's
+// ALWAYS_INLINED_COST says where that ends).
+#[inline(always)]
 #[must_use]
 pub fn dynamics_with(
     x: &SVector<f64, 4>,
@@ -690,7 +692,9 @@ pub fn dynamics_jacobian(
 /// [`dynamics_jacobian`] with the tool's [`DynamicsJacobianCoefficients`] computed beforehand.
 ///
 /// Cost per call: 134 operations, weighted 152 (29 ADD, 2 DIV, 84 MUL, 2 NEG, 4 POW, 13 SUB), plus 2 `sin_cos` (derive/toolconf_derive/cost.py).
-#[inline]
+// Always inlined: so cheap that a call would be a cost of its own (the renderer's
+// ALWAYS_INLINED_COST says where that ends).
+#[inline(always)]
 #[must_use]
 pub fn dynamics_jacobian_with(
     x: &SVector<f64, 4>,

@@ -580,7 +580,9 @@ pub fn dynamics(
 /// [`dynamics`] with the tool's [`DynamicsCoefficients`] computed beforehand.
 ///
 /// Cost per call: 136 operations, weighted 149 (44 ADD, 1 DIV, 77 MUL, 6 POW, 8 SUB), plus 3 `sin_cos` (derive/toolconf_derive/cost.py).
-#[inline]
+// Always inlined: so cheap that a call would be a cost of its own (the renderer's
+// ALWAYS_INLINED_COST says where that ends).
+#[inline(always)]
 #[must_use]
 pub fn dynamics_with(
     x: &SVector<f64, 6>,

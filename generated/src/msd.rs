@@ -494,7 +494,9 @@ pub fn dynamics(
 /// [`dynamics`] with the tool's [`DynamicsCoefficients`] computed beforehand.
 ///
 /// Cost per call: 5 operations, weighted 5 (2 ADD, 3 MUL) (derive/toolconf_derive/cost.py).
-#[inline]
+// Always inlined: so cheap that a call would be a cost of its own (the renderer's
+// ALWAYS_INLINED_COST says where that ends).
+#[inline(always)]
 #[must_use]
 pub fn dynamics_with(
     x: &SVector<f64, 2>,
@@ -562,7 +564,9 @@ pub fn dynamics_jacobian(
 /// [`dynamics_jacobian`] with the tool's [`DynamicsJacobianCoefficients`] computed beforehand.
 ///
 /// Cost per call: 0 operations, weighted 0 (derive/toolconf_derive/cost.py).
-#[inline]
+// Always inlined: so cheap that a call would be a cost of its own (the renderer's
+// ALWAYS_INLINED_COST says where that ends).
+#[inline(always)]
 #[must_use]
 pub fn dynamics_jacobian_with(
     _x: &SVector<f64, 2>,

@@ -170,7 +170,9 @@ macro_rules! arm_model {
                 generated::$module::DynamicsJacobianCoefficients::new(p)
             }
 
-            #[inline]
+            // Always: a forwarder, which the compiler kept out of line around a small model's
+            // inlined body (the generated `dynamics_with` is always inlined where it is cheap).
+            #[inline(always)]
             fn dynamics_with(
                 x: &SVector<f64, { generated::$module::STATE_DIM }>,
                 u: &SVector<f64, { generated::$module::DOF }>,
@@ -179,7 +181,9 @@ macro_rules! arm_model {
                 generated::$module::dynamics_with(x, u, k)
             }
 
-            #[inline]
+            // Always: a forwarder, which the compiler kept out of line around a small model's
+            // inlined body (the generated `dynamics_jacobian_with` is always inlined where it is cheap).
+            #[inline(always)]
             fn dynamics_jacobian_with(
                 x: &SVector<f64, { generated::$module::STATE_DIM }>,
                 u: &SVector<f64, { generated::$module::DOF }>,
